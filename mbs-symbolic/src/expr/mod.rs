@@ -1,0 +1,229 @@
+//! The expression DAG: a hash-consed arena of scalar expressions, with canonical local rules,
+//! differentiation, numeric evaluation, s-expressions, op counting, scheduling and emission.
+//! Nothing here knows about mechanics.
+
+mod arena;
+pub mod count;
+pub mod cse;
+mod diff;
+pub mod emit;
+mod eval;
+pub mod sexpr;
+mod simplify;
+
+pub use arena::Arena;
+pub use count::OpCount;
+pub use eval::{Env, SliceEnv};
+
+use std::fmt;
+
+/// Handle of a node in an [`Arena`]. Ids are handed out in creation order, and a node's
+/// children are always created before it, so id order is a topological order.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Debug)]
+pub struct ExprId(pub(crate) u32);
+
+impl ExprId {
+    /// Position of the node in its arena.
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+}
+
+/// The leaves an expression can depend on.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Debug)]
+pub enum Var {
+    /// coordinate `q[i]`
+    Q(u16),
+    /// velocity `qd[i]`
+    Qd(u16),
+    /// acceleration `qdd[i]`
+    Qdd(u16),
+    /// time `t`
+    T,
+    /// parameter number `i` of the model
+    Param(u16),
+    /// input `u[i]`
+    Input(u16),
+}
+
+impl Var {
+    /// Bit of the dependency mask: coordinates, velocities and accelerations get 40 bits each,
+    /// parameters and inputs share a few. Collisions only make the mask conservative.
+    pub(crate) fn mask(self) -> u128 {
+        let bit = match self {
+            Var::Q(i) => i as u32 % 40,
+            Var::Qd(i) => 40 + i as u32 % 40,
+            Var::Qdd(i) => 80 + i as u32 % 40,
+            Var::T => 120,
+            Var::Param(i) => 121 + i as u32 % 4,
+            Var::Input(i) => 125 + i as u32 % 3,
+        };
+        1u128 << bit
+    }
+}
+
+impl fmt::Display for Var {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Var::Q(i) => write!(f, "q{i}"),
+            Var::Qd(i) => write!(f, "qd{i}"),
+            Var::Qdd(i) => write!(f, "qdd{i}"),
+            Var::T => write!(f, "t"),
+            Var::Param(i) => write!(f, "p{i}"),
+            Var::Input(i) => write!(f, "u{i}"),
+        }
+    }
+}
+
+/// Elementary functions of one argument.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Debug)]
+pub enum Func {
+    Sin,
+    Cos,
+    Tan,
+    Asin,
+    Acos,
+    Atan,
+    Sinh,
+    Cosh,
+    Tanh,
+    Exp,
+    Ln,
+    Sqrt,
+    Abs,
+    Sign,
+}
+
+impl Func {
+    /// All functions, for name lookup.
+    pub const ALL: [Func; 14] = [
+        Func::Sin,
+        Func::Cos,
+        Func::Tan,
+        Func::Asin,
+        Func::Acos,
+        Func::Atan,
+        Func::Sinh,
+        Func::Cosh,
+        Func::Tanh,
+        Func::Exp,
+        Func::Ln,
+        Func::Sqrt,
+        Func::Abs,
+        Func::Sign,
+    ];
+
+    /// The name used in the DSL, in s-expressions and (as an `f64` method) in emitted code.
+    pub fn name(self) -> &'static str {
+        match self {
+            Func::Sin => "sin",
+            Func::Cos => "cos",
+            Func::Tan => "tan",
+            Func::Asin => "asin",
+            Func::Acos => "acos",
+            Func::Atan => "atan",
+            Func::Sinh => "sinh",
+            Func::Cosh => "cosh",
+            Func::Tanh => "tanh",
+            Func::Exp => "exp",
+            Func::Ln => "ln",
+            Func::Sqrt => "sqrt",
+            Func::Abs => "abs",
+            Func::Sign => "sign",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<Func> {
+        match name {
+            "log" => Some(Func::Ln),
+            "signum" => Some(Func::Sign),
+            _ => Func::ALL.into_iter().find(|f| f.name() == name),
+        }
+    }
+
+    pub fn apply(self, x: f64) -> f64 {
+        match self {
+            Func::Sin => x.sin(),
+            Func::Cos => x.cos(),
+            Func::Tan => x.tan(),
+            Func::Asin => x.asin(),
+            Func::Acos => x.acos(),
+            Func::Atan => x.atan(),
+            Func::Sinh => x.sinh(),
+            Func::Cosh => x.cosh(),
+            Func::Tanh => x.tanh(),
+            Func::Exp => x.exp(),
+            Func::Ln => x.ln(),
+            Func::Sqrt => x.sqrt(),
+            Func::Abs => x.abs(),
+            Func::Sign => {
+                if x > 0.0 {
+                    1.0
+                } else if x < 0.0 {
+                    -1.0
+                } else {
+                    0.0
+                }
+            }
+        }
+    }
+}
+
+/// A user scalar function `f(x)` supplied as Rust code, with derivatives up to `orders - 1`.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct UserFn {
+    /// DSL name (`g5`)
+    pub name: String,
+    /// Rust paths of f, f', f'', … as written by the user
+    pub paths: Vec<String>,
+}
+
+/// One node of the DAG. Commutative operands are stored in canonical order (a number first,
+/// otherwise by id); the rules in `simplify.rs` keep nodes in canonical form.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Debug)]
+pub enum Node {
+    /// a finite or non-finite constant, stored by bits (`-0.0` is stored as `0.0`)
+    Num(u64),
+    Var(Var),
+    Add(ExprId, ExprId),
+    Sub(ExprId, ExprId),
+    Mul(ExprId, ExprId),
+    Div(ExprId, ExprId),
+    Neg(ExprId),
+    /// integer power, exponent ≥ 2
+    Powi(ExprId, i32),
+    /// real power x^y
+    Pow(ExprId, ExprId),
+    Func(Func, ExprId),
+    /// atan2(y, x)
+    Atan2(ExprId, ExprId),
+    /// derivative number `order` of user function number `f`, at the argument
+    Call(u16, u8, ExprId),
+}
+
+impl Node {
+    /// Children of the node, at most two.
+    pub fn children(&self) -> ([ExprId; 2], usize) {
+        let z = ExprId(0);
+        match *self {
+            Node::Num(_) | Node::Var(_) => ([z, z], 0),
+            Node::Neg(a) | Node::Powi(a, _) | Node::Func(_, a) | Node::Call(_, _, a) => ([a, z], 1),
+            Node::Add(a, b)
+            | Node::Sub(a, b)
+            | Node::Mul(a, b)
+            | Node::Div(a, b)
+            | Node::Pow(a, b)
+            | Node::Atan2(a, b) => ([a, b], 2),
+        }
+    }
+}
+
+pub(crate) fn num_bits(v: f64) -> u64 {
+    if v == 0.0 {
+        0.0f64.to_bits()
+    } else if v.is_nan() {
+        f64::NAN.to_bits()
+    } else {
+        v.to_bits()
+    }
+}

@@ -1,0 +1,2 @@
+//! The mbs generator.
+pub mod expr;

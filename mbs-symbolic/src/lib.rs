@@ -1,2 +1,19 @@
-//! The mbs generator.
+//! The mbs generator: the expression DAG, the `multibody!` language, mechanics and code
+//! emission. The proc-macro, `mbs expand` and tests all call the same functions.
+
+pub mod dsl;
 pub mod expr;
+pub mod mech;
+
+pub use mech::{SymbolicModel, System};
+
+/// Parses and checks the body of a `multibody!` block given as text.
+pub fn systems_from_str(src: &str) -> Result<Vec<System>, String> {
+    let models: dsl::parse::Models = syn::parse_str(src).map_err(|e| e.to_string())?;
+    let mut out = Vec::new();
+    for m in &models.0 {
+        let c = dsl::check::check(m).map_err(|e| e.into_compile_error().to_string())?;
+        out.push(c.system);
+    }
+    Ok(out)
+}

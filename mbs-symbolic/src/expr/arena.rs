@@ -23,6 +23,8 @@ pub(crate) enum Dir {
     Partial(Var),
     /// total time derivative: q → qd, qd → qdd, t → 1
     Time,
+    /// total time derivative at zero acceleration: q → qd, qd → 0, t → 1
+    TimeBias,
 }
 
 impl Default for Arena {
@@ -141,22 +143,23 @@ impl Arena {
         self.intern(Node::Num(num_bits(v)))
     }
 
-    /// All nodes reachable from `roots`, in increasing id (topological) order.
+    /// All nodes reachable from `roots`, in increasing id (topological) order. Children have
+    /// smaller ids than parents, so one backward sweep marks everything.
     pub fn reachable(&self, roots: &[ExprId]) -> Vec<ExprId> {
-        let mut seen = vec![false; self.nodes.len()];
-        let mut stack: Vec<ExprId> = roots.to_vec();
-        let mut out = Vec::new();
-        while let Some(n) = stack.pop() {
-            if seen[n.index()] {
-                continue;
-            }
-            seen[n.index()] = true;
-            out.push(n);
-            let (ch, k) = self.nodes[n.index()].children();
-            stack.extend_from_slice(&ch[..k]);
+        let Some(top) = roots.iter().max() else { return Vec::new() };
+        let mut need = vec![false; top.index() + 1];
+        for r in roots {
+            need[r.index()] = true;
         }
-        out.sort_unstable();
-        out
+        for i in (0..need.len()).rev() {
+            if need[i] {
+                let (ch, k) = self.nodes[i].children();
+                for c in &ch[..k] {
+                    need[c.index()] = true;
+                }
+            }
+        }
+        (0..need.len()).filter(|&i| need[i]).map(|i| ExprId(i as u32)).collect()
     }
 
     /// The variables that the expressions depend on (exactly, by traversal), sorted.

@@ -17,12 +17,18 @@ impl Arena {
         self.derive(e, Dir::Time)
     }
 
+    /// Total time derivative with the accelerations set to zero: the "bias" part of d/dt.
+    /// For a velocity ė(q, qd, t) it is ë at qdd = 0 (J̇·qd plus rheonomic terms).
+    pub fn dt_bias(&mut self, e: ExprId) -> ExprId {
+        self.derive(e, Dir::TimeBias)
+    }
+
     /// True when the derivative in this direction is certainly zero.
     fn constant_along(&self, e: ExprId, dir: Dir) -> bool {
         match dir {
             Dir::Partial(v) => !self.may_depend(e, v),
             // parameters and inputs are constant in time: bits 0..=120 are q, qd, qdd and t
-            Dir::Time => self.mask(e) & ((1u128 << 121) - 1) == 0,
+            Dir::Time | Dir::TimeBias => self.mask(e) & ((1u128 << 121) - 1) == 0,
         }
     }
 
@@ -73,9 +79,10 @@ impl Arena {
                         self.zero()
                     }
                 }
-                Dir::Time => match v {
+                Dir::Time | Dir::TimeBias => match v {
                     Var::Q(i) => self.var(Var::Qd(i)),
-                    Var::Qd(i) => self.var(Var::Qdd(i)),
+                    Var::Qd(i) if dir == Dir::Time => self.var(Var::Qdd(i)),
+                    Var::Qd(_) => self.zero(),
                     Var::T => self.one(),
                     // jerk, parameters and inputs: never differentiated in time by the
                     // generator (the checker keeps inputs and velocities out of positions)

@@ -1,0 +1,7 @@
+//! The `multibody!` language: `parse` (tokens → syntax tree with spans), then `check`
+//! (names, shapes, constants → a [`System`](crate::mech::System)), collecting every error.
+
+pub mod ast;
+pub mod check;
+pub mod names;
+pub mod parse;

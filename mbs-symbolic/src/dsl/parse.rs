@@ -1,0 +1,280 @@
+//! Tokens → [`ModelDef`]s. Only the statement structure is parsed here; expressions are
+//! `syn::Expr` and get their meaning in `check`.
+
+use super::ast::{BodyRef, DofName, EffectStmt, Item, ModelDef};
+use syn::parse::{Parse, ParseStream};
+use syn::punctuated::Punctuated;
+use syn::{Expr, Ident, Token, bracketed, braced, parenthesized};
+
+/// All models of one `multibody!` invocation.
+pub struct Models(pub Vec<ModelDef>);
+
+impl Parse for Models {
+    fn parse(input: ParseStream) -> syn::Result<Self> {
+        let mut v = Vec::new();
+        while !input.is_empty() {
+            v.push(input.parse()?);
+        }
+        if v.is_empty() {
+            return Err(input.error("expected `model Name { … }`: a multibody! block declares at least one model"));
+        }
+        Ok(Models(v))
+    }
+}
+
+fn keyword(input: ParseStream, kw: &str) -> bool {
+    input.fork().parse::<Ident>().is_ok_and(|i| i == kw)
+}
+
+impl Parse for ModelDef {
+    fn parse(input: ParseStream) -> syn::Result<Self> {
+        let attrs = input.call(syn::Attribute::parse_outer)?;
+        let mut docs = Vec::new();
+        for a in &attrs {
+            match &a.meta {
+                syn::Meta::NameValue(nv) if a.path().is_ident("doc") => {
+                    if let Expr::Lit(syn::ExprLit { lit: syn::Lit::Str(s), .. }) = &nv.value {
+                        docs.push(s.value());
+                    }
+                }
+                _ => return Err(syn::Error::new_spanned(a, "only `///` doc comments may precede a model")),
+            }
+        }
+        let vis: syn::Visibility = input.parse()?;
+        let kw: Ident = input
+            .parse()
+            .map_err(|e| syn::Error::new(e.span(), "expected `model Name { … }`"))?;
+        if kw != "model" {
+            return Err(syn::Error::new(kw.span(), format!("expected `model`, found `{kw}`: write `model Name {{ … }}`")));
+        }
+        let name: Ident = input.parse()?;
+        let content;
+        braced!(content in input);
+        let mut items = Vec::new();
+        while !content.is_empty() {
+            items.push(parse_item(&content)?);
+        }
+        Ok(ModelDef { docs, vis, name, items })
+    }
+}
+
+fn body_ref(input: ParseStream) -> syn::Result<BodyRef> {
+    if input.peek(syn::LitInt) {
+        let l: syn::LitInt = input.parse()?;
+        return Ok(BodyRef::Index(l.base10_parse()?, l.span()));
+    }
+    let i: Ident = input.parse().map_err(|e| syn::Error::new(e.span(), "expected a body name or number"))?;
+    Ok(BodyRef::Name(i))
+}
+
+fn semi(input: ParseStream, what: &str) -> syn::Result<()> {
+    if input.peek(Token![;]) {
+        input.parse::<Token![;]>()?;
+        Ok(())
+    } else {
+        Err(input.error(format!("expected `;` after {what}")))
+    }
+}
+
+fn parse_item(input: ParseStream) -> syn::Result<Item> {
+    if input.peek(Token![let]) {
+        input.parse::<Token![let]>()?;
+        let name: Ident = input.parse()?;
+        input.parse::<Token![=]>()?;
+        let value: Expr = input.parse()?;
+        semi(input, "`let`")?;
+        return Ok(Item::Let { name, value });
+    }
+    if input.peek(Token![fn]) {
+        input.parse::<Token![fn]>()?;
+        let name: Ident = input.parse()?;
+        let args;
+        parenthesized!(args in input);
+        let args: Punctuated<Ident, Token![,]> = args.parse_terminated(Ident::parse, Token![,])?;
+        input.parse::<Token![=]>()?;
+        let body: Expr = input.parse()?;
+        semi(input, "`fn`")?;
+        return Ok(Item::Fn { name, args: args.into_iter().collect(), body });
+    }
+    if input.peek(Token![extern]) {
+        input.parse::<Token![extern]>()?;
+        input.parse::<Token![fn]>()?;
+        let name: Ident = input.parse()?;
+        input.parse::<Token![=]>()?;
+        let list;
+        bracketed!(list in input);
+        let paths: Punctuated<syn::Path, Token![,]> = list.parse_terminated(syn::Path::parse, Token![,])?;
+        semi(input, "`extern fn`")?;
+        return Ok(Item::ExternFn { name, paths: paths.into_iter().collect() });
+    }
+    let kw: Ident = input.fork().parse().map_err(|e| {
+        syn::Error::new(e.span(), "expected a statement: param, let, dof, input, body, frame, point, TOG[…], fn, extern fn, effect, scene, option or an effect such as gravity(…)")
+    })?;
+    let k = kw.to_string();
+    match k.as_str() {
+        "param" => {
+            input.parse::<Ident>()?;
+            let name: Ident = input.parse()?;
+            input
+                .parse::<Token![=]>()
+                .map_err(|e| syn::Error::new(e.span(), format!("a parameter needs a default value: `param {name} = 1.0;`")))?;
+            let value: Expr = input.parse()?;
+            semi(input, "`param`")?;
+            Ok(Item::Param { name, value })
+        }
+        "dof" => {
+            input.parse::<Ident>()?;
+            let span = input.span();
+            let id: Ident = input.parse()?;
+            let name = if id == "q" && input.peek(syn::token::Bracket) {
+                let idx;
+                bracketed!(idx in input);
+                let l: syn::LitInt = idx.parse()?;
+                DofName::Indexed(l.base10_parse()?, l.span())
+            } else {
+                DofName::Named(id)
+            };
+            let mut q0 = None;
+            let mut qd0 = None;
+            if input.peek(Token![=]) {
+                input.parse::<Token![=]>()?;
+                q0 = Some(input.parse()?);
+                if input.peek(Token![,]) {
+                    input.parse::<Token![,]>()?;
+                    let k: Ident = input.parse()?;
+                    if k != "qd" {
+                        return Err(syn::Error::new(k.span(), "expected `qd = …` (the initial velocity) after the initial position"));
+                    }
+                    input.parse::<Token![=]>()?;
+                    qd0 = Some(input.parse()?);
+                }
+            }
+            semi(input, "`dof`")?;
+            Ok(Item::Dof { name, q0, qd0, span })
+        }
+        "input" => {
+            input.parse::<Ident>()?;
+            let name: Ident = input.parse()?;
+            semi(input, "`input`")?;
+            Ok(Item::Input { name })
+        }
+        "body" => {
+            input.parse::<Ident>()?;
+            let name: Ident = input.parse()?;
+            let mut props = Vec::new();
+            if input.peek(syn::token::Brace) {
+                let content;
+                braced!(content in input);
+                while !content.is_empty() {
+                    let key: Ident = content.parse()?;
+                    content.parse::<Token![=]>()?;
+                    let value: Expr = content.parse()?;
+                    semi(&content, &format!("`{key} = …`"))?;
+                    props.push((key, value));
+                }
+            } else {
+                semi(input, "`body` (or give its properties in `{ mass = …; inertia = …; }`)")?;
+            }
+            Ok(Item::Body { name, props })
+        }
+        "frame" => {
+            input.parse::<Ident>()?;
+            let name: Ident = input.parse()?;
+            semi(input, "`frame`")?;
+            Ok(Item::Frame { name })
+        }
+        "point" => {
+            input.parse::<Ident>()?;
+            let name: Ident = input.parse()?;
+            let on: Ident = input.parse()?;
+            if on != "on" {
+                return Err(syn::Error::new(on.span(), "expected `on`: write `point name on body at (x, y, z);`"));
+            }
+            let body = body_ref(input)?;
+            let at: Ident = input.parse()?;
+            if at != "at" {
+                return Err(syn::Error::new(at.span(), "expected `at`: write `point name on body at (x, y, z);`"));
+            }
+            let pos: Expr = input.parse()?;
+            semi(input, "`point`")?;
+            Ok(Item::Point { name, body, at: pos })
+        }
+        "TOG" => {
+            let span = input.parse::<Ident>()?.span();
+            let idx;
+            bracketed!(idx in input);
+            let target = body_ref(&idx)?;
+            input.parse::<Token![=]>()?;
+            let chain: Expr = input.parse()?;
+            semi(input, "`TOG[…] = …`")?;
+            Ok(Item::Tog { target, chain, span })
+        }
+        "effect" => {
+            input.parse::<Ident>()?;
+            let name: Ident = input.parse()?;
+            let content;
+            braced!(content in input);
+            let mut stmts = Vec::new();
+            while !content.is_empty() {
+                stmts.push(parse_effect(&content)?);
+            }
+            Ok(Item::EffectBlock { name, stmts })
+        }
+        "scene" => {
+            input.parse::<Ident>()?;
+            let name: Ident = input.parse()?;
+            input.parse::<Token![=]>()?;
+            let list;
+            bracketed!(list in input);
+            let effects: Punctuated<Ident, Token![,]> = list.parse_terminated(Ident::parse, Token![,])?;
+            semi(input, "`scene`")?;
+            Ok(Item::Scene { name, effects: effects.into_iter().collect() })
+        }
+        "option" => {
+            input.parse::<Ident>()?;
+            let key: Ident = input.parse()?;
+            let value = if input.peek(Token![=]) {
+                input.parse::<Token![=]>()?;
+                Some(input.parse()?)
+            } else {
+                None
+            };
+            semi(input, "`option`")?;
+            Ok(Item::Option { key, value })
+        }
+        _ if keyword(input, &k) && input.peek2(syn::token::Paren) => Ok(Item::Effect(parse_effect(input)?)),
+        _ => Err(syn::Error::new(
+            kw.span(),
+            format!(
+                "unknown statement `{kw}`: expected param, let, dof, input, body, frame, point, TOG[…], fn, extern fn, effect, scene, option or an effect such as gravity(…)"
+            ),
+        )),
+    }
+}
+
+fn parse_effect(input: ParseStream) -> syn::Result<EffectStmt> {
+    let kind: Ident = input.parse()?;
+    let args;
+    parenthesized!(args in input);
+    let list: Punctuated<Expr, Token![,]> = args.parse_terminated(Expr::parse, Token![,])?;
+    semi(input, &format!("`{kind}(…)`"))?;
+    let mut positional = Vec::new();
+    let mut named = Vec::new();
+    for a in list {
+        match a {
+            Expr::Assign(asg) => match &*asg.left {
+                Expr::Path(p) if p.path.get_ident().is_some() => {
+                    named.push((p.path.get_ident().unwrap().clone(), *asg.right));
+                }
+                other => return Err(syn::Error::new_spanned(other, "expected an argument name before `=`")),
+            },
+            e => {
+                if !named.is_empty() {
+                    // positional after named is allowed (`torque(b, axis = z, expr)`)
+                }
+                positional.push(e);
+            }
+        }
+    }
+    Ok(EffectStmt { kind, positional, named })
+}

@@ -1,0 +1,190 @@
+//! Everything a scene's model computes, as DAG roots: M, h and τ from the cheaper formulation
+//! (or the one the model forces), tangents when asked for, energies, power, static forces.
+
+use super::effects::Loads;
+use super::recursive::{body_kinematics, crba, newton_euler};
+use super::spatial as s;
+use super::system::{Formulation, System};
+use super::tree::Tree;
+use super::virtual_power::virtual_power;
+use super::world::World;
+use crate::expr::{Arena, ExprId, OpCount, Var};
+use rustc_hash::FxHashMap;
+
+/// M (dense, row-major) and h of one formulation.
+#[derive(Clone, Debug)]
+pub struct MassBias {
+    pub m: Vec<Vec<ExprId>>,
+    pub h: Vec<ExprId>,
+}
+
+impl MassBias {
+    /// Roots of the lower triangle of M then h.
+    pub fn roots(&self) -> Vec<ExprId> {
+        let mut v: Vec<ExprId> = Vec::new();
+        for (r, row) in self.m.iter().enumerate() {
+            v.extend_from_slice(&row[..=r]);
+        }
+        v.extend_from_slice(&self.h);
+        v
+    }
+}
+
+/// The symbolic equations of one scene.
+#[derive(Clone, Debug)]
+pub struct SceneEquations {
+    /// scene index (`None`: the model without scenes)
+    pub scene: Option<usize>,
+    pub effects: Vec<usize>,
+    /// virtual power M, h
+    pub vp: MassBias,
+    /// recursive M (composite inertia), h (Newton–Euler)
+    pub rec: MassBias,
+    /// the formulation used for M and h
+    pub formulation: Formulation,
+    /// τ = M qdd − h by Newton–Euler
+    pub tau_rec: Vec<ExprId>,
+    /// τ = M qdd − h from the virtual-power M and h
+    pub tau_vp: Vec<ExprId>,
+    /// the formulation used for τ
+    pub tau_formulation: Formulation,
+    /// h with qd = 0
+    pub static_h: Vec<ExprId>,
+    /// K_t = ∂τ/∂q and C_t = ∂τ/∂qd (dense, row-major), when the model asks for them
+    pub tangents: Option<(Vec<Vec<ExprId>>, Vec<Vec<ExprId>>)>,
+    pub kinetic: ExprId,
+    pub potential: ExprId,
+    /// power of the non-conservative effects
+    pub power: ExprId,
+}
+
+impl SceneEquations {
+    /// M and h of the chosen formulation.
+    pub fn chosen(&self) -> &MassBias {
+        match self.formulation {
+            Formulation::VirtualPower => &self.vp,
+            Formulation::Recursive => &self.rec,
+        }
+    }
+
+    /// τ of the chosen formulation.
+    pub fn tau(&self) -> &[ExprId] {
+        match self.tau_formulation {
+            Formulation::VirtualPower => &self.tau_vp,
+            Formulation::Recursive => &self.tau_rec,
+        }
+    }
+
+    pub fn build(sys: &mut System, tree: &Tree, world: &World, scene: Option<usize>) -> SceneEquations {
+        let nd = sys.ndof();
+        let effects = sys.scene_effects(scene);
+        let loads = Loads::build(sys, tree, world, &effects);
+        let (m_vp, h_vp) = virtual_power(sys, tree, world, &loads);
+        let vp = MassBias { m: m_vp, h: h_vp };
+        let m_rec = crba(sys, tree);
+        let minus_h = newton_euler(sys, tree, world, &loads, false);
+        let h_rec: Vec<ExprId> = minus_h.iter().map(|&x| sys.arena.neg(x)).collect();
+        let rec = MassBias { m: m_rec, h: h_rec };
+        let tau_rec = newton_euler(sys, tree, world, &loads, true);
+        let a = &mut sys.arena;
+        let qdd: Vec<ExprId> = (0..nd).map(|k| a.var(Var::Qdd(k as u16))).collect();
+        let tau_vp: Vec<ExprId> = (0..nd)
+            .map(|i| {
+                let mq = a.dot(&vp.m[i], &qdd);
+                a.sub(mq, vp.h[i])
+            })
+            .collect();
+        let cost = |a: &Arena, r: &[ExprId]| OpCount::of(a, r).flops();
+        let formulation = sys.options.formulation.unwrap_or_else(|| {
+            if cost(a, &vp.roots()) < cost(a, &rec.roots()) { Formulation::VirtualPower } else { Formulation::Recursive }
+        });
+        let tau_formulation = sys.options.formulation.unwrap_or_else(|| {
+            if cost(a, &tau_vp) < cost(a, &tau_rec) { Formulation::VirtualPower } else { Formulation::Recursive }
+        });
+        let chosen_h = match formulation {
+            Formulation::VirtualPower => vp.h.clone(),
+            Formulation::Recursive => rec.h.clone(),
+        };
+        let mut zero_qd = FxHashMap::default();
+        for k in 0..nd {
+            zero_qd.insert(Var::Qd(k as u16), a.zero());
+        }
+        let static_h = a.substitute(&chosen_h, &zero_qd);
+        let tau: Vec<ExprId> = match tau_formulation {
+            Formulation::VirtualPower => tau_vp.clone(),
+            Formulation::Recursive => tau_rec.clone(),
+        };
+        let tangents = sys.options.tangents.then(|| {
+            let k: Vec<Vec<ExprId>> =
+                tau.iter().map(|&t| (0..nd).map(|j| a.diff(t, Var::Q(j as u16))).collect()).collect();
+            let c: Vec<Vec<ExprId>> =
+                tau.iter().map(|&t| (0..nd).map(|j| a.diff(t, Var::Qd(j as u16))).collect()).collect();
+            (k, c)
+        });
+        let (kinetic, potential) = energies(sys, tree, world, &loads);
+        let power = loads.power.unwrap_or(sys.arena.zero());
+        SceneEquations {
+            scene,
+            effects,
+            vp,
+            rec,
+            formulation,
+            tau_rec,
+            tau_vp,
+            tau_formulation,
+            static_h,
+            tangents,
+            kinetic,
+            potential,
+            power,
+        }
+    }
+}
+
+/// Kinetic energy Σ ½ m v_G² + ½ ωᵀ Φ ω, and potential energy of gravity and springs
+/// (gravity's measured from the world origin).
+fn energies(sys: &mut System, tree: &Tree, world: &World, loads: &Loads) -> (ExprId, ExprId) {
+    let bk = body_kinematics(&mut sys.arena, tree, None, false);
+    let a = &mut sys.arena;
+    let half = a.num(0.5);
+    let mut t = a.zero();
+    let mut v = loads.spring_potential.unwrap_or(a.zero());
+    for (n, node) in tree.nodes.iter().enumerate().skip(1) {
+        for &f in &node.frames {
+            let Some(inr) = sys.frames[f].inertia else { continue };
+            let k = bk[n];
+            let vv = s::dot(a, k.v, k.v);
+            let mvv = a.mul(inr.mass, vv);
+            let phi = s::sym(&inr.tensor);
+            let iw = s::mul_mv(a, &phi, k.w);
+            let wiw = s::dot(a, k.w, iw);
+            let sum = a.add(mvv, wiw);
+            let e = a.mul(half, sum);
+            t = a.add(t, e);
+            if let Some(g) = loads.gravity {
+                let gp = s::dot(a, g, world.nodes[n].p);
+                let mgp = a.mul(inr.mass, gp);
+                v = a.sub(v, mgp);
+            }
+        }
+    }
+    (t, v)
+}
+
+/// The symbolic model: system, tree, world kinematics and the equations of every scene.
+pub struct SymbolicModel {
+    pub sys: System,
+    pub tree: Tree,
+    pub world: World,
+    pub scenes: Vec<SceneEquations>,
+}
+
+impl SymbolicModel {
+    pub fn build(mut sys: System) -> SymbolicModel {
+        let tree = Tree::build(&mut sys);
+        let world = World::build(&mut sys.arena, &tree);
+        let scenes: Vec<Option<usize>> = if sys.scenes.is_empty() { vec![None] } else { (0..sys.scenes.len()).map(Some).collect() };
+        let scenes = scenes.into_iter().map(|s| SceneEquations::build(&mut sys, &tree, &world, s)).collect();
+        SymbolicModel { sys, tree, world, scenes }
+    }
+}

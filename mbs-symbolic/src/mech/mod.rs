@@ -1,0 +1,14 @@
+//! Mechanics on the expression DAG: the system description, the frame tree, kinematics,
+//! effects and the two formulations of the equations of motion.
+
+pub mod dynamics;
+pub mod effects;
+pub mod recursive;
+pub mod spatial;
+pub mod system;
+pub mod tree;
+pub mod virtual_power;
+pub mod world;
+
+pub use dynamics::{SceneEquations, SymbolicModel};
+pub use system::System;

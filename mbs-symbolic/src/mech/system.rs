@@ -1,0 +1,184 @@
+//! The checked description of a multibody system: what the DSL means, independent of syntax.
+//! The DSL checker produces it; tests and tools may also build it directly.
+
+use crate::expr::{Arena, ExprId};
+
+/// A multibody system: parameters, coordinates, frames given by products of elementary
+/// transforms, points, effects and scenes, with all expressions in one [`Arena`].
+#[derive(Clone, Debug)]
+pub struct System {
+    pub arena: Arena,
+    /// type name of the generated model
+    pub name: String,
+    /// doc lines of the model
+    pub docs: Vec<String>,
+    pub params: Vec<ParamDef>,
+    pub dofs: Vec<DofDef>,
+    /// names of the inputs `u[k]`
+    pub inputs: Vec<String>,
+    /// bodies and massless frames, parents before children
+    pub frames: Vec<FrameDef>,
+    pub points: Vec<PointDef>,
+    pub effects: Vec<EffectDef>,
+    /// declared scenes; none means one model with every effect
+    pub scenes: Vec<SceneDef>,
+    pub options: Options,
+}
+
+#[derive(Clone, Debug)]
+pub struct ParamDef {
+    pub name: String,
+    pub default: f64,
+}
+
+#[derive(Clone, Debug)]
+pub struct DofDef {
+    /// `q[3]` for an indexed coordinate, or the user's name (`knee`)
+    pub name: String,
+    /// initial position (an expression of parameters)
+    pub q0: ExprId,
+    /// initial velocity (an expression of parameters)
+    pub qd0: ExprId,
+}
+
+/// Mass and inertia tensor about G in body axes.
+#[derive(Clone, Copy, Debug)]
+pub struct Inertia {
+    pub mass: ExprId,
+    /// tensor components xx, yy, zz, xy, xz, yz (the tensor's entries, so I_xy = −∫xy dm)
+    pub tensor: [ExprId; 6],
+}
+
+/// One elementary factor of a transform product.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Factor {
+    /// `Tdisp(x, y, z)`: translation, in the axes of the frame it starts from
+    Disp([ExprId; 3]),
+    /// `Trotx/Troty/Trotz(a)`, `Trotn(nx, ny, nz, a)`: rotation by `angle` about the unit `axis`
+    Rot { axis: [ExprId; 3], angle: ExprId },
+}
+
+/// A body (with inertia) or a massless frame. Its frame is at G for a body.
+#[derive(Clone, Debug)]
+pub struct FrameDef {
+    pub name: String,
+    /// the frame the product starts from (`TOG[parent] * …`); `None` is the ground
+    pub parent: Option<usize>,
+    pub factors: Vec<Factor>,
+    /// `None` for a massless frame
+    pub inertia: Option<Inertia>,
+}
+
+/// A point fixed on a frame (or on the ground).
+#[derive(Clone, Debug)]
+pub struct PointDef {
+    pub name: String,
+    pub frame: Option<usize>,
+    /// position in the frame's axes, relative to its origin
+    pub pos: [ExprId; 3],
+}
+
+/// Where a force acts: a frame (or the ground) and a position in its axes.
+#[derive(Clone, Copy, Debug)]
+pub struct Attach {
+    pub frame: Option<usize>,
+    pub pos: [ExprId; 3],
+}
+
+/// Something an effect applies.
+#[derive(Clone, Debug)]
+pub enum Load {
+    /// uniform gravity (world components); conservative
+    Gravity([ExprId; 3]),
+    /// point-to-point spring with stiffness `k` and rest length `l0`; conservative
+    Spring { a: Attach, b: Attach, k: ExprId, l0: ExprId },
+    /// point-to-point linear damper
+    Damper { a: Attach, b: Attach, c: ExprId },
+    /// a force at a point, components in `frame`'s axes (`None`: world)
+    Force { at: Attach, force: [ExprId; 3], frame: Option<usize> },
+    /// a torque on `on`, components in `frame`'s axes (`None`: world), with the opposite
+    /// torque on `reaction` when given (`Some(None)`: the ground)
+    Torque { on: Option<usize>, torque: [ExprId; 3], frame: Option<usize>, reaction: Option<Option<usize>> },
+    /// a generalised force on one coordinate
+    GenForce { dof: usize, value: ExprId },
+}
+
+impl Load {
+    /// Gravity and springs derive from a potential; the rest do work counted as power.
+    pub fn is_conservative(&self) -> bool {
+        matches!(self, Load::Gravity(_) | Load::Spring { .. })
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct EffectDef {
+    /// effect name; `None` for statements outside any `effect` block (always on)
+    pub name: Option<String>,
+    pub loads: Vec<Load>,
+}
+
+#[derive(Clone, Debug)]
+pub struct SceneDef {
+    pub name: String,
+    /// indices into `effects` (always-on effects are added automatically)
+    pub effects: Vec<usize>,
+}
+
+/// Which equations-of-motion formulation to emit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Formulation {
+    /// Σ Jᵀ m J with Jacobians composed along the tree (the seed's)
+    VirtualPower,
+    /// Newton–Euler for h and τ, composite inertia for M
+    Recursive,
+}
+
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Options {
+    /// emit exact tangents K_t = ∂τ/∂q and C_t = ∂τ/∂qd
+    pub tangents: bool,
+    /// force a formulation; `None` picks the cheaper by op count
+    pub formulation: Option<Formulation>,
+}
+
+impl System {
+    /// An empty system named `name`.
+    pub fn new(name: &str) -> System {
+        System {
+            arena: Arena::new(),
+            name: name.to_string(),
+            docs: Vec::new(),
+            params: Vec::new(),
+            dofs: Vec::new(),
+            inputs: Vec::new(),
+            frames: Vec::new(),
+            points: Vec::new(),
+            effects: Vec::new(),
+            scenes: Vec::new(),
+            options: Options::default(),
+        }
+    }
+
+    pub fn ndof(&self) -> usize {
+        self.dofs.len()
+    }
+
+    /// The effects active in scene `s` (`None`: the model without scenes, every effect).
+    pub fn scene_effects(&self, s: Option<usize>) -> Vec<usize> {
+        match s {
+            None => (0..self.effects.len()).collect(),
+            Some(i) => {
+                let mut v: Vec<usize> = (0..self.effects.len()).filter(|&e| self.effects[e].name.is_none()).collect();
+                v.extend(&self.scenes[i].effects);
+                v.sort_unstable();
+                v.dedup();
+                v
+            }
+        }
+    }
+
+    /// Default parameter values, in declaration order.
+    pub fn param_defaults(&self) -> Vec<f64> {
+        self.params.iter().map(|p| p.default).collect()
+    }
+}

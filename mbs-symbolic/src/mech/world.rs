@@ -1,0 +1,183 @@
+//! World-frame kinematics composed along the tree (EasyDyn's ComposeMotion): for every node,
+//! its pose, its velocity Jacobians (sparse columns, world axes), its full velocities and its
+//! bias accelerations (J̇·qd plus rheonomic terms, i.e. the acceleration at qdd = 0).
+//! Each factor is differentiated once, locally; cost grows with the tree, not with the square
+//! of its depth.
+
+use super::spatial::{self as s, M3, V3};
+use super::system::Factor;
+use super::tree::Tree;
+use crate::expr::{Arena, ExprId, Var};
+
+/// Sparse Jacobian: (coordinate, column) sorted by coordinate.
+pub type Cols = Vec<(u16, V3)>;
+
+/// Kinematics of one node, world axes.
+#[derive(Clone, Debug)]
+pub struct NodeKin {
+    /// orientation: columns are the node's axes
+    pub r: M3,
+    /// origin
+    pub p: V3,
+    /// ∂ω/∂qd
+    pub jw: Cols,
+    /// ∂v/∂qd (velocity of the origin)
+    pub jv: Cols,
+    /// angular velocity
+    pub w: V3,
+    /// velocity of the origin
+    pub v: V3,
+    /// angular acceleration at qdd = 0
+    pub alb: V3,
+    /// acceleration of the origin at qdd = 0
+    pub ab: V3,
+}
+
+/// World kinematics of every node of a tree.
+pub struct World {
+    pub nodes: Vec<NodeKin>,
+}
+
+fn add_cols(a: &mut Arena, x: &Cols, y: &Cols) -> Cols {
+    let mut out = Vec::with_capacity(x.len() + y.len());
+    let (mut i, mut j) = (0, 0);
+    while i < x.len() || j < y.len() {
+        if j == y.len() || (i < x.len() && x[i].0 < y[j].0) {
+            out.push(x[i]);
+            i += 1;
+        } else if i == x.len() || y[j].0 < x[i].0 {
+            out.push(y[j]);
+            j += 1;
+        } else {
+            out.push((x[i].0, s::add(a, x[i].1, y[j].1)));
+            i += 1;
+            j += 1;
+        }
+    }
+    out
+}
+
+/// Coordinates that `e` depends on.
+pub fn q_deps(a: &Arena, roots: &[ExprId]) -> Vec<u16> {
+    a.vars_of(roots)
+        .into_iter()
+        .filter_map(|v| match v {
+            Var::Q(k) => Some(k),
+            _ => None,
+        })
+        .collect()
+}
+
+impl World {
+    pub fn build(a: &mut Arena, tree: &Tree) -> World {
+        let z = s::zero3(a);
+        let ground = NodeKin { r: s::identity(a), p: z, jw: Vec::new(), jv: Vec::new(), w: z, v: z, alb: z, ab: z };
+        let mut nodes = vec![ground];
+        for n in 1..tree.nodes.len() {
+            let par = nodes[tree.nodes[n].parent].clone();
+            let k = match tree.nodes[n].factor.expect("non-root nodes have a factor") {
+                Factor::Rot { axis, angle } => {
+                    let rel = s::rotation(a, axis, angle);
+                    let r = s::mul_mm(a, &par.r, &rel);
+                    let nw = s::mul_mv(a, &par.r, axis);
+                    let cols: Cols = q_deps(a, &[angle])
+                        .into_iter()
+                        .map(|k| {
+                            let d = a.diff(angle, Var::Q(k));
+                            (k, s::scale(a, d, nw))
+                        })
+                        .collect();
+                    let jw = add_cols(a, &par.jw, &cols);
+                    let th_d = a.dt(angle);
+                    let th_dd0 = a.dt_bias(th_d);
+                    let w_rel = s::scale(a, th_d, nw);
+                    let w = s::add(a, par.w, w_rel);
+                    // α = α_p + θ̈ n_w + ω_p × (θ̇ n_w)
+                    let t1 = s::scale(a, th_dd0, nw);
+                    let t2 = s::cross(a, par.w, w_rel);
+                    let alb = s::add(a, par.alb, t1);
+                    let alb = s::add(a, alb, t2);
+                    NodeKin { r, p: par.p, jw, jv: par.jv.clone(), w, v: par.v, alb, ab: par.ab }
+                }
+                Factor::Disp(d) => {
+                    let dw = s::mul_mv(a, &par.r, d);
+                    let p = s::add(a, par.p, dw);
+                    // Jv = Jv_p + Jω_p × d_w + R_p ∂d/∂q
+                    let mut jv_extra: Cols = par.jw.iter().map(|&(k, c)| (k, s::cross(a, c, dw))).collect();
+                    let own: Cols = q_deps(a, &d)
+                        .into_iter()
+                        .map(|k| {
+                            let dd = [a.diff(d[0], Var::Q(k)), a.diff(d[1], Var::Q(k)), a.diff(d[2], Var::Q(k))];
+                            (k, s::mul_mv(a, &par.r, dd))
+                        })
+                        .collect();
+                    jv_extra = add_cols(a, &jv_extra, &own);
+                    let jv = add_cols(a, &par.jv, &jv_extra);
+                    let ddot = [a.dt(d[0]), a.dt(d[1]), a.dt(d[2])];
+                    let ddot_w = s::mul_mv(a, &par.r, ddot);
+                    let dd0 = [a.dt_bias(ddot[0]), a.dt_bias(ddot[1]), a.dt_bias(ddot[2])];
+                    let dd0_w = s::mul_mv(a, &par.r, dd0);
+                    let wxd = s::cross(a, par.w, dw);
+                    let v = s::add(a, par.v, wxd);
+                    let v = s::add(a, v, ddot_w);
+                    // a = a_p + α_p × d + ω_p × (ω_p × d) + 2 ω_p × ḋ + d̈
+                    let t1 = s::cross(a, par.alb, dw);
+                    let t2 = s::cross(a, par.w, wxd);
+                    let two = a.num(2.0);
+                    let t3 = s::cross(a, par.w, ddot_w);
+                    let t3 = s::scale(a, two, t3);
+                    let mut ab = s::add(a, par.ab, t1);
+                    ab = s::add(a, ab, t2);
+                    ab = s::add(a, ab, t3);
+                    ab = s::add(a, ab, dd0_w);
+                    NodeKin { r: par.r, p, jw: par.jw.clone(), jv, w: par.w, v, alb: par.alb, ab }
+                }
+            };
+            nodes.push(k);
+        }
+        World { nodes }
+    }
+
+    /// World position of a point at `r` (node axes) on node `n`.
+    pub fn point_position(&self, a: &mut Arena, n: usize, r: V3) -> V3 {
+        let k = &self.nodes[n];
+        let rw = s::mul_mv(a, &k.r, r);
+        s::add(a, k.p, rw)
+    }
+
+    /// World velocity of that point.
+    pub fn point_velocity(&self, a: &mut Arena, n: usize, r: V3) -> V3 {
+        let k = &self.nodes[n];
+        let rw = s::mul_mv(a, &k.r, r);
+        let wx = s::cross(a, k.w, rw);
+        s::add(a, k.v, wx)
+    }
+
+    /// Jacobian of that point (sparse columns).
+    pub fn point_jacobian(&self, a: &mut Arena, n: usize, r: V3) -> Cols {
+        let k = &self.nodes[n];
+        let rw = s::mul_mv(a, &k.r, r);
+        let extra: Cols = k.jw.iter().map(|&(q, c)| (q, s::cross(a, c, rw))).collect();
+        add_cols(a, &k.jv, &extra)
+    }
+
+    /// Bias acceleration of that point: a_b + α_b × r + ω × (ω × r).
+    pub fn point_bias(&self, a: &mut Arena, n: usize, r: V3) -> V3 {
+        let k = &self.nodes[n];
+        let rw = s::mul_mv(a, &k.r, r);
+        let t1 = s::cross(a, k.alb, rw);
+        let wr = s::cross(a, k.w, rw);
+        let t2 = s::cross(a, k.w, wr);
+        let x = s::add(a, k.ab, t1);
+        s::add(a, x, t2)
+    }
+}
+
+/// Dense n-column form of sparse columns (for emission).
+pub fn dense(a: &Arena, cols: &Cols, n: usize) -> Vec<V3> {
+    let mut out = vec![s::zero3(a); n];
+    for &(k, c) in cols {
+        out[k as usize] = c;
+    }
+    out
+}

@@ -1,1 +1,8 @@
-//! placeholder
+//! The `multibody!` macro. All the work happens in `mbs-symbolic`, which `mbs expand` shares.
+
+/// Generates a specialised multibody model from CAGeM-style transforms.
+/// See the `mbs` crate for the language.
+#[proc_macro]
+pub fn multibody(input: proc_macro::TokenStream) -> proc_macro::TokenStream {
+    mbs_symbolic::expand(input.into()).into()
+}

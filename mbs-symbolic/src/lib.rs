@@ -1,10 +1,13 @@
 //! The mbs generator: the expression DAG, the `multibody!` language, mechanics and code
 //! emission. The proc-macro, `mbs expand` and tests all call the same functions.
 
+pub mod codegen;
 pub mod dsl;
+pub mod expand;
 pub mod expr;
 pub mod mech;
 
+pub use expand::expand;
 pub use mech::{SymbolicModel, System};
 
 /// Parses and checks the body of a `multibody!` block given as text.

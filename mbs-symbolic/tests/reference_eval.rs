@@ -26,8 +26,16 @@ fn dpend_matches_reference_at_test_state() {
     let params = sys.param_defaults();
     let model = SymbolicModel::build(sys);
     let (q, qd) = test_state(2);
-    let env = SliceEnv { q: &q, qd: &qd, params: &params, ..SliceEnv::default() };
-    let m_ref = [[2.546239652854929, 0.7731198264274626], [0.7731198264274626, 0.333333333333333]];
+    let env = SliceEnv {
+        q: &q,
+        qd: &qd,
+        params: &params,
+        ..SliceEnv::default()
+    };
+    let m_ref = [
+        [2.546239652854929, 0.7731198264274626],
+        [0.7731198264274626, 0.333333333333333],
+    ];
     let f_ref = [-5.843720128970542, -3.236224706838456];
     let eq = &model.scenes[0];
     for mb in [&eq.vp, &eq.rec] {

@@ -46,19 +46,39 @@ pub enum Item {
     /// `let I = m*l*l/12;` (an alias, substituted where used)
     Let { name: Ident, value: Expr },
     /// `dof q[0] = PI/2;`, `dof knee = 0.2, qd = 1.0;`
-    Dof { name: DofName, q0: Option<Expr>, qd0: Option<Expr>, span: Span },
+    Dof {
+        name: DofName,
+        q0: Option<Expr>,
+        qd0: Option<Expr>,
+        span: Span,
+    },
     /// `input torque;`
     Input { name: Ident },
     /// `body bar { mass = m; inertia = (ixx, iyy, izz); }`
-    Body { name: Ident, props: Vec<(Ident, Expr)> },
+    Body {
+        name: Ident,
+        props: Vec<(Ident, Expr)>,
+    },
     /// `frame sensor;` (massless)
     Frame { name: Ident },
     /// `point tip on bar at (x, y, z);`
-    Point { name: Ident, body: BodyRef, at: Expr },
+    Point {
+        name: Ident,
+        body: BodyRef,
+        at: Expr,
+    },
     /// `TOG[bar] = chain;`
-    Tog { target: BodyRef, chain: Expr, span: Span },
+    Tog {
+        target: BodyRef,
+        chain: Expr,
+        span: Span,
+    },
     /// `fn f(x, y) = expr;`
-    Fn { name: Ident, args: Vec<Ident>, body: Expr },
+    Fn {
+        name: Ident,
+        args: Vec<Ident>,
+        body: Expr,
+    },
     /// `extern fn g = [path, d_path, dd_path];`
     ExternFn { name: Ident, paths: Vec<syn::Path> },
     /// an effect statement outside any `effect` block: always on

@@ -12,7 +12,9 @@ use syn::spanned::Spanned;
 use syn::{Expr, Ident};
 
 /// Names that the DSL reserves.
-const RESERVED: [&str; 10] = ["t", "q", "qd", "qdd", "u", "PI", "E", "TAU", "ground", "TOG"];
+const RESERVED: [&str; 10] = [
+    "t", "q", "qd", "qdd", "u", "PI", "E", "TAU", "ground", "TOG",
+];
 
 /// What an expression may depend on, and how to say so when it does not.
 #[derive(Clone, Copy)]
@@ -26,10 +28,38 @@ struct Allow {
     what: &'static str,
 }
 
-const CONSTANT: Allow = Allow { q: false, qd: false, t: false, u: false, params: false, what: "a parameter default" };
-const PARAMS_ONLY: Allow = Allow { q: false, qd: false, t: false, u: false, params: true, what: "" };
-const POSITION: Allow = Allow { q: true, qd: false, t: true, u: false, params: true, what: "a transform" };
-const ANY: Allow = Allow { q: true, qd: true, t: true, u: true, params: true, what: "" };
+const CONSTANT: Allow = Allow {
+    q: false,
+    qd: false,
+    t: false,
+    u: false,
+    params: false,
+    what: "a parameter default",
+};
+const PARAMS_ONLY: Allow = Allow {
+    q: false,
+    qd: false,
+    t: false,
+    u: false,
+    params: true,
+    what: "",
+};
+const POSITION: Allow = Allow {
+    q: true,
+    qd: false,
+    t: true,
+    u: false,
+    params: true,
+    what: "a transform",
+};
+const ANY: Allow = Allow {
+    q: true,
+    qd: true,
+    t: true,
+    u: true,
+    params: true,
+    what: "",
+};
 
 #[derive(Clone)]
 enum Scalar {
@@ -101,7 +131,10 @@ pub fn check(def: &ModelDef) -> Result<Checked, syn::Error> {
     c.final_checks();
     let mut errs = c.errors.into_iter();
     match errs.next() {
-        None => Ok(Checked { system: c.sys, extern_spans: c.extern_spans }),
+        None => Ok(Checked {
+            system: c.sys,
+            extern_spans: c.extern_spans,
+        }),
         Some(mut first) => {
             for e in errs {
                 first.combine(e);
@@ -123,7 +156,10 @@ impl Checker {
     fn reserved(&mut self, name: &Ident) -> bool {
         let s = name.to_string();
         if RESERVED.contains(&s.as_str()) {
-            self.error(name.span(), format!("`{s}` is a reserved name in multibody!; choose another name"));
+            self.error(
+                name.span(),
+                format!("`{s}` is a reserved name in multibody!; choose another name"),
+            );
             return true;
         }
         false
@@ -142,18 +178,26 @@ impl Checker {
                     let default = match v {
                         Some(v) if v.is_finite() => v,
                         Some(_) => {
-                            self.error(value.span(), format!("the default of parameter `{name}` is not finite"));
+                            self.error(
+                                value.span(),
+                                format!("the default of parameter `{name}` is not finite"),
+                            );
                             0.0
                         }
                         None => 0.0,
                     };
-                    self.scalars.insert(name.to_string(), Scalar::Param(self.sys.params.len()));
-                    self.sys.params.push(ParamDef { name: name.to_string(), default });
+                    self.scalars
+                        .insert(name.to_string(), Scalar::Param(self.sys.params.len()));
+                    self.sys.params.push(ParamDef {
+                        name: name.to_string(),
+                        default,
+                    });
                     self.defaults.push(default);
                 }
                 Item::Let { name, value } => {
                     if !self.reserved(name) && !self.duplicate_scalar(name) {
-                        self.scalars.insert(name.to_string(), Scalar::Let(value.clone()));
+                        self.scalars
+                            .insert(name.to_string(), Scalar::Let(value.clone()));
                     }
                 }
                 Item::Dof { name, span, .. } => {
@@ -174,12 +218,17 @@ impl Checker {
                         }
                     };
                     let z = self.sys.arena.zero();
-                    self.sys.dofs.push(DofDef { name: display, q0: z, qd0: z });
+                    self.sys.dofs.push(DofDef {
+                        name: display,
+                        q0: z,
+                        qd0: z,
+                    });
                     self.dof_spans.push(*span);
                 }
                 Item::Input { name } => {
                     if !self.reserved(name) && !self.duplicate_scalar(name) {
-                        self.scalars.insert(name.to_string(), Scalar::Input(self.sys.inputs.len()));
+                        self.scalars
+                            .insert(name.to_string(), Scalar::Input(self.sys.inputs.len()));
                         self.sys.inputs.push(name.to_string());
                     }
                 }
@@ -187,32 +236,52 @@ impl Checker {
                     if self.reserved(name) {
                         continue;
                     }
-                    if self.frame_names.contains_key(&name.to_string()) || self.points.contains_key(&name.to_string()) {
+                    if self.frame_names.contains_key(&name.to_string())
+                        || self.points.contains_key(&name.to_string())
+                    {
                         self.error(name.span(), format!("duplicate body or frame `{name}`: each body, frame and point needs its own name"));
                         continue;
                     }
-                    self.frame_names.insert(name.to_string(), self.sys.frames.len());
+                    self.frame_names
+                        .insert(name.to_string(), self.sys.frames.len());
                     self.frame_spans.push(name.span());
                     self.tog_defined.push(false);
-                    self.sys.frames.push(FrameDef { name: name.to_string(), parent: None, factors: Vec::new(), inertia: None });
+                    self.sys.frames.push(FrameDef {
+                        name: name.to_string(),
+                        parent: None,
+                        factors: Vec::new(),
+                        inertia: None,
+                    });
                 }
                 Item::Point { name, .. } => {
                     if self.reserved(name) {
                         continue;
                     }
-                    if self.frame_names.contains_key(&name.to_string()) || self.points.contains_key(&name.to_string()) {
+                    if self.frame_names.contains_key(&name.to_string())
+                        || self.points.contains_key(&name.to_string())
+                    {
                         self.error(name.span(), format!("duplicate point `{name}`: each body, frame and point needs its own name"));
                         continue;
                     }
                     self.points.insert(name.to_string(), self.sys.points.len());
                     let z = self.sys.arena.zero();
-                    self.sys.points.push(PointDef { name: name.to_string(), frame: None, pos: [z; 3] });
+                    self.sys.points.push(PointDef {
+                        name: name.to_string(),
+                        frame: None,
+                        pos: [z; 3],
+                    });
                 }
                 Item::Fn { name, args, body } => {
                     if self.duplicate_fn(name) {
                         continue;
                     }
-                    self.fns.insert(name.to_string(), FnSym::Inline { args: args.clone(), body: body.clone() });
+                    self.fns.insert(
+                        name.to_string(),
+                        FnSym::Inline {
+                            args: args.clone(),
+                            body: body.clone(),
+                        },
+                    );
                 }
                 Item::ExternFn { name, paths } => {
                     if self.duplicate_fn(name) {
@@ -224,7 +293,10 @@ impl Checker {
                     }
                     let uf = UserFn {
                         name: name.to_string(),
-                        paths: paths.iter().map(|p| quote::quote!(#p).to_string().replace(' ', "")).collect(),
+                        paths: paths
+                            .iter()
+                            .map(|p| quote::quote!(#p).to_string().replace(' ', ""))
+                            .collect(),
                     };
                     let id = self.sys.arena.user_fn(uf);
                     self.extern_spans.push((name.to_string(), name.span()));
@@ -235,8 +307,12 @@ impl Checker {
                         self.error(name.span(), format!("duplicate effect `{name}`"));
                         continue;
                     }
-                    self.effects.insert(name.to_string(), self.sys.effects.len());
-                    self.sys.effects.push(EffectDef { name: Some(name.to_string()), loads: Vec::new() });
+                    self.effects
+                        .insert(name.to_string(), self.sys.effects.len());
+                    self.sys.effects.push(EffectDef {
+                        name: Some(name.to_string()),
+                        loads: Vec::new(),
+                    });
                 }
                 _ => {}
             }
@@ -253,8 +329,16 @@ impl Checker {
 
     fn duplicate_fn(&mut self, name: &Ident) -> bool {
         let s = name.to_string();
-        if self.fns.contains_key(&s) || Func::from_name(&s).is_some() || matches!(s.as_str(), "atan2" | "powi" | "pow") {
-            self.error(name.span(), format!("duplicate function `{name}`: it is already defined (or built in); rename it"));
+        if self.fns.contains_key(&s)
+            || Func::from_name(&s).is_some()
+            || matches!(s.as_str(), "atan2" | "powi" | "pow")
+        {
+            self.error(
+                name.span(),
+                format!(
+                    "duplicate function `{name}`: it is already defined (or built in); rename it"
+                ),
+            );
             return true;
         }
         false
@@ -268,11 +352,15 @@ impl Checker {
             match item {
                 Item::Dof { q0, qd0, name, .. } => {
                     if let DofName::Named(id) = name {
-                        if !matches!(self.scalars.get(&id.to_string()), Some(Scalar::Dof(i)) if *i == dof_i) {
+                        if !matches!(self.scalars.get(&id.to_string()), Some(Scalar::Dof(i)) if *i == dof_i)
+                        {
                             continue;
                         }
                     }
-                    let a = Allow { what: "an initial value", ..PARAMS_ONLY };
+                    let a = Allow {
+                        what: "an initial value",
+                        ..PARAMS_ONLY
+                    };
                     if let Some(e) = q0 {
                         self.sys.dofs[dof_i].q0 = self.lower(e, a);
                     }
@@ -283,15 +371,28 @@ impl Checker {
                 }
                 Item::Body { name, props } => self.lower_body(name, props),
                 Item::Point { name, body, at } => {
-                    let Some(&pi) = self.points.get(&name.to_string()) else { continue };
+                    let Some(&pi) = self.points.get(&name.to_string()) else {
+                        continue;
+                    };
                     let frame = self.body_ref(body);
-                    let pos = self.triple(at, Allow { what: "a point position", ..PARAMS_ONLY }, "a point position");
+                    let pos = self.triple(
+                        at,
+                        Allow {
+                            what: "a point position",
+                            ..PARAMS_ONLY
+                        },
+                        "a point position",
+                    );
                     self.sys.points[pi].frame = frame.flatten();
                     if let Some(p) = pos {
                         self.sys.points[pi].pos = p;
                     }
                 }
-                Item::Tog { target, chain, span } => self.lower_tog(target, chain, *span),
+                Item::Tog {
+                    target,
+                    chain,
+                    span,
+                } => self.lower_tog(target, chain, *span),
                 Item::Effect(stmt) => {
                     let loads = self.lower_effect(stmt);
                     match self.sys.effects.iter_mut().find(|e| e.name.is_none()) {
@@ -300,7 +401,9 @@ impl Checker {
                     }
                 }
                 Item::EffectBlock { name, stmts } => {
-                    let Some(&ei) = self.effects.get(&name.to_string()) else { continue };
+                    let Some(&ei) = self.effects.get(&name.to_string()) else {
+                        continue;
+                    };
                     for s in stmts {
                         let loads = self.lower_effect(s);
                         self.sys.effects[ei].loads.extend(loads);
@@ -316,17 +419,33 @@ impl Checker {
                         match self.effects.get(&e.to_string()) {
                             Some(&i) => {
                                 if list.contains(&i) {
-                                    self.error(e.span(), format!("effect `{e}` is listed twice in scene `{name}`"));
+                                    self.error(
+                                        e.span(),
+                                        format!("effect `{e}` is listed twice in scene `{name}`"),
+                                    );
                                 }
                                 list.push(i);
                             }
                             None => {
                                 let names: Vec<String> = self.effects.keys().cloned().collect();
-                                self.error(e.span(), format!("unknown effect `{e}` in scene `{name}`{}", did_you_mean(&e.to_string(), names.iter().map(String::as_str), "declare it with `effect NAME { … }`")));
+                                self.error(
+                                    e.span(),
+                                    format!(
+                                        "unknown effect `{e}` in scene `{name}`{}",
+                                        did_you_mean(
+                                            &e.to_string(),
+                                            names.iter().map(String::as_str),
+                                            "declare it with `effect NAME { … }`"
+                                        )
+                                    ),
+                                );
                             }
                         }
                     }
-                    self.sys.scenes.push(SceneDef { name: name.to_string(), effects: list });
+                    self.sys.scenes.push(SceneDef {
+                        name: name.to_string(),
+                        effects: list,
+                    });
                 }
                 Item::Option { key, value } => self.lower_option(key, value.as_ref()),
                 _ => {}
@@ -355,7 +474,9 @@ impl Checker {
     }
 
     fn lower_body(&mut self, name: &Ident, props: &[(Ident, Expr)]) {
-        let Some(&fi) = self.frame_names.get(&name.to_string()) else { return };
+        let Some(&fi) = self.frame_names.get(&name.to_string()) else {
+            return;
+        };
         let mut mass = None;
         let mut tensor = None;
         for (key, value) in props {
@@ -384,7 +505,8 @@ impl Checker {
                         t[i] = self.lower(e, a);
                     }
                     let vals: Vec<f64> = t.iter().map(|&e| self.eval_default(e)).collect();
-                    if let Err(msg) = mbs_inertia_check(&vals) {
+                    let vals6 = [vals[0], vals[1], vals[2], vals.get(3).copied().unwrap_or(0.0), vals.get(4).copied().unwrap_or(0.0), vals.get(5).copied().unwrap_or(0.0)];
+                    if let Some(msg) = super::inertia::inertia_problem(vals6) {
                         self.error(value.span(), format!("inertia of body `{name}`: {msg}"));
                     }
                     tensor = Some(t);
@@ -404,7 +526,10 @@ impl Checker {
     }
 
     fn eval_default(&self, e: ExprId) -> f64 {
-        let env = SliceEnv { params: &self.defaults, ..SliceEnv::default() };
+        let env = SliceEnv {
+            params: &self.defaults,
+            ..SliceEnv::default()
+        };
         self.sys.arena.eval(&[e], &env)[0]
     }
 
@@ -416,7 +541,17 @@ impl Checker {
                 Some(&i) => Some(Some(i)),
                 None => {
                     let names: Vec<String> = self.frame_names.keys().cloned().collect();
-                    self.error(id.span(), format!("unknown body `{id}`{}", did_you_mean(&id.to_string(), names.iter().map(String::as_str), "declare it with `body NAME { … }` or `frame NAME;`")));
+                    self.error(
+                        id.span(),
+                        format!(
+                            "unknown body `{id}`{}",
+                            did_you_mean(
+                                &id.to_string(),
+                                names.iter().map(String::as_str),
+                                "declare it with `body NAME { … }` or `frame NAME;`"
+                            )
+                        ),
+                    );
                     None
                 }
             },
@@ -433,7 +568,9 @@ impl Checker {
 
     fn ident_body_ref(&mut self, e: &Expr) -> Option<Option<usize>> {
         match e {
-            Expr::Path(p) if p.path.get_ident().is_some() => self.body_ref(&BodyRef::Name(p.path.get_ident().unwrap().clone())),
+            Expr::Path(p) if p.path.get_ident().is_some() => {
+                self.body_ref(&BodyRef::Name(p.path.get_ident().unwrap().clone()))
+            }
             _ => {
                 self.error(e.span(), "expected a body or frame name");
                 None
@@ -442,13 +579,24 @@ impl Checker {
     }
 
     fn lower_tog(&mut self, target: &BodyRef, chain: &Expr, span: Span) {
-        let Some(t) = self.body_ref(target) else { return };
+        let Some(t) = self.body_ref(target) else {
+            return;
+        };
         let Some(fi) = t else {
-            self.error(target.span(), "the ground does not move: TOG[ground] cannot be assigned");
+            self.error(
+                target.span(),
+                "the ground does not move: TOG[ground] cannot be assigned",
+            );
             return;
         };
         if self.tog_defined[fi] {
-            self.error(span, format!("TOG[{}] is defined twice: each body and frame has one TOG", self.sys.frames[fi].name));
+            self.error(
+                span,
+                format!(
+                    "TOG[{}] is defined twice: each body and frame has one TOG",
+                    self.sys.frames[fi].name
+                ),
+            );
             return;
         }
         let mut leaves = Vec::new();
@@ -462,12 +610,20 @@ impl Checker {
             if let Expr::Index(ix) = leaf {
                 if matches!(&*ix.expr, Expr::Path(p) if p.path.is_ident("TOG")) {
                     if k != 0 {
-                        self.error(leaf.span(), "TOG[…] may only start a product: write `TOG[parent] * Tdisp(…) * …`");
+                        self.error(
+                            leaf.span(),
+                            "TOG[…] may only start a product: write `TOG[parent] * Tdisp(…) * …`",
+                        );
                         continue;
                     }
                     let r = match &*ix.index {
-                        Expr::Path(p) if p.path.get_ident().is_some() => BodyRef::Name(p.path.get_ident().unwrap().clone()),
-                        Expr::Lit(syn::ExprLit { lit: syn::Lit::Int(l), .. }) => match l.base10_parse() {
+                        Expr::Path(p) if p.path.get_ident().is_some() => {
+                            BodyRef::Name(p.path.get_ident().unwrap().clone())
+                        }
+                        Expr::Lit(syn::ExprLit {
+                            lit: syn::Lit::Int(l),
+                            ..
+                        }) => match l.base10_parse() {
                             Ok(v) => BodyRef::Index(v, l.span()),
                             Err(e) => {
                                 self.errors.push(e);
@@ -501,7 +657,9 @@ impl Checker {
     /// Splits `a * b * c` into its factors; anything but products is an error.
     fn flatten_product<'e>(&mut self, e: &'e Expr, out: &mut Vec<&'e Expr>) -> bool {
         match e {
-            Expr::Binary(b) if matches!(b.op, syn::BinOp::Mul(_)) => self.flatten_product(&b.left, out) && self.flatten_product(&b.right, out),
+            Expr::Binary(b) if matches!(b.op, syn::BinOp::Mul(_)) => {
+                self.flatten_product(&b.left, out) && self.flatten_product(&b.right, out)
+            }
             Expr::Binary(b) => {
                 self.error(b.op.span(), "transforms combine by products only: write `TOG[parent] * Trotz(q[0]) * Tdisp(x, y, z)`");
                 false
@@ -534,7 +692,14 @@ impl Checker {
         let a = Allow { what, ..POSITION };
         let arity = |c: &mut Checker, n: usize| {
             if args.len() != n {
-                c.error(call.span(), format!("`{name}` takes {n} argument{}, found {}", if n == 1 { "" } else { "s" }, args.len()));
+                c.error(
+                    call.span(),
+                    format!(
+                        "`{name}` takes {n} argument{}, found {}",
+                        if n == 1 { "" } else { "s" },
+                        args.len()
+                    ),
+                );
                 false
             } else {
                 true
@@ -554,7 +719,11 @@ impl Checker {
                 if !arity(self, 3) {
                     return None;
                 }
-                let d = [self.lower(args[0], a), self.lower(args[1], a), self.lower(args[2], a)];
+                let d = [
+                    self.lower(args[0], a),
+                    self.lower(args[1], a),
+                    self.lower(args[2], a),
+                ];
                 if d.iter().all(|&x| self.sys.arena.is_num(x, 0.0)) {
                     return Some(Vec::new());
                 }
@@ -567,13 +736,26 @@ impl Checker {
                 if !arity(self, 4) {
                     return None;
                 }
-                let pa = Allow { what: "the axis of Trotn", ..PARAMS_ONLY };
-                let n = [self.lower(args[0], pa), self.lower(args[1], pa), self.lower(args[2], pa)];
+                let pa = Allow {
+                    what: "the axis of Trotn",
+                    ..PARAMS_ONLY
+                };
+                let n = [
+                    self.lower(args[0], pa),
+                    self.lower(args[1], pa),
+                    self.lower(args[2], pa),
+                ];
                 let v: Vec<f64> = n.iter().map(|&x| self.eval_default(x)).collect();
                 let norm = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-                let span = args[0].span().join(args[2].span()).unwrap_or(args[0].span());
+                let span = args[0]
+                    .span()
+                    .join(args[2].span())
+                    .unwrap_or(args[0].span());
                 if norm == 0.0 {
-                    self.error(span, "the axis of Trotn is zero: give a unit axis, e.g. Trotn(0, 0, 1, a)");
+                    self.error(
+                        span,
+                        "the axis of Trotn is zero: give a unit axis, e.g. Trotn(0, 0, 1, a)",
+                    );
                     return None;
                 }
                 if (norm - 1.0).abs() > 1e-9 {
@@ -584,7 +766,13 @@ impl Checker {
             }
             other => {
                 let known = ["Tdisp", "Trotx", "Troty", "Trotz", "Trotn"];
-                self.error(name.span(), format!("unknown transform `{other}`{}", did_you_mean(other, known.into_iter(), bad)));
+                self.error(
+                    name.span(),
+                    format!(
+                        "unknown transform `{other}`{}",
+                        did_you_mean(other, known.into_iter(), bad)
+                    ),
+                );
                 None
             }
         }
@@ -612,16 +800,40 @@ impl Checker {
                 let s = id.to_string();
                 if let Some(&pi) = self.points.get(&s) {
                     let pt = &self.sys.points[pi];
-                    return Some(Attach { frame: pt.frame, pos: pt.pos });
+                    return Some(Attach {
+                        frame: pt.frame,
+                        pos: pt.pos,
+                    });
                 }
                 if s == "ground" {
-                    return Some(Attach { frame: None, pos: [z; 3] });
+                    return Some(Attach {
+                        frame: None,
+                        pos: [z; 3],
+                    });
                 }
                 if let Some(&fi) = self.frame_names.get(&s) {
-                    return Some(Attach { frame: Some(fi), pos: [z; 3] });
+                    return Some(Attach {
+                        frame: Some(fi),
+                        pos: [z; 3],
+                    });
                 }
-                let names: Vec<String> = self.points.keys().chain(self.frame_names.keys()).cloned().collect();
-                self.error(id.span(), format!("unknown point or body `{s}`{}", did_you_mean(&s, names.iter().map(String::as_str), "declare it with `point NAME on BODY at (x, y, z);`")));
+                let names: Vec<String> = self
+                    .points
+                    .keys()
+                    .chain(self.frame_names.keys())
+                    .cloned()
+                    .collect();
+                self.error(
+                    id.span(),
+                    format!(
+                        "unknown point or body `{s}`{}",
+                        did_you_mean(
+                            &s,
+                            names.iter().map(String::as_str),
+                            "declare it with `point NAME on BODY at (x, y, z);`"
+                        )
+                    ),
+                );
                 return None;
             }
         }
@@ -641,54 +853,114 @@ impl Checker {
         };
         for (k, _) in &s.named {
             if !known_named.contains(&k.to_string().as_str()) {
-                let list = if known_named.is_empty() { "none".to_string() } else { known_named.join(", ") };
-                self.error(k.span(), format!("`{kind}` has no argument `{k}`; its named arguments: {list}"));
+                let list = if known_named.is_empty() {
+                    "none".to_string()
+                } else {
+                    known_named.join(", ")
+                };
+                self.error(
+                    k.span(),
+                    format!("`{kind}` has no argument `{k}`; its named arguments: {list}"),
+                );
             }
         }
         let npos = |c: &mut Checker, n: usize, usage: &str| {
             if s.positional.len() != n {
-                c.error(s.kind.span(), format!("`{kind}` takes {n} positional argument{}, found {}: write `{usage}`", if n == 1 { "" } else { "s" }, s.positional.len()));
+                c.error(
+                    s.kind.span(),
+                    format!(
+                        "`{kind}` takes {n} positional argument{}, found {}: write `{usage}`",
+                        if n == 1 { "" } else { "s" },
+                        s.positional.len()
+                    ),
+                );
                 false
             } else {
                 true
             }
         };
-        let pa = Allow { what: "", ..PARAMS_ONLY };
+        let pa = Allow {
+            what: "",
+            ..PARAMS_ONLY
+        };
         let mut out = Vec::new();
         match kind.as_str() {
             "gravity" => {
                 if npos(self, 3, "gravity(gx, gy, gz)") {
-                    let g = [0, 1, 2].map(|i| self.lower(&s.positional[i], Allow { what: "gravity", ..PARAMS_ONLY }));
+                    let g = [0, 1, 2].map(|i| {
+                        self.lower(
+                            &s.positional[i],
+                            Allow {
+                                what: "gravity",
+                                ..PARAMS_ONLY
+                            },
+                        )
+                    });
                     out.push(Load::Gravity(g));
                 }
             }
             "spring" | "damper" => {
-                let usage = if kind == "spring" { "spring(a, b, k = …, l0 = …)" } else { "damper(a, b, c = …)" };
+                let usage = if kind == "spring" {
+                    "spring(a, b, k = …, l0 = …)"
+                } else {
+                    "damper(a, b, c = …)"
+                };
                 if !npos(self, 2, usage) {
                     return out;
                 }
-                let (Some(a), Some(b)) = (self.attach(&s.positional[0]), self.attach(&s.positional[1])) else { return out };
+                let (Some(a), Some(b)) =
+                    (self.attach(&s.positional[0]), self.attach(&s.positional[1]))
+                else {
+                    return out;
+                };
                 if kind == "spring" {
                     let Some(k) = named("k") else {
-                        self.error(s.kind.span(), "a spring needs its stiffness: `spring(a, b, k = …, l0 = …)`");
+                        self.error(
+                            s.kind.span(),
+                            "a spring needs its stiffness: `spring(a, b, k = …, l0 = …)`",
+                        );
                         return out;
                     };
-                    let k = self.lower(k, Allow { what: "a spring stiffness", ..pa });
+                    let k = self.lower(
+                        k,
+                        Allow {
+                            what: "a spring stiffness",
+                            ..pa
+                        },
+                    );
                     if self.eval_default(k) < 0.0 {
-                        self.error(named("k").unwrap().span(), "a spring stiffness must not be negative");
+                        self.error(
+                            named("k").unwrap().span(),
+                            "a spring stiffness must not be negative",
+                        );
                     }
                     let l0 = match named("l0") {
-                        Some(e) => self.lower(e, Allow { what: "a rest length", ..pa }),
+                        Some(e) => self.lower(
+                            e,
+                            Allow {
+                                what: "a rest length",
+                                ..pa
+                            },
+                        ),
                         None => self.sys.arena.zero(),
                     };
                     out.push(Load::Spring { a, b, k, l0 });
                 }
                 let c_expr = named("c");
                 if kind == "damper" && c_expr.is_none() {
-                    self.error(s.kind.span(), "a damper needs its coefficient: `damper(a, b, c = …)`");
+                    self.error(
+                        s.kind.span(),
+                        "a damper needs its coefficient: `damper(a, b, c = …)`",
+                    );
                 }
                 if let Some(c) = c_expr {
-                    let c = self.lower(c, Allow { what: "a damping coefficient", ..pa });
+                    let c = self.lower(
+                        c,
+                        Allow {
+                            what: "a damping coefficient",
+                            ..pa
+                        },
+                    );
                     out.push(Load::Damper { a, b, c });
                 }
             }
@@ -713,7 +985,11 @@ impl Checker {
                     None => Some(None),
                 };
                 let (torque, frame) = if let Some(axis) = named("axis") {
-                    if !npos(self, 2, "torque(body, axis = z, value[, relative_to = other])") {
+                    if !npos(
+                        self,
+                        2,
+                        "torque(body, axis = z, value[, relative_to = other])",
+                    ) {
                         return out;
                     }
                     let z = self.sys.arena.zero();
@@ -722,7 +998,14 @@ impl Checker {
                         Expr::Path(p) if p.path.is_ident("x") => Some([o, z, z]),
                         Expr::Path(p) if p.path.is_ident("y") => Some([z, o, z]),
                         Expr::Path(p) if p.path.is_ident("z") => Some([z, z, o]),
-                        Expr::Tuple(_) => self.triple(axis, Allow { what: "a torque axis", ..pa }, "a torque axis"),
+                        Expr::Tuple(_) => self.triple(
+                            axis,
+                            Allow {
+                                what: "a torque axis",
+                                ..pa
+                            },
+                            "a torque axis",
+                        ),
                         _ => {
                             self.error(axis.span(), "the axis is x, y, z or a unit vector (nx, ny, nz), in the body's axes");
                             None
@@ -732,7 +1015,11 @@ impl Checker {
                     let t = dir.map(|d| d.map(|c| self.sys.arena.mul(c, v)));
                     (t, on)
                 } else {
-                    if !npos(self, 2, "torque(body, (mx, my, mz)[, frame = body][, relative_to = other])") {
+                    if !npos(
+                        self,
+                        2,
+                        "torque(body, (mx, my, mz)[, frame = body][, relative_to = other])",
+                    ) {
                         return out;
                     }
                     let t = self.triple(&s.positional[1], ANY, "a torque");
@@ -742,12 +1029,22 @@ impl Checker {
                     };
                     (t, frame)
                 };
-                if let (Some(on), Some(torque), Some(frame), Some(reaction)) = (on, torque, frame, reaction) {
+                if let (Some(on), Some(torque), Some(frame), Some(reaction)) =
+                    (on, torque, frame, reaction)
+                {
                     if on.is_none() {
-                        self.error(s.positional[0].span(), "a torque on the ground does nothing: apply it to a body");
+                        self.error(
+                            s.positional[0].span(),
+                            "a torque on the ground does nothing: apply it to a body",
+                        );
                         return out;
                     }
-                    out.push(Load::Torque { on, torque, frame, reaction });
+                    out.push(Load::Torque {
+                        on,
+                        torque,
+                        frame,
+                        reaction,
+                    });
                 }
             }
             "generalized_force" => {
@@ -761,7 +1058,14 @@ impl Checker {
                 }
             }
             other => {
-                let known = ["gravity", "spring", "damper", "force", "torque", "generalized_force"];
+                let known = [
+                    "gravity",
+                    "spring",
+                    "damper",
+                    "force",
+                    "torque",
+                    "generalized_force",
+                ];
                 self.error(s.kind.span(), format!("unknown effect `{other}`{}", did_you_mean(other, known.into_iter(), "the effects are gravity, spring, damper, force, torque and generalized_force")));
             }
         }
@@ -771,19 +1075,29 @@ impl Checker {
     /// `q[2]` or a coordinate name.
     fn dof_ref(&mut self, e: &Expr) -> Option<usize> {
         match e {
-            Expr::Index(ix) if matches!(&*ix.expr, Expr::Path(p) if p.path.is_ident("q")) => self.index_of(&ix.index, "q"),
+            Expr::Index(ix) if matches!(&*ix.expr, Expr::Path(p) if p.path.is_ident("q")) => {
+                self.index_of(&ix.index, "q")
+            }
             Expr::Path(p) if p.path.get_ident().is_some() => {
                 let id = p.path.get_ident().unwrap();
                 match self.scalars.get(&id.to_string()) {
                     Some(Scalar::Dof(i)) => Some(*i),
                     _ => {
-                        self.error(id.span(), format!("`{id}` is not a coordinate: write `q[i]` or a coordinate's name"));
+                        self.error(
+                            id.span(),
+                            format!(
+                                "`{id}` is not a coordinate: write `q[i]` or a coordinate's name"
+                            ),
+                        );
                         None
                     }
                 }
             }
             _ => {
-                self.error(e.span(), "expected a coordinate: `q[i]` or a coordinate's name");
+                self.error(
+                    e.span(),
+                    "expected a coordinate: `q[i]` or a coordinate's name",
+                );
                 None
             }
         }
@@ -791,13 +1105,27 @@ impl Checker {
 
     /// The index in `v[idx]`: a number in range or a name of the right kind.
     fn index_of(&mut self, idx: &Expr, v: &str) -> Option<usize> {
-        let (count, kind) = if v == "u" { (self.sys.inputs.len(), "inputs") } else { (self.sys.dofs.len(), "coordinates") };
+        let (count, kind) = if v == "u" {
+            (self.sys.inputs.len(), "inputs")
+        } else {
+            (self.sys.dofs.len(), "coordinates")
+        };
         match idx {
-            Expr::Lit(syn::ExprLit { lit: syn::Lit::Int(l), .. }) => {
+            Expr::Lit(syn::ExprLit {
+                lit: syn::Lit::Int(l),
+                ..
+            }) => {
                 let i: usize = l.base10_parse().ok()?;
                 if i >= count {
-                    let fix = if v == "u" { format!("declare it with `input NAME;`") } else { format!("declare it with `dof q[{i}] = 0.0;`") };
-                    self.error(l.span(), format!("`{v}[{i}]` is out of range: the model has {count} {kind}; {fix}"));
+                    let fix = if v == "u" {
+                        format!("declare it with `input NAME;`")
+                    } else {
+                        format!("declare it with `dof q[{i}] = 0.0;`")
+                    };
+                    self.error(
+                        l.span(),
+                        format!("`{v}[{i}]` is out of range: the model has {count} {kind}; {fix}"),
+                    );
                     return None;
                 }
                 Some(i)
@@ -814,18 +1142,29 @@ impl Checker {
                 }
             }
             other => {
-                self.error(other.span(), format!("the index of `{v}[…]` is a number or a name"));
+                self.error(
+                    other.span(),
+                    format!("the index of `{v}[…]` is a number or a name"),
+                );
                 None
             }
         }
     }
 
     fn not_allowed(&mut self, span: Span, thing: &str, a: Allow) -> ExprId {
-        let what = if a.what.is_empty() { "this expression" } else { a.what };
+        let what = if a.what.is_empty() {
+            "this expression"
+        } else {
+            a.what
+        };
         let hint = match thing {
-            "qd" | "qdd" => "positions and constants cannot depend on velocities or accelerations; use them in effects",
+            "qd" | "qdd" => {
+                "positions and constants cannot depend on velocities or accelerations; use them in effects"
+            }
             "u" => "inputs act through effects (forces, torques), not here",
-            "q" | "t" => "this value must be constant during the motion: use parameters and numbers",
+            "q" | "t" => {
+                "this value must be constant during the motion: use parameters and numbers"
+            }
             _ => "use numbers and parameters only",
         };
         self.error(span, format!("`{thing}` cannot appear in {what}: {hint}"));
@@ -883,7 +1222,10 @@ impl Checker {
                         ar.div(x, y)
                     }
                     syn::BinOp::BitXor(_) => {
-                        let e = err(b.op.span(), "`^` is not a power in Rust: write `powi(x, 2)` for an integer power or `pow(x, y)`");
+                        let e = err(
+                            b.op.span(),
+                            "`^` is not a power in Rust: write `powi(x, 2)` for an integer power or `pow(x, y)`",
+                        );
                         self.errors.push(e);
                         self.sys.arena.zero()
                     }
@@ -896,32 +1238,52 @@ impl Checker {
             }
             Expr::Path(p) => {
                 let Some(id) = p.path.get_ident() else {
-                    self.error(p.span(), "expected a name: paths are allowed only in `extern fn`");
+                    self.error(
+                        p.span(),
+                        "expected a name: paths are allowed only in `extern fn`",
+                    );
                     return self.sys.arena.zero();
                 };
                 self.lower_name(id, a)
             }
             Expr::Index(ix) => {
                 let Expr::Path(p) = &*ix.expr else {
-                    self.error(ix.expr.span(), "only `q[i]`, `qd[i]`, `qdd[i]` and `u[i]` can be indexed");
+                    self.error(
+                        ix.expr.span(),
+                        "only `q[i]`, `qd[i]`, `qdd[i]` and `u[i]` can be indexed",
+                    );
                     return self.sys.arena.zero();
                 };
-                let v = p.path.get_ident().map(|i| i.to_string()).unwrap_or_default();
+                let v = p
+                    .path
+                    .get_ident()
+                    .map(|i| i.to_string())
+                    .unwrap_or_default();
                 let (allowed, mk): (bool, fn(u16) -> Var) = match v.as_str() {
                     "q" => (a.q, Var::Q),
                     "qd" => (a.qd, Var::Qd),
                     "qdd" => (a.qd, Var::Qdd),
                     "u" => (a.u, Var::Input),
                     "TOG" => {
-                        self.error(ix.span(), "TOG[…] is a transform, not a number: it can only start a TOG product");
+                        self.error(
+                            ix.span(),
+                            "TOG[…] is a transform, not a number: it can only start a TOG product",
+                        );
                         return self.sys.arena.zero();
                     }
                     _ => {
-                        self.error(ix.expr.span(), format!("`{v}[…]`: only `q[i]`, `qd[i]`, `qdd[i]` and `u[i]` can be indexed"));
+                        self.error(
+                            ix.expr.span(),
+                            format!(
+                                "`{v}[…]`: only `q[i]`, `qd[i]`, `qdd[i]` and `u[i]` can be indexed"
+                            ),
+                        );
                         return self.sys.arena.zero();
                     }
                 };
-                let Some(i) = self.index_of(&ix.index, &v) else { return self.sys.arena.zero() };
+                let Some(i) = self.index_of(&ix.index, &v) else {
+                    return self.sys.arena.zero();
+                };
                 if !allowed {
                     return self.not_allowed(ix.span(), &v, a);
                 }
@@ -932,8 +1294,17 @@ impl Checker {
                 // x.sin() reads as sin(x)
                 let mut args: Vec<Expr> = vec![(*m.receiver).clone()];
                 args.extend(m.args.iter().cloned());
-                let f = Expr::Path(syn::ExprPath { attrs: vec![], qself: None, path: m.method.clone().into() });
-                let call = syn::ExprCall { attrs: vec![], func: Box::new(f), paren_token: m.paren_token, args: args.into_iter().collect() };
+                let f = Expr::Path(syn::ExprPath {
+                    attrs: vec![],
+                    qself: None,
+                    path: m.method.clone().into(),
+                });
+                let call = syn::ExprCall {
+                    attrs: vec![],
+                    func: Box::new(f),
+                    paren_token: m.paren_token,
+                    args: args.into_iter().collect(),
+                };
                 self.lower_call(&call, a)
             }
             other => {
@@ -961,7 +1332,13 @@ impl Checker {
             Some(Scalar::Bound(e)) => e,
             Some(Scalar::Param(i)) => {
                 if !a.params {
-                    self.error(id.span(), format!("`{s}` is a parameter; {} must be a constant number", if a.what.is_empty() { "this" } else { a.what }));
+                    self.error(
+                        id.span(),
+                        format!(
+                            "`{s}` is a parameter; {} must be a constant number",
+                            if a.what.is_empty() { "this" } else { a.what }
+                        ),
+                    );
                     return self.sys.arena.zero();
                 }
                 self.sys.arena.var(Var::Param(i as u16))
@@ -994,11 +1371,31 @@ impl Checker {
             }
             None => {
                 if self.frame_names.contains_key(&s) {
-                    self.error(id.span(), format!("`{s}` is a body, not a number: write TOG[{s}] in a transform product"));
+                    self.error(
+                        id.span(),
+                        format!(
+                            "`{s}` is a body, not a number: write TOG[{s}] in a transform product"
+                        ),
+                    );
                     return self.sys.arena.zero();
                 }
-                let names: Vec<String> = self.scalars.keys().cloned().chain(["t", "PI"].map(String::from)).collect();
-                self.error(id.span(), format!("unknown name `{s}`{}", did_you_mean(&s, names.iter().map(String::as_str), "declare it with `param NAME = value;` or `let NAME = expr;`")));
+                let names: Vec<String> = self
+                    .scalars
+                    .keys()
+                    .cloned()
+                    .chain(["t", "PI"].map(String::from))
+                    .collect();
+                self.error(
+                    id.span(),
+                    format!(
+                        "unknown name `{s}`{}",
+                        did_you_mean(
+                            &s,
+                            names.iter().map(String::as_str),
+                            "declare it with `param NAME = value;` or `let NAME = expr;`"
+                        )
+                    ),
+                );
                 self.sys.arena.zero()
             }
         }
@@ -1029,14 +1426,24 @@ impl Checker {
             return self.sys.arena.zero();
         };
         let Some(id) = p.path.get_ident() else {
-            self.error(p.span(), "call user functions by name: declare `extern fn NAME = [path, …];`");
+            self.error(
+                p.span(),
+                "call user functions by name: declare `extern fn NAME = [path, …];`",
+            );
             return self.sys.arena.zero();
         };
         let name = id.to_string();
         let args: Vec<&Expr> = c.args.iter().collect();
         let arity = |ch: &mut Checker, n: usize| {
             if args.len() != n {
-                ch.error(c.span(), format!("`{name}` takes {n} argument{}, found {}", if n == 1 { "" } else { "s" }, args.len()));
+                ch.error(
+                    c.span(),
+                    format!(
+                        "`{name}` takes {n} argument{}, found {}",
+                        if n == 1 { "" } else { "s" },
+                        args.len()
+                    ),
+                );
                 false
             } else {
                 true
@@ -1056,7 +1463,11 @@ impl Checker {
                 }
                 let x = self.lower(args[0], a);
                 let y = self.lower(args[1], a);
-                return if name == "atan2" { self.sys.arena.atan2(x, y) } else { self.sys.arena.pow(x, y) };
+                return if name == "atan2" {
+                    self.sys.arena.atan2(x, y)
+                } else {
+                    self.sys.arena.pow(x, y)
+                };
             }
             "powi" => {
                 if !arity(self, 2) {
@@ -1064,9 +1475,15 @@ impl Checker {
                 }
                 let x = self.lower(args[0], a);
                 let n = match args[1] {
-                    Expr::Lit(syn::ExprLit { lit: syn::Lit::Int(l), .. }) => l.base10_parse::<i32>().ok(),
+                    Expr::Lit(syn::ExprLit {
+                        lit: syn::Lit::Int(l),
+                        ..
+                    }) => l.base10_parse::<i32>().ok(),
                     Expr::Unary(u) if matches!(u.op, syn::UnOp::Neg(_)) => match &*u.expr {
-                        Expr::Lit(syn::ExprLit { lit: syn::Lit::Int(l), .. }) => l.base10_parse::<i32>().ok().map(|v| -v),
+                        Expr::Lit(syn::ExprLit {
+                            lit: syn::Lit::Int(l),
+                            ..
+                        }) => l.base10_parse::<i32>().ok().map(|v| -v),
                         _ => None,
                     },
                     _ => None,
@@ -1089,14 +1506,24 @@ impl Checker {
                     return self.sys.arena.zero();
                 }
                 if self.depth > 64 {
-                    self.error(c.span(), format!("`{name}` calls itself too deeply: inline functions cannot recurse"));
+                    self.error(
+                        c.span(),
+                        format!(
+                            "`{name}` calls itself too deeply: inline functions cannot recurse"
+                        ),
+                    );
                     return self.sys.arena.zero();
                 }
                 let vals: Vec<ExprId> = args.iter().map(|e| self.lower(e, a)).collect();
                 let saved: Vec<(String, Option<Scalar>)> = params
                     .iter()
                     .zip(&vals)
-                    .map(|(p, &v)| (p.to_string(), self.scalars.insert(p.to_string(), Scalar::Bound(v))))
+                    .map(|(p, &v)| {
+                        (
+                            p.to_string(),
+                            self.scalars.insert(p.to_string(), Scalar::Bound(v)),
+                        )
+                    })
                     .collect();
                 self.depth += 1;
                 let r = self.lower(&body, a);
@@ -1120,7 +1547,17 @@ impl Checker {
                 let mut names: Vec<String> = self.fns.keys().cloned().collect();
                 names.extend(Func::ALL.iter().map(|f| f.name().to_string()));
                 names.extend(["atan2", "pow", "powi"].map(String::from));
-                self.error(id.span(), format!("unknown function `{name}`{}", did_you_mean(&name, names.iter().map(String::as_str), "declare it with `fn NAME(x) = …;` or `extern fn NAME = [path, …];`")));
+                self.error(
+                    id.span(),
+                    format!(
+                        "unknown function `{name}`{}",
+                        did_you_mean(
+                            &name,
+                            names.iter().map(String::as_str),
+                            "declare it with `fn NAME(x) = …;` or `extern fn NAME = [path, …];`"
+                        )
+                    ),
+                );
                 self.sys.arena.zero()
             }
         }
@@ -1130,7 +1567,13 @@ impl Checker {
         for (i, f) in self.sys.frames.iter().enumerate() {
             if !self.tog_defined[i] {
                 let kind = if f.inertia.is_some() { "body" } else { "frame" };
-                self.errors.push(err(self.frame_spans[i], format!("{kind} `{}` has no position: add `TOG[{}] = …;`", f.name, f.name)));
+                self.errors.push(err(
+                    self.frame_spans[i],
+                    format!(
+                        "{kind} `{}` has no position: add `TOG[{}] = …;`",
+                        f.name, f.name
+                    ),
+                ));
             }
         }
         if !self.errors.is_empty() {
@@ -1156,67 +1599,15 @@ impl Checker {
             }
         }
         for k in 0..n {
-            let moved = self.sys.frames.iter().enumerate().any(|(i, f)| f.inertia.is_some() && moves[i][k]);
+            let moved = self
+                .sys
+                .frames
+                .iter()
+                .enumerate()
+                .any(|(i, f)| f.inertia.is_some() && moves[i][k]);
             if !moved {
                 self.errors.push(err(self.dof_spans[k], format!("coordinate {} moves no body with mass, so the mass matrix would be singular: use it in the TOG of a body with mass (or of a frame that carries one), or remove it", self.sys.dofs[k].name)));
             }
         }
     }
-}
-
-/// Checks an inertia tensor (xx, yy, zz[, xy, xz, yz]): principal moments non-negative and
-/// satisfying the triangle inequality. Shared with the runtime check of parameters.
-pub fn mbs_inertia_check(v: &[f64]) -> Result<(), String> {
-    let get = |i: usize| v.get(i).copied().unwrap_or(0.0);
-    let t = [get(0), get(1), get(2), get(3), get(4), get(5)];
-    if t.iter().any(|x| !x.is_finite()) {
-        return Err("the components must be finite".into());
-    }
-    let p = principal_moments(t);
-    if p.iter().any(|&x| x < -1e-12 * p.iter().fold(0.0f64, |m, y| m.max(y.abs()))) {
-        return Err(format!("principal moments {p:?} must not be negative"));
-    }
-    let tol = 1e-12 * (p[0] + p[1] + p[2]).abs();
-    for i in 0..3 {
-        let (a, b, c) = (p[i], p[(i + 1) % 3], p[(i + 2) % 3]);
-        if a > b + c + tol {
-            return Err(format!(
-                "principal moments ({}, {}, {}) violate the triangle inequality ({a} > {b} + {c}): no rigid body has this inertia",
-                p[0], p[1], p[2]
-            ));
-        }
-    }
-    Ok(())
-}
-
-/// Eigenvalues of the symmetric tensor (xx, yy, zz, xy, xz, yz), by Jacobi rotations.
-pub fn principal_moments(t: [f64; 6]) -> [f64; 3] {
-    let mut a = [[t[0], t[3], t[4]], [t[3], t[1], t[5]], [t[4], t[5], t[2]]];
-    for _ in 0..50 {
-        let off = a[0][1].abs() + a[0][2].abs() + a[1][2].abs();
-        if off <= 1e-300 {
-            break;
-        }
-        for (p, q) in [(0, 1), (0, 2), (1, 2)] {
-            if a[p][q].abs() <= 1e-300 {
-                continue;
-            }
-            let theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
-            let tt = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
-            let tt = if theta == 0.0 { 1.0 } else { tt };
-            let c = 1.0 / (tt * tt + 1.0).sqrt();
-            let s = tt * c;
-            for k in 0..3 {
-                let (akp, akq) = (a[k][p], a[k][q]);
-                a[k][p] = c * akp - s * akq;
-                a[k][q] = s * akp + c * akq;
-            }
-            for k in 0..3 {
-                let (apk, aqk) = (a[p][k], a[q][k]);
-                a[p][k] = c * apk - s * aqk;
-                a[q][k] = s * apk + c * aqk;
-            }
-        }
-    }
-    [a[0][0], a[1][1], a[2][2]]
 }

@@ -5,3 +5,7 @@ pub mod ast;
 pub mod check;
 pub mod names;
 pub mod parse;
+
+/// The admissibility check of inertia tensors, shared with the runtime's `validate()`.
+#[path = "../../../mbs-runtime/src/inertia.rs"]
+pub mod inertia;

@@ -16,7 +16,11 @@ pub fn distance(a: &str, b: &str) -> usize {
 }
 
 /// "; did you mean `x`?" for the closest candidate, or "; " + `otherwise`.
-pub fn did_you_mean<'a>(name: &str, candidates: impl Iterator<Item = &'a str>, otherwise: &str) -> String {
+pub fn did_you_mean<'a>(
+    name: &str,
+    candidates: impl Iterator<Item = &'a str>,
+    otherwise: &str,
+) -> String {
     let best = candidates
         .filter(|c| *c != name)
         .map(|c| (distance(name, c), c))
@@ -35,7 +39,13 @@ mod tests {
     #[test]
     fn suggests_close_names_only() {
         assert_eq!(distance("uper_arm", "upper_arm"), 1);
-        assert_eq!(did_you_mean("uper_arm", ["upper_arm", "leg"].into_iter(), "x"), "; did you mean `upper_arm`?");
-        assert_eq!(did_you_mean("zzz", ["upper_arm"].into_iter(), "declare it"), "; declare it");
+        assert_eq!(
+            did_you_mean("uper_arm", ["upper_arm", "leg"].into_iter(), "x"),
+            "; did you mean `upper_arm`?"
+        );
+        assert_eq!(
+            did_you_mean("zzz", ["upper_arm"].into_iter(), "declare it"),
+            "; declare it"
+        );
     }
 }

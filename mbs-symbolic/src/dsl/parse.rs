@@ -4,7 +4,7 @@
 use super::ast::{BodyRef, DofName, EffectStmt, Item, ModelDef};
 use syn::parse::{Parse, ParseStream};
 use syn::punctuated::Punctuated;
-use syn::{Expr, Ident, Token, bracketed, braced, parenthesized};
+use syn::{Expr, Ident, Token, braced, bracketed, parenthesized};
 
 /// All models of one `multibody!` invocation.
 pub struct Models(pub Vec<ModelDef>);
@@ -16,7 +16,9 @@ impl Parse for Models {
             v.push(input.parse()?);
         }
         if v.is_empty() {
-            return Err(input.error("expected `model Name { … }`: a multibody! block declares at least one model"));
+            return Err(input.error(
+                "expected `model Name { … }`: a multibody! block declares at least one model",
+            ));
         }
         Ok(Models(v))
     }
@@ -33,11 +35,20 @@ impl Parse for ModelDef {
         for a in &attrs {
             match &a.meta {
                 syn::Meta::NameValue(nv) if a.path().is_ident("doc") => {
-                    if let Expr::Lit(syn::ExprLit { lit: syn::Lit::Str(s), .. }) = &nv.value {
+                    if let Expr::Lit(syn::ExprLit {
+                        lit: syn::Lit::Str(s),
+                        ..
+                    }) = &nv.value
+                    {
                         docs.push(s.value());
                     }
                 }
-                _ => return Err(syn::Error::new_spanned(a, "only `///` doc comments may precede a model")),
+                _ => {
+                    return Err(syn::Error::new_spanned(
+                        a,
+                        "only `///` doc comments may precede a model",
+                    ));
+                }
             }
         }
         let vis: syn::Visibility = input.parse()?;
@@ -45,7 +56,10 @@ impl Parse for ModelDef {
             .parse()
             .map_err(|e| syn::Error::new(e.span(), "expected `model Name { … }`"))?;
         if kw != "model" {
-            return Err(syn::Error::new(kw.span(), format!("expected `model`, found `{kw}`: write `model Name {{ … }}`")));
+            return Err(syn::Error::new(
+                kw.span(),
+                format!("expected `model`, found `{kw}`: write `model Name {{ … }}`"),
+            ));
         }
         let name: Ident = input.parse()?;
         let content;
@@ -54,7 +68,12 @@ impl Parse for ModelDef {
         while !content.is_empty() {
             items.push(parse_item(&content)?);
         }
-        Ok(ModelDef { docs, vis, name, items })
+        Ok(ModelDef {
+            docs,
+            vis,
+            name,
+            items,
+        })
     }
 }
 
@@ -63,7 +82,9 @@ fn body_ref(input: ParseStream) -> syn::Result<BodyRef> {
         let l: syn::LitInt = input.parse()?;
         return Ok(BodyRef::Index(l.base10_parse()?, l.span()));
     }
-    let i: Ident = input.parse().map_err(|e| syn::Error::new(e.span(), "expected a body name or number"))?;
+    let i: Ident = input
+        .parse()
+        .map_err(|e| syn::Error::new(e.span(), "expected a body name or number"))?;
     Ok(BodyRef::Name(i))
 }
 
@@ -94,7 +115,11 @@ fn parse_item(input: ParseStream) -> syn::Result<Item> {
         input.parse::<Token![=]>()?;
         let body: Expr = input.parse()?;
         semi(input, "`fn`")?;
-        return Ok(Item::Fn { name, args: args.into_iter().collect(), body });
+        return Ok(Item::Fn {
+            name,
+            args: args.into_iter().collect(),
+            body,
+        });
     }
     if input.peek(Token![extern]) {
         input.parse::<Token![extern]>()?;
@@ -103,9 +128,13 @@ fn parse_item(input: ParseStream) -> syn::Result<Item> {
         input.parse::<Token![=]>()?;
         let list;
         bracketed!(list in input);
-        let paths: Punctuated<syn::Path, Token![,]> = list.parse_terminated(syn::Path::parse, Token![,])?;
+        let paths: Punctuated<syn::Path, Token![,]> =
+            list.parse_terminated(syn::Path::parse, Token![,])?;
         semi(input, "`extern fn`")?;
-        return Ok(Item::ExternFn { name, paths: paths.into_iter().collect() });
+        return Ok(Item::ExternFn {
+            name,
+            paths: paths.into_iter().collect(),
+        });
     }
     let kw: Ident = input.fork().parse().map_err(|e| {
         syn::Error::new(e.span(), "expected a statement: param, let, dof, input, body, frame, point, TOG[…], fn, extern fn, effect, scene, option or an effect such as gravity(…)")
@@ -115,9 +144,12 @@ fn parse_item(input: ParseStream) -> syn::Result<Item> {
         "param" => {
             input.parse::<Ident>()?;
             let name: Ident = input.parse()?;
-            input
-                .parse::<Token![=]>()
-                .map_err(|e| syn::Error::new(e.span(), format!("a parameter needs a default value: `param {name} = 1.0;`")))?;
+            input.parse::<Token![=]>().map_err(|e| {
+                syn::Error::new(
+                    e.span(),
+                    format!("a parameter needs a default value: `param {name} = 1.0;`"),
+                )
+            })?;
             let value: Expr = input.parse()?;
             semi(input, "`param`")?;
             Ok(Item::Param { name, value })
@@ -143,14 +175,22 @@ fn parse_item(input: ParseStream) -> syn::Result<Item> {
                     input.parse::<Token![,]>()?;
                     let k: Ident = input.parse()?;
                     if k != "qd" {
-                        return Err(syn::Error::new(k.span(), "expected `qd = …` (the initial velocity) after the initial position"));
+                        return Err(syn::Error::new(
+                            k.span(),
+                            "expected `qd = …` (the initial velocity) after the initial position",
+                        ));
                     }
                     input.parse::<Token![=]>()?;
                     qd0 = Some(input.parse()?);
                 }
             }
             semi(input, "`dof`")?;
-            Ok(Item::Dof { name, q0, qd0, span })
+            Ok(Item::Dof {
+                name,
+                q0,
+                qd0,
+                span,
+            })
         }
         "input" => {
             input.parse::<Ident>()?;
@@ -173,7 +213,10 @@ fn parse_item(input: ParseStream) -> syn::Result<Item> {
                     props.push((key, value));
                 }
             } else {
-                semi(input, "`body` (or give its properties in `{ mass = …; inertia = …; }`)")?;
+                semi(
+                    input,
+                    "`body` (or give its properties in `{ mass = …; inertia = …; }`)",
+                )?;
             }
             Ok(Item::Body { name, props })
         }
@@ -188,16 +231,26 @@ fn parse_item(input: ParseStream) -> syn::Result<Item> {
             let name: Ident = input.parse()?;
             let on: Ident = input.parse()?;
             if on != "on" {
-                return Err(syn::Error::new(on.span(), "expected `on`: write `point name on body at (x, y, z);`"));
+                return Err(syn::Error::new(
+                    on.span(),
+                    "expected `on`: write `point name on body at (x, y, z);`",
+                ));
             }
             let body = body_ref(input)?;
             let at: Ident = input.parse()?;
             if at != "at" {
-                return Err(syn::Error::new(at.span(), "expected `at`: write `point name on body at (x, y, z);`"));
+                return Err(syn::Error::new(
+                    at.span(),
+                    "expected `at`: write `point name on body at (x, y, z);`",
+                ));
             }
             let pos: Expr = input.parse()?;
             semi(input, "`point`")?;
-            Ok(Item::Point { name, body, at: pos })
+            Ok(Item::Point {
+                name,
+                body,
+                at: pos,
+            })
         }
         "TOG" => {
             let span = input.parse::<Ident>()?.span();
@@ -207,7 +260,11 @@ fn parse_item(input: ParseStream) -> syn::Result<Item> {
             input.parse::<Token![=]>()?;
             let chain: Expr = input.parse()?;
             semi(input, "`TOG[…] = …`")?;
-            Ok(Item::Tog { target, chain, span })
+            Ok(Item::Tog {
+                target,
+                chain,
+                span,
+            })
         }
         "effect" => {
             input.parse::<Ident>()?;
@@ -226,9 +283,13 @@ fn parse_item(input: ParseStream) -> syn::Result<Item> {
             input.parse::<Token![=]>()?;
             let list;
             bracketed!(list in input);
-            let effects: Punctuated<Ident, Token![,]> = list.parse_terminated(Ident::parse, Token![,])?;
+            let effects: Punctuated<Ident, Token![,]> =
+                list.parse_terminated(Ident::parse, Token![,])?;
             semi(input, "`scene`")?;
-            Ok(Item::Scene { name, effects: effects.into_iter().collect() })
+            Ok(Item::Scene {
+                name,
+                effects: effects.into_iter().collect(),
+            })
         }
         "option" => {
             input.parse::<Ident>()?;
@@ -242,7 +303,9 @@ fn parse_item(input: ParseStream) -> syn::Result<Item> {
             semi(input, "`option`")?;
             Ok(Item::Option { key, value })
         }
-        _ if keyword(input, &k) && input.peek2(syn::token::Paren) => Ok(Item::Effect(parse_effect(input)?)),
+        _ if keyword(input, &k) && input.peek2(syn::token::Paren) => {
+            Ok(Item::Effect(parse_effect(input)?))
+        }
         _ => Err(syn::Error::new(
             kw.span(),
             format!(
@@ -266,7 +329,12 @@ fn parse_effect(input: ParseStream) -> syn::Result<EffectStmt> {
                 Expr::Path(p) if p.path.get_ident().is_some() => {
                     named.push((p.path.get_ident().unwrap().clone(), *asg.right));
                 }
-                other => return Err(syn::Error::new_spanned(other, "expected an argument name before `=`")),
+                other => {
+                    return Err(syn::Error::new_spanned(
+                        other,
+                        "expected an argument name before `=`",
+                    ));
+                }
             },
             e => {
                 if !named.is_empty() {
@@ -276,5 +344,9 @@ fn parse_effect(input: ParseStream) -> syn::Result<EffectStmt> {
             }
         }
     }
-    Ok(EffectStmt { kind, positional, named })
+    Ok(EffectStmt {
+        kind,
+        positional,
+        named,
+    })
 }

@@ -146,7 +146,9 @@ impl Arena {
     /// All nodes reachable from `roots`, in increasing id (topological) order. Children have
     /// smaller ids than parents, so one backward sweep marks everything.
     pub fn reachable(&self, roots: &[ExprId]) -> Vec<ExprId> {
-        let Some(top) = roots.iter().max() else { return Vec::new() };
+        let Some(top) = roots.iter().max() else {
+            return Vec::new();
+        };
         let mut need = vec![false; top.index() + 1];
         for r in roots {
             need[r.index()] = true;
@@ -159,7 +161,10 @@ impl Arena {
                 }
             }
         }
-        (0..need.len()).filter(|&i| need[i]).map(|i| ExprId(i as u32)).collect()
+        (0..need.len())
+            .filter(|&i| need[i])
+            .map(|i| ExprId(i as u32))
+            .collect()
     }
 
     /// The variables that the expressions depend on (exactly, by traversal), sorted.

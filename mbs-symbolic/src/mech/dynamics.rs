@@ -7,7 +7,7 @@ use super::spatial as s;
 use super::system::{Formulation, System};
 use super::tree::Tree;
 use super::virtual_power::virtual_power;
-use super::world::World;
+use super::world::{Cols, World};
 use crate::expr::{Arena, ExprId, OpCount, Var};
 use rustc_hash::FxHashMap;
 
@@ -75,7 +75,12 @@ impl SceneEquations {
         }
     }
 
-    pub fn build(sys: &mut System, tree: &Tree, world: &World, scene: Option<usize>) -> SceneEquations {
+    pub fn build(
+        sys: &mut System,
+        tree: &Tree,
+        world: &World,
+        scene: Option<usize>,
+    ) -> SceneEquations {
         let nd = sys.ndof();
         let effects = sys.scene_effects(scene);
         let loads = Loads::build(sys, tree, world, &effects);
@@ -96,10 +101,18 @@ impl SceneEquations {
             .collect();
         let cost = |a: &Arena, r: &[ExprId]| OpCount::of(a, r).flops();
         let formulation = sys.options.formulation.unwrap_or_else(|| {
-            if cost(a, &vp.roots()) < cost(a, &rec.roots()) { Formulation::VirtualPower } else { Formulation::Recursive }
+            if cost(a, &vp.roots()) < cost(a, &rec.roots()) {
+                Formulation::VirtualPower
+            } else {
+                Formulation::Recursive
+            }
         });
         let tau_formulation = sys.options.formulation.unwrap_or_else(|| {
-            if cost(a, &tau_vp) < cost(a, &tau_rec) { Formulation::VirtualPower } else { Formulation::Recursive }
+            if cost(a, &tau_vp) < cost(a, &tau_rec) {
+                Formulation::VirtualPower
+            } else {
+                Formulation::Recursive
+            }
         });
         let chosen_h = match formulation {
             Formulation::VirtualPower => vp.h.clone(),
@@ -115,10 +128,14 @@ impl SceneEquations {
             Formulation::Recursive => tau_rec.clone(),
         };
         let tangents = sys.options.tangents.then(|| {
-            let k: Vec<Vec<ExprId>> =
-                tau.iter().map(|&t| (0..nd).map(|j| a.diff(t, Var::Q(j as u16))).collect()).collect();
-            let c: Vec<Vec<ExprId>> =
-                tau.iter().map(|&t| (0..nd).map(|j| a.diff(t, Var::Qd(j as u16))).collect()).collect();
+            let k: Vec<Vec<ExprId>> = tau
+                .iter()
+                .map(|&t| (0..nd).map(|j| a.diff(t, Var::Q(j as u16))).collect())
+                .collect();
+            let c: Vec<Vec<ExprId>> = tau
+                .iter()
+                .map(|&t| (0..nd).map(|j| a.diff(t, Var::Qd(j as u16))).collect())
+                .collect();
             (k, c)
         });
         let (kinetic, potential) = energies(sys, tree, world, &loads);
@@ -151,7 +168,9 @@ fn energies(sys: &mut System, tree: &Tree, world: &World, loads: &Loads) -> (Exp
     let mut v = loads.spring_potential.unwrap_or(a.zero());
     for (n, node) in tree.nodes.iter().enumerate().skip(1) {
         for &f in &node.frames {
-            let Some(inr) = sys.frames[f].inertia else { continue };
+            let Some(inr) = sys.frames[f].inertia else {
+                continue;
+            };
             let k = bk[n];
             let vv = s::dot(a, k.v, k.v);
             let mvv = a.mul(inr.mass, vv);
@@ -171,11 +190,22 @@ fn energies(sys: &mut System, tree: &Tree, world: &World, loads: &Loads) -> (Exp
     (t, v)
 }
 
+/// Kinematics of a declared point, world axes.
+#[derive(Clone, Debug)]
+pub struct PointKin {
+    pub position: s::V3,
+    pub velocity: s::V3,
+    pub jacobian: Cols,
+    /// acceleration at qdd = 0
+    pub bias: s::V3,
+}
+
 /// The symbolic model: system, tree, world kinematics and the equations of every scene.
 pub struct SymbolicModel {
     pub sys: System,
     pub tree: Tree,
     pub world: World,
+    pub points: Vec<PointKin>,
     pub scenes: Vec<SceneEquations>,
 }
 
@@ -183,8 +213,46 @@ impl SymbolicModel {
     pub fn build(mut sys: System) -> SymbolicModel {
         let tree = Tree::build(&mut sys);
         let world = World::build(&mut sys.arena, &tree);
-        let scenes: Vec<Option<usize>> = if sys.scenes.is_empty() { vec![None] } else { (0..sys.scenes.len()).map(Some).collect() };
-        let scenes = scenes.into_iter().map(|s| SceneEquations::build(&mut sys, &tree, &world, s)).collect();
-        SymbolicModel { sys, tree, world, scenes }
+        let scenes: Vec<Option<usize>> = if sys.scenes.is_empty() {
+            vec![None]
+        } else {
+            (0..sys.scenes.len()).map(Some).collect()
+        };
+        let scenes = scenes
+            .into_iter()
+            .map(|s| SceneEquations::build(&mut sys, &tree, &world, s))
+            .collect();
+        let points = sys
+            .points
+            .clone()
+            .iter()
+            .map(|pt| {
+                let a = &mut sys.arena;
+                match pt.frame {
+                    Some(fr) => {
+                        let node = tree.frame_node[fr];
+                        PointKin {
+                            position: world.point_position(a, node, pt.pos),
+                            velocity: world.point_velocity(a, node, pt.pos),
+                            jacobian: world.point_jacobian(a, node, pt.pos),
+                            bias: world.point_bias(a, node, pt.pos),
+                        }
+                    }
+                    None => PointKin {
+                        position: pt.pos,
+                        velocity: s::zero3(a),
+                        jacobian: Vec::new(),
+                        bias: s::zero3(a),
+                    },
+                }
+            })
+            .collect();
+        SymbolicModel {
+            sys,
+            tree,
+            world,
+            points,
+            scenes,
+        }
     }
 }

@@ -30,7 +30,10 @@ struct Pt {
 }
 
 fn pt(tree: &Tree, at: &Attach) -> Pt {
-    Pt { node: at.frame.map(|f| tree.frame_node[f]), r: at.pos }
+    Pt {
+        node: at.frame.map(|f| tree.frame_node[f]),
+        r: at.pos,
+    }
 }
 
 fn position(a: &mut Arena, w: &World, p: &Pt) -> V3 {
@@ -51,7 +54,10 @@ impl Loads {
     /// The loads of `effects` (indices into `sys.effects`).
     pub fn build(sys: &mut System, tree: &Tree, w: &World, effects: &[usize]) -> Loads {
         let mut out = Loads::default();
-        let loads: Vec<Load> = effects.iter().flat_map(|&e| sys.effects[e].loads.clone()).collect();
+        let loads: Vec<Load> = effects
+            .iter()
+            .flat_map(|&e| sys.effects[e].loads.clone())
+            .collect();
         let a = &mut sys.arena;
         let mut potential = a.zero();
         let mut power = a.zero();
@@ -66,7 +72,12 @@ impl Loads {
                         None => g,
                     });
                 }
-                Load::Spring { a: pa, b: pb, k, l0 } => {
+                Load::Spring {
+                    a: pa,
+                    b: pb,
+                    k,
+                    l0,
+                } => {
                     any_spring = true;
                     let (p1, p2) = (pt(tree, &pa), pt(tree, &pb));
                     let x1 = position(a, w, &p1);
@@ -119,7 +130,12 @@ impl Loads {
                     power = a.add(power, pw);
                     out.push_force(&p, fw);
                 }
-                Load::Torque { on, torque, frame, reaction } => {
+                Load::Torque {
+                    on,
+                    torque,
+                    frame,
+                    reaction,
+                } => {
                     any_nc = true;
                     let tw = match frame {
                         Some(fr) => s::mul_mv(a, &w.nodes[tree.frame_node[fr]].r, torque),

@@ -37,21 +37,35 @@ pub fn rotations(a: &mut Arena, tree: &Tree) -> Vec<Option<M3>> {
 }
 
 /// Outward pass. `with_qdd`: accelerations include qdd (for τ) or not (for h).
-pub fn body_kinematics(a: &mut Arena, tree: &Tree, gravity: Option<V3>, with_qdd: bool) -> Vec<BodyKin> {
+pub fn body_kinematics(
+    a: &mut Arena,
+    tree: &Tree,
+    gravity: Option<V3>,
+    with_qdd: bool,
+) -> Vec<BodyKin> {
     let z = s::zero3(a);
     let a0 = match gravity {
         Some(g) => s::neg(a, g),
         None => z,
     };
     let rots = rotations(a, tree);
-    let mut out = vec![BodyKin { w: z, v: z, al: z, a: a0 }];
+    let mut out = vec![BodyKin {
+        w: z,
+        v: z,
+        al: z,
+        a: a0,
+    }];
     for n in 1..tree.nodes.len() {
         let p = out[tree.nodes[n].parent];
         let k = match tree.nodes[n].factor.unwrap() {
             Factor::Rot { axis, angle } => {
                 let r = rots[n].unwrap();
                 let th_d = a.dt(angle);
-                let th_dd = if with_qdd { a.dt(th_d) } else { a.dt_bias(th_d) };
+                let th_dd = if with_qdd {
+                    a.dt(th_d)
+                } else {
+                    a.dt_bias(th_d)
+                };
                 let wp = s::mul_mtv(a, &r, p.w);
                 let rel = s::scale(a, th_d, axis);
                 let w = s::add(a, wp, rel);
@@ -83,7 +97,12 @@ pub fn body_kinematics(a: &mut Arena, tree: &Tree, gravity: Option<V3>, with_qdd
                 acc = s::add(a, acc, t2);
                 acc = s::add(a, acc, t3);
                 acc = s::add(a, acc, ddd);
-                BodyKin { w: p.w, v, al: p.al, a: acc }
+                BodyKin {
+                    w: p.w,
+                    v,
+                    al: p.al,
+                    a: acc,
+                }
             }
         };
         out.push(k);
@@ -92,7 +111,13 @@ pub fn body_kinematics(a: &mut Arena, tree: &Tree, gravity: Option<V3>, with_qdd
 }
 
 /// τ(q, qd, qdd) by Newton–Euler (or −h when `with_qdd` is false).
-pub fn newton_euler(sys: &mut System, tree: &Tree, world: &World, loads: &Loads, with_qdd: bool) -> Vec<ExprId> {
+pub fn newton_euler(
+    sys: &mut System,
+    tree: &Tree,
+    world: &World,
+    loads: &Loads,
+    with_qdd: bool,
+) -> Vec<ExprId> {
     let nd = sys.ndof();
     let bk = body_kinematics(&mut sys.arena, tree, loads.gravity, with_qdd);
     let a = &mut sys.arena;
@@ -137,7 +162,11 @@ pub fn newton_euler(sys: &mut System, tree: &Tree, world: &World, loads: &Loads,
                     a.mul(d, nm)
                 }
                 Factor::Disp(dv) => {
-                    let dd = [a.diff(dv[0], Var::Q(k)), a.diff(dv[1], Var::Q(k)), a.diff(dv[2], Var::Q(k))];
+                    let dd = [
+                        a.diff(dv[0], Var::Q(k)),
+                        a.diff(dv[1], Var::Q(k)),
+                        a.diff(dv[2], Var::Q(k)),
+                    ];
                     s::dot(a, dd, f)
                 }
             };
@@ -182,7 +211,11 @@ impl SpInertia {
                 i[r][c] = a.add(x.i[r][c], y.i[r][c]);
             }
         }
-        SpInertia { m: a.add(x.m, y.m), h: s::add(a, x.h, y.h), i }
+        SpInertia {
+            m: a.add(x.m, y.m),
+            h: s::add(a, x.h, y.h),
+            i,
+        }
     }
 
     /// This inertia (child axes) expressed in the parent's axes/origin across `fac`, whose
@@ -201,7 +234,9 @@ impl SpInertia {
                 SpInertia { m: self.m, h, i }
             }
             None => {
-                let Factor::Disp(d) = *fac else { unreachable!() };
+                let Factor::Disp(d) = *fac else {
+                    unreachable!()
+                };
                 // I' = I + (2 d·h + m d·d) 1 − (d hᵀ + h dᵀ + m d dᵀ)
                 let md = s::scale(a, self.m, d);
                 let dh = s::dot(a, d, self.h);
@@ -224,7 +259,11 @@ impl SpInertia {
                         i[row][col] = e;
                     }
                 }
-                SpInertia { m: self.m, h: s::add(a, self.h, md), i }
+                SpInertia {
+                    m: self.m,
+                    h: s::add(a, self.h, md),
+                    i,
+                }
             }
         }
     }
@@ -238,7 +277,14 @@ fn motion(a: &mut Arena, fac: &Factor, k: u16) -> (V3, V3) {
             let d = a.diff(angle, Var::Q(k));
             (s::scale(a, d, axis), z)
         }
-        Factor::Disp(dv) => (z, [a.diff(dv[0], Var::Q(k)), a.diff(dv[1], Var::Q(k)), a.diff(dv[2], Var::Q(k))]),
+        Factor::Disp(dv) => (
+            z,
+            [
+                a.diff(dv[0], Var::Q(k)),
+                a.diff(dv[1], Var::Q(k)),
+                a.diff(dv[2], Var::Q(k)),
+            ],
+        ),
     }
 }
 
@@ -249,12 +295,20 @@ pub fn crba(sys: &mut System, tree: &Tree) -> Vec<Vec<ExprId>> {
     let rots = rotations(a, tree);
     let zero = a.zero();
     let z3 = s::zero3(a);
-    let empty = SpInertia { m: zero, h: z3, i: [z3; 3] };
+    let empty = SpInertia {
+        m: zero,
+        h: z3,
+        i: [z3; 3],
+    };
     let mut comp = vec![empty; tree.nodes.len()];
     for (n, node) in tree.nodes.iter().enumerate().skip(1) {
         for &f in &node.frames {
             if let Some(inr) = sys.frames[f].inertia {
-                let body = SpInertia { m: inr.mass, h: z3, i: s::sym(&inr.tensor) };
+                let body = SpInertia {
+                    m: inr.mass,
+                    h: z3,
+                    i: s::sym(&inr.tensor),
+                };
                 comp[n] = SpInertia::add(a, &comp[n], &body);
             }
         }
@@ -271,10 +325,14 @@ pub fn crba(sys: &mut System, tree: &Tree) -> Vec<Vec<ExprId>> {
     // unit motions of every factor, per coordinate
     let motions: Vec<Vec<(u16, V3, V3)>> = (0..tree.nodes.len())
         .map(|n| match tree.nodes[n].factor {
-            Some(fac) => tree.factor_dofs(a, n).into_iter().map(|k| {
-                let (w, v) = motion(a, &fac, k);
-                (k, w, v)
-            }).collect(),
+            Some(fac) => tree
+                .factor_dofs(a, n)
+                .into_iter()
+                .map(|k| {
+                    let (w, v) = motion(a, &fac, k);
+                    (k, w, v)
+                })
+                .collect(),
             None => Vec::new(),
         })
         .collect();

@@ -91,14 +91,28 @@ pub enum Load {
     /// uniform gravity (world components); conservative
     Gravity([ExprId; 3]),
     /// point-to-point spring with stiffness `k` and rest length `l0`; conservative
-    Spring { a: Attach, b: Attach, k: ExprId, l0: ExprId },
+    Spring {
+        a: Attach,
+        b: Attach,
+        k: ExprId,
+        l0: ExprId,
+    },
     /// point-to-point linear damper
     Damper { a: Attach, b: Attach, c: ExprId },
     /// a force at a point, components in `frame`'s axes (`None`: world)
-    Force { at: Attach, force: [ExprId; 3], frame: Option<usize> },
+    Force {
+        at: Attach,
+        force: [ExprId; 3],
+        frame: Option<usize>,
+    },
     /// a torque on `on`, components in `frame`'s axes (`None`: world), with the opposite
     /// torque on `reaction` when given (`Some(None)`: the ground)
-    Torque { on: Option<usize>, torque: [ExprId; 3], frame: Option<usize>, reaction: Option<Option<usize>> },
+    Torque {
+        on: Option<usize>,
+        torque: [ExprId; 3],
+        frame: Option<usize>,
+        reaction: Option<Option<usize>>,
+    },
     /// a generalised force on one coordinate
     GenForce { dof: usize, value: ExprId },
 }
@@ -168,7 +182,9 @@ impl System {
         match s {
             None => (0..self.effects.len()).collect(),
             Some(i) => {
-                let mut v: Vec<usize> = (0..self.effects.len()).filter(|&e| self.effects[e].name.is_none()).collect();
+                let mut v: Vec<usize> = (0..self.effects.len())
+                    .filter(|&e| self.effects[e].name.is_none())
+                    .collect();
                 v.extend(&self.scenes[i].effects);
                 v.sort_unstable();
                 v.dedup();

@@ -28,16 +28,30 @@ pub struct Tree {
 
 impl Tree {
     pub fn build(sys: &mut System) -> Tree {
-        let mut nodes = vec![TreeNode { parent: 0, factor: None, frames: Vec::new(), children: Vec::new() }];
+        let mut nodes = vec![TreeNode {
+            parent: 0,
+            factor: None,
+            frames: Vec::new(),
+            children: Vec::new(),
+        }];
         let mut frame_node = Vec::with_capacity(sys.frames.len());
         for (i, f) in sys.frames.iter().enumerate() {
             let mut cur = f.parent.map_or(0, |p| frame_node[p]);
             for fac in &f.factors {
-                let existing = nodes[cur].children.iter().copied().find(|&c| nodes[c].factor == Some(*fac));
+                let existing = nodes[cur]
+                    .children
+                    .iter()
+                    .copied()
+                    .find(|&c| nodes[c].factor == Some(*fac));
                 cur = match existing {
                     Some(c) => c,
                     None => {
-                        nodes.push(TreeNode { parent: cur, factor: Some(*fac), frames: Vec::new(), children: Vec::new() });
+                        nodes.push(TreeNode {
+                            parent: cur,
+                            factor: Some(*fac),
+                            frames: Vec::new(),
+                            children: Vec::new(),
+                        });
                         let n = nodes.len() - 1;
                         nodes[cur].children.push(n);
                         n
@@ -61,12 +75,28 @@ impl Tree {
                 continue;
             }
             let c = node.children[0];
-            let (Some(fx), Some(fc)) = (node.factor, self.nodes[c].factor) else { continue };
+            let (Some(fx), Some(fc)) = (node.factor, self.nodes[c].factor) else {
+                continue;
+            };
             let fused = match (fx, fc) {
-                (Factor::Disp(d1), Factor::Disp(d2)) => Some(Factor::Disp([a.add(d1[0], d2[0]), a.add(d1[1], d2[1]), a.add(d1[2], d2[2])])),
-                (Factor::Rot { axis: n1, angle: a1 }, Factor::Rot { axis: n2, angle: a2 }) if n1 == n2 => {
-                    Some(Factor::Rot { axis: n1, angle: a.add(a1, a2) })
-                }
+                (Factor::Disp(d1), Factor::Disp(d2)) => Some(Factor::Disp([
+                    a.add(d1[0], d2[0]),
+                    a.add(d1[1], d2[1]),
+                    a.add(d1[2], d2[2]),
+                ])),
+                (
+                    Factor::Rot {
+                        axis: n1,
+                        angle: a1,
+                    },
+                    Factor::Rot {
+                        axis: n2,
+                        angle: a2,
+                    },
+                ) if n1 == n2 => Some(Factor::Rot {
+                    axis: n1,
+                    angle: a.add(a1, a2),
+                }),
                 _ => None,
             };
             let Some(f) = fused else { continue };
@@ -105,7 +135,9 @@ impl Tree {
 
     /// Coordinates that the factor into `node` depends on.
     pub fn factor_dofs(&self, a: &Arena, node: usize) -> Vec<u16> {
-        let Some(f) = self.nodes[node].factor else { return Vec::new() };
+        let Some(f) = self.nodes[node].factor else {
+            return Vec::new();
+        };
         let roots: Vec<ExprId> = match f {
             Factor::Disp(d) => d.to_vec(),
             Factor::Rot { angle, .. } => vec![angle],

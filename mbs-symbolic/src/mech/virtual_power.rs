@@ -10,7 +10,12 @@ use super::world::World;
 use crate::expr::ExprId;
 
 /// Mass matrix (dense, row-major, symmetric) and h.
-pub fn virtual_power(sys: &mut System, tree: &Tree, world: &World, loads: &Loads) -> (Vec<Vec<ExprId>>, Vec<ExprId>) {
+pub fn virtual_power(
+    sys: &mut System,
+    tree: &Tree,
+    world: &World,
+    loads: &Loads,
+) -> (Vec<Vec<ExprId>>, Vec<ExprId>) {
     let nd = sys.ndof();
     let a = &mut sys.arena;
     let zero = a.zero();
@@ -18,11 +23,16 @@ pub fn virtual_power(sys: &mut System, tree: &Tree, world: &World, loads: &Loads
     let mut h = vec![zero; nd];
     for (n, node) in tree.nodes.iter().enumerate().skip(1) {
         for &f in &node.frames {
-            let Some(inr) = sys.frames[f].inertia else { continue };
+            let Some(inr) = sys.frames[f].inertia else {
+                continue;
+            };
             let k = &world.nodes[n];
             let phi = s::sym(&inr.tensor);
             // rotational columns in body axes, and Φ times them
-            let jwb: Vec<(u16, V3)> = k.jw.iter().map(|&(q, c)| (q, s::mul_mtv(a, &k.r, c))).collect();
+            let jwb: Vec<(u16, V3)> =
+                k.jw.iter()
+                    .map(|&(q, c)| (q, s::mul_mtv(a, &k.r, c)))
+                    .collect();
             let ijw: Vec<V3> = jwb.iter().map(|&(_, c)| s::mul_mv(a, &phi, c)).collect();
             for (x, &(i, vi)) in k.jv.iter().enumerate() {
                 for &(j, vj) in &k.jv[..=x] {

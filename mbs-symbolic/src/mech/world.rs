@@ -71,7 +71,16 @@ pub fn q_deps(a: &Arena, roots: &[ExprId]) -> Vec<u16> {
 impl World {
     pub fn build(a: &mut Arena, tree: &Tree) -> World {
         let z = s::zero3(a);
-        let ground = NodeKin { r: s::identity(a), p: z, jw: Vec::new(), jv: Vec::new(), w: z, v: z, alb: z, ab: z };
+        let ground = NodeKin {
+            r: s::identity(a),
+            p: z,
+            jw: Vec::new(),
+            jv: Vec::new(),
+            w: z,
+            v: z,
+            alb: z,
+            ab: z,
+        };
         let mut nodes = vec![ground];
         for n in 1..tree.nodes.len() {
             let par = nodes[tree.nodes[n].parent].clone();
@@ -97,17 +106,34 @@ impl World {
                     let t2 = s::cross(a, par.w, w_rel);
                     let alb = s::add(a, par.alb, t1);
                     let alb = s::add(a, alb, t2);
-                    NodeKin { r, p: par.p, jw, jv: par.jv.clone(), w, v: par.v, alb, ab: par.ab }
+                    NodeKin {
+                        r,
+                        p: par.p,
+                        jw,
+                        jv: par.jv.clone(),
+                        w,
+                        v: par.v,
+                        alb,
+                        ab: par.ab,
+                    }
                 }
                 Factor::Disp(d) => {
                     let dw = s::mul_mv(a, &par.r, d);
                     let p = s::add(a, par.p, dw);
                     // Jv = Jv_p + Jω_p × d_w + R_p ∂d/∂q
-                    let mut jv_extra: Cols = par.jw.iter().map(|&(k, c)| (k, s::cross(a, c, dw))).collect();
+                    let mut jv_extra: Cols = par
+                        .jw
+                        .iter()
+                        .map(|&(k, c)| (k, s::cross(a, c, dw)))
+                        .collect();
                     let own: Cols = q_deps(a, &d)
                         .into_iter()
                         .map(|k| {
-                            let dd = [a.diff(d[0], Var::Q(k)), a.diff(d[1], Var::Q(k)), a.diff(d[2], Var::Q(k))];
+                            let dd = [
+                                a.diff(d[0], Var::Q(k)),
+                                a.diff(d[1], Var::Q(k)),
+                                a.diff(d[2], Var::Q(k)),
+                            ];
                             (k, s::mul_mv(a, &par.r, dd))
                         })
                         .collect();
@@ -130,7 +156,16 @@ impl World {
                     ab = s::add(a, ab, t2);
                     ab = s::add(a, ab, t3);
                     ab = s::add(a, ab, dd0_w);
-                    NodeKin { r: par.r, p, jw: par.jw.clone(), jv, w: par.w, v, alb: par.alb, ab }
+                    NodeKin {
+                        r: par.r,
+                        p,
+                        jw: par.jw.clone(),
+                        jv,
+                        w: par.w,
+                        v,
+                        alb: par.alb,
+                        ab,
+                    }
                 }
             };
             nodes.push(k);

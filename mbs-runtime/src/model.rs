@@ -1,0 +1,245 @@
+//! The contract between generated models and the runtime.
+//!
+//! Matrices are slices in column-major order (`m[i + n*j]` is row i, column j), the layout of
+//! nalgebra's `DMatrix`. Lengths are fixed by the model (`NQ`, `NU`, …); passing slices of
+//! other lengths is a programming error and panics.
+
+use crate::error::{ModelError, ParamError};
+use serde::{Serialize, de::DeserializeOwned};
+use std::fmt;
+
+/// Operation counts of one generated function, as reported by `mbs expand`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct OpCount {
+    /// additions and subtractions
+    pub adds: usize,
+    /// multiplications
+    pub muls: usize,
+    /// divisions
+    pub divs: usize,
+    /// square roots, trigonometric and other elementary or user functions
+    pub funcs: usize,
+    /// `let` temporaries
+    pub lets: usize,
+}
+
+impl OpCount {
+    /// adds + muls + divs
+    pub fn flops(&self) -> usize {
+        self.adds + self.muls + self.divs
+    }
+}
+
+impl fmt::Display for OpCount {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{} flops ({} adds, {} muls, {} divs), {} funcs",
+            self.flops(),
+            self.adds,
+            self.muls,
+            self.divs,
+            self.funcs
+        )
+    }
+}
+
+/// What a generated model is: names, sizes, formulation and op counts. Built by generated code.
+#[derive(Debug)]
+pub struct ModelInfo {
+    /// type name of the generated model
+    pub name: &'static str,
+    /// scene name (empty for a model without scenes)
+    pub scene: &'static str,
+    /// coordinate names: `q[3]` or the DSL name
+    pub dofs: &'static [&'static str],
+    /// input names (`u[k]`)
+    pub inputs: &'static [&'static str],
+    /// bodies and massless frames, in declaration order
+    pub frames: &'static [&'static str],
+    /// whether each frame is a body (has mass)
+    pub is_body: &'static [bool],
+    /// declared points
+    pub points: &'static [&'static str],
+    /// parameter names, in declaration order
+    pub params: &'static [&'static str],
+    /// effects active in this model
+    pub effects: &'static [&'static str],
+    /// formulation of M and h: "recursive" or "virtual power"
+    pub formulation: &'static str,
+    /// whether `tangents` is generated
+    pub has_tangents: bool,
+    /// op counts per generated function
+    pub ops: &'static [(&'static str, OpCount)],
+}
+
+impl ModelInfo {
+    /// "q[3] (knee)" for a named coordinate, "q[3]" otherwise.
+    pub fn dof_label(&self, i: usize) -> String {
+        match self.dofs.get(i) {
+            Some(n) if n.starts_with("q[") => n.to_string(),
+            Some(n) => format!("q[{i}] ({n})"),
+            None => format!("q[{i}]"),
+        }
+    }
+}
+
+/// Kinetic and potential energy.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct Energy {
+    /// ½ Σ (m v_G² + ωᵀ Φ_G ω)
+    pub kinetic: f64,
+    /// gravity (from the world origin) and springs
+    pub potential: f64,
+}
+
+impl Energy {
+    pub fn total(&self) -> f64 {
+        self.kinetic + self.potential
+    }
+}
+
+/// Pose of a frame: `rotation[i][j]` (columns are the frame's axes in world axes) and the
+/// world position of its origin (G for a body).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct Pose {
+    pub rotation: [[f64; 3]; 3],
+    pub position: [f64; 3],
+}
+
+/// Kinematics of a body or frame, world axes.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct FrameKinematics {
+    pub pose: Pose,
+    /// velocity of the origin
+    pub velocity: [f64; 3],
+    pub angular_velocity: [f64; 3],
+    /// J_G = ∂v/∂qd, 3 × NQ column-major (`jv[3*k + i]`)
+    pub jv: Vec<f64>,
+    /// J_ω = ∂ω/∂qd, 3 × NQ column-major
+    pub jw: Vec<f64>,
+    /// acceleration of the origin at qdd = 0 (J̇_G·qd plus rheonomic terms)
+    pub bias_acceleration: [f64; 3],
+    /// angular acceleration at qdd = 0 (J̇_ω·qd plus rheonomic terms)
+    pub bias_angular_acceleration: [f64; 3],
+}
+
+/// Kinematics of a declared point, world axes.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct PointKinematics {
+    pub position: [f64; 3],
+    pub velocity: [f64; 3],
+    /// ∂v/∂qd, 3 × NQ column-major
+    pub jv: Vec<f64>,
+    /// acceleration at qdd = 0
+    pub bias_acceleration: [f64; 3],
+}
+
+/// Kinematics of every frame and point, filled by [`Model::kinematics`].
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Kinematics {
+    pub frames: Vec<FrameKinematics>,
+    pub points: Vec<PointKinematics>,
+}
+
+impl Kinematics {
+    /// Buffers sized for `M` (allocates once; reuse it).
+    pub fn new<M: Model>() -> Kinematics {
+        let f = FrameKinematics {
+            jv: vec![0.0; 3 * M::NQ],
+            jw: vec![0.0; 3 * M::NQ],
+            ..Default::default()
+        };
+        let p = PointKinematics {
+            jv: vec![0.0; 3 * M::NQ],
+            ..Default::default()
+        };
+        Kinematics {
+            frames: vec![f; M::NFRAMES],
+            points: vec![p; M::NPOINTS],
+        }
+    }
+}
+
+/// Parameters of a generated model: a plain struct with `Default` = the DSL's values.
+pub trait Parameters:
+    Clone + fmt::Debug + Default + PartialEq + Serialize + DeserializeOwned
+{
+    /// Names, in declaration order.
+    const NAMES: &'static [&'static str];
+    /// Values, in declaration order.
+    fn values(&self) -> Vec<f64>;
+    /// Sets one parameter by name.
+    fn set(&mut self, name: &str, value: f64) -> Result<(), ParamError>;
+    /// Checks values: finite, masses positive, inertias physical, stiffnesses ≥ 0.
+    fn validate(&self) -> Result<(), ParamError>;
+}
+
+/// A model generated by `multibody!`: `M(q,t) qdd = h(q,qd,t)` and its companions.
+pub trait Model {
+    type Params: Parameters;
+    /// number of coordinates
+    const NQ: usize;
+    /// number of inputs u
+    const NU: usize;
+    /// number of bodies and massless frames
+    const NFRAMES: usize;
+    /// number of declared points
+    const NPOINTS: usize;
+
+    /// Names, sizes, formulation and op counts.
+    fn info(&self) -> &'static ModelInfo;
+
+    fn params(&self) -> &Self::Params;
+
+    /// Replaces the parameters after validating them.
+    fn set_params(&mut self, params: Self::Params) -> Result<(), ParamError>;
+
+    /// Initial q (NQ) and qd (NQ) as declared in the DSL.
+    fn initial_state(&self, q: &mut [f64], qd: &mut [f64]);
+
+    /// Mass matrix M(q, t) (NQ × NQ).
+    fn mass_matrix(&self, t: f64, q: &[f64], m: &mut [f64]);
+
+    /// M (NQ × NQ) and h(q, qd, t, u) (NQ) together, sharing their common work.
+    fn dynamics(&self, t: f64, q: &[f64], qd: &[f64], u: &[f64], m: &mut [f64], h: &mut [f64]);
+
+    /// τ = M qdd − h (NQ): the generalised forces that produce qdd.
+    fn inverse_dynamics(
+        &self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        u: &[f64],
+        tau: &mut [f64],
+    );
+
+    /// Exact tangents K_t = ∂τ/∂q and C_t = ∂τ/∂qd (NQ × NQ each), when generated
+    /// (`option tangents;`).
+    #[allow(clippy::too_many_arguments)]
+    fn tangents(
+        &self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        u: &[f64],
+        k: &mut [f64],
+        c: &mut [f64],
+    ) -> Result<(), ModelError>;
+
+    /// h(q, 0, t, u): forces at rest, for statics (NQ).
+    fn static_forces(&self, t: f64, q: &[f64], u: &[f64], h: &mut [f64]);
+
+    fn energy(&self, t: f64, q: &[f64], qd: &[f64]) -> Energy;
+
+    /// Power of the non-conservative effects (dampers, forces, torques, generalised forces).
+    fn power(&self, t: f64, q: &[f64], qd: &[f64], u: &[f64]) -> f64;
+
+    /// Poses of every body and frame (NFRAMES).
+    fn frames(&self, t: f64, q: &[f64], out: &mut [Pose]);
+
+    /// Poses, velocities, Jacobians and bias accelerations of every frame and point.
+    fn kinematics(&self, t: f64, q: &[f64], qd: &[f64], out: &mut Kinematics);
+}

@@ -1,0 +1,135 @@
+//! One generated method: outputs scheduled, emitted, and split into chunk methods when there
+//! are more than [`MAX_LETS`](crate::expr::cse::MAX_LETS) temporaries.
+
+use crate::expr::cse::Schedule;
+use crate::expr::emit::{MissingDerivative, Naming, emit};
+use crate::expr::{Arena, ExprId, OpCount, Var};
+use crate::mech::system::ParamDef;
+use std::fmt::Write;
+
+/// How leaves are bound in generated code: coordinates from slices, parameters from a struct.
+pub struct RustNames<'a> {
+    pub params: &'a [ParamDef],
+    /// path of the parameter struct: `self.params` in models, `self` in the parameter struct
+    pub params_path: &'a str,
+}
+
+impl Naming for RustNames<'_> {
+    fn var(&self, v: Var) -> String {
+        match v {
+            Var::Q(i) => format!("q_{i}"),
+            Var::Qd(i) => format!("qd_{i}"),
+            Var::Qdd(i) => format!("qdd_{i}"),
+            Var::T => "t".into(),
+            Var::Param(i) => format!("p_{}", self.params[i as usize].name),
+            Var::Input(i) => format!("u_{i}"),
+        }
+    }
+
+    fn bind(&self, v: Var) -> String {
+        match v {
+            Var::Q(i) => format!("let q_{i} = q[{i}];"),
+            Var::Qd(i) => format!("let qd_{i} = qd[{i}];"),
+            Var::Qdd(i) => format!("let qdd_{i} = qdd[{i}];"),
+            Var::T => String::new(),
+            Var::Param(i) => {
+                let n = &self.params[i as usize].name;
+                format!("let p_{n} = {}.{n};", self.params_path)
+            }
+            Var::Input(i) => format!("let u_{i} = u[{i}];"),
+        }
+    }
+}
+
+/// A method to generate: `fn {name}(&self, {args})` computing `outputs`.
+pub struct FnSpec {
+    pub name: String,
+    /// parameter list, e.g. `t: f64, q: &[f64], m: &mut [f64]`
+    pub args: String,
+    /// the same names as a call's arguments, e.g. `t, q, m`
+    pub call: String,
+    /// statements before the computation (buffer resets)
+    pub prelude: Vec<String>,
+    pub outputs: Vec<(String, ExprId)>,
+}
+
+impl FnSpec {
+    pub fn new(name: &str, args: &str) -> FnSpec {
+        let call = args
+            .split(',')
+            .filter_map(|a| a.split(':').next())
+            .map(str::trim)
+            .filter(|a| !a.is_empty())
+            .collect::<Vec<_>>()
+            .join(", ");
+        FnSpec {
+            name: name.into(),
+            args: args.into(),
+            call,
+            prelude: Vec::new(),
+            outputs: Vec::new(),
+        }
+    }
+
+    /// Adds a dense matrix output given by rows, stored column-major (`target[i + rows*j]`);
+    /// zeros are written by one `fill`.
+    pub fn matrix(&mut self, a: &Arena, target: &str, rows: &[Vec<ExprId>]) {
+        let n = rows.len();
+        if rows.iter().flatten().any(|&e| a.is_num(e, 0.0)) {
+            self.prelude.push(format!("{target}.fill(0.0);"));
+        }
+        for (i, row) in rows.iter().enumerate() {
+            for (j, &e) in row.iter().enumerate() {
+                if !a.is_num(e, 0.0) {
+                    self.outputs.push((format!("{target}[{}]", i + n * j), e));
+                }
+            }
+        }
+    }
+
+    /// Adds a vector output `target[i]`.
+    pub fn vector(&mut self, target: &str, v: &[ExprId]) {
+        for (i, &e) in v.iter().enumerate() {
+            self.outputs.push((format!("{target}[{i}]"), e));
+        }
+    }
+}
+
+/// Emits the method(s) of `spec`; returns their text and op count.
+pub fn emit_fn(
+    arena: &Arena,
+    spec: &FnSpec,
+    names: &RustNames,
+) -> Result<(String, OpCount), Vec<MissingDerivative>> {
+    let roots: Vec<ExprId> = spec.outputs.iter().map(|o| o.1).collect();
+    let targets: Vec<String> = spec.outputs.iter().map(|o| o.0.clone()).collect();
+    let sch = Schedule::new(arena, &roots);
+    let em = emit(arena, &sch, &targets, names)?;
+    let mut s = String::new();
+    let prelude: String = spec.prelude.iter().map(|p| format!("{p}\n")).collect();
+    if em.chunks.len() == 1 {
+        let _ = writeln!(
+            s,
+            "#[inline]\nfn {}(&self, {}) {{\n{prelude}{}}}",
+            spec.name, spec.args, em.chunks[0]
+        );
+    } else {
+        let _ = write!(
+            s,
+            "#[inline]\nfn {}(&self, {}) {{\n{prelude}let mut w = [0.0f64; {}];\n",
+            spec.name, spec.args, em.workspace
+        );
+        for k in 0..em.chunks.len() {
+            let _ = writeln!(s, "self.{}_part{k}({}, &mut w);", spec.name, spec.call);
+        }
+        s.push_str("}\n");
+        for (k, c) in em.chunks.iter().enumerate() {
+            let _ = writeln!(
+                s,
+                "#[inline(never)]\nfn {}_part{k}(&self, {}, w: &mut [f64]) {{\n{c}}}",
+                spec.name, spec.args
+            );
+        }
+    }
+    Ok((s, em.count))
+}

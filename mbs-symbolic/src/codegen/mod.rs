@@ -1,0 +1,578 @@
+//! Emission of a [`SymbolicModel`] as Rust source: a parameter struct, one model type per scene
+//! implementing `mbs::Model`, docs listing bodies, coordinates, effects and op counts.
+//! The text is what the macro emits (parsed into tokens) and what `mbs expand` prints.
+
+pub mod function;
+
+use crate::expr::emit::MissingDerivative;
+use crate::expr::{ExprId, OpCount};
+use crate::mech::dynamics::SceneEquations;
+use crate::mech::system::{Formulation, Load, System};
+use crate::mech::{SymbolicModel, world};
+use function::{FnSpec, RustNames, emit_fn};
+use std::fmt::Write;
+use std::time::{Duration, Instant};
+
+/// Op counts of one generated function of one scene.
+#[derive(Clone, Debug)]
+pub struct FunctionReport {
+    /// scene type name
+    pub model: String,
+    pub function: String,
+    pub ops: OpCount,
+}
+
+/// The generated code of one model and what it cost.
+#[derive(Clone, Debug)]
+pub struct Generated {
+    /// Rust source of every item
+    pub code: String,
+    /// FNV-1a hash of the code before the hash constants were appended
+    pub hash: u64,
+    pub reports: Vec<FunctionReport>,
+    /// time spent building the symbolic model
+    pub build_time: Duration,
+    /// time spent scheduling and emitting
+    pub emit_time: Duration,
+}
+
+/// 64-bit FNV-1a.
+pub fn fnv1a(s: &str) -> u64 {
+    let mut h: u64 = 0xcbf29ce484222325;
+    for b in s.bytes() {
+        h ^= b as u64;
+        h = h.wrapping_mul(0x100000001b3);
+    }
+    h
+}
+
+fn runtime_ops(c: OpCount) -> String {
+    format!(
+        "::mbs::OpCount {{ adds: {}, muls: {}, divs: {}, funcs: {}, lets: {} }}",
+        c.adds + c.negs,
+        c.muls,
+        c.divs,
+        c.funcs,
+        c.lets
+    )
+}
+
+fn str_list(v: impl IntoIterator<Item = String>) -> String {
+    let items: Vec<String> = v.into_iter().map(|s| format!("{s:?}")).collect();
+    format!("&[{}]", items.join(", "))
+}
+
+/// Type name of scene `s` of model `name`.
+pub fn scene_type(sys: &System, s: Option<usize>) -> String {
+    match s {
+        None => sys.name.clone(),
+        Some(i) => format!("{}{}", sys.name, sys.scenes[i].name),
+    }
+}
+
+/// Generates the code of a checked system.
+pub fn generate(sys: System, vis: &str) -> Result<Generated, Vec<MissingDerivative>> {
+    let t0 = Instant::now();
+    let model = SymbolicModel::build(sys);
+    let build_time = t0.elapsed();
+    let t1 = Instant::now();
+    let mut code = String::new();
+    let mut reports = Vec::new();
+    let mut missing = Vec::new();
+    emit_params(&model, vis, &mut code, &mut missing);
+    for eq in &model.scenes {
+        emit_scene(&model, eq, vis, &mut code, &mut reports, &mut missing);
+    }
+    if !missing.is_empty() {
+        missing.dedup();
+        return Err(missing);
+    }
+    let hash = fnv1a(&code);
+    for eq in &model.scenes {
+        let ty = scene_type(&model.sys, eq.scene);
+        let _ = writeln!(
+            code,
+            "impl {ty} {{\n/// Hash of the code `multibody!` generated for this model (`mbs expand` prints the same).\npub const GENERATED_HASH: u64 = {hash};\n}}"
+        );
+    }
+    Ok(Generated {
+        code,
+        hash,
+        reports,
+        build_time,
+        emit_time: t1.elapsed(),
+    })
+}
+
+fn collect<T>(
+    r: Result<(String, OpCount), Vec<MissingDerivative>>,
+    missing: &mut Vec<MissingDerivative>,
+    f: impl FnOnce(String, OpCount) -> T,
+) -> Option<T> {
+    match r {
+        Ok((s, c)) => Some(f(s, c)),
+        Err(m) => {
+            missing.extend(m);
+            None
+        }
+    }
+}
+
+fn emit_params(
+    model: &SymbolicModel,
+    vis: &str,
+    code: &mut String,
+    missing: &mut Vec<MissingDerivative>,
+) {
+    let sys = &model.sys;
+    let a = &sys.arena;
+    let ty = format!("{}Params", sys.name);
+    let _ = writeln!(
+        code,
+        "/// Parameters of [`{}`]-generated models; `Default` gives the values written in the model.",
+        sys.name
+    );
+    let _ = writeln!(
+        code,
+        "#[derive(Clone, Debug, PartialEq, ::mbs::__private::serde::Serialize, ::mbs::__private::serde::Deserialize)]\n#[serde(crate = \"::mbs::__private::serde\", default, deny_unknown_fields)]\n{vis} struct {ty} {{"
+    );
+    for p in &sys.params {
+        let _ = writeln!(
+            code,
+            "/// default {}\npub {}: f64,",
+            crate::expr::emit::literal(p.default),
+            p.name
+        );
+    }
+    code.push_str("}\n");
+    let fields: Vec<String> = sys
+        .params
+        .iter()
+        .map(|p| format!("{}: {}", p.name, crate::expr::emit::literal(p.default)))
+        .collect();
+    let _ = writeln!(
+        code,
+        "impl ::core::default::Default for {ty} {{\nfn default() -> Self {{\nSelf {{ {} }}\n}}\n}}",
+        fields.join(", ")
+    );
+    // validation: masses, inertias, spring stiffnesses as functions of the parameters
+    let mut spec = FnSpec::new("__derived", "v: &mut [f64]");
+    let mut checks = Vec::new();
+    let mut k = 0;
+    for f in &sys.frames {
+        if let Some(inr) = f.inertia {
+            spec.outputs.push((format!("v[{k}]"), inr.mass));
+            checks.push(format!(
+                "if !(v[{k}] > 0.0) {{ return Err(::mbs::ParamError::NonPositiveMass {{ body: {:?}, value: v[{k}] }}); }}",
+                f.name
+            ));
+            k += 1;
+            let first = k;
+            for &e in &inr.tensor {
+                spec.outputs.push((format!("v[{k}]"), e));
+                k += 1;
+            }
+            let arr: Vec<String> = (first..first + 6).map(|i| format!("v[{i}]")).collect();
+            checks.push(format!(
+                "::mbs::check_inertia({:?}, [{}])?;",
+                f.name,
+                arr.join(", ")
+            ));
+        }
+    }
+    let mut spring = 0;
+    for e in &sys.effects {
+        for l in &e.loads {
+            if let Load::Spring { k: stiff, .. } = l {
+                spec.outputs.push((format!("v[{k}]"), *stiff));
+                checks.push(format!(
+                    "if v[{k}] < 0.0 {{ return Err(::mbs::ParamError::NegativeStiffness {{ index: {spring}, value: v[{k}] }}); }}"
+                ));
+                k += 1;
+                spring += 1;
+            }
+        }
+    }
+    let names = RustNames {
+        params: &sys.params,
+        params_path: "self",
+    };
+    let derived = collect(emit_fn(a, &spec, &names), missing, |s, _| s).unwrap_or_default();
+    let _ = writeln!(code, "impl {ty} {{\n{derived}}}");
+    let values: Vec<String> = sys
+        .params
+        .iter()
+        .map(|p| format!("self.{}", p.name))
+        .collect();
+    let sets: Vec<String> = sys
+        .params
+        .iter()
+        .map(|p| format!("{:?} => self.{} = value,", p.name, p.name))
+        .collect();
+    let _ = writeln!(
+        code,
+        "#[automatically_derived]
+impl ::mbs::Parameters for {ty} {{
+const NAMES: &'static [&'static str] = {names};
+fn values(&self) -> ::std::vec::Vec<f64> {{ ::std::vec![{values}] }}
+fn set(&mut self, name: &str, value: f64) -> ::core::result::Result<(), ::mbs::ParamError> {{
+match name {{
+{sets}
+_ => return Err(::mbs::ParamError::Unknown {{ name: name.to_string(), known: Self::NAMES.join(\", \") }}),
+}}
+Ok(())
+}}
+#[allow(clippy::neg_cmp_op_on_partial_ord)]
+fn validate(&self) -> ::core::result::Result<(), ::mbs::ParamError> {{
+for (name, value) in Self::NAMES.iter().zip(self.values()) {{
+if !value.is_finite() {{ return Err(::mbs::ParamError::NonFinite {{ name, value }}); }}
+}}
+let mut v = [0.0f64; {k}];
+self.__derived(&mut v);
+{checks}
+Ok(())
+}}
+}}",
+        names = str_list(sys.params.iter().map(|p| p.name.clone())),
+        values = values.join(", "),
+        sets = sets.join("\n"),
+        checks = checks.join("\n"),
+    );
+}
+
+fn dense3(a: &crate::expr::Arena, cols: &world::Cols, n: usize) -> Vec<Vec<ExprId>> {
+    // rows i = 0..3 of a 3 × n matrix
+    let d = world::dense(a, cols, n);
+    (0..3).map(|i| d.iter().map(|c| c[i]).collect()).collect()
+}
+
+fn emit_scene(
+    model: &SymbolicModel,
+    eq: &SceneEquations,
+    vis: &str,
+    code: &mut String,
+    reports: &mut Vec<FunctionReport>,
+    missing: &mut Vec<MissingDerivative>,
+) {
+    let sys = &model.sys;
+    let a = &sys.arena;
+    let n = sys.ndof();
+    let ty = scene_type(sys, eq.scene);
+    let names = RustNames {
+        params: &sys.params,
+        params_path: "self.params",
+    };
+    let mut methods = String::new();
+    let mut ops: Vec<(String, OpCount)> = Vec::new();
+    let mut add = |spec: FnSpec, label: &str, methods: &mut String| {
+        if let Some(c) = collect(emit_fn(a, &spec, &names), missing, |s, c| {
+            methods.push_str(&s);
+            c
+        }) {
+            ops.push((label.to_string(), c));
+            reports.push(FunctionReport {
+                model: ty.clone(),
+                function: label.to_string(),
+                ops: c,
+            });
+        }
+    };
+    let mb = eq.chosen();
+    let mut f = FnSpec::new(
+        "__dynamics",
+        "t: f64, q: &[f64], qd: &[f64], u: &[f64], m: &mut [f64], h: &mut [f64]",
+    );
+    f.matrix(a, "m", &mb.m);
+    f.vector("h", &mb.h);
+    add(f, "dynamics (M, h)", &mut methods);
+    let mut f = FnSpec::new("__mass_matrix", "t: f64, q: &[f64], m: &mut [f64]");
+    f.matrix(a, "m", &mb.m);
+    add(f, "mass_matrix", &mut methods);
+    let mut f = FnSpec::new(
+        "__inverse_dynamics",
+        "t: f64, q: &[f64], qd: &[f64], qdd: &[f64], u: &[f64], tau: &mut [f64]",
+    );
+    f.vector("tau", eq.tau());
+    add(f, "inverse_dynamics", &mut methods);
+    if let Some((kt, ct)) = &eq.tangents {
+        let mut f = FnSpec::new(
+            "__tangents",
+            "t: f64, q: &[f64], qd: &[f64], qdd: &[f64], u: &[f64], k: &mut [f64], c: &mut [f64]",
+        );
+        f.matrix(a, "k", kt);
+        f.matrix(a, "c", ct);
+        add(f, "tangents (K, C)", &mut methods);
+    }
+    let mut f = FnSpec::new(
+        "__static_forces",
+        "t: f64, q: &[f64], u: &[f64], h: &mut [f64]",
+    );
+    f.vector("h", &eq.static_h);
+    add(f, "static_forces", &mut methods);
+    let mut f = FnSpec::new("__energy", "t: f64, q: &[f64], qd: &[f64], e: &mut [f64]");
+    f.vector("e", &[eq.kinetic, eq.potential]);
+    add(f, "energy", &mut methods);
+    let mut f = FnSpec::new(
+        "__power",
+        "t: f64, q: &[f64], qd: &[f64], u: &[f64], e: &mut [f64]",
+    );
+    f.vector("e", &[eq.power]);
+    add(f, "power", &mut methods);
+    // poses and kinematics of frames and points
+    let mut f = FnSpec::new("__frames", "t: f64, q: &[f64], out: &mut [::mbs::Pose]");
+    let mut fk = FnSpec::new(
+        "__kinematics",
+        "t: f64, q: &[f64], qd: &[f64], out: &mut ::mbs::Kinematics",
+    );
+    for (i, &node) in model.tree.frame_node.iter().enumerate() {
+        let k = &model.world.nodes[node];
+        for r in 0..3 {
+            for c in 0..3 {
+                f.outputs
+                    .push((format!("out[{i}].rotation[{r}][{c}]"), k.r[r][c]));
+                fk.outputs.push((
+                    format!("out.frames[{i}].pose.rotation[{r}][{c}]"),
+                    k.r[r][c],
+                ));
+            }
+            f.outputs.push((format!("out[{i}].position[{r}]"), k.p[r]));
+            fk.outputs
+                .push((format!("out.frames[{i}].pose.position[{r}]"), k.p[r]));
+            fk.outputs
+                .push((format!("out.frames[{i}].velocity[{r}]"), k.v[r]));
+            fk.outputs
+                .push((format!("out.frames[{i}].angular_velocity[{r}]"), k.w[r]));
+            fk.outputs
+                .push((format!("out.frames[{i}].bias_acceleration[{r}]"), k.ab[r]));
+            fk.outputs.push((
+                format!("out.frames[{i}].bias_angular_acceleration[{r}]"),
+                k.alb[r],
+            ));
+        }
+        fk.matrix(a, &format!("out.frames[{i}].jv"), &dense3(a, &k.jv, n));
+        fk.matrix(a, &format!("out.frames[{i}].jw"), &dense3(a, &k.jw, n));
+    }
+    add(f, "frames", &mut methods);
+    for (i, pk) in model.points.iter().enumerate() {
+        for r in 0..3 {
+            fk.outputs
+                .push((format!("out.points[{i}].position[{r}]"), pk.position[r]));
+            fk.outputs
+                .push((format!("out.points[{i}].velocity[{r}]"), pk.velocity[r]));
+            fk.outputs.push((
+                format!("out.points[{i}].bias_acceleration[{r}]"),
+                pk.bias[r],
+            ));
+        }
+        fk.matrix(
+            a,
+            &format!("out.points[{i}].jv"),
+            &dense3(a, &pk.jacobian, n),
+        );
+    }
+    let kin = emit_fn(a, &fk, &names);
+    if let Some(c) = collect(kin, missing, |s, c| {
+        methods.push_str(&s);
+        c
+    }) {
+        ops.push(("kinematics".into(), c));
+        reports.push(FunctionReport {
+            model: ty.clone(),
+            function: "kinematics".into(),
+            ops: c,
+        });
+    }
+    let mut f = FnSpec::new("__initial_state", "q: &mut [f64], qd: &mut [f64]");
+    let q0: Vec<ExprId> = sys.dofs.iter().map(|d| d.q0).collect();
+    let qd0: Vec<ExprId> = sys.dofs.iter().map(|d| d.qd0).collect();
+    f.vector("q", &q0);
+    f.vector("qd", &qd0);
+    if let Some((s, _)) = collect(emit_fn(a, &f, &names), missing, |s, c| (s, c)) {
+        methods.push_str(&s);
+    }
+
+    // the type, its docs and the trait impl
+    let scene_name = eq
+        .scene
+        .map(|s| sys.scenes[s].name.clone())
+        .unwrap_or_default();
+    let effect_names: Vec<String> = eq
+        .effects
+        .iter()
+        .map(|&e| {
+            sys.effects[e]
+                .name
+                .clone()
+                .unwrap_or_else(|| "(always on)".into())
+        })
+        .collect();
+    let form = match eq.formulation {
+        Formulation::Recursive => "recursive",
+        Formulation::VirtualPower => "virtual power",
+    };
+    let mut doc = String::new();
+    for d in &sys.docs {
+        let _ = writeln!(doc, "///{d}");
+    }
+    if !sys.docs.is_empty() {
+        doc.push_str("///\n");
+    }
+    let _ = writeln!(
+        doc,
+        "/// Generated by `multibody!`{}.",
+        if scene_name.is_empty() {
+            String::new()
+        } else {
+            format!(", scene `{scene_name}`")
+        }
+    );
+    let _ = writeln!(
+        doc,
+        "///\n/// - coordinates: {}",
+        sys.dofs
+            .iter()
+            .map(|d| format!("`{}`", d.name))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    let bodies: Vec<String> = sys
+        .frames
+        .iter()
+        .map(|f| {
+            format!(
+                "`{}`{}",
+                f.name,
+                if f.inertia.is_some() { "" } else { " (frame)" }
+            )
+        })
+        .collect();
+    let _ = writeln!(doc, "/// - bodies: {}", bodies.join(", "));
+    if !sys.points.is_empty() {
+        let _ = writeln!(
+            doc,
+            "/// - points: {}",
+            sys.points
+                .iter()
+                .map(|p| format!("`{}`", p.name))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    let _ = writeln!(
+        doc,
+        "/// - effects: {}",
+        if effect_names.is_empty() {
+            "none".into()
+        } else {
+            effect_names.join(", ")
+        }
+    );
+    let _ = writeln!(
+        doc,
+        "/// - formulation of M and h: {form}\n///\n/// | function | flops | adds | muls | divs | funcs | lets |\n/// |---|---|---|---|---|---|---|"
+    );
+    for (name, c) in &ops {
+        let _ = writeln!(
+            doc,
+            "/// | {name} | {} | {} | {} | {} | {} | {} |",
+            c.flops(),
+            c.adds + c.negs,
+            c.muls,
+            c.divs,
+            c.funcs,
+            c.lets
+        );
+    }
+    let pty = format!("{}Params", sys.name);
+    let info = format!(
+        "static INFO: ::mbs::ModelInfo = ::mbs::ModelInfo {{ name: {name:?}, scene: {scene:?}, dofs: {dofs}, inputs: {inputs}, frames: {frames}, is_body: &[{is_body}], points: {points}, params: {params}, effects: {effects}, formulation: {form:?}, has_tangents: {tan}, ops: &[{ops}] }};",
+        name = ty,
+        scene = scene_name,
+        dofs = str_list(sys.dofs.iter().map(|d| d.name.clone())),
+        inputs = str_list(sys.inputs.iter().cloned()),
+        frames = str_list(sys.frames.iter().map(|f| f.name.clone())),
+        is_body = sys
+            .frames
+            .iter()
+            .map(|f| f.inertia.is_some().to_string())
+            .collect::<Vec<_>>()
+            .join(", "),
+        points = str_list(sys.points.iter().map(|p| p.name.clone())),
+        params = str_list(sys.params.iter().map(|p| p.name.clone())),
+        effects = str_list(effect_names.iter().cloned()),
+        tan = eq.tangents.is_some(),
+        ops = ops
+            .iter()
+            .map(|(n, c)| format!("({n:?}, {})", runtime_ops(*c)))
+            .collect::<Vec<_>>()
+            .join(", "),
+    );
+    let tangents_body = if eq.tangents.is_some() {
+        "self.__tangents(t, q, qd, qdd, u, k, c);\nOk(())".to_string()
+    } else {
+        format!(
+            "let _ = (t, q, qd, qdd, u, k, c);\nErr(::mbs::ModelError::TangentsNotGenerated {{ model: {ty:?} }})"
+        )
+    };
+    let _ = write!(
+        code,
+        "{doc}#[derive(Clone, Debug, Default, PartialEq)]
+{vis} struct {ty} {{
+params: {pty},
+}}
+impl {ty} {{
+/// The model with `params`, after checking them.
+pub fn new(params: {pty}) -> ::core::result::Result<Self, ::mbs::ParamError> {{
+::mbs::Parameters::validate(&params)?;
+Ok(Self {{ params }})
+}}
+}}
+#[automatically_derived]
+#[allow(unused_variables, clippy::all)]
+impl {ty} {{
+{methods}}}
+#[automatically_derived]
+#[allow(unused_variables, clippy::all)]
+impl ::mbs::Model for {ty} {{
+type Params = {pty};
+const NQ: usize = {n};
+const NU: usize = {nu};
+const NFRAMES: usize = {nf};
+const NPOINTS: usize = {np};
+fn info(&self) -> &'static ::mbs::ModelInfo {{
+{info}
+&INFO
+}}
+fn params(&self) -> &{pty} {{ &self.params }}
+fn set_params(&mut self, params: {pty}) -> ::core::result::Result<(), ::mbs::ParamError> {{
+::mbs::Parameters::validate(&params)?;
+self.params = params;
+Ok(())
+}}
+fn initial_state(&self, q: &mut [f64], qd: &mut [f64]) {{ self.__initial_state(q, qd) }}
+fn mass_matrix(&self, t: f64, q: &[f64], m: &mut [f64]) {{ self.__mass_matrix(t, q, m) }}
+fn dynamics(&self, t: f64, q: &[f64], qd: &[f64], u: &[f64], m: &mut [f64], h: &mut [f64]) {{ self.__dynamics(t, q, qd, u, m, h) }}
+fn inverse_dynamics(&self, t: f64, q: &[f64], qd: &[f64], qdd: &[f64], u: &[f64], tau: &mut [f64]) {{ self.__inverse_dynamics(t, q, qd, qdd, u, tau) }}
+fn tangents(&self, t: f64, q: &[f64], qd: &[f64], qdd: &[f64], u: &[f64], k: &mut [f64], c: &mut [f64]) -> ::core::result::Result<(), ::mbs::ModelError> {{
+{tangents_body}
+}}
+fn static_forces(&self, t: f64, q: &[f64], u: &[f64], h: &mut [f64]) {{ self.__static_forces(t, q, u, h) }}
+fn energy(&self, t: f64, q: &[f64], qd: &[f64]) -> ::mbs::Energy {{
+let mut e = [0.0f64; 2];
+self.__energy(t, q, qd, &mut e);
+::mbs::Energy {{ kinetic: e[0], potential: e[1] }}
+}}
+fn power(&self, t: f64, q: &[f64], qd: &[f64], u: &[f64]) -> f64 {{
+let mut e = [0.0f64; 1];
+self.__power(t, q, qd, u, &mut e);
+e[0]
+}}
+fn frames(&self, t: f64, q: &[f64], out: &mut [::mbs::Pose]) {{ self.__frames(t, q, out) }}
+fn kinematics(&self, t: f64, q: &[f64], qd: &[f64], out: &mut ::mbs::Kinematics) {{ self.__kinematics(t, q, qd, out) }}
+}}
+",
+        nu = sys.inputs.len(),
+        nf = sys.frames.len(),
+        np = sys.points.len(),
+    );
+}

@@ -49,11 +49,7 @@ pub fn fnv1a(s: &str) -> u64 {
 fn runtime_ops(c: OpCount) -> String {
     format!(
         "::mbs::OpCount {{ adds: {}, muls: {}, divs: {}, funcs: {}, lets: {} }}",
-        c.adds + c.negs,
-        c.muls,
-        c.divs,
-        c.funcs,
-        c.lets
+        c.adds, c.muls, c.divs, c.funcs, c.lets
     )
 }
 
@@ -476,7 +472,7 @@ fn emit_scene(
             doc,
             "/// | {name} | {} | {} | {} | {} | {} | {} |",
             c.flops(),
-            c.adds + c.negs,
+            c.adds,
             c.muls,
             c.divs,
             c.funcs,

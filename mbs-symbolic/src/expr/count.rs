@@ -8,13 +8,11 @@ use std::ops::AddAssign;
 /// Operations of a generated function.
 #[derive(Clone, Copy, Default, Debug, PartialEq, Eq, serde::Serialize)]
 pub struct OpCount {
-    /// additions and subtractions
+    /// additions, subtractions and negations
     pub adds: usize,
     /// multiplications (an integer power `x^n` counts n − 1)
     pub muls: usize,
     pub divs: usize,
-    /// negations (free in practice: folded into subtractions by the compiler)
-    pub negs: usize,
     /// sqrt, trigonometric and other elementary or user functions
     pub funcs: usize,
     /// `let` temporaries in the emitted code (filled in by the scheduler)
@@ -36,7 +34,7 @@ impl OpCount {
                 Node::Add(..) | Node::Sub(..) => c.adds += 1,
                 Node::Mul(..) => c.muls += 1,
                 Node::Div(..) => c.divs += 1,
-                Node::Neg(..) => c.negs += 1,
+                Node::Neg(..) => c.adds += 1,
                 Node::Powi(_, k) => c.muls += (k.unsigned_abs() as usize).saturating_sub(1),
                 Node::Pow(..) | Node::Func(..) | Node::Atan2(..) | Node::Call(..) => c.funcs += 1,
             }
@@ -50,7 +48,6 @@ impl AddAssign for OpCount {
         self.adds += o.adds;
         self.muls += o.muls;
         self.divs += o.divs;
-        self.negs += o.negs;
         self.funcs += o.funcs;
         self.lets += o.lets;
     }

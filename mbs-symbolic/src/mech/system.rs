@@ -1,7 +1,7 @@
 //! The checked description of a multibody system: what the DSL means, independent of syntax.
 //! The DSL checker produces it; tests and tools may also build it directly.
 
-use crate::expr::{Arena, ExprId};
+use crate::expr::{Arena, ExprId, Var};
 
 /// A multibody system: parameters, coordinates, frames given by products of elementary
 /// transforms, points, effects and scenes, with all expressions in one [`Arena`].
@@ -196,5 +196,122 @@ impl System {
     /// Default parameter values, in declaration order.
     pub fn param_defaults(&self) -> Vec<f64> {
         self.params.iter().map(|p| p.default).collect()
+    }
+}
+
+/// Building a system in code (the DSL's checker does the same from tokens).
+impl System {
+    /// Declares a parameter; returns its expression.
+    pub fn param(&mut self, name: &str, default: f64) -> ExprId {
+        self.params.push(ParamDef {
+            name: name.into(),
+            default,
+        });
+        self.arena.var(Var::Param((self.params.len() - 1) as u16))
+    }
+
+    /// Declares a coordinate with its initial position and velocity; returns its index.
+    pub fn dof(&mut self, name: &str, q0: f64, qd0: f64) -> usize {
+        let (q0, qd0) = (self.arena.num(q0), self.arena.num(qd0));
+        self.dofs.push(DofDef {
+            name: name.into(),
+            q0,
+            qd0,
+        });
+        self.dofs.len() - 1
+    }
+
+    /// `q[i]`
+    pub fn q(&mut self, i: usize) -> ExprId {
+        self.arena.var(Var::Q(i as u16))
+    }
+
+    /// `qd[i]`
+    pub fn qd(&mut self, i: usize) -> ExprId {
+        self.arena.var(Var::Qd(i as u16))
+    }
+
+    /// time `t`
+    pub fn t(&mut self) -> ExprId {
+        self.arena.var(Var::T)
+    }
+
+    /// A constant.
+    pub fn num(&mut self, v: f64) -> ExprId {
+        self.arena.num(v)
+    }
+
+    /// A constant vector.
+    pub fn vec3(&mut self, v: [f64; 3]) -> [ExprId; 3] {
+        v.map(|x| self.arena.num(x))
+    }
+
+    /// Rotation by `angle` about `axis` (normalised here).
+    pub fn rot(&mut self, axis: [f64; 3], angle: ExprId) -> Factor {
+        let n = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
+        let axis = self.vec3(axis.map(|x| x / n));
+        Factor::Rot { axis, angle }
+    }
+
+    /// Constant displacement.
+    pub fn disp(&mut self, d: [f64; 3]) -> Factor {
+        Factor::Disp(self.vec3(d))
+    }
+
+    /// Declares a body (with `inertia`) or a massless frame at `TOG[parent] * factors…`;
+    /// returns its index. The parent must have been declared before.
+    pub fn frame(
+        &mut self,
+        name: &str,
+        parent: Option<usize>,
+        factors: Vec<Factor>,
+        inertia: Option<Inertia>,
+    ) -> usize {
+        assert!(
+            parent.is_none_or(|p| p < self.frames.len()),
+            "parents come before children"
+        );
+        self.frames.push(FrameDef {
+            name: name.into(),
+            parent,
+            factors,
+            inertia,
+        });
+        self.frames.len() - 1
+    }
+
+    /// Mass and full inertia tensor (xx, yy, zz, xy, xz, yz) given as numbers.
+    pub fn inertia(&mut self, mass: f64, tensor: [f64; 6]) -> Inertia {
+        Inertia {
+            mass: self.arena.num(mass),
+            tensor: tensor.map(|x| self.arena.num(x)),
+        }
+    }
+
+    /// Declares a point on a frame (`None`: the ground); returns its index.
+    pub fn point(&mut self, name: &str, frame: Option<usize>, pos: [ExprId; 3]) -> usize {
+        self.points.push(PointDef {
+            name: name.into(),
+            frame,
+            pos,
+        });
+        self.points.len() - 1
+    }
+
+    /// Declares an effect (`None`: always on); returns its index.
+    pub fn effect(&mut self, name: Option<&str>, loads: Vec<Load>) -> usize {
+        self.effects.push(EffectDef {
+            name: name.map(String::from),
+            loads,
+        });
+        self.effects.len() - 1
+    }
+
+    /// Declares a scene made of effects.
+    pub fn scene(&mut self, name: &str, effects: Vec<usize>) {
+        self.scenes.push(SceneDef {
+            name: name.into(),
+            effects,
+        });
     }
 }

@@ -27,15 +27,37 @@ mbs::multibody! {
 fn main() {
     let model = DoublePendulumFull::default();
     let info = model.info();
-    println!("{} — {} coordinates, {} bodies, effects: {}", info.name, DoublePendulumFull::NQ, info.frames.len(), info.effects.join(", "));
-    println!("formulation of M and h chosen by op count: {}\n", info.formulation);
+    println!(
+        "{} — {} coordinates, {} bodies, effects: {}",
+        info.name,
+        DoublePendulumFull::NQ,
+        info.is_body.iter().filter(|&&b| b).count(),
+        info.effects.join(", ")
+    );
+    println!(
+        "formulation of M and h chosen by op count: {}\n",
+        info.formulation
+    );
 
     println!("operations of each generated function, per scene:");
-    println!("  {:<18} {:>8} {:>8} {:>8}", "function", "Free", "Swing", "Full");
-    let scenes = [DoublePendulumFree::default().info(), DoublePendulumSwing::default().info(), info];
+    println!(
+        "  {:<18} {:>8} {:>8} {:>8}",
+        "function", "Free", "Swing", "Full"
+    );
+    let scenes = [
+        DoublePendulumFree::default().info(),
+        DoublePendulumSwing::default().info(),
+        info,
+    ];
     for (k, (name, _)) in info.ops.iter().enumerate() {
-        let counts: Vec<String> = scenes.iter().map(|s| s.ops.get(k).map_or("-".into(), |o| o.1.flops().to_string())).collect();
-        println!("  {:<18} {:>8} {:>8} {:>8}", name, counts[0], counts[1], counts[2]);
+        let counts: Vec<String> = scenes
+            .iter()
+            .map(|s| s.ops.get(k).map_or("-".into(), |o| o.1.flops().to_string()))
+            .collect();
+        println!(
+            "  {:<18} {:>8} {:>8} {:>8}",
+            name, counts[0], counts[1], counts[2]
+        );
     }
 
     // the MODELS.md test state
@@ -44,27 +66,49 @@ fn main() {
     let (mut m, mut h) = ([0.0; 4], [0.0; 2]);
     model.dynamics(0.0, &q, &qd, &[], &mut m, &mut h);
     println!("\nat q = {q:.4?}, qd = {qd:.4?}:");
-    println!("  M = [{:9.6} {:9.6}; {:9.6} {:9.6}]", m[0], m[2], m[1], m[3]);
+    println!(
+        "  M = [{:9.6} {:9.6}; {:9.6} {:9.6}]",
+        m[0], m[2], m[1], m[3]
+    );
     println!("  h = [{:9.6} {:9.6}]", h[0], h[1]);
 
     // forward dynamics of the 2 × 2 system, then back through inverse dynamics
     let det = m[0] * m[3] - m[1] * m[2];
-    let qdd = [(m[3] * h[0] - m[2] * h[1]) / det, (m[0] * h[1] - m[1] * h[0]) / det];
+    let qdd = [
+        (m[3] * h[0] - m[2] * h[1]) / det,
+        (m[0] * h[1] - m[1] * h[0]) / det,
+    ];
     let mut tau = [0.0; 2];
     model.inverse_dynamics(0.0, &q, &qd, &qdd, &[], &mut tau);
-    println!("  qdd = M⁻¹h = [{:9.6} {:9.6}], and τ(qdd) = [{:.1e} {:.1e}] (zero: no actuation)", qdd[0], qdd[1], tau[0], tau[1]);
+    println!(
+        "  qdd = M⁻¹h = [{:9.6} {:9.6}], and τ(qdd) = [{:.1e} {:.1e}] (zero: no actuation)",
+        qdd[0], qdd[1], tau[0], tau[1]
+    );
 
     let e = model.energy(0.0, &q, &qd);
-    println!("  energy: kinetic {:.6} J, potential {:.6} J; damper power {:.6} W", e.kinetic, e.potential, model.power(0.0, &q, &qd, &[]));
+    println!(
+        "  energy: kinetic {:.6} J, potential {:.6} J; damper power {:.6} W",
+        e.kinetic,
+        e.potential,
+        model.power(0.0, &q, &qd, &[])
+    );
 
     let mut kin = Kinematics::new::<DoublePendulumFull>();
     model.kinematics(0.0, &q, &qd, &mut kin);
     let tip = &kin.points[0];
-    println!("  tip at {:.4?} m, moving at {:.4?} m/s", tip.position, tip.velocity);
+    println!(
+        "  tip at {:.4?} m, moving at {:.4?} m/s",
+        tip.position, tip.velocity
+    );
 
     let (mut k, mut c) = ([0.0; 4], [0.0; 4]);
-    model.tangents(0.0, &q, &qd, &qdd, &[], &mut k, &mut c).expect("generated with `option tangents`");
-    println!("  exact tangents: K_t = [{:.4} {:.4}; {:.4} {:.4}], C_t = [{:.4} {:.4}; {:.4} {:.4}]", k[0], k[2], k[1], k[3], c[0], c[2], c[1], c[3]);
+    model
+        .tangents(0.0, &q, &qd, &qdd, &[], &mut k, &mut c)
+        .expect("generated with `option tangents`");
+    println!(
+        "  exact tangents: K_t = [{:.4} {:.4}; {:.4} {:.4}], C_t = [{:.4} {:.4}; {:.4} {:.4}]",
+        k[0], k[2], k[1], k[3], c[0], c[2], c[1], c[3]
+    );
 
     // parameters change at run time, and are checked
     let mut p = model.params().clone();

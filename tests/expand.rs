@@ -48,7 +48,11 @@ struct Finder(Vec<proc_macro2::TokenStream>);
 
 impl<'a> Visit<'a> for Finder {
     fn visit_macro(&mut self, m: &'a syn::Macro) {
-        if m.path.segments.last().is_some_and(|s| s.ident == "multibody") {
+        if m.path
+            .segments
+            .last()
+            .is_some_and(|s| s.ident == "multibody")
+        {
             self.0.push(m.tokens.clone());
         }
     }
@@ -61,22 +65,39 @@ fn expansion_is_byte_identical_to_the_macro() {
     finder.visit_file(&syn::parse_file(&src).unwrap());
     assert_eq!(finder.0.len(), 1);
     let mut expansions = mbs_symbolic::expand::expand_models(finder.0.remove(0)).unwrap();
-    let mbs_symbolic::expand::Expansion::Ok { generated, .. } = expansions.remove(0) else { panic!("the model has errors") };
+    let mbs_symbolic::expand::Expansion::Ok { generated, .. } = expansions.remove(0) else {
+        panic!("the model has errors")
+    };
     assert_eq!(generated.hash, LegPassive::GENERATED_HASH);
     assert_eq!(generated.hash, LegDriven::GENERATED_HASH);
 
     // the command-line tool prints the same code, pretty-printed, then the op counts
-    let out = Command::new(env!("CARGO_BIN_EXE_mbs")).args(["expand", &this_file()]).output().unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = Command::new(env!("CARGO_BIN_EXE_mbs"))
+        .args(["expand", &this_file()])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let stdout = String::from_utf8(out.stdout).unwrap();
     let pretty = prettyplease::unparse(&syn::parse_str(&generated.code).unwrap());
     assert!(stdout.starts_with(&pretty));
     assert!(stdout.contains(&format!("GENERATED_HASH: u64 = {}", generated.hash)));
-    for f in ["dynamics (M, h)", "tangents (K, C)", "kinematics", "generation"] {
+    for f in [
+        "dynamics (M, h)",
+        "tangents (K, C)",
+        "kinematics",
+        "generation",
+    ] {
         assert!(stdout.contains(f), "missing `{f}` in the report");
     }
     // --scene keeps the parameter struct and that scene's type only
-    let out = Command::new(env!("CARGO_BIN_EXE_mbs")).args(["expand", &this_file(), "--scene", "Driven"]).output().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_mbs"))
+        .args(["expand", &this_file(), "--scene", "Driven"])
+        .output()
+        .unwrap();
     let stdout = String::from_utf8(out.stdout).unwrap();
     assert!(stdout.contains("pub struct LegDriven") && stdout.contains("pub struct LegParams"));
     assert!(!stdout.contains("pub struct LegPassive"));
@@ -99,7 +120,9 @@ fn user_functions_and_inputs_reach_the_generated_code() {
     assert!((tau[0] + h1[0]).abs() < 1e-12 && (tau[1] + h1[1]).abs() < 1e-12);
     let mut k = [0.0; 4];
     let mut c = [0.0; 4];
-    model.tangents(0.0, &q, &qd, &qdd, &[2.0], &mut k, &mut c).unwrap();
+    model
+        .tangents(0.0, &q, &qd, &qdd, &[2.0], &mut k, &mut c)
+        .unwrap();
     assert!(k.iter().all(|x| x.is_finite()) && c.iter().any(|&x| x != 0.0));
     assert_eq!(model.info().dof_label(1), "q[1] (knee_angle)");
     let mut q0 = [0.0; 2];

@@ -1,8 +1,8 @@
 //! Work guards on generated code: operation counts are deterministic, so they are asserted.
 
+use mbs_symbolic::SymbolicModel;
 use mbs_symbolic::expr::OpCount;
 use mbs_symbolic::mech::system::{Load, System};
-use mbs_symbolic::SymbolicModel;
 
 /// chainN of MODELS.md: N uniform bars (l = 0.5 m, 1 kg), relative angles, gravity.
 fn chain(n: usize) -> SymbolicModel {
@@ -18,7 +18,10 @@ fn chain(n: usize) -> SymbolicModel {
     let mll = a.mul(m, ll);
     let i = a.scale(1.0 / 12.0, mll);
     let z = a.zero();
-    let inertia = mbs_symbolic::mech::system::Inertia { mass: m, tensor: [i, z, i, z, z, z] };
+    let inertia = mbs_symbolic::mech::system::Inertia {
+        mass: m,
+        tensor: [i, z, i, z, z, z],
+    };
     let mut parent = None;
     for k in 0..n {
         sys.dof(&format!("q[{k}]"), 0.3, 0.0);
@@ -40,8 +43,16 @@ fn mass_and_bias(model: &SymbolicModel) -> (usize, usize, usize) {
     let e = &model.scenes[0];
     let mb = e.chosen();
     let a = &model.sys.arena;
-    let lower: Vec<_> = mb.m.iter().enumerate().flat_map(|(r, row)| row[..=r].to_vec()).collect();
-    (OpCount::of(a, &lower).flops(), OpCount::of(a, &mb.h).flops(), OpCount::of(a, &mb.roots()).flops())
+    let lower: Vec<_> =
+        mb.m.iter()
+            .enumerate()
+            .flat_map(|(r, row)| row[..=r].to_vec())
+            .collect();
+    (
+        OpCount::of(a, &lower).flops(),
+        OpCount::of(a, &mb.h).flops(),
+        OpCount::of(a, &mb.roots()).flops(),
+    )
 }
 
 #[test]
@@ -49,7 +60,10 @@ fn chain_op_counts_grow_at_most_quadratically() {
     let (_, _, small) = mass_and_bias(&chain(12));
     let (m48, h48, big) = mass_and_bias(&chain(48));
     let ratio = big as f64 / small as f64;
-    assert!(ratio <= 20.0, "M+h of chain48 is {ratio:.1} × chain12's ({big} vs {small} flops)");
+    assert!(
+        ratio <= 20.0,
+        "M+h of chain48 is {ratio:.1} × chain12's ({big} vs {small} flops)"
+    );
     // the budgets: h ≤ 100 flops per dof, M ≤ 25 n² flops
     assert!(h48 <= 100 * 48, "h of chain48: {h48} flops");
     assert!(m48 <= 25 * 48 * 48, "M of chain48: {m48} flops");

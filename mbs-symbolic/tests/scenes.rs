@@ -37,7 +37,10 @@ fn ops(a: &Arena, r: &[ExprId]) -> usize {
 
 /// Nodes (operations, not leaves) reachable from `r`.
 fn op_nodes(a: &Arena, r: &[ExprId]) -> HashSet<ExprId> {
-    a.reachable(r).into_iter().filter(|&n| !matches!(a.node(n), Node::Num(_) | Node::Var(_))).collect()
+    a.reachable(r)
+        .into_iter()
+        .filter(|&n| !matches!(a.node(n), Node::Num(_) | Node::Var(_)))
+        .collect()
 }
 
 #[test]
@@ -59,20 +62,32 @@ fn absent_effects_have_no_operations() {
     // lies below an operation on g); likewise for Full beyond Swing and the damping coefficient
     let (nf, ns, nu) = (op_nodes(a, &free), op_nodes(a, &swing), op_nodes(a, &full));
     let serving = |nodes: &HashSet<ExprId>, v: Var| -> HashSet<ExprId> {
-        let dependent: Vec<ExprId> = nodes.iter().copied().filter(|&n| a.vars_of(&[n]).contains(&v)).collect();
+        let dependent: Vec<ExprId> = nodes
+            .iter()
+            .copied()
+            .filter(|&n| a.vars_of(&[n]).contains(&v))
+            .collect();
         a.reachable(&dependent).into_iter().collect()
     };
     let for_g = serving(&ns, g);
     let extra_swing: Vec<_> = ns.difference(&nf).copied().collect();
     assert!(!extra_swing.is_empty());
     for n in &extra_swing {
-        assert!(for_g.contains(n), "Swing has an operation beyond Free that serves no gravity term: {}", a.to_sexpr(*n));
+        assert!(
+            for_g.contains(n),
+            "Swing has an operation beyond Free that serves no gravity term: {}",
+            a.to_sexpr(*n)
+        );
     }
     let for_c = serving(&nu, c);
     let extra_full: Vec<_> = nu.difference(&ns).copied().collect();
     assert!(!extra_full.is_empty());
     for n in &extra_full {
-        assert!(for_c.contains(n), "Full has an operation beyond Swing that serves no damping term: {}", a.to_sexpr(*n));
+        assert!(
+            for_c.contains(n),
+            "Full has an operation beyond Swing that serves no damping term: {}",
+            a.to_sexpr(*n)
+        );
     }
 }
 
@@ -83,14 +98,28 @@ fn emitted_scene_code_mentions_only_its_effects() {
     let code = &generated.code;
     let section = |ty: &str| {
         let start = code.find(&format!("impl {ty} {{\n#[inline]")).unwrap();
-        let end = code[start..].find(&format!("impl ::mbs::Model for {ty}")).unwrap();
+        let end = code[start..]
+            .find(&format!("impl ::mbs::Model for {ty}"))
+            .unwrap();
         &code[start..start + end]
     };
-    let (free, swing, full) = (section("DoublePendulumFree"), section("DoublePendulumSwing"), section("DoublePendulumFull"));
+    let (free, swing, full) = (
+        section("DoublePendulumFree"),
+        section("DoublePendulumSwing"),
+        section("DoublePendulumFull"),
+    );
     assert!(!free.contains("p_g") && !free.contains("p_c"));
     assert!(swing.contains("p_g") && !swing.contains("p_c"));
     assert!(full.contains("p_g") && full.contains("p_c"));
-    let dynamics = |ty: &str| generated.reports.iter().find(|r| r.model == ty && r.function.starts_with("dynamics")).unwrap().ops.flops();
+    let dynamics = |ty: &str| {
+        generated
+            .reports
+            .iter()
+            .find(|r| r.model == ty && r.function.starts_with("dynamics"))
+            .unwrap()
+            .ops
+            .flops()
+    };
     assert!(dynamics("DoublePendulumFree") < dynamics("DoublePendulumSwing"));
     assert!(dynamics("DoublePendulumSwing") < dynamics("DoublePendulumFull"));
 }

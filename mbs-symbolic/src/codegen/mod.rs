@@ -36,11 +36,15 @@ pub struct Generated {
     pub emit_time: Duration,
 }
 
-/// 64-bit FNV-1a.
+/// FNV-1a over 8-byte words (little-endian, the tail zero-padded): the same in the macro and
+/// in `mbs expand`, and fast without optimisation.
 pub fn fnv1a(s: &str) -> u64 {
     let mut h: u64 = 0xcbf29ce484222325;
-    for b in s.bytes() {
-        h ^= b as u64;
+    let chunks = s.as_bytes().chunks(8);
+    for c in chunks {
+        let mut w = [0u8; 8];
+        w[..c.len()].copy_from_slice(c);
+        h ^= u64::from_le_bytes(w);
         h = h.wrapping_mul(0x100000001b3);
     }
     h
@@ -203,7 +207,7 @@ fn emit_params(
     let sets: Vec<String> = sys
         .params
         .iter()
-        .map(|p| format!("{:?} => self.{} = value,", p.name, p.name))
+        .map(|p| format!("{:?} => {{ self.{} = value; Ok(()) }}", p.name, p.name))
         .collect();
     let _ = writeln!(
         code,
@@ -214,9 +218,8 @@ fn values(&self) -> ::std::vec::Vec<f64> {{ ::std::vec![{values}] }}
 fn set(&mut self, name: &str, value: f64) -> ::core::result::Result<(), ::mbs::ParamError> {{
 match name {{
 {sets}
-_ => return Err(::mbs::ParamError::Unknown {{ name: name.to_string(), known: Self::NAMES.join(\", \") }}),
+_ => Err(::mbs::ParamError::Unknown {{ name: name.to_string(), known: Self::NAMES.join(\", \") }}),
 }}
-Ok(())
 }}
 #[allow(clippy::neg_cmp_op_on_partial_ord)]
 fn validate(&self) -> ::core::result::Result<(), ::mbs::ParamError> {{

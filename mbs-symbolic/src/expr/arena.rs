@@ -10,9 +10,10 @@ pub struct Arena {
     nodes: Vec<Node>,
     /// conservative mask of the variables each node depends on (see [`Var::mask`])
     deps: Vec<u128>,
-    interned: FxHashMap<Node, ExprId>,
-    /// memo of derivatives: (node, direction) -> derivative
-    pub(super) dmemo: FxHashMap<(ExprId, Dir), ExprId>,
+    /// open-addressing table of node ids by hash (hash-consing); `u32::MAX` is empty
+    slots: Vec<u32>,
+    /// memo of derivatives: (node, direction) packed by [`Dir::key`] -> derivative
+    pub(super) dmemo: FxHashMap<u64, ExprId>,
     pub(super) user_fns: Vec<UserFn>,
 }
 
@@ -27,6 +28,29 @@ pub(crate) enum Dir {
     TimeBias,
 }
 
+impl Dir {
+    /// The memo key of (node, direction).
+    pub(super) fn key(self, n: ExprId) -> u64 {
+        let d: u64 = match self {
+            Dir::Partial(v) => var_code(v),
+            Dir::Time => 6 << 16,
+            Dir::TimeBias => 7 << 16,
+        };
+        d << 32 | n.0 as u64
+    }
+}
+
+fn var_code(v: Var) -> u64 {
+    match v {
+        Var::Q(i) => i as u64,
+        Var::Qd(i) => 1 << 16 | i as u64,
+        Var::Qdd(i) => 2 << 16 | i as u64,
+        Var::T => 3 << 16,
+        Var::Param(i) => 4 << 16 | i as u64,
+        Var::Input(i) => 5 << 16 | i as u64,
+    }
+}
+
 impl Default for Arena {
     fn default() -> Self {
         Self::new()
@@ -38,7 +62,7 @@ impl Arena {
         let mut a = Arena {
             nodes: Vec::with_capacity(1 << 12),
             deps: Vec::with_capacity(1 << 12),
-            interned: FxHashMap::default(),
+            slots: vec![u32::MAX; 1 << 13],
             dmemo: FxHashMap::default(),
             user_fns: Vec::new(),
         };
@@ -115,22 +139,48 @@ impl Arena {
 
     /// Inserts a node as is (no rules): callers are the canonicalising constructors.
     pub(super) fn intern(&mut self, n: Node) -> ExprId {
-        if let Some(&id) = self.interned.get(&n) {
-            return id;
+        let mask = self.slots.len() - 1;
+        let mut i = node_hash(&n) as usize & mask;
+        loop {
+            let s = self.slots[i];
+            if s == u32::MAX {
+                break;
+            }
+            if self.nodes[s as usize] == n {
+                return ExprId(s);
+            }
+            i = (i + 1) & mask;
         }
         let id = ExprId(self.nodes.len() as u32);
         let (ch, k) = n.children();
-        let mut mask = match n {
+        let mut mask_deps = match n {
             Node::Var(v) => v.mask(),
             _ => 0,
         };
         for c in &ch[..k] {
-            mask |= self.deps[c.index()];
+            mask_deps |= self.deps[c.index()];
         }
         self.nodes.push(n);
-        self.deps.push(mask);
-        self.interned.insert(n, id);
+        self.deps.push(mask_deps);
+        self.slots[i] = id.0;
+        if self.nodes.len() * 2 > self.slots.len() {
+            self.grow();
+        }
         id
+    }
+
+    /// Doubles the table and re-inserts every node.
+    fn grow(&mut self) {
+        let size = self.slots.len() * 2;
+        self.slots = vec![u32::MAX; size];
+        let mask = size - 1;
+        for (id, n) in self.nodes.iter().enumerate() {
+            let mut i = node_hash(n) as usize & mask;
+            while self.slots[i] != u32::MAX {
+                i = (i + 1) & mask;
+            }
+            self.slots[i] = id as u32;
+        }
     }
 
     /// The variable node.
@@ -143,28 +193,41 @@ impl Arena {
         self.intern(Node::Num(num_bits(v)))
     }
 
-    /// All nodes reachable from `roots`, in increasing id (topological) order. Children have
-    /// smaller ids than parents, so one backward sweep marks everything.
+    /// All nodes reachable from `roots`, in increasing id (topological) order: a depth-first
+    /// walk over a bitmap, then the visited ids in order (a sort when they are few, a scan of
+    /// the bitmap otherwise).
     pub fn reachable(&self, roots: &[ExprId]) -> Vec<ExprId> {
         let Some(top) = roots.iter().max() else {
             return Vec::new();
         };
-        let mut need = vec![false; top.index() + 1];
-        for r in roots {
-            need[r.index()] = true;
-        }
-        for i in (0..need.len()).rev() {
-            if need[i] {
-                let (ch, k) = self.nodes[i].children();
-                for c in &ch[..k] {
-                    need[c.index()] = true;
-                }
+        let mut seen = vec![0u64; top.index() / 64 + 1];
+        let mut stack: Vec<u32> = roots.iter().map(|r| r.0).collect();
+        let mut out: Vec<ExprId> = Vec::new();
+        while let Some(n) = stack.pop() {
+            let (w, b) = (n as usize / 64, 1u64 << (n % 64));
+            if seen[w] & b != 0 {
+                continue;
+            }
+            seen[w] |= b;
+            out.push(ExprId(n));
+            let (ch, k) = self.nodes[n as usize].children();
+            for c in &ch[..k] {
+                stack.push(c.0);
             }
         }
-        (0..need.len())
-            .filter(|&i| need[i])
-            .map(|i| ExprId(i as u32))
-            .collect()
+        if out.len() * 16 < top.index() {
+            out.sort_unstable();
+            return out;
+        }
+        out.clear();
+        for (w, &bits) in seen.iter().enumerate() {
+            let mut x = bits;
+            while x != 0 {
+                out.push(ExprId((w * 64) as u32 + x.trailing_zeros()));
+                x &= x - 1;
+            }
+        }
+        out
     }
 
     /// The variables that the expressions depend on (exactly, by traversal), sorted.
@@ -181,4 +244,26 @@ impl Arena {
         vs.dedup();
         vs
     }
+}
+
+/// A cheap hash of a node, written out so that it stays fast without optimisation (the
+/// proc-macro runs at opt-level 0).
+fn node_hash(n: &Node) -> u64 {
+    let (tag, a, b): (u64, u64, u64) = match *n {
+        Node::Num(bits) => (1, bits, 0),
+        Node::Var(v) => (2, var_code(v), 0),
+        Node::Add(x, y) => (3, x.0 as u64, y.0 as u64),
+        Node::Sub(x, y) => (4, x.0 as u64, y.0 as u64),
+        Node::Mul(x, y) => (5, x.0 as u64, y.0 as u64),
+        Node::Div(x, y) => (6, x.0 as u64, y.0 as u64),
+        Node::Neg(x) => (7, x.0 as u64, 0),
+        Node::Powi(x, k) => (8, x.0 as u64, k as u64),
+        Node::Pow(x, y) => (9, x.0 as u64, y.0 as u64),
+        Node::Func(f, x) => (10 + f as u64 * 16, x.0 as u64, 0),
+        Node::Atan2(x, y) => (11, x.0 as u64, y.0 as u64),
+        Node::Call(f, o, x) => (12 + ((f as u64) << 8 | o as u64) * 16, x.0 as u64, 0),
+    };
+    let h = (tag ^ a.wrapping_mul(0x9E3779B97F4A7C15)).wrapping_mul(0xff51afd7ed558ccd)
+        ^ b.wrapping_mul(0xc4ceb9fe1a85ec53);
+    h ^ (h >> 29)
 }

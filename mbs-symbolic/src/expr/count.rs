@@ -27,8 +27,13 @@ impl OpCount {
 
     /// Counts the work to compute all of `roots`.
     pub fn of(arena: &Arena, roots: &[ExprId]) -> OpCount {
+        Self::of_nodes(arena, &arena.reachable(roots))
+    }
+
+    /// Counts the work of computing each of `nodes` once.
+    pub fn of_nodes(arena: &Arena, nodes: &[ExprId]) -> OpCount {
         let mut c = OpCount::default();
-        for n in arena.reachable(roots) {
+        for &n in nodes {
             match arena.node(n) {
                 Node::Num(_) | Node::Var(_) => {}
                 Node::Add(..) | Node::Sub(..) => c.adds += 1,

@@ -17,6 +17,8 @@ const MAX_INLINE_DEPTH: u32 = 10;
 pub struct Schedule {
     /// output roots, in the order given
     pub outputs: Vec<ExprId>,
+    /// every node the outputs need, in topological order
+    pub order: Vec<ExprId>,
     /// nodes that get a `let`, in emission (topological) order
     pub lets: Vec<ExprId>,
     /// for each chunk, the range of `lets` it defines
@@ -43,13 +45,15 @@ impl Schedule {
                 uses[c.index()] += 1;
             }
         }
+        let mut is_output = vec![false; top];
         for o in outputs {
             uses[o.index()] += 1;
+            is_output[o.index()] = true;
         }
         let mut depth = vec![0u32; top];
         let mut is_let = vec![false; top];
         let mut lets = Vec::new();
-        for &n in &order {
+        for &n in order.iter() {
             let node = arena.node(n);
             if matches!(node, Node::Num(_) | Node::Var(_)) {
                 continue;
@@ -71,7 +75,7 @@ impl Schedule {
                 node,
                 Node::Func(..) | Node::Pow(..) | Node::Atan2(..) | Node::Call(..)
             );
-            let output_only = outputs.contains(&n) && uses[n.index()] == 1;
+            let output_only = is_output[n.index()] && uses[n.index()] == 1;
             if !output_only && (uses[n.index()] > 1 || expensive || d > MAX_INLINE_DEPTH) {
                 is_let[n.index()] = true;
                 lets.push(n);
@@ -99,6 +103,7 @@ impl Schedule {
             .collect();
         Schedule {
             outputs: outputs.to_vec(),
+            order,
             lets,
             chunks,
             let_chunk,

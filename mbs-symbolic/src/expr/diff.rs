@@ -36,28 +36,28 @@ impl Arena {
         if self.constant_along(root, dir) {
             return self.zero();
         }
-        if let Some(&d) = self.dmemo.get(&(root, dir)) {
+        if let Some(&d) = self.dmemo.get(&dir.key(root)) {
             return d;
         }
         let mut stack = vec![(root, false)];
         while let Some((n, expanded)) = stack.pop() {
-            if self.dmemo.contains_key(&(n, dir)) {
+            if self.dmemo.contains_key(&dir.key(n)) {
                 continue;
             }
             let (ch, k) = self.node(n).children();
             if !expanded {
                 stack.push((n, true));
                 for &c in &ch[..k] {
-                    if !self.constant_along(c, dir) && !self.dmemo.contains_key(&(c, dir)) {
+                    if !self.constant_along(c, dir) && !self.dmemo.contains_key(&dir.key(c)) {
                         stack.push((c, false));
                     }
                 }
                 continue;
             }
             let d = self.derive_node(n, dir);
-            self.dmemo.insert((n, dir), d);
+            self.dmemo.insert(dir.key(n), d);
         }
-        self.dmemo[&(root, dir)]
+        self.dmemo[&dir.key(root)]
     }
 
     /// Derivative of one node, its children's derivatives being known.
@@ -66,7 +66,7 @@ impl Arena {
             if a.constant_along(c, dir) {
                 a.zero()
             } else {
-                a.dmemo[&(c, dir)]
+                a.dmemo[&dir.key(c)]
             }
         };
         match self.node(n) {

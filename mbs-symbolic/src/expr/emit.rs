@@ -47,6 +47,8 @@ struct Writer<'a> {
     sch: &'a Schedule,
     naming: &'a dyn Naming,
     missing: Vec<MissingDerivative>,
+    /// identifier of each leaf, computed once
+    var_names: rustc_hash::FxHashMap<Var, String>,
 }
 
 /// Rust literal of a number.
@@ -65,94 +67,130 @@ pub fn literal(v: f64) -> String {
 }
 
 impl Writer<'_> {
-    fn name(&self, n: ExprId) -> String {
-        match self.arena.node(n) {
-            Node::Func(f @ (Func::Sin | Func::Cos), a) => match self.arena.node(a) {
-                Node::Var(v) => format!("{}_{}", f.name(), self.naming.var(v)),
-                _ => format!("x{}", n.index()),
-            },
-            _ => format!("x{}", n.index()),
-        }
+    fn var(&mut self, v: Var) -> &str {
+        let naming = self.naming;
+        self.var_names.entry(v).or_insert_with(|| naming.var(v))
     }
 
-    /// Text and precedence of `n` where it is used.
-    fn expr(&mut self, n: ExprId) -> (String, Prec) {
+    fn name(&mut self, n: ExprId, out: &mut String) {
+        if let Node::Func(f @ (Func::Sin | Func::Cos), a) = self.arena.node(n) {
+            if let Node::Var(v) = self.arena.node(a) {
+                out.push_str(f.name());
+                out.push('_');
+                out.push_str(self.var(v));
+                return;
+            }
+        }
+        out.push('x');
+        push_int(out, n.index());
+    }
+
+    fn name_string(&mut self, n: ExprId) -> String {
+        let mut s = String::new();
+        self.name(n, &mut s);
+        s
+    }
+
+    /// Precedence of `n` where it is used.
+    fn prec(&self, n: ExprId) -> Prec {
         if self.sch.is_let(n) {
-            return (self.name(n), Prec::Atom);
+            return Prec::Atom;
         }
-        self.body(n)
-    }
-
-    fn wrap(&mut self, n: ExprId, min: Prec) -> String {
-        let (s, p) = self.expr(n);
-        if p < min { format!("({s})") } else { s }
-    }
-
-    /// Text of the definition of `n` (ignoring any `let` of its own).
-    fn body(&mut self, n: ExprId) -> (String, Prec) {
         match self.arena.node(n) {
             Node::Num(b) => {
-                let v = f64::from_bits(b);
-                let s = literal(v);
-                (s, if v < 0.0 { Prec::Unary } else { Prec::Atom })
+                if f64::from_bits(b) < 0.0 {
+                    Prec::Unary
+                } else {
+                    Prec::Atom
+                }
             }
-            Node::Var(v) => (self.naming.var(v), Prec::Atom),
-            Node::Add(a, b) => (
-                format!("{} + {}", self.wrap(a, Prec::Add), self.wrap(b, Prec::Mul)),
-                Prec::Add,
-            ),
-            Node::Sub(a, b) => (
-                format!("{} - {}", self.wrap(a, Prec::Add), self.wrap(b, Prec::Mul)),
-                Prec::Add,
-            ),
-            Node::Mul(a, b) => (
-                format!(
-                    "{} * {}",
-                    self.wrap(a, Prec::Mul),
-                    self.wrap(b, Prec::Unary)
-                ),
-                Prec::Mul,
-            ),
-            Node::Div(a, b) => (
-                format!(
-                    "{} / {}",
-                    self.wrap(a, Prec::Mul),
-                    self.wrap(b, Prec::Unary)
-                ),
-                Prec::Mul,
-            ),
-            Node::Neg(a) => (format!("-{}", self.wrap(a, Prec::Atom)), Prec::Unary),
+            Node::Add(..) | Node::Sub(..) | Node::Func(Func::Sign, _) => Prec::Add,
+            Node::Mul(..) | Node::Div(..) | Node::Powi(_, 2) => Prec::Mul,
+            Node::Neg(_) => Prec::Unary,
+            _ => Prec::Atom,
+        }
+    }
+
+    /// Writes `n` where it is used: its name if it has a `let`, its definition otherwise,
+    /// in parentheses when its precedence is below `min`.
+    fn expr(&mut self, n: ExprId, min: Prec, out: &mut String) {
+        if self.sch.is_let(n) {
+            self.name(n, out);
+            return;
+        }
+        if self.prec(n) < min {
+            out.push('(');
+            self.body(n, out);
+            out.push(')');
+        } else {
+            self.body(n, out);
+        }
+    }
+
+    /// Writes the definition of `n` (ignoring any `let` of its own).
+    fn body(&mut self, n: ExprId, out: &mut String) {
+        match self.arena.node(n) {
+            Node::Num(b) => out.push_str(&literal(f64::from_bits(b))),
+            Node::Var(v) => {
+                let name = self.var(v).to_string();
+                out.push_str(&name);
+            }
+            Node::Add(a, b) | Node::Sub(a, b) => {
+                self.expr(a, Prec::Add, out);
+                out.push_str(if matches!(self.arena.node(n), Node::Add(..)) {
+                    " + "
+                } else {
+                    " - "
+                });
+                self.expr(b, Prec::Mul, out);
+            }
+            Node::Mul(a, b) | Node::Div(a, b) => {
+                self.expr(a, Prec::Mul, out);
+                out.push_str(if matches!(self.arena.node(n), Node::Mul(..)) {
+                    " * "
+                } else {
+                    " / "
+                });
+                self.expr(b, Prec::Unary, out);
+            }
+            Node::Neg(a) => {
+                out.push('-');
+                self.expr(a, Prec::Atom, out);
+            }
             Node::Powi(a, 2) => {
-                let s = self.wrap(a, Prec::Atom);
-                (format!("{s} * {s}"), Prec::Mul)
+                self.expr(a, Prec::Atom, out);
+                out.push_str(" * ");
+                self.expr(a, Prec::Atom, out);
             }
-            Node::Powi(a, k) => (
-                format!("{}.powi({k})", self.wrap(a, Prec::Atom)),
-                Prec::Atom,
-            ),
-            Node::Pow(a, b) => (
-                format!("{}.powf({})", self.wrap(a, Prec::Atom), self.expr(b).0),
-                Prec::Atom,
-            ),
+            Node::Powi(a, k) => {
+                self.expr(a, Prec::Atom, out);
+                let _ = write!(out, ".powi({k})");
+            }
+            Node::Pow(a, b) => {
+                self.expr(a, Prec::Atom, out);
+                out.push_str(".powf(");
+                self.expr(b, Prec::Add, out);
+                out.push(')');
+            }
             Node::Func(Func::Sign, a) => {
-                let s = self.wrap(a, Prec::Atom);
-                (
-                    format!("if {s} == 0.0 {{ 0.0 }} else {{ {s}.signum() }}"),
-                    Prec::Add,
-                )
+                let mut s = String::new();
+                self.expr(a, Prec::Atom, &mut s);
+                let _ = write!(out, "if {s} == 0.0 {{ 0.0 }} else {{ {s}.signum() }}");
             }
-            Node::Func(f, a) => (
-                format!("{}.{}()", self.wrap(a, Prec::Atom), f.name()),
-                Prec::Atom,
-            ),
-            Node::Atan2(y, x) => (
-                format!("{}.atan2({})", self.wrap(y, Prec::Atom), self.expr(x).0),
-                Prec::Atom,
-            ),
+            Node::Func(f, a) => {
+                self.expr(a, Prec::Atom, out);
+                let _ = write!(out, ".{}()", f.name());
+            }
+            Node::Atan2(y, x) => {
+                self.expr(y, Prec::Atom, out);
+                out.push_str(".atan2(");
+                self.expr(x, Prec::Add, out);
+                out.push(')');
+            }
             Node::Call(f, k, a) => {
                 let uf = &self.arena.user_fns()[f as usize];
-                let path = match uf.paths.get(k as usize) {
-                    Some(p) => p.clone(),
+                match uf.paths.get(k as usize) {
+                    Some(p) => out.push_str(p),
                     None => {
                         let m = MissingDerivative {
                             function: uf.name.clone(),
@@ -161,13 +199,30 @@ impl Writer<'_> {
                         if !self.missing.contains(&m) {
                             self.missing.push(m);
                         }
-                        "f64::from".into()
+                        out.push_str("f64::from");
                     }
-                };
-                (format!("{path}({})", self.expr(a).0), Prec::Atom)
+                }
+                out.push('(');
+                self.expr(a, Prec::Add, out);
+                out.push(')');
             }
         }
     }
+}
+
+/// Appends a non-negative integer without the formatting machinery (slow unoptimised).
+fn push_int(out: &mut String, mut v: usize) {
+    let mut buf = [0u8; 20];
+    let mut i = buf.len();
+    loop {
+        i -= 1;
+        buf[i] = b'0' + (v % 10) as u8;
+        v /= 10;
+        if v == 0 {
+            break;
+        }
+    }
+    out.push_str(std::str::from_utf8(&buf[i..]).expect("ascii digits"));
 }
 
 /// Leaves and `let`s that the inline text of `n` reads.
@@ -259,6 +314,7 @@ pub fn emit(
         sch,
         naming,
         missing: Vec::new(),
+        var_names: Default::default(),
     };
     let mut chunks = Vec::with_capacity(nchunks);
     for (c, r) in sch.chunks.iter().enumerate() {
@@ -273,20 +329,29 @@ pub fn emit(
         loads.sort_unstable();
         loads.dedup();
         for &l in loads.iter() {
-            let _ = writeln!(s, "let {} = w[{}];", w.name(l), slot[l.index()].unwrap());
+            let _ = writeln!(
+                s,
+                "let {} = w[{}];",
+                w.name_string(l),
+                slot[l.index()].unwrap()
+            );
         }
         for &n in &sch.lets[r.clone()] {
-            let (text, _) = w.body(n);
-            let name = w.name(n);
-            let _ = writeln!(s, "let {name} = {text};");
+            s.push_str("let ");
+            w.name(n, &mut s);
+            s.push_str(" = ");
+            w.body(n, &mut s);
+            s.push_str(";\n");
             if let Some(k) = slot[n.index()] {
-                let _ = writeln!(s, "w[{k}] = {name};");
+                let _ = writeln!(s, "w[{k}] = {};", w.name_string(n));
             }
         }
         for (i, &o) in sch.outputs.iter().enumerate() {
             if sch.output_chunk[i] as usize == c {
-                let (text, _) = w.expr(o);
-                let _ = writeln!(s, "{} = {text};", targets[i]);
+                s.push_str(&targets[i]);
+                s.push_str(" = ");
+                w.expr(o, Prec::Add, &mut s);
+                s.push_str(";\n");
             }
         }
         chunks.push(s);
@@ -294,7 +359,7 @@ pub fn emit(
     if !w.missing.is_empty() {
         return Err(w.missing);
     }
-    let mut count = OpCount::of(arena, &sch.outputs);
+    let mut count = OpCount::of_nodes(arena, &sch.order);
     count.lets = sch.lets.len();
     Ok(Emitted {
         chunks,

@@ -1,0 +1,314 @@
+//! Random 3-D trees: M and h of both formulations (virtual power and recursive) against an
+//! independent numeric Newton–Euler / composite-rigid-body oracle, M symmetric positive
+//! definite, τ = M qdd − h for both τ's; also centre-of-mass positions, static h and the
+//! kinetic and potential energies against the oracle.
+
+mod common;
+
+use common::*;
+use mbs_symbolic::SymbolicModel;
+use mbs_symbolic::expr::ExprId;
+
+const TREES: u64 = 100;
+const STATES: usize = 3;
+
+fn pendulum_link(kind: Kind, axis: V3, drive: Drive, mass: f64, com: V3, i: [f64; 6]) -> Link {
+    Link {
+        parent: None,
+        offset: [0.0; 3],
+        fixed: Vec::new(),
+        kind,
+        axis,
+        drive,
+        mass,
+        com,
+        inertia: i,
+    }
+}
+
+fn dof_drive(k: usize) -> Drive {
+    Drive {
+        dof: Some(k),
+        scale: 1.0,
+        bias: 0.0,
+        amp: 0.0,
+        omega: 0.0,
+        phase: 0.0,
+    }
+}
+
+/// The oracle against closed forms: a pendulum (also with an imposed oscillation of its
+/// angle) and a mass sliding on a spinning arm (Coriolis and centrifugal terms).
+#[test]
+fn oracle_closed_forms() {
+    let (m, l, g, izz) = (1.7, 0.8, 9.81, 0.05);
+    let (amp, om, ph) = (0.3, 2.0, 0.4);
+    for rheo in [false, true] {
+        let mut drive = dof_drive(0);
+        if rheo {
+            (drive.amp, drive.omega, drive.phase) = (amp, om, ph);
+        }
+        let desc = Desc {
+            links: vec![pendulum_link(
+                Kind::Revolute,
+                [0.0, 0.0, 1.0],
+                drive,
+                m,
+                [0.0, -l, 0.0],
+                [0.02, 0.03, izz, 0.0, 0.0, 0.0],
+            )],
+            ndof: 1,
+            gravity: [0.0, -g, 0.0],
+        };
+        let o = Oracle::new(&desc);
+        for &(th, thd, t) in &[(0.3, 0.0, 0.0), (-1.2, 2.0, 0.7), (2.5, -1.0, 3.1)] {
+            let mm = o.crba(&[th], t);
+            let h = o.bias(&[th], &[thd], t);
+            let inertia = izz + m * l * l;
+            let (angle, h_ref) = if rheo {
+                let angle = th + amp * (om * t + ph).sin();
+                let thdd_rheo = -amp * om * om * (om * t + ph).sin();
+                (angle, -m * g * l * angle.sin() - inertia * thdd_rheo)
+            } else {
+                (th, -m * g * l * th.sin())
+            };
+            let _ = angle;
+            assert!((mm[0][0] - inertia).abs() < 1e-14, "{mm:?}");
+            assert!((h[0] - h_ref).abs() < 1e-13, "{h:?} vs {h_ref}");
+        }
+    }
+    // spinning arm (about z) carrying a slider along its x axis; no gravity
+    let (i0, m1, i1) = (0.4, 1.3, 0.02);
+    let desc = Desc {
+        links: vec![
+            pendulum_link(
+                Kind::Revolute,
+                [0.0, 0.0, 1.0],
+                dof_drive(0),
+                2.0,
+                [0.0; 3],
+                [0.3, 0.3, i0, 0.0, 0.0, 0.0],
+            ),
+            Link {
+                parent: Some(0),
+                ..pendulum_link(
+                    Kind::Prismatic,
+                    [1.0, 0.0, 0.0],
+                    dof_drive(1),
+                    m1,
+                    [0.0; 3],
+                    [0.01, 0.01, i1, 0.0, 0.0, 0.0],
+                )
+            },
+        ],
+        ndof: 2,
+        gravity: [0.0; 3],
+    };
+    let o = Oracle::new(&desc);
+    let (q, qd) = ([0.4, 0.7], [1.3, -0.6]);
+    let (r, rd, thd) = (q[1], qd[1], qd[0]);
+    let mm = o.crba(&q, 0.0);
+    let h = o.bias(&q, &qd, 0.0);
+    let m_ref = [[i0 + i1 + m1 * r * r, 0.0], [0.0, m1]];
+    let h_ref = [-2.0 * m1 * r * rd * thd, m1 * r * thd * thd];
+    for i in 0..2 {
+        assert!((h[i] - h_ref[i]).abs() < 1e-14, "{h:?} vs {h_ref:?}");
+        for j in 0..2 {
+            assert!((mm[i][j] - m_ref[i][j]).abs() < 1e-14, "{mm:?}");
+        }
+    }
+}
+
+/// The oracle against the reference double pendulum of `reference_eval.rs`.
+#[test]
+fn oracle_matches_reference_double_pendulum() {
+    let (l, m) = (1.0, 1.0);
+    let i = [m * l * l / 12.0, 0.0, m * l * l / 12.0, 0.0, 0.0, 0.0];
+    let bar = |parent, offset| Link {
+        parent,
+        offset,
+        ..pendulum_link(
+            Kind::Revolute,
+            [0.0, 0.0, 1.0],
+            dof_drive(0),
+            m,
+            [0.0, -l / 2.0, 0.0],
+            i,
+        )
+    };
+    let mut b2 = bar(Some(0), [0.0, -l, 0.0]);
+    b2.drive = dof_drive(1);
+    let desc = Desc {
+        links: vec![bar(None, [0.0; 3]), b2],
+        ndof: 2,
+        gravity: [0.0, -9.81, 0.0],
+    };
+    let q: Vec<f64> = (0..2).map(|i| 0.5 * (1.3 * i as f64 + 0.4).sin()).collect();
+    let qd: Vec<f64> = (0..2).map(|i| 0.7 * (0.9 * i as f64 + 0.2).cos()).collect();
+    let m_ref = [
+        [2.546239652854929, 0.7731198264274626],
+        [0.7731198264274626, 0.333333333333333],
+    ];
+    let f_ref = [-5.843720128970542, -3.236224706838456];
+    let o = Oracle::new(&desc);
+    let mm = o.crba(&q, 0.0);
+    let h = o.bias(&q, &qd, 0.0);
+    for r in 0..2 {
+        assert!((h[r] - f_ref[r]).abs() < 1e-12, "{h:?}");
+        for c in 0..2 {
+            assert!((mm[r][c] - m_ref[r][c]).abs() < 1e-12, "{mm:?}");
+        }
+    }
+}
+
+fn flat(m: &[Vec<ExprId>]) -> Vec<ExprId> {
+    m.iter().flatten().copied().collect()
+}
+
+fn square(v: &[f64], n: usize) -> Vec<Vec<f64>> {
+    v.chunks(n).map(|r| r.to_vec()).collect()
+}
+
+#[test]
+fn random_trees_match_oracle() {
+    let mut w_m_vp = Worst::default();
+    let mut w_m_rec = Worst::default();
+    let mut w_h_vp = Worst::default();
+    let mut w_h_rec = Worst::default();
+    let mut w_vp_rec = Worst::default();
+    let mut w_tau_rec = Worst::default();
+    let mut w_tau_vp = Worst::default();
+    let mut w_sym = Worst::default();
+    let mut w_pos = Worst::default();
+    let mut w_static = Worst::default();
+    let mut w_energy = Worst::default();
+    let (mut branching, mut prismatic, mut revolute, mut rheonomic, mut driven, mut coupled) =
+        (0, 0, 0, 0, 0, 0);
+    let mut max_dof = 0;
+    let mut dof_hist = [0usize; 13];
+    for seed in 0..TREES {
+        let mut rng = Rng::new(seed);
+        let desc = random_desc(
+            &mut rng,
+            GenOpts {
+                min_dof: 1,
+                max_dof: 12,
+                rheonomic: true,
+                gravity: true,
+            },
+        );
+        let n = desc.ndof;
+        max_dof = max_dof.max(n);
+        dof_hist[n] += 1;
+        branching += desc.branching() as usize;
+        for l in &desc.links {
+            match l.kind {
+                Kind::Prismatic => prismatic += 1,
+                Kind::Revolute => revolute += 1,
+            }
+            rheonomic += l.drive.rheonomic() as usize;
+            driven += l.drive.dof.is_none() as usize;
+        }
+        let mut used = vec![0; n];
+        for l in &desc.links {
+            if let Some(k) = l.drive.dof {
+                used[k] += 1;
+            }
+        }
+        coupled += used.iter().any(|&u| u > 1) as usize;
+        let oracle = Oracle::new(&desc);
+        let built = to_system(&desc, &mut rng);
+        let bodies = built.body.clone();
+        let model = SymbolicModel::build(built.sys);
+        let eq = &model.scenes[0];
+        let mut roots = Vec::new();
+        roots.extend(flat(&eq.vp.m));
+        roots.extend(&eq.vp.h);
+        roots.extend(flat(&eq.rec.m));
+        roots.extend(&eq.rec.h);
+        roots.extend(&eq.tau_rec);
+        roots.extend(&eq.tau_vp);
+        roots.extend(&eq.static_h);
+        roots.extend([eq.kinetic, eq.potential]);
+        for &b in &bodies {
+            roots.extend(model.world.nodes[model.tree.frame_node[b]].p);
+        }
+        for s in 0..STATES {
+            let (t, q, qd, qdd) = random_state(&mut rng, n);
+            let v = eval(&model, &roots, t, &q, &qd, &qdd);
+            let mut it = 0;
+            let mut take = |k: usize| {
+                let s = v[it..it + k].to_vec();
+                it += k;
+                s
+            };
+            let (m_vp, h_vp) = (take(n * n), take(n));
+            let (m_rec, h_rec) = (take(n * n), take(n));
+            let (tau_rec, tau_vp) = (take(n), take(n));
+            let static_h = take(n);
+            let energy = take(2);
+            let pos = take(3 * bodies.len());
+            let at = || format!("seed {seed}, state {s}, {n} dof");
+            let m_ref = oracle.crba(&q, t);
+            let m_flat: Vec<f64> = m_ref.iter().flatten().copied().collect();
+            let h_ref = oracle.bias(&q, &qd, t);
+            let tau_ref = oracle.rnea(&q, &qd, &qdd, t, true);
+            w_m_vp.see(rel_err(&m_vp, &m_flat), at);
+            w_m_rec.see(rel_err(&m_rec, &m_flat), at);
+            w_h_vp.see(rel_err(&h_vp, &h_ref), at);
+            w_h_rec.see(rel_err(&h_rec, &h_ref), at);
+            w_vp_rec.see(rel_err(&m_vp, &m_rec).max(rel_err(&h_vp, &h_rec)), at);
+            // τ at random qdd equals M qdd − h (of the oracle and of the same formulation)
+            for (tau, m, h, w) in [
+                (&tau_rec, &m_rec, &h_rec, &mut w_tau_rec),
+                (&tau_vp, &m_vp, &h_vp, &mut w_tau_vp),
+            ] {
+                let mq = mat_vec(&square(m, n), &qdd);
+                let own: Vec<f64> = mq.iter().zip(h).map(|(a, b)| a - b).collect();
+                w.see(rel_err(tau, &tau_ref).max(rel_err(tau, &own)), at);
+            }
+            // symmetric positive definite
+            for m in [&m_vp, &m_rec] {
+                let mm = square(m, n);
+                let scale = m.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+                let asym = (0..n)
+                    .flat_map(|i| (0..n).map(move |j| (i, j)))
+                    .fold(0.0f64, |a, (i, j)| a.max((mm[i][j] - mm[j][i]).abs()));
+                w_sym.see(asym / scale, at);
+                assert!(
+                    cholesky(&mm).is_some(),
+                    "M not positive definite at {}",
+                    at()
+                );
+            }
+            let g_ref: Vec<f64> = oracle.com_positions(&q, t).concat();
+            w_pos.see(rel_err(&pos, &g_ref), at);
+            let zero = vec![0.0; n];
+            w_static.see(rel_err(&static_h, &oracle.bias(&q, &zero, t)), at);
+            let e_ref = [oracle.kinetic(&q, &qd, t), oracle.potential(&q, t)];
+            w_energy.see(rel_err(&energy, &e_ref), at);
+        }
+    }
+    println!(
+        "{TREES} trees x {STATES} states; dof histogram {dof_hist:?}; {branching} branching; \
+         {revolute} revolute, {prismatic} prismatic joints; {rheonomic} rheonomic, {driven} \
+         purely time-driven; {coupled} trees with a coordinate driving two joints"
+    );
+    w_pos.check("centre-of-mass positions vs oracle", 1e-12);
+    w_m_vp.check("M virtual power vs oracle", 1e-10);
+    w_m_rec.check("M recursive vs oracle", 1e-10);
+    w_h_vp.check("h virtual power vs oracle", 1e-10);
+    w_h_rec.check("h recursive vs oracle", 1e-10);
+    w_vp_rec.check("M, h virtual power vs recursive", 1e-10);
+    w_tau_rec.check("tau_rec vs oracle and M qdd - h", 1e-10);
+    w_tau_vp.check("tau_vp vs oracle and M qdd - h", 1e-10);
+    w_sym.check("M symmetry", 1e-14);
+    w_static.check("static h (qd = 0) vs oracle", 1e-10);
+    w_energy.check("kinetic and potential energy vs oracle", 1e-10);
+    assert_eq!(max_dof, 12);
+    assert!(
+        branching >= TREES as usize / 2,
+        "{branching} branching trees"
+    );
+    assert!(prismatic > 20 && revolute > 20 && rheonomic > 20 && driven > 10 && coupled > 3);
+}

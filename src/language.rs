@@ -114,11 +114,14 @@
 //!
 //! ```text
 //! error: unknown body `uper_arm`; did you mean `upper_arm`?
-//! error: coordinate q[2] moves no body with mass, so the mass matrix would be singular: …
+//! error: coordinate `q[2]` moves no body with mass, so the mass matrix would be singular: …
 //! error: the mass of body `arm` must be positive, it is -1: …
 //! ```
 //!
-//! The macro still emits placeholder types, so the rest of the code does not fail in cascade.
+//! All the mistakes of a model are reported at once. The macro still emits placeholder types
+//! (the parameter struct with its fields, the model types with `new` and the
+//! [`Model`](crate::Model) trait), so the code using them does not fail in cascade. Each
+//! message has a compile-fail case under `tests/ui/`.
 //!
 //! ## Reading the generated code
 //!

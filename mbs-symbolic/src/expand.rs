@@ -6,7 +6,7 @@ use crate::codegen::{Generated, generate};
 use crate::dsl::ast::{Item, ModelDef};
 use crate::dsl::check::check;
 use crate::dsl::parse::Models;
-use proc_macro2::TokenStream;
+use proc_macro2::{Group, TokenStream, TokenTree};
 use quote::ToTokens;
 
 /// One model's outcome.
@@ -25,7 +25,32 @@ pub enum Expansion {
 /// Expands every model of a block.
 pub fn expand_models(input: TokenStream) -> Result<Vec<Expansion>, syn::Error> {
     let models: Models = syn::parse2(input)?;
-    Ok(models.0.iter().map(expand_one).collect())
+    Ok(expand_defs(&models))
+}
+
+/// One expansion per model, in order.
+fn expand_defs(models: &Models) -> Vec<Expansion> {
+    let mut out = Vec::new();
+    for (i, def) in models.0.iter().enumerate() {
+        if models.0[..i].iter().any(|d| d.name == def.name) {
+            // the first model of that name defines the types; this one only reports
+            let error = syn::Error::new(
+                def.name.span(),
+                format!(
+                    "duplicate model `{}`: each model of a multibody! block needs its own name (it names the generated types); rename one of them",
+                    def.name
+                ),
+            );
+            out.push(Expansion::Err {
+                name: def.name.to_string(),
+                error,
+                stub: String::new(),
+            });
+            continue;
+        }
+        out.push(expand_one(def));
+    }
+    out
 }
 
 fn vis_text(def: &ModelDef) -> String {
@@ -34,6 +59,18 @@ fn vis_text(def: &ModelDef) -> String {
 
 fn expand_one(def: &ModelDef) -> Expansion {
     let name = def.name.to_string();
+    if let Some((first, rest)) = def.errors.split_first() {
+        // statements that did not parse: report them only, checking the rest would cascade
+        let mut error = first.clone();
+        for e in rest {
+            error.combine(e.clone());
+        }
+        return Expansion::Err {
+            name,
+            error,
+            stub: stub(def),
+        };
+    }
     let checked = match check(def) {
         Ok(c) => c,
         Err(error) => {
@@ -48,23 +85,7 @@ fn expand_one(def: &ModelDef) -> Expansion {
     match generate(checked.system, &vis_text(def)) {
         Ok(generated) => Expansion::Ok { name, generated },
         Err(missing) => {
-            let mut errs = missing.iter().map(|m| {
-                let span = spans.iter().find(|(n, _)| *n == m.function).map_or(def.name.span(), |s| s.1);
-                let which = ["the function", "the first derivative", "the second derivative", "the third derivative"]
-                    .get(m.order as usize)
-                    .map_or_else(|| format!("derivative {}", m.order), |s| s.to_string());
-                syn::Error::new(
-                    span,
-                    format!(
-                        "the generated equations need {which} of `{f}`, which `extern fn {f}` does not give: append its path to the list `extern fn {f} = [f, f', f'', …];`",
-                        f = m.function
-                    ),
-                )
-            });
-            let mut error = errs.next().expect("at least one missing derivative");
-            for e in errs {
-                error.combine(e);
-            }
+            let error = missing_derivatives(def, &spans, &missing);
             Expansion::Err {
                 name,
                 error,
@@ -74,41 +95,226 @@ fn expand_one(def: &ModelDef) -> Expansion {
     }
 }
 
-/// Placeholder types for a model with errors.
+/// One error per `extern fn` whose list stops short of the derivatives the equations need.
+fn missing_derivatives(
+    def: &ModelDef,
+    spans: &[(String, proc_macro2::Span)],
+    missing: &[crate::expr::emit::MissingDerivative],
+) -> syn::Error {
+    const ORDINAL: [&str; 5] = ["", "first", "second", "third", "fourth"];
+    let mut functions: Vec<&str> = Vec::new();
+    for m in missing {
+        if !functions.contains(&m.function.as_str()) {
+            functions.push(&m.function);
+        }
+    }
+    let mut errors = functions.iter().map(|&f| {
+        let needed = missing
+            .iter()
+            .filter(|m| m.function == f)
+            .map(|m| m.order as usize)
+            .max()
+            .unwrap_or(1);
+        let given: Vec<String> = def
+            .items
+            .iter()
+            .find_map(|i| match i {
+                Item::ExternFn { name, paths } if name == f => Some(
+                    paths
+                        .iter()
+                        .map(|p| p.to_token_stream().to_string().replace(' ', ""))
+                        .collect(),
+                ),
+                _ => None,
+            })
+            .unwrap_or_default();
+        let ordinal = |k: usize| {
+            ORDINAL
+                .get(k)
+                .map_or_else(|| format!("order-{k}"), |s| s.to_string())
+        };
+        let has = match given.len() {
+            0 | 1 => format!("gives only `{f}` itself"),
+            n => format!("gives `{f}` and its derivatives up to the {}", ordinal(n - 1)),
+        };
+        let mut list = given.clone();
+        for k in given.len()..=needed {
+            list.push(format!("path::to::{f}_{}", "d".repeat(k)));
+        }
+        let primes = "'".repeat(needed);
+        let span = spans
+            .iter()
+            .find(|(n, _)| n == f)
+            .map_or(def.name.span(), |s| s.1);
+        syn::Error::new(
+            span,
+            format!(
+                "`extern fn {f}` {has}, but the equations of motion need its {} derivative ({f}{primes}): list the derivatives after the function, `extern fn {f} = [{}];`",
+                ordinal(needed),
+                list.join(", ")
+            ),
+        )
+    });
+    let mut error = errors.next().expect("at least one missing derivative");
+    for e in errors {
+        error.combine(e);
+    }
+    error
+}
+
+/// Placeholder types for a model with errors: the parameter struct with its fields and the
+/// model types with `new` and the `Model` trait, so that code using them type-checks and the
+/// only errors are the model's own. Their methods are never run: the crate does not compile.
 fn stub(def: &ModelDef) -> String {
     let vis = vis_text(def);
     let name = def.name.to_string();
-    let mut types = vec![format!("{name}Params")];
-    let scenes: Vec<String> = def
-        .items
-        .iter()
-        .filter_map(|i| match i {
-            Item::Scene { name: s, .. } => Some(format!("{name}{s}")),
-            _ => None,
-        })
-        .collect();
-    if scenes.is_empty() {
-        types.push(name);
-    } else {
-        types.extend(scenes);
+    let pty = format!("{name}Params");
+    let mut params: Vec<String> = Vec::new();
+    let (mut nq, mut nu, mut nframes, mut npoints) = (0, 0, 0, 0);
+    let mut scenes: Vec<String> = Vec::new();
+    for item in &def.items {
+        match item {
+            Item::Param { name: p, .. } => {
+                let p = p.to_string();
+                if !params.contains(&p) && !matches!(p.as_str(), "t" | "q" | "qd" | "qdd" | "u") {
+                    params.push(p);
+                }
+            }
+            Item::Dof { .. } => nq += 1,
+            Item::Input { .. } => nu += 1,
+            Item::Body { .. } | Item::Frame { .. } => nframes += 1,
+            Item::Point { .. } => npoints += 1,
+            Item::Scene { name: s, .. } => {
+                let ty = format!("{name}{s}");
+                if !scenes.contains(&ty) && ty != pty {
+                    scenes.push(ty);
+                }
+            }
+            _ => {}
+        }
     }
-    types
-        .iter()
-        .map(|t| format!("#[derive(Clone, Debug, Default)] {vis} struct {t};\n"))
-        .collect()
+    if scenes.is_empty() {
+        scenes.push(name.clone());
+    }
+    let fields: String = params.iter().map(|p| format!("pub {p}: f64,")).collect();
+    let zeros: String = params.iter().map(|p| format!("{p}: 0.0,")).collect();
+    let names: String = params.iter().map(|p| format!("{p:?},")).collect();
+    let never = format!("::core::unreachable!(\"model `{name}` has errors\")");
+    let mut code = format!(
+        "#[derive(Clone, Debug, PartialEq, ::mbs::__private::serde::Serialize, ::mbs::__private::serde::Deserialize)]
+#[serde(crate = \"::mbs::__private::serde\")]
+{vis} struct {pty} {{ {fields} }}
+impl ::core::default::Default for {pty} {{ fn default() -> Self {{ Self {{ {zeros} }} }} }}
+impl ::mbs::Parameters for {pty} {{
+const NAMES: &'static [&'static str] = &[{names}];
+fn values(&self) -> ::std::vec::Vec<f64> {{ {never} }}
+fn set(&mut self, _: &str, _: f64) -> ::core::result::Result<(), ::mbs::ParamError> {{ {never} }}
+fn validate(&self) -> ::core::result::Result<(), ::mbs::ParamError> {{ {never} }}
+}}
+"
+    );
+    for ty in scenes {
+        code.push_str(&format!(
+            "#[derive(Clone, Debug, Default, PartialEq)]
+{vis} struct {ty} {{ params: {pty} }}
+impl {ty} {{
+pub const GENERATED_HASH: u64 = 0;
+pub fn new(_: {pty}) -> ::core::result::Result<Self, ::mbs::ParamError> {{ {never} }}
+}}
+impl ::mbs::Model for {ty} {{
+type Params = {pty};
+const NQ: usize = {nq};
+const NU: usize = {nu};
+const NFRAMES: usize = {nframes};
+const NPOINTS: usize = {npoints};
+fn info(&self) -> &'static ::mbs::ModelInfo {{ {never} }}
+fn params(&self) -> &{pty} {{ &self.params }}
+fn set_params(&mut self, _: {pty}) -> ::core::result::Result<(), ::mbs::ParamError> {{ {never} }}
+fn initial_state(&self, _: &mut [f64], _: &mut [f64]) {{ {never} }}
+fn mass_matrix(&self, _: f64, _: &[f64], _: &mut [f64]) {{ {never} }}
+fn dynamics(&self, _: f64, _: &[f64], _: &[f64], _: &[f64], _: &mut [f64], _: &mut [f64]) {{ {never} }}
+fn inverse_dynamics(&self, _: f64, _: &[f64], _: &[f64], _: &[f64], _: &[f64], _: &mut [f64]) {{ {never} }}
+fn tangents(&self, _: f64, _: &[f64], _: &[f64], _: &[f64], _: &[f64], _: &mut [f64], _: &mut [f64]) -> ::core::result::Result<(), ::mbs::ModelError> {{ {never} }}
+fn static_forces(&self, _: f64, _: &[f64], _: &[f64], _: &mut [f64]) {{ {never} }}
+fn energy(&self, _: f64, _: &[f64], _: &[f64]) -> ::mbs::Energy {{ {never} }}
+fn power(&self, _: f64, _: &[f64], _: &[f64], _: &[f64]) -> f64 {{ {never} }}
+fn frames(&self, _: f64, _: &[f64], _: &mut [::mbs::Pose]) {{ {never} }}
+fn kinematics(&self, _: f64, _: &[f64], _: &[f64], _: &mut ::mbs::Kinematics) {{ {never} }}
+}}
+"
+        ));
+    }
+    code
+}
+
+/// The generated code calls `extern fn` paths; gives those calls the spans of the paths as
+/// written, so that an unresolved or ill-typed path is reported on the user's tokens (rustc
+/// reports identical errors once) rather than on the whole macro call.
+fn respan_extern_paths(ts: TokenStream, paths: &[Vec<TokenTree>]) -> TokenStream {
+    fn same(a: &TokenTree, b: &TokenTree) -> bool {
+        match (a, b) {
+            (TokenTree::Ident(x), TokenTree::Ident(y)) => x == y,
+            (TokenTree::Punct(x), TokenTree::Punct(y)) => x.as_char() == y.as_char(),
+            _ => false,
+        }
+    }
+    let tts: Vec<TokenTree> = ts.into_iter().collect();
+    let mut out = Vec::with_capacity(tts.len());
+    let mut i = 0;
+    while i < tts.len() {
+        let method = i > 0 && matches!(&tts[i - 1], TokenTree::Punct(p) if p.as_char() == '.');
+        let called = |n: usize| matches!(tts.get(i + n), Some(TokenTree::Group(g)) if g.delimiter() == proc_macro2::Delimiter::Parenthesis);
+        let hit = paths.iter().find(|p| {
+            !method
+                && tts.len() >= i + p.len()
+                && p.iter().zip(&tts[i..]).all(|(a, b)| same(a, b))
+                && called(p.len())
+        });
+        if let Some(p) = hit {
+            for (k, user) in p.iter().enumerate() {
+                let mut t = tts[i + k].clone();
+                t.set_span(user.span());
+                out.push(t);
+            }
+            i += p.len();
+            continue;
+        }
+        match &tts[i] {
+            TokenTree::Group(g) => {
+                let mut ng = Group::new(g.delimiter(), respan_extern_paths(g.stream(), paths));
+                ng.set_span(g.span());
+                out.push(TokenTree::Group(ng));
+            }
+            t => out.push(t.clone()),
+        }
+        i += 1;
+    }
+    out.into_iter().collect()
 }
 
 /// What the macro emits.
 pub fn expand(input: TokenStream) -> TokenStream {
-    let expansions = match expand_models(input) {
-        Ok(e) => e,
+    let models: Models = match syn::parse2(input) {
+        Ok(m) => m,
         Err(e) => return e.to_compile_error(),
     };
+    let expansions = expand_defs(&models);
     let mut out = TokenStream::new();
-    for e in expansions {
+    for (def, e) in models.0.iter().zip(expansions) {
+        let paths: Vec<Vec<TokenTree>> = def
+            .items
+            .iter()
+            .filter_map(|i| match i {
+                Item::ExternFn { paths, .. } => Some(paths),
+                _ => None,
+            })
+            .flatten()
+            .map(|p| p.to_token_stream().into_iter().collect())
+            .collect();
         match e {
             Expansion::Ok { generated, .. } => match generated.code.parse::<TokenStream>() {
-                Ok(ts) => out.extend(ts),
+                Ok(ts) if paths.is_empty() => out.extend(ts),
+                Ok(ts) => out.extend(respan_extern_paths(ts, &paths)),
                 Err(err) => {
                     let msg = format!(
                         "internal error: generated code does not parse ({err}); please report it"

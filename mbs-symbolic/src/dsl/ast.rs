@@ -13,6 +13,9 @@ pub struct ModelDef {
     pub vis: syn::Visibility,
     pub name: Ident,
     pub items: Vec<Item>,
+    /// statements that did not parse (the parser skips them and goes on, so that the model
+    /// still gets placeholder types)
+    pub errors: Vec<syn::Error>,
 }
 
 /// A reference to a body or frame: `TOG[bar1]`, `TOG[2]` (declaration order) or `ground`.

@@ -6,7 +6,8 @@ use super::ast::{BodyRef, DofName, EffectStmt, Item, ModelDef};
 use super::names::did_you_mean;
 use crate::expr::{ExprId, Func, SliceEnv, UserFn, Var};
 use crate::mech::system::*;
-use proc_macro2::Span;
+use proc_macro2::{Span, TokenStream};
+use quote::ToTokens;
 use rustc_hash::FxHashMap;
 use syn::spanned::Spanned;
 use syn::{Expr, Ident};
@@ -15,6 +16,62 @@ use syn::{Expr, Ident};
 const RESERVED: [&str; 10] = [
     "t", "q", "qd", "qdd", "u", "PI", "E", "TAU", "ground", "TOG",
 ];
+
+/// What a reserved name stands for.
+fn reserved_meaning(s: &str) -> &'static str {
+    match s {
+        "t" => "the time",
+        "q" => "the coordinates q[i]",
+        "qd" => "the velocities qd[i]",
+        "qdd" => "the accelerations qdd[i]",
+        "u" => "the inputs u[k]",
+        "PI" => "the constant π",
+        "E" => "the constant e",
+        "TAU" => "the constant τ = 2π",
+        "ground" => "the fixed world frame",
+        _ => "poses, TOG[body]",
+    }
+}
+
+/// Source text of tokens, spaced as people write it: `q[0]`, `sin(x)`, `a + b`.
+fn text(t: &impl ToTokens) -> String {
+    let raw = t.to_token_stream().to_string();
+    let mut out = String::with_capacity(raw.len());
+    let chars: Vec<char> = raw.chars().collect();
+    for (i, &c) in chars.iter().enumerate() {
+        if c == ' ' {
+            let prev = out.chars().last().unwrap_or(' ');
+            let next = chars.get(i + 1).copied().unwrap_or(' ');
+            let glue_next = matches!(next, ')' | ']' | ',' | '.')
+                || (matches!(next, '(' | '[') && (prev.is_alphanumeric() || prev == '_'));
+            // a unary minus: `-x`, `(-x)`, `[-1]`
+            let before = out.chars().rev().nth(1);
+            let unary = prev == '-' && matches!(before, None | Some('(' | '['));
+            if glue_next || unary || matches!(prev, '(' | '[' | '.') {
+                continue;
+            }
+        }
+        out.push(c);
+    }
+    out
+}
+
+/// Tokens whose first and last spans are those of `a` and `b`: an error on them underlines
+/// everything from `a` to `b`.
+fn range(a: &impl ToTokens, b: &impl ToTokens) -> TokenStream {
+    let mut t = a.to_token_stream();
+    t.extend(b.to_token_stream());
+    t
+}
+
+/// "1 coordinate", "2 coordinates"
+fn count(n: usize, what: &str) -> String {
+    if n == 1 {
+        format!("1 {what}")
+    } else {
+        format!("{n} {what}s")
+    }
+}
 
 /// What an expression may depend on, and how to say so when it does not.
 #[derive(Clone, Copy)]
@@ -95,6 +152,15 @@ struct Checker {
     dof_spans: Vec<Span>,
     extern_spans: Vec<(String, Span)>,
     defaults: Vec<f64>,
+    /// parameters whose default could not be computed (an error was reported): checks of
+    /// values that depend on them are skipped rather than fail in cascade
+    bad_params: Vec<bool>,
+    /// "body", "frame" or "point" for each declared name of those kinds
+    kinds: FxHashMap<String, &'static str>,
+    /// a TOG[…] target could not be resolved (then "has no pose" would be a cascade)
+    tog_target_error: bool,
+    /// a body or frame was named `ground` (reported; then TOG[ground] is a cascade)
+    ground_declared: bool,
     /// inline-function call depth, against runaway recursion
     depth: usize,
 }
@@ -123,6 +189,10 @@ pub fn check(def: &ModelDef) -> Result<Checked, syn::Error> {
         dof_spans: Vec::new(),
         extern_spans: Vec::new(),
         defaults: Vec::new(),
+        bad_params: Vec::new(),
+        kinds: FxHashMap::default(),
+        tog_target_error: false,
+        ground_declared: false,
         depth: 0,
     };
     c.sys.docs = def.docs.clone();
@@ -153,12 +223,22 @@ impl Checker {
         self.errors.push(err(span, msg));
     }
 
-    fn reserved(&mut self, name: &Ident) -> bool {
+    /// An error underlining all of `tokens` (an expression, a call, …).
+    fn error_at(&mut self, tokens: &impl ToTokens, msg: impl std::fmt::Display) {
+        self.errors
+            .push(syn::Error::new_spanned(tokens, msg.to_string()));
+    }
+
+    /// `what`: the construct being named ("parameter", "body", …)
+    fn reserved(&mut self, name: &Ident, what: &str) -> bool {
         let s = name.to_string();
         if RESERVED.contains(&s.as_str()) {
             self.error(
                 name.span(),
-                format!("`{s}` is a reserved name in multibody!; choose another name"),
+                format!(
+                    "`{s}` is reserved for {}: give this {what} another name",
+                    reserved_meaning(&s)
+                ),
             );
             return true;
         }
@@ -170,22 +250,31 @@ impl Checker {
         for item in &def.items {
             match item {
                 Item::Param { name, value } => {
-                    if self.reserved(name) || self.duplicate_scalar(name) {
+                    if self.reserved(name, "parameter") || self.duplicate_scalar(name) {
                         continue;
                     }
+                    let before = self.errors.len();
                     let e = self.lower(value, CONSTANT);
-                    let v = self.sys.arena.as_num(e);
-                    let default = match v {
-                        Some(v) if v.is_finite() => v,
-                        Some(_) => {
-                            self.error(
-                                value.span(),
-                                format!("the default of parameter `{name}` is not finite"),
-                            );
-                            0.0
-                        }
-                        None => 0.0,
+                    let mut bad = self.errors.len() > before;
+                    let v = match self.sys.arena.as_num(e) {
+                        Some(v) => v,
+                        None => self.sys.arena.eval(&[e], &SliceEnv::default())[0],
                     };
+                    let default = if bad {
+                        0.0
+                    } else if v.is_finite() {
+                        v
+                    } else {
+                        self.error_at(
+                            value,
+                            format!(
+                                "the default of parameter `{name}` is {v}: give it a finite value"
+                            ),
+                        );
+                        bad = true;
+                        0.0
+                    };
+                    self.bad_params.push(bad);
                     self.scalars
                         .insert(name.to_string(), Scalar::Param(self.sys.params.len()));
                     self.sys.params.push(ParamDef {
@@ -195,7 +284,8 @@ impl Checker {
                     self.defaults.push(default);
                 }
                 Item::Let { name, value } => {
-                    if !self.reserved(name) && !self.duplicate_scalar(name) {
+                    let ok = !self.reserved(name, "`let`") && !self.duplicate_scalar(name);
+                    if ok {
                         self.scalars
                             .insert(name.to_string(), Scalar::Let(value.clone()));
                     }
@@ -205,12 +295,12 @@ impl Checker {
                     let display = match name {
                         DofName::Indexed(k, s) => {
                             if *k != i {
-                                self.error(*s, format!("coordinates are numbered in declaration order: this is the coordinate number {i}, write `dof q[{i}]` (or declare q[{k}] in its place)"));
+                                self.error(*s, format!("`dof q[{k}]` is out of order: coordinates are numbered in declaration order and this one is q[{i}]; write `dof q[{i}]` (or give it a name: `dof knee;`)"));
                             }
                             format!("q[{i}]")
                         }
                         DofName::Named(id) => {
-                            if self.reserved(id) || self.duplicate_scalar(id) {
+                            if self.reserved(id, "coordinate") || self.duplicate_scalar(id) {
                                 continue;
                             }
                             self.scalars.insert(id.to_string(), Scalar::Dof(i));
@@ -226,22 +316,24 @@ impl Checker {
                     self.dof_spans.push(*span);
                 }
                 Item::Input { name } => {
-                    if !self.reserved(name) && !self.duplicate_scalar(name) {
+                    let ok = !self.reserved(name, "input") && !self.duplicate_scalar(name);
+                    if ok {
                         self.scalars
                             .insert(name.to_string(), Scalar::Input(self.sys.inputs.len()));
                         self.sys.inputs.push(name.to_string());
                     }
                 }
                 Item::Body { name, .. } | Item::Frame { name } => {
-                    if self.reserved(name) {
+                    let kind = if matches!(item, Item::Body { .. }) {
+                        "body"
+                    } else {
+                        "frame"
+                    };
+                    self.ground_declared |= name == "ground";
+                    if self.reserved(name, kind) || self.duplicate_frame_or_point(name) {
                         continue;
                     }
-                    if self.frame_names.contains_key(&name.to_string())
-                        || self.points.contains_key(&name.to_string())
-                    {
-                        self.error(name.span(), format!("duplicate body or frame `{name}`: each body, frame and point needs its own name"));
-                        continue;
-                    }
+                    self.kinds.insert(name.to_string(), kind);
                     self.frame_names
                         .insert(name.to_string(), self.sys.frames.len());
                     self.frame_spans.push(name.span());
@@ -254,15 +346,10 @@ impl Checker {
                     });
                 }
                 Item::Point { name, .. } => {
-                    if self.reserved(name) {
+                    if self.reserved(name, "point") || self.duplicate_frame_or_point(name) {
                         continue;
                     }
-                    if self.frame_names.contains_key(&name.to_string())
-                        || self.points.contains_key(&name.to_string())
-                    {
-                        self.error(name.span(), format!("duplicate point `{name}`: each body, frame and point needs its own name"));
-                        continue;
-                    }
+                    self.kinds.insert(name.to_string(), "point");
                     self.points.insert(name.to_string(), self.sys.points.len());
                     let z = self.sys.arena.zero();
                     self.sys.points.push(PointDef {
@@ -274,6 +361,18 @@ impl Checker {
                 Item::Fn { name, args, body } => {
                     if self.duplicate_fn(name) {
                         continue;
+                    }
+                    for (k, a) in args.iter().enumerate() {
+                        if args[..k].iter().any(|b| b == a) {
+                            self.error(
+                                a.span(),
+                                format!(
+                                    "`fn {name}` has two arguments named `{a}`: rename one of them"
+                                ),
+                            );
+                        } else {
+                            self.reserved(a, "argument");
+                        }
                     }
                     self.fns.insert(
                         name.to_string(),
@@ -304,7 +403,7 @@ impl Checker {
                 }
                 Item::EffectBlock { name, .. } => {
                     if self.effects.contains_key(&name.to_string()) {
-                        self.error(name.span(), format!("duplicate effect `{name}`"));
+                        self.error(name.span(), format!("duplicate effect `{name}`: each `effect` block needs its own name; rename one of them or merge their statements"));
                         continue;
                     }
                     self.effects
@@ -327,17 +426,29 @@ impl Checker {
         false
     }
 
+    fn duplicate_frame_or_point(&mut self, name: &Ident) -> bool {
+        match self.kinds.get(&name.to_string()) {
+            Some(kind) => {
+                self.error(name.span(), format!("duplicate name `{name}`: it already names a {kind}; each body, frame and point needs its own name"));
+                true
+            }
+            None => false,
+        }
+    }
+
     fn duplicate_fn(&mut self, name: &Ident) -> bool {
         let s = name.to_string();
-        if self.fns.contains_key(&s)
-            || Func::from_name(&s).is_some()
-            || matches!(s.as_str(), "atan2" | "powi" | "pow")
-        {
+        if Func::from_name(&s).is_some() || matches!(s.as_str(), "atan2" | "powi" | "pow") {
             self.error(
                 name.span(),
-                format!(
-                    "duplicate function `{name}`: it is already defined (or built in); rename it"
-                ),
+                format!("`{name}` is a built-in function: give yours another name"),
+            );
+            return true;
+        }
+        if self.fns.contains_key(&s) {
+            self.error(
+                name.span(),
+                format!("duplicate function `{name}`: rename one of the two"),
             );
             return true;
         }
@@ -346,6 +457,27 @@ impl Checker {
 
     /// Pass 2: lower every statement in order.
     fn lower_items(&mut self, def: &ModelDef) {
+        // points first: effects may name points declared after them
+        for item in &def.items {
+            if let Item::Point { name, body, at } = item {
+                let Some(&pi) = self.points.get(&name.to_string()) else {
+                    continue;
+                };
+                let frame = self.body_ref(body);
+                let pos = self.triple(
+                    at,
+                    Allow {
+                        what: "a point position",
+                        ..PARAMS_ONLY
+                    },
+                    "a point position",
+                );
+                self.sys.points[pi].frame = frame.flatten();
+                if let Some(p) = pos {
+                    self.sys.points[pi].pos = p;
+                }
+            }
+        }
         let mut dof_i = 0;
         let mut scene_names: FxHashMap<String, ()> = FxHashMap::default();
         for item in &def.items {
@@ -370,24 +502,6 @@ impl Checker {
                     dof_i += 1;
                 }
                 Item::Body { name, props } => self.lower_body(name, props),
-                Item::Point { name, body, at } => {
-                    let Some(&pi) = self.points.get(&name.to_string()) else {
-                        continue;
-                    };
-                    let frame = self.body_ref(body);
-                    let pos = self.triple(
-                        at,
-                        Allow {
-                            what: "a point position",
-                            ..PARAMS_ONLY
-                        },
-                        "a point position",
-                    );
-                    self.sys.points[pi].frame = frame.flatten();
-                    if let Some(p) = pos {
-                        self.sys.points[pi].pos = p;
-                    }
-                }
                 Item::Tog {
                     target,
                     chain,
@@ -411,7 +525,7 @@ impl Checker {
                 }
                 Item::Scene { name, effects } => {
                     if scene_names.insert(name.to_string(), ()).is_some() {
-                        self.error(name.span(), format!("duplicate scene `{name}`"));
+                        self.error(name.span(), format!("duplicate scene `{name}`: each scene is a type (`{}{name}`) and needs its own name; rename one of them", def.name));
                         continue;
                     }
                     let mut list = Vec::new();
@@ -421,7 +535,7 @@ impl Checker {
                                 if list.contains(&i) {
                                     self.error(
                                         e.span(),
-                                        format!("effect `{e}` is listed twice in scene `{name}`"),
+                                        format!("effect `{e}` is listed twice in scene `{name}`: remove one"),
                                     );
                                 }
                                 list.push(i);
@@ -435,7 +549,7 @@ impl Checker {
                                         did_you_mean(
                                             &e.to_string(),
                                             names.iter().map(String::as_str),
-                                            "declare it with `effect NAME { … }`"
+                                            &format!("declare it with `effect {e} {{ … }}`")
                                         )
                                     ),
                                 );
@@ -483,10 +597,11 @@ impl Checker {
             match key.to_string().as_str() {
                 "mass" => {
                     let m = self.lower(value, Allow { what: "a mass", ..PARAMS_ONLY });
-                    let mv = self.eval_default(m);
-                    if mv <= 0.0 || !mv.is_finite() {
-                        let how = if self.sys.arena.is_const(m) { "" } else { " with the default parameters" };
-                        self.error(value.span(), format!("the mass of body `{name}` must be positive, it is {mv}{how}: give it a positive mass, or declare a massless `frame {name};`"));
+                    if let Some(mv) = self.eval_default(m) {
+                        if mv <= 0.0 || !mv.is_finite() {
+                            let how = self.with_defaults(m);
+                            self.error_at(value, format!("the mass of body `{name}` must be positive, it is {mv}{how}: give it a positive mass, or declare a massless `frame {name};`"));
+                        }
                     }
                     mass = Some(m);
                 }
@@ -497,21 +612,29 @@ impl Checker {
                         _ => Vec::new(),
                     };
                     if elems.len() != 3 && elems.len() != 6 {
-                        self.error(value.span(), "inertia is `(Ixx, Iyy, Izz)` or `(Ixx, Iyy, Izz, Ixy, Ixz, Iyz)`, about G in body axes");
+                        let found = if matches!(value, Expr::Tuple(_)) { format!("{} values", elems.len()) } else { format!("`{}`", text(value)) };
+                        self.error_at(value, format!("the inertia of body `{name}` is `(Ixx, Iyy, Izz)` or `(Ixx, Iyy, Izz, Ixy, Ixz, Iyz)`, about G in body axes; found {found}"));
                         continue;
                     }
                     let mut t = [self.sys.arena.zero(); 6];
                     for (i, e) in elems.iter().enumerate() {
                         t[i] = self.lower(e, a);
                     }
-                    let vals: Vec<f64> = t.iter().map(|&e| self.eval_default(e)).collect();
-                    let vals6 = [vals[0], vals[1], vals[2], vals.get(3).copied().unwrap_or(0.0), vals.get(4).copied().unwrap_or(0.0), vals.get(5).copied().unwrap_or(0.0)];
-                    if let Some(msg) = super::inertia::inertia_problem(vals6) {
-                        self.error(value.span(), format!("inertia of body `{name}`: {msg}"));
+                    let vals: Option<Vec<f64>> = t.iter().map(|&e| self.eval_default(e)).collect();
+                    if let Some(v) = vals {
+                        if let Some(msg) = super::inertia::inertia_problem([v[0], v[1], v[2], v[3], v[4], v[5]]) {
+                            let how = self.with_defaults_all(&t);
+                            let fix = if msg.contains("triangle") {
+                                "; each principal moment must be at most the sum of the other two (a thin plate in the xy plane has Izz = Ixx + Iyy)"
+                            } else {
+                                ""
+                            };
+                            self.error_at(value, format!("the inertia of body `{name}` is impossible{how}: {msg}{fix}"));
+                        }
                     }
                     tensor = Some(t);
                 }
-                other => self.error(key.span(), format!("unknown body property `{other}`: a body has `mass = …;` and `inertia = (Ixx, Iyy, Izz[, Ixy, Ixz, Iyz]);`")),
+                other => self.error(key.span(), format!("unknown property `{other}` of body `{name}`: a body has `mass = …;` and `inertia = (Ixx, Iyy, Izz[, Ixy, Ixz, Iyz]);`")),
             }
         }
         match (mass, tensor) {
@@ -525,12 +648,33 @@ impl Checker {
         }
     }
 
-    fn eval_default(&self, e: ExprId) -> f64 {
+    /// The value of a parameter expression with the default parameters; `None` when it
+    /// depends on a parameter whose default is in error (already reported).
+    fn eval_default(&self, e: ExprId) -> Option<f64> {
+        let bad = self.sys.arena.vars_of(&[e]).into_iter().any(|v| {
+            matches!(v, Var::Param(i) if self.bad_params.get(i as usize).copied().unwrap_or(false))
+        });
+        if bad {
+            return None;
+        }
         let env = SliceEnv {
             params: &self.defaults,
             ..SliceEnv::default()
         };
-        self.sys.arena.eval(&[e], &env)[0]
+        Some(self.sys.arena.eval(&[e], &env)[0])
+    }
+
+    /// " with the default parameters" when `e` depends on parameters.
+    fn with_defaults(&self, e: ExprId) -> &'static str {
+        self.with_defaults_all(&[e])
+    }
+
+    fn with_defaults_all(&self, e: &[ExprId]) -> &'static str {
+        if e.iter().all(|&x| self.sys.arena.is_const(x)) {
+            ""
+        } else {
+            " with the default parameters"
+        }
     }
 
     /// A body/frame reference: `Some(None)` is the ground, `None` an error already reported.
@@ -539,6 +683,13 @@ impl Checker {
             BodyRef::Name(id) if id == "ground" => Some(None),
             BodyRef::Name(id) => match self.frame_names.get(&id.to_string()) {
                 Some(&i) => Some(Some(i)),
+                None if self.points.contains_key(&id.to_string()) => {
+                    self.error(
+                        id.span(),
+                        format!("`{id}` is a point, not a body or frame: name the body it is on, or the ground"),
+                    );
+                    None
+                }
                 None => {
                     let names: Vec<String> = self.frame_names.keys().cloned().collect();
                     self.error(
@@ -548,7 +699,7 @@ impl Checker {
                             did_you_mean(
                                 &id.to_string(),
                                 names.iter().map(String::as_str),
-                                "declare it with `body NAME { … }` or `frame NAME;`"
+                                &format!("declare it with `body {id} {{ … }}` or `frame {id};`")
                             )
                         ),
                     );
@@ -559,7 +710,30 @@ impl Checker {
                 if *i < self.sys.frames.len() {
                     Some(Some(*i))
                 } else {
-                    self.error(*s, format!("TOG[{i}] is out of range: the model declares {} bodies and frames, numbered from 0", self.sys.frames.len()));
+                    let n = self.sys.frames.len();
+                    let listed: Vec<String> = self
+                        .sys
+                        .frames
+                        .iter()
+                        .enumerate()
+                        .take(8)
+                        .map(|(k, f)| format!("{k} is `{}`", f.name))
+                        .collect();
+                    let more = if n > 8 { ", …" } else { "" };
+                    let numbering = if n == 0 {
+                        "the model declares no body or frame".to_string()
+                    } else {
+                        format!(
+                            "bodies and frames are numbered from 0 in declaration order ({}{more})",
+                            listed.join(", ")
+                        )
+                    };
+                    self.error(
+                        *s,
+                        format!(
+                            "TOG[{i}] is out of range: {numbering}; or write the name, TOG[name]"
+                        ),
+                    );
                     None
                 }
             }
@@ -572,7 +746,13 @@ impl Checker {
                 self.body_ref(&BodyRef::Name(p.path.get_ident().unwrap().clone()))
             }
             _ => {
-                self.error(e.span(), "expected a body or frame name");
+                self.error_at(
+                    e,
+                    format!(
+                        "expected the name of a body, a frame or `ground`, found `{}`",
+                        text(e)
+                    ),
+                );
                 None
             }
         }
@@ -580,20 +760,23 @@ impl Checker {
 
     fn lower_tog(&mut self, target: &BodyRef, chain: &Expr, span: Span) {
         let Some(t) = self.body_ref(target) else {
+            self.tog_target_error = true;
             return;
         };
         let Some(fi) = t else {
-            self.error(
-                target.span(),
-                "the ground does not move: TOG[ground] cannot be assigned",
-            );
+            if !self.ground_declared {
+                self.error(
+                    target.span(),
+                    "the ground is fixed: TOG[ground] cannot be assigned; for a fixed frame elsewhere, declare `frame base;` and `TOG[base] = Tdisp(x, y, z);`",
+                );
+            }
             return;
         };
         if self.tog_defined[fi] {
             self.error(
                 span,
                 format!(
-                    "TOG[{}] is defined twice: each body and frame has one TOG",
+                    "TOG[{}] is defined twice: each body and frame has one pose; remove one of the two",
                     self.sys.frames[fi].name
                 ),
             );
@@ -601,6 +784,8 @@ impl Checker {
         }
         let mut leaves = Vec::new();
         if !self.flatten_product(chain, &mut leaves) {
+            // counts as defined: its children and the final checks should not fail in cascade
+            self.tog_defined[fi] = true;
             return;
         }
         let what: &'static str = "a transform (TOG)";
@@ -610,9 +795,13 @@ impl Checker {
             if let Expr::Index(ix) = leaf {
                 if matches!(&*ix.expr, Expr::Path(p) if p.path.is_ident("TOG")) {
                     if k != 0 {
-                        self.error(
-                            leaf.span(),
-                            "TOG[…] may only start a product: write `TOG[parent] * Tdisp(…) * …`",
+                        self.error_at(
+                            leaf,
+                            format!(
+                                "`{}` may only start a product: write `{} * Tdisp(…) * …`",
+                                text(leaf),
+                                text(leaf)
+                            ),
                         );
                         continue;
                     }
@@ -631,13 +820,13 @@ impl Checker {
                             }
                         },
                         other => {
-                            self.error(other.span(), "expected a body name or number in TOG[…]");
+                            self.error_at(other, "expected a body name or number in TOG[…]");
                             continue;
                         }
                     };
                     match self.body_ref(&r) {
-                        Some(Some(p)) if p == fi => self.error(r.span(), format!("TOG[{}] cannot refer to itself: start from its parent's TOG", self.sys.frames[fi].name)),
-                        Some(Some(p)) if !self.tog_defined[p] => self.error(r.span(), format!("TOG[{}] is used before it is defined: define TOG[{}] earlier (a product may refer only to earlier bodies)", self.sys.frames[p].name, self.sys.frames[p].name)),
+                        Some(Some(p)) if p == fi => self.error(r.span(), format!("TOG[{}] cannot refer to itself: start from its parent's pose, `TOG[parent] * …`, or from the ground", self.sys.frames[fi].name)),
+                        Some(Some(p)) if !self.tog_defined[p] => self.error(r.span(), format!("TOG[{}] is used before it is defined: move `TOG[{}] = …;` above this line (a pose may refer only to poses defined earlier)", self.sys.frames[p].name, self.sys.frames[p].name)),
                         Some(p) => parent = p,
                         None => {}
                     }
@@ -661,7 +850,7 @@ impl Checker {
                 self.flatten_product(&b.left, out) && self.flatten_product(&b.right, out)
             }
             Expr::Binary(b) => {
-                self.error(b.op.span(), "transforms combine by products only: write `TOG[parent] * Trotz(q[0]) * Tdisp(x, y, z)`");
+                self.error(b.op.span(), format!("transforms combine by products only, not `{}`: write `TOG[parent] * Trotz(q[0]) * Tdisp(x, y, z)`", text(&b.op)));
                 false
             }
             Expr::Paren(p) => self.flatten_product(&p.expr, out),
@@ -675,28 +864,39 @@ impl Checker {
 
     /// One transform factor; `None` after an error, an empty list for an identity.
     fn lower_factor(&mut self, e: &Expr, what: &'static str) -> Option<Vec<Factor>> {
-        let bad = "expected a transform: Tdisp(x, y, z), Trotx(a), Troty(a), Trotz(a), Trotn(nx, ny, nz, a) or TOG[body]";
-        let Expr::Call(call) = e else {
-            self.error(e.span(), bad);
-            return None;
+        const TRANSFORMS: &str =
+            "Tdisp(x, y, z), Trotx(a), Troty(a), Trotz(a) and Trotn(nx, ny, nz, a)";
+        let not_a_transform = |c: &mut Checker, found: &str| {
+            c.error_at(
+                e,
+                format!("expected a transform, found {found}: a pose (TOG) is a product of {TRANSFORMS}, possibly starting with TOG[parent]"),
+            );
         };
-        let Expr::Path(p) = &*call.func else {
-            self.error(e.span(), bad);
-            return None;
+        let name = match e {
+            Expr::Call(call) => match &*call.func {
+                Expr::Path(p) => p.path.get_ident(),
+                _ => None,
+            },
+            _ => None,
         };
-        let Some(name) = p.path.get_ident() else {
-            self.error(e.span(), bad);
+        let (Expr::Call(call), Some(name)) = (e, name) else {
+            let found = match e {
+                Expr::Lit(_) => format!("the number `{}`", text(e)),
+                Expr::Path(_) => format!("`{}`", text(e)),
+                _ => format!("the expression `{}`", text(e)),
+            };
+            not_a_transform(self, &found);
             return None;
         };
         let args: Vec<&Expr> = call.args.iter().collect();
         let a = Allow { what, ..POSITION };
-        let arity = |c: &mut Checker, n: usize| {
+        let arity = |c: &mut Checker, n: usize, usage: &str| {
             if args.len() != n {
-                c.error(
-                    call.span(),
+                c.error_at(
+                    call,
                     format!(
-                        "`{name}` takes {n} argument{}, found {}",
-                        if n == 1 { "" } else { "s" },
+                        "`{name}` takes {}, found {}: write `{usage}`",
+                        count(n, "argument"),
                         args.len()
                     ),
                 );
@@ -716,7 +916,7 @@ impl Checker {
         };
         match name.to_string().as_str() {
             "Tdisp" => {
-                if !arity(self, 3) {
+                if !arity(self, 3, "Tdisp(x, y, z)") {
                     return None;
                 }
                 let d = [
@@ -729,11 +929,17 @@ impl Checker {
                 }
                 Some(vec![Factor::Disp(d)])
             }
-            "Trotx" => arity(self, 1).then(|| rot(self, [o, z, z])).flatten(),
-            "Troty" => arity(self, 1).then(|| rot(self, [z, o, z])).flatten(),
-            "Trotz" => arity(self, 1).then(|| rot(self, [z, z, o])).flatten(),
+            "Trotx" => arity(self, 1, "Trotx(angle)")
+                .then(|| rot(self, [o, z, z]))
+                .flatten(),
+            "Troty" => arity(self, 1, "Troty(angle)")
+                .then(|| rot(self, [z, o, z]))
+                .flatten(),
+            "Trotz" => arity(self, 1, "Trotz(angle)")
+                .then(|| rot(self, [z, z, o]))
+                .flatten(),
             "Trotn" => {
-                if !arity(self, 4) {
+                if !arity(self, 4, "Trotn(nx, ny, nz, angle)") {
                     return None;
                 }
                 let pa = Allow {
@@ -745,21 +951,8 @@ impl Checker {
                     self.lower(args[1], pa),
                     self.lower(args[2], pa),
                 ];
-                let v: Vec<f64> = n.iter().map(|&x| self.eval_default(x)).collect();
-                let norm = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-                let span = args[0]
-                    .span()
-                    .join(args[2].span())
-                    .unwrap_or(args[0].span());
-                if norm == 0.0 {
-                    self.error(
-                        span,
-                        "the axis of Trotn is zero: give a unit axis, e.g. Trotn(0, 0, 1, a)",
-                    );
-                    return None;
-                }
-                if (norm - 1.0).abs() > 1e-9 {
-                    self.error(span, format!("Trotn needs a unit axis; ({}, {}, {}) has norm {norm}: divide it by its norm", v[0], v[1], v[2]));
+                let axis_tokens = range(args[0], args[2]);
+                if !self.unit_axis(&n, &axis_tokens, "Trotn", "Trotn(nx, ny, nz, angle)") {
                     return None;
                 }
                 rot(self, n)
@@ -770,12 +963,67 @@ impl Checker {
                     name.span(),
                     format!(
                         "unknown transform `{other}`{}",
-                        did_you_mean(other, known.into_iter(), bad)
+                        did_you_mean(
+                            other,
+                            known.into_iter(),
+                            &format!("the transforms are {TRANSFORMS}")
+                        )
                     ),
                 );
                 None
             }
         }
+    }
+
+    /// Checks that an axis (parameters only) is a unit vector with the default parameters;
+    /// `usage` shows where it goes, with `nx, ny, nz` in it.
+    fn unit_axis(&mut self, n: &[ExprId; 3], at: &TokenStream, of: &str, usage: &str) -> bool {
+        let (Some(x), Some(y), Some(z)) = (
+            self.eval_default(n[0]),
+            self.eval_default(n[1]),
+            self.eval_default(n[2]),
+        ) else {
+            return true;
+        };
+        let how = self.with_defaults_all(n);
+        let n2 = x * x + y * y + z * z;
+        if n2 == 0.0 {
+            self.error_at(
+                at,
+                format!(
+                    "the axis of {of} is zero{how}: give a unit vector, e.g. `{}`",
+                    usage.replace("nx, ny, nz", "0, 0, 1")
+                ),
+            );
+            return false;
+        }
+        if (n2.sqrt() - 1.0).abs() > 1e-9 {
+            let norm = n2.sqrt();
+            let integers = [x, y, z].iter().all(|v| v.fract() == 0.0);
+            let example = if integers && how.is_empty() {
+                let c = |v: f64| {
+                    if v == 0.0 {
+                        "0".to_string()
+                    } else if norm.fract() == 0.0 {
+                        format!("{}", v / norm)
+                    } else {
+                        format!("{v} / sqrt({n2})")
+                    }
+                };
+                format!(
+                    ": `{}`",
+                    usage.replace("nx, ny, nz", &format!("{}, {}, {}", c(x), c(y), c(z)))
+                )
+            } else {
+                String::new()
+            };
+            self.error_at(
+                at,
+                format!("the axis of {of} must be a unit vector, but ({x}, {y}, {z}) has norm {norm}{how}: divide it by its norm{example}"),
+            );
+            return false;
+        }
+        true
     }
 
     /// `(x, y, z)` → three expressions.
@@ -787,7 +1035,10 @@ impl Checker {
             }
             Expr::Paren(p) => self.triple(&p.expr, a, what),
             _ => {
-                self.error(e.span(), format!("{what} is a vector `(x, y, z)`"));
+                self.error_at(
+                    e,
+                    format!("{what} is a vector `(x, y, z)`, found `{}`", text(e)),
+                );
                 None
             }
         }
@@ -830,14 +1081,20 @@ impl Checker {
                         did_you_mean(
                             &s,
                             names.iter().map(String::as_str),
-                            "declare it with `point NAME on BODY at (x, y, z);`"
+                            &format!("declare it with `point {s} on BODY at (x, y, z);`")
                         )
                     ),
                 );
                 return None;
             }
         }
-        self.error(e.span(), "expected a point or body name");
+        self.error_at(
+            e,
+            format!(
+                "expected the name of a point, a body or `ground`, found `{}`",
+                text(e)
+            ),
+        );
         None
     }
 
@@ -851,17 +1108,25 @@ impl Checker {
             "torque" => &["frame", "relative_to", "axis"],
             _ => &[],
         };
-        for (k, _) in &s.named {
-            if !known_named.contains(&k.to_string().as_str()) {
-                let list = if known_named.is_empty() {
-                    "none".to_string()
-                } else {
-                    known_named.join(", ")
-                };
+        for (i, (k, _)) in s.named.iter().enumerate() {
+            if s.named[..i].iter().any(|(j, _)| j == k) {
                 self.error(
                     k.span(),
-                    format!("`{kind}` has no argument `{k}`; its named arguments: {list}"),
+                    format!("argument `{k}` is given twice: remove one"),
                 );
+            } else if !known_named.contains(&k.to_string().as_str()) {
+                let list = match known_named {
+                    [] => format!("`{kind}` takes no named argument"),
+                    [one] => format!("its only named argument is `{one}`"),
+                    [init @ .., last] => format!(
+                        "its named arguments are {} and `{last}`",
+                        init.iter()
+                            .map(|a| format!("`{a}`"))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    ),
+                };
+                self.error(k.span(), format!("`{kind}` has no argument `{k}`; {list}"));
             }
         }
         let npos = |c: &mut Checker, n: usize, usage: &str| {
@@ -869,8 +1134,8 @@ impl Checker {
                 c.error(
                     s.kind.span(),
                     format!(
-                        "`{kind}` takes {n} positional argument{}, found {}: write `{usage}`",
-                        if n == 1 { "" } else { "s" },
+                        "`{kind}` takes {}, found {}: write `{usage}`",
+                        count(n, "positional argument"),
                         s.positional.len()
                     ),
                 );
@@ -913,14 +1178,25 @@ impl Checker {
                 else {
                     return out;
                 };
+                if a.frame == b.frame && a.pos == b.pos {
+                    self.error_at(
+                        &range(&s.positional[0], &s.positional[1]),
+                        format!(
+                            "this {kind} joins `{}` to itself, so it has no length or direction: attach its ends to two different points",
+                            text(&s.positional[0])
+                        ),
+                    );
+                    return out;
+                }
                 if kind == "spring" {
                     let Some(k) = named("k") else {
                         self.error(
                             s.kind.span(),
-                            "a spring needs its stiffness: `spring(a, b, k = …, l0 = …)`",
+                            "a spring needs its stiffness: add `k = …`, as in `spring(a, b, k = …, l0 = …)`",
                         );
                         return out;
                     };
+                    let k_expr = k;
                     let k = self.lower(
                         k,
                         Allow {
@@ -928,20 +1204,19 @@ impl Checker {
                             ..pa
                         },
                     );
-                    if self.eval_default(k) < 0.0 {
-                        self.error(
-                            named("k").unwrap().span(),
-                            "a spring stiffness must not be negative",
-                        );
-                    }
+                    self.not_negative(k, k_expr, "the stiffness `k` of a spring");
                     let l0 = match named("l0") {
-                        Some(e) => self.lower(
-                            e,
-                            Allow {
-                                what: "a rest length",
-                                ..pa
-                            },
-                        ),
+                        Some(e) => {
+                            let l0 = self.lower(
+                                e,
+                                Allow {
+                                    what: "a rest length",
+                                    ..pa
+                                },
+                            );
+                            self.not_negative(l0, e, "the rest length `l0` of a spring");
+                            l0
+                        }
                         None => self.sys.arena.zero(),
                     };
                     out.push(Load::Spring { a, b, k, l0 });
@@ -950,17 +1225,18 @@ impl Checker {
                 if kind == "damper" && c_expr.is_none() {
                     self.error(
                         s.kind.span(),
-                        "a damper needs its coefficient: `damper(a, b, c = …)`",
+                        "a damper needs its coefficient: add `c = …`, as in `damper(a, b, c = …)`",
                     );
                 }
-                if let Some(c) = c_expr {
+                if let Some(e) = c_expr {
                     let c = self.lower(
-                        c,
+                        e,
                         Allow {
                             what: "a damping coefficient",
                             ..pa
                         },
                     );
+                    self.not_negative(c, e, &format!("the damping coefficient `c` of a {kind}"));
                     out.push(Load::Damper { a, b, c });
                 }
             }
@@ -992,22 +1268,34 @@ impl Checker {
                     ) {
                         return out;
                     }
+                    if let Some((k, _)) = s.named.iter().find(|(k, _)| k == "frame") {
+                        self.error(k.span(), "`frame` does not go with `axis`: the axis is in the axes of the body the torque acts on; remove `frame = …`");
+                    }
                     let z = self.sys.arena.zero();
                     let o = self.sys.arena.one();
                     let dir = match axis {
                         Expr::Path(p) if p.path.is_ident("x") => Some([o, z, z]),
                         Expr::Path(p) if p.path.is_ident("y") => Some([z, o, z]),
                         Expr::Path(p) if p.path.is_ident("z") => Some([z, z, o]),
-                        Expr::Tuple(_) => self.triple(
-                            axis,
-                            Allow {
-                                what: "a torque axis",
-                                ..pa
-                            },
-                            "a torque axis",
-                        ),
+                        Expr::Tuple(_) => self
+                            .triple(
+                                axis,
+                                Allow {
+                                    what: "a torque axis",
+                                    ..pa
+                                },
+                                "a torque axis",
+                            )
+                            .filter(|n| {
+                                self.unit_axis(
+                                    n,
+                                    &axis.to_token_stream(),
+                                    "the torque",
+                                    "torque(body, axis = (nx, ny, nz), value)",
+                                )
+                            }),
                         _ => {
-                            self.error(axis.span(), "the axis is x, y, z or a unit vector (nx, ny, nz), in the body's axes");
+                            self.error_at(axis, format!("unknown torque axis `{}`: write `axis = x`, `y`, `z` or a unit vector `(nx, ny, nz)`, in the axes of the body", text(axis)));
                             None
                         }
                     };
@@ -1033,10 +1321,14 @@ impl Checker {
                     (on, torque, frame, reaction)
                 {
                     if on.is_none() {
-                        self.error(
-                            s.positional[0].span(),
-                            "a torque on the ground does nothing: apply it to a body",
-                        );
+                        let msg = match reaction {
+                            Some(Some(r)) => format!(
+                                "a torque on the ground does nothing, the ground does not move: put it on `{}` with the opposite sign",
+                                self.sys.frames[r].name
+                            ),
+                            _ => "a torque on the ground does nothing, the ground does not move: apply it to a body".to_string(),
+                        };
+                        self.error(s.positional[0].span(), msg);
                         return out;
                     }
                     out.push(Load::Torque {
@@ -1072,59 +1364,96 @@ impl Checker {
         out
     }
 
+    /// Reports `value` (on `at`) if it is negative with the default parameters.
+    fn not_negative(&mut self, value: ExprId, at: &Expr, what: &str) {
+        if let Some(v) = self.eval_default(value) {
+            if v < 0.0 {
+                let how = self.with_defaults(value);
+                self.error_at(
+                    at,
+                    format!("{what} must not be negative, it is {v}{how}: give a value ≥ 0"),
+                );
+            }
+        }
+    }
+
     /// `q[2]` or a coordinate name.
     fn dof_ref(&mut self, e: &Expr) -> Option<usize> {
         match e {
             Expr::Index(ix) if matches!(&*ix.expr, Expr::Path(p) if p.path.is_ident("q")) => {
-                self.index_of(&ix.index, "q")
+                self.index_of(&ix.index, "q", e)
             }
             Expr::Path(p) if p.path.get_ident().is_some() => {
                 let id = p.path.get_ident().unwrap();
                 match self.scalars.get(&id.to_string()) {
                     Some(Scalar::Dof(i)) => Some(*i),
-                    _ => {
+                    other => {
+                        let is = self.describe(id, other);
                         self.error(
                             id.span(),
-                            format!(
-                                "`{id}` is not a coordinate: write `q[i]` or a coordinate's name"
-                            ),
+                            format!("{is}, not a coordinate: write `q[i]` or a coordinate's name"),
                         );
                         None
                     }
                 }
             }
             _ => {
-                self.error(
-                    e.span(),
-                    "expected a coordinate: `q[i]` or a coordinate's name",
+                self.error_at(
+                    e,
+                    format!(
+                        "expected a coordinate, found `{}`: write `q[i]` or a coordinate's name",
+                        text(e)
+                    ),
                 );
                 None
             }
         }
     }
 
-    /// The index in `v[idx]`: a number in range or a name of the right kind.
-    fn index_of(&mut self, idx: &Expr, v: &str) -> Option<usize> {
-        let (count, kind) = if v == "u" {
-            (self.sys.inputs.len(), "inputs")
+    /// "`k` is a parameter", "`foo` is unknown", … for messages.
+    fn describe(&self, id: &Ident, s: Option<&Scalar>) -> String {
+        let what = match s {
+            Some(Scalar::Param(_)) => "is a parameter",
+            Some(Scalar::Let(_)) => "is a `let`",
+            Some(Scalar::Dof(_)) => "is a coordinate",
+            Some(Scalar::Input(_)) => "is an input",
+            Some(Scalar::Bound(_)) => "is a function argument",
+            None if self.kinds.contains_key(&id.to_string()) => {
+                return format!("`{id}` is a {}", self.kinds[&id.to_string()]);
+            }
+            None => "is not declared",
+        };
+        format!("`{id}` {what}")
+    }
+
+    /// The index in `v[idx]`: a number in range or a name of the right kind. `whole` is the
+    /// indexing expression, for messages.
+    fn index_of(&mut self, idx: &Expr, v: &str, whole: &Expr) -> Option<usize> {
+        let (n, kind) = if v == "u" {
+            (self.sys.inputs.len(), "input")
         } else {
-            (self.sys.dofs.len(), "coordinates")
+            (self.sys.dofs.len(), "coordinate")
         };
         match idx {
             Expr::Lit(syn::ExprLit {
                 lit: syn::Lit::Int(l),
                 ..
             }) => {
-                let i: usize = l.base10_parse().ok()?;
-                if i >= count {
-                    let fix = if v == "u" {
-                        format!("declare it with `input NAME;`")
-                    } else {
-                        format!("declare it with `dof q[{i}] = 0.0;`")
+                let i = l.base10_parse::<usize>().unwrap_or(usize::MAX);
+                if i >= n {
+                    let has = match n {
+                        0 => format!("the model has no {kind}"),
+                        1 => format!("the model has 1 {kind}, {v}[0]"),
+                        _ => format!("the model has {}, {v}[0] to {v}[{}]", count(n, kind), n - 1),
                     };
-                    self.error(
-                        l.span(),
-                        format!("`{v}[{i}]` is out of range: the model has {count} {kind}; {fix}"),
+                    let fix = if v == "u" {
+                        "declare inputs with `input NAME;`".to_string()
+                    } else {
+                        format!("declare coordinates with `dof q[{n}] = 0.0;`")
+                    };
+                    self.error_at(
+                        whole,
+                        format!("`{v}[{}]` is out of range: {has}; {fix}", l.base10_digits()),
                     );
                     return None;
                 }
@@ -1135,39 +1464,61 @@ impl Checker {
                 match (self.scalars.get(&id.to_string()), v) {
                     (Some(Scalar::Input(i)), "u") => Some(*i),
                     (Some(Scalar::Dof(i)), "q" | "qd" | "qdd") => Some(*i),
-                    _ => {
-                        self.error(id.span(), format!("`{id}` is not one of the {kind}: write `{v}[i]` with a number or a name of the {kind}"));
+                    (other, _) => {
+                        let is = self.describe(id, other);
+                        self.error(
+                            id.span(),
+                            format!(
+                                "{is}, not {}: index `{v}[…]` with a number or the name of {}",
+                                if kind == "input" {
+                                    "an input"
+                                } else {
+                                    "a coordinate"
+                                },
+                                if kind == "input" {
+                                    "an input"
+                                } else {
+                                    "a coordinate"
+                                }
+                            ),
+                        );
                         None
                     }
                 }
             }
             other => {
-                self.error(
-                    other.span(),
-                    format!("the index of `{v}[…]` is a number or a name"),
+                self.error_at(
+                    other,
+                    format!(
+                        "the index of `{v}[…]` is a number or a name, found `{}`",
+                        text(other)
+                    ),
                 );
                 None
             }
         }
     }
 
-    fn not_allowed(&mut self, span: Span, thing: &str, a: Allow) -> ExprId {
+    /// `thing` (as written: "velocity `qd[0]`") may not appear where `a` says.
+    fn not_allowed(&mut self, at: &impl ToTokens, thing: &str, kind: &str, a: Allow) -> ExprId {
         let what = if a.what.is_empty() {
             "this expression"
         } else {
             a.what
         };
-        let hint = match thing {
+        let hint = match kind {
             "qd" | "qdd" => {
-                "positions and constants cannot depend on velocities or accelerations; use them in effects"
+                if a.q {
+                    "a pose depends only on q, t and parameters; velocities and accelerations belong in the values of forces, torques and generalized forces".to_string()
+                } else {
+                    "velocities and accelerations belong in the values of forces, torques and generalized forces".to_string()
+                }
             }
-            "u" => "inputs act through effects (forces, torques), not here",
-            "q" | "t" => {
-                "this value must be constant during the motion: use parameters and numbers"
-            }
-            _ => "use numbers and parameters only",
+            "u" => "inputs belong in the values of forces, torques and generalized forces".to_string(),
+            _ if !a.params => "a parameter default is a number; to derive a quantity from parameters, use `let NAME = …;`".to_string(),
+            _ => format!("{what} is constant during the motion, so it may use numbers and parameters only"),
         };
-        self.error(span, format!("`{thing}` cannot appear in {what}: {hint}"));
+        self.error_at(at, format!("{thing} cannot appear in {what}: {hint}"));
         self.sys.arena.zero()
     }
 
@@ -1190,7 +1541,7 @@ impl Checker {
                     }
                 },
                 other => {
-                    self.error(other.span(), "expected a number");
+                    self.error_at(other, format!("expected a number, found `{}`", text(other)));
                     self.sys.arena.zero()
                 }
             },
@@ -1202,7 +1553,7 @@ impl Checker {
                     self.sys.arena.neg(x)
                 }
                 _ => {
-                    self.error(u.op.span(), "only `-` is a unary operator in expressions");
+                    self.error(u.op.span(), format!("`{}` is not an operator of multibody! expressions: the only unary operator is `-`", text(&u.op)));
                     self.sys.arena.zero()
                 }
             },
@@ -1216,31 +1567,57 @@ impl Checker {
                     syn::BinOp::Mul(_) => ar.mul(x, y),
                     syn::BinOp::Div(_) => {
                         if ar.is_num(y, 0.0) {
-                            self.error(b.right.span(), "division by zero");
+                            self.error_at(&b.right, "division by zero: the divisor is zero");
                             return self.sys.arena.zero();
                         }
                         ar.div(x, y)
                     }
                     syn::BinOp::BitXor(_) => {
-                        let e = err(
-                            b.op.span(),
-                            "`^` is not a power in Rust: write `powi(x, 2)` for an integer power or `pow(x, y)`",
+                        // `^` binds more loosely than `* /`: `l^2 / 12` is `l ^ (2 / 12)`; the
+                        // power meant is between the operands next to the `^`
+                        let mut base = &*b.left;
+                        while let Expr::Binary(l) = base {
+                            base = &l.right;
+                        }
+                        let mut exp = &*b.right;
+                        while let Expr::Binary(r) = exp {
+                            exp = &r.left;
+                        }
+                        let int = matches!(
+                            exp,
+                            Expr::Lit(syn::ExprLit {
+                                lit: syn::Lit::Int(_),
+                                ..
+                            })
                         );
-                        self.errors.push(e);
+                        let (x, y) = (text(base), text(exp));
+                        let fix = if int {
+                            format!("powi({x}, {y})")
+                        } else {
+                            format!("pow({x}, {y})")
+                        };
+                        self.error_at(
+                            &range(base, exp),
+                            format!(
+                                "`^` is not a power (in Rust it is the bitwise xor): write `{fix}`"
+                            ),
+                        );
                         self.sys.arena.zero()
                     }
-                    _ => {
-                        let e = err(b.op.span(), "expressions use `+ - * /` and functions");
-                        self.errors.push(e);
+                    op => {
+                        self.error(
+                            b.op.span(),
+                            format!("`{}` is not an operator of multibody! expressions: they use `+ - * /`, parentheses and functions", text(&op)),
+                        );
                         self.sys.arena.zero()
                     }
                 }
             }
             Expr::Path(p) => {
                 let Some(id) = p.path.get_ident() else {
-                    self.error(
-                        p.span(),
-                        "expected a name: paths are allowed only in `extern fn`",
+                    self.error_at(
+                        p,
+                        format!("expected a name, found the path `{}`: paths are allowed only in `extern fn NAME = [path, …];`", text(p)),
                     );
                     return self.sys.arena.zero();
                 };
@@ -1265,9 +1642,9 @@ impl Checker {
                     "qdd" => (a.qd, Var::Qdd),
                     "u" => (a.u, Var::Input),
                     "TOG" => {
-                        self.error(
-                            ix.span(),
-                            "TOG[…] is a transform, not a number: it can only start a TOG product",
+                        self.error_at(
+                            ix,
+                            format!("`{}` is a pose, not a number: it can only start the product of a `TOG[…] = …;`", text(ix)),
                         );
                         return self.sys.arena.zero();
                     }
@@ -1281,12 +1658,18 @@ impl Checker {
                         return self.sys.arena.zero();
                     }
                 };
-                let Some(i) = self.index_of(&ix.index, &v) else {
+                if !allowed {
+                    let thing = match v.as_str() {
+                        "q" => "coordinate",
+                        "qd" => "velocity",
+                        "qdd" => "acceleration",
+                        _ => "input",
+                    };
+                    return self.not_allowed(ix, &format!("{thing} `{}`", text(ix)), &v, a);
+                }
+                let Some(i) = self.index_of(&ix.index, &v, e) else {
                     return self.sys.arena.zero();
                 };
-                if !allowed {
-                    return self.not_allowed(ix.span(), &v, a);
-                }
                 self.sys.arena.var(mk(i as u16))
             }
             Expr::Call(c) => self.lower_call(c, a),
@@ -1308,7 +1691,7 @@ impl Checker {
                 self.lower_call(&call, a)
             }
             other => {
-                self.error(other.span(), "unsupported expression: use numbers, names, q[i], qd[i], u[i], t, + - * / and functions");
+                self.error_at(other, format!("`{}` is not a multibody! expression: use numbers, names, q[i], qd[i], u[i], t, + - * /, parentheses and functions", text(other)));
                 self.sys.arena.zero()
             }
         }
@@ -1319,7 +1702,7 @@ impl Checker {
         match s.as_str() {
             "t" => {
                 if !a.t {
-                    return self.not_allowed(id.span(), "t", a);
+                    return self.not_allowed(id, "the time `t`", "t", a);
                 }
                 return self.sys.arena.var(Var::T);
             }
@@ -1332,51 +1715,58 @@ impl Checker {
             Some(Scalar::Bound(e)) => e,
             Some(Scalar::Param(i)) => {
                 if !a.params {
-                    self.error(
-                        id.span(),
-                        format!(
-                            "`{s}` is a parameter; {} must be a constant number",
-                            if a.what.is_empty() { "this" } else { a.what }
-                        ),
-                    );
-                    return self.sys.arena.zero();
+                    return self.not_allowed(id, &format!("parameter `{s}`"), "param", a);
                 }
                 self.sys.arena.var(Var::Param(i as u16))
             }
             Some(Scalar::Dof(i)) => {
                 if !a.q {
-                    return self.not_allowed(id.span(), "q", a);
+                    return self.not_allowed(id, &format!("coordinate `{s}`"), "q", a);
                 }
                 self.sys.arena.var(Var::Q(i as u16))
             }
             Some(Scalar::Input(i)) => {
                 if !a.u {
-                    return self.not_allowed(id.span(), "u", a);
+                    return self.not_allowed(id, &format!("input `{s}`"), "u", a);
                 }
                 self.sys.arena.var(Var::Input(i as u16))
             }
             Some(Scalar::Let(body)) => {
                 if let Some(&e) = self.let_done.get(&s) {
-                    return self.check_allowed(e, id.span(), a);
+                    return self.check_allowed(e, id, a);
                 }
                 if self.let_busy.contains(&s) {
-                    self.error(id.span(), format!("`let {s}` refers to itself"));
+                    let via =
+                        &self.let_busy[self.let_busy.iter().position(|b| *b == s).unwrap_or(0)..];
+                    let cycle = if via.len() > 1 {
+                        format!(
+                            " (through {})",
+                            via[1..]
+                                .iter()
+                                .map(|b| format!("`{b}`"))
+                                .collect::<Vec<_>>()
+                                .join(", ")
+                        )
+                    } else {
+                        String::new()
+                    };
+                    self.error(id.span(), format!("`let {s}` refers to itself{cycle}: a `let` cannot be defined in terms of itself"));
                     return self.sys.arena.zero();
                 }
                 self.let_busy.push(s.clone());
                 let e = self.lower(&body, ANY);
                 self.let_busy.pop();
                 self.let_done.insert(s, e);
-                self.check_allowed(e, id.span(), a)
+                self.check_allowed(e, id, a)
             }
             None => {
-                if self.frame_names.contains_key(&s) {
-                    self.error(
-                        id.span(),
-                        format!(
-                            "`{s}` is a body, not a number: write TOG[{s}] in a transform product"
-                        ),
-                    );
+                if let Some(kind) = self.kinds.get(&s) {
+                    let fix = if *kind == "point" {
+                        "points appear in effects such as `spring(…)` and `force(…)`".to_string()
+                    } else {
+                        format!("its pose TOG[{s}] may start a transform product")
+                    };
+                    self.error(id.span(), format!("`{s}` is a {kind}, not a number: {fix}"));
                     return self.sys.arena.zero();
                 }
                 let names: Vec<String> = self
@@ -1392,7 +1782,7 @@ impl Checker {
                         did_you_mean(
                             &s,
                             names.iter().map(String::as_str),
-                            "declare it with `param NAME = value;` or `let NAME = expr;`"
+                            &format!("declare it with `param {s} = …;` or `let {s} = …;`")
                         )
                     ),
                 );
@@ -1402,19 +1792,24 @@ impl Checker {
     }
 
     /// A `let` used where some variables are not allowed.
-    fn check_allowed(&mut self, e: ExprId, span: Span, a: Allow) -> ExprId {
+    fn check_allowed(&mut self, e: ExprId, id: &Ident, a: Allow) -> ExprId {
         for v in self.sys.arena.vars_of(&[e]) {
             let bad = match v {
-                Var::Q(_) if !a.q => Some("q"),
-                Var::Qd(_) if !a.qd => Some("qd"),
-                Var::Qdd(_) if !a.qd => Some("qdd"),
-                Var::T if !a.t => Some("t"),
-                Var::Input(_) if !a.u => Some("u"),
-                Var::Param(_) if !a.params => Some("a parameter"),
+                Var::Q(_) if !a.q => Some(("q", "the coordinates")),
+                Var::Qd(_) if !a.qd => Some(("qd", "the velocities")),
+                Var::Qdd(_) if !a.qd => Some(("qdd", "the accelerations")),
+                Var::T if !a.t => Some(("t", "the time")),
+                Var::Input(_) if !a.u => Some(("u", "the inputs")),
+                Var::Param(_) if !a.params => Some(("param", "parameters")),
                 _ => None,
             };
-            if let Some(b) = bad {
-                return self.not_allowed(span, b, a);
+            if let Some((kind, on)) = bad {
+                return self.not_allowed(
+                    id,
+                    &format!("`{id}` (a `let` that depends on {on})"),
+                    kind,
+                    a,
+                );
             }
         }
         e
@@ -1422,7 +1817,10 @@ impl Checker {
 
     fn lower_call(&mut self, c: &syn::ExprCall, a: Allow) -> ExprId {
         let Expr::Path(p) = &*c.func else {
-            self.error(c.func.span(), "expected a function name");
+            self.error_at(
+                &c.func,
+                format!("expected a function name, found `{}`", text(&c.func)),
+            );
             return self.sys.arena.zero();
         };
         let Some(id) = p.path.get_ident() else {
@@ -1434,13 +1832,13 @@ impl Checker {
         };
         let name = id.to_string();
         let args: Vec<&Expr> = c.args.iter().collect();
-        let arity = |ch: &mut Checker, n: usize| {
+        let arity = |ch: &mut Checker, n: usize, usage: &str| {
             if args.len() != n {
-                ch.error(
-                    c.span(),
+                ch.error_at(
+                    c,
                     format!(
-                        "`{name}` takes {n} argument{}, found {}",
-                        if n == 1 { "" } else { "s" },
+                        "`{name}` takes {}, found {}: write `{usage}`",
+                        count(n, "argument"),
                         args.len()
                     ),
                 );
@@ -1450,7 +1848,7 @@ impl Checker {
             }
         };
         if let Some(f) = Func::from_name(&name) {
-            if !arity(self, 1) {
+            if !arity(self, 1, &format!("{name}(x)")) {
                 return self.sys.arena.zero();
             }
             let x = self.lower(args[0], a);
@@ -1458,7 +1856,12 @@ impl Checker {
         }
         match name.as_str() {
             "atan2" | "pow" => {
-                if !arity(self, 2) {
+                let usage = if name == "atan2" {
+                    "atan2(y, x)"
+                } else {
+                    "pow(x, y)"
+                };
+                if !arity(self, 2, usage) {
                     return self.sys.arena.zero();
                 }
                 let x = self.lower(args[0], a);
@@ -1470,7 +1873,7 @@ impl Checker {
                 };
             }
             "powi" => {
-                if !arity(self, 2) {
+                if !arity(self, 2, "powi(x, n)") {
                     return self.sys.arena.zero();
                 }
                 let x = self.lower(args[0], a);
@@ -1489,27 +1892,35 @@ impl Checker {
                     _ => None,
                 };
                 let Some(n) = n else {
-                    self.error(args[1].span(), "the exponent of `powi` is an integer literal; use `pow(x, y)` for a real exponent");
+                    self.error_at(args[1], format!("the exponent of `powi` is an integer literal, found `{}`: use `pow(x, y)` for a real exponent", text(args[1])));
                     return self.sys.arena.zero();
                 };
                 return self.sys.arena.powi(x, n);
             }
             "Tdisp" | "Trotx" | "Troty" | "Trotz" | "Trotn" => {
-                self.error(id.span(), format!("`{name}` is a transform, not a number: transforms appear only in TOG[…] = … products"));
+                self.error(id.span(), format!("`{name}` is a transform, not a number: transforms appear only in the products of `TOG[…] = …;`"));
                 return self.sys.arena.zero();
             }
             _ => {}
         }
         match self.fns.get(&name).cloned() {
             Some(FnSym::Inline { args: params, body }) => {
-                if !arity(self, params.len()) {
+                let usage = format!(
+                    "{name}({})",
+                    params
+                        .iter()
+                        .map(|p| p.to_string())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                );
+                if !arity(self, params.len(), &usage) {
                     return self.sys.arena.zero();
                 }
                 if self.depth > 64 {
-                    self.error(
-                        c.span(),
+                    self.error_at(
+                        c,
                         format!(
-                            "`{name}` calls itself too deeply: inline functions cannot recurse"
+                            "`{name}` calls itself without end: an inline `fn` cannot be recursive"
                         ),
                     );
                     return self.sys.arena.zero();
@@ -1537,7 +1948,7 @@ impl Checker {
                 r
             }
             Some(FnSym::Extern { id: fid }) => {
-                if !arity(self, 1) {
+                if !arity(self, 1, &format!("{name}(x)")) {
                     return self.sys.arena.zero();
                 }
                 let x = self.lower(args[0], a);
@@ -1554,7 +1965,7 @@ impl Checker {
                         did_you_mean(
                             &name,
                             names.iter().map(String::as_str),
-                            "declare it with `fn NAME(x) = …;` or `extern fn NAME = [path, …];`"
+                            &format!("declare it with `fn {name}(x) = …;` or `extern fn {name} = [path::to::{name}, …];`")
                         )
                     ),
                 );
@@ -1565,12 +1976,12 @@ impl Checker {
 
     fn final_checks(&mut self) {
         for (i, f) in self.sys.frames.iter().enumerate() {
-            if !self.tog_defined[i] {
+            if !self.tog_defined[i] && !self.tog_target_error {
                 let kind = if f.inertia.is_some() { "body" } else { "frame" };
                 self.errors.push(err(
                     self.frame_spans[i],
                     format!(
-                        "{kind} `{}` has no position: add `TOG[{}] = …;`",
+                        "{kind} `{}` has no pose: add `TOG[{}] = …;`",
                         f.name, f.name
                     ),
                 ));
@@ -1598,16 +2009,17 @@ impl Checker {
                 }
             }
         }
-        for k in 0..n {
-            let moved = self
-                .sys
-                .frames
-                .iter()
-                .enumerate()
-                .any(|(i, f)| f.inertia.is_some() && moves[i][k]);
-            if !moved {
-                self.errors.push(err(self.dof_spans[k], format!("coordinate {} moves no body with mass, so the mass matrix would be singular: use it in the TOG of a body with mass (or of a frame that carries one), or remove it", self.sys.dofs[k].name)));
-            }
+        let frames = &self.sys.frames;
+        let unmoved: Vec<usize> = (0..n)
+            .filter(|&k| {
+                !frames
+                    .iter()
+                    .zip(&moves)
+                    .any(|(f, m)| f.inertia.is_some() && m[k])
+            })
+            .collect();
+        for k in unmoved {
+            self.errors.push(err(self.dof_spans[k], format!("coordinate `{}` moves no body with mass, so the mass matrix would be singular: use it in the TOG of a body with mass (or of a frame that carries one), or remove it", self.sys.dofs[k].name)));
         }
     }
 }

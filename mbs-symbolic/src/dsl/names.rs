@@ -15,20 +15,36 @@ pub fn distance(a: &str, b: &str) -> usize {
     prev[b.len()]
 }
 
-/// "; did you mean `x`?" for the closest candidate, or "; " + `otherwise`.
+/// "; did you mean `x`?" for the closest candidate (or "`x` or `y`", "`x`, `y` or `z`" for
+/// equally close ones), else "; " + `otherwise`.
 pub fn did_you_mean<'a>(
     name: &str,
     candidates: impl Iterator<Item = &'a str>,
     otherwise: &str,
 ) -> String {
-    let best = candidates
+    let prefix = |c: &str| {
+        name.chars()
+            .zip(c.chars())
+            .take_while(|(a, b)| a == b)
+            .count()
+    };
+    let mut close: Vec<(usize, std::cmp::Reverse<usize>, &str)> = candidates
         .filter(|c| *c != name)
-        .map(|c| (distance(name, c), c))
-        .filter(|(d, c)| *d <= (name.len().max(c.len()) / 3).max(1))
-        .min();
-    match best {
-        Some((_, c)) => format!("; did you mean `{c}`?"),
-        None => format!("; {otherwise}"),
+        .map(|c| (distance(name, c), std::cmp::Reverse(prefix(c)), c))
+        .filter(|(d, _, c)| *d <= (name.len().max(c.len()) / 3).max(1))
+        .collect();
+    close.sort();
+    close.dedup();
+    let best: Vec<&str> = close
+        .iter()
+        .take_while(|(d, _, _)| *d == close[0].0)
+        .map(|(_, _, c)| *c)
+        .collect();
+    match best.as_slice() {
+        [c] => format!("; did you mean `{c}`?"),
+        [a, b] => format!("; did you mean `{a}` or `{b}`?"),
+        [a, b, c] => format!("; did you mean `{a}`, `{b}` or `{c}`?"),
+        _ => format!("; {otherwise}"),
     }
 }
 
@@ -46,6 +62,22 @@ mod tests {
         assert_eq!(
             did_you_mean("zzz", ["upper_arm"].into_iter(), "declare it"),
             "; declare it"
+        );
+        assert_eq!(
+            did_you_mean("sinn", ["sign", "sin", "cos"].into_iter(), "x"),
+            "; did you mean `sin` or `sign`?"
+        );
+        assert_eq!(
+            did_you_mean("sinn", ["sign", "sin", "sinh", "cos"].into_iter(), "x"),
+            "; did you mean `sin`, `sinh` or `sign`?"
+        );
+        assert_eq!(
+            did_you_mean(
+                "Trotw",
+                ["Trotx", "Troty", "Trotz", "Trotn"].into_iter(),
+                "x"
+            ),
+            "; x"
         );
     }
 }

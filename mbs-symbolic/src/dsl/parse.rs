@@ -2,6 +2,8 @@
 //! `syn::Expr` and get their meaning in `check`.
 
 use super::ast::{BodyRef, DofName, EffectStmt, Item, ModelDef};
+use proc_macro2::TokenTree;
+use syn::parse::discouraged::Speculative;
 use syn::parse::{Parse, ParseStream};
 use syn::punctuated::Punctuated;
 use syn::{Expr, Ident, Token, braced, bracketed, parenthesized};
@@ -65,16 +67,48 @@ impl Parse for ModelDef {
         let content;
         braced!(content in input);
         let mut items = Vec::new();
+        let mut errors = Vec::new();
         while !content.is_empty() {
-            items.push(parse_item(&content)?);
+            let fork = content.fork();
+            match parse_item(&fork) {
+                Ok(item) => {
+                    content.advance_to(&fork);
+                    items.push(item);
+                }
+                Err(e) => {
+                    errors.push(e);
+                    skip_statement(&content)?;
+                }
+            }
         }
         Ok(ModelDef {
             docs,
             vis,
             name,
             items,
+            errors,
         })
     }
+}
+
+/// Skips a statement that did not parse: up to and including its `;`, or up to its `{ … }`
+/// block (`body`, `effect`) and an optional `;` after it.
+fn skip_statement(input: ParseStream) -> syn::Result<()> {
+    while !input.is_empty() {
+        if input.peek(Token![;]) {
+            input.parse::<Token![;]>()?;
+            return Ok(());
+        }
+        if let TokenTree::Group(g) = input.parse::<TokenTree>()? {
+            if g.delimiter() == proc_macro2::Delimiter::Brace {
+                if input.peek(Token![;]) {
+                    input.parse::<Token![;]>()?;
+                }
+                return Ok(());
+            }
+        }
+    }
+    Ok(())
 }
 
 fn body_ref(input: ParseStream) -> syn::Result<BodyRef> {
@@ -93,7 +127,19 @@ fn semi(input: ParseStream, what: &str) -> syn::Result<()> {
         input.parse::<Token![;]>()?;
         Ok(())
     } else {
-        Err(input.error(format!("expected `;` after {what}")))
+        let found = match input.fork().parse::<TokenTree>() {
+            Ok(TokenTree::Group(g)) => match g.delimiter() {
+                proc_macro2::Delimiter::Brace => "`{`".to_string(),
+                proc_macro2::Delimiter::Bracket => "`[`".to_string(),
+                proc_macro2::Delimiter::Parenthesis => "`(`".to_string(),
+                proc_macro2::Delimiter::None => "an expression".to_string(),
+            },
+            Ok(t) => format!("`{t}`"),
+            Err(_) => "the end of the model".to_string(),
+        };
+        Err(input.error(format!(
+            "expected `;` after {what}, found {found}: end each statement with `;`"
+        )))
     }
 }
 
@@ -206,8 +252,18 @@ fn parse_item(input: ParseStream) -> syn::Result<Item> {
                 let content;
                 braced!(content in input);
                 while !content.is_empty() {
-                    let key: Ident = content.parse()?;
-                    content.parse::<Token![=]>()?;
+                    let key: Ident = content.parse().map_err(|e| {
+                        syn::Error::new(
+                            e.span(),
+                            format!("expected a property of body `{name}`: `mass = …;` or `inertia = (Ixx, Iyy, Izz);`"),
+                        )
+                    })?;
+                    content.parse::<Token![=]>().map_err(|e| {
+                        syn::Error::new(
+                            e.span(),
+                            format!("expected `=` after `{key}`: body properties are written `{key} = …;`"),
+                        )
+                    })?;
                     let value: Expr = content.parse()?;
                     semi(&content, &format!("`{key} = …`"))?;
                     props.push((key, value));
@@ -254,10 +310,20 @@ fn parse_item(input: ParseStream) -> syn::Result<Item> {
         }
         "TOG" => {
             let span = input.parse::<Ident>()?.span();
+            if !input.peek(syn::token::Bracket) {
+                return Err(input.error(
+                    "expected `[`: a pose is written `TOG[body] = …;`, with the body in square brackets",
+                ));
+            }
             let idx;
             bracketed!(idx in input);
             let target = body_ref(&idx)?;
-            input.parse::<Token![=]>()?;
+            input.parse::<Token![=]>().map_err(|e| {
+                syn::Error::new(
+                    e.span(),
+                    "expected `=`: write `TOG[body] = Trotz(q[0]) * Tdisp(x, y, z);`",
+                )
+            })?;
             let chain: Expr = input.parse()?;
             semi(input, "`TOG[…] = …`")?;
             Ok(Item::Tog {
@@ -280,7 +346,18 @@ fn parse_item(input: ParseStream) -> syn::Result<Item> {
         "scene" => {
             input.parse::<Ident>()?;
             let name: Ident = input.parse()?;
-            input.parse::<Token![=]>()?;
+            let usage = |e: syn::Error| {
+                syn::Error::new(
+                    e.span(),
+                    format!(
+                        "expected `scene {name} = [effect, …];`, with the effects in square brackets"
+                    ),
+                )
+            };
+            input.parse::<Token![=]>().map_err(usage)?;
+            if !input.peek(syn::token::Bracket) {
+                return Err(usage(input.error("")));
+            }
             let list;
             bracketed!(list in input);
             let effects: Punctuated<Ident, Token![,]> =

@@ -1,0 +1,21 @@
+use mbs::Model;
+
+mbs::multibody! {
+    model Pendulum {
+        dof q[0] = 0.5;
+        body bar { mass = 1.0; inertia = (0.1, 0.0, 0.1); }
+        TOG[bar] = Trotz(q[0]) * Tdisp(0, -0.5, 0);
+        effect weight { gravity(0, -9.81, 0); }
+        scene Free = [];
+        scene Swing = [wieght];
+    }
+}
+
+fn run<M: Model>(model: &M) -> f64 {
+    let q = vec![0.1; M::NQ];
+    model.energy(0.0, &q, &q).total()
+}
+
+fn main() {
+    println!("{} {}", run(&PendulumFree::default()), run(&PendulumSwing::default()));
+}

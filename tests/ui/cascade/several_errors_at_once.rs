@@ -1,0 +1,12 @@
+mbs::multibody! {
+    model Pendulum {
+        param l = 1.0;
+        dof q[0] = 0.5; dof q[1] = 0.0;
+        body bar1 { mass = -1.0; inertia = (0.1, 0.0, 0.1); }
+        body bar2 { mass = 1.0; inertia = (0.1, 0.1, 0.3); }
+        TOG[bar1] = Trotz(q[0]) * Tdisp(0, -lenght / 2, 0);
+        TOG[bar2] = TOG[bar] * Trotz(q[1]) * Tdisp(0, -l / 2, 0);
+    }
+}
+
+fn main() {}

@@ -1,0 +1,11 @@
+mbs::multibody! {
+    model Pendulum {
+        dof q[0] = 0.5;
+        input motor;
+        body bar { mass = 1.0; inertia = (0.1, 0.0, 0.1); }
+        TOG[bar] = Trotz(q[0]) * Tdisp(0, -0.5, 0);
+        torque(bar, axis = z, u[1]);
+    }
+}
+
+fn main() {}

@@ -1,0 +1,10 @@
+mbs::multibody! {
+    model Pendulum {
+        param length = 1.0;
+        dof q[0] = 0.5;
+        body bar { mass = 1.0; inertia = (0.1, 0.0, 0.1); }
+        TOG[bar] = Trotz(q[0]) * Tdisp(0, -lenght / 2, 0);
+    }
+}
+
+fn main() {}

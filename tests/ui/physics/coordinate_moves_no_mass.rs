@@ -1,0 +1,11 @@
+mbs::multibody! {
+    model Pendulum {
+        dof q[0] = 0.5; dof q[1] = 0.0;
+        body bar { mass = 1.0; inertia = (0.1, 0.0, 0.1); }
+        frame sensor;
+        TOG[bar] = Trotz(q[0]) * Tdisp(0, -0.5, 0);
+        TOG[sensor] = TOG[bar] * Trotz(q[1]);
+    }
+}
+
+fn main() {}

@@ -1,0 +1,10 @@
+mbs::multibody! {
+    model Pendulum {
+        param m = -2.0;
+        dof q[0] = 0.5;
+        body bar { mass = m; inertia = (0.1, 0.0, 0.1); }
+        TOG[bar] = Trotz(q[0]) * Tdisp(0, -0.5, 0);
+    }
+}
+
+fn main() {}

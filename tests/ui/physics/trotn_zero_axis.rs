@@ -1,0 +1,9 @@
+mbs::multibody! {
+    model Pendulum {
+        dof q[0] = 0.5;
+        body bar { mass = 1.0; inertia = (0.1, 0.0, 0.1); }
+        TOG[bar] = Trotn(0, 0, 0, q[0]) * Tdisp(0, -0.5, 0);
+    }
+}
+
+fn main() {}

@@ -2,9 +2,11 @@
 //! (or the one the model forces), tangents when asked for, energies, power, static forces.
 
 use super::effects::Loads;
-use super::recursive::{body_kinematics, crba, newton_euler};
+use super::recursive::{body_kinematics, crba, newton_euler, spinning_body_motion};
+use super::spin::spinning_frames;
+
 use super::spatial as s;
-use super::system::{Formulation, System};
+use super::system::{Factor, Formulation, System};
 use super::tree::Tree;
 use super::virtual_power::virtual_power;
 use super::world::{Cols, World};
@@ -162,6 +164,7 @@ impl SceneEquations {
 /// (gravity's measured from the world origin).
 fn energies(sys: &mut System, tree: &Tree, world: &World, loads: &Loads) -> (ExprId, ExprId) {
     let bk = body_kinematics(&mut sys.arena, tree, None, false);
+    let spinning = spinning_frames(sys, tree);
     let a = &mut sys.arena;
     let half = a.num(0.5);
     let mut t = a.zero();
@@ -171,7 +174,16 @@ fn energies(sys: &mut System, tree: &Tree, world: &World, loads: &Loads) -> (Exp
             let Some(inr) = sys.frames[f].inertia else {
                 continue;
             };
-            let k = bk[n];
+            let mut k = bk[n];
+            if spinning[f] {
+                // in the parent's axes, the spin leaves the inertia unchanged
+                let Some(Factor::Rot { axis, angle }) = node.factor else {
+                    unreachable!()
+                };
+                let p = bk[node.parent];
+                k.v = p.v;
+                k.w = spinning_body_motion(a, &p, axis, angle, false).0;
+            }
             let vv = s::dot(a, k.v, k.v);
             let mvv = a.mul(inr.mass, vv);
             let phi = s::sym(&inr.tensor);

@@ -5,6 +5,7 @@ pub mod dynamics;
 pub mod effects;
 pub mod recursive;
 pub mod spatial;
+pub mod spin;
 pub mod system;
 pub mod tree;
 pub mod virtual_power;

@@ -9,6 +9,7 @@
 
 use super::effects::Loads;
 use super::spatial::{self as s, M3, V3};
+use super::spin::spinning_frames;
 use super::system::{Factor, System};
 use super::tree::Tree;
 use super::world::World;
@@ -120,24 +121,45 @@ pub fn newton_euler(
 ) -> Vec<ExprId> {
     let nd = sys.ndof();
     let bk = body_kinematics(&mut sys.arena, tree, loads.gravity, with_qdd);
+    let spinning = spinning_frames(sys, tree);
     let a = &mut sys.arena;
     let rots = rotations(a, tree);
     let z = s::zero3(a);
     let mut force = vec![z; tree.nodes.len()];
     let mut moment = vec![z; tree.nodes.len()];
+    let mut tau = vec![a.zero(); nd];
     for (n, node) in tree.nodes.iter().enumerate().skip(1) {
         for &f in &node.frames {
-            if let Some(inr) = sys.frames[f].inertia {
-                let k = bk[n];
-                let ma = s::scale(a, inr.mass, k.a);
-                force[n] = s::add(a, force[n], ma);
-                let phi = s::sym(&inr.tensor);
-                let ia = s::mul_mv(a, &phi, k.al);
-                let iw = s::mul_mv(a, &phi, k.w);
-                let gyro = s::cross(a, k.w, iw);
-                let m = s::add(a, ia, gyro);
-                moment[n] = s::add(a, moment[n], m);
+            let Some(inr) = sys.frames[f].inertia else {
+                continue;
+            };
+            let phi = s::sym(&inr.tensor);
+            if spinning[f] {
+                // in the parent's axes, where the spin does not change the inertia
+                let Some(Factor::Rot { axis, angle }) = tree.nodes[n].factor else {
+                    unreachable!()
+                };
+                let p = tree.nodes[n].parent;
+                let (fb, mb) =
+                    spinning_body_wrench(a, &bk[p], axis, angle, inr.mass, &phi, with_qdd);
+                for k in tree.factor_dofs(a, n) {
+                    let d = a.diff(angle, Var::Q(k));
+                    let nm = s::dot(a, axis, mb);
+                    let t = a.mul(d, nm);
+                    tau[k as usize] = a.add(tau[k as usize], t);
+                }
+                force[p] = s::add(a, force[p], fb);
+                moment[p] = s::add(a, moment[p], mb);
+                continue;
             }
+            let k = bk[n];
+            let ma = s::scale(a, inr.mass, k.a);
+            force[n] = s::add(a, force[n], ma);
+            let ia = s::mul_mv(a, &phi, k.al);
+            let iw = s::mul_mv(a, &phi, k.w);
+            let gyro = s::cross(a, k.w, iw);
+            let m = s::add(a, ia, gyro);
+            moment[n] = s::add(a, moment[n], m);
         }
     }
     for &(n, r, fw) in &loads.forces {
@@ -150,7 +172,6 @@ pub fn newton_euler(
         let t = s::mul_mtv(a, &world.nodes[n].r, tw);
         moment[n] = s::sub(a, moment[n], t);
     }
-    let mut tau = vec![a.zero(); nd];
     for n in (1..tree.nodes.len()).rev() {
         let fac = tree.nodes[n].factor.unwrap();
         let (f, m) = (force[n], moment[n]);
@@ -193,6 +214,47 @@ pub fn newton_euler(
         tau[k] = a.sub(tau[k], q);
     }
     tau
+}
+
+/// Velocity of a body spinning by `angle` about `axis` relative to the frame whose kinematics
+/// is `p`, in that frame's axes: (ω, α).
+pub fn spinning_body_motion(
+    a: &mut Arena,
+    p: &BodyKin,
+    axis: V3,
+    angle: ExprId,
+    with_qdd: bool,
+) -> (V3, V3) {
+    let th_d = a.dt(angle);
+    let th_dd = if with_qdd {
+        a.dt(th_d)
+    } else {
+        a.dt_bias(th_d)
+    };
+    let rel = s::scale(a, th_d, axis);
+    let w = s::add(a, p.w, rel);
+    let t1 = s::scale(a, th_dd, axis);
+    let t2 = s::cross(a, p.w, rel);
+    let al = s::add(a, p.al, t1);
+    (w, s::add(a, al, t2))
+}
+
+/// Force m a and moment Φ α + ω × Φ ω of a spinning body, in its parent's axes.
+fn spinning_body_wrench(
+    a: &mut Arena,
+    p: &BodyKin,
+    axis: V3,
+    angle: ExprId,
+    mass: ExprId,
+    phi: &M3,
+    with_qdd: bool,
+) -> (V3, V3) {
+    let (w, al) = spinning_body_motion(a, p, axis, angle, with_qdd);
+    let f = s::scale(a, mass, p.a);
+    let ia = s::mul_mv(a, phi, al);
+    let iw = s::mul_mv(a, phi, w);
+    let gyro = s::cross(a, w, iw);
+    (f, s::add(a, ia, gyro))
 }
 
 /// Spatial inertia about a frame origin: mass, first moment h = m·c, inertia about the origin.
@@ -291,6 +353,7 @@ fn motion(a: &mut Arena, fac: &Factor, k: u16) -> (V3, V3) {
 /// Mass matrix by composite rigid bodies; returned dense, row-major, symmetric.
 pub fn crba(sys: &mut System, tree: &Tree) -> Vec<Vec<ExprId>> {
     let nd = sys.ndof();
+    let spinning = spinning_frames(sys, tree);
     let a = &mut sys.arena;
     let rots = rotations(a, tree);
     let zero = a.zero();
@@ -301,6 +364,8 @@ pub fn crba(sys: &mut System, tree: &Tree) -> Vec<Vec<ExprId>> {
         i: [z3; 3],
     };
     let mut comp = vec![empty; tree.nodes.len()];
+    // inertias of bodies spinning about their node's axis, carried by the parent
+    let mut spin_phi: Vec<Option<M3>> = vec![None; tree.nodes.len()];
     for (n, node) in tree.nodes.iter().enumerate().skip(1) {
         for &f in &node.frames {
             if let Some(inr) = sys.frames[f].inertia {
@@ -309,6 +374,26 @@ pub fn crba(sys: &mut System, tree: &Tree) -> Vec<Vec<ExprId>> {
                     h: z3,
                     i: s::sym(&inr.tensor),
                 };
+                if spinning[f] {
+                    let p = tree.nodes[n].parent;
+                    comp[p] = SpInertia::add(a, &comp[p], &body);
+                    spin_phi[n] = Some(match spin_phi[n] {
+                        Some(prev) => {
+                            SpInertia::add(
+                                a,
+                                &SpInertia {
+                                    m: zero,
+                                    h: z3,
+                                    i: prev,
+                                },
+                                &body,
+                            )
+                            .i
+                        }
+                        None => body.i,
+                    });
+                    continue;
+                }
                 comp[n] = SpInertia::add(a, &comp[n], &body);
             }
         }
@@ -346,6 +431,10 @@ pub fn crba(sys: &mut System, tree: &Tree) -> Vec<Vec<ExprId>> {
             let iw = s::mul_mv(a, &c.i, sw);
             let hv = s::cross(a, c.h, sv);
             let mut ang = s::add(a, iw, hv);
+            if let Some(phi) = spin_phi[n] {
+                let spin = s::mul_mv(a, &phi, sw);
+                ang = s::add(a, ang, spin);
+            }
             let mut x = n;
             while x != 0 {
                 let fx = tree.nodes[x].factor.unwrap();

@@ -4,6 +4,7 @@
 
 use super::effects::Loads;
 use super::spatial::{self as s, V3};
+use super::spin::spinning_frames;
 use super::system::System;
 use super::tree::Tree;
 use super::world::World;
@@ -17,6 +18,7 @@ pub fn virtual_power(
     loads: &Loads,
 ) -> (Vec<Vec<ExprId>>, Vec<ExprId>) {
     let nd = sys.ndof();
+    let spinning = spinning_frames(sys, tree);
     let a = &mut sys.arena;
     let zero = a.zero();
     let mut m = vec![vec![zero; nd]; nd];
@@ -28,10 +30,16 @@ pub fn virtual_power(
             };
             let k = &world.nodes[n];
             let phi = s::sym(&inr.tensor);
+            // a body spinning about a symmetry axis has the same inertia in its parent's axes
+            let r = if spinning[f] {
+                world.nodes[node.parent].r
+            } else {
+                k.r
+            };
             // rotational columns in body axes, and Φ times them
             let jwb: Vec<(u16, V3)> =
                 k.jw.iter()
-                    .map(|&(q, c)| (q, s::mul_mtv(a, &k.r, c)))
+                    .map(|&(q, c)| (q, s::mul_mtv(a, &r, c)))
                     .collect();
             let ijw: Vec<V3> = jwb.iter().map(|&(_, c)| s::mul_mv(a, &phi, c)).collect();
             for (x, &(i, vi)) in k.jv.iter().enumerate() {
@@ -58,8 +66,8 @@ pub fn virtual_power(
                 h[i as usize] = a.add(h[i as usize], t);
             }
             // rotational: −(Φ α_b + ω × Φ ω), body axes
-            let wb = s::mul_mtv(a, &k.r, k.w);
-            let alb = s::mul_mtv(a, &k.r, k.alb);
+            let wb = s::mul_mtv(a, &r, k.w);
+            let alb = s::mul_mtv(a, &r, k.alb);
             let ia = s::mul_mv(a, &phi, alb);
             let iw = s::mul_mv(a, &phi, wb);
             let gyro = s::cross(a, wb, iw);

@@ -36,18 +36,42 @@ pub struct Generated {
     pub emit_time: Duration,
 }
 
-/// FNV-1a over 8-byte words (little-endian, the tail zero-padded): the same in the macro and
-/// in `mbs expand`, and fast without optimisation.
+/// FNV-1a over 8-byte words (little-endian, the tail zero-padded), four lanes at a time so
+/// that it stays fast without optimisation; the macro and `mbs expand` share it.
 pub fn fnv1a(s: &str) -> u64 {
-    let mut h: u64 = 0xcbf29ce484222325;
-    let chunks = s.as_bytes().chunks(8);
-    for c in chunks {
+    const PRIME: u64 = 0x100000001b3;
+    let mut lanes = [
+        0xcbf29ce484222325u64,
+        0x84222325cbf29ce4,
+        0x9ce484222325cbf2,
+        0x2325cbf29ce48422,
+    ];
+    let bytes = s.as_bytes();
+    let blocks = bytes.chunks_exact(32);
+    let tail = blocks.remainder();
+    for b in blocks {
+        let w: [u64; 4] = [
+            u64::from_le_bytes([b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]]),
+            u64::from_le_bytes([b[8], b[9], b[10], b[11], b[12], b[13], b[14], b[15]]),
+            u64::from_le_bytes([b[16], b[17], b[18], b[19], b[20], b[21], b[22], b[23]]),
+            u64::from_le_bytes([b[24], b[25], b[26], b[27], b[28], b[29], b[30], b[31]]),
+        ];
+        lanes = [
+            (lanes[0] ^ w[0]).wrapping_mul(PRIME),
+            (lanes[1] ^ w[1]).wrapping_mul(PRIME),
+            (lanes[2] ^ w[2]).wrapping_mul(PRIME),
+            (lanes[3] ^ w[3]).wrapping_mul(PRIME),
+        ];
+    }
+    let mut h = lanes
+        .iter()
+        .fold(0xcbf29ce484222325u64, |h, &l| (h ^ l).wrapping_mul(PRIME));
+    for c in tail.chunks(8) {
         let mut w = [0u8; 8];
         w[..c.len()].copy_from_slice(c);
-        h ^= u64::from_le_bytes(w);
-        h = h.wrapping_mul(0x100000001b3);
+        h = (h ^ u64::from_le_bytes(w)).wrapping_mul(PRIME);
     }
-    h
+    (h ^ bytes.len() as u64).wrapping_mul(PRIME)
 }
 
 fn runtime_ops(c: OpCount) -> String {
@@ -261,21 +285,8 @@ fn emit_scene(
         params: &sys.params,
         params_path: "self.params",
     };
-    let mut methods = String::new();
-    let mut ops: Vec<(String, OpCount)> = Vec::new();
-    let mut add = |spec: FnSpec, label: &str, methods: &mut String| {
-        if let Some(c) = collect(emit_fn(a, &spec, &names), missing, |s, c| {
-            methods.push_str(&s);
-            c
-        }) {
-            ops.push((label.to_string(), c));
-            reports.push(FunctionReport {
-                model: ty.clone(),
-                function: label.to_string(),
-                ops: c,
-            });
-        }
-    };
+    // the methods to emit, with the label of their op-count row (none for initial_state)
+    let mut specs: Vec<(FnSpec, Option<&str>)> = Vec::new();
     let mb = eq.chosen();
     let mut f = FnSpec::new(
         "__dynamics",
@@ -283,16 +294,16 @@ fn emit_scene(
     );
     f.matrix(a, "m", &mb.m);
     f.vector("h", &mb.h);
-    add(f, "dynamics (M, h)", &mut methods);
+    specs.push((f, Some("dynamics (M, h)")));
     let mut f = FnSpec::new("__mass_matrix", "t: f64, q: &[f64], m: &mut [f64]");
     f.matrix(a, "m", &mb.m);
-    add(f, "mass_matrix", &mut methods);
+    specs.push((f, Some("mass_matrix")));
     let mut f = FnSpec::new(
         "__inverse_dynamics",
         "t: f64, q: &[f64], qd: &[f64], qdd: &[f64], u: &[f64], tau: &mut [f64]",
     );
     f.vector("tau", eq.tau());
-    add(f, "inverse_dynamics", &mut methods);
+    specs.push((f, Some("inverse_dynamics")));
     if let Some((kt, ct)) = &eq.tangents {
         let mut f = FnSpec::new(
             "__tangents",
@@ -300,23 +311,23 @@ fn emit_scene(
         );
         f.matrix(a, "k", kt);
         f.matrix(a, "c", ct);
-        add(f, "tangents (K, C)", &mut methods);
+        specs.push((f, Some("tangents (K, C)")));
     }
     let mut f = FnSpec::new(
         "__static_forces",
         "t: f64, q: &[f64], u: &[f64], h: &mut [f64]",
     );
     f.vector("h", &eq.static_h);
-    add(f, "static_forces", &mut methods);
+    specs.push((f, Some("static_forces")));
     let mut f = FnSpec::new("__energy", "t: f64, q: &[f64], qd: &[f64], e: &mut [f64]");
     f.vector("e", &[eq.kinetic, eq.potential]);
-    add(f, "energy", &mut methods);
+    specs.push((f, Some("energy")));
     let mut f = FnSpec::new(
         "__power",
         "t: f64, q: &[f64], qd: &[f64], u: &[f64], e: &mut [f64]",
     );
     f.vector("e", &[eq.power]);
-    add(f, "power", &mut methods);
+    specs.push((f, Some("power")));
     // poses and kinematics of frames and points
     let mut f = FnSpec::new("__frames", "t: f64, q: &[f64], out: &mut [::mbs::Pose]");
     let mut fk = FnSpec::new(
@@ -351,7 +362,7 @@ fn emit_scene(
         fk.matrix(a, &format!("out.frames[{i}].jv"), &dense3(a, &k.jv, n));
         fk.matrix(a, &format!("out.frames[{i}].jw"), &dense3(a, &k.jw, n));
     }
-    add(f, "frames", &mut methods);
+    specs.push((f, Some("frames")));
     for (i, pk) in model.points.iter().enumerate() {
         for r in 0..3 {
             fk.outputs
@@ -369,25 +380,42 @@ fn emit_scene(
             &dense3(a, &pk.jacobian, n),
         );
     }
-    let kin = emit_fn(a, &fk, &names);
-    if let Some(c) = collect(kin, missing, |s, c| {
-        methods.push_str(&s);
-        c
-    }) {
-        ops.push(("kinematics".into(), c));
-        reports.push(FunctionReport {
-            model: ty.clone(),
-            function: "kinematics".into(),
-            ops: c,
-        });
-    }
+    specs.push((fk, Some("kinematics")));
     let mut f = FnSpec::new("__initial_state", "q: &mut [f64], qd: &mut [f64]");
     let q0: Vec<ExprId> = sys.dofs.iter().map(|d| d.q0).collect();
     let qd0: Vec<ExprId> = sys.dofs.iter().map(|d| d.qd0).collect();
     f.vector("q", &q0);
     f.vector("qd", &qd0);
-    if let Some((s, _)) = collect(emit_fn(a, &f, &names), missing, |s, c| (s, c)) {
-        methods.push_str(&s);
+    specs.push((f, None));
+
+    // the methods are independent and the arena is read-only: emit them in parallel, then
+    // assemble in order so that the text does not depend on scheduling
+    let emitted: Vec<_> = std::thread::scope(|scope| {
+        let handles: Vec<_> = specs
+            .iter()
+            .map(|(spec, _)| scope.spawn(|| emit_fn(a, spec, &names)))
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().expect("emission does not panic"))
+            .collect()
+    });
+    let mut methods = String::new();
+    let mut ops: Vec<(String, OpCount)> = Vec::new();
+    for ((_, label), result) in specs.iter().zip(emitted) {
+        if let Some(c) = collect(result, missing, |s, c| {
+            methods.push_str(&s);
+            c
+        }) {
+            if let Some(label) = label {
+                ops.push((label.to_string(), c));
+                reports.push(FunctionReport {
+                    model: ty.clone(),
+                    function: label.to_string(),
+                    ops: c,
+                });
+            }
+        }
     }
 
     // the type, its docs and the trait impl

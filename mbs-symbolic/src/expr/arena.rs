@@ -60,9 +60,9 @@ impl Default for Arena {
 impl Arena {
     pub fn new() -> Self {
         let mut a = Arena {
-            nodes: Vec::with_capacity(1 << 12),
-            deps: Vec::with_capacity(1 << 12),
-            slots: vec![u32::MAX; 1 << 13],
+            nodes: Vec::with_capacity(1 << 16),
+            deps: Vec::with_capacity(1 << 16),
+            slots: vec![u32::MAX; 1 << 17],
             dmemo: FxHashMap::default(),
             user_fns: Vec::new(),
         };
@@ -98,6 +98,10 @@ impl Arena {
 
     /// Value of a constant node.
     pub fn as_num(&self, id: ExprId) -> Option<f64> {
+        // a node on variables is not a number (cheap test first: this is called by every rule)
+        if self.deps[id.index()] != 0 {
+            return None;
+        }
         match self.nodes[id.index()] {
             Node::Num(b) => Some(f64::from_bits(b)),
             _ => None,

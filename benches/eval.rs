@@ -1,0 +1,66 @@
+//! Evaluation time of generated functions (criterion).
+//!
+//! ```text
+//! cargo bench --bench eval
+//! ```
+//!
+//! At the MODELS.md test state: M+h (`dynamics`), M alone, τ (`inverse_dynamics`) for dpend,
+//! arm3d_6, chain24 and the hexapod.
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use mbs::Model;
+use std::hint::black_box;
+
+#[path = "../examples/models/arm3d_6.rs"]
+mod arm3d_6;
+#[path = "models/chain24.rs"]
+mod chain24;
+#[path = "../examples/models/dpend.rs"]
+mod dpend;
+#[path = "../examples/models/hexapod.rs"]
+mod hexapod;
+
+fn test_state(n: usize) -> (Vec<f64>, Vec<f64>) {
+    let q = (0..n).map(|i| 0.5 * (1.3 * i as f64 + 0.4).sin()).collect();
+    let qd = (0..n).map(|i| 0.7 * (0.9 * i as f64 + 0.2).cos()).collect();
+    (q, qd)
+}
+
+fn bench_model<M: Model>(c: &mut Criterion, name: &str, model: M) {
+    let n = M::NQ;
+    let (q, qd) = test_state(n);
+    let qdd = vec![0.1; n];
+    let u = vec![0.0; M::NU];
+    let mut m = vec![0.0; n * n];
+    let mut h = vec![0.0; n];
+    let mut g = c.benchmark_group(name);
+    g.bench_function("dynamics (M, h)", |b| {
+        b.iter(|| model.dynamics(0.0, black_box(&q), black_box(&qd), &u, &mut m, &mut h))
+    });
+    g.bench_function("mass_matrix", |b| {
+        b.iter(|| model.mass_matrix(0.0, black_box(&q), &mut m))
+    });
+    g.bench_function("inverse_dynamics", |b| {
+        b.iter(|| {
+            model.inverse_dynamics(
+                0.0,
+                black_box(&q),
+                black_box(&qd),
+                black_box(&qdd),
+                &u,
+                &mut h,
+            )
+        })
+    });
+    g.finish();
+}
+
+fn benches(c: &mut Criterion) {
+    bench_model(c, "dpend", dpend::DoublePendulum::default());
+    bench_model(c, "arm3d_6", arm3d_6::Arm3d6::default());
+    bench_model(c, "chain24", chain24::Chain24::default());
+    bench_model(c, "hexapod", hexapod::Hexapod::default());
+}
+
+criterion_group!(eval, benches);
+criterion_main!(eval);

@@ -3,7 +3,6 @@
 
 use mbs::Model;
 use std::process::Command;
-use syn::visit::Visit;
 
 /// A knee whose slider follows a curve of the joint angle (user function and derivatives).
 mod knee {
@@ -44,27 +43,12 @@ fn this_file() -> String {
     concat!(env!("CARGO_MANIFEST_DIR"), "/tests/expand.rs").to_string()
 }
 
-struct Finder(Vec<proc_macro2::TokenStream>);
-
-impl<'a> Visit<'a> for Finder {
-    fn visit_macro(&mut self, m: &'a syn::Macro) {
-        if m.path
-            .segments
-            .last()
-            .is_some_and(|s| s.ident == "multibody")
-        {
-            self.0.push(m.tokens.clone());
-        }
-    }
-}
-
 #[test]
 fn expansion_is_byte_identical_to_the_macro() {
     let src = std::fs::read_to_string(this_file()).unwrap();
-    let mut finder = Finder(Vec::new());
-    finder.visit_file(&syn::parse_file(&src).unwrap());
-    assert_eq!(finder.0.len(), 1);
-    let mut expansions = mbs_symbolic::expand::expand_models(finder.0.remove(0)).unwrap();
+    let mut blocks = mbs_symbolic::expand::multibody_blocks(&syn::parse_file(&src).unwrap());
+    assert_eq!(blocks.len(), 1);
+    let mut expansions = mbs_symbolic::expand::expand_models(blocks.remove(0)).unwrap();
     let mbs_symbolic::expand::Expansion::Ok { generated, .. } = expansions.remove(0) else {
         panic!("the model has errors")
     };

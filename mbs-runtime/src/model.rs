@@ -73,7 +73,43 @@ pub struct ModelInfo {
     pub ops: &'static [(&'static str, OpCount)],
 }
 
+/// The op-count table of a model's generated functions, for printing.
+pub struct OpsTable<'a>(&'a ModelInfo);
+
+impl fmt::Display for OpsTable<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(
+            f,
+            "{:<18} {:>7} {:>7} {:>7} {:>5} {:>6} {:>6}",
+            "function", "flops", "adds", "muls", "divs", "funcs", "lets"
+        )?;
+        for (name, c) in self.0.ops {
+            writeln!(
+                f,
+                "{name:<18} {:>7} {:>7} {:>7} {:>5} {:>6} {:>6}",
+                c.flops(),
+                c.adds,
+                c.muls,
+                c.divs,
+                c.funcs,
+                c.lets
+            )?;
+        }
+        Ok(())
+    }
+}
+
 impl ModelInfo {
+    /// The op counts of the generated functions as a table (`Display`).
+    pub fn ops_table(&self) -> OpsTable<'_> {
+        OpsTable(self)
+    }
+
+    /// Number of bodies (frames with mass).
+    pub fn body_count(&self) -> usize {
+        self.is_body.iter().filter(|&&b| b).count()
+    }
+
     /// "q[3] (knee)" for a named coordinate, "q[3]" otherwise.
     pub fn dof_label(&self, i: usize) -> String {
         match self.dofs.get(i) {

@@ -11,9 +11,8 @@
 //! tangents, and prints the best of several runs with the op counts. Arguments select cases
 //! by name (`-- hexapod chain24`).
 
-use mbs_symbolic::expand::{Expansion, expand_models};
+use mbs_symbolic::expand::{Expansion, expand_models, multibody_blocks};
 use std::time::{Duration, Instant};
-use syn::visit::Visit;
 
 /// chainN of MODELS.md in the DSL.
 fn chain(n: usize, tangents: bool) -> String {
@@ -37,26 +36,11 @@ fn chain(n: usize, tangents: bool) -> String {
     s + "}"
 }
 
-struct Finder(Vec<proc_macro2::TokenStream>);
-
-impl<'a> Visit<'a> for Finder {
-    fn visit_macro(&mut self, m: &'a syn::Macro) {
-        if m.path
-            .segments
-            .last()
-            .is_some_and(|s| s.ident == "multibody")
-        {
-            self.0.push(m.tokens.clone());
-        }
-    }
-}
-
 fn hexapod(tangents: bool) -> Option<String> {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/models/hexapod.rs");
     let src = std::fs::read_to_string(path).ok()?;
-    let mut f = Finder(Vec::new());
-    f.visit_file(&syn::parse_file(&src).ok()?);
-    let mut body = f.0.first()?.to_string();
+    let blocks = multibody_blocks(&syn::parse_file(&src).ok()?);
+    let mut body = blocks.first()?.to_string();
     if tangents {
         let close = body.rfind('}')?;
         body.insert_str(close, " option tangents ; ");
@@ -130,7 +114,7 @@ fn main() {
     }
     let only: Vec<String> = std::env::args().skip(1).collect();
     for (name, src) in cases {
-        if !only.is_empty() && !only.iter().any(|o| name == *o) {
+        if !only.is_empty() && !only.contains(&name) {
             continue;
         }
         let (best, median, mh, kc) = time(&src, 5);

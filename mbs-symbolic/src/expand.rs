@@ -9,6 +9,27 @@ use crate::dsl::parse::Models;
 use proc_macro2::{Group, TokenStream, TokenTree};
 use quote::ToTokens;
 
+/// The tokens of every `multibody! { … }` invocation in a Rust file (for `mbs expand` and
+/// tools that expand a file the way the macro does).
+pub fn multibody_blocks(file: &syn::File) -> Vec<TokenStream> {
+    struct Finder(Vec<TokenStream>);
+    impl<'a> syn::visit::Visit<'a> for Finder {
+        fn visit_macro(&mut self, m: &'a syn::Macro) {
+            if m.path
+                .segments
+                .last()
+                .is_some_and(|s| s.ident == "multibody")
+            {
+                self.0.push(m.tokens.clone());
+            }
+            syn::visit::visit_macro(self, m);
+        }
+    }
+    let mut f = Finder(Vec::new());
+    syn::visit::Visit::visit_file(&mut f, file);
+    f.0
+}
+
 /// One model's outcome.
 pub enum Expansion {
     Ok {

@@ -1,6 +1,9 @@
 //! The mbs generator: the expression DAG, the `multibody!` language, mechanics and code
 //! emission. The proc-macro, `mbs expand` and tests all call the same functions.
 
+// Matrix and vector code reads best with explicit indices (M[r][c], symmetric halves).
+#![allow(clippy::needless_range_loop)]
+
 pub mod codegen;
 pub mod dsl;
 pub mod expand;

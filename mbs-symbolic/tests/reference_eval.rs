@@ -1,3 +1,4 @@
+#![allow(clippy::needless_range_loop)]
 //! Reference models evaluated on the DAG (no emission involved).
 
 use mbs_symbolic::expr::SliceEnv;

@@ -5,10 +5,9 @@
 //! operation counts per generated function and the generation time.
 
 use clap::{Parser, Subcommand};
-use mbs_symbolic::expand::{Expansion, expand_models};
+use mbs_symbolic::expand::{Expansion, expand_models, multibody_blocks};
 use std::path::PathBuf;
 use std::process::ExitCode;
-use syn::visit::Visit;
 
 #[derive(Parser)]
 #[command(name = "mbs", version, about = "Tools of the mbs multibody toolkit")]
@@ -33,22 +32,6 @@ enum Command {
         #[arg(long)]
         counts_only: bool,
     },
-}
-
-/// Finds the token streams of every `multibody!` invocation.
-struct Finder(Vec<proc_macro2::TokenStream>);
-
-impl<'ast> Visit<'ast> for Finder {
-    fn visit_macro(&mut self, m: &'ast syn::Macro) {
-        if m.path
-            .segments
-            .last()
-            .is_some_and(|s| s.ident == "multibody")
-        {
-            self.0.push(m.tokens.clone());
-        }
-        syn::visit::visit_macro(self, m);
-    }
 }
 
 fn main() -> ExitCode {
@@ -79,13 +62,12 @@ fn expand_file(
         .map_err(|e| format!("cannot read {}: {e}", file.display()))?;
     let ast = syn::parse_file(&src)
         .map_err(|e| format!("{} does not parse as Rust: {e}", file.display()))?;
-    let mut finder = Finder(Vec::new());
-    finder.visit_file(&ast);
-    if finder.0.is_empty() {
+    let blocks = multibody_blocks(&ast);
+    if blocks.is_empty() {
         return Err(format!("no multibody! block in {}", file.display()));
     }
     let mut found = false;
-    for tokens in finder.0 {
+    for tokens in blocks {
         let expansions = expand_models(tokens).map_err(|e| e.to_string())?;
         for e in expansions {
             match e {

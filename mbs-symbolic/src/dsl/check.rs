@@ -224,6 +224,27 @@ impl Checker {
     }
 
     /// An error underlining all of `tokens` (an expression, a call, …).
+    /// Whether a call of `name` has the `expected` number of arguments; reports it if not.
+    fn arity_ok(
+        &mut self,
+        call: &impl ToTokens,
+        name: &(impl std::fmt::Display + ?Sized),
+        found: usize,
+        expected: usize,
+        usage: &str,
+    ) -> bool {
+        if found != expected {
+            self.error_at(
+                call,
+                format!(
+                    "`{name}` takes {}, found {found}: write `{usage}`",
+                    count(expected, "argument")
+                ),
+            );
+        }
+        found == expected
+    }
+
     fn error_at(&mut self, tokens: &impl ToTokens, msg: impl std::fmt::Display) {
         self.errors
             .push(syn::Error::new_spanned(tokens, msg.to_string()));
@@ -890,21 +911,8 @@ impl Checker {
         };
         let args: Vec<&Expr> = call.args.iter().collect();
         let a = Allow { what, ..POSITION };
-        let arity = |c: &mut Checker, n: usize, usage: &str| {
-            if args.len() != n {
-                c.error_at(
-                    call,
-                    format!(
-                        "`{name}` takes {}, found {}: write `{usage}`",
-                        count(n, "argument"),
-                        args.len()
-                    ),
-                );
-                false
-            } else {
-                true
-            }
-        };
+        let arity =
+            |c: &mut Checker, n: usize, usage: &str| c.arity_ok(call, name, args.len(), n, usage);
         let z = self.sys.arena.zero();
         let o = self.sys.arena.one();
         let rot = |c: &mut Checker, axis: [ExprId; 3]| -> Option<Vec<Factor>> {
@@ -1832,21 +1840,8 @@ impl Checker {
         };
         let name = id.to_string();
         let args: Vec<&Expr> = c.args.iter().collect();
-        let arity = |ch: &mut Checker, n: usize, usage: &str| {
-            if args.len() != n {
-                ch.error_at(
-                    c,
-                    format!(
-                        "`{name}` takes {}, found {}: write `{usage}`",
-                        count(n, "argument"),
-                        args.len()
-                    ),
-                );
-                false
-            } else {
-                true
-            }
-        };
+        let arity =
+            |ch: &mut Checker, n: usize, usage: &str| ch.arity_ok(c, &name, args.len(), n, usage);
         if let Some(f) = Func::from_name(&name) {
             if !arity(self, 1, &format!("{name}(x)")) {
                 return self.sys.arena.zero();

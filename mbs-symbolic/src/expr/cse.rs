@@ -83,7 +83,7 @@ impl Schedule {
         }
         let max_lets = max_lets.max(1);
         let chunks: Vec<_> = if lets.is_empty() {
-            vec![0..0]
+            std::iter::once(0..0).collect()
         } else {
             (0..lets.len())
                 .step_by(max_lets)

@@ -13,6 +13,9 @@ use super::world::{Cols, World};
 use crate::expr::{Arena, ExprId, OpCount, Var};
 use rustc_hash::FxHashMap;
 
+/// A dense matrix of expressions, row-major.
+pub type Matrix = Vec<Vec<ExprId>>;
+
 /// M (dense, row-major) and h of one formulation.
 #[derive(Clone, Debug)]
 pub struct MassBias {
@@ -53,7 +56,7 @@ pub struct SceneEquations {
     /// h with qd = 0
     pub static_h: Vec<ExprId>,
     /// K_t = ∂τ/∂q and C_t = ∂τ/∂qd (dense, row-major), when the model asks for them
-    pub tangents: Option<(Vec<Vec<ExprId>>, Vec<Vec<ExprId>>)>,
+    pub tangents: Option<(Matrix, Matrix)>,
     pub kinetic: ExprId,
     pub potential: ExprId,
     /// power of the non-conservative effects

@@ -86,18 +86,7 @@ pub fn body_kinematics(
                 } else {
                     [a.dt_bias(dd[0]), a.dt_bias(dd[1]), a.dt_bias(dd[2])]
                 };
-                let wxd = s::cross(a, p.w, d);
-                let v = s::add(a, p.v, wxd);
-                let v = s::add(a, v, dd);
-                let t1 = s::cross(a, p.al, d);
-                let t2 = s::cross(a, p.w, wxd);
-                let two = a.num(2.0);
-                let t3 = s::cross(a, p.w, dd);
-                let t3 = s::scale(a, two, t3);
-                let mut acc = s::add(a, p.a, t1);
-                acc = s::add(a, acc, t2);
-                acc = s::add(a, acc, t3);
-                acc = s::add(a, acc, ddd);
+                let (v, acc) = s::displaced_motion(a, p.w, p.al, p.v, p.a, d, dd, ddd);
                 BodyKin {
                     w: p.w,
                     v,
@@ -282,7 +271,7 @@ impl SpInertia {
 
     /// This inertia (child axes) expressed in the parent's axes/origin across `fac`, whose
     /// rotation is `rot`.
-    fn to_parent(&self, a: &mut Arena, fac: &Factor, rot: Option<M3>) -> SpInertia {
+    fn to_parent(self, a: &mut Arena, fac: &Factor, rot: Option<M3>) -> SpInertia {
         match rot {
             Some(r) => {
                 let h = s::mul_mv(a, &r, self.h);

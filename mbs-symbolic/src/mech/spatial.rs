@@ -115,3 +115,31 @@ pub fn rotation(a: &mut Arena, axis: V3, angle: ExprId) -> M3 {
     }
     r
 }
+
+/// Velocity and acceleration of a point displaced by d (d's rate ḋ, acceleration d̈, all in
+/// the same axes as the motion of the frame it starts from: ω, α, v, a):
+/// v' = v + ω × d + ḋ, a' = a + α × d + ω × (ω × d) + 2 ω × ḋ + d̈.
+#[allow(clippy::too_many_arguments)]
+pub fn displaced_motion(
+    a: &mut Arena,
+    w: V3,
+    al: V3,
+    v: V3,
+    acc: V3,
+    d: V3,
+    dd: V3,
+    ddd: V3,
+) -> (V3, V3) {
+    let wxd = cross(a, w, d);
+    let v1 = add(a, v, wxd);
+    let v1 = add(a, v1, dd);
+    let t1 = cross(a, al, d);
+    let t2 = cross(a, w, wxd);
+    let two = a.num(2.0);
+    let t3 = cross(a, w, dd);
+    let t3 = scale(a, two, t3);
+    let mut a1 = add(a, acc, t1);
+    a1 = add(a, a1, t2);
+    a1 = add(a, a1, t3);
+    (v1, add(a, a1, ddd))
+}

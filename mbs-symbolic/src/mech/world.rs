@@ -143,19 +143,8 @@ impl World {
                     let ddot_w = s::mul_mv(a, &par.r, ddot);
                     let dd0 = [a.dt_bias(ddot[0]), a.dt_bias(ddot[1]), a.dt_bias(ddot[2])];
                     let dd0_w = s::mul_mv(a, &par.r, dd0);
-                    let wxd = s::cross(a, par.w, dw);
-                    let v = s::add(a, par.v, wxd);
-                    let v = s::add(a, v, ddot_w);
-                    // a = a_p + α_p × d + ω_p × (ω_p × d) + 2 ω_p × ḋ + d̈
-                    let t1 = s::cross(a, par.alb, dw);
-                    let t2 = s::cross(a, par.w, wxd);
-                    let two = a.num(2.0);
-                    let t3 = s::cross(a, par.w, ddot_w);
-                    let t3 = s::scale(a, two, t3);
-                    let mut ab = s::add(a, par.ab, t1);
-                    ab = s::add(a, ab, t2);
-                    ab = s::add(a, ab, t3);
-                    ab = s::add(a, ab, dd0_w);
+                    let (v, ab) =
+                        s::displaced_motion(a, par.w, par.alb, par.v, par.ab, dw, ddot_w, dd0_w);
                     NodeKin {
                         r: par.r,
                         p,

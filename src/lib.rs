@@ -40,3 +40,8 @@ pub use mbs_runtime::*;
 pub mod __private {
     pub use serde;
 }
+
+/// The README's code blocks run as doc-tests, so the front page cannot rot.
+#[doc = include_str!("../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;

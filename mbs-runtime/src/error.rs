@@ -37,3 +37,65 @@ pub fn check_inertia(body: &'static str, t: [f64; 6]) -> Result<(), ParamError> 
         Some(reason) => Err(ParamError::InvalidInertia { body, reason }),
     }
 }
+
+/// Why a simulation stopped early. Each variant carries what is needed to act on it; the
+/// time, step, work done and the trajectory so far travel with it in [`SimError`].
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum Failure {
+    #[error("option `{name}` = {value} is invalid: {reason}")]
+    InvalidOption {
+        name: &'static str,
+        value: String,
+        reason: &'static str,
+    },
+    #[error("invalid parameters: {0}")]
+    InvalidParameters(ParamError),
+    #[error(
+        "the step fell below h_min = {h_min:e} (the solution may be singular or too stiff for the scheme)"
+    )]
+    StepTooSmall { h_min: f64 },
+    #[error(
+        "more than {max_steps} steps (raise max_steps, loosen the tolerance, or use a scheme suited to the stiffness)"
+    )]
+    TooMuchWork { max_steps: usize },
+    #[error(
+        "Newton did not converge in {iterations} iterations (last correction {correction:e}) even at h_min"
+    )]
+    NewtonDiverged { iterations: usize, correction: f64 },
+    #[error("{matrix} is singular (rcond ≈ {rcond:.1e}) near coordinates {}", coordinates.join(", "))]
+    SingularMatrix {
+        matrix: &'static str,
+        rcond: f64,
+        coordinates: Vec<String>,
+    },
+    #[error("{quantity} of coordinate {coordinate} is not finite")]
+    NonFinite {
+        quantity: &'static str,
+        coordinate: String,
+    },
+    #[error(
+        "h·ρ = {h_rho:.3} leaves the stability region of {scheme} (limit {limit:.3}; ρ ≈ {rho:.4e} 1/s is the fastest mode): take h < {h_stable:.4e} s or an implicit scheme"
+    )]
+    UnstableStep {
+        scheme: &'static str,
+        rho: f64,
+        h_rho: f64,
+        limit: f64,
+        h_stable: f64,
+    },
+}
+
+/// A simulation that stopped early, with what it had computed until then: every recorded
+/// output before the failure (never a non-finite value) and the work counters.
+#[derive(Debug, Clone, Error)]
+#[error("{kind} (at t = {t}, h = {h:e})")]
+pub struct SimError {
+    pub kind: Failure,
+    /// time of the last accepted state
+    pub t: f64,
+    /// step being attempted
+    pub h: f64,
+    pub stats: crate::stats::Stats,
+    pub trajectory: Box<crate::trajectory::Trajectory>,
+}

@@ -1,19 +1,33 @@
-//! The mbs runtime: the [`Model`] trait that `multibody!` implements, its output records and
-//! typed errors. Integrators and analyses build on it.
+//! The mbs runtime: the [`Model`] trait that `multibody!` implements, the integrators that
+//! run it, their options, statistics and typed failures.
 //!
-//! Main types, in the order a user meets them: [`Model`] (what a generated model can
-//! compute), [`Parameters`] (its parameter struct), [`ModelInfo`] (names, sizes, op counts),
-//! [`Energy`], [`Pose`] and [`Kinematics`] (outputs), [`ParamError`] and [`ModelError`].
+//! Main types, in the order a user meets them: [`Model`] (what a generated model computes),
+//! [`Scheme`] and [`Options`] (how to integrate it), [`simulate`] and [`Simulation`] (the
+//! [`Integrator`]), [`Trajectory`] (outputs, CSV, JSON), [`Stats`] (the work done),
+//! [`SimError`] and [`Failure`] (why a run stopped, with what it computed until then);
+//! [`Parameters`], [`ModelInfo`], [`Energy`], [`Pose`], [`Kinematics`] describe models.
 
 // Matrix code reads best with explicit indices.
 #![allow(clippy::needless_range_loop)]
 
 pub mod error;
 pub mod inertia;
+pub mod integrators;
+pub mod linalg;
 pub mod model;
+pub mod options;
+pub mod stats;
+pub mod trajectory;
 
-pub use error::{ModelError, ParamError, check_inertia};
+pub use error::{Failure, ModelError, ParamError, SimError, check_inertia};
+pub use integrators::{Integrator, Simulation, State, simulate};
 pub use model::{
     Energy, FrameKinematics, Kinematics, Model, ModelInfo, OpCount, OpsTable, Parameters,
     PointKinematics, Pose,
 };
+pub use options::{
+    BdfParams, GenAlphaParams, HhtParams, IterationMatrix, NewmarkParams, NewtonOptions, Options,
+    Output, Scheme, StepControl,
+};
+pub use stats::Stats;
+pub use trajectory::{Observer, Trajectory};

@@ -5,7 +5,7 @@
 //! other lengths is a programming error and panics.
 
 use crate::error::{ModelError, ParamError};
-use serde::{Serialize, de::DeserializeOwned};
+use serde::{Deserialize, Serialize, de::DeserializeOwned};
 use std::fmt;
 
 /// Operation counts of one generated function, as reported by `mbs expand`.
@@ -121,7 +121,7 @@ impl ModelInfo {
 }
 
 /// Kinetic and potential energy.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Energy {
     /// ½ Σ (m v_G² + ωᵀ Φ_G ω)
     pub kinetic: f64,
@@ -137,7 +137,7 @@ impl Energy {
 
 /// Pose of a frame: `rotation[i][j]` (columns are the frame's axes in world axes) and the
 /// world position of its origin (G for a body).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Pose {
     pub rotation: [[f64; 3]; 3],
     pub position: [f64; 3],

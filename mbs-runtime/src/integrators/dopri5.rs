@@ -1,0 +1,224 @@
+//! Dormand–Prince 5(4) (Dormand & Prince 1980) on y = (q, qd): seven stages, first same as
+//! last (six evaluations per step), error estimated by the embedded order-4 solution, step
+//! chosen by Hairer's PI controller (β = 0.04), dense output by the order-4 continuous
+//! extension of Shampine (1986), as in Hairer's DOPRI5. Stability interval on the negative
+//! real axis ≈ 3.3; not for stiff problems.
+
+use super::problem::Problem;
+use super::{Attempt, Control, State, Stepper};
+use crate::error::Failure;
+use crate::model::Model;
+
+const C: [f64; 7] = [0.0, 0.2, 0.3, 0.8, 8.0 / 9.0, 1.0, 1.0];
+const A: [[f64; 6]; 7] = [
+    [0.0; 6],
+    [0.2, 0.0, 0.0, 0.0, 0.0, 0.0],
+    [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0],
+    [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0, 0.0],
+    [
+        19372.0 / 6561.0,
+        -25360.0 / 2187.0,
+        64448.0 / 6561.0,
+        -212.0 / 729.0,
+        0.0,
+        0.0,
+    ],
+    [
+        9017.0 / 3168.0,
+        -355.0 / 33.0,
+        46732.0 / 5247.0,
+        49.0 / 176.0,
+        -5103.0 / 18656.0,
+        0.0,
+    ],
+    [
+        35.0 / 384.0,
+        0.0,
+        500.0 / 1113.0,
+        125.0 / 192.0,
+        -2187.0 / 6784.0,
+        11.0 / 84.0,
+    ],
+];
+/// b − b̂: the error estimate's weights
+const E: [f64; 7] = [
+    71.0 / 57600.0,
+    0.0,
+    -71.0 / 16695.0,
+    71.0 / 1920.0,
+    -17253.0 / 339200.0,
+    22.0 / 525.0,
+    -1.0 / 40.0,
+];
+/// dense output weights (Shampine)
+const D: [f64; 7] = [
+    -12715105075.0 / 11282082432.0,
+    0.0,
+    87487479700.0 / 32700410799.0,
+    -10690763975.0 / 1880347072.0,
+    701980252875.0 / 199316789632.0,
+    -1453857185.0 / 822651844.0,
+    69997945.0 / 29380423.0,
+];
+
+pub(crate) struct Dopri5 {
+    n: usize,
+    /// stage derivatives (velocity part kv, acceleration part ka); stage 0 is qd0, qdd0
+    kv: [Vec<f64>; 7],
+    ka: [Vec<f64>; 7],
+    q: Vec<f64>,
+    v: Vec<f64>,
+    err: Vec<f64>,
+    y0: Vec<f64>,
+    y1: Vec<f64>,
+    /// previous error norm, for the PI controller
+    err_old: f64,
+    /// dense output of the last accepted step: 5 coefficient vectors for q and for qd
+    cont_q: [Vec<f64>; 5],
+    cont_v: [Vec<f64>; 5],
+    /// whether the last attempt was rejected (no step growth right after a rejection)
+    last_rejected: bool,
+}
+
+impl Dopri5 {
+    pub fn new(n: usize) -> Dopri5 {
+        let z = || vec![0.0; n];
+        let s7 = || [z(), z(), z(), z(), z(), z(), z()];
+        let s5 = || [z(), z(), z(), z(), z()];
+        Dopri5 {
+            n,
+            kv: s7(),
+            ka: s7(),
+            q: z(),
+            v: z(),
+            err: vec![0.0; 2 * n],
+            y0: vec![0.0; 2 * n],
+            y1: vec![0.0; 2 * n],
+            err_old: 1e-4,
+            cont_q: s5(),
+            cont_v: s5(),
+            last_rejected: false,
+        }
+    }
+}
+
+impl<M: Model> Stepper<M> for Dopri5 {
+    fn attempt(
+        &mut self,
+        p: &mut Problem<M>,
+        cur: &State,
+        h: f64,
+        ctl: &Control,
+        next: &mut State,
+    ) -> Result<Attempt, Failure> {
+        let n = self.n;
+        self.kv[0].copy_from_slice(&cur.qd);
+        self.ka[0].copy_from_slice(&cur.qdd);
+        for s in 1..7 {
+            for i in 0..n {
+                let (mut dq, mut dv) = (0.0, 0.0);
+                for j in 0..s {
+                    dq += A[s][j] * self.kv[j][i];
+                    dv += A[s][j] * self.ka[j][i];
+                }
+                self.q[i] = cur.q[i] + h * dq;
+                self.v[i] = cur.qd[i] + h * dv;
+            }
+            self.kv[s].copy_from_slice(&self.v);
+            let r = p.accel(cur.t + C[s] * h, &self.q, &self.v, &mut self.ka[s]);
+            if let Err(e) = r {
+                // a non-finite stage: too large a step when adaptive, fatal when fixed
+                if ctl.adaptive.is_some() && matches!(e, Failure::NonFinite { .. }) {
+                    self.last_rejected = true;
+                    return Ok(Attempt::RejectedNewton {
+                        h_next: 0.25 * h,
+                        iterations: 0,
+                        correction: f64::INFINITY,
+                        cause: Some(e),
+                    });
+                }
+                return Err(e);
+            }
+        }
+        // stage 7 is at (q1, qd1): the new state, first same as last
+        next.q.copy_from_slice(&self.q);
+        next.qd.copy_from_slice(&self.v);
+        next.qdd.copy_from_slice(&self.ka[6]);
+        let Some(_) = ctl.adaptive else {
+            self.dense(cur, next, h);
+            return Ok(Attempt::Accepted { h_next: h });
+        };
+        for i in 0..n {
+            let (mut eq, mut ev) = (0.0, 0.0);
+            for s in 0..7 {
+                eq += E[s] * self.kv[s][i];
+                ev += E[s] * self.ka[s][i];
+            }
+            self.err[i] = h * eq;
+            self.err[n + i] = h * ev;
+            self.y0[i] = cur.q[i];
+            self.y0[n + i] = cur.qd[i];
+            self.y1[i] = next.q[i];
+            self.y1[n + i] = next.qd[i];
+        }
+        let err = ctl.error_norm(&self.err, &self.y0, &self.y1);
+        // PI control (Hairer): fac = err^(0.2 − 0.75β) / err_old^β, β = 0.04
+        let beta = 0.04;
+        let fac11 = err.powf(0.2 - 0.75 * beta);
+        let fac = (fac11 / self.err_old.powf(beta) / 0.9).clamp(0.1, 5.0);
+        if err <= 1.0 {
+            self.err_old = err.max(1e-4);
+            let mut h_next = h / fac;
+            if self.last_rejected {
+                h_next = h_next.min(h);
+            }
+            self.last_rejected = false;
+            self.dense(cur, next, h);
+            Ok(Attempt::Accepted { h_next })
+        } else {
+            self.last_rejected = true;
+            Ok(Attempt::RejectedError {
+                h_next: h / (fac11 / 0.9).min(5.0),
+            })
+        }
+    }
+
+    fn interpolate(&self, prev: &State, cur: &State, t: f64, out: &mut State) {
+        let h = cur.t - prev.t;
+        let th = if h == 0.0 { 1.0 } else { (t - prev.t) / h };
+        let th1 = 1.0 - th;
+        out.t = t;
+        for i in 0..self.n {
+            let [c1, c2, c3, c4, c5] = &self.cont_q;
+            out.q[i] = c1[i] + th * (c2[i] + th1 * (c3[i] + th * (c4[i] + th1 * c5[i])));
+            let [d1, d2, d3, d4, d5] = &self.cont_v;
+            out.qd[i] = d1[i] + th * (d2[i] + th1 * (d3[i] + th * (d4[i] + th1 * d5[i])));
+            // qdd: derivative of the velocity polynomial in θ, divided by h
+            let dp = d2[i]
+                + (1.0 - 2.0 * th) * d3[i]
+                + (2.0 * th - 3.0 * th * th) * d4[i]
+                + (2.0 * th - 6.0 * th * th + 4.0 * th * th * th) * d5[i];
+            out.qdd[i] = if h == 0.0 { cur.qdd[i] } else { dp / h };
+        }
+    }
+}
+
+impl Dopri5 {
+    /// Coefficients of the continuous extension of the step just accepted.
+    fn dense(&mut self, cur: &State, next: &State, h: f64) {
+        for i in 0..self.n {
+            for (y0, y1, k, c) in [
+                (cur.q[i], next.q[i], &self.kv, &mut self.cont_q),
+                (cur.qd[i], next.qd[i], &self.ka, &mut self.cont_v),
+            ] {
+                let diff = y1 - y0;
+                let bspl = h * k[0][i] - diff;
+                c[0][i] = y0;
+                c[1][i] = diff;
+                c[2][i] = bspl;
+                c[3][i] = diff - h * k[6][i] - bspl;
+                c[4][i] = h * (0..7).map(|s| D[s] * k[s][i]).sum::<f64>();
+            }
+        }
+    }
+}

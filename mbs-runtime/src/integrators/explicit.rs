@@ -1,0 +1,241 @@
+//! Explicit fixed-step schemes on the first-order form y = (q, qd), y' = (qd, M⁻¹h):
+//! - explicit Euler (order 1): y₁ = y₀ + h f(y₀);
+//! - classical Runge–Kutta (Kutta 1901, order 4), stability interval on the imaginary axis
+//!   |hω| < 2√2 and on the real axis hλ > −2.785.
+//!
+//! Past its stability limit an explicit scheme amplifies the fastest mode until the numbers
+//! overflow. To fail before that, every 16 steps a power iteration on J² (J = ∂f/∂y, two extra
+//! evaluations) estimates the largest |λ| of the dynamics: J² has eigenvalues −ω² on an
+//! oscillating mode whatever the scaling of q and qd, so ‖J²δ‖/‖δ‖ → ρ². When h·ρ leaves the
+//! scheme's stability interval, the step fails with `UnstableStep`.
+
+use super::problem::Problem;
+use super::{Attempt, Control, State, Stepper};
+use crate::error::Failure;
+use crate::model::Model;
+
+#[derive(Clone, Copy, PartialEq)]
+enum Kind {
+    Euler,
+    Rk4,
+}
+
+pub(crate) struct Explicit {
+    kind: Kind,
+    n: usize,
+    /// stage positions, and the stages' velocities and accelerations
+    qs: Vec<f64>,
+    vs: [Vec<f64>; 3],
+    acc: [Vec<f64>; 3],
+    /// power iteration on J²: the direction δ = (dq, dv), J δ = (jq, jv), scratch
+    dq: Vec<f64>,
+    dv: Vec<f64>,
+    jq: Vec<f64>,
+    jv: Vec<f64>,
+    pq: Vec<f64>,
+    pv: Vec<f64>,
+    pa: Vec<f64>,
+    steps: usize,
+    rho: f64,
+}
+
+/// A start for the power iteration with components on every coordinate and both halves.
+fn seed_direction(dq: &mut [f64], dv: &mut [f64]) {
+    for i in 0..dq.len() {
+        dq[i] = 1.0 + 0.37 * i as f64;
+        dv[i] = if i % 2 == 0 { 0.5 } else { -0.8 };
+    }
+}
+
+fn norm2(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().chain(b).map(|x| x * x).sum::<f64>().sqrt()
+}
+
+impl Explicit {
+    fn new(kind: Kind, n: usize) -> Explicit {
+        let z = || vec![0.0; n];
+        let (mut dq, mut dv) = (z(), z());
+        seed_direction(&mut dq, &mut dv);
+        Explicit {
+            kind,
+            n,
+            qs: z(),
+            vs: [z(), z(), z()],
+            acc: [z(), z(), z()],
+            dq,
+            dv,
+            jq: z(),
+            jv: z(),
+            pq: z(),
+            pv: z(),
+            pa: z(),
+            steps: 0,
+            rho: 0.0,
+        }
+    }
+
+    pub fn euler(n: usize) -> Explicit {
+        Explicit::new(Kind::Euler, n)
+    }
+
+    pub fn rk4(n: usize) -> Explicit {
+        Explicit::new(Kind::Rk4, n)
+    }
+
+    fn name(&self) -> &'static str {
+        match self.kind {
+            Kind::Euler => "explicit Euler",
+            Kind::Rk4 => "RK4",
+        }
+    }
+
+    /// Radius of the stability interval of h·λ on the axes (RK4: min(2√2, 2.785) on the
+    /// imaginary and real axes; Euler: 2 on the real axis, and it is unstable for any undamped
+    /// oscillation, slowly).
+    fn limit(&self) -> f64 {
+        match self.kind {
+            Kind::Euler => 2.0,
+            Kind::Rk4 => 2.785,
+        }
+    }
+
+    /// (oq, ov) = J·(iq, iv) at `s`, by a forward difference of the accelerations.
+    #[allow(clippy::too_many_arguments)]
+    fn apply_j<M: Model>(
+        p: &mut Problem<M>,
+        s: &State,
+        iq: &[f64],
+        iv: &[f64],
+        oq: &mut [f64],
+        ov: &mut [f64],
+        pq: &mut [f64],
+        pv: &mut [f64],
+        pa: &mut [f64],
+    ) -> Result<(), Failure> {
+        let norm = norm2(iq, iv).max(f64::MIN_POSITIVE);
+        let scale =
+            s.q.iter()
+                .chain(s.qd.iter())
+                .map(|x| x.abs())
+                .fold(1.0, f64::max);
+        let eps = f64::EPSILON.sqrt() * scale / norm;
+        for i in 0..s.q.len() {
+            pq[i] = s.q[i] + eps * iq[i];
+            pv[i] = s.qd[i] + eps * iv[i];
+        }
+        p.accel(s.t, pq, pv, pa)?;
+        for i in 0..s.q.len() {
+            oq[i] = iv[i];
+            ov[i] = (pa[i] - s.qdd[i]) / eps;
+        }
+        Ok(())
+    }
+
+    /// One power-iteration step on J²; returns the estimate of ρ(J).
+    fn estimate_rho<M: Model>(&mut self, p: &mut Problem<M>, s: &State) -> Result<f64, Failure> {
+        let n0 = norm2(&self.dq, &self.dv);
+        Self::apply_j(
+            p,
+            s,
+            &self.dq,
+            &self.dv,
+            &mut self.jq,
+            &mut self.jv,
+            &mut self.pq,
+            &mut self.pv,
+            &mut self.pa,
+        )?;
+        Self::apply_j(
+            p,
+            s,
+            &self.jq,
+            &self.jv,
+            &mut self.dq,
+            &mut self.dv,
+            &mut self.pq,
+            &mut self.pv,
+            &mut self.pa,
+        )?;
+        let n2 = norm2(&self.dq, &self.dv);
+        if !(n2 > 0.0) || !n2.is_finite() || !(n0 > 0.0) {
+            seed_direction(&mut self.dq, &mut self.dv);
+            return Ok(self.rho);
+        }
+        for x in self.dq.iter_mut().chain(self.dv.iter_mut()) {
+            *x /= n2;
+        }
+        Ok((n2 / n0).sqrt())
+    }
+}
+
+impl<M: Model> Stepper<M> for Explicit {
+    fn attempt(
+        &mut self,
+        p: &mut Problem<M>,
+        cur: &State,
+        h: f64,
+        ctl: &Control,
+        next: &mut State,
+    ) -> Result<Attempt, Failure> {
+        if ctl.stability_check && self.steps % 16 == 0 {
+            self.rho = self.estimate_rho(p, cur)?;
+            let h_rho = h * self.rho;
+            if h_rho > self.limit() {
+                return Err(Failure::UnstableStep {
+                    scheme: self.name(),
+                    rho: self.rho,
+                    h_rho,
+                    limit: self.limit(),
+                    h_stable: self.limit() / self.rho,
+                });
+            }
+        }
+        let n = self.n;
+        let t = cur.t;
+        match self.kind {
+            Kind::Euler => {
+                for i in 0..n {
+                    next.q[i] = cur.q[i] + h * cur.qd[i];
+                    next.qd[i] = cur.qd[i] + h * cur.qdd[i];
+                }
+            }
+            Kind::Rk4 => {
+                // stage k at t + c_k h from the previous stage's (v, a); stage 1 is (qd0, qdd0)
+                for k in 0..3 {
+                    let c = if k < 2 { 0.5 } else { 1.0 };
+                    let (vdone, vrest) = self.vs.split_at_mut(k);
+                    let (adone, arest) = self.acc.split_at_mut(k);
+                    let (vprev, aprev): (&[f64], &[f64]) = if k == 0 {
+                        (&cur.qd, &cur.qdd)
+                    } else {
+                        (&vdone[k - 1], &adone[k - 1])
+                    };
+                    for i in 0..n {
+                        self.qs[i] = cur.q[i] + c * h * vprev[i];
+                        vrest[0][i] = cur.qd[i] + c * h * aprev[i];
+                    }
+                    p.accel(t + c * h, &self.qs, &vrest[0], &mut arest[0])?;
+                }
+                for i in 0..n {
+                    next.q[i] = cur.q[i]
+                        + h / 6.0
+                            * (cur.qd[i]
+                                + 2.0 * self.vs[0][i]
+                                + 2.0 * self.vs[1][i]
+                                + self.vs[2][i]);
+                    next.qd[i] = cur.qd[i]
+                        + h / 6.0
+                            * (cur.qdd[i]
+                                + 2.0 * self.acc[0][i]
+                                + 2.0 * self.acc[1][i]
+                                + self.acc[2][i]);
+                }
+            }
+        }
+        p.check("q", &next.q)?;
+        p.check("qd", &next.qd)?;
+        p.accel(t + h, &next.q, &next.qd, &mut next.qdd)?;
+        self.steps += 1;
+        Ok(Attempt::Accepted { h_next: h })
+    }
+}

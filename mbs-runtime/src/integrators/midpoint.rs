@@ -1,0 +1,80 @@
+//! The implicit midpoint rule on y = (q, qd): y₁ = y₀ + h f((y₀ + y₁)/2), order 2, symmetric
+//! (time-reversible) and A-stable, with no numerical damping; on linear and canonical
+//! Hamiltonian systems it is symplectic and keeps the energy bounded over long runs.
+//! With a = the acceleration at the midpoint, q_m = q₀ + h/2 qd₀ + h²/4 a,
+//! qd_m = qd₀ + h/2 a, and Newton solves τ(t + h/2, q_m, qd_m, a) = 0 with the iteration
+//! matrix M + (h/2)·C_t + (h²/4)·K_t; then q₁ = q₀ + h qd₀ + h²/2 a, qd₁ = qd₀ + h a, and qdd₁
+//! from M qdd = h at the new state (one more evaluation, so that outputs are consistent).
+
+use super::newton::AccelNewton;
+use super::problem::Problem;
+use super::{Attempt, Control, State, Stepper};
+use crate::error::Failure;
+use crate::model::Model;
+
+pub(crate) struct Midpoint {
+    n: usize,
+    qhat: Vec<f64>,
+    vhat: Vec<f64>,
+    a: Vec<f64>,
+    newton: AccelNewton,
+}
+
+impl Midpoint {
+    pub fn new(n: usize) -> Midpoint {
+        let z = || vec![0.0; n];
+        Midpoint {
+            n,
+            qhat: z(),
+            vhat: z(),
+            a: z(),
+            newton: AccelNewton::new(n),
+        }
+    }
+}
+
+impl<M: Model> Stepper<M> for Midpoint {
+    fn start(&mut self, _p: &mut Problem<M>, s: &State, _ctl: &Control) -> Result<(), Failure> {
+        self.a.copy_from_slice(&s.qdd);
+        Ok(())
+    }
+
+    fn attempt(
+        &mut self,
+        p: &mut Problem<M>,
+        cur: &State,
+        h: f64,
+        ctl: &Control,
+        next: &mut State,
+    ) -> Result<Attempt, Failure> {
+        for i in 0..self.n {
+            self.qhat[i] = cur.q[i] + 0.5 * h * cur.qd[i];
+            self.vhat[i] = cur.qd[i];
+        }
+        // the previous midpoint acceleration is the better guess
+        let r = self.newton.solve(
+            p,
+            cur.t + 0.5 * h,
+            &self.qhat,
+            &self.vhat,
+            0.25 * h * h,
+            0.5 * h,
+            &mut self.a,
+            &ctl.newton,
+        );
+        if let Err(f) = r {
+            return Ok(Attempt::RejectedNewton {
+                h_next: 0.25 * h,
+                iterations: f.iterations,
+                correction: f.correction,
+                cause: f.cause,
+            });
+        }
+        for i in 0..self.n {
+            next.q[i] = cur.q[i] + h * cur.qd[i] + 0.5 * h * h * self.a[i];
+            next.qd[i] = cur.qd[i] + h * self.a[i];
+        }
+        p.accel(cur.t + h, &next.q, &next.qd, &mut next.qdd)?;
+        Ok(Attempt::Accepted { h_next: h })
+    }
+}

@@ -1,0 +1,686 @@
+//! Integration of `M(q,t) qdd = h(q, qd, t)` with the scheme the user picks. One driver
+//! ([`Simulation`], the [`Integrator`] trait) runs every scheme: it validates options, starts
+//! consistently (qdd(0) from M qdd = h), chooses steps, samples outputs, and turns every
+//! failure into a typed [`SimError`] that keeps the trajectory computed so far. Schemes live
+//! one per file and implement the internal `Stepper` trait.
+//!
+//! | scheme | file | order | steps |
+//! |---|---|---|---|
+//! | explicit Euler, RK4 | `explicit.rs` | 1, 4 | fixed (with a stability check) |
+//! | Dormand–Prince 5(4) | `dopri5.rs` | 5 | adaptive or fixed, dense output |
+//! | Newmark, HHT-α, generalized-α | `newmark.rs` | 2 | fixed or adaptive |
+//! | implicit midpoint | `midpoint.rs` | 2 | fixed |
+//! | BDF 1–5 | `bdf.rs` | 1–5 | adaptive, variable order |
+//! | Radau IIA 3, 5 | `radau.rs` | 3, 5 | adaptive or fixed |
+
+mod dopri5;
+mod explicit;
+mod midpoint;
+mod newmark;
+pub(crate) mod newton;
+pub(crate) mod problem;
+
+use crate::error::{Failure, SimError};
+use crate::model::{Model, Pose};
+use crate::options::{Options, Output, Scheme, StepControl};
+use crate::stats::Stats;
+use crate::trajectory::{Observer, Trajectory};
+use newton::NewtonTol;
+use problem::Problem;
+
+/// A state of the motion.
+#[derive(Clone, Debug, PartialEq)]
+pub struct State {
+    pub t: f64,
+    pub q: Vec<f64>,
+    pub qd: Vec<f64>,
+    /// accelerations consistent with M qdd = h (or the scheme's own at this step)
+    pub qdd: Vec<f64>,
+}
+
+impl State {
+    pub(crate) fn zeros(n: usize) -> State {
+        State {
+            t: 0.0,
+            q: vec![0.0; n],
+            qd: vec![0.0; n],
+            qdd: vec![0.0; n],
+        }
+    }
+
+    pub(crate) fn copy_from(&mut self, o: &State) {
+        self.t = o.t;
+        self.q.copy_from_slice(&o.q);
+        self.qd.copy_from_slice(&o.qd);
+        self.qdd.copy_from_slice(&o.qdd);
+    }
+}
+
+/// One integrator interface for every scheme.
+pub trait Integrator {
+    /// Advances by one accepted step (retrying rejected attempts); records outputs it passes.
+    fn step(&mut self) -> Result<(), SimError>;
+    /// Advances until `t` (≤ t_end), recording outputs on the way.
+    fn integrate_to(&mut self, t: f64) -> Result<(), SimError>;
+    /// The current state.
+    fn state(&self) -> &State;
+    /// Work so far.
+    fn stats(&self) -> &Stats;
+    /// Outputs so far.
+    fn trajectory(&self) -> &Trajectory;
+}
+
+/// What one attempted step gave.
+pub(crate) enum Attempt {
+    /// `next` holds the state at t + h
+    Accepted { h_next: f64 },
+    /// the local error test failed
+    RejectedError { h_next: f64 },
+    /// Newton did not converge (or an evaluation failed inside the step)
+    RejectedNewton {
+        h_next: f64,
+        iterations: usize,
+        correction: f64,
+        cause: Option<Failure>,
+    },
+}
+
+/// Step control and Newton settings handed to the schemes.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Control {
+    /// (rtol, atol) when adaptive
+    pub adaptive: Option<(f64, f64)>,
+    pub newton: NewtonTol,
+    /// explicit fixed-step schemes check h·ρ against their stability region
+    pub stability_check: bool,
+}
+
+impl Control {
+    /// Weighted RMS norm of an error vector e against the state scales y0, y1:
+    /// sqrt(mean (e_i / (atol + rtol·max(|y0_i|, |y1_i|)))²).
+    pub fn error_norm(&self, e: &[f64], y0: &[f64], y1: &[f64]) -> f64 {
+        let (rtol, atol) = self.adaptive.unwrap_or((1.0, 1.0));
+        let mut s = 0.0;
+        for i in 0..e.len() {
+            let w = atol + rtol * y0[i].abs().max(y1[i].abs());
+            s += (e[i] / w) * (e[i] / w);
+        }
+        (s / e.len().max(1) as f64).sqrt()
+    }
+}
+
+/// Next step from an error norm (≤ 1 accepted) of a method whose error estimate is of order
+/// `order` (local error ∝ h^(order+1)): h·min(fmax, max(0.2, 0.9·err^(−1/(order+1)))).
+pub(crate) fn next_step(h: f64, err: f64, order: usize, fmax: f64) -> f64 {
+    let fac = if err == 0.0 {
+        fmax
+    } else {
+        (0.9 * err.powf(-1.0 / (order as f64 + 1.0))).clamp(0.2, fmax)
+    };
+    h * fac
+}
+
+/// A scheme, as the driver sees it.
+pub(crate) trait Stepper<M: Model> {
+    /// Called once with the consistent initial state.
+    fn start(&mut self, _p: &mut Problem<M>, _s: &State, _ctl: &Control) -> Result<(), Failure> {
+        Ok(())
+    }
+    /// Attempts a step of size `h` from `cur`; on acceptance fills `next`.
+    fn attempt(
+        &mut self,
+        p: &mut Problem<M>,
+        cur: &State,
+        h: f64,
+        ctl: &Control,
+        next: &mut State,
+    ) -> Result<Attempt, Failure>;
+    /// Called once the driver has accepted the step from `prev` to `cur`.
+    fn accepted(&mut self, _p: &mut Problem<M>, _prev: &State, _cur: &State) {}
+    /// Dense output on [prev.t, cur.t]: by default the quintic Hermite interpolant of
+    /// (q, qd, qdd) at both ends, accurate beyond every scheme's order here.
+    fn interpolate(&self, prev: &State, cur: &State, t: f64, out: &mut State) {
+        hermite5(prev, cur, t, out);
+    }
+}
+
+/// Quintic Hermite interpolation of q between two states (qd and qdd from its derivatives).
+pub(crate) fn hermite5(s0: &State, s1: &State, t: f64, out: &mut State) {
+    let h = s1.t - s0.t;
+    out.t = t;
+    if h == 0.0 {
+        out.copy_from(s1);
+        return;
+    }
+    let s = (t - s0.t) / h;
+    let (s2, s3, s4, s5) = (s * s, s * s * s, s * s * s * s, s * s * s * s * s);
+    // basis and its first and second derivatives in s
+    let b = [
+        1.0 - 10.0 * s3 + 15.0 * s4 - 6.0 * s5,
+        s - 6.0 * s3 + 8.0 * s4 - 3.0 * s5,
+        0.5 * s2 - 1.5 * s3 + 1.5 * s4 - 0.5 * s5,
+        0.5 * s3 - s4 + 0.5 * s5,
+        -4.0 * s3 + 7.0 * s4 - 3.0 * s5,
+        10.0 * s3 - 15.0 * s4 + 6.0 * s5,
+    ];
+    let d = [
+        -30.0 * s2 + 60.0 * s3 - 30.0 * s4,
+        1.0 - 18.0 * s2 + 32.0 * s3 - 15.0 * s4,
+        s - 4.5 * s2 + 6.0 * s3 - 2.5 * s4,
+        1.5 * s2 - 4.0 * s3 + 2.5 * s4,
+        -12.0 * s2 + 28.0 * s3 - 15.0 * s4,
+        30.0 * s2 - 60.0 * s3 + 30.0 * s4,
+    ];
+    let dd = [
+        -60.0 * s + 180.0 * s2 - 120.0 * s3,
+        -36.0 * s + 96.0 * s2 - 60.0 * s3,
+        1.0 - 9.0 * s + 18.0 * s2 - 10.0 * s3,
+        3.0 * s - 12.0 * s2 + 10.0 * s3,
+        -24.0 * s + 84.0 * s2 - 60.0 * s3,
+        60.0 * s - 180.0 * s2 + 120.0 * s3,
+    ];
+    for i in 0..s0.q.len() {
+        let c = [
+            s0.q[i],
+            h * s0.qd[i],
+            h * h * s0.qdd[i],
+            h * h * s1.qdd[i],
+            h * s1.qd[i],
+            s1.q[i],
+        ];
+        let dot = |w: &[f64; 6]| w.iter().zip(&c).map(|(a, b)| a * b).sum::<f64>();
+        out.q[i] = dot(&b);
+        out.qd[i] = dot(&d) / h;
+        out.qdd[i] = dot(&dd) / (h * h);
+    }
+}
+
+/// Runs `scheme` on `model` with `options` to the end; on failure, the error keeps the
+/// trajectory up to the failure.
+pub fn simulate<M: Model + 'static>(
+    model: M,
+    scheme: Scheme,
+    options: Options,
+) -> Result<(Trajectory, Stats), SimError> {
+    let mut sim = Simulation::new(model, scheme, options)?;
+    let t_end = sim.options.t_end;
+    sim.integrate_to(t_end)?;
+    Ok(sim.finish())
+}
+
+/// A running simulation: the model, the scheme, the state, the outputs and the work done.
+pub struct Simulation<M: Model> {
+    problem: Problem<M>,
+    stepper: Box<dyn Stepper<M>>,
+    scheme: Scheme,
+    options: Options,
+    ctl: Control,
+    cur: State,
+    next: State,
+    prev: State,
+    scratch: State,
+    h: f64,
+    attempts: usize,
+    traj: Trajectory,
+    /// pending output times (for `Output::Every` and `Times`), next one first
+    out_times: Vec<f64>,
+    out_next: usize,
+    poses: Vec<Pose>,
+    observers: Vec<Box<dyn Observer>>,
+}
+
+impl<M: Model + 'static> Simulation<M> {
+    /// Validates everything, then starts from a consistent state: the given or declared q0,
+    /// qd0 and qdd0 from M qdd = h.
+    pub fn new(model: M, scheme: Scheme, options: Options) -> Result<Simulation<M>, SimError> {
+        let n = M::NQ;
+        let info = model.info();
+        let dof_names: Vec<String> = info.dofs.iter().map(|s| s.to_string()).collect();
+        let frame_names: Vec<String> = info.frames.iter().map(|s| s.to_string()).collect();
+        let early = |kind: Failure, stats: Stats| SimError {
+            kind,
+            t: options.t0,
+            h: 0.0,
+            stats,
+            trajectory: Box::new(Trajectory::new(dof_names.clone(), frame_names.clone())),
+        };
+        if let Err(e) = options.validate(&scheme, n, info.has_tangents) {
+            return Err(early(e, Stats::default()));
+        }
+        if let Err(e) = crate::model::Parameters::validate(model.params()) {
+            return Err(early(Failure::InvalidParameters(e), Stats::default()));
+        }
+        let mut problem = Problem::new(model, options.iteration_matrix);
+        let mut cur = State::zeros(n);
+        cur.t = options.t0;
+        problem.model.initial_state(&mut cur.q, &mut cur.qd);
+        if let Some(q0) = &options.q0 {
+            cur.q.copy_from_slice(q0);
+        }
+        if let Some(qd0) = &options.qd0 {
+            cur.qd.copy_from_slice(qd0);
+        }
+        let start = problem
+            .check("q0", &cur.q)
+            .and_then(|_| problem.check("qd0", &cur.qd));
+        let start =
+            start.and_then(|_| problem.accel(cur.t, &cur.q.clone(), &cur.qd.clone(), &mut cur.qdd));
+        if let Err(e) = start {
+            return Err(early(e, problem.stats.clone()));
+        }
+        let newton = NewtonTol {
+            atol: options.newton.atol,
+            rtol: options.newton.rtol,
+            kappa: 1.0,
+            max_iterations: options.newton.max_iterations,
+            reuse: options.newton.reuse,
+        };
+        let (adaptive, newton) = match options.step {
+            StepControl::Fixed { .. } => (None, newton),
+            StepControl::Adaptive { rtol, atol, .. } => (
+                Some((rtol, atol)),
+                NewtonTol {
+                    atol,
+                    rtol,
+                    kappa: options.newton.tolerance_factor,
+                    ..newton
+                },
+            ),
+        };
+        let ctl = Control {
+            adaptive,
+            newton,
+            stability_check: options.stability_check,
+        };
+        let mut stepper = stepper_for::<M>(&scheme, n);
+        if let Err(e) = stepper.start(&mut problem, &cur, &ctl) {
+            return Err(early(e, problem.stats.clone()));
+        }
+        let h = match options.step {
+            StepControl::Fixed { h } => h,
+            StepControl::Adaptive { h0: Some(h0), .. } => h0,
+            StepControl::Adaptive { rtol, atol, .. } => {
+                initial_step(&mut problem, &cur, rtol, atol, scheme.order(), &options)
+            }
+        };
+        let out_times: Vec<f64> = match &options.output {
+            Output::Times(ts) => ts.clone(),
+            Output::Every { dt } => {
+                let k = ((options.t_end - options.t0) / dt + 1e-9).floor() as usize;
+                (0..=k).map(|i| options.t0 + i as f64 * dt).collect()
+            }
+            Output::Steps | Output::Last => Vec::new(),
+        };
+        let mut traj = Trajectory::new(dof_names, frame_names);
+        let expected = match &options.output {
+            Output::Steps => 1024,
+            Output::Last => 1,
+            _ => out_times.len(),
+        };
+        traj.reserve(expected, options.energy, options.frames);
+        let nf = M::NFRAMES;
+        let mut sim = Simulation {
+            problem,
+            stepper,
+            scheme,
+            ctl,
+            next: cur.clone(),
+            prev: cur.clone(),
+            scratch: cur.clone(),
+            cur,
+            h: h.min(options.h_max),
+            attempts: 0,
+            traj,
+            out_times,
+            out_next: 0,
+            poses: vec![Pose::default(); nf],
+            observers: Vec::new(),
+            options,
+        };
+        // outputs at t0
+        match sim.options.output {
+            Output::Steps => sim.record_cur(),
+            Output::Last => {}
+            _ => {
+                while sim.out_next < sim.out_times.len() && sim.out_times[sim.out_next] <= sim.cur.t
+                {
+                    sim.out_next += 1;
+                    sim.record_cur();
+                }
+            }
+        }
+        Ok(sim)
+    }
+
+    /// Adds an observer that sees every output as it is recorded.
+    pub fn observe(&mut self, o: impl Observer + 'static) {
+        self.observers.push(Box::new(o));
+    }
+
+    /// The scheme.
+    pub fn scheme(&self) -> Scheme {
+        self.scheme
+    }
+
+    /// The model.
+    pub fn model(&self) -> &M {
+        &self.problem.model
+    }
+
+    /// The step the next attempt will use.
+    pub fn h(&self) -> f64 {
+        self.h
+    }
+
+    /// Trajectory and work counters (records the final state for `Output::Last`).
+    pub fn finish(mut self) -> (Trajectory, Stats) {
+        if self.options.output == Output::Last && self.traj.is_empty() {
+            self.record_cur();
+        }
+        (self.traj, self.problem.stats)
+    }
+
+    fn record(&mut self, s: &State) {
+        self.traj.push(s.t, &s.q, &s.qd, &s.qdd);
+        if self.options.energy {
+            let e = self.problem.energy(s.t, &s.q, &s.qd);
+            self.traj.energy.push(e);
+        }
+        if self.options.frames {
+            self.problem.model.frames(s.t, &s.q, &mut self.poses);
+            self.traj.poses.extend_from_slice(&self.poses);
+        }
+        for o in self.observers.iter_mut() {
+            o.observe(s.t, &s.q, &s.qd, &s.qdd);
+        }
+    }
+
+    fn record_cur(&mut self) {
+        let s = std::mem::replace(&mut self.cur, State::zeros(0));
+        self.record(&s);
+        self.cur = s;
+    }
+
+    fn fail(&self, kind: Failure, h: f64) -> SimError {
+        SimError {
+            kind,
+            t: self.cur.t,
+            h,
+            stats: self.problem.stats.clone(),
+            trajectory: Box::new(self.traj.clone()),
+        }
+    }
+
+    /// Outputs in (prev.t, cur.t] after an accepted step.
+    fn outputs_after_step(&mut self) {
+        match self.options.output {
+            Output::Steps => self.record_cur(),
+            Output::Last => {}
+            _ => {
+                while self.out_next < self.out_times.len()
+                    && self.out_times[self.out_next] <= self.cur.t
+                {
+                    let t = self.out_times[self.out_next];
+                    self.out_next += 1;
+                    let mut s = std::mem::replace(&mut self.scratch, State::zeros(0));
+                    if t == self.cur.t {
+                        s.copy_from(&self.cur);
+                    } else {
+                        self.stepper.interpolate(&self.prev, &self.cur, t, &mut s);
+                    }
+                    self.record(&s);
+                    self.scratch = s;
+                }
+            }
+        }
+    }
+
+    fn step_until(&mut self, t_stop: f64) -> Result<(), SimError> {
+        let h_min = self.options.h_min();
+        let fixed = matches!(self.options.step, StepControl::Fixed { .. });
+        loop {
+            if self.attempts >= self.options.max_steps {
+                return Err(self.fail(
+                    Failure::TooMuchWork {
+                        max_steps: self.options.max_steps,
+                    },
+                    self.h,
+                ));
+            }
+            let remaining = t_stop - self.cur.t;
+            let mut h = self.h.min(self.options.h_max);
+            let t_next = if fixed {
+                // fixed steps stay on the grid t0 + k h, whatever the rounding of sums
+                let k = ((self.cur.t - self.options.t0) / h + 1e-9).floor();
+                self.options.t0 + (k + 1.0) * h
+            } else {
+                self.cur.t + h
+            };
+            // land on t_stop exactly, without leaving a sliver of a step behind
+            let last = t_next >= t_stop - 1e-9 * h
+                || (!fixed && h > 0.5 * remaining && remaining - h < 0.1 * h);
+            if last {
+                h = remaining;
+            } else if fixed {
+                h = t_next - self.cur.t;
+            }
+            if h < h_min && !last {
+                return Err(self.fail(Failure::StepTooSmall { h_min }, h));
+            }
+            self.attempts += 1;
+            let result =
+                self.stepper
+                    .attempt(&mut self.problem, &self.cur, h, &self.ctl, &mut self.next);
+            match result {
+                Err(kind) => return Err(self.fail(kind, h)),
+                Ok(Attempt::Accepted { h_next }) => {
+                    if let Err(kind) = self.check_next() {
+                        return Err(self.fail(kind, h));
+                    }
+                    self.next.t = if last {
+                        t_stop
+                    } else if fixed {
+                        t_next
+                    } else {
+                        self.cur.t + h
+                    };
+                    self.problem.stats.record_step(h);
+                    self.prev.copy_from(&self.cur);
+                    std::mem::swap(&mut self.cur, &mut self.next);
+                    self.stepper
+                        .accepted(&mut self.problem, &self.prev, &self.cur);
+                    self.outputs_after_step();
+                    if !fixed {
+                        // a shortened last step says nothing about the next one
+                        self.h = if last {
+                            self.h.max(h_next.min(self.h * 5.0))
+                        } else {
+                            h_next
+                        };
+                    }
+                    return Ok(());
+                }
+                Ok(Attempt::RejectedError { h_next }) => {
+                    // only adaptive schemes test errors
+                    self.problem.stats.rejected_error += 1;
+                    self.h = h_next;
+                }
+                Ok(Attempt::RejectedNewton {
+                    h_next,
+                    iterations,
+                    correction,
+                    cause,
+                }) => {
+                    self.problem.stats.rejected_newton += 1;
+                    if fixed || h <= h_min {
+                        let kind = cause.unwrap_or(Failure::NewtonDiverged {
+                            iterations,
+                            correction,
+                        });
+                        return Err(self.fail(kind, h));
+                    }
+                    self.h = h_next.max(h_min);
+                }
+            }
+        }
+    }
+
+    fn check_next(&self) -> Result<(), Failure> {
+        self.problem.check("q", &self.next.q)?;
+        self.problem.check("qd", &self.next.qd)?;
+        self.problem.check("qdd", &self.next.qdd)
+    }
+}
+
+impl<M: Model + 'static> Integrator for Simulation<M> {
+    fn step(&mut self) -> Result<(), SimError> {
+        if self.cur.t >= self.options.t_end {
+            return Ok(());
+        }
+        let t_end = self.options.t_end;
+        self.step_until(t_end)
+    }
+
+    fn integrate_to(&mut self, t: f64) -> Result<(), SimError> {
+        let t = t.min(self.options.t_end);
+        while self.cur.t < t {
+            self.step_until(t)?;
+        }
+        Ok(())
+    }
+
+    fn state(&self) -> &State {
+        &self.cur
+    }
+
+    fn stats(&self) -> &Stats {
+        &self.problem.stats
+    }
+
+    fn trajectory(&self) -> &Trajectory {
+        &self.traj
+    }
+}
+
+/// First step of adaptive schemes (Hairer, Nørsett & Wanner, II.4): from the sizes of y, f
+/// and of f's change over a trial Euler step.
+fn initial_step<M: Model>(
+    p: &mut Problem<M>,
+    s: &State,
+    rtol: f64,
+    atol: f64,
+    order: usize,
+    o: &Options,
+) -> f64 {
+    let n = s.q.len();
+    let w = |y: f64| atol + rtol * y.abs();
+    let norm = |a: &[f64], b: &[f64], ya: &[f64], yb: &[f64]| {
+        let ss: f64 = (0..n)
+            .map(|i| (a[i] / w(ya[i])).powi(2) + (b[i] / w(yb[i])).powi(2))
+            .sum();
+        (ss / (2 * n).max(1) as f64).sqrt()
+    };
+    let d0 = norm(&s.q, &s.qd, &s.q, &s.qd);
+    let d1 = norm(&s.qd, &s.qdd, &s.q, &s.qd);
+    let mut h0 = if d0 < 1e-5 || d1 < 1e-5 {
+        1e-6
+    } else {
+        0.01 * d0 / d1
+    };
+    h0 = h0.min(o.t_end - o.t0).min(o.h_max);
+    let q1: Vec<f64> = (0..n).map(|i| s.q[i] + h0 * s.qd[i]).collect();
+    let v1: Vec<f64> = (0..n).map(|i| s.qd[i] + h0 * s.qdd[i]).collect();
+    let mut a1 = vec![0.0; n];
+    if p.accel(s.t + h0, &q1, &v1, &mut a1).is_err() {
+        return h0;
+    }
+    let dv: Vec<f64> = (0..n).map(|i| (v1[i] - s.qd[i]) / h0).collect();
+    let da: Vec<f64> = (0..n).map(|i| (a1[i] - s.qdd[i]) / h0).collect();
+    let d2 = norm(&dv, &da, &s.q, &s.qd);
+    let h1 = if d1.max(d2) <= 1e-15 {
+        (h0 * 1e-3).max(1e-6)
+    } else {
+        (0.01 / d1.max(d2)).powf(1.0 / (order as f64 + 1.0))
+    };
+    (100.0 * h0)
+        .min(h1)
+        .min(o.t_end - o.t0)
+        .min(o.h_max)
+        .max(o.h_min())
+}
+
+fn stepper_for<M: Model>(scheme: &Scheme, n: usize) -> Box<dyn Stepper<M>> {
+    match *scheme {
+        Scheme::ExplicitEuler => Box::new(explicit::Explicit::euler(n)),
+        Scheme::Rk4 => Box::new(explicit::Explicit::rk4(n)),
+        Scheme::Dopri5 => Box::new(dopri5::Dopri5::new(n)),
+        Scheme::Newmark(p) => Box::new(newmark::AlphaFamily::newmark(n, p)),
+        Scheme::Hht(p) => Box::new(newmark::AlphaFamily::hht(n, p)),
+        Scheme::GenAlpha(p) => Box::new(newmark::AlphaFamily::gen_alpha(n, p)),
+        Scheme::ImplicitMidpoint => Box::new(midpoint::Midpoint::new(n)),
+        Scheme::Bdf(_) | Scheme::Radau3 | Scheme::Radau5 => Box::new(Unavailable(scheme.name())),
+    }
+}
+
+/// A scheme not available yet: fails at the first step with a typed error.
+struct Unavailable(&'static str);
+
+impl<M: Model> Stepper<M> for Unavailable {
+    fn start(&mut self, _p: &mut Problem<M>, _s: &State, _ctl: &Control) -> Result<(), Failure> {
+        Err(Failure::InvalidOption {
+            name: "scheme",
+            value: self.0.to_string(),
+            reason: "this scheme is not available in this version",
+        })
+    }
+    fn attempt(
+        &mut self,
+        _p: &mut Problem<M>,
+        _c: &State,
+        _h: f64,
+        _ctl: &Control,
+        _n: &mut State,
+    ) -> Result<Attempt, Failure> {
+        Err(Failure::InvalidOption {
+            name: "scheme",
+            value: self.0.to_string(),
+            reason: "this scheme is not available in this version",
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quintic_hermite_reproduces_quintics() {
+        let f = |t: f64| {
+            (
+                1.0 - 2.0 * t + 0.5 * t * t - t.powi(3) + 0.25 * t.powi(4) - 0.1 * t.powi(5),
+                -2.0 + t - 3.0 * t * t + t.powi(3) - 0.5 * t.powi(4),
+                1.0 - 6.0 * t + 3.0 * t * t - 2.0 * t.powi(3),
+            )
+        };
+        let st = |t: f64| {
+            let (q, v, a) = f(t);
+            State {
+                t,
+                q: vec![q],
+                qd: vec![v],
+                qdd: vec![a],
+            }
+        };
+        let (s0, s1) = (st(0.3), st(1.1));
+        let mut out = State::zeros(1);
+        for t in [0.3, 0.5, 0.77, 1.1] {
+            hermite5(&s0, &s1, t, &mut out);
+            let (q, v, a) = f(t);
+            assert!(
+                (out.q[0] - q).abs() < 1e-13
+                    && (out.qd[0] - v).abs() < 1e-12
+                    && (out.qdd[0] - a).abs() < 1e-11
+            );
+        }
+    }
+}

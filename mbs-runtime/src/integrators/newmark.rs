@@ -1,0 +1,155 @@
+//! The Newmark family in second-order form, one implementation: generalized-α as written by
+//! Arnold & Brüls (2007) for nonlinear systems, with an acceleration-like variable a,
+//!
+//! ```text
+//! q₁ = q₀ + h qd₀ + h²(½ − β) a₀ + h² β a₁
+//! qd₁ = qd₀ + h (1 − γ) a₀ + h γ a₁
+//! (1 − α_m) a₁ + α_m a₀ = (1 − α_f) qdd₁ + α_f qdd₀,   M(q₁) qdd₁ = h(q₁, qd₁)
+//! ```
+//!
+//! - Newmark (1959): α_m = α_f = 0 (a = qdd); (¼, ½) is the trapezoidal rule, order 2, no
+//!   numerical damping, unconditionally stable;
+//! - HHT-α (Hilber, Hughes & Taylor 1977): α_m = 0, α_f = −α, β = (1 − α)²/4, γ = ½ − α;
+//! - generalized-α (Chung & Hulbert 1993): α_m, α_f from ρ∞, order 2, unconditionally stable,
+//!   damping the high frequencies to ρ∞ while preserving the low ones.
+//!
+//! For linear systems the form is equivalent to Chung & Hulbert's. Newton solves for qdd₁
+//! with the iteration matrix M + γ'·C_t + β'·K_t, γ' = γ h c, β' = β h² c,
+//! c = (1 − α_f)/(1 − α_m). Step control (when adaptive) uses the local error estimate of
+//! Zienkiewicz & Xie (1991), e ≈ h² (β − 1/6)(a₁ − a₀), of order 3 in h.
+
+use super::newton::AccelNewton;
+use super::problem::Problem;
+use super::{Attempt, Control, State, Stepper, next_step};
+use crate::error::Failure;
+use crate::model::Model;
+use crate::options::{GenAlphaParams, HhtParams, NewmarkParams};
+
+pub(crate) struct AlphaFamily {
+    alpha_m: f64,
+    alpha_f: f64,
+    beta: f64,
+    gamma: f64,
+    n: usize,
+    /// acceleration-like variable of the current state, and its candidate for the next
+    a: Vec<f64>,
+    a_next: Vec<f64>,
+    qhat: Vec<f64>,
+    vhat: Vec<f64>,
+    qdd: Vec<f64>,
+    err: Vec<f64>,
+    newton: AccelNewton,
+}
+
+impl AlphaFamily {
+    fn new(n: usize, alpha_m: f64, alpha_f: f64, beta: f64, gamma: f64) -> AlphaFamily {
+        let z = || vec![0.0; n];
+        AlphaFamily {
+            alpha_m,
+            alpha_f,
+            beta,
+            gamma,
+            n,
+            a: z(),
+            a_next: z(),
+            qhat: z(),
+            vhat: z(),
+            qdd: z(),
+            err: z(),
+            newton: AccelNewton::new(n),
+        }
+    }
+
+    pub fn newmark(n: usize, p: NewmarkParams) -> AlphaFamily {
+        AlphaFamily::new(n, 0.0, 0.0, p.beta, p.gamma)
+    }
+
+    pub fn hht(n: usize, p: HhtParams) -> AlphaFamily {
+        AlphaFamily::new(
+            n,
+            0.0,
+            -p.alpha,
+            0.25 * (1.0 - p.alpha) * (1.0 - p.alpha),
+            0.5 - p.alpha,
+        )
+    }
+
+    pub fn gen_alpha(n: usize, p: GenAlphaParams) -> AlphaFamily {
+        AlphaFamily::new(n, p.alpha_m, p.alpha_f, p.beta, p.gamma)
+    }
+}
+
+impl<M: Model> Stepper<M> for AlphaFamily {
+    fn start(&mut self, _p: &mut Problem<M>, s: &State, _ctl: &Control) -> Result<(), Failure> {
+        self.a.copy_from_slice(&s.qdd);
+        Ok(())
+    }
+
+    fn attempt(
+        &mut self,
+        p: &mut Problem<M>,
+        cur: &State,
+        h: f64,
+        ctl: &Control,
+        next: &mut State,
+    ) -> Result<Attempt, Failure> {
+        let (am, af, b, g) = (self.alpha_m, self.alpha_f, self.beta, self.gamma);
+        // a₁ = c·qdd₁ + a_c, with a_c from the current state
+        let c = (1.0 - af) / (1.0 - am);
+        for i in 0..self.n {
+            let ac = (af * cur.qdd[i] - am * self.a[i]) / (1.0 - am);
+            self.qhat[i] = cur.q[i] + h * cur.qd[i] + h * h * ((0.5 - b) * self.a[i] + b * ac);
+            self.vhat[i] = cur.qd[i] + h * ((1.0 - g) * self.a[i] + g * ac);
+            self.qdd[i] = cur.qdd[i];
+        }
+        let (bp, gp) = (b * h * h * c, g * h * c);
+        let result = self.newton.solve(
+            p,
+            cur.t + h,
+            &self.qhat,
+            &self.vhat,
+            bp,
+            gp,
+            &mut self.qdd,
+            &ctl.newton,
+        );
+        match result {
+            Ok(_) => {}
+            Err(f) => {
+                return Ok(Attempt::RejectedNewton {
+                    h_next: 0.25 * h,
+                    iterations: f.iterations,
+                    correction: f.correction,
+                    cause: f.cause,
+                });
+            }
+        }
+        for i in 0..self.n {
+            next.q[i] = self.newton.q()[i];
+            next.qd[i] = self.newton.v()[i];
+            next.qdd[i] = self.qdd[i];
+            self.a_next[i] = c * self.qdd[i] + (af * cur.qdd[i] - am * self.a[i]) / (1.0 - am);
+        }
+        let Some(_) = ctl.adaptive else {
+            return Ok(Attempt::Accepted { h_next: h });
+        };
+        let k = h * h * (b - 1.0 / 6.0);
+        for i in 0..self.n {
+            self.err[i] = k * (self.a_next[i] - self.a[i]);
+        }
+        let err = ctl.error_norm(&self.err, &cur.q, &next.q);
+        if err <= 1.0 {
+            Ok(Attempt::Accepted {
+                h_next: next_step(h, err, 2, 2.0),
+            })
+        } else {
+            Ok(Attempt::RejectedError {
+                h_next: next_step(h, err, 2, 1.0),
+            })
+        }
+    }
+
+    fn accepted(&mut self, _p: &mut Problem<M>, _prev: &State, _cur: &State) {
+        std::mem::swap(&mut self.a, &mut self.a_next);
+    }
+}

@@ -1,0 +1,613 @@
+//! Options in: plain structs with documented defaults, validated before any work.
+
+use crate::error::Failure;
+use serde::{Deserialize, Serialize};
+
+/// Newmark's parameters β and γ (default: the trapezoidal rule β = ¼, γ = ½, unconditionally
+/// stable, no numerical damping).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct NewmarkParams {
+    pub beta: f64,
+    pub gamma: f64,
+}
+
+impl Default for NewmarkParams {
+    fn default() -> Self {
+        NewmarkParams {
+            beta: 0.25,
+            gamma: 0.5,
+        }
+    }
+}
+
+/// Hilber–Hughes–Taylor α ∈ [−1/3, 0] (default −0.05); β = (1 − α)²/4, γ = ½ − α.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct HhtParams {
+    pub alpha: f64,
+}
+
+impl Default for HhtParams {
+    fn default() -> Self {
+        HhtParams { alpha: -0.05 }
+    }
+}
+
+/// Generalized-α (Chung & Hulbert 1993): α_m, α_f, β, γ; build it from the spectral radius at
+/// infinite frequency with [`GenAlphaParams::from_rho_inf`] (default ρ∞ = 0.8).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GenAlphaParams {
+    pub alpha_m: f64,
+    pub alpha_f: f64,
+    pub beta: f64,
+    pub gamma: f64,
+    /// the ρ∞ it was built from (NaN when given by hand)
+    pub rho_inf: f64,
+}
+
+impl GenAlphaParams {
+    /// The second-order, unconditionally stable member with spectral radius ρ∞ ∈ [0, 1] at
+    /// infinite frequency: α_m = (2ρ∞ − 1)/(ρ∞ + 1), α_f = ρ∞/(ρ∞ + 1), γ = ½ − α_m + α_f,
+    /// β = ¼(1 − α_m + α_f)².
+    pub fn from_rho_inf(rho_inf: f64) -> GenAlphaParams {
+        let alpha_m = (2.0 * rho_inf - 1.0) / (rho_inf + 1.0);
+        let alpha_f = rho_inf / (rho_inf + 1.0);
+        let gamma = 0.5 - alpha_m + alpha_f;
+        GenAlphaParams {
+            alpha_m,
+            alpha_f,
+            beta: 0.25 * (gamma + 0.5) * (gamma + 0.5),
+            gamma,
+            rho_inf,
+        }
+    }
+}
+
+impl Default for GenAlphaParams {
+    fn default() -> Self {
+        GenAlphaParams::from_rho_inf(0.8)
+    }
+}
+
+/// BDF of variable order up to `max_order` ∈ 1..=5 (default 5).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BdfParams {
+    pub max_order: usize,
+}
+
+impl Default for BdfParams {
+    fn default() -> Self {
+        BdfParams { max_order: 5 }
+    }
+}
+
+/// The integration schemes.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
+pub enum Scheme {
+    /// explicit Euler, order 1 (fixed step)
+    ExplicitEuler,
+    /// classical Runge–Kutta, order 4 (fixed step)
+    Rk4,
+    /// Dormand–Prince 5(4) with dense output (adaptive or fixed step)
+    Dopri5,
+    /// Newmark (β, γ), second-order form, Newton on accelerations
+    Newmark(NewmarkParams),
+    /// Hilber–Hughes–Taylor α
+    Hht(HhtParams),
+    /// generalized-α (Chung & Hulbert 1993, Arnold & Brüls 2007 form)
+    GenAlpha(GenAlphaParams),
+    /// backward differentiation formulas, variable step and order
+    Bdf(BdfParams),
+    /// Radau IIA, 2 stages, order 3 (the seed's RKI 5/12)
+    Radau3,
+    /// Radau IIA, 3 stages, order 5 (RADAU5-like)
+    Radau5,
+    /// implicit midpoint rule, order 2, symmetric (fixed step)
+    ImplicitMidpoint,
+}
+
+impl Scheme {
+    /// Short name, as on the command line.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Scheme::ExplicitEuler => "euler",
+            Scheme::Rk4 => "rk4",
+            Scheme::Dopri5 => "dopri5",
+            Scheme::Newmark(_) => "newmark",
+            Scheme::Hht(_) => "hht",
+            Scheme::GenAlpha(_) => "gen-alpha",
+            Scheme::Bdf(_) => "bdf",
+            Scheme::Radau3 => "radau3",
+            Scheme::Radau5 => "radau5",
+            Scheme::ImplicitMidpoint => "midpoint",
+        }
+    }
+
+    /// The scheme of a name (defaults for its parameters).
+    pub fn from_name(name: &str) -> Option<Scheme> {
+        Some(match name {
+            "euler" => Scheme::ExplicitEuler,
+            "rk4" => Scheme::Rk4,
+            "dopri5" => Scheme::Dopri5,
+            "newmark" => Scheme::Newmark(NewmarkParams::default()),
+            "hht" => Scheme::Hht(HhtParams::default()),
+            "gen-alpha" => Scheme::GenAlpha(GenAlphaParams::default()),
+            "bdf" => Scheme::Bdf(BdfParams::default()),
+            "radau3" => Scheme::Radau3,
+            "radau5" => Scheme::Radau5,
+            "midpoint" => Scheme::ImplicitMidpoint,
+            _ => return None,
+        })
+    }
+
+    /// Every scheme with default parameters.
+    pub fn all() -> [Scheme; 10] {
+        [
+            "euler",
+            "rk4",
+            "dopri5",
+            "newmark",
+            "hht",
+            "gen-alpha",
+            "bdf",
+            "radau3",
+            "radau5",
+            "midpoint",
+        ]
+        .map(|n| Scheme::from_name(n).expect("known name"))
+    }
+
+    /// Classical order of accuracy.
+    pub fn order(&self) -> usize {
+        match self {
+            Scheme::ExplicitEuler => 1,
+            Scheme::Rk4 => 4,
+            Scheme::Dopri5 => 5,
+            Scheme::Newmark(p) => {
+                if (p.gamma - 0.5).abs() < 1e-15 {
+                    2
+                } else {
+                    1
+                }
+            }
+            Scheme::Hht(_) | Scheme::GenAlpha(_) | Scheme::ImplicitMidpoint => 2,
+            Scheme::Bdf(p) => p.max_order,
+            Scheme::Radau3 => 3,
+            Scheme::Radau5 => 5,
+        }
+    }
+
+    /// Whether the scheme solves nonlinear equations (Newton) at each step.
+    pub fn is_implicit(&self) -> bool {
+        !matches!(self, Scheme::ExplicitEuler | Scheme::Rk4 | Scheme::Dopri5)
+    }
+
+    /// Whether the scheme can control its step by a local error estimate.
+    pub fn is_adaptive(&self) -> bool {
+        !matches!(
+            self,
+            Scheme::ExplicitEuler | Scheme::Rk4 | Scheme::ImplicitMidpoint
+        )
+    }
+}
+
+/// How the step is chosen.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum StepControl {
+    /// constant step `h` (s); the last step is shortened to land on `t_end`
+    Fixed { h: f64 },
+    /// local error control: ‖err‖ ≤ 1 with weights atol + rtol·|y| per component;
+    /// `h0` the first step (default: chosen from the initial state)
+    Adaptive {
+        rtol: f64,
+        atol: f64,
+        h0: Option<f64>,
+    },
+}
+
+impl Default for StepControl {
+    /// Adaptive, rtol 1e-6, atol 1e-8.
+    fn default() -> Self {
+        StepControl::Adaptive {
+            rtol: 1e-6,
+            atol: 1e-8,
+            h0: None,
+        }
+    }
+}
+
+/// Where the trajectory is sampled.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+pub enum Output {
+    /// every accepted step (the default)
+    #[default]
+    Steps,
+    /// every `dt` seconds from t0 (interpolated, of the scheme's order)
+    Every { dt: f64 },
+    /// at these times (sorted, within [t0, t_end]; interpolated)
+    Times(Vec<f64>),
+    /// only the final state
+    Last,
+}
+
+/// How implicit schemes build their iteration matrix M + γ'·C_t + β'·K_t.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum IterationMatrix {
+    /// exact tangents when the model was generated with `option tangents`, finite
+    /// differences of τ otherwise (the default; `Stats` shows which evaluations were made)
+    #[default]
+    Auto,
+    /// exact generated tangents (an error if the model has none)
+    Exact,
+    /// M alone: cheaper, converges for mild stiffness ("an approximate iteration matrix is
+    /// sufficient"); stiff springs need the full matrix
+    MassOnly,
+    /// forward differences of τ, one evaluation per coordinate
+    FiniteDifferences,
+}
+
+/// Newton iterations of implicit schemes.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct NewtonOptions {
+    /// iterations per solve before the step is rejected and h reduced (default 7)
+    pub max_iterations: usize,
+    /// convergence when the predicted remaining correction of positions and velocities is
+    /// below `tolerance_factor` times the step's error tolerance (adaptive) ...
+    pub tolerance_factor: f64,
+    /// ... or, for fixed steps, below ATOL + RTOL·‖…‖ with these (defaults 1e-10, 1e-10)
+    pub atol: f64,
+    pub rtol: f64,
+    /// reuse the factorised iteration matrix across iterations and steps while convergence
+    /// is fast (modified Newton; default true)
+    pub reuse: bool,
+}
+
+impl Default for NewtonOptions {
+    fn default() -> Self {
+        NewtonOptions {
+            max_iterations: 7,
+            tolerance_factor: 0.03,
+            atol: 1e-10,
+            rtol: 1e-10,
+            reuse: true,
+        }
+    }
+}
+
+/// Everything a simulation needs besides the model and the scheme.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Options {
+    /// start time (s), default 0
+    pub t0: f64,
+    /// end time (s), default 1
+    pub t_end: f64,
+    /// initial q and qd (default: the model's declared initial state)
+    pub q0: Option<Vec<f64>>,
+    pub qd0: Option<Vec<f64>>,
+    pub step: StepControl,
+    pub output: Output,
+    /// largest step (s), default unbounded
+    pub h_max: f64,
+    /// smallest step before `StepTooSmall` (s), default 1e-12·max(1, |t_end|)
+    pub h_min: Option<f64>,
+    /// accepted plus rejected steps before `TooMuchWork` (default 1,000,000)
+    pub max_steps: usize,
+    pub newton: NewtonOptions,
+    pub iteration_matrix: IterationMatrix,
+    /// explicit fixed-step schemes estimate the largest eigenvalue of the dynamics (one extra
+    /// evaluation every 8 steps) and stop with `UnstableStep` when h·ρ leaves the scheme's
+    /// stability region (default true)
+    pub stability_check: bool,
+    /// record the poses of every body and frame at each output (default false)
+    pub frames: bool,
+    /// record kinetic and potential energy at each output (default true)
+    pub energy: bool,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            t0: 0.0,
+            t_end: 1.0,
+            q0: None,
+            qd0: None,
+            step: StepControl::default(),
+            output: Output::default(),
+            h_max: f64::INFINITY,
+            h_min: None,
+            max_steps: 1_000_000,
+            newton: NewtonOptions::default(),
+            iteration_matrix: IterationMatrix::default(),
+            stability_check: true,
+            frames: false,
+            energy: true,
+        }
+    }
+}
+
+fn invalid(name: &'static str, value: impl ToString, reason: &'static str) -> Failure {
+    Failure::InvalidOption {
+        name,
+        value: value.to_string(),
+        reason,
+    }
+}
+
+impl Options {
+    /// Fixed step `h` from 0 to `t_end`, every step recorded.
+    pub fn fixed(t_end: f64, h: f64) -> Options {
+        Options {
+            t_end,
+            step: StepControl::Fixed { h },
+            ..Options::default()
+        }
+    }
+
+    /// Adaptive steps with `rtol` (atol = rtol/100) from 0 to `t_end`.
+    pub fn adaptive(t_end: f64, rtol: f64) -> Options {
+        Options {
+            t_end,
+            step: StepControl::Adaptive {
+                rtol,
+                atol: rtol * 1e-2,
+                h0: None,
+            },
+            ..Options::default()
+        }
+    }
+
+    /// The smallest step allowed.
+    pub fn h_min(&self) -> f64 {
+        self.h_min
+            .unwrap_or(1e-12 * self.t_end.abs().max(self.t0.abs()).max(1.0))
+    }
+
+    /// Checks every option against the scheme and the model's sizes.
+    pub fn validate(&self, scheme: &Scheme, nq: usize, has_tangents: bool) -> Result<(), Failure> {
+        let finite = |name: &'static str, v: f64| {
+            if v.is_finite() {
+                Ok(())
+            } else {
+                Err(invalid(name, v, "must be finite"))
+            }
+        };
+        finite("t0", self.t0)?;
+        finite("t_end", self.t_end)?;
+        if self.t_end < self.t0 {
+            return Err(invalid("t_end", self.t_end, "must not be before t0"));
+        }
+        for (name, v) in [("q0", &self.q0), ("qd0", &self.qd0)] {
+            if let Some(v) = v {
+                if v.len() != nq {
+                    return Err(invalid(name, v.len(), "must have one value per coordinate"));
+                }
+                if let Some(x) = v.iter().find(|x| !x.is_finite()) {
+                    return Err(invalid(name, x, "must be finite"));
+                }
+            }
+        }
+        match self.step {
+            StepControl::Fixed { h } => {
+                if !(h > 0.0) || !h.is_finite() {
+                    return Err(invalid("h", h, "must be > 0 and finite"));
+                }
+            }
+            StepControl::Adaptive { rtol, atol, h0 } => {
+                if !scheme.is_adaptive() {
+                    return Err(invalid(
+                        "step",
+                        scheme.name(),
+                        "this scheme has no error estimate: use StepControl::Fixed",
+                    ));
+                }
+                if !(rtol > 0.0) || !rtol.is_finite() {
+                    return Err(invalid("rtol", rtol, "must be > 0"));
+                }
+                if rtol < 10.0 * f64::EPSILON {
+                    return Err(invalid(
+                        "rtol",
+                        rtol,
+                        "must be at least 10 ε (2.2e-15): no scheme resolves below rounding",
+                    ));
+                }
+                if !(atol >= 0.0) || !atol.is_finite() {
+                    return Err(invalid("atol", atol, "must be ≥ 0"));
+                }
+                if let Some(h0) = h0 {
+                    if !(h0 > 0.0) || !h0.is_finite() {
+                        return Err(invalid("h0", h0, "must be > 0 and finite"));
+                    }
+                }
+            }
+        }
+        if !(self.h_max > 0.0) {
+            return Err(invalid("h_max", self.h_max, "must be > 0"));
+        }
+        if let Some(h) = self.h_min {
+            if !(h > 0.0) || !h.is_finite() {
+                return Err(invalid("h_min", h, "must be > 0 and finite"));
+            }
+        }
+        if self.max_steps == 0 {
+            return Err(invalid("max_steps", 0, "must be > 0"));
+        }
+        match &self.output {
+            Output::Every { dt } if !(*dt > 0.0) || !dt.is_finite() => {
+                return Err(invalid("output.dt", dt, "must be > 0 and finite"));
+            }
+            Output::Times(ts) => {
+                if ts
+                    .iter()
+                    .any(|t| !t.is_finite() || *t < self.t0 || *t > self.t_end)
+                {
+                    return Err(invalid(
+                        "output.times",
+                        format!("{ts:?}"),
+                        "must be finite and within [t0, t_end]",
+                    ));
+                }
+                if ts.windows(2).any(|w| w[1] < w[0]) {
+                    return Err(invalid("output.times", format!("{ts:?}"), "must be sorted"));
+                }
+            }
+            _ => {}
+        }
+        let n = &self.newton;
+        if n.max_iterations == 0 {
+            return Err(invalid("newton.max_iterations", 0, "must be > 0"));
+        }
+        for (name, v) in [
+            ("newton.tolerance_factor", n.tolerance_factor),
+            ("newton.atol", n.atol),
+            ("newton.rtol", n.rtol),
+        ] {
+            if !(v > 0.0) || !v.is_finite() {
+                return Err(invalid(name, v, "must be > 0 and finite"));
+            }
+        }
+        if self.iteration_matrix == IterationMatrix::Exact && !has_tangents {
+            return Err(invalid(
+                "iteration_matrix",
+                "Exact",
+                "the model was generated without tangents: add `option tangents;` to its multibody! block, or use Auto, MassOnly or FiniteDifferences",
+            ));
+        }
+        validate_scheme(scheme)
+    }
+}
+
+/// Parameters of a scheme within their ranges of stability.
+pub fn validate_scheme(scheme: &Scheme) -> Result<(), Failure> {
+    match *scheme {
+        Scheme::Newmark(p) => {
+            if !p.beta.is_finite() || !p.gamma.is_finite() {
+                return Err(invalid(
+                    "newmark.beta/gamma",
+                    format!("{}/{}", p.beta, p.gamma),
+                    "must be finite",
+                ));
+            }
+            if p.gamma < 0.5 {
+                return Err(invalid(
+                    "newmark.gamma",
+                    p.gamma,
+                    "γ < ½ amplifies oscillations (negative numerical damping): use γ ≥ ½",
+                ));
+            }
+            let b_min = 0.25 * (p.gamma + 0.5) * (p.gamma + 0.5);
+            if p.beta < b_min - 1e-15 {
+                return Err(invalid(
+                    "newmark.beta",
+                    p.beta,
+                    "β < ¼(γ + ½)² is only conditionally stable: use β ≥ ¼(γ + ½)² (β = ¼ for γ = ½)",
+                ));
+            }
+        }
+        Scheme::Hht(p) => {
+            if !(-1.0 / 3.0 - 1e-15..=0.0).contains(&p.alpha) {
+                return Err(invalid("hht.alpha", p.alpha, "must be in [−1/3, 0]"));
+            }
+        }
+        Scheme::GenAlpha(p) => {
+            if !p.rho_inf.is_nan() && !(0.0..=1.0).contains(&p.rho_inf) {
+                return Err(invalid("gen_alpha.rho_inf", p.rho_inf, "must be in [0, 1]"));
+            }
+            let ok = p.alpha_m <= p.alpha_f
+                && p.alpha_f <= 0.5
+                && (p.gamma - (0.5 - p.alpha_m + p.alpha_f)).abs() < 1e-12
+                && p.beta >= 0.25 * (0.5 + p.gamma) * (0.5 + p.gamma) - 1e-12;
+            if !ok
+                || [p.alpha_m, p.alpha_f, p.beta, p.gamma]
+                    .iter()
+                    .any(|x| !x.is_finite())
+            {
+                return Err(invalid(
+                    "gen_alpha",
+                    format!(
+                        "α_m {} α_f {} β {} γ {}",
+                        p.alpha_m, p.alpha_f, p.beta, p.gamma
+                    ),
+                    "not second-order and unconditionally stable: build it with GenAlphaParams::from_rho_inf(ρ∞)",
+                ));
+            }
+        }
+        Scheme::Bdf(p) => {
+            if !(1..=5).contains(&p.max_order) {
+                return Err(invalid(
+                    "bdf.max_order",
+                    p.max_order,
+                    "must be 1 to 5 (BDF 6+ is unstable)",
+                ));
+            }
+        }
+        _ => {}
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gen_alpha_from_rho_inf() {
+        let p = GenAlphaParams::from_rho_inf(1.0);
+        assert!((p.alpha_m - 0.5).abs() < 1e-15 && (p.alpha_f - 0.5).abs() < 1e-15);
+        assert!((p.gamma - 0.5).abs() < 1e-15 && (p.beta - 0.25).abs() < 1e-15);
+        assert!(validate_scheme(&Scheme::GenAlpha(GenAlphaParams::from_rho_inf(0.0))).is_ok());
+        assert!(validate_scheme(&Scheme::GenAlpha(GenAlphaParams::from_rho_inf(1.2))).is_err());
+    }
+
+    #[test]
+    fn bad_options_are_named() {
+        let e = Options {
+            t_end: -1.0,
+            ..Options::default()
+        }
+        .validate(&Scheme::Rk4, 2, false)
+        .unwrap_err();
+        assert!(matches!(e, Failure::InvalidOption { name: "t_end", .. }));
+        let e = Options::adaptive(1.0, 1e-17)
+            .validate(&Scheme::Dopri5, 2, false)
+            .unwrap_err();
+        assert!(matches!(e, Failure::InvalidOption { name: "rtol", .. }));
+        let e = Options::adaptive(1.0, 1e-6)
+            .validate(&Scheme::Rk4, 2, false)
+            .unwrap_err();
+        assert!(matches!(e, Failure::InvalidOption { name: "step", .. }));
+        let e = Options::fixed(1.0, 0.0)
+            .validate(&Scheme::Rk4, 2, false)
+            .unwrap_err();
+        assert!(matches!(e, Failure::InvalidOption { name: "h", .. }));
+        let bad = Scheme::Newmark(NewmarkParams {
+            beta: 0.1,
+            gamma: 0.5,
+        });
+        assert!(matches!(
+            Options::fixed(1.0, 0.1).validate(&bad, 2, false),
+            Err(Failure::InvalidOption {
+                name: "newmark.beta",
+                ..
+            })
+        ));
+        let bad = Scheme::Hht(HhtParams { alpha: 0.1 });
+        assert!(matches!(
+            Options::fixed(1.0, 0.1).validate(&bad, 2, false),
+            Err(Failure::InvalidOption {
+                name: "hht.alpha",
+                ..
+            })
+        ));
+        let o = Options {
+            iteration_matrix: IterationMatrix::Exact,
+            ..Options::fixed(1.0, 0.1)
+        };
+        assert!(matches!(
+            o.validate(&Scheme::ImplicitMidpoint, 2, false),
+            Err(Failure::InvalidOption {
+                name: "iteration_matrix",
+                ..
+            })
+        ));
+    }
+}

@@ -1,0 +1,100 @@
+//! Work counters of a simulation: what the scheme spent, so that work–precision comparisons
+//! and regressions can be measured rather than assumed.
+
+use serde::Serialize;
+use std::fmt;
+
+/// What a simulation did. Snapshot it in tests: a change that silently doubles the work fails.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+#[non_exhaustive]
+pub struct Stats {
+    /// accepted steps
+    pub steps: usize,
+    /// steps rejected by the local error test
+    pub rejected_error: usize,
+    /// steps rejected because Newton did not converge
+    pub rejected_newton: usize,
+    /// evaluations of M and h together (`Model::dynamics`)
+    pub dynamics: usize,
+    /// evaluations of M alone
+    pub mass_matrix: usize,
+    /// evaluations of τ = M qdd − h (`Model::inverse_dynamics`)
+    pub inverse_dynamics: usize,
+    /// evaluations of the exact tangents K_t, C_t
+    pub tangents: usize,
+    /// evaluations of user efforts (none yet: reserved for user force hooks)
+    pub user_efforts: usize,
+    /// evaluations of energy (for outputs)
+    pub energy: usize,
+    /// LU or Cholesky factorisations
+    pub factorizations: usize,
+    /// solves with a factorisation
+    pub solves: usize,
+    /// Newton iterations, all steps together
+    pub newton_iterations: usize,
+    /// smallest and largest accepted step
+    pub h_min: f64,
+    pub h_max: f64,
+    /// for multistep schemes of variable order: steps taken at each order (index 0 = order 1)
+    pub order_steps: Vec<usize>,
+}
+
+impl Stats {
+    /// Evaluations of the model's equations of any kind (M+h, M, τ, tangents).
+    pub fn evaluations(&self) -> usize {
+        self.dynamics + self.mass_matrix + self.inverse_dynamics + self.tangents
+    }
+
+    pub(crate) fn record_step(&mut self, h: f64) {
+        if self.steps == 0 {
+            self.h_min = h;
+            self.h_max = h;
+        } else {
+            self.h_min = self.h_min.min(h);
+            self.h_max = self.h_max.max(h);
+        }
+        self.steps += 1;
+    }
+
+    pub(crate) fn record_order(&mut self, order: usize) {
+        if self.order_steps.len() < order {
+            self.order_steps.resize(order, 0);
+        }
+        self.order_steps[order - 1] += 1;
+    }
+}
+
+impl fmt::Display for Stats {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(
+            f,
+            "steps {} accepted, {} rejected by the error test, {} by Newton; h in [{:.3e}, {:.3e}]",
+            self.steps, self.rejected_error, self.rejected_newton, self.h_min, self.h_max
+        )?;
+        writeln!(
+            f,
+            "evaluations: {} M+h, {} M, {} τ, {} tangents, {} user efforts, {} energy",
+            self.dynamics,
+            self.mass_matrix,
+            self.inverse_dynamics,
+            self.tangents,
+            self.user_efforts,
+            self.energy
+        )?;
+        write!(
+            f,
+            "linear algebra: {} factorisations, {} solves; {} Newton iterations",
+            self.factorizations, self.solves, self.newton_iterations
+        )?;
+        if !self.order_steps.is_empty() {
+            let orders: Vec<String> = self
+                .order_steps
+                .iter()
+                .enumerate()
+                .map(|(k, s)| format!("{}:{s}", k + 1))
+                .collect();
+            write!(f, "\nsteps per order: {}", orders.join(" "))?;
+        }
+        Ok(())
+    }
+}

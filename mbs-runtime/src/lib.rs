@@ -7,8 +7,8 @@
 //! [`SimError`] and [`Failure`] (why a run stopped, with what it computed until then);
 //! [`Parameters`], [`ModelInfo`], [`Energy`], [`Pose`], [`Kinematics`] describe models.
 
-// Matrix code reads best with explicit indices.
-#![allow(clippy::needless_range_loop)]
+// Matrix code reads best with explicit indices; `!(x > 0.0)` is meant to reject NaN too.
+#![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod error;
 pub mod inertia;

@@ -98,7 +98,9 @@
 //! |---|---|
 //! | `gravity(gx, gy, gz);` | uniform gravity, world axes (constants and parameters) |
 //! | `spring(a, b, k = …, l0 = …);` | point-to-point spring between points or body origins (`ground` is the world origin); `c = …` adds a damper |
+//! | `spring(a, b, k = …, l0 = …, axis = x);` | a linear spring along a fixed world direction (`x`, `y`, `z` or a unit `(nx, ny, nz)`): its length is the signed distance along the axis, linear for any motion (1-D models) |
 //! | `damper(a, b, c = …);` | point-to-point linear damper |
+//! | `damper(a, b, c = …, axis = x);` | a linear damper along a fixed world direction |
 //! | `force(p, (fx, fy, fz));` | a force at a point, world axes; `frame = body` for that body's axes |
 //! | `torque(b, (mx, my, mz));` | a torque on a body, world axes; `frame = body`, `relative_to = other` (reaction on `other`) |
 //! | `torque(b, axis = z, value, relative_to = other);` | a torque about one of `b`'s axes, reaction on `other` |

@@ -78,21 +78,30 @@ fn oracle_h(
         for load in &model.sys.effects[e].loads {
             match load {
                 Load::Gravity(_) => {}
-                Load::Spring { a, b, k, l0 } => {
+                Load::Spring { a, b, k, l0, axis } => {
                     let (pa, _, la) = point(a);
                     let (pb, _, lb) = point(b);
                     let d = sub(pb, pa);
-                    let l = norm(d);
                     let kv = ev(&[*k, *l0]);
-                    let f = scale(kv[0] * (l - kv[1]) / l, d);
+                    // along the line of the ends, or a fixed axis (signed length)
+                    let f = match axis {
+                        None => scale(kv[0] * (norm(d) - kv[1]) / norm(d), d),
+                        Some(n) => {
+                            let n = ev3(n);
+                            scale(kv[0] * (dot(n, d) - kv[1]), n)
+                        }
+                    };
                     force(&mut ext, la, f);
                     force(&mut ext, lb, scale(-1.0, f));
                 }
-                Load::Damper { a, b, c } => {
+                Load::Damper { a, b, c, axis } => {
                     let (pa, va, la) = point(a);
                     let (pb, vb, lb) = point(b);
                     let d = sub(pb, pa);
-                    let e = scale(1.0 / norm(d), d);
+                    let e = match axis {
+                        None => scale(1.0 / norm(d), d),
+                        Some(n) => ev3(n),
+                    };
                     let f = scale(ev(&[*c])[0] * dot(e, sub(vb, va)), e);
                     force(&mut ext, la, f);
                     force(&mut ext, lb, scale(-1.0, f));

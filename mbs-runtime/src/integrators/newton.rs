@@ -61,11 +61,6 @@ impl AccelNewton {
         }
     }
 
-    /// Forgets the factorisation (e.g. after the state jumped).
-    pub fn invalidate(&mut self) {
-        self.valid = false;
-    }
-
     /// Solves τ(t, q̂ + β'a, v̂ + γ'a, a) = 0; `a` holds the guess and receives the solution.
     /// Returns the iterations used. `q` and `v` of the solution are then in [`AccelNewton::q`]
     /// and [`AccelNewton::v`].

@@ -985,6 +985,36 @@ impl Checker {
 
     /// Checks that an axis (parameters only) is a unit vector with the default parameters;
     /// `usage` shows where it goes, with `nx, ny, nz` in it.
+    /// `axis = x | y | z | (nx, ny, nz)` of an effect: a unit vector (`axes` says in which axes).
+    fn axis_arg(
+        &mut self,
+        axis: &Expr,
+        of: &'static str,
+        usage: &str,
+        axes: &str,
+    ) -> Option<[ExprId; 3]> {
+        let z = self.sys.arena.zero();
+        let o = self.sys.arena.one();
+        match axis {
+            Expr::Path(p) if p.path.is_ident("x") => Some([o, z, z]),
+            Expr::Path(p) if p.path.is_ident("y") => Some([z, o, z]),
+            Expr::Path(p) if p.path.is_ident("z") => Some([z, z, o]),
+            Expr::Tuple(_) => {
+                let what = Allow {
+                    what: "an axis",
+                    ..PARAMS_ONLY
+                };
+                self.triple(axis, what, "an axis").filter(|n| {
+                    self.unit_axis(n, &axis.to_token_stream(), &format!("the {of}"), usage)
+                })
+            }
+            _ => {
+                self.error_at(axis, format!("unknown {of} axis `{}`: write `axis = x`, `y`, `z` or a unit vector `(nx, ny, nz)`, {axes}", text(axis)));
+                None
+            }
+        }
+    }
+
     fn unit_axis(&mut self, n: &[ExprId; 3], at: &TokenStream, of: &str, usage: &str) -> bool {
         let (Some(x), Some(y), Some(z)) = (
             self.eval_default(n[0]),
@@ -1110,8 +1140,8 @@ impl Checker {
         let kind = s.kind.to_string();
         let named = |key: &str| s.named.iter().find(|(k, _)| k == key).map(|(_, v)| v);
         let known_named: &[&str] = match kind.as_str() {
-            "spring" => &["k", "l0", "c"],
-            "damper" => &["c"],
+            "spring" => &["k", "l0", "c", "axis"],
+            "damper" => &["c", "axis"],
             "force" => &["frame"],
             "torque" => &["frame", "relative_to", "axis"],
             _ => &[],
@@ -1196,6 +1226,19 @@ impl Checker {
                     );
                     return out;
                 }
+                // along a fixed direction of the world (linear), or along the line of its ends
+                let axis = match named("axis") {
+                    Some(e) => match self.axis_arg(
+                        e,
+                        kind_static(&kind),
+                        &format!("{kind}(a, b, …, axis = (nx, ny, nz))"),
+                        "in world axes",
+                    ) {
+                        Some(n) => Some(n),
+                        None => return out,
+                    },
+                    None => None,
+                };
                 if kind == "spring" {
                     let Some(k) = named("k") else {
                         self.error(
@@ -1227,7 +1270,7 @@ impl Checker {
                         }
                         None => self.sys.arena.zero(),
                     };
-                    out.push(Load::Spring { a, b, k, l0 });
+                    out.push(Load::Spring { a, b, k, l0, axis });
                 }
                 let c_expr = named("c");
                 if kind == "damper" && c_expr.is_none() {
@@ -1245,7 +1288,7 @@ impl Checker {
                         },
                     );
                     self.not_negative(c, e, &format!("the damping coefficient `c` of a {kind}"));
-                    out.push(Load::Damper { a, b, c });
+                    out.push(Load::Damper { a, b, c, axis });
                 }
             }
             "force" => {
@@ -1279,34 +1322,12 @@ impl Checker {
                     if let Some((k, _)) = s.named.iter().find(|(k, _)| k == "frame") {
                         self.error(k.span(), "`frame` does not go with `axis`: the axis is in the axes of the body the torque acts on; remove `frame = …`");
                     }
-                    let z = self.sys.arena.zero();
-                    let o = self.sys.arena.one();
-                    let dir = match axis {
-                        Expr::Path(p) if p.path.is_ident("x") => Some([o, z, z]),
-                        Expr::Path(p) if p.path.is_ident("y") => Some([z, o, z]),
-                        Expr::Path(p) if p.path.is_ident("z") => Some([z, z, o]),
-                        Expr::Tuple(_) => self
-                            .triple(
-                                axis,
-                                Allow {
-                                    what: "a torque axis",
-                                    ..pa
-                                },
-                                "a torque axis",
-                            )
-                            .filter(|n| {
-                                self.unit_axis(
-                                    n,
-                                    &axis.to_token_stream(),
-                                    "the torque",
-                                    "torque(body, axis = (nx, ny, nz), value)",
-                                )
-                            }),
-                        _ => {
-                            self.error_at(axis, format!("unknown torque axis `{}`: write `axis = x`, `y`, `z` or a unit vector `(nx, ny, nz)`, in the axes of the body", text(axis)));
-                            None
-                        }
-                    };
+                    let dir = self.axis_arg(
+                        axis,
+                        "torque",
+                        "torque(body, axis = (nx, ny, nz), value)",
+                        "in the axes of the body",
+                    );
                     let v = self.lower(&s.positional[1], ANY);
                     let t = dir.map(|d| d.map(|c| self.sys.arena.mul(c, v)));
                     (t, on)
@@ -2016,5 +2037,14 @@ impl Checker {
         for k in unmoved {
             self.errors.push(err(self.dof_spans[k], format!("coordinate `{}` moves no body with mass, so the mass matrix would be singular: use it in the TOG of a body with mass (or of a frame that carries one), or remove it", self.sys.dofs[k].name)));
         }
+    }
+}
+
+/// The name of an effect kind that takes an axis, as a static string for messages.
+fn kind_static(kind: &str) -> &'static str {
+    match kind {
+        "spring" => "spring",
+        "damper" => "damper",
+        _ => "effect",
     }
 }

@@ -50,6 +50,19 @@ fn velocity(a: &mut Arena, w: &World, p: &Pt) -> V3 {
     }
 }
 
+/// The length of d and its direction: |d| and d/|d| along the line, or n·d and n along a
+/// fixed unit axis n (a linear element: signed length, constant direction).
+fn length_and_direction(a: &mut Arena, d: V3, axis: Option<V3>) -> (ExprId, V3) {
+    match axis {
+        Some(n) => (s::dot(a, n, d), n),
+        None => {
+            let l2 = s::dot(a, d, d);
+            let l = a.sqrt(l2);
+            (l, [a.div(d[0], l), a.div(d[1], l), a.div(d[2], l)])
+        }
+    }
+}
+
 impl Loads {
     /// The loads of `effects` (indices into `sys.effects`).
     pub fn build(sys: &mut System, tree: &Tree, w: &World, effects: &[usize]) -> Loads {
@@ -77,17 +90,17 @@ impl Loads {
                     b: pb,
                     k,
                     l0,
+                    axis,
                 } => {
                     any_spring = true;
                     let (p1, p2) = (pt(tree, &pa), pt(tree, &pb));
                     let x1 = position(a, w, &p1);
                     let x2 = position(a, w, &p2);
                     let d = s::sub(a, x2, x1);
-                    let l2 = s::dot(a, d, d);
-                    let l = a.sqrt(l2);
+                    // length and direction: along the line of the ends, or the given axis
+                    let (l, e) = length_and_direction(a, d, axis);
                     let stretch = a.sub(l, l0);
                     let tension = a.mul(k, stretch);
-                    let e = [a.div(d[0], l), a.div(d[1], l), a.div(d[2], l)];
                     let f1 = s::scale(a, tension, e);
                     let f2 = s::neg(a, f1);
                     out.push_force(&p1, f1);
@@ -97,7 +110,12 @@ impl Loads {
                     let v = a.mul(half, ks);
                     potential = a.add(potential, v);
                 }
-                Load::Damper { a: pa, b: pb, c } => {
+                Load::Damper {
+                    a: pa,
+                    b: pb,
+                    c,
+                    axis,
+                } => {
                     any_nc = true;
                     let (p1, p2) = (pt(tree, &pa), pt(tree, &pb));
                     let x1 = position(a, w, &p1);
@@ -105,9 +123,7 @@ impl Loads {
                     let v1 = velocity(a, w, &p1);
                     let v2 = velocity(a, w, &p2);
                     let d = s::sub(a, x2, x1);
-                    let l2 = s::dot(a, d, d);
-                    let l = a.sqrt(l2);
-                    let e = [a.div(d[0], l), a.div(d[1], l), a.div(d[2], l)];
+                    let (_, e) = length_and_direction(a, d, axis);
                     let dv = s::sub(a, v2, v1);
                     let ldot = s::dot(a, e, dv);
                     let f = a.mul(c, ldot);

@@ -90,15 +90,23 @@ pub struct Attach {
 pub enum Load {
     /// uniform gravity (world components); conservative
     Gravity([ExprId; 3]),
-    /// point-to-point spring with stiffness `k` and rest length `l0`; conservative
+    /// spring with stiffness `k` and rest length `l0` between two points, acting along the
+    /// line between them, or along the fixed world direction `axis` (a linear spring whose
+    /// length is the signed distance along the axis); conservative
     Spring {
         a: Attach,
         b: Attach,
         k: ExprId,
         l0: ExprId,
+        axis: Option<[ExprId; 3]>,
     },
-    /// point-to-point linear damper
-    Damper { a: Attach, b: Attach, c: ExprId },
+    /// linear damper between two points, along their line or the world direction `axis`
+    Damper {
+        a: Attach,
+        b: Attach,
+        c: ExprId,
+        axis: Option<[ExprId; 3]>,
+    },
     /// a force at a point, components in `frame`'s axes (`None`: world)
     Force {
         at: Attach,

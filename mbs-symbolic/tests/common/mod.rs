@@ -884,6 +884,17 @@ pub fn value3(rng: &mut Rng, a: &mut Arena, n: usize) -> [ExprId; 3] {
     [value(rng, a, n), value(rng, a, n), value(rng, a, n)]
 }
 
+/// A random unit vector as expressions.
+fn random_unit(rng: &mut Rng, sys: &mut System) -> [ExprId; 3] {
+    let v = [
+        rng.range(-1.0, 1.0),
+        rng.range(-1.0, 1.0),
+        rng.range(0.2, 1.0),
+    ];
+    let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    sys.vec3([v[0] / n, v[1] / n, v[2] / n])
+}
+
 /// Adds random loads to a system of `n` coordinates: an effect `springs` (conservative) and
 /// an effect `losses` (dampers, forces, torques, generalised forces). Returns their indices;
 /// `tally` counts springs, dampers, world forces, body-frame forces, torques, torques with
@@ -900,7 +911,9 @@ pub fn add_loads(
         let b = attach(rng, sys, false);
         let k = sys.num(rng.range(5.0, 50.0));
         let l0 = sys.num(rng.range(0.1, 0.8));
-        cons.push(Load::Spring { a, b, k, l0 });
+        // half the springs act along a fixed unit direction (linear springs)
+        let axis = (rng.below(2) == 0).then(|| random_unit(rng, sys));
+        cons.push(Load::Spring { a, b, k, l0, axis });
         tally[0] += 1;
     }
     let mut nc = Vec::new();
@@ -908,7 +921,8 @@ pub fn add_loads(
         let a = attach(rng, sys, true);
         let b = attach(rng, sys, false);
         let c = sys.num(rng.range(0.5, 3.0));
-        nc.push(Load::Damper { a, b, c });
+        let axis = (rng.below(2) == 0).then(|| random_unit(rng, sys));
+        nc.push(Load::Damper { a, b, c, axis });
         tally[1] += 1;
     }
     for _ in 0..1 + rng.below(2) {

@@ -1,0 +1,92 @@
+//! Helpers shared by the integration tests: exact solutions and reference data.
+#![allow(dead_code)]
+
+use mbs::Trajectory;
+
+/// The seed2dof system: M = I, K = [[k1 + k2, −k2], [−k2, k2]], q0 = (0, 1), qd0 = 0.
+pub const K1: f64 = 79.15;
+pub const K2: f64 = 1961.0;
+
+/// Angular frequencies ω₁ < ω₂ and orthonormal modes (columns) of seed2dof.
+pub fn seed2dof_modes() -> ([f64; 2], [[f64; 2]; 2]) {
+    let (a, b, d) = (K1 + K2, -K2, K2);
+    let tr = a + d;
+    let disc = ((a - d) * (a - d) / 4.0 + b * b).sqrt();
+    let lam = [tr / 2.0 - disc, tr / 2.0 + disc];
+    let mut modes = [[0.0; 2]; 2];
+    for (k, &l) in lam.iter().enumerate() {
+        let v = [b, l - a];
+        let nv = v[0].hypot(v[1]);
+        modes[k] = [v[0] / nv, v[1] / nv];
+    }
+    ([lam[0].sqrt(), lam[1].sqrt()], modes)
+}
+
+/// Exact q(t) of seed2dof from q0 = (0, 1), qd0 = 0.
+pub fn seed2dof_exact(t: f64) -> [f64; 2] {
+    let (w, v) = seed2dof_modes();
+    let mut q = [0.0; 2];
+    for k in 0..2 {
+        let c = v[k][1]; // projection of q0 = (0, 1) on mode k
+        for i in 0..2 {
+            q[i] += v[k][i] * c * (w[k] * t).cos();
+        }
+    }
+    q
+}
+
+/// Largest |q − q_exact| over the outputs of a seed2dof trajectory.
+pub fn seed2dof_max_error(tr: &Trajectory) -> f64 {
+    (0..tr.len())
+        .map(|i| {
+            let e = seed2dof_exact(tr.t[i]);
+            let q = tr.q(i);
+            (q[0] - e[0]).abs().max((q[1] - e[1]).abs())
+        })
+        .fold(0.0, f64::max)
+}
+
+/// Least-squares slope of log(y) against log(x).
+pub fn loglog_slope(x: &[f64], y: &[f64]) -> f64 {
+    let lx: Vec<f64> = x.iter().map(|v| v.ln()).collect();
+    let ly: Vec<f64> = y.iter().map(|v| v.ln()).collect();
+    let n = lx.len() as f64;
+    let (mx, my) = (lx.iter().sum::<f64>() / n, ly.iter().sum::<f64>() / n);
+    let sxy: f64 = lx.iter().zip(&ly).map(|(a, b)| (a - mx) * (b - my)).sum();
+    let sxx: f64 = lx.iter().map(|a| (a - mx) * (a - mx)).sum();
+    sxy / sxx
+}
+
+/// A reference state from `tests/reference/<model>.json` at time `t`: (q, qd).
+pub fn reference_state(model: &str, t: f64) -> (Vec<f64>, Vec<f64>) {
+    let path = format!(
+        "{}/tests/reference/{model}.json",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let states = json["states"].as_array().expect("states");
+    let s = states
+        .iter()
+        .find(|s| (s["t"].as_f64().unwrap() - t).abs() < 1e-12)
+        .unwrap_or_else(|| panic!("no state at t = {t}"));
+    let v = |k: &str| {
+        s[k].as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect::<Vec<f64>>()
+    };
+    (v("q"), v("qd"))
+}
+
+/// Largest difference between the last output of `tr` and a reference state.
+pub fn final_error(tr: &Trajectory, q: &[f64], qd: &[f64]) -> f64 {
+    let i = tr.len() - 1;
+    tr.q(i)
+        .iter()
+        .zip(q)
+        .chain(tr.qd(i).iter().zip(qd))
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max)
+}

@@ -31,6 +31,7 @@
 //! assert!((h[0] / m[0] + 10.0).abs() < 1e-12); // x'' = -k x / m
 //! ```
 
+pub mod cli;
 pub mod language;
 
 pub use mbs_macros::multibody;

@@ -5,10 +5,7 @@ mod common;
 mod seed2dof;
 
 use common::*;
-use mbs::{
-    Failure, GenAlphaParams, HhtParams, NewmarkParams, Options, Output, Scheme, StepControl,
-    simulate,
-};
+use mbs::{GenAlphaParams, HhtParams, NewmarkParams, Options, Output, Scheme, simulate};
 use seed2dof::Seed2dof;
 
 /// Period of the 10 Hz mode.

@@ -4,6 +4,7 @@
 //! radius and period error are measured on the simulated motion — each modal coordinate of a
 //! linear system integrated by a linear scheme obeys a linear recurrence, fitted here — and
 //! compared with the eigenvalues of the amplification matrix of Chung & Hulbert's equations.
+#![allow(clippy::needless_range_loop)]
 
 mod common;
 #[path = "../examples/models/seed2dof.rs"]

@@ -96,6 +96,6 @@ pub struct SimError {
     pub t: f64,
     /// step being attempted
     pub h: f64,
-    pub stats: crate::stats::Stats,
+    pub stats: Box<crate::stats::Stats>,
     pub trajectory: Box<crate::trajectory::Trajectory>,
 }

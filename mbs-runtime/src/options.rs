@@ -503,10 +503,8 @@ pub fn validate_scheme(scheme: &Scheme) -> Result<(), Failure> {
                 ));
             }
         }
-        Scheme::Hht(p) => {
-            if !(-1.0 / 3.0 - 1e-15..=0.0).contains(&p.alpha) {
-                return Err(invalid("hht.alpha", p.alpha, "must be in [−1/3, 0]"));
-            }
+        Scheme::Hht(p) if !(-1.0 / 3.0 - 1e-15..=0.0).contains(&p.alpha) => {
+            return Err(invalid("hht.alpha", p.alpha, "must be in [−1/3, 0]"));
         }
         Scheme::GenAlpha(p) => {
             if !p.rho_inf.is_nan() && !(0.0..=1.0).contains(&p.rho_inf) {
@@ -531,14 +529,12 @@ pub fn validate_scheme(scheme: &Scheme) -> Result<(), Failure> {
                 ));
             }
         }
-        Scheme::Bdf(p) => {
-            if !(1..=5).contains(&p.max_order) {
-                return Err(invalid(
-                    "bdf.max_order",
-                    p.max_order,
-                    "must be 1 to 5 (BDF 6+ is unstable)",
-                ));
-            }
+        Scheme::Bdf(p) if !(1..=5).contains(&p.max_order) => {
+            return Err(invalid(
+                "bdf.max_order",
+                p.max_order,
+                "must be 1 to 5 (BDF 6+ is unstable)",
+            ));
         }
         _ => {}
     }

@@ -13,12 +13,14 @@
 //! | BDF 1–5 | `bdf.rs` | 1–5 | adaptive, variable order |
 //! | Radau IIA 3, 5 | `radau.rs` | 3, 5 | adaptive or fixed |
 
+mod bdf;
 mod dopri5;
 mod explicit;
 mod midpoint;
 mod newmark;
 pub(crate) mod newton;
 pub(crate) mod problem;
+mod radau;
 
 use crate::error::{Failure, SimError};
 use crate::model::{Model, Pose};
@@ -221,6 +223,8 @@ pub struct Simulation<M: Model> {
     scratch: State,
     h: f64,
     attempts: usize,
+    /// why the last attempt was rejected, when an evaluation failed (reported if h collapses)
+    last_cause: Option<Failure>,
     traj: Trajectory,
     /// pending output times (for `Output::Every` and `Times`), next one first
     out_times: Vec<f64>,
@@ -241,7 +245,7 @@ impl<M: Model + 'static> Simulation<M> {
             kind,
             t: options.t0,
             h: 0.0,
-            stats,
+            stats: Box::new(stats),
             trajectory: Box::new(Trajectory::new(dof_names.clone(), frame_names.clone())),
         };
         if let Err(e) = options.validate(&scheme, n, info.has_tangents) {
@@ -251,6 +255,10 @@ impl<M: Model + 'static> Simulation<M> {
             return Err(early(Failure::InvalidParameters(e), Stats::default()));
         }
         let mut problem = Problem::new(model, options.iteration_matrix);
+        if let Scheme::Bdf(p) = scheme {
+            // the order history is counted per order: sized now, not while stepping
+            problem.stats.order_steps = vec![0; p.max_order];
+        }
         let mut cur = State::zeros(n);
         cur.t = options.t0;
         problem.model.initial_state(&mut cur.q, &mut cur.qd);
@@ -330,6 +338,7 @@ impl<M: Model + 'static> Simulation<M> {
             cur,
             h: h.min(options.h_max),
             attempts: 0,
+            last_cause: None,
             traj,
             out_times,
             out_next: 0,
@@ -406,7 +415,7 @@ impl<M: Model + 'static> Simulation<M> {
             kind,
             t: self.cur.t,
             h,
-            stats: self.problem.stats.clone(),
+            stats: Box::new(self.problem.stats.clone()),
             trajectory: Box::new(self.traj.clone()),
         }
     }
@@ -465,7 +474,12 @@ impl<M: Model + 'static> Simulation<M> {
                 h = t_next - self.cur.t;
             }
             if h < h_min && !last {
-                return Err(self.fail(Failure::StepTooSmall { h_min }, h));
+                // the cause of the rejections that shrank the step, when there is one
+                let kind = self
+                    .last_cause
+                    .take()
+                    .unwrap_or(Failure::StepTooSmall { h_min });
+                return Err(self.fail(kind, h));
             }
             self.attempts += 1;
             let result =
@@ -485,6 +499,7 @@ impl<M: Model + 'static> Simulation<M> {
                         self.cur.t + h
                     };
                     self.problem.stats.record_step(h);
+                    self.last_cause = None;
                     self.prev.copy_from(&self.cur);
                     std::mem::swap(&mut self.cur, &mut self.next);
                     self.stepper
@@ -519,6 +534,7 @@ impl<M: Model + 'static> Simulation<M> {
                         });
                         return Err(self.fail(kind, h));
                     }
+                    self.last_cause = cause;
                     self.h = h_next.max(h_min);
                 }
             }
@@ -618,34 +634,9 @@ fn stepper_for<M: Model>(scheme: &Scheme, n: usize) -> Box<dyn Stepper<M>> {
         Scheme::Hht(p) => Box::new(newmark::AlphaFamily::hht(n, p)),
         Scheme::GenAlpha(p) => Box::new(newmark::AlphaFamily::gen_alpha(n, p)),
         Scheme::ImplicitMidpoint => Box::new(midpoint::Midpoint::new(n)),
-        Scheme::Bdf(_) | Scheme::Radau3 | Scheme::Radau5 => Box::new(Unavailable(scheme.name())),
-    }
-}
-
-/// A scheme not available yet: fails at the first step with a typed error.
-struct Unavailable(&'static str);
-
-impl<M: Model> Stepper<M> for Unavailable {
-    fn start(&mut self, _p: &mut Problem<M>, _s: &State, _ctl: &Control) -> Result<(), Failure> {
-        Err(Failure::InvalidOption {
-            name: "scheme",
-            value: self.0.to_string(),
-            reason: "this scheme is not available in this version",
-        })
-    }
-    fn attempt(
-        &mut self,
-        _p: &mut Problem<M>,
-        _c: &State,
-        _h: f64,
-        _ctl: &Control,
-        _n: &mut State,
-    ) -> Result<Attempt, Failure> {
-        Err(Failure::InvalidOption {
-            name: "scheme",
-            value: self.0.to_string(),
-            reason: "this scheme is not available in this version",
-        })
+        Scheme::Bdf(p) => Box::new(bdf::Bdf::new(n, p.max_order)),
+        Scheme::Radau3 => Box::new(radau::Radau::radau3(n)),
+        Scheme::Radau5 => Box::new(radau::Radau::radau5(n)),
     }
 }
 

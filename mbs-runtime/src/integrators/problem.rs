@@ -76,7 +76,7 @@ impl<M: Model> Problem<M> {
         }
     }
 
-    fn singular(&self, matrix: &'static str, s: Singular) -> Failure {
+    pub(crate) fn singular(&self, matrix: &'static str, s: Singular) -> Failure {
         Failure::SingularMatrix {
             matrix,
             rcond: s.rcond,
@@ -116,6 +116,7 @@ impl<M: Model> Problem<M> {
 
     /// Fills and factorises the iteration matrix M + γ'·C_t + β'·K_t at (t, q, qd, qdd): the
     /// derivative of τ(q̂ + β'a, v̂ + γ'a, a) with respect to a.
+    #[allow(clippy::too_many_arguments)]
     pub fn iteration_matrix(
         &mut self,
         t: f64,
@@ -193,6 +194,73 @@ impl<M: Model> Problem<M> {
         self.stats.factorizations += 1;
         lu.factor()
             .map_err(|s| self.singular("the iteration matrix M + γ'C + β'K", s))
+    }
+
+    /// The pieces of the iteration matrix, unfactorised, for schemes that combine them with
+    /// several (or complex) coefficients: M, C_t = ∂τ/∂qd and K_t = ∂τ/∂q at
+    /// (t, q, qd, qdd), n × n column-major each, as `self.iteration` says: exact (M and the
+    /// generated tangents: one evaluation of each), finite differences (M exact, C_t and K_t
+    /// by forward differences of τ: 2n + 1 evaluations of τ), or mass only (C_t = K_t = 0).
+    #[allow(clippy::too_many_arguments)]
+    pub fn tangent_matrices(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        m: &mut [f64],
+        c: &mut [f64],
+        k: &mut [f64],
+    ) -> Result<(), Failure> {
+        let n = self.n;
+        self.model.mass_matrix(t, q, m);
+        self.stats.mass_matrix += 1;
+        match self.iteration {
+            IterationMatrix::Exact | IterationMatrix::Auto => {
+                if let Err(e) = self.model.tangents(t, q, qd, qdd, &self.u, k, c) {
+                    return Err(Failure::InvalidOption {
+                        name: "iteration_matrix",
+                        value: "Exact".into(),
+                        reason: model_error_reason(&e),
+                    });
+                }
+                self.stats.tangents += 1;
+            }
+            IterationMatrix::MassOnly => {
+                c.fill(0.0);
+                k.fill(0.0);
+            }
+            IterationMatrix::FiniteDifferences => {
+                self.model
+                    .inverse_dynamics(t, q, qd, qdd, &self.u, &mut self.tau0);
+                self.stats.inverse_dynamics += 1;
+                self.qp.copy_from_slice(q);
+                self.vp.copy_from_slice(qd);
+                for j in 0..n {
+                    // the increment actually represented in floating point
+                    let eps = (q[j] + f64::EPSILON.sqrt() * q[j].abs().max(1.0)) - q[j];
+                    self.qp[j] = q[j] + eps;
+                    self.model
+                        .inverse_dynamics(t, &self.qp, qd, qdd, &self.u, &mut self.tau1);
+                    self.qp[j] = q[j];
+                    for i in 0..n {
+                        k[i + n * j] = (self.tau1[i] - self.tau0[i]) / eps;
+                    }
+                    let eps = (qd[j] + f64::EPSILON.sqrt() * qd[j].abs().max(1.0)) - qd[j];
+                    self.vp[j] = qd[j] + eps;
+                    self.model
+                        .inverse_dynamics(t, q, &self.vp, qdd, &self.u, &mut self.tau1);
+                    self.vp[j] = qd[j];
+                    for i in 0..n {
+                        c[i + n * j] = (self.tau1[i] - self.tau0[i]) / eps;
+                    }
+                }
+                self.stats.inverse_dynamics += 2 * n;
+            }
+        }
+        self.check("M", m)?;
+        self.check("C_t", c)?;
+        self.check("K_t", k)
     }
 
     /// Evaluations for one output: energy, and poses when asked for.

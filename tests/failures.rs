@@ -1,0 +1,200 @@
+//! Failures are values: typed errors with the trajectory computed so far, never a panic, never
+//! a non-finite value in a trajectory.
+
+#[path = "../examples/models/seed2dof.rs"]
+mod seed2dof;
+
+use mbs::{
+    Failure, GenAlphaParams, HhtParams, Model, NewmarkParams, Options, Output, Scheme, Simulation,
+    simulate,
+};
+use seed2dof::Seed2dof;
+
+mbs::multibody! {
+    /// A pendulum pushed by a force that is not defined after t = 0.5 (sqrt of a negative).
+    pub model Broken {
+        dof theta = 0.3;
+        body bob { mass = 1.0; inertia = (0.01, 0.01, 0.01); }
+        TOG[bob] = Trotz(theta) * Tdisp(0, -1, 0);
+        gravity(0, -9.81, 0);
+        generalized_force(theta, sqrt(0.5 - t));
+    }
+}
+
+mbs::multibody! {
+    /// A slider driven through a crank-like sine: its inertia vanishes at q = π/2.
+    pub model Degenerate {
+        dof q[0] = PI / 2; dof q[1] = 0.0;
+        body slider { mass = 1.0; }
+        body other { mass = 2.0; }
+        TOG[slider] = Tdisp(sin(q[0]), 0, 0);
+        TOG[other] = Tdisp(0, q[1], 0);
+    }
+}
+
+fn all_finite(tr: &mbs::Trajectory) -> bool {
+    tr.q_data
+        .iter()
+        .chain(&tr.qd_data)
+        .chain(&tr.qdd_data)
+        .all(|x| x.is_finite())
+        && tr
+            .energy
+            .iter()
+            .all(|e| e.kinetic.is_finite() && e.potential.is_finite())
+}
+
+#[test]
+fn rk4_past_its_stability_limit_stops_before_any_non_finite_value() {
+    let e = simulate(Seed2dof::default(), Scheme::Rk4, Options::fixed(10.0, 0.2)).unwrap_err();
+    assert!(matches!(e.kind, Failure::UnstableStep { .. }), "{e}");
+    assert!(all_finite(&e.trajectory));
+    // the stability edge h < 2.785/ω₂ of RK4 (2√2/ω₂ on the imaginary axis): 0.044 s runs
+    // 1000 periods of the 1 Hz mode, 0.046 s is refused
+    let opts = |h| Options {
+        output: Output::Last,
+        energy: false,
+        ..Options::fixed(1000.0, h)
+    };
+    let (tr, _) = simulate(Seed2dof::default(), Scheme::Rk4, opts(0.044)).unwrap();
+    assert!(all_finite(&tr) && tr.q(0)[1].abs() < 2.0);
+    let e = simulate(Seed2dof::default(), Scheme::Rk4, opts(0.046)).unwrap_err();
+    match e.kind {
+        Failure::UnstableStep { h_stable, .. } => {
+            assert!((0.044..0.046).contains(&h_stable), "{h_stable}")
+        }
+        other => panic!("{other}"),
+    }
+}
+
+#[test]
+fn invalid_options_are_named_before_any_work() {
+    let cases: Vec<(Scheme, Options, &str)> = vec![
+        (
+            Scheme::Rk4,
+            Options {
+                q0: Some(vec![f64::NAN, 0.0]),
+                ..Options::fixed(1.0, 0.01)
+            },
+            "q0",
+        ),
+        (
+            Scheme::Rk4,
+            Options {
+                t0: 2.0,
+                ..Options::fixed(1.0, 0.01)
+            },
+            "t_end",
+        ),
+        (Scheme::Rk4, Options::fixed(1.0, -0.01), "h"),
+        (Scheme::Dopri5, Options::adaptive(1.0, 1e-16), "rtol"),
+        (Scheme::Dopri5, Options::adaptive(1.0, 0.0), "rtol"),
+        (
+            Scheme::GenAlpha(GenAlphaParams::from_rho_inf(1.5)),
+            Options::fixed(1.0, 0.01),
+            "gen_alpha.rho_inf",
+        ),
+        (
+            Scheme::Hht(HhtParams { alpha: -0.5 }),
+            Options::fixed(1.0, 0.01),
+            "hht.alpha",
+        ),
+        (
+            Scheme::Newmark(NewmarkParams {
+                beta: 0.1,
+                gamma: 0.5,
+            }),
+            Options::fixed(1.0, 0.01),
+            "newmark.beta",
+        ),
+        (
+            Scheme::Newmark(NewmarkParams {
+                beta: 0.25,
+                gamma: 0.4,
+            }),
+            Options::fixed(1.0, 0.01),
+            "newmark.gamma",
+        ),
+    ];
+    for (scheme, opts, name) in cases {
+        let e = Simulation::new(Seed2dof::default(), scheme, opts)
+            .err()
+            .expect("refused");
+        match &e.kind {
+            Failure::InvalidOption { name: n, .. } => assert_eq!(*n, name, "{e}"),
+            other => panic!("{other}"),
+        }
+        assert_eq!(e.stats.evaluations(), 0, "nothing was evaluated");
+    }
+    // parameters are validated too
+    let mut model = Seed2dof::default();
+    let mut p = model.params().clone();
+    p.m1 = f64::NAN;
+    assert!(model.set_params(p).is_err());
+}
+
+#[test]
+fn a_model_that_returns_nan_stops_every_scheme_near_the_time_it_starts() {
+    for scheme in Scheme::all() {
+        let opts = if scheme.is_adaptive() {
+            Options::adaptive(2.0, 1e-6)
+        } else {
+            Options::fixed(2.0, 0.01)
+        };
+        let e = simulate(Broken::default(), scheme, opts).unwrap_err();
+        match &e.kind {
+            Failure::NonFinite { coordinate, .. } => {
+                assert_eq!(coordinate, "q[0] (theta)", "{}: {e}", scheme.name())
+            }
+            other => panic!("{}: {other}", scheme.name()),
+        }
+        assert!(
+            (0.45..=0.5).contains(&e.t),
+            "{}: stopped at t = {}",
+            scheme.name(),
+            e.t
+        );
+        assert!(
+            all_finite(&e.trajectory) && !e.trajectory.is_empty(),
+            "{}",
+            scheme.name()
+        );
+    }
+}
+
+#[test]
+fn a_singular_mass_matrix_is_named_by_its_coordinate() {
+    let e = Simulation::new(
+        Degenerate::default(),
+        Scheme::Dopri5,
+        Options::adaptive(1.0, 1e-6),
+    )
+    .err()
+    .unwrap();
+    match e.kind {
+        Failure::SingularMatrix { coordinates, .. } => {
+            assert_eq!(coordinates, vec!["q[0]".to_string()])
+        }
+        other => panic!("{other}"),
+    }
+}
+
+#[test]
+fn work_limits_are_typed_errors() {
+    let o = Options {
+        max_steps: 50,
+        ..Options::adaptive(10.0, 1e-8)
+    };
+    let e = simulate(Seed2dof::default(), Scheme::Dopri5, o).unwrap_err();
+    assert!(
+        matches!(e.kind, Failure::TooMuchWork { max_steps: 50 }),
+        "{e}"
+    );
+    assert_eq!(e.trajectory.len(), e.stats.steps + 1);
+    let o = Options {
+        h_min: Some(0.01),
+        ..Options::adaptive(10.0, 1e-10)
+    };
+    let e = simulate(Seed2dof::default(), Scheme::Dopri5, o).unwrap_err();
+    assert!(matches!(e.kind, Failure::StepTooSmall { .. }), "{e}");
+}

@@ -1,0 +1,301 @@
+//! BDF 1–5 with variable step and order (`mbs-runtime/src/integrators/bdf.rs`) on the
+//! canonical models: observed orders, accuracy on the chaotic double pendulum and why it stops
+//! short of 1e-6 at t = 10 s at rtol 1e-10, a snapshot of the work, the order history, fixed
+//! steps, failures.
+
+mod common;
+#[path = "../examples/models/dpend.rs"]
+mod dpend;
+#[path = "../examples/models/seed2dof.rs"]
+mod seed2dof;
+
+use common::*;
+use dpend::DoublePendulum;
+use mbs::{BdfParams, Failure, Options, Output, Scheme, StepControl, simulate};
+use seed2dof::Seed2dof;
+
+fn bdf(max_order: usize) -> Scheme {
+    Scheme::Bdf(BdfParams { max_order })
+}
+
+fn sci(v: &[f64]) -> String {
+    let s: Vec<String> = v.iter().map(|x| format!("{x:.2e}")).collect();
+    s.join(" ")
+}
+
+/// Largest |Δq|, |Δqd| between two states.
+fn distance(q: &[f64], qd: &[f64], rq: &[f64], rqd: &[f64]) -> f64 {
+    q.iter()
+        .zip(rq)
+        .chain(qd.iter().zip(rqd))
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max)
+}
+
+/// Error against the number of steps on seed2dof (max over outputs every 10 ms, so that the
+/// two modes' interference at single instants averages out) as rtol tightens: slope ≈ −k.
+///
+/// Measured (slopes of the fits below): k = 1: 0.97, 2: 2.00, 3: 3.00, 4: 4.01, 5: 5.05.
+/// BDF1 and BDF2 need small steps on the 10 Hz mode (their damping is of order hω per step),
+/// hence the looser tolerances and the many steps of k = 1 (up to 230,000, still fast).
+#[test]
+fn observed_orders_on_seed2dof() {
+    let cases: [(usize, &[f64]); 5] = [
+        (1, &[1e-5, 1e-6, 1e-7]),
+        (2, &[1e-6, 1e-7, 1e-8, 1e-9]),
+        (3, &[1e-6, 1e-7, 1e-8, 1e-9]),
+        (4, &[1e-6, 1e-7, 1e-8, 1e-9]),
+        (5, &[1e-6, 1e-7, 1e-8, 1e-9]),
+    ];
+    for (k, rtols) in cases {
+        let mut steps = Vec::new();
+        let mut errs = Vec::new();
+        for &rtol in rtols {
+            let opts = Options {
+                output: Output::Every { dt: 0.01 },
+                energy: false,
+                ..Options::adaptive(1.0, rtol)
+            };
+            let (tr, st) = simulate(Seed2dof::default(), bdf(k), opts).unwrap();
+            steps.push(st.steps as f64);
+            errs.push(seed2dof_max_error(&tr));
+            // the top order is reached and carries the run
+            let top = st.order_steps.get(k - 1).copied().unwrap_or(0);
+            assert!(
+                top * 10 >= st.steps * 9,
+                "BDF{k}: orders {:?}",
+                st.order_steps
+            );
+        }
+        let p = -loglog_slope(&steps, &errs);
+        println!(
+            "BDF{k}: steps {steps:?}, errors {} → order {p:.2}",
+            sci(&errs)
+        );
+        assert!(
+            (p - k as f64).abs() <= 0.3,
+            "BDF{k}: error–steps slope {p:.2}"
+        );
+    }
+}
+
+/// States (t, q, qd) at output times.
+type States = Vec<(f64, Vec<f64>, Vec<f64>)>;
+
+/// dpend at the reference times, adaptive at (rtol, atol), max order 5; q0 shifted by `dq0`.
+fn dpend_run(rtol: f64, atol: f64, dq0: f64) -> (States, mbs::Stats) {
+    let times = vec![0.5, 1.0, 2.0, 5.0, 10.0];
+    let opts = Options {
+        t_end: 10.0,
+        q0: Some(vec![std::f64::consts::FRAC_PI_2 + dq0, 0.0]),
+        step: StepControl::Adaptive {
+            rtol,
+            atol,
+            h0: None,
+        },
+        output: Output::Times(times.clone()),
+        energy: false,
+        ..Options::default()
+    };
+    let (tr, st) = simulate(DoublePendulum::default(), bdf(5), opts).unwrap();
+    assert_eq!(tr.len(), times.len());
+    let states = (0..tr.len())
+        .map(|i| (tr.t[i], tr.q(i).to_vec(), tr.qd(i).to_vec()))
+        .collect();
+    (states, st)
+}
+
+fn dpend_errors(states: &[(f64, Vec<f64>, Vec<f64>)]) -> Vec<f64> {
+    states
+        .iter()
+        .map(|(t, q, qd)| {
+            let (rq, rqd) = reference_state("dpend", *t);
+            distance(q, qd, &rq, &rqd)
+        })
+        .collect()
+}
+
+/// The issue asks every adaptive scheme for dpend within 1e-6 of the reference at t = 10 s at
+/// rtol 1e-10. BDF misses it by about 700×: measured 7.3e-4 (7,372 steps, 146 rejected,
+/// 15,840 evaluations). SciPy's `BDF` (the same formulation) gives 4.6e-4 on the same problem
+/// and tolerances, its DOP853 9e-6 (reference file), DOPRI5 here 3.7e-5. The cause is the
+/// pendulum, not the scheme. Why 1e-6 at t = 10 s is out of reach at rtol 1e-10, measured:
+/// - up to 5 s BDF at rtol 1e-10 stays within ~1e-6 (errors 5e-9, 2e-8, 7e-8, 6e-7 at
+///   0.5, 1, 2, 5 s), then the error grows ×1000 in the next 5 s (7e-4 at 10 s);
+/// - a shift of 1e-10 of q0 alone moves the state at 10 s by ~2e-5 (amplification ~2e5):
+///   every one of the ~7,000 local errors of ~1e-10 (rtol·|y|, |y| up to 14) is amplified
+///   likewise, so rtol 1e-10 cannot give 1e-6; BDF5's global error goes as rtol^(5/6);
+/// - tightening rtol reaches it: 2e-6 at rtol 1e-13, 3e-7 at rtol 1e-14 (33,000 steps).
+#[test]
+fn dpend_error_is_amplified_by_the_chaos() {
+    let (states, st) = dpend_run(1e-10, 1e-12, 0.0);
+    let e = dpend_errors(&states);
+    println!(
+        "rtol 1e-10: errors at 0.5, 1, 2, 5, 10 s: {}\n{st}",
+        sci(&e)
+    );
+    assert!(
+        e[0] < 2e-8 && e[1] < 1e-7 && e[2] < 3e-7 && e[3] < 2e-6,
+        "{}",
+        sci(&e)
+    );
+    assert!(e[4] < 3e-3, "{}", sci(&e));
+
+    let (tight, st) = dpend_run(1e-14, 1e-16, 0.0);
+    let e_tight = dpend_errors(&tight);
+    println!("rtol 1e-14: errors {}\n{st}", sci(&e_tight));
+    assert!(e_tight[4] < 1e-6, "{}", sci(&e_tight));
+
+    let (shifted, _) = dpend_run(1e-14, 1e-16, 1e-10);
+    let (_, q, qd) = &tight[4];
+    let (_, sq, sqd) = &shifted[4];
+    let moved = distance(q, qd, sq, sqd);
+    println!("q0 shifted by 1e-10: the state at 10 s moves by {moved:.2e}");
+    assert!(moved > 1e-6, "amplification {:.1e}", moved / 1e-10);
+}
+
+/// A snapshot of the work: dpend to 2 s at rtol 1e-6 (atol 1e-8), max order 5, finite
+/// difference iteration matrices (dpend has no tangents). Any change that alters the work
+/// must update these numbers knowingly.
+///
+/// - 2 `dynamics` (M and h): the consistent qdd(0) and the first-step heuristic's trial
+///   evaluation; BDF itself only evaluates τ.
+/// - τ: one per Newton iteration, plus n + 1 = 3 per finite-difference iteration matrix:
+///   inverse_dynamics = newton_iterations + 3·(factorizations − 2), the 2 being the
+///   Cholesky factorisations of the two `dynamics` calls; solves = newton_iterations + 2.
+/// - 340 attempts (308 accepted, 32 rejected), 575 Newton iterations (1.7 per attempt),
+///   59 iteration matrices (752 τ = 575 + 3·59): a matrix is rebuilt when c = h/γ_k moves by
+///   more than 20 % or convergence slows. 754 evaluations in all, 2.4 per accepted step.
+/// - Rejections (~10 % of attempts) are the quasi-constant-step formulation's: h changes only
+///   after k + 1 steps at constant h or on a rejection, so when the error grows within those
+///   steps (bars swinging through the bottom), the step is rejected instead of shrunk ahead.
+/// - Orders: 2 steps at order 1 (h ramps from the driver's first step), the lower orders at
+///   the start, then order 5.
+#[test]
+fn work_counters_snapshot() {
+    let opts = Options {
+        output: Output::Last,
+        energy: false,
+        ..Options::adaptive(2.0, 1e-6)
+    };
+    let (_, st) = simulate(DoublePendulum::default(), bdf(5), opts).unwrap();
+    println!("{st}");
+    assert_eq!(st.dynamics, 2);
+    assert_eq!(st.mass_matrix + st.tangents, 0);
+    assert_eq!(
+        st.inverse_dynamics,
+        st.newton_iterations + 3 * (st.factorizations - 2)
+    );
+    assert_eq!(st.solves, st.newton_iterations + 2);
+    let got = (
+        st.steps,
+        st.rejected_error,
+        st.rejected_newton,
+        st.newton_iterations,
+        st.factorizations,
+        st.evaluations(),
+        st.order_steps.clone(),
+    );
+    // (steps, rejected by the error test, by Newton, Newton iterations, factorisations,
+    // evaluations, steps per order)
+    assert_eq!(
+        got,
+        (308, 32, 0, 575, 61, 754, vec![2, 17, 4, 5, 280]),
+        "{st}"
+    );
+}
+
+/// The order history is recorded, climbs from 1, and the top order carries the run.
+#[test]
+fn order_history_is_recorded() {
+    let opts = Options {
+        output: Output::Last,
+        energy: false,
+        ..Options::adaptive(5.0, 1e-8)
+    };
+    let (_, st) = simulate(DoublePendulum::default(), bdf(5), opts).unwrap();
+    println!("{st}");
+    assert_eq!(st.order_steps.len(), 5, "{:?}", st.order_steps);
+    assert_eq!(st.order_steps.iter().sum::<usize>(), st.steps);
+    assert!(st.order_steps[0] >= 1, "starts at order 1");
+    assert!(
+        st.order_steps[4] * 10 >= st.steps * 9,
+        "mostly order 5: {:?}",
+        st.order_steps
+    );
+    // max_order caps it
+    let opts = Options {
+        output: Output::Last,
+        energy: false,
+        ..Options::adaptive(5.0, 1e-8)
+    };
+    let (_, st) = simulate(DoublePendulum::default(), bdf(3), opts).unwrap();
+    assert_eq!(st.order_steps.len(), 3, "{:?}", st.order_steps);
+    assert!(
+        st.order_steps[2] * 10 >= st.steps * 9,
+        "{:?}",
+        st.order_steps
+    );
+}
+
+/// Fixed steps: the order rises by one per step (step s at order min(s, k)), without error
+/// test. The first steps, at orders 1.., leave an O(h²) error that the later ones carry: the
+/// observed order of fixed-step BDF3–5 is 2 (measured 2.0), BDF2 2 as well; fixed-step BDF
+/// works, but its orders above 2 pay off only with adaptive steps.
+#[test]
+fn fixed_steps_ramp_the_order() {
+    let t2 = 2.0 * std::f64::consts::PI / seed2dof_modes().0[1];
+    for k in [2, 5] {
+        let hs = [t2 / 40.0, t2 / 80.0, t2 / 160.0, t2 / 320.0];
+        let mut errs = Vec::new();
+        for &h in &hs {
+            let opts = Options {
+                output: Output::Every { dt: 0.02 },
+                energy: false,
+                ..Options::fixed(1.0, h)
+            };
+            let (tr, st) = simulate(Seed2dof::default(), bdf(k), opts).unwrap();
+            let mut ramp = vec![1; k - 1];
+            ramp.push(st.steps - (k - 1));
+            assert_eq!(st.order_steps, ramp);
+            assert_eq!(st.rejected_error + st.rejected_newton, 0);
+            errs.push(seed2dof_max_error(&tr));
+        }
+        let p = loglog_slope(&hs, &errs);
+        println!("fixed BDF{k}: errors {} → order {p:.2}", sci(&errs));
+        assert!((p - 2.0).abs() <= 0.3, "BDF{k} fixed: order {p:.2}");
+    }
+}
+
+mbs::multibody! {
+    /// A pendulum pushed by a force that is not defined after t = 0.5 (sqrt of a negative).
+    pub model Broken {
+        dof theta = 0.3;
+        body bob { mass = 1.0; inertia = (0.01, 0.01, 0.01); }
+        TOG[bob] = Trotz(theta) * Tdisp(0, -1, 0);
+        gravity(0, -9.81, 0);
+        generalized_force(theta, sqrt(0.5 - t));
+    }
+}
+
+/// A model that returns NaN after t = 0.5: Newton fails with the cause, the step shrinks, and
+/// the run stops near 0.5 s naming the coordinate, keeping a finite trajectory.
+#[test]
+fn a_model_that_returns_nan_stops_with_its_coordinate() {
+    for opts in [Options::adaptive(2.0, 1e-6), Options::fixed(2.0, 0.01)] {
+        let e = simulate(Broken::default(), bdf(5), opts).unwrap_err();
+        match &e.kind {
+            Failure::NonFinite { coordinate, .. } => assert_eq!(coordinate, "q[0] (theta)", "{e}"),
+            other => panic!("{other}"),
+        }
+        assert!((0.45..=0.5).contains(&e.t), "stopped at t = {}", e.t);
+        assert!(!e.trajectory.is_empty());
+        assert!(
+            e.trajectory
+                .q_data
+                .iter()
+                .chain(&e.trajectory.qd_data)
+                .all(|x| x.is_finite())
+        );
+    }
+}

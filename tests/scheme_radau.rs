@@ -1,0 +1,347 @@
+//! Radau IIA 3 and 5 (`mbs-runtime/src/integrators/radau.rs`) on the canonical models:
+//! observed orders on seed2dof (fixed step and adaptive), accuracy against the reference runs
+//! of dpend and arm3d_6, work counters of one reference run per scheme, and no allocation per
+//! step.
+
+#[path = "../examples/models/arm3d_6.rs"]
+mod arm3d_6;
+mod common;
+#[path = "../examples/models/dpend.rs"]
+mod dpend;
+#[path = "../examples/models/seed2dof.rs"]
+mod seed2dof;
+
+use common::*;
+use mbs::{
+    Failure, Integrator, IterationMatrix, Options, Output, Scheme, Simulation, Stats, simulate,
+};
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+
+/// Counts the allocations of the current thread (tests run in parallel threads).
+struct Counting;
+
+thread_local! {
+    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+}
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.with(|c| c.set(c.get() + 1));
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.with(|c| c.set(c.get() + 1));
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+fn allocations() -> usize {
+    ALLOCATIONS.with(|c| c.get())
+}
+
+mbs::multibody! {
+    /// dpend (`examples/models/dpend.rs`) with generated tangents, for exact iteration matrices.
+    pub model DoublePendulumT {
+        param l = 1.0; param m = 1.0; param g = 9.81;
+        let i_bar = m * l * l / 12;
+        dof q[0] = PI / 2; dof q[1] = 0.0;
+        body bar1 { mass = m; inertia = (i_bar, 0, i_bar); }
+        body bar2 { mass = m; inertia = (i_bar, 0, i_bar); }
+        TOG[bar1] = Trotz(q[0]) * Tdisp(0, -l / 2, 0);
+        TOG[bar2] = TOG[bar1] * Tdisp(0, -l / 2, 0) * Trotz(q[1]) * Tdisp(0, -l / 2, 0);
+        gravity(0, -g, 0);
+        option tangents;
+    }
+}
+
+const SCHEMES: [Scheme; 2] = [Scheme::Radau3, Scheme::Radau5];
+
+fn sci(v: &[f64]) -> String {
+    let items: Vec<String> = v.iter().map(|x| format!("{x:.3e}")).collect();
+    items.join(", ")
+}
+
+/// Period of the 10 Hz mode of seed2dof.
+fn t2() -> f64 {
+    2.0 * std::f64::consts::PI / seed2dof_modes().0[1]
+}
+
+/// Largest error over 50 outputs of a fixed-step run to `t_end`.
+fn fixed_error(scheme: Scheme, h: f64, t_end: f64) -> f64 {
+    let opts = Options {
+        output: Output::Every { dt: t_end / 50.0 },
+        energy: false,
+        ..Options::fixed(t_end, h)
+    };
+    let (tr, _) = simulate(seed2dof::Seed2dof::default(), scheme, opts).unwrap();
+    seed2dof_max_error(&tr)
+}
+
+#[test]
+fn fixed_step_orders_on_seed2dof() {
+    let t2 = t2();
+    for scheme in SCHEMES {
+        // h = T₂/20 … T₂/160 over one period of the 1 Hz mode
+        let hs: Vec<f64> = (0..4).map(|k| t2 / 20.0 / 2f64.powi(k)).collect();
+        let errs: Vec<f64> = hs.iter().map(|&h| fixed_error(scheme, h, 1.0)).collect();
+        let p = loglog_slope(&hs, &errs);
+        println!(
+            "{:<7} h {}\n        errors {} → order {p:.2}",
+            scheme.name(),
+            sci(&hs),
+            sci(&errs)
+        );
+        let theory = scheme.order() as f64;
+        assert!(
+            (p - theory).abs() <= 0.3,
+            "{}: observed order {p:.2}, theory {theory}",
+            scheme.name()
+        );
+    }
+}
+
+#[test]
+fn adaptive_orders_on_seed2dof() {
+    for (scheme, rtols) in [
+        (Scheme::Radau3, [1e-4, 1e-5, 1e-6, 1e-7]),
+        (Scheme::Radau5, [1e-5, 1e-6, 1e-7, 1e-8]),
+    ] {
+        let mut steps = Vec::new();
+        let mut errs = Vec::new();
+        for rtol in rtols {
+            let opts = Options {
+                output: Output::Every { dt: 0.02 },
+                energy: false,
+                ..Options::adaptive(1.0, rtol)
+            };
+            let (tr, st) = simulate(seed2dof::Seed2dof::default(), scheme, opts).unwrap();
+            steps.push(st.steps as f64);
+            errs.push(seed2dof_max_error(&tr));
+        }
+        let p = -loglog_slope(&steps, &errs);
+        println!(
+            "{:<7} steps {steps:?}\n        errors {} → order {p:.2}",
+            scheme.name(),
+            sci(&errs)
+        );
+        let theory = scheme.order() as f64;
+        assert!(
+            (p - theory).abs() <= 0.3,
+            "{}: error–steps slope {p:.2}, theory {theory}",
+            scheme.name()
+        );
+    }
+}
+
+/// Runs `model` adaptively to `t_end` and compares the final state with the reference.
+fn against_reference<M: mbs::Model + 'static>(
+    model: M,
+    name: &str,
+    scheme: Scheme,
+    t_end: f64,
+    rtol: f64,
+) -> (f64, Stats) {
+    let (q, qd) = reference_state(name, t_end);
+    let opts = Options {
+        output: Output::Last,
+        energy: false,
+        ..Options::adaptive(t_end, rtol)
+    };
+    let (tr, st) = simulate(model, scheme, opts).unwrap();
+    let e = final_error(&tr, &q, &qd);
+    println!(
+        "{name} {:<7} t = {t_end}: error {e:.2e}, {} steps, rejected {} (error) {} (Newton), \
+         {} evaluations, {} factorisations",
+        scheme.name(),
+        st.steps,
+        st.rejected_error,
+        st.rejected_newton,
+        st.evaluations(),
+        st.factorizations
+    );
+    (e, st)
+}
+
+/// dpend is chaotic: a state error grows about 10⁴-fold from t = 5 to t = 10 s (the reference's
+/// own DOP853 run at rtol 1e-10 is 9e-6 away at t = 10). At rtol 1e-10 both schemes are within
+/// 1e-6 at t = 5 s, but not at t = 10 s (Radau5: 1.3e-5 in 3373 steps, Radau3: 6.7e-4 in 35306
+/// steps; Dopri5: 3.7e-5); within 1e-6 at t = 10 s takes rtol 1e-12 for Radau5 (7.1e-7, 7309
+/// steps) and 1e-14 for Radau3 (6.1e-7, 353647 steps: an order-3 method at this accuracy).
+#[test]
+fn dpend_against_reference() {
+    for scheme in SCHEMES {
+        let model = dpend::DoublePendulum::default();
+        let (e, _) = against_reference(model, "dpend", scheme, 5.0, 1e-10);
+        assert!(e < 1e-6, "{}: dpend error {e:e} at t = 5", scheme.name());
+    }
+    for (scheme, rtol) in [(Scheme::Radau5, 1e-12), (Scheme::Radau3, 1e-14)] {
+        let model = dpend::DoublePendulum::default();
+        let (e, _) = against_reference(model, "dpend", scheme, 10.0, rtol);
+        assert!(e < 1e-6, "{}: dpend error {e:e} at t = 10", scheme.name());
+    }
+}
+
+#[test]
+fn arm3d_6_at_2_s() {
+    for scheme in SCHEMES {
+        let (e, _) = against_reference(arm3d_6::Arm3d6::default(), "arm3d_6", scheme, 2.0, 1e-10);
+        assert!(e < 1e-6, "{}: arm3d_6 error {e:e} at t = 2", scheme.name());
+    }
+}
+
+/// steps, rejected by the error test, by Newton, M+h, M, τ, factorisations, solves, Newton
+/// iterations
+fn counts(s: &Stats) -> [usize; 9] {
+    [
+        s.steps,
+        s.rejected_error,
+        s.rejected_newton,
+        s.dynamics,
+        s.mass_matrix,
+        s.inverse_dynamics,
+        s.factorizations,
+        s.solves,
+        s.newton_iterations,
+    ]
+}
+
+/// One reference run per scheme, dpend from 0 to 2 s at rtol 1e-6 (atol 1e-8), snapshotted: a
+/// change that silently doubles the work fails here. dpend has no generated tangents: each
+/// evaluation of M, C_t, K_t is 1 M and 2n + 1 = 5 τ (finite differences); each Newton
+/// iteration is s τ (one per stage). M+h: the start and the initial-step probe (2, with a
+/// Cholesky factorisation and solve each). Every (re)factorisation is a complex and a real LU
+/// (Radau3's real one is the error filter only); solves: 1 complex per Newton iteration (+1
+/// real for Radau5) and 1 real per error estimate.
+///
+/// - Radau3: 654 attempts, 571 matrix evaluations (571·5 + 1267·2 = 5389 τ), 632
+///   factorisations of both blocks (2 + 2·632 = 1266), 2 + 1267 + 654 = 1923 solves;
+/// - Radau5: 141 attempts, 129 matrix evaluations (129·5 + 370·3 = 1755 τ), 140
+///   factorisations of both blocks (2 + 2·140 = 282), 2 + 2·370 + 141 = 883 solves.
+///
+/// RADAU5's rule re-evaluates the matrices whenever Newton contracted by more than θ = 0.001,
+/// which on this non-stiff problem is nearly every step; h changes at almost every step, so
+/// the blocks are refactorised too.
+#[test]
+fn work_counters_snapshot() {
+    let cases = [
+        (Scheme::Radau3, [649, 5, 0, 2, 571, 5389, 1266, 1923, 1267]),
+        (Scheme::Radau5, [133, 8, 0, 2, 129, 1755, 282, 883, 370]),
+    ];
+    for (scheme, expected) in cases {
+        let opts = Options {
+            output: Output::Last,
+            energy: false,
+            ..Options::adaptive(2.0, 1e-6)
+        };
+        let (_, st) = simulate(dpend::DoublePendulum::default(), scheme, opts).unwrap();
+        println!("{} dpend to 2 s at rtol 1e-6:\n{st}", scheme.name());
+        assert_eq!(counts(&st), expected, "{}", scheme.name());
+    }
+}
+
+#[test]
+fn no_allocation_per_step() {
+    for scheme in SCHEMES {
+        for opts in [Options::adaptive(10.0, 1e-8), Options::fixed(10.0, 1e-3)] {
+            let opts = Options {
+                output: Output::Last,
+                energy: false,
+                ..opts
+            };
+            let mut sim = Simulation::new(dpend::DoublePendulum::default(), scheme, opts).unwrap();
+            for _ in 0..20 {
+                sim.step().unwrap();
+            }
+            let before = allocations();
+            for _ in 0..200 {
+                sim.step().unwrap();
+            }
+            let n = allocations() - before;
+            assert_eq!(n, 0, "{}: {n} allocations in 200 steps", scheme.name());
+        }
+    }
+}
+
+/// Every way of building the iteration matrices gives the same motion (to the tolerance); the
+/// work differs: exact tangents (1 M and 1 tangent evaluation per Jacobian), finite
+/// differences (1 M and 2n + 1 = 5 τ), mass only (1 M, slower Newton).
+#[test]
+fn iteration_matrices() {
+    let (q, qd) = reference_state("dpend", 2.0);
+    for scheme in SCHEMES {
+        for im in [
+            IterationMatrix::Exact,
+            IterationMatrix::FiniteDifferences,
+            IterationMatrix::MassOnly,
+        ] {
+            for step in [Options::adaptive(2.0, 1e-9), Options::fixed(2.0, 2e-3)] {
+                let opts = Options {
+                    output: Output::Last,
+                    energy: false,
+                    iteration_matrix: im,
+                    ..step
+                };
+                let (tr, st) = simulate(DoublePendulumT::default(), scheme, opts).unwrap();
+                let e = final_error(&tr, &q, &qd);
+                println!(
+                    "{:<7} {im:?} {:?}: error {e:.2e}, {} steps, {} Newton iterations, \
+                     {} M, {} τ, {} tangents",
+                    scheme.name(),
+                    step.step,
+                    st.steps,
+                    st.newton_iterations,
+                    st.mass_matrix,
+                    st.inverse_dynamics,
+                    st.tangents
+                );
+                assert!(e < 1e-5, "{} {im:?}: error {e:e}", scheme.name());
+                assert_eq!(st.tangents > 0, im == IterationMatrix::Exact);
+            }
+        }
+    }
+}
+
+mbs::multibody! {
+    /// A pendulum pushed by a force that is not defined after t = 0.5 (sqrt of a negative).
+    pub model Broken {
+        dof theta = 0.3;
+        body bob { mass = 1.0; inertia = (0.01, 0.01, 0.01); }
+        TOG[bob] = Trotz(theta) * Tdisp(0, -1, 0);
+        gravity(0, -9.81, 0);
+        generalized_force(theta, sqrt(0.5 - t));
+    }
+}
+
+/// A model that returns NaN after t = 0.5: a stage past 0.5 s fails Newton with the cause, the
+/// step shrinks (or, fixed, the run stops at once), and the run stops near 0.5 s naming the
+/// coordinate, keeping a finite trajectory.
+#[test]
+fn a_model_that_returns_nan_stops_with_its_coordinate() {
+    for scheme in SCHEMES {
+        for opts in [Options::adaptive(2.0, 1e-6), Options::fixed(2.0, 0.01)] {
+            let e = simulate(Broken::default(), scheme, opts).unwrap_err();
+            match &e.kind {
+                Failure::NonFinite { coordinate, .. } => {
+                    assert_eq!(coordinate, "q[0] (theta)", "{}: {e}", scheme.name())
+                }
+                other => panic!("{}: {other}", scheme.name()),
+            }
+            assert!(
+                (0.45..=0.5).contains(&e.t),
+                "{}: stopped at t = {}",
+                scheme.name(),
+                e.t
+            );
+            let tr = &e.trajectory;
+            assert!(!tr.is_empty());
+            assert!(tr.q_data.iter().chain(&tr.qd_data).all(|x| x.is_finite()));
+        }
+    }
+}

@@ -1,0 +1,79 @@
+//! Work counters of one reference run per scheme (dpend, 0 → 2 s), snapshotted: a change that
+//! silently doubles the work fails here. Adaptive schemes run at rtol 1e-6 (atol 1e-8); fixed-
+//! step ones at h = 2 ms. dpend has no generated tangents, so implicit schemes build their
+//! iteration matrix by finite differences (3 evaluations of τ for 2 coordinates).
+
+#[path = "../examples/models/dpend.rs"]
+mod dpend;
+
+use mbs::{GenAlphaParams, HhtParams, NewmarkParams, Options, Output, Scheme, Stats, simulate};
+
+fn run(scheme: Scheme) -> Stats {
+    let opts = if scheme.is_adaptive() {
+        Options::adaptive(2.0, 1e-6)
+    } else {
+        Options::fixed(2.0, 2e-3)
+    };
+    let opts = Options {
+        output: Output::Last,
+        energy: false,
+        ..opts
+    };
+    simulate(dpend::DoublePendulum::default(), scheme, opts)
+        .unwrap()
+        .1
+}
+
+/// steps, rejected by the error test, by Newton, M+h, M, τ, factorisations, solves, Newton iterations
+fn counts(s: &Stats) -> [usize; 9] {
+    [
+        s.steps,
+        s.rejected_error,
+        s.rejected_newton,
+        s.dynamics,
+        s.mass_matrix,
+        s.inverse_dynamics,
+        s.factorizations,
+        s.solves,
+        s.newton_iterations,
+    ]
+}
+
+#[test]
+fn work_counters_of_reference_runs() {
+    let cases: [(Scheme, [usize; 9]); 7] = [
+        // 1000 steps, 1 evaluation each + the start + 2 every 16 steps for the stability check
+        (
+            Scheme::ExplicitEuler,
+            [1000, 0, 0, 1127, 0, 0, 1127, 1127, 0],
+        ),
+        (Scheme::Rk4, [1000, 0, 0, 4127, 0, 0, 4127, 4127, 0]),
+        // 93 attempts × 6 evaluations (first same as last) + the start + the initial-step probe
+        (Scheme::Dopri5, [80, 13, 0, 560, 0, 0, 560, 560, 0]),
+        // about 2.4 Newton iterations per step; a factorisation every 4–5 steps
+        (
+            Scheme::Newmark(NewmarkParams::default()),
+            [839, 22, 0, 2, 0, 2624, 194, 2050, 2048],
+        ),
+        (
+            Scheme::Hht(HhtParams::default()),
+            [917, 21, 0, 2, 0, 2824, 189, 2265, 2263],
+        ),
+        (
+            Scheme::GenAlpha(GenAlphaParams::default()),
+            [1001, 19, 0, 2, 0, 3034, 193, 2463, 2461],
+        ),
+        // fixed step, Newton to 1e-10 (5 iterations per step) and one M+h per step for qdd
+        (
+            Scheme::ImplicitMidpoint,
+            [1000, 0, 0, 1001, 0, 5122, 1035, 6021, 5020],
+        ),
+    ];
+    let got: Vec<[usize; 9]> = cases.iter().map(|(s, _)| counts(&run(*s))).collect();
+    for ((scheme, _), got) in cases.iter().zip(&got) {
+        println!("{:<10} {got:?}", scheme.name());
+    }
+    for ((scheme, expected), got) in cases.iter().zip(&got) {
+        assert_eq!(got, expected, "{}", scheme.name());
+    }
+}

@@ -11,7 +11,7 @@
 //! | Newmark, HHT-α, generalized-α | `newmark.rs` | 2 | fixed or adaptive |
 //! | implicit midpoint | `midpoint.rs` | 2 | fixed |
 //! | BDF 1–5 | `bdf.rs` | 1–5 | adaptive, variable order |
-//! | Radau IIA 3, 5 | `radau.rs` | 3, 5 | adaptive or fixed |
+//! | Radau IIA 3, 5 | `radau/` | 3, 5 | adaptive or fixed |
 
 mod bdf;
 mod dopri5;

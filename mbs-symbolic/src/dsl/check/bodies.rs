@@ -1,0 +1,488 @@
+//! Bodies, options and poses: mass and inertia, references to bodies, TOG products and
+//! their elementary transforms, axes.
+
+use super::*;
+
+impl Checker {
+    pub(super) fn lower_option(&mut self, key: &Ident, value: Option<&Expr>) {
+        match (key.to_string().as_str(), value) {
+            ("tangents", None) => self.sys.options.tangents = true,
+            ("formulation", Some(Expr::Path(p))) if p.path.get_ident().is_some() => {
+                let v = p.path.get_ident().unwrap();
+                self.sys.options.formulation = match v.to_string().as_str() {
+                    "recursive" => Some(Formulation::Recursive),
+                    "virtual_power" => Some(Formulation::VirtualPower),
+                    other => {
+                        self.error(v.span(), format!("unknown formulation `{other}`: write `option formulation = recursive;` or `option formulation = virtual_power;`"));
+                        None
+                    }
+                }
+            }
+            ("formulation", _) => self.error(key.span(), "write `option formulation = recursive;` or `option formulation = virtual_power;`"),
+            ("tangents", Some(v)) => self.error(v.span(), "write `option tangents;` (it takes no value)"),
+            (other, _) => self.error(key.span(), format!("unknown option `{other}`: the options are `tangents` and `formulation = recursive | virtual_power`")),
+        }
+    }
+
+    pub(super) fn lower_body(&mut self, name: &Ident, props: &[(Ident, Expr)]) {
+        let Some(&fi) = self.frame_names.get(&name.to_string()) else {
+            return;
+        };
+        let mut mass = None;
+        let mut tensor = None;
+        for (key, value) in props {
+            match key.to_string().as_str() {
+                "mass" => {
+                    let m = self.lower(value, Allow { what: "a mass", ..PARAMS_ONLY });
+                    if let Some(mv) = self.eval_default(m) {
+                        if mv <= 0.0 || !mv.is_finite() {
+                            let how = self.with_defaults(m);
+                            self.error_at(value, format!("the mass of body `{name}` must be positive, it is {mv}{how}: give it a positive mass, or declare a massless `frame {name};`"));
+                        }
+                    }
+                    mass = Some(m);
+                }
+                "inertia" => {
+                    let a = Allow { what: "an inertia", ..PARAMS_ONLY };
+                    let elems: Vec<&Expr> = match value {
+                        Expr::Tuple(t) => t.elems.iter().collect(),
+                        _ => Vec::new(),
+                    };
+                    if elems.len() != 3 && elems.len() != 6 {
+                        let found = if matches!(value, Expr::Tuple(_)) { format!("{} values", elems.len()) } else { format!("`{}`", text(value)) };
+                        self.error_at(value, format!("the inertia of body `{name}` is `(Ixx, Iyy, Izz)` or `(Ixx, Iyy, Izz, Ixy, Ixz, Iyz)`, about G in body axes; found {found}"));
+                        continue;
+                    }
+                    let mut t = [self.sys.arena.zero(); 6];
+                    for (i, e) in elems.iter().enumerate() {
+                        t[i] = self.lower(e, a);
+                    }
+                    let vals: Option<Vec<f64>> = t.iter().map(|&e| self.eval_default(e)).collect();
+                    if let Some(v) = vals {
+                        if let Some(msg) = crate::dsl::inertia::inertia_problem([v[0], v[1], v[2], v[3], v[4], v[5]]) {
+                            let how = self.with_defaults_all(&t);
+                            let fix = if msg.contains("triangle") {
+                                "; each principal moment must be at most the sum of the other two (a thin plate in the xy plane has Izz = Ixx + Iyy)"
+                            } else {
+                                ""
+                            };
+                            self.error_at(value, format!("the inertia of body `{name}` is impossible{how}: {msg}{fix}"));
+                        }
+                    }
+                    tensor = Some(t);
+                }
+                other => self.error(key.span(), format!("unknown property `{other}` of body `{name}`: a body has `mass = …;` and `inertia = (Ixx, Iyy, Izz[, Ixy, Ixz, Iyz]);`")),
+            }
+        }
+        match (mass, tensor) {
+            (Some(m), Some(t)) => self.sys.frames[fi].inertia = Some(Inertia { mass: m, tensor: t }),
+            (Some(m), None) => {
+                // a point mass
+                let z = self.sys.arena.zero();
+                self.sys.frames[fi].inertia = Some(Inertia { mass: m, tensor: [z; 6] });
+            }
+            (None, _) => self.error(name.span(), format!("body `{name}` has no mass: add `mass = …;` (or declare a massless `frame {name};`)")),
+        }
+    }
+
+    /// The value of a parameter expression with the default parameters; `None` when it
+    /// depends on a parameter whose default is in error (already reported).
+    pub(super) fn eval_default(&self, e: ExprId) -> Option<f64> {
+        let bad = self.sys.arena.vars_of(&[e]).into_iter().any(|v| {
+            matches!(v, Var::Param(i) if self.bad_params.get(i as usize).copied().unwrap_or(false))
+        });
+        if bad {
+            return None;
+        }
+        let env = SliceEnv {
+            params: &self.defaults,
+            ..SliceEnv::default()
+        };
+        Some(self.sys.arena.eval(&[e], &env)[0])
+    }
+
+    /// " with the default parameters" when `e` depends on parameters.
+    pub(super) fn with_defaults(&self, e: ExprId) -> &'static str {
+        self.with_defaults_all(&[e])
+    }
+
+    pub(super) fn with_defaults_all(&self, e: &[ExprId]) -> &'static str {
+        if e.iter().all(|&x| self.sys.arena.is_const(x)) {
+            ""
+        } else {
+            " with the default parameters"
+        }
+    }
+
+    /// A body/frame reference: `Some(None)` is the ground, `None` an error already reported.
+    pub(super) fn body_ref(&mut self, r: &BodyRef) -> Option<Option<usize>> {
+        match r {
+            BodyRef::Name(id) if id == "ground" => Some(None),
+            BodyRef::Name(id) => match self.frame_names.get(&id.to_string()) {
+                Some(&i) => Some(Some(i)),
+                None if self.points.contains_key(&id.to_string()) => {
+                    self.error(
+                        id.span(),
+                        format!("`{id}` is a point, not a body or frame: name the body it is on, or the ground"),
+                    );
+                    None
+                }
+                None => {
+                    let names: Vec<String> = self.frame_names.keys().cloned().collect();
+                    self.error(
+                        id.span(),
+                        format!(
+                            "unknown body `{id}`{}",
+                            did_you_mean(
+                                &id.to_string(),
+                                names.iter().map(String::as_str),
+                                &format!("declare it with `body {id} {{ … }}` or `frame {id};`")
+                            )
+                        ),
+                    );
+                    None
+                }
+            },
+            BodyRef::Index(i, s) => {
+                if *i < self.sys.frames.len() {
+                    Some(Some(*i))
+                } else {
+                    let n = self.sys.frames.len();
+                    let listed: Vec<String> = self
+                        .sys
+                        .frames
+                        .iter()
+                        .enumerate()
+                        .take(8)
+                        .map(|(k, f)| format!("{k} is `{}`", f.name))
+                        .collect();
+                    let more = if n > 8 { ", …" } else { "" };
+                    let numbering = if n == 0 {
+                        "the model declares no body or frame".to_string()
+                    } else {
+                        format!(
+                            "bodies and frames are numbered from 0 in declaration order ({}{more})",
+                            listed.join(", ")
+                        )
+                    };
+                    self.error(
+                        *s,
+                        format!(
+                            "TOG[{i}] is out of range: {numbering}; or write the name, TOG[name]"
+                        ),
+                    );
+                    None
+                }
+            }
+        }
+    }
+
+    pub(super) fn ident_body_ref(&mut self, e: &Expr) -> Option<Option<usize>> {
+        match e {
+            Expr::Path(p) if p.path.get_ident().is_some() => {
+                self.body_ref(&BodyRef::Name(p.path.get_ident().unwrap().clone()))
+            }
+            _ => {
+                self.error_at(
+                    e,
+                    format!(
+                        "expected the name of a body, a frame or `ground`, found `{}`",
+                        text(e)
+                    ),
+                );
+                None
+            }
+        }
+    }
+
+    pub(super) fn lower_tog(&mut self, target: &BodyRef, chain: &Expr, span: Span) {
+        let Some(t) = self.body_ref(target) else {
+            self.tog_target_error = true;
+            return;
+        };
+        let Some(fi) = t else {
+            if !self.ground_declared {
+                self.error(
+                    target.span(),
+                    "the ground is fixed: TOG[ground] cannot be assigned; for a fixed frame elsewhere, declare `frame base;` and `TOG[base] = Tdisp(x, y, z);`",
+                );
+            }
+            return;
+        };
+        if self.tog_defined[fi] {
+            self.error(
+                span,
+                format!(
+                    "TOG[{}] is defined twice: each body and frame has one pose; remove one of the two",
+                    self.sys.frames[fi].name
+                ),
+            );
+            return;
+        }
+        let mut leaves = Vec::new();
+        if !self.flatten_product(chain, &mut leaves) {
+            // counts as defined: its children and the final checks should not fail in cascade
+            self.tog_defined[fi] = true;
+            return;
+        }
+        let what: &'static str = "a transform (TOG)";
+        let mut parent = None;
+        let mut factors = Vec::new();
+        for (k, leaf) in leaves.iter().enumerate() {
+            if let Expr::Index(ix) = leaf {
+                if matches!(&*ix.expr, Expr::Path(p) if p.path.is_ident("TOG")) {
+                    if k != 0 {
+                        self.error_at(
+                            leaf,
+                            format!(
+                                "`{}` may only start a product: write `{} * Tdisp(…) * …`",
+                                text(leaf),
+                                text(leaf)
+                            ),
+                        );
+                        continue;
+                    }
+                    let r = match &*ix.index {
+                        Expr::Path(p) if p.path.get_ident().is_some() => {
+                            BodyRef::Name(p.path.get_ident().unwrap().clone())
+                        }
+                        Expr::Lit(syn::ExprLit {
+                            lit: syn::Lit::Int(l),
+                            ..
+                        }) => match l.base10_parse() {
+                            Ok(v) => BodyRef::Index(v, l.span()),
+                            Err(e) => {
+                                self.errors.push(e);
+                                continue;
+                            }
+                        },
+                        other => {
+                            self.error_at(other, "expected a body name or number in TOG[…]");
+                            continue;
+                        }
+                    };
+                    match self.body_ref(&r) {
+                        Some(Some(p)) if p == fi => self.error(r.span(), format!("TOG[{}] cannot refer to itself: start from its parent's pose, `TOG[parent] * …`, or from the ground", self.sys.frames[fi].name)),
+                        Some(Some(p)) if !self.tog_defined[p] => self.error(r.span(), format!("TOG[{}] is used before it is defined: move `TOG[{}] = …;` above this line (a pose may refer only to poses defined earlier)", self.sys.frames[p].name, self.sys.frames[p].name)),
+                        Some(p) => parent = p,
+                        None => {}
+                    }
+                    continue;
+                }
+            }
+            if let Some(f) = self.lower_factor(leaf, what) {
+                factors.extend(f);
+            }
+        }
+        let frame = &mut self.sys.frames[fi];
+        frame.parent = parent;
+        frame.factors = factors;
+        self.tog_defined[fi] = true;
+    }
+
+    /// Splits `a * b * c` into its factors; anything but products is an error.
+    pub(super) fn flatten_product<'e>(&mut self, e: &'e Expr, out: &mut Vec<&'e Expr>) -> bool {
+        match e {
+            Expr::Binary(b) if matches!(b.op, syn::BinOp::Mul(_)) => {
+                self.flatten_product(&b.left, out) && self.flatten_product(&b.right, out)
+            }
+            Expr::Binary(b) => {
+                self.error(b.op.span(), format!("transforms combine by products only, not `{}`: write `TOG[parent] * Trotz(q[0]) * Tdisp(x, y, z)`", text(&b.op)));
+                false
+            }
+            Expr::Paren(p) => self.flatten_product(&p.expr, out),
+            Expr::Group(g) => self.flatten_product(&g.expr, out),
+            _ => {
+                out.push(e);
+                true
+            }
+        }
+    }
+
+    /// One transform factor; `None` after an error, an empty list for an identity.
+    pub(super) fn lower_factor(&mut self, e: &Expr, what: &'static str) -> Option<Vec<Factor>> {
+        const TRANSFORMS: &str =
+            "Tdisp(x, y, z), Trotx(a), Troty(a), Trotz(a) and Trotn(nx, ny, nz, a)";
+        let not_a_transform = |c: &mut Checker, found: &str| {
+            c.error_at(
+                e,
+                format!("expected a transform, found {found}: a pose (TOG) is a product of {TRANSFORMS}, possibly starting with TOG[parent]"),
+            );
+        };
+        let name = match e {
+            Expr::Call(call) => match &*call.func {
+                Expr::Path(p) => p.path.get_ident(),
+                _ => None,
+            },
+            _ => None,
+        };
+        let (Expr::Call(call), Some(name)) = (e, name) else {
+            let found = match e {
+                Expr::Lit(_) => format!("the number `{}`", text(e)),
+                Expr::Path(_) => format!("`{}`", text(e)),
+                _ => format!("the expression `{}`", text(e)),
+            };
+            not_a_transform(self, &found);
+            return None;
+        };
+        let args: Vec<&Expr> = call.args.iter().collect();
+        let a = Allow { what, ..POSITION };
+        let arity =
+            |c: &mut Checker, n: usize, usage: &str| c.arity_ok(call, name, args.len(), n, usage);
+        let z = self.sys.arena.zero();
+        let o = self.sys.arena.one();
+        let rot = |c: &mut Checker, axis: [ExprId; 3]| -> Option<Vec<Factor>> {
+            let angle = c.lower(args[args.len() - 1], a);
+            if c.sys.arena.is_num(angle, 0.0) {
+                return Some(Vec::new());
+            }
+            Some(vec![Factor::Rot { axis, angle }])
+        };
+        match name.to_string().as_str() {
+            "Tdisp" => {
+                if !arity(self, 3, "Tdisp(x, y, z)") {
+                    return None;
+                }
+                let d = [
+                    self.lower(args[0], a),
+                    self.lower(args[1], a),
+                    self.lower(args[2], a),
+                ];
+                if d.iter().all(|&x| self.sys.arena.is_num(x, 0.0)) {
+                    return Some(Vec::new());
+                }
+                Some(vec![Factor::Disp(d)])
+            }
+            "Trotx" => arity(self, 1, "Trotx(angle)")
+                .then(|| rot(self, [o, z, z]))
+                .flatten(),
+            "Troty" => arity(self, 1, "Troty(angle)")
+                .then(|| rot(self, [z, o, z]))
+                .flatten(),
+            "Trotz" => arity(self, 1, "Trotz(angle)")
+                .then(|| rot(self, [z, z, o]))
+                .flatten(),
+            "Trotn" => {
+                if !arity(self, 4, "Trotn(nx, ny, nz, angle)") {
+                    return None;
+                }
+                let pa = Allow {
+                    what: "the axis of Trotn",
+                    ..PARAMS_ONLY
+                };
+                let n = [
+                    self.lower(args[0], pa),
+                    self.lower(args[1], pa),
+                    self.lower(args[2], pa),
+                ];
+                let axis_tokens = range(args[0], args[2]);
+                if !self.unit_axis(&n, &axis_tokens, "Trotn", "Trotn(nx, ny, nz, angle)") {
+                    return None;
+                }
+                rot(self, n)
+            }
+            other => {
+                let known = ["Tdisp", "Trotx", "Troty", "Trotz", "Trotn"];
+                self.error(
+                    name.span(),
+                    format!(
+                        "unknown transform `{other}`{}",
+                        did_you_mean(
+                            other,
+                            known.into_iter(),
+                            &format!("the transforms are {TRANSFORMS}")
+                        )
+                    ),
+                );
+                None
+            }
+        }
+    }
+
+    /// Checks that an axis (parameters only) is a unit vector with the default parameters;
+    /// `usage` shows where it goes, with `nx, ny, nz` in it.
+    /// `axis = x | y | z | (nx, ny, nz)` of an effect: a unit vector (`axes` says in which axes).
+    pub(super) fn axis_arg(
+        &mut self,
+        axis: &Expr,
+        of: &'static str,
+        usage: &str,
+        axes: &str,
+    ) -> Option<[ExprId; 3]> {
+        let z = self.sys.arena.zero();
+        let o = self.sys.arena.one();
+        match axis {
+            Expr::Path(p) if p.path.is_ident("x") => Some([o, z, z]),
+            Expr::Path(p) if p.path.is_ident("y") => Some([z, o, z]),
+            Expr::Path(p) if p.path.is_ident("z") => Some([z, z, o]),
+            Expr::Tuple(_) => {
+                let what = Allow {
+                    what: "an axis",
+                    ..PARAMS_ONLY
+                };
+                self.triple(axis, what, "an axis").filter(|n| {
+                    self.unit_axis(n, &axis.to_token_stream(), &format!("the {of}"), usage)
+                })
+            }
+            _ => {
+                self.error_at(axis, format!("unknown {of} axis `{}`: write `axis = x`, `y`, `z` or a unit vector `(nx, ny, nz)`, {axes}", text(axis)));
+                None
+            }
+        }
+    }
+
+    pub(super) fn unit_axis(
+        &mut self,
+        n: &[ExprId; 3],
+        at: &TokenStream,
+        of: &str,
+        usage: &str,
+    ) -> bool {
+        let (Some(x), Some(y), Some(z)) = (
+            self.eval_default(n[0]),
+            self.eval_default(n[1]),
+            self.eval_default(n[2]),
+        ) else {
+            return true;
+        };
+        let how = self.with_defaults_all(n);
+        let n2 = x * x + y * y + z * z;
+        if n2 == 0.0 {
+            self.error_at(
+                at,
+                format!(
+                    "the axis of {of} is zero{how}: give a unit vector, e.g. `{}`",
+                    usage.replace("nx, ny, nz", "0, 0, 1")
+                ),
+            );
+            return false;
+        }
+        if (n2.sqrt() - 1.0).abs() > 1e-9 {
+            let norm = n2.sqrt();
+            let integers = [x, y, z].iter().all(|v| v.fract() == 0.0);
+            let example = if integers && how.is_empty() {
+                let c = |v: f64| {
+                    if v == 0.0 {
+                        "0".to_string()
+                    } else if norm.fract() == 0.0 {
+                        format!("{}", v / norm)
+                    } else {
+                        format!("{v} / sqrt({n2})")
+                    }
+                };
+                format!(
+                    ": `{}`",
+                    usage.replace("nx, ny, nz", &format!("{}, {}, {}", c(x), c(y), c(z)))
+                )
+            } else {
+                String::new()
+            };
+            self.error_at(
+                at,
+                format!("the axis of {of} must be a unit vector, but ({x}, {y}, {z}) has norm {norm}{how}: divide it by its norm{example}"),
+            );
+            return false;
+        }
+        true
+    }
+}

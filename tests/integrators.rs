@@ -104,3 +104,73 @@ fn adaptive_orders_on_seed2dof() {
         );
     }
 }
+
+mbs::multibody! {
+    /// dpend with generated tangents, for the iteration-matrix variants.
+    pub model DoublePendulumTangents {
+        param l = 1.0; param m = 1.0; param g = 9.81;
+        dof q[0] = PI / 2; dof q[1] = 0.0;
+        body bar1 { mass = m; inertia = (m*l*l/12, 0, m*l*l/12); }
+        body bar2 { mass = m; inertia = (m*l*l/12, 0, m*l*l/12); }
+        TOG[bar1] = Trotz(q[0]) * Tdisp(0, -l/2, 0);
+        TOG[bar2] = TOG[bar1] * Tdisp(0, -l/2, 0) * Trotz(q[1]) * Tdisp(0, -l/2, 0);
+        gravity(0, -9.81 * g / 9.81, 0);
+        option tangents;
+    }
+}
+
+/// Newton to 1e-12: M alone converges linearly, and at the default 1e-10 its solutions stop
+/// ~1e-9 from the exact-matrix ones per step (2e-6 after 1000 steps of dpend).
+const NEWTON_TOL: f64 = 1e-12;
+
+#[test]
+fn iteration_matrices_exact_finite_differences_and_mass_only() {
+    use mbs::IterationMatrix;
+    let run = |im: IterationMatrix| {
+        // fixed steps: the same step sequence, so results differ only by Newton's tolerance
+        let newton = mbs::NewtonOptions {
+            atol: NEWTON_TOL,
+            rtol: NEWTON_TOL,
+            ..Default::default()
+        };
+        let opts = Options {
+            iteration_matrix: im,
+            newton,
+            output: Output::Last,
+            energy: false,
+            ..Options::fixed(2.0, 2e-3)
+        };
+        simulate(
+            DoublePendulumTangents::default(),
+            Scheme::Newmark(NewmarkParams::default()),
+            opts,
+        )
+        .unwrap()
+    };
+    let (exact, se) = run(IterationMatrix::Exact);
+    let (fd, sf) = run(IterationMatrix::FiniteDifferences);
+    let (mass, sm) = run(IterationMatrix::MassOnly);
+    let (auto, sa) = run(IterationMatrix::Auto);
+    // Auto uses the generated tangents; finite differences spend τ evaluations instead
+    assert!(se.tangents > 0 && sf.tangents == 0 && sm.tangents == 0);
+    assert_eq!(sa, se);
+    assert!(sf.inverse_dynamics > se.inverse_dynamics);
+    // all converge to the same motion
+    for tr in [&fd, &mass, &auto] {
+        let d = tr
+            .q(0)
+            .iter()
+            .zip(exact.q(0))
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(d < 1e-8, "{d:e}");
+    }
+    // M alone is an approximation: more Newton iterations per step
+    let per_step = |s: &mbs::Stats| s.newton_iterations as f64 / s.steps as f64;
+    assert!(
+        per_step(&sm) > per_step(&se),
+        "{} vs {}",
+        per_step(&sm),
+        per_step(&se)
+    );
+}

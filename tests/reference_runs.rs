@@ -47,9 +47,16 @@ fn check<M: mbs::Model + Default + 'static>(model: &str, scheme: Scheme, t: f64,
 }
 
 #[test]
-fn dopri5_on_dpend_at_10_s_and_arm3d_6_at_2_s() {
+fn high_order_schemes_on_dpend_at_10_s_and_arm3d_6_at_2_s() {
     check::<dpend::DoublePendulum>("dpend", Scheme::Dopri5, 10.0, 1e-12);
-    check::<arm3d_6::Arm3d6>("arm3d_6", Scheme::Dopri5, 2.0, 1e-10);
+    for scheme in [
+        Scheme::Dopri5,
+        Scheme::Bdf(mbs::BdfParams::default()),
+        Scheme::Radau3,
+        Scheme::Radau5,
+    ] {
+        check::<arm3d_6::Arm3d6>("arm3d_6", scheme, 2.0, 1e-10);
+    }
 }
 
 /// Error at t against the reference, for rtol.

@@ -1,5 +1,5 @@
 //! No allocation per step after warm-up: a counting global allocator watches every scheme
-//! take 200 steps after its first 20.
+//! take 200 steps after its first 20, with fixed steps and, where it has them, adaptive ones.
 
 #[path = "../examples/models/dpend.rs"]
 mod dpend;
@@ -33,32 +33,33 @@ static GLOBAL: Counting = Counting;
 fn steps_allocate_nothing_after_warm_up() {
     for scheme in Scheme::all() {
         // outputs every 10 ms: their buffers are reserved up front
-        let base = if scheme.is_adaptive() {
-            Options::adaptive(100.0, 1e-7)
-        } else {
-            Options::fixed(100.0, 1e-3)
-        };
-        let opts = Options {
-            output: Output::Every { dt: 0.01 },
-            ..base
-        };
-        let mut sim = match Simulation::new(dpend::DoublePendulum::default(), scheme, opts) {
-            Ok(s) => s,
-            Err(e) => panic!("{}: {e}", scheme.name()),
-        };
-        for _ in 0..20 {
-            sim.step().unwrap();
+        let mut modes = vec![Options::fixed(100.0, 1e-3)];
+        if scheme.is_adaptive() {
+            modes.push(Options::adaptive(100.0, 1e-7));
         }
-        let before = ALLOCATIONS.load(Ordering::Relaxed);
-        for _ in 0..200 {
-            sim.step().unwrap();
+        for base in modes {
+            let opts = Options {
+                output: Output::Every { dt: 0.01 },
+                ..base
+            };
+            let mut sim = match Simulation::new(dpend::DoublePendulum::default(), scheme, opts) {
+                Ok(s) => s,
+                Err(e) => panic!("{}: {e}", scheme.name()),
+            };
+            for _ in 0..20 {
+                sim.step().unwrap();
+            }
+            let before = ALLOCATIONS.load(Ordering::Relaxed);
+            for _ in 0..200 {
+                sim.step().unwrap();
+            }
+            let allocated = ALLOCATIONS.load(Ordering::Relaxed) - before;
+            assert_eq!(
+                allocated,
+                0,
+                "{} allocated {allocated} times in 200 steps",
+                scheme.name()
+            );
         }
-        let allocated = ALLOCATIONS.load(Ordering::Relaxed) - before;
-        assert_eq!(
-            allocated,
-            0,
-            "{} allocated {allocated} times in 200 steps",
-            scheme.name()
-        );
     }
 }

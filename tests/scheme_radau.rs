@@ -1,7 +1,8 @@
-//! Radau IIA 3 and 5 (`mbs-runtime/src/integrators/radau.rs`) on the canonical models:
+//! Radau IIA 3 and 5 (`mbs-runtime/src/integrators/radau/`) on the canonical models:
 //! observed orders on seed2dof (fixed step and adaptive), accuracy against the reference runs
-//! of dpend and arm3d_6, work counters of one reference run per scheme, and no allocation per
-//! step.
+//! of dpend and arm3d_6, work counters of one reference run per scheme, and the iteration
+//! matrices (failures and allocations are checked with every scheme in `failures.rs` and
+//! `no_alloc.rs`).
 
 #[path = "../examples/models/arm3d_6.rs"]
 mod arm3d_6;
@@ -12,39 +13,7 @@ mod dpend;
 mod seed2dof;
 
 use common::*;
-use mbs::{
-    Failure, Integrator, IterationMatrix, Options, Output, Scheme, Simulation, Stats, simulate,
-};
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
-
-/// Counts the allocations of the current thread (tests run in parallel threads).
-struct Counting;
-
-thread_local! {
-    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
-}
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.with(|c| c.set(c.get() + 1));
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.with(|c| c.set(c.get() + 1));
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
-
-fn allocations() -> usize {
-    ALLOCATIONS.with(|c| c.get())
-}
+use mbs::{IterationMatrix, Options, Output, Scheme, Stats, simulate};
 
 mbs::multibody! {
     /// dpend (`examples/models/dpend.rs`) with generated tangents, for exact iteration matrices.
@@ -246,29 +215,6 @@ fn work_counters_snapshot() {
     }
 }
 
-#[test]
-fn no_allocation_per_step() {
-    for scheme in SCHEMES {
-        for opts in [Options::adaptive(10.0, 1e-8), Options::fixed(10.0, 1e-3)] {
-            let opts = Options {
-                output: Output::Last,
-                energy: false,
-                ..opts
-            };
-            let mut sim = Simulation::new(dpend::DoublePendulum::default(), scheme, opts).unwrap();
-            for _ in 0..20 {
-                sim.step().unwrap();
-            }
-            let before = allocations();
-            for _ in 0..200 {
-                sim.step().unwrap();
-            }
-            let n = allocations() - before;
-            assert_eq!(n, 0, "{}: {n} allocations in 200 steps", scheme.name());
-        }
-    }
-}
-
 /// Every way of building the iteration matrices gives the same motion (to the tolerance); the
 /// work differs: exact tangents (1 M and 1 tangent evaluation per Jacobian), finite
 /// differences (1 M and 2n + 1 = 5 τ), mass only (1 M, slower Newton).
@@ -304,44 +250,6 @@ fn iteration_matrices() {
                 assert!(e < 1e-5, "{} {im:?}: error {e:e}", scheme.name());
                 assert_eq!(st.tangents > 0, im == IterationMatrix::Exact);
             }
-        }
-    }
-}
-
-mbs::multibody! {
-    /// A pendulum pushed by a force that is not defined after t = 0.5 (sqrt of a negative).
-    pub model Broken {
-        dof theta = 0.3;
-        body bob { mass = 1.0; inertia = (0.01, 0.01, 0.01); }
-        TOG[bob] = Trotz(theta) * Tdisp(0, -1, 0);
-        gravity(0, -9.81, 0);
-        generalized_force(theta, sqrt(0.5 - t));
-    }
-}
-
-/// A model that returns NaN after t = 0.5: a stage past 0.5 s fails Newton with the cause, the
-/// step shrinks (or, fixed, the run stops at once), and the run stops near 0.5 s naming the
-/// coordinate, keeping a finite trajectory.
-#[test]
-fn a_model_that_returns_nan_stops_with_its_coordinate() {
-    for scheme in SCHEMES {
-        for opts in [Options::adaptive(2.0, 1e-6), Options::fixed(2.0, 0.01)] {
-            let e = simulate(Broken::default(), scheme, opts).unwrap_err();
-            match &e.kind {
-                Failure::NonFinite { coordinate, .. } => {
-                    assert_eq!(coordinate, "q[0] (theta)", "{}: {e}", scheme.name())
-                }
-                other => panic!("{}: {other}", scheme.name()),
-            }
-            assert!(
-                (0.45..=0.5).contains(&e.t),
-                "{}: stopped at t = {}",
-                scheme.name(),
-                e.t
-            );
-            let tr = &e.trajectory;
-            assert!(!tr.is_empty());
-            assert!(tr.q_data.iter().chain(&tr.qd_data).all(|x| x.is_finite()));
         }
     }
 }

@@ -228,12 +228,7 @@ impl<M: Model> Stepper<M> for Bdf {
         let iterations = match r {
             Ok(it) => it,
             Err(f) => {
-                return Ok(Attempt::RejectedNewton {
-                    h_next: 0.25 * h,
-                    iterations: f.iterations,
-                    correction: f.correction,
-                    cause: f.cause,
-                });
+                return Ok(f.reject(h));
             }
         };
         for i in 0..n {

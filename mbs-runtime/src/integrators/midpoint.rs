@@ -63,12 +63,7 @@ impl<M: Model> Stepper<M> for Midpoint {
             &ctl.newton,
         );
         if let Err(f) = r {
-            return Ok(Attempt::RejectedNewton {
-                h_next: 0.25 * h,
-                iterations: f.iterations,
-                correction: f.correction,
-                cause: f.cause,
-            });
+            return Ok(f.reject(h));
         }
         for i in 0..self.n {
             next.q[i] = cur.q[i] + h * cur.qd[i] + 0.5 * h * h * self.a[i];

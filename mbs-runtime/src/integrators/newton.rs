@@ -31,6 +31,18 @@ pub(crate) struct NewtonFail {
     pub cause: Option<Failure>,
 }
 
+impl NewtonFail {
+    /// The attempt rejected, with a step a quarter of `h` to try next.
+    pub fn reject(self, h: f64) -> super::Attempt {
+        super::Attempt::RejectedNewton {
+            h_next: 0.25 * h,
+            iterations: self.iterations,
+            correction: self.correction,
+            cause: self.cause,
+        }
+    }
+}
+
 pub(crate) struct AccelNewton {
     pub lu: Lu<f64>,
     n: usize,

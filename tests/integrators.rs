@@ -174,3 +174,49 @@ fn iteration_matrices_exact_finite_differences_and_mass_only() {
         per_step(&se)
     );
 }
+
+#[test]
+fn outputs_at_chosen_times_observers_and_frames() {
+    use std::sync::{Arc, Mutex};
+    let times: Vec<f64> = (0..40).map(|k| 0.0123 + 0.0247 * k as f64).collect();
+    for scheme in [
+        Scheme::Dopri5,
+        Scheme::Radau5,
+        Scheme::Bdf(mbs::BdfParams::default()),
+        Scheme::GenAlpha(GenAlphaParams::default()),
+    ] {
+        let opts = Options {
+            output: Output::Times(times.clone()),
+            frames: true,
+            ..Options::adaptive(1.0, 1e-9)
+        };
+        let mut sim = mbs::Simulation::new(Seed2dof::default(), scheme, opts).unwrap();
+        let seen = Arc::new(Mutex::new(Vec::new()));
+        let sink = seen.clone();
+        sim.observe(move |t: f64, q: &[f64], _: &[f64], _: &[f64]| {
+            sink.lock().unwrap().push((t, q[1]))
+        });
+        mbs::Integrator::integrate_to(&mut sim, 1.0).unwrap();
+        let (tr, _) = sim.finish();
+        // exactly the chosen times, interpolated between steps as accurately as the steps
+        assert_eq!(tr.t, times);
+        let err = seed2dof_max_error(&tr);
+        assert!(
+            err < if scheme.order() >= 5 { 1e-6 } else { 1e-4 },
+            "{}: {err:e}",
+            scheme.name()
+        );
+        // observers see every output as it is recorded
+        let seen = seen.lock().unwrap();
+        assert_eq!(seen.len(), tr.len());
+        assert!(
+            seen.iter()
+                .enumerate()
+                .all(|(i, &(t, q1))| t == tr.t[i] && q1 == tr.q(i)[1])
+        );
+        // poses of both masses on request: mass 2 sits at x = 2 + q1
+        assert_eq!(tr.poses.len(), 2 * tr.len());
+        let p = tr.poses_at(7)[1].position[0];
+        assert!((p - 2.0 - tr.q(7)[1]).abs() < 1e-12);
+    }
+}

@@ -99,6 +99,10 @@ fn user_functions_and_inputs_reach_the_generated_code() {
     // the motor torque acts on the knee only (its reaction on the thigh cancels on the hip)
     assert!((h1[1] - h0[1] - 2.0).abs() < 1e-12, "{h0:?} {h1:?}");
     assert!((h1[0] - h0[0]).abs() < 1e-12, "{h0:?} {h1:?}");
+    // the input matrix ∂h/∂u says the same: the knee only
+    let mut b = [f64::NAN; 2];
+    model.input_matrix(0.0, &q, &qd, &[2.0], &mut b);
+    assert_eq!(b, [0.0, 1.0]);
     let mut tau = [0.0; 2];
     model.inverse_dynamics(0.0, &q, &qd, &qdd, &[2.0], &mut tau);
     assert!((tau[0] + h1[0]).abs() < 1e-12 && (tau[1] + h1[1]).abs() < 1e-12);

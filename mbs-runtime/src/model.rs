@@ -268,6 +268,9 @@ pub trait Model {
     /// h(q, 0, t, u): forces at rest, for statics (NQ).
     fn static_forces(&self, t: f64, q: &[f64], u: &[f64], h: &mut [f64]);
 
+    /// ∂h/∂u (NQ × NU, column-major): how the inputs enter the equations (linearisation).
+    fn input_matrix(&self, t: f64, q: &[f64], qd: &[f64], u: &[f64], b: &mut [f64]);
+
     fn energy(&self, t: f64, q: &[f64], qd: &[f64]) -> Energy;
 
     /// Power of the non-conservative effects (dampers, forces, torques, generalised forces).

@@ -257,6 +257,7 @@ fn dynamics(&self, _: f64, _: &[f64], _: &[f64], _: &[f64], _: &mut [f64], _: &m
 fn inverse_dynamics(&self, _: f64, _: &[f64], _: &[f64], _: &[f64], _: &[f64], _: &mut [f64]) {{ {never} }}
 fn tangents(&self, _: f64, _: &[f64], _: &[f64], _: &[f64], _: &[f64], _: &mut [f64], _: &mut [f64]) -> ::core::result::Result<(), ::mbs::ModelError> {{ {never} }}
 fn static_forces(&self, _: f64, _: &[f64], _: &[f64], _: &mut [f64]) {{ {never} }}
+fn input_matrix(&self, _: f64, _: &[f64], _: &[f64], _: &[f64], _: &mut [f64]) {{ {never} }}
 fn energy(&self, _: f64, _: &[f64], _: &[f64]) -> ::mbs::Energy {{ {never} }}
 fn power(&self, _: f64, _: &[f64], _: &[f64], _: &[f64]) -> f64 {{ {never} }}
 fn frames(&self, _: f64, _: &[f64], _: &mut [::mbs::Pose]) {{ {never} }}

@@ -319,6 +319,12 @@ fn emit_scene(
     );
     f.vector("h", &eq.static_h);
     specs.push((f, Some("static_forces")));
+    let mut f = FnSpec::new(
+        "__input_matrix",
+        "t: f64, q: &[f64], qd: &[f64], u: &[f64], b: &mut [f64]",
+    );
+    f.matrix(a, "b", &eq.input_matrix);
+    specs.push((f, Some("input_matrix")));
     let mut f = FnSpec::new("__energy", "t: f64, q: &[f64], qd: &[f64], e: &mut [f64]");
     f.vector("e", &[eq.kinetic, eq.potential]);
     specs.push((f, Some("energy")));
@@ -584,6 +590,7 @@ fn tangents(&self, t: f64, q: &[f64], qd: &[f64], qdd: &[f64], u: &[f64], k: &mu
 {tangents_body}
 }}
 fn static_forces(&self, t: f64, q: &[f64], u: &[f64], h: &mut [f64]) {{ self.__static_forces(t, q, u, h) }}
+fn input_matrix(&self, t: f64, q: &[f64], qd: &[f64], u: &[f64], b: &mut [f64]) {{ self.__input_matrix(t, q, qd, u, b) }}
 fn energy(&self, t: f64, q: &[f64], qd: &[f64]) -> ::mbs::Energy {{
 let mut e = [0.0f64; 2];
 self.__energy(t, q, qd, &mut e);

@@ -55,6 +55,8 @@ pub struct SceneEquations {
     pub tau_formulation: Formulation,
     /// h with qd = 0
     pub static_h: Vec<ExprId>,
+    /// ∂h/∂u (dense, row-major, NQ × NU): how inputs enter the equations
+    pub input_matrix: Matrix,
     /// K_t = ∂τ/∂q and C_t = ∂τ/∂qd (dense, row-major), when the model asks for them
     pub tangents: Option<(Matrix, Matrix)>,
     pub kinetic: ExprId,
@@ -128,6 +130,11 @@ impl SceneEquations {
             zero_qd.insert(Var::Qd(k as u16), a.zero());
         }
         let static_h = a.substitute(&chosen_h, &zero_qd);
+        let nu = sys.inputs.len();
+        let input_matrix: Matrix = chosen_h
+            .iter()
+            .map(|&e| (0..nu).map(|k| a.diff(e, Var::Input(k as u16))).collect())
+            .collect();
         let tau: Vec<ExprId> = match tau_formulation {
             Formulation::VirtualPower => tau_vp.clone(),
             Formulation::Recursive => tau_rec.clone(),
@@ -155,6 +162,7 @@ impl SceneEquations {
             tau_vp,
             tau_formulation,
             static_h,
+            input_matrix,
             tangents,
             kinetic,
             potential,

@@ -5,11 +5,13 @@
 //! [`Scheme`] and [`Options`] (how to integrate it), [`simulate`] and [`Simulation`] (the
 //! [`Integrator`]), [`Trajectory`] (outputs, CSV, JSON), [`Stats`] (the work done),
 //! [`SimError`] and [`Failure`] (why a run stopped, with what it computed until then);
-//! [`Parameters`], [`ModelInfo`], [`Energy`], [`Pose`], [`Kinematics`] describe models.
+//! [`Parameters`], [`ModelInfo`], [`Energy`], [`Pose`], [`Kinematics`] describe models;
+//! [`analysis`] finds equilibria, linearises, computes poles and modes and inverse dynamics.
 
 // Matrix code reads best with explicit indices; `!(x > 0.0)` is meant to reject NaN too.
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod analysis;
 pub mod error;
 pub mod inertia;
 pub mod integrators;
@@ -19,6 +21,10 @@ pub mod options;
 pub mod stats;
 pub mod trajectory;
 
+pub use analysis::{
+    AnalysisError, Equilibrium, Linearization, Modes, Stability, StaticsOptions, linearize, modes,
+    static_equilibrium,
+};
 pub use error::{Failure, ModelError, ParamError, SimError, check_inertia};
 pub use integrators::{Integrator, Simulation, State, simulate};
 pub use model::{

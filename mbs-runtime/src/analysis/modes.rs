@@ -1,0 +1,199 @@
+//! Poles and modes of a linearisation (EasyDyn's ComputePoles): the eigenvalues λ of A,
+//! one mode per complex pair (Im λ > 0) or real eigenvalue, with natural frequency |λ|/2π,
+//! damping ratio −Re λ/|λ|, the mode shape (the q part of the eigenvector, scaled so that its
+//! largest component is 1) named by coordinate, and the modal mass φᴴMφ of that shape.
+//! Eigenvalues come from nalgebra's Schur decomposition, eigenvectors from inverse iteration.
+
+use super::AnalysisError;
+use super::linearize::Linearization;
+use crate::error::Failure;
+use crate::linalg::{C64, Field, Lu};
+use serde::Serialize;
+use std::fmt;
+use std::io::{self, Write};
+
+/// One mode.
+#[derive(Clone, Debug, Serialize)]
+#[non_exhaustive]
+pub struct Mode {
+    /// the eigenvalue λ (1/s)
+    pub re: f64,
+    pub im: f64,
+    /// |λ|/2π (Hz)
+    pub frequency_hz: f64,
+    /// −Re λ/|λ| (0 for undamped, negative for unstable oscillations, ±1 for real λ)
+    pub damping_ratio: f64,
+    /// φᴴ M φ for the shape below
+    pub modal_mass: f64,
+    /// shape: per coordinate, (real, imaginary) parts, largest magnitude 1
+    pub shape: Vec<(f64, f64)>,
+}
+
+/// The modes of a linearised model, sorted by frequency.
+#[derive(Clone, Debug, Serialize)]
+pub struct Modes {
+    pub dof_names: Vec<String>,
+    pub modes: Vec<Mode>,
+}
+
+/// Computes the modes of `lin` whose frequency is within `window` (Hz, inclusive), or all.
+pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, AnalysisError> {
+    let n2 = lin.a.nrows();
+    let n = n2 / 2;
+    if lin.a.iter().any(|x| !x.is_finite()) {
+        return Err(Failure::NonFinite {
+            quantity: "A",
+            coordinate: String::new(),
+        }
+        .into());
+    }
+    let eig = lin.a.clone().complex_eigenvalues();
+    let scale = lin.a.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+    let mut out = Vec::new();
+    let mut lu = Lu::<C64>::new(n2);
+    for lambda in eig.iter() {
+        // one mode per conjugate pair
+        if lambda.im < -1e-12 * scale {
+            continue;
+        }
+        let (re, im) = (lambda.re, lambda.im.max(0.0));
+        let mag = re.hypot(im);
+        let frequency_hz = mag / (2.0 * std::f64::consts::PI);
+        if let Some((lo, hi)) = window {
+            if frequency_hz < lo || frequency_hz > hi {
+                continue;
+            }
+        }
+        // inverse iteration on A − μI, μ a hair off λ
+        let shift = 1e-9 * scale.max(mag);
+        let mu = C64::new(re + shift, im + shift);
+        let a = lu.matrix_mut();
+        for j in 0..n2 {
+            for i in 0..n2 {
+                let d = if i == j { mu } else { C64::default() };
+                a[i + n2 * j] = C64::new(lin.a[(i, j)], 0.0) - d;
+            }
+        }
+        let mut v: Vec<C64> = (0..n2)
+            .map(|i| C64::new(1.0 + 0.1 * i as f64, 0.05 * i as f64))
+            .collect();
+        if lu.factor().is_ok() {
+            for _ in 0..3 {
+                lu.solve(&mut v);
+                let nv = v.iter().map(|z| z.abs()).fold(0.0, f64::max);
+                for z in v.iter_mut() {
+                    *z = *z / C64::new(nv, 0.0);
+                }
+            }
+        }
+        // the q part, scaled to a largest component of 1 (real, positive)
+        let big = (0..n)
+            .max_by(|&i, &j| v[i].abs().total_cmp(&v[j].abs()))
+            .unwrap_or(0);
+        let pivot = v[big];
+        let shape: Vec<C64> = (0..n)
+            .map(|i| {
+                if pivot.abs() > 0.0 {
+                    v[i] / pivot
+                } else {
+                    v[i]
+                }
+            })
+            .collect();
+        let mut modal_mass = 0.0;
+        for i in 0..n {
+            for j in 0..n {
+                let p =
+                    C64::new(shape[i].re, -shape[i].im) * C64::new(lin.m[(i, j)], 0.0) * shape[j];
+                modal_mass += p.re;
+            }
+        }
+        let damping_ratio = if mag > 0.0 { -re / mag } else { 0.0 };
+        out.push(Mode {
+            re,
+            im,
+            frequency_hz,
+            damping_ratio,
+            modal_mass,
+            shape: shape.iter().map(|z| (z.re, z.im)).collect(),
+        });
+    }
+    out.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
+    Ok(Modes {
+        dof_names: lin.dof_names.clone(),
+        modes: out,
+    })
+}
+
+impl Modes {
+    /// Frequencies (Hz) in ascending order.
+    pub fn frequencies(&self) -> Vec<f64> {
+        self.modes.iter().map(|m| m.frequency_hz).collect()
+    }
+
+    /// One row per mode: frequency, damping ratio, eigenvalue, modal mass, then the shape
+    /// (real and imaginary parts per coordinate).
+    pub fn write_csv(&self, mut w: impl Write) -> io::Result<()> {
+        let mut header = vec![
+            "frequency_hz".to_string(),
+            "damping_ratio".into(),
+            "re".into(),
+            "im".into(),
+            "modal_mass".into(),
+        ];
+        for n in &self.dof_names {
+            header.push(format!("{n}.re"));
+            header.push(format!("{n}.im"));
+        }
+        writeln!(w, "{}", header.join(","))?;
+        for m in &self.modes {
+            write!(
+                w,
+                "{:e},{:e},{:e},{:e},{:e}",
+                m.frequency_hz, m.damping_ratio, m.re, m.im, m.modal_mass
+            )?;
+            for (re, im) in &m.shape {
+                write!(w, ",{re:e},{im:e}")?;
+            }
+            writeln!(w)?;
+        }
+        Ok(())
+    }
+}
+
+impl fmt::Display for Modes {
+    /// A pole list like EasyDyn's: one line per mode, then its shape by coordinate.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(
+            f,
+            "{:>4} {:>14} {:>12} {:>14} {:>14} {:>12}",
+            "mode", "frequency Hz", "damping", "Re λ", "Im λ", "modal mass"
+        )?;
+        for (k, m) in self.modes.iter().enumerate() {
+            writeln!(
+                f,
+                "{:>4} {:>14.6} {:>12.4e} {:>14.6e} {:>14.6e} {:>12.4e}",
+                k + 1,
+                m.frequency_hz,
+                m.damping_ratio,
+                m.re,
+                m.im,
+                m.modal_mass
+            )?;
+            let parts: Vec<String> = self
+                .dof_names
+                .iter()
+                .zip(&m.shape)
+                .map(|(n, (re, im))| {
+                    if im.abs() < 1e-9 {
+                        format!("{n} {re:+.4}")
+                    } else {
+                        format!("{n} {re:+.4}{im:+.4}i")
+                    }
+                })
+                .collect();
+            writeln!(f, "     shape: {}", parts.join(", "))?;
+        }
+        Ok(())
+    }
+}

@@ -47,6 +47,10 @@
 //! | `effect name { … }` | a named group of effect statements |
 //! | `gravity(0, -g, 0);` … outside an `effect` | an effect that is always on |
 //! | `scene Swing = [gravity];` | a model type `{Model}Swing` with those effects (plus the always-on ones) |
+//! | `constraint drive = crank - w * t;` | a scalar constraint Φ(q, t) = 0 (closed loops, driving constraints) |
+//! | `constraint close: coincide(a, b, along = [x, y]);` | two points meet along world axes (default x, y, z), or the axes of `frame = body`: one constraint per axis, named `close.x`, `close.y` |
+//! | `constraint hinge: align(A, B, about = [x, y]);` | frame B keeps its orientation relative to A about A's axes: `hinge.rx`, `hinge.ry` |
+//! | `dof crank = PI/3, independent;` | kept at its value when a closed loop is assembled |
 //! | `option tangents;` | also generate exact K_t = ∂τ/∂q and C_t = ∂τ/∂qd |
 //! | `option formulation = recursive;` | force `recursive` or `virtual_power` (default: the cheaper by op count) |
 //!
@@ -108,6 +112,43 @@
 //!
 //! Force and torque values may depend on `q`, `qd`, `t`, parameters and inputs `u[k]`.
 //! Gravity and springs are conservative (potential energy); the others count in `power()`.
+//!
+//! ## Constraints
+//!
+//! With constraints the equations are `M qdd = h + Bᵀλ`, `Φ(q, t) = 0`, `B = ∂Φ/∂q`; the model
+//! also provides Φ, B, ∂Φ/∂t, γ (with `B qdd = γ`) and ∂(Bᵀλ)/∂q, generated from the same
+//! expressions. A crank–slider closed at its pin:
+//!
+//! ```
+//! mbs::multibody! {
+//!     model SliderCrank {
+//!         dof theta = 0.0, qd = 10.0, independent; dof phi = 0.0; dof s = 0.4;
+//!         body crank { mass = 0.5; inertia = (0, 0.5 * 0.01 / 12, 0.5 * 0.01 / 12); }
+//!         body rod { mass = 1.0; inertia = (0, 0.09 / 12, 0.09 / 12); }
+//!         body slider { mass = 2.0; }
+//!         point crank_tip on crank at (0.05, 0, 0);
+//!         point rod_end on rod at (0.15, 0, 0);
+//!         TOG[crank] = Trotz(theta) * Tdisp(0.05, 0, 0);
+//!         TOG[rod] = TOG[crank] * Tdisp(0.05, 0, 0) * Trotz(phi) * Tdisp(0.15, 0, 0);
+//!         TOG[slider] = Tdisp(s, 0, 0);
+//!         constraint pin: coincide(rod_end, slider, along = [x, y]);
+//!     }
+//! }
+//! use mbs::Model;
+//! let (model, mut phi) = (SliderCrank::default(), [1.0; 2]);
+//! model.constraints(0.0, &[0.0, 0.0, 0.4], &mut phi);
+//! assert!(phi.iter().all(|p| p.abs() < 1e-12));
+//! ```
+//!
+//! | constraint | equations |
+//! |---|---|
+//! | `constraint NAME = expr;` | one scalar equation `expr = 0` in `q` and `t` |
+//! | `constraint NAME: coincide(a, b);` | points (or body origins, `ground`) `a` and `b` coincide: 3 equations, world axes |
+//! | `… coincide(a, b, along = [x, y]);` | only along the listed axes; `frame = body` for that body's axes |
+//! | `constraint NAME: align(A, B);` | bodies `A` and `B` keep their relative orientation (3 equations) |
+//! | `… align(A, B, about = [z]);` | only the listed rotations: each equation is the antisymmetric part of `R_Aᵀ R_B` about that axis (the sine of the relative angle for a single rotation), so keep the start within ±90° of aligned |
+//!
+//! `dof …, independent` marks the coordinates kept when the initial state is assembled.
 //!
 //! ## Errors
 //!

@@ -65,6 +65,10 @@ pub struct ModelInfo {
     pub params: &'static [&'static str],
     /// effects active in this model
     pub effects: &'static [&'static str],
+    /// names of the scalar constraints Φ(q, t) = 0 (`loop.x`, `drive`…)
+    pub constraints: &'static [&'static str],
+    /// coordinates marked `independent` (kept when a closed loop is assembled)
+    pub independent: &'static [bool],
     /// formulation of M and h: "recursive" or "virtual power"
     pub formulation: &'static str,
     /// whether `tangents` is generated
@@ -222,6 +226,9 @@ pub trait Model {
     const NFRAMES: usize;
     /// number of declared points
     const NPOINTS: usize;
+    /// number of scalar constraints Φ(q, t) = 0; the equations are then
+    /// M qdd = h + Bᵀλ, Φ = 0 with B = ∂Φ/∂q
+    const NC: usize;
 
     /// Names, sizes, formulation and op counts.
     fn info(&self) -> &'static ModelInfo;
@@ -275,6 +282,21 @@ pub trait Model {
 
     /// Power of the non-conservative effects (dampers, forces, torques, generalised forces).
     fn power(&self, t: f64, q: &[f64], qd: &[f64], u: &[f64]) -> f64;
+
+    /// Φ(q, t) (NC).
+    fn constraints(&self, t: f64, q: &[f64], phi: &mut [f64]);
+
+    /// B = ∂Φ/∂q (NC × NQ, column-major).
+    fn constraint_jacobian(&self, t: f64, q: &[f64], b: &mut [f64]);
+
+    /// ∂Φ/∂t (NC): with B qd it gives Φ̇ = B qd + ∂Φ/∂t.
+    fn constraint_rate(&self, t: f64, q: &[f64], phi_t: &mut [f64]);
+
+    /// γ (NC) with B qdd = γ: the part of Φ̈ that does not depend on qdd, negated.
+    fn constraint_bias(&self, t: f64, q: &[f64], qd: &[f64], gamma: &mut [f64]);
+
+    /// ∂(Bᵀλ)/∂q (NQ × NQ, column-major), for Newton on constrained systems.
+    fn constraint_tangent(&self, t: f64, q: &[f64], lambda: &[f64], k: &mut [f64]);
 
     /// Poses of every body and frame (NFRAMES).
     fn frames(&self, t: f64, q: &[f64], out: &mut [Pose]);

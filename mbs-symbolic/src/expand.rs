@@ -248,6 +248,7 @@ const NQ: usize = {nq};
 const NU: usize = {nu};
 const NFRAMES: usize = {nframes};
 const NPOINTS: usize = {npoints};
+const NC: usize = 0;
 fn info(&self) -> &'static ::mbs::ModelInfo {{ {never} }}
 fn params(&self) -> &{pty} {{ &self.params }}
 fn set_params(&mut self, _: {pty}) -> ::core::result::Result<(), ::mbs::ParamError> {{ {never} }}
@@ -258,6 +259,11 @@ fn inverse_dynamics(&self, _: f64, _: &[f64], _: &[f64], _: &[f64], _: &[f64], _
 fn tangents(&self, _: f64, _: &[f64], _: &[f64], _: &[f64], _: &[f64], _: &mut [f64], _: &mut [f64]) -> ::core::result::Result<(), ::mbs::ModelError> {{ {never} }}
 fn static_forces(&self, _: f64, _: &[f64], _: &[f64], _: &mut [f64]) {{ {never} }}
 fn input_matrix(&self, _: f64, _: &[f64], _: &[f64], _: &[f64], _: &mut [f64]) {{ {never} }}
+fn constraints(&self, _: f64, _: &[f64], _: &mut [f64]) {{ {never} }}
+fn constraint_jacobian(&self, _: f64, _: &[f64], _: &mut [f64]) {{ {never} }}
+fn constraint_rate(&self, _: f64, _: &[f64], _: &mut [f64]) {{ {never} }}
+fn constraint_bias(&self, _: f64, _: &[f64], _: &[f64], _: &mut [f64]) {{ {never} }}
+fn constraint_tangent(&self, _: f64, _: &[f64], _: &[f64], _: &mut [f64]) {{ {never} }}
 fn energy(&self, _: f64, _: &[f64], _: &[f64]) -> ::mbs::Energy {{ {never} }}
 fn power(&self, _: f64, _: &[f64], _: &[f64], _: &[f64]) -> f64 {{ {never} }}
 fn frames(&self, _: f64, _: &[f64], _: &mut [::mbs::Pose]) {{ {never} }}

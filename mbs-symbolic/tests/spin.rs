@@ -145,6 +145,7 @@ fn spinning_bodies_have_the_same_equations_as_without_the_shortcut() {
                 qdd: &qdd,
                 params: &pf,
                 u: &[],
+                lambda: &[],
             };
             let es = SliceEnv {
                 t,
@@ -153,6 +154,7 @@ fn spinning_bodies_have_the_same_equations_as_without_the_shortcut() {
                 qdd: &qdd,
                 params: &ps,
                 u: &[],
+                lambda: &[],
             };
             let (f, s) = (&mf.scenes[0], &ms.scenes[0]);
             let pairs: Vec<(Vec<ExprId>, Vec<ExprId>)> = vec![

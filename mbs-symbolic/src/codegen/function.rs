@@ -23,6 +23,7 @@ impl Naming for RustNames<'_> {
             Var::T => "t".into(),
             Var::Param(i) => format!("p_{}", self.params[i as usize].name),
             Var::Input(i) => format!("u_{i}"),
+            Var::Lambda(i) => format!("lambda_{i}"),
         }
     }
 
@@ -37,6 +38,7 @@ impl Naming for RustNames<'_> {
                 format!("let p_{n} = {}.{n};", self.params_path)
             }
             Var::Input(i) => format!("let u_{i} = u[{i}];"),
+            Var::Lambda(i) => format!("let lambda_{i} = lambda[{i}];"),
         }
     }
 }

@@ -221,8 +221,41 @@ fn emit_params(
         params: &sys.params,
         params_path: "self",
     };
-    let derived = collect(emit_fn(a, &spec, &names), missing, |s, _| s).unwrap_or_default();
-    let _ = writeln!(code, "impl {ty} {{\n{derived}}}");
+    let mut derived = collect(emit_fn(a, &spec, &names), missing, |s, _| s).unwrap_or_default();
+    // the constraints are the same in every scene: emitted once, here
+    let c = &model.constraints;
+    let mut specs = vec![FnSpec::new(
+        "__constraints",
+        "t: f64, q: &[f64], phi: &mut [f64]",
+    )];
+    specs[0].vector("phi", &c.phi);
+    let mut f = FnSpec::new("__constraint_jacobian", "t: f64, q: &[f64], b: &mut [f64]");
+    f.matrix(a, "b", &c.b);
+    specs.push(f);
+    let mut f = FnSpec::new("__constraint_rate", "t: f64, q: &[f64], phi_t: &mut [f64]");
+    f.vector("phi_t", &c.phi_t);
+    specs.push(f);
+    let mut f = FnSpec::new(
+        "__constraint_bias",
+        "t: f64, q: &[f64], qd: &[f64], gamma: &mut [f64]",
+    );
+    f.vector("gamma", &c.gamma);
+    specs.push(f);
+    let mut f = FnSpec::new(
+        "__constraint_tangent",
+        "t: f64, q: &[f64], lambda: &[f64], k: &mut [f64]",
+    );
+    f.matrix(a, "k", &c.tangent);
+    specs.push(f);
+    for spec in &specs {
+        if let Some(s) = collect(emit_fn(a, spec, &names), missing, |s, _| s) {
+            derived.push_str(&s);
+        }
+    }
+    let _ = writeln!(
+        code,
+        "#[automatically_derived]\n#[allow(unused_variables, clippy::all)]\nimpl {ty} {{\n{derived}}}"
+    );
     let values: Vec<String> = sys
         .params
         .iter()
@@ -518,7 +551,7 @@ fn emit_scene(
     }
     let pty = format!("{}Params", sys.name);
     let info = format!(
-        "static INFO: ::mbs::ModelInfo = ::mbs::ModelInfo {{ name: {name:?}, scene: {scene:?}, dofs: {dofs}, inputs: {inputs}, frames: {frames}, is_body: &[{is_body}], points: {points}, params: {params}, effects: {effects}, formulation: {form:?}, has_tangents: {tan}, ops: &[{ops}] }};",
+        "static INFO: ::mbs::ModelInfo = ::mbs::ModelInfo {{ name: {name:?}, scene: {scene:?}, dofs: {dofs}, inputs: {inputs}, frames: {frames}, is_body: &[{is_body}], points: {points}, params: {params}, effects: {effects}, constraints: {constraints}, independent: &[{independent}], formulation: {form:?}, has_tangents: {tan}, ops: &[{ops}] }};",
         name = ty,
         scene = scene_name,
         dofs = str_list(sys.dofs.iter().map(|d| d.name.clone())),
@@ -533,6 +566,13 @@ fn emit_scene(
         points = str_list(sys.points.iter().map(|p| p.name.clone())),
         params = str_list(sys.params.iter().map(|p| p.name.clone())),
         effects = str_list(effect_names.iter().cloned()),
+        constraints = str_list(sys.constraints.iter().map(|c| c.name.clone())),
+        independent = sys
+            .dofs
+            .iter()
+            .map(|d| d.independent.to_string())
+            .collect::<Vec<_>>()
+            .join(", "),
         tan = eq.tangents.is_some(),
         ops = ops
             .iter()
@@ -572,6 +612,7 @@ const NQ: usize = {n};
 const NU: usize = {nu};
 const NFRAMES: usize = {nf};
 const NPOINTS: usize = {np};
+const NC: usize = {nc};
 fn info(&self) -> &'static ::mbs::ModelInfo {{
 {info}
 &INFO
@@ -602,11 +643,17 @@ self.__power(t, q, qd, u, &mut e);
 e[0]
 }}
 fn frames(&self, t: f64, q: &[f64], out: &mut [::mbs::Pose]) {{ self.__frames(t, q, out) }}
+fn constraints(&self, t: f64, q: &[f64], phi: &mut [f64]) {{ self.params.__constraints(t, q, phi) }}
+fn constraint_jacobian(&self, t: f64, q: &[f64], b: &mut [f64]) {{ self.params.__constraint_jacobian(t, q, b) }}
+fn constraint_rate(&self, t: f64, q: &[f64], phi_t: &mut [f64]) {{ self.params.__constraint_rate(t, q, phi_t) }}
+fn constraint_bias(&self, t: f64, q: &[f64], qd: &[f64], gamma: &mut [f64]) {{ self.params.__constraint_bias(t, q, qd, gamma) }}
+fn constraint_tangent(&self, t: f64, q: &[f64], lambda: &[f64], k: &mut [f64]) {{ self.params.__constraint_tangent(t, q, lambda, k) }}
 fn kinematics(&self, t: f64, q: &[f64], qd: &[f64], out: &mut ::mbs::Kinematics) {{ self.__kinematics(t, q, qd, out) }}
 }}
 ",
         nu = sys.inputs.len(),
         nf = sys.frames.len(),
         np = sys.points.len(),
+        nc = sys.constraints.len(),
     );
 }

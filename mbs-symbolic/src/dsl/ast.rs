@@ -50,6 +50,8 @@ pub enum Item {
     Let { name: Ident, value: Expr },
     /// `dof q[0] = PI/2;`, `dof knee = 0.2, qd = 1.0;`
     Dof {
+        /// kept at its value when a closed loop is assembled
+        independent: bool,
         name: DofName,
         q0: Option<Expr>,
         qd0: Option<Expr>,
@@ -90,8 +92,20 @@ pub enum Item {
     EffectBlock { name: Ident, stmts: Vec<EffectStmt> },
     /// `scene Name = [effect, …];`
     Scene { name: Ident, effects: Vec<Ident> },
+    /// `constraint NAME = Φ;` or `constraint NAME: coincide(…);`
+    Constraint { name: Ident, body: ConstraintBody },
     /// `option tangents;`, `option formulation = recursive;`
     Option { key: Ident, value: Option<Expr> },
+}
+
+/// The body of a `constraint` statement.
+#[derive(Clone)]
+pub enum ConstraintBody {
+    /// `constraint drive = crank - omega * t;` (Φ = 0)
+    Scalar(Expr),
+    /// `constraint loop: coincide(a, b[, along = [x, y]][, frame = body]);`,
+    /// `constraint hinge: align(A, B[, about = [x, y]]);`
+    Closure(EffectStmt),
 }
 
 /// `gravity(0, -g, 0);`, `spring(a, b, k = 10, l0 = 1);`, … : a call with positional and

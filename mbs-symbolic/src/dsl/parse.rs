@@ -1,7 +1,7 @@
 //! Tokens → [`ModelDef`]s. Only the statement structure is parsed here; expressions are
 //! `syn::Expr` and get their meaning in `check`.
 
-use super::ast::{BodyRef, DofName, EffectStmt, Item, ModelDef};
+use super::ast::{BodyRef, ConstraintBody, DofName, EffectStmt, Item, ModelDef};
 use proc_macro2::TokenTree;
 use syn::parse::discouraged::Speculative;
 use syn::parse::{Parse, ParseStream};
@@ -214,20 +214,25 @@ fn parse_item(input: ParseStream) -> syn::Result<Item> {
             };
             let mut q0 = None;
             let mut qd0 = None;
+            let mut independent = false;
             if input.peek(Token![=]) {
                 input.parse::<Token![=]>()?;
                 q0 = Some(input.parse()?);
-                if input.peek(Token![,]) {
-                    input.parse::<Token![,]>()?;
-                    let k: Ident = input.parse()?;
-                    if k != "qd" {
-                        return Err(syn::Error::new(
-                            k.span(),
-                            "expected `qd = …` (the initial velocity) after the initial position",
-                        ));
-                    }
+            }
+            // `, qd = …` and `, independent`, in any order
+            while input.peek(Token![,]) {
+                input.parse::<Token![,]>()?;
+                let k: Ident = input.parse()?;
+                if k == "qd" && qd0.is_none() {
                     input.parse::<Token![=]>()?;
                     qd0 = Some(input.parse()?);
+                } else if k == "independent" && !independent {
+                    independent = true;
+                } else {
+                    return Err(syn::Error::new(
+                        k.span(),
+                        "expected `qd = …` (the initial velocity) or `independent` (kept when a closed loop is assembled)",
+                    ));
                 }
             }
             semi(input, "`dof`")?;
@@ -235,6 +240,7 @@ fn parse_item(input: ParseStream) -> syn::Result<Item> {
                 name,
                 q0,
                 qd0,
+                independent,
                 span,
             })
         }
@@ -367,6 +373,24 @@ fn parse_item(input: ParseStream) -> syn::Result<Item> {
                 name,
                 effects: effects.into_iter().collect(),
             })
+        }
+        "constraint" => {
+            input.parse::<Ident>()?;
+            let name: Ident = input.parse()?;
+            let body = if input.peek(Token![=]) {
+                input.parse::<Token![=]>()?;
+                let e: Expr = input.parse()?;
+                semi(input, "`constraint NAME = expression`")?;
+                ConstraintBody::Scalar(e)
+            } else if input.peek(Token![:]) {
+                input.parse::<Token![:]>()?;
+                ConstraintBody::Closure(parse_effect(input)?)
+            } else {
+                return Err(input.error(format!(
+                    "expected `=` or `:` after `constraint {name}`: write `constraint {name} = expression;` (Φ = 0) or `constraint {name}: coincide(a, b);`"
+                )));
+            };
+            Ok(Item::Constraint { name, body })
         }
         "option" => {
             input.parse::<Ident>()?;

@@ -33,8 +33,8 @@ impl Dir {
     pub(super) fn key(self, n: ExprId) -> u64 {
         let d: u64 = match self {
             Dir::Partial(v) => var_code(v),
-            Dir::Time => 6 << 16,
-            Dir::TimeBias => 7 << 16,
+            Dir::Time => 7 << 16,
+            Dir::TimeBias => 8 << 16,
         };
         d << 32 | n.0 as u64
     }
@@ -48,6 +48,7 @@ fn var_code(v: Var) -> u64 {
         Var::T => 3 << 16,
         Var::Param(i) => 4 << 16 | i as u64,
         Var::Input(i) => 5 << 16 | i as u64,
+        Var::Lambda(i) => 6 << 16 | i as u64,
     }
 }
 

@@ -86,7 +86,7 @@ impl Arena {
                     Var::T => self.one(),
                     // jerk, parameters and inputs: never differentiated in time by the
                     // generator (the checker keeps inputs and velocities out of positions)
-                    Var::Qdd(_) | Var::Param(_) | Var::Input(_) => self.zero(),
+                    Var::Qdd(_) | Var::Param(_) | Var::Input(_) | Var::Lambda(_) => self.zero(),
                 },
             },
             Node::Add(a, b) => {

@@ -22,6 +22,7 @@ pub struct SliceEnv<'a> {
     pub qdd: &'a [f64],
     pub params: &'a [f64],
     pub u: &'a [f64],
+    pub lambda: &'a [f64],
 }
 
 impl Env for SliceEnv<'_> {
@@ -34,6 +35,7 @@ impl Env for SliceEnv<'_> {
             Var::T => self.t,
             Var::Param(i) => get(self.params, i),
             Var::Input(i) => get(self.u, i),
+            Var::Lambda(i) => get(self.lambda, i),
         }
     }
 }

@@ -44,6 +44,8 @@ pub enum Var {
     Param(u16),
     /// input `u[i]`
     Input(u16),
+    /// Lagrange multiplier `λ[i]` of constraint i (in generated constraint tangents)
+    Lambda(u16),
 }
 
 impl Var {
@@ -56,7 +58,7 @@ impl Var {
             Var::Qdd(i) => 80 + i as u32 % 40,
             Var::T => 120,
             Var::Param(i) => 121 + i as u32 % 4,
-            Var::Input(i) => 125 + i as u32 % 3,
+            Var::Input(i) | Var::Lambda(i) => 125 + i as u32 % 3,
         };
         1u128 << bit
     }
@@ -71,6 +73,7 @@ impl fmt::Display for Var {
             Var::T => write!(f, "t"),
             Var::Param(i) => write!(f, "p{i}"),
             Var::Input(i) => write!(f, "u{i}"),
+            Var::Lambda(i) => write!(f, "l{i}"),
         }
     }
 }

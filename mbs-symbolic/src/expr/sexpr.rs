@@ -147,6 +147,8 @@ impl Arena {
             Var::Param(idx(r)?)
         } else if let Some(r) = tok.strip_prefix('u') {
             Var::Input(idx(r)?)
+        } else if let Some(r) = tok.strip_prefix('l') {
+            Var::Lambda(idx(r)?)
         } else {
             return Err(format!("unknown atom `{tok}`"));
         };

@@ -230,6 +230,8 @@ pub struct SymbolicModel {
     pub world: World,
     pub points: Vec<PointKin>,
     pub scenes: Vec<SceneEquations>,
+    /// Φ, B, Φ_t, γ, ∂(Bᵀλ)/∂q of the constraints (empty without constraints)
+    pub constraints: super::constraints::ConstraintEquations,
 }
 
 impl SymbolicModel {
@@ -270,12 +272,14 @@ impl SymbolicModel {
                 }
             })
             .collect();
+        let constraints = super::constraints::ConstraintEquations::build(&mut sys, &tree, &world);
         SymbolicModel {
             sys,
             tree,
             world,
             points,
             scenes,
+            constraints,
         }
     }
 }

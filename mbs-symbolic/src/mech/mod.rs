@@ -1,6 +1,7 @@
 //! Mechanics on the expression DAG: the system description, the frame tree, kinematics,
 //! effects and the two formulations of the equations of motion.
 
+pub mod constraints;
 pub mod dynamics;
 pub mod effects;
 pub mod recursive;

@@ -22,6 +22,8 @@ pub struct System {
     pub effects: Vec<EffectDef>,
     /// declared scenes; none means one model with every effect
     pub scenes: Vec<SceneDef>,
+    /// holonomic constraints Φ(q, t) = 0 (closed loops, driving constraints)
+    pub constraints: Vec<ConstraintDef>,
     pub options: Options,
 }
 
@@ -39,6 +41,8 @@ pub struct DofDef {
     pub q0: ExprId,
     /// initial velocity (an expression of parameters)
     pub qd0: ExprId,
+    /// kept at its value when a closed loop is assembled
+    pub independent: bool,
 }
 
 /// Mass and inertia tensor about G in body axes.
@@ -146,6 +150,36 @@ pub struct SceneDef {
     pub effects: Vec<usize>,
 }
 
+/// One scalar constraint Φ(q, t) = 0, named.
+#[derive(Clone, Debug)]
+pub struct ConstraintDef {
+    /// `drive`, or `loop.x` for one direction of a closure
+    pub name: String,
+    pub kind: ConstraintKind,
+}
+
+/// What a constraint says.
+#[derive(Clone, Copy, Debug)]
+pub enum ConstraintKind {
+    /// Φ = the expression (of q, t and parameters)
+    Scalar(ExprId),
+    /// the two points coincide along axis `axis` (0, 1, 2) of `frame` (`None`: world):
+    /// Φ = e · (x_b − x_a)
+    Coincide {
+        a: Attach,
+        b: Attach,
+        axis: usize,
+        frame: Option<usize>,
+    },
+    /// frame `b` does not turn relative to frame `a` about `a`'s axis `axis`:
+    /// Φ = ½ (e_{i,a} · e_{j,b} − e_{j,a} · e_{i,b}), (axis, i, j) a cyclic permutation
+    Align {
+        a: Option<usize>,
+        b: Option<usize>,
+        axis: usize,
+    },
+}
+
 /// Which equations-of-motion formulation to emit.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Formulation {
@@ -177,6 +211,7 @@ impl System {
             points: Vec::new(),
             effects: Vec::new(),
             scenes: Vec::new(),
+            constraints: Vec::new(),
             options: Options::default(),
         }
     }
@@ -225,6 +260,7 @@ impl System {
             name: name.into(),
             q0,
             qd0,
+            independent: false,
         });
         self.dofs.len() - 1
     }

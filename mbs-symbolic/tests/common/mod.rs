@@ -988,6 +988,7 @@ pub fn eval(
         qdd,
         params: &params,
         u: &[],
+        lambda: &[],
     };
     model.sys.arena.eval(roots, &env)
 }

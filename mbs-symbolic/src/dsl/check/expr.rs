@@ -139,6 +139,9 @@ impl Checker {
             a.what
         };
         let hint = match kind {
+            "qd" | "qdd" if a.what.starts_with("a constraint") => {
+                "constraints are holonomic, Φ(q, t) = 0; velocity constraints (rolling without slipping) are not supported, model them with a stiff damper or force instead".to_string()
+            }
             "qd" | "qdd" => {
                 if a.q {
                     "a pose depends only on q, t and parameters; velocities and accelerations belong in the values of forces, torques and generalized forces".to_string()

@@ -311,7 +311,12 @@ impl Checker {
                             .insert(name.to_string(), Scalar::Let(value.clone()));
                     }
                 }
-                Item::Dof { name, span, .. } => {
+                Item::Dof {
+                    name,
+                    span,
+                    independent,
+                    ..
+                } => {
                     let i = self.sys.dofs.len();
                     let display = match name {
                         DofName::Indexed(k, s) => {
@@ -333,6 +338,7 @@ impl Checker {
                         name: display,
                         q0: z,
                         qd0: z,
+                        independent: *independent,
                     });
                     self.dof_spans.push(*span);
                 }
@@ -582,6 +588,7 @@ impl Checker {
                         effects: list,
                     });
                 }
+                Item::Constraint { name, body } => self.lower_constraint(name, body),
                 Item::Option { key, value } => self.lower_option(key, value.as_ref()),
                 _ => {}
             }
@@ -639,5 +646,6 @@ impl Checker {
 }
 
 mod bodies;
+mod constraints;
 mod effects;
 mod expr;

@@ -84,6 +84,48 @@ pub enum Failure {
         limit: f64,
         h_stable: f64,
     },
+    #[error(
+        "the constraints are redundant or degenerate: B = ∂Φ/∂q has rank {rank} for {nc} constraints (smallest singular value {sigma_min:.2e}); involved: {}; remove the redundant equations (e.g. the out-of-plane ones of a planar loop) or start away from the singular configuration",
+        constraints.join(", ")
+    )]
+    RankDeficientConstraints {
+        rank: usize,
+        nc: usize,
+        sigma_min: f64,
+        constraints: Vec<String>,
+    },
+    #[error(
+        "no consistent start: {reason} (largest |Φ| = {residual:.2e}, at constraint `{constraint}`, after {iterations} iterations)"
+    )]
+    InconsistentStart {
+        reason: String,
+        constraint: String,
+        residual: f64,
+        iterations: usize,
+    },
+    #[error(
+        "constraint `{constraint}` drifted to |Φ| = {value:.2e}, beyond drift_tol = {tolerance:.1e}: use Projection, Index3 or Partitioning, or stronger Baumgarte terms"
+    )]
+    ConstraintDrift {
+        constraint: String,
+        value: f64,
+        tolerance: f64,
+    },
+    #[error(
+        "Newton could not close constraint `{constraint}` by moving {what} (|Φ| = {residual:.2e} after {iterations} iterations)"
+    )]
+    ClosureFailed {
+        what: &'static str,
+        constraint: String,
+        residual: f64,
+        iterations: usize,
+    },
+    #[error("{scheme} cannot integrate constraints by {method}: {supported}")]
+    ConstraintsUnsupported {
+        scheme: &'static str,
+        method: &'static str,
+        supported: &'static str,
+    },
 }
 
 /// A simulation that stopped early, with what it had computed until then: every recorded

@@ -26,14 +26,14 @@ pub use analysis::{
     static_equilibrium,
 };
 pub use error::{Failure, ModelError, ParamError, SimError, check_inertia};
-pub use integrators::{Integrator, Simulation, State, simulate};
+pub use integrators::{Assembly, Integrator, Simulation, State, assemble, simulate};
 pub use model::{
     Energy, FrameKinematics, Kinematics, Model, ModelInfo, OpCount, OpsTable, Parameters,
     PointKinematics, Pose,
 };
 pub use options::{
-    BdfParams, GenAlphaParams, HhtParams, IterationMatrix, NewmarkParams, NewtonOptions, Options,
-    Output, Scheme, StepControl,
+    BdfParams, ConstraintMethod, ConstraintOptions, GenAlphaParams, HhtParams, IterationMatrix,
+    NewmarkParams, NewtonOptions, Options, Output, Scheme, StepControl,
 };
 pub use stats::Stats;
 pub use trajectory::{Observer, Trajectory};

@@ -53,6 +53,12 @@ pub fn cholesky(a: &mut [f64], n: usize) -> Result<(), Singular> {
 
 /// Solves L Lᵀ x = b in place, with L from [`cholesky`].
 pub fn cholesky_solve(l: &[f64], n: usize, b: &mut [f64]) {
+    forward(l, n, b);
+    backward(l, n, b);
+}
+
+/// Solves L y = b in place (L lower triangular, from [`cholesky`]).
+pub fn forward(l: &[f64], n: usize, b: &mut [f64]) {
     for i in 0..n {
         let mut s = b[i];
         for k in 0..i {
@@ -60,6 +66,10 @@ pub fn cholesky_solve(l: &[f64], n: usize, b: &mut [f64]) {
         }
         b[i] = s / l[i + n * i];
     }
+}
+
+/// Solves Lᵀ x = b in place (L from [`cholesky`]).
+pub fn backward(l: &[f64], n: usize, b: &mut [f64]) {
     for i in (0..n).rev() {
         let mut s = b[i];
         for k in i + 1..n {

@@ -182,6 +182,31 @@ impl Scheme {
         !matches!(self, Scheme::ExplicitEuler | Scheme::Rk4 | Scheme::Dopri5)
     }
 
+    /// Spectral radius at infinite frequency ρ∞ of the Newmark family (1: no numerical
+    /// damping; `None` for other schemes).
+    pub fn spectral_radius_at_infinity(&self) -> Option<f64> {
+        match *self {
+            Scheme::Newmark(p) if (p.gamma - 0.5).abs() < 1e-15 => Some(1.0),
+            Scheme::Newmark(_) => Some(f64::NAN),
+            Scheme::Hht(p) => Some((1.0 + p.alpha) / (1.0 - p.alpha)),
+            Scheme::GenAlpha(p)
+                if (p.alpha_m - 0.5).abs() < 1e-12 && (p.alpha_f - 0.5).abs() < 1e-12 =>
+            {
+                Some(1.0)
+            }
+            Scheme::GenAlpha(p) => Some(p.rho_inf),
+            _ => None,
+        }
+    }
+
+    /// Whether the scheme solves constrained models at index 3 ([`ConstraintMethod::Index3`]).
+    pub fn solves_index3(&self) -> bool {
+        matches!(
+            self,
+            Scheme::Newmark(_) | Scheme::Hht(_) | Scheme::GenAlpha(_)
+        )
+    }
+
     /// Whether the scheme can control its step by a local error estimate.
     pub fn is_adaptive(&self) -> bool {
         !matches!(
@@ -274,6 +299,76 @@ impl Default for NewtonOptions {
     }
 }
 
+/// How a constrained model (`M qdd = h + Bᵀλ`, `Φ(q, t) = 0`) is integrated. Every method
+/// starts from a consistent state (assembly, velocity projection, qdd₀ and λ₀ from the
+/// index-1 equations) and records λ in the trajectory.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[non_exhaustive]
+pub enum ConstraintMethod {
+    /// `Index3` for the schemes that solve it (generalized-α, HHT, Newmark), `Projection`
+    /// for the others and for adaptive steps of the undamped members (ρ∞ = 1: Newmark's
+    /// trapezoidal rule, generalized-α at ρ∞ = 1, HHT at α = 0) — the default
+    #[default]
+    Auto,
+    /// the index-3 DAE solved directly: Φ(q₁) = 0 and the dynamics with λ₁ as unknowns
+    /// (generalized-α, HHT, Newmark with the scaled iteration matrix of Bottasso, Dopico &
+    /// Trainelli 2008); refused for the undamped members with adaptive steps
+    Index3,
+    /// the index-1 form (B qdd = γ, λ eliminated) with Baumgarte's stabilisation
+    /// Φ̈ + 2αΦ̇ + β²Φ = 0 (α, β in 1/s; α = β = 0 is the plain index-1 form, which drifts);
+    /// stops with `ConstraintDrift` when |Φ| exceeds `drift_tol`
+    Baumgarte { alpha: f64, beta: f64 },
+    /// the index-1 form, with q and qd projected onto Φ = 0 and Φ̇ = 0 (in the metric of M)
+    /// after every accepted step
+    Projection,
+    /// coordinate partitioning (Wehage & Haug 1982): the scheme integrates an ODE in the
+    /// independent coordinates; the dependent ones are solved from Φ = 0 and Φ̇ = 0 at every
+    /// evaluation; the partition is chosen again (pivoting on B) when it becomes
+    /// ill-conditioned
+    Partitioning,
+}
+
+impl ConstraintMethod {
+    /// Short name, as on the command line.
+    pub fn name(&self) -> &'static str {
+        match self {
+            ConstraintMethod::Auto => "auto",
+            ConstraintMethod::Index3 => "index3",
+            ConstraintMethod::Baumgarte { .. } => "baumgarte",
+            ConstraintMethod::Projection => "projection",
+            ConstraintMethod::Partitioning => "partitioning",
+        }
+    }
+}
+
+/// Settings for constrained models (ignored when the model has no constraints).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ConstraintOptions {
+    pub method: ConstraintMethod,
+    /// |Φ_i| to reach when assembling, projecting, completing dependent coordinates and in
+    /// the index-3 Newton (in the constraint's units, m or rad; default 1e-11)
+    pub tolerance: f64,
+    /// stop with `ConstraintDrift` when some |Φ_i| exceeds this after a step (default 1e-6)
+    pub drift_tol: f64,
+    /// Newton iterations for assembly, projection and completion (default 50)
+    pub max_iterations: usize,
+    /// index-3 Newmark family: scale the constraint rows of the iteration matrix by 1/β'
+    /// (default true; false keeps the unscaled matrix whose condition grows as 1/h²)
+    pub scaling: bool,
+}
+
+impl Default for ConstraintOptions {
+    fn default() -> Self {
+        ConstraintOptions {
+            method: ConstraintMethod::Auto,
+            tolerance: 1e-11,
+            drift_tol: 1e-6,
+            max_iterations: 50,
+            scaling: true,
+        }
+    }
+}
+
 /// Everything a simulation needs besides the model and the scheme.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Options {
@@ -302,6 +397,8 @@ pub struct Options {
     pub frames: bool,
     /// record kinetic and potential energy at each output (default true)
     pub energy: bool,
+    /// how constraints are integrated (constrained models only)
+    pub constraints: ConstraintOptions,
 }
 
 impl Default for Options {
@@ -321,6 +418,7 @@ impl Default for Options {
             stability_check: true,
             frames: false,
             energy: true,
+            constraints: ConstraintOptions::default(),
         }
     }
 }
@@ -463,6 +561,27 @@ impl Options {
         ] {
             if !(v > 0.0) || !v.is_finite() {
                 return Err(invalid(name, v, "must be > 0 and finite"));
+            }
+        }
+        let c = &self.constraints;
+        for (name, v) in [
+            ("constraints.tolerance", c.tolerance),
+            ("constraints.drift_tol", c.drift_tol),
+        ] {
+            if !(v > 0.0) || !v.is_finite() {
+                return Err(invalid(name, v, "must be > 0 and finite"));
+            }
+        }
+        if c.max_iterations == 0 {
+            return Err(invalid("constraints.max_iterations", 0, "must be > 0"));
+        }
+        if let ConstraintMethod::Baumgarte { alpha, beta } = c.method {
+            if !(alpha >= 0.0 && beta >= 0.0 && alpha.is_finite() && beta.is_finite()) {
+                return Err(invalid(
+                    "constraints.method",
+                    format!("Baumgarte {{ alpha: {alpha}, beta: {beta} }}"),
+                    "α and β must be finite and ≥ 0 (negative values destabilise the constraints)",
+                ));
             }
         }
         if self.iteration_matrix == IterationMatrix::Exact && !has_tangents {

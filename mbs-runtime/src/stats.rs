@@ -22,6 +22,12 @@ pub struct Stats {
     pub inverse_dynamics: usize,
     /// evaluations of the exact tangents K_t, C_t
     pub tangents: usize,
+    /// evaluations of constraint functions (Φ, B, ∂Φ/∂t, γ or ∂(Bᵀλ)/∂q, each counted)
+    pub constraints: usize,
+    /// projections of a state onto Φ = 0, Φ̇ = 0 (or completions of dependent coordinates)
+    pub projections: usize,
+    /// changes of the independent coordinates (coordinate partitioning)
+    pub repartitions: usize,
     /// evaluations of user efforts (none yet: reserved for user force hooks)
     pub user_efforts: usize,
     /// evaluations of energy (for outputs)
@@ -81,6 +87,13 @@ impl fmt::Display for Stats {
             self.user_efforts,
             self.energy
         )?;
+        if self.constraints > 0 {
+            writeln!(
+                f,
+                "constraints: {} evaluations, {} projections, {} changes of partition",
+                self.constraints, self.projections, self.repartitions
+            )?;
+        }
         write!(
             f,
             "linear algebra: {} factorisations, {} solves; {} Newton iterations",

@@ -13,10 +13,19 @@ pub struct Trajectory {
     pub dof_names: Vec<String>,
     /// body and frame names (poses are recorded only on request)
     pub frame_names: Vec<String>,
+    /// constraint names (`pin.x`, …), one λ each
+    #[serde(default)]
+    pub constraint_names: Vec<String>,
     pub t: Vec<f64>,
     pub q_data: Vec<f64>,
     pub qd_data: Vec<f64>,
     pub qdd_data: Vec<f64>,
+    /// Lagrange multipliers, `constraint_names.len()` per output: λ_i is the generalised
+    /// force Bᵢᵀλ_i's magnitude; for `coincide(a, b, along = [x])` it is the force along x
+    /// that the closure applies to b (−λ to a), for a scalar constraint the multiplier of
+    /// its gradient
+    #[serde(default)]
+    pub lambda_data: Vec<f64>,
     /// energy at each output (empty when not recorded)
     pub energy: Vec<Energy>,
     /// poses of every frame at each output (empty when not recorded)
@@ -35,10 +44,15 @@ impl<F: FnMut(f64, &[f64], &[f64], &[f64])> Observer for F {
 }
 
 impl Trajectory {
-    pub(crate) fn new(dof_names: Vec<String>, frame_names: Vec<String>) -> Trajectory {
+    pub(crate) fn new(
+        dof_names: Vec<String>,
+        frame_names: Vec<String>,
+        constraint_names: Vec<String>,
+    ) -> Trajectory {
         Trajectory {
             dof_names,
             frame_names,
+            constraint_names,
             ..Trajectory::default()
         }
     }
@@ -75,6 +89,19 @@ impl Trajectory {
         &self.qdd_data[i * n..(i + 1) * n]
     }
 
+    /// λ at output `i` (one per constraint).
+    pub fn lambda(&self, i: usize) -> &[f64] {
+        let n = self.constraint_names.len();
+        &self.lambda_data[i * n..(i + 1) * n]
+    }
+
+    /// The multiplier of the constraint named `name` at every output (`None` if no such
+    /// constraint).
+    pub fn constraint_force(&self, name: &str) -> Option<Vec<f64>> {
+        let k = self.constraint_names.iter().position(|c| c == name)?;
+        Some((0..self.len()).map(|i| self.lambda(i)[k]).collect())
+    }
+
     /// Poses of every frame at output `i` (empty unless recorded).
     pub fn poses_at(&self, i: usize) -> &[Pose] {
         let n = self.frame_names.len();
@@ -92,6 +119,8 @@ impl Trajectory {
         self.q_data.reserve(outputs * n);
         self.qd_data.reserve(outputs * n);
         self.qdd_data.reserve(outputs * n);
+        self.lambda_data
+            .reserve(outputs * self.constraint_names.len());
         if energy {
             self.energy.reserve(outputs);
         }
@@ -100,11 +129,12 @@ impl Trajectory {
         }
     }
 
-    pub(crate) fn push(&mut self, t: f64, q: &[f64], qd: &[f64], qdd: &[f64]) {
+    pub(crate) fn push(&mut self, t: f64, q: &[f64], qd: &[f64], qdd: &[f64], lambda: &[f64]) {
         self.t.push(t);
         self.q_data.extend_from_slice(q);
         self.qd_data.extend_from_slice(qd);
         self.qdd_data.extend_from_slice(qdd);
+        self.lambda_data.extend_from_slice(lambda);
     }
 
     /// Energy drift: max |E(t) − E(t0)| over the outputs (`None` when energy was not recorded).
@@ -119,7 +149,8 @@ impl Trajectory {
     }
 
     /// CSV with a header of named columns: `t`, then `q[…]`, `qd[…]`, `qdd[…]` per coordinate,
-    /// then `kinetic, potential, total` when energy was recorded.
+    /// then `NAME.lambda` per constraint, then `kinetic, potential, total` when energy was
+    /// recorded.
     pub fn write_csv(&self, mut w: impl Write) -> io::Result<()> {
         let mut header = vec!["t".to_string()];
         for prefix in ["", "d", "dd"] {
@@ -130,6 +161,9 @@ impl Trajectory {
                     format!("{name}.{prefix}")
                 });
             }
+        }
+        for name in &self.constraint_names {
+            header.push(format!("{name}.lambda"));
         }
         let with_energy = self.energy.len() == self.len() && !self.is_empty();
         if with_energy {
@@ -146,7 +180,13 @@ impl Trajectory {
         )?;
         for i in 0..self.len() {
             write!(w, "{:e}", self.t[i])?;
-            for v in self.q(i).iter().chain(self.qd(i)).chain(self.qdd(i)) {
+            for v in self
+                .q(i)
+                .iter()
+                .chain(self.qd(i))
+                .chain(self.qdd(i))
+                .chain(self.lambda(i))
+            {
                 write!(w, ",{v:e}")?;
             }
             if with_energy {
@@ -178,9 +218,13 @@ mod tests {
 
     #[test]
     fn csv_has_named_columns_and_one_row_per_output() {
-        let mut t = Trajectory::new(vec!["q[0]".into(), "knee".into()], vec![]);
-        t.push(0.0, &[1.0, 2.0], &[0.0, 0.5], &[0.1, 0.2]);
-        t.push(0.5, &[1.5, 2.5], &[1.0, 0.5], &[0.1, 0.2]);
+        let mut t = Trajectory::new(
+            vec!["q[0]".into(), "knee".into()],
+            vec![],
+            vec!["pin".into()],
+        );
+        t.push(0.0, &[1.0, 2.0], &[0.0, 0.5], &[0.1, 0.2], &[3.0]);
+        t.push(0.5, &[1.5, 2.5], &[1.0, 0.5], &[0.1, 0.2], &[4.0]);
         t.energy = vec![
             Energy {
                 kinetic: 1.0,
@@ -194,10 +238,11 @@ mod tests {
         let lines: Vec<&str> = text.lines().collect();
         assert_eq!(
             lines[0],
-            "t,q[0],knee,q[0].d,knee.d,q[0].dd,knee.dd,kinetic,potential,total"
+            "t,q[0],knee,q[0].d,knee.d,q[0].dd,knee.dd,pin.lambda,kinetic,potential,total"
         );
         assert_eq!(lines.len(), 3);
-        assert_eq!(lines[2].split(',').count(), 10);
+        assert_eq!(lines[2].split(',').count(), 11);
+        assert_eq!(t.constraint_force("pin"), Some(vec![3.0, 4.0]));
         let mut json = Vec::new();
         t.write_json(&mut json).unwrap();
         let back: Trajectory = serde_json::from_slice(&json).unwrap();

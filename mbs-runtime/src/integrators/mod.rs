@@ -14,6 +14,7 @@
 //! | Radau IIA 3, 5 | `radau/` | 3, 5 | adaptive or fixed |
 
 mod bdf;
+pub(crate) mod constrained;
 mod dopri5;
 mod explicit;
 mod midpoint;
@@ -22,11 +23,15 @@ pub(crate) mod newton;
 pub(crate) mod problem;
 mod radau;
 
+pub use constrained::{Assembly, assemble};
+pub use newmark::index3_iteration_matrix;
+
 use crate::error::{Failure, SimError};
 use crate::model::{Model, Pose};
-use crate::options::{Options, Output, Scheme, StepControl};
+use crate::options::{ConstraintMethod, Options, Output, Scheme, StepControl};
 use crate::stats::Stats;
 use crate::trajectory::{Observer, Trajectory};
+use constrained::{Constrained, Mode};
 use newton::NewtonTol;
 use problem::Problem;
 
@@ -38,15 +43,18 @@ pub struct State {
     pub qd: Vec<f64>,
     /// accelerations consistent with M qdd = h (or the scheme's own at this step)
     pub qdd: Vec<f64>,
+    /// Lagrange multipliers of the constraints, one per named constraint (empty without)
+    pub lambda: Vec<f64>,
 }
 
 impl State {
-    pub(crate) fn zeros(n: usize) -> State {
+    pub(crate) fn zeros(n: usize, nc: usize) -> State {
         State {
             t: 0.0,
             q: vec![0.0; n],
             qd: vec![0.0; n],
             qdd: vec![0.0; n],
+            lambda: vec![0.0; nc],
         }
     }
 
@@ -55,6 +63,7 @@ impl State {
         self.q.copy_from_slice(&o.q);
         self.qd.copy_from_slice(&o.qd);
         self.qdd.copy_from_slice(&o.qdd);
+        self.lambda.copy_from_slice(&o.lambda);
     }
 }
 
@@ -195,6 +204,10 @@ pub(crate) fn hermite5(s0: &State, s1: &State, t: f64, out: &mut State) {
         out.qd[i] = dot(&d) / h;
         out.qdd[i] = dot(&dd) / (h * h);
     }
+    // λ between steps: linear (λ has no derivative information here)
+    for i in 0..s0.lambda.len() {
+        out.lambda[i] = (1.0 - s) * s0.lambda[i] + s * s1.lambda[i];
+    }
 }
 
 /// Runs `scheme` on `model` with `options` to the end; on failure, the error keeps the
@@ -231,6 +244,7 @@ pub struct Simulation<M: Model> {
     out_next: usize,
     poses: Vec<Pose>,
     observers: Vec<Box<dyn Observer>>,
+    assembly: Option<Assembly>,
 }
 
 impl<M: Model + 'static> Simulation<M> {
@@ -241,12 +255,21 @@ impl<M: Model + 'static> Simulation<M> {
         let info = model.info();
         let dof_names: Vec<String> = info.dofs.iter().map(|s| s.to_string()).collect();
         let frame_names: Vec<String> = info.frames.iter().map(|s| s.to_string()).collect();
+        let constraint_names: Vec<String> =
+            info.constraints.iter().map(|s| s.to_string()).collect();
+        let new_traj = || {
+            Trajectory::new(
+                dof_names.clone(),
+                frame_names.clone(),
+                constraint_names.clone(),
+            )
+        };
         let early = |kind: Failure, stats: Stats| SimError {
             kind,
             t: options.t0,
             h: 0.0,
             stats: Box::new(stats),
-            trajectory: Box::new(Trajectory::new(dof_names.clone(), frame_names.clone())),
+            trajectory: Box::new(new_traj()),
         };
         if let Err(e) = options.validate(&scheme, n, info.has_tangents) {
             return Err(early(e, Stats::default()));
@@ -259,7 +282,7 @@ impl<M: Model + 'static> Simulation<M> {
             // the order history is counted per order: sized now, not while stepping
             problem.stats.order_steps = vec![0; p.max_order];
         }
-        let mut cur = State::zeros(n);
+        let mut cur = State::zeros(n, M::NC);
         cur.t = options.t0;
         problem.model.initial_state(&mut cur.q, &mut cur.qd);
         if let Some(q0) = &options.q0 {
@@ -271,10 +294,37 @@ impl<M: Model + 'static> Simulation<M> {
         let start = problem
             .check("q0", &cur.q)
             .and_then(|_| problem.check("qd0", &cur.qd));
-        let start =
-            start.and_then(|_| problem.accel(cur.t, &cur.q.clone(), &cur.qd.clone(), &mut cur.qdd));
         if let Err(e) = start {
             return Err(early(e, problem.stats.clone()));
+        }
+        let mut assembly = None;
+        if M::NC > 0 {
+            // consistent start: assembly, velocities, then qdd₀ and λ₀ of the index-1 form
+            let oc = &options.constraints;
+            let adaptive = matches!(options.step, StepControl::Adaptive { .. });
+            let start = constraint_mode(oc.method, &scheme, adaptive).and_then(|mode| {
+                let a = assemble(&problem.model, cur.t, &mut cur.q, &mut cur.qd, oc)?;
+                let mut c = Constrained::new(&problem.model, mode, oc);
+                if mode == Mode::Partitioning {
+                    c.eval_b(&problem.model, &mut problem.stats, cur.t, &cur.q);
+                    let marks = problem.model.info().independent;
+                    let marked = marks.iter().any(|&m| m);
+                    c.choose_partition(marked.then_some(marks), &mut problem.stats);
+                }
+                problem.con = Some(c);
+                Ok(a)
+            });
+            match start {
+                Ok(a) => assembly = Some(a),
+                Err(e) => return Err(early(e, problem.stats.clone())),
+            }
+        }
+        let start = problem.accel(cur.t, &cur.q.clone(), &cur.qd.clone(), &mut cur.qdd);
+        if let Err(e) = start {
+            return Err(early(e, problem.stats.clone()));
+        }
+        if let Some(c) = &problem.con {
+            cur.lambda.copy_from_slice(&c.lambda);
         }
         let newton = NewtonTol {
             atol: options.newton.atol,
@@ -319,7 +369,7 @@ impl<M: Model + 'static> Simulation<M> {
             }
             Output::Steps | Output::Last => Vec::new(),
         };
-        let mut traj = Trajectory::new(dof_names, frame_names);
+        let mut traj = new_traj();
         let expected = match &options.output {
             Output::Steps => 1024,
             Output::Last => 1,
@@ -345,6 +395,7 @@ impl<M: Model + 'static> Simulation<M> {
             poses: vec![Pose::default(); nf],
             observers: Vec::new(),
             options,
+            assembly,
         };
         // outputs at t0
         match sim.options.output {
@@ -376,6 +427,21 @@ impl<M: Model + 'static> Simulation<M> {
         &self.problem.model
     }
 
+    /// How the start was made consistent (constrained models only): residuals before and
+    /// after, iterations, the largest change.
+    pub fn assembly(&self) -> Option<&Assembly> {
+        self.assembly.as_ref()
+    }
+
+    /// The independent coordinates of coordinate partitioning, as they are now (empty for
+    /// other methods).
+    pub fn independent_coordinates(&self) -> Vec<String> {
+        match &self.problem.con {
+            Some(c) if c.mode == Mode::Partitioning => c.independent_labels(),
+            _ => Vec::new(),
+        }
+    }
+
     /// The step the next attempt will use.
     pub fn h(&self) -> f64 {
         self.h
@@ -390,7 +456,7 @@ impl<M: Model + 'static> Simulation<M> {
     }
 
     fn record(&mut self, s: &State) {
-        self.traj.push(s.t, &s.q, &s.qd, &s.qdd);
+        self.traj.push(s.t, &s.q, &s.qd, &s.qdd, &s.lambda);
         if self.options.energy {
             let e = self.problem.energy(s.t, &s.q, &s.qd);
             self.traj.energy.push(e);
@@ -405,7 +471,7 @@ impl<M: Model + 'static> Simulation<M> {
     }
 
     fn record_cur(&mut self) {
-        let s = std::mem::replace(&mut self.cur, State::zeros(0));
+        let s = std::mem::replace(&mut self.cur, State::zeros(0, 0));
         self.record(&s);
         self.cur = s;
     }
@@ -431,7 +497,7 @@ impl<M: Model + 'static> Simulation<M> {
                 {
                     let t = self.out_times[self.out_next];
                     self.out_next += 1;
-                    let mut s = std::mem::replace(&mut self.scratch, State::zeros(0));
+                    let mut s = std::mem::replace(&mut self.scratch, State::zeros(0, 0));
                     if t == self.cur.t {
                         s.copy_from(&self.cur);
                     } else {
@@ -488,9 +554,6 @@ impl<M: Model + 'static> Simulation<M> {
             match result {
                 Err(kind) => return Err(self.fail(kind, h)),
                 Ok(Attempt::Accepted { h_next }) => {
-                    if let Err(kind) = self.check_next() {
-                        return Err(self.fail(kind, h));
-                    }
                     self.next.t = if last {
                         t_stop
                     } else if fixed {
@@ -498,6 +561,13 @@ impl<M: Model + 'static> Simulation<M> {
                     } else {
                         self.cur.t + h
                     };
+                    if let Err(kind) = self
+                        .problem
+                        .after_step(&mut self.next)
+                        .and_then(|_| self.check_next())
+                    {
+                        return Err(self.fail(kind, h));
+                    }
                     self.problem.stats.record_step(h);
                     self.last_cause = None;
                     self.prev.copy_from(&self.cur);
@@ -544,7 +614,17 @@ impl<M: Model + 'static> Simulation<M> {
     fn check_next(&self) -> Result<(), Failure> {
         self.problem.check("q", &self.next.q)?;
         self.problem.check("qd", &self.next.qd)?;
-        self.problem.check("qdd", &self.next.qdd)
+        self.problem.check("qdd", &self.next.qdd)?;
+        match self.next.lambda.iter().position(|x| !x.is_finite()) {
+            None => Ok(()),
+            Some(i) => Err(Failure::NonFinite {
+                quantity: "λ",
+                coordinate: format!(
+                    "of constraint `{}`",
+                    self.problem.model.info().constraints[i]
+                ),
+            }),
+        }
     }
 }
 
@@ -625,6 +705,40 @@ fn initial_step<M: Model>(
         .max(o.h_min())
 }
 
+/// The constraint method a scheme runs: `Auto` resolved, unsupported pairs refused.
+fn constraint_mode(
+    method: ConstraintMethod,
+    scheme: &Scheme,
+    adaptive: bool,
+) -> Result<Mode, Failure> {
+    // without numerical damping, index 3 and step control do not go together
+    let undamped = adaptive && scheme.spectral_radius_at_infinity() == Some(1.0);
+    Ok(match method {
+        ConstraintMethod::Auto if scheme.solves_index3() && !undamped => Mode::Index3,
+        ConstraintMethod::Auto | ConstraintMethod::Projection => Mode::Projection,
+        ConstraintMethod::Index3 if !scheme.solves_index3() => {
+            return Err(Failure::ConstraintsUnsupported {
+                scheme: scheme.name(),
+                method: "index 3",
+                supported: INDEX3_SCHEMES,
+            });
+        }
+        ConstraintMethod::Index3 if undamped => {
+            return Err(Failure::ConstraintsUnsupported {
+                scheme: scheme.name(),
+                method: "index 3 with adaptive steps",
+                supported: "without numerical damping (ρ∞ = 1) the multipliers λ and the accelerations oscillate from step to step at index 3 (Cardona & Géradin 1989), which defeats the error estimate: use gen-alpha with ρ∞ < 1 or hht, fixed steps, or Projection",
+            });
+        }
+        ConstraintMethod::Index3 => Mode::Index3,
+        ConstraintMethod::Baumgarte { alpha, beta } => Mode::Baumgarte { alpha, beta },
+        ConstraintMethod::Partitioning => Mode::Partitioning,
+    })
+}
+
+/// The schemes that solve the index-3 equations, for messages.
+const INDEX3_SCHEMES: &str = "index-3 constraints are solved by gen-alpha, hht and newmark; every scheme takes them with Projection, Baumgarte or Partitioning";
+
 fn stepper_for<M: Model>(scheme: &Scheme, n: usize) -> Box<dyn Stepper<M>> {
     match *scheme {
         Scheme::ExplicitEuler => Box::new(explicit::Explicit::euler(n)),
@@ -660,10 +774,11 @@ mod tests {
                 q: vec![q],
                 qd: vec![v],
                 qdd: vec![a],
+                lambda: vec![],
             }
         };
         let (s0, s1) = (st(0.3), st(1.1));
-        let mut out = State::zeros(1);
+        let mut out = State::zeros(1, 0);
         for t in [0.3, 0.5, 0.77, 1.1] {
             hermite5(&s0, &s1, t, &mut out);
             let (q, v, a) = f(t);

@@ -17,7 +17,16 @@
 //! with the iteration matrix M + γ'·C_t + β'·K_t, γ' = γ h c, β' = β h² c,
 //! c = (1 − α_f)/(1 − α_m). Step control (when adaptive) uses the local error estimate of
 //! Zienkiewicz & Xie (1991), e ≈ h² (β − 1/6)(a₁ − a₀), of order 3 in h.
+//!
+//! ## Constraints at index 3
+//! With `Index3`, the step solves M qdd₁ = h₁ + B₁ᵀλ₁, Φ(q₁, t₁) = 0 for (qdd₁, λ₁) (Arnold &
+//! Brüls 2007, §4): the positions satisfy the constraints at every step to the constraint
+//! tolerance, the velocities only to O(h²). Newton uses the scaled iteration matrix of
+//! [`super::newton`]. λ₁ converges with order 2 for ρ∞ < 1; at ρ∞ = 1 (α_m = α_f = ½, and
+//! the trapezoidal Newmark) nothing damps the O(h) error the first step leaves in λ, which
+//! then oscillates from step to step (Cardona & Géradin 1989).
 
+use super::constrained::Mode;
 use super::newton::AccelNewton;
 use super::problem::Problem;
 use super::{Attempt, Control, State, Stepper, next_step};
@@ -39,6 +48,8 @@ pub(crate) struct AlphaFamily {
     qdd: Vec<f64>,
     err: Vec<f64>,
     newton: AccelNewton,
+    /// index 3: the multipliers being solved for (empty otherwise)
+    lam: Vec<f64>,
 }
 
 impl AlphaFamily {
@@ -57,6 +68,7 @@ impl AlphaFamily {
             qdd: z(),
             err: z(),
             newton: AccelNewton::new(n),
+            lam: Vec::new(),
         }
     }
 
@@ -80,8 +92,12 @@ impl AlphaFamily {
 }
 
 impl<M: Model> Stepper<M> for AlphaFamily {
-    fn start(&mut self, _p: &mut Problem<M>, s: &State, _ctl: &Control) -> Result<(), Failure> {
+    fn start(&mut self, p: &mut Problem<M>, s: &State, _ctl: &Control) -> Result<(), Failure> {
         self.a.copy_from_slice(&s.qdd);
+        if let Some(c) = p.con.as_ref().filter(|c| c.mode == Mode::Index3) {
+            self.newton.enable_index3(c.nc, c.scaling, c.tol);
+            self.lam = vec![0.0; c.nc];
+        }
         Ok(())
     }
 
@@ -102,8 +118,10 @@ impl<M: Model> Stepper<M> for AlphaFamily {
             self.vhat[i] = cur.qd[i] + h * ((1.0 - g) * self.a[i] + g * ac);
             self.qdd[i] = cur.qdd[i];
         }
+        let nl = self.lam.len();
+        self.lam.copy_from_slice(&cur.lambda[..nl]);
         let (bp, gp) = (b * h * h * c, g * h * c);
-        let result = self.newton.solve(
+        let result = self.newton.solve_index3(
             p,
             cur.t + h,
             &self.qhat,
@@ -111,6 +129,7 @@ impl<M: Model> Stepper<M> for AlphaFamily {
             bp,
             gp,
             &mut self.qdd,
+            &mut self.lam,
             &ctl.newton,
         );
         match result {
@@ -125,6 +144,7 @@ impl<M: Model> Stepper<M> for AlphaFamily {
             next.qdd[i] = self.qdd[i];
             self.a_next[i] = c * self.qdd[i] + (af * cur.qdd[i] - am * self.a[i]) / (1.0 - am);
         }
+        next.lambda[..self.lam.len()].copy_from_slice(&self.lam);
         let Some(_) = ctl.adaptive else {
             return Ok(Attempt::Accepted { h_next: h });
         };
@@ -147,4 +167,40 @@ impl<M: Model> Stepper<M> for AlphaFamily {
     fn accepted(&mut self, _p: &mut Problem<M>, _prev: &State, _cur: &State) {
         std::mem::swap(&mut self.a, &mut self.a_next);
     }
+}
+
+/// The iteration matrix of an index-3 generalized-α step of size `h` (N × N column-major,
+/// N = NQ + NC), evaluated at `state` (q, qd, qdd, λ), with the constraint rows scaled by
+/// 1/β' or not: the matrix the integrator factorises, exposed for condition studies.
+pub fn index3_iteration_matrix<M: Model>(
+    model: M,
+    params: GenAlphaParams,
+    h: f64,
+    state: &State,
+    scaled: bool,
+) -> Result<Vec<f64>, Failure> {
+    let options = crate::options::ConstraintOptions {
+        scaling: scaled,
+        ..Default::default()
+    };
+    let mut p = Problem::new(model, crate::options::IterationMatrix::Auto);
+    p.con = Some(super::constrained::Constrained::new(
+        &p.model,
+        Mode::Index3,
+        &options,
+    ));
+    let mut newton = AccelNewton::new(M::NQ);
+    newton.enable_index3(M::NC, scaled, options.tolerance);
+    let c = (1.0 - params.alpha_f) / (1.0 - params.alpha_m);
+    let (bp, gp) = (params.beta * h * h * c, params.gamma * h * c);
+    newton.index3_matrix_at(
+        &mut p,
+        state.t,
+        &state.q,
+        &state.qd,
+        &state.qdd,
+        &state.lambda,
+        bp,
+        gp,
+    )
 }

@@ -5,11 +5,32 @@
 //! iterations and steps while convergence is fast, refreshed when it slows or fails).
 //! Convergence follows Hairer & Wanner: with the contraction θ = ‖δ_k‖/‖δ_{k−1}‖, stop when
 //! θ/(1 − θ)·‖δ_k‖ ≤ κ in the norm of the position and velocity corrections.
+//!
+//! ## Index 3
+//! With constraints solved at index 3 (`Index3Newton::enable`), the unknowns are (a, λ) and
+//! the equations τ(t, q, v, a) − B(q)ᵀλ = 0, Φ(q, t)/β' = 0, with the iteration matrix
+//!
+//! ```text
+//! [ M + γ'C_t + β'(K_t − ∂(Bᵀλ)/∂q)   −Bᵀ ]
+//! [ B                                   0  ]
+//! ```
+//!
+//! Dividing the constraint rows by β' = O(h²) is the scaling of Bottasso, Dopico & Trainelli
+//! (2008) written for acceleration unknowns: unscaled (rows β'B, residual Φ) the condition
+//! number grows as h⁻², scaled it stays bounded as h → 0. The λ corrections count in the
+//! convergence norm with the Newton tolerance, floored at λ's rounding noise 10ε·max|q|/β'
+//! (a rounding error ε in Φ moves λ by ε/β'); convergence also requires the predicted |Φ_i|
+//! after the update to be below the constraint tolerance. The matrix is made afresh at every
+//! step (kept only within it): on the index-3 pendulum, matrices kept across steps needed
+//! 2–3 times the iterations of fresh ones and left λ less converged.
 
 use super::problem::Problem;
 use crate::error::Failure;
 use crate::linalg::Lu;
 use crate::model::Model;
+use crate::options::IterationMatrix;
+
+const INDEX3_MATRIX: &str = "the index-3 iteration matrix [M + γ'C + β'K, −Bᵀ; B, 0]";
 
 /// Weights of the convergence test: a correction δq_i counts as δq_i / (atol + rtol·|q_i|),
 /// likewise for velocities; converged when the predicted remaining correction is ≤ κ.
@@ -46,6 +67,16 @@ impl NewtonFail {
 pub(crate) struct AccelNewton {
     pub lu: Lu<f64>,
     n: usize,
+    /// index 3: constraints, scaling and tolerance on Φ, and buffers
+    nc: usize,
+    scaled: bool,
+    tol_phi: f64,
+    l0: Vec<f64>,
+    phi_max: f64,
+    mm: Vec<f64>,
+    cm: Vec<f64>,
+    km: Vec<f64>,
+    kc: Vec<f64>,
     valid: bool,
     /// (β', γ') the factorisation was made with
     coeffs: (f64, f64),
@@ -62,6 +93,15 @@ impl AccelNewton {
         AccelNewton {
             lu: Lu::new(n),
             n,
+            nc: 0,
+            scaled: true,
+            tol_phi: f64::INFINITY,
+            l0: Vec::new(),
+            phi_max: 0.0,
+            mm: Vec::new(),
+            cm: Vec::new(),
+            km: Vec::new(),
+            kc: Vec::new(),
             valid: false,
             coeffs: (f64::NAN, f64::NAN),
             refresh: true,
@@ -71,6 +111,20 @@ impl AccelNewton {
             r: vec![0.0; n],
             a0: vec![0.0; n],
         }
+    }
+
+    /// Solves for (a, λ) at index 3 from now on: `nc` constraints, the constraint rows
+    /// scaled by 1/β' when `scaled`, |Φ_i| ≤ `tol_phi` at convergence.
+    pub fn enable_index3(&mut self, nc: usize, scaled: bool, tol_phi: f64) {
+        let (n, z) = (self.n, |k: usize| vec![0.0; k]);
+        self.nc = nc;
+        self.scaled = scaled;
+        self.tol_phi = tol_phi;
+        self.lu = Lu::new(n + nc);
+        self.r = z(n + nc);
+        self.l0 = z(nc);
+        (self.mm, self.cm, self.km, self.kc) = (z(n * n), z(n * n), z(n * n), z(n * n));
+        self.valid = false;
     }
 
     /// Solves τ(t, q̂ + β'a, v̂ + γ'a, a) = 0; `a` holds the guess and receives the solution.
@@ -88,7 +142,28 @@ impl AccelNewton {
         a: &mut [f64],
         tol: &NewtonTol,
     ) -> Result<usize, NewtonFail> {
+        self.solve_index3(p, t, qhat, vhat, beta, gamma, a, &mut [], tol)
+    }
+
+    /// [`AccelNewton::solve`] with the multipliers λ as unknowns too (after
+    /// [`AccelNewton::enable_index3`]; `lambda` empty otherwise).
+    #[allow(clippy::too_many_arguments)]
+    pub fn solve_index3<M: Model>(
+        &mut self,
+        p: &mut Problem<M>,
+        t: f64,
+        qhat: &[f64],
+        vhat: &[f64],
+        beta: f64,
+        gamma: f64,
+        a: &mut [f64],
+        lambda: &mut [f64],
+        tol: &NewtonTol,
+    ) -> Result<usize, NewtonFail> {
+        let nc = lambda.len();
+        debug_assert_eq!(nc, self.nc);
         self.a0.copy_from_slice(a);
+        self.l0.copy_from_slice(lambda);
         // an iteration matrix made for a step within 20 % of this one is still a good
         // approximation (modified Newton); the contraction test refreshes it when it is not
         let close = |x: f64, y: f64| (x - y).abs() <= 0.2 * x.abs().max(y.abs());
@@ -96,16 +171,25 @@ impl AccelNewton {
         let mut total = 0;
         let mut last = f64::INFINITY;
         for pass in 0..2 {
-            let fresh = !(tol.reuse && self.valid && same && !self.refresh && pass == 0);
+            // index 3: a fresh matrix at every step (see the module notes)
+            let fresh = !(tol.reuse && self.valid && same && !self.refresh && pass == 0 && nc == 0);
             if pass == 1 {
                 // the reused matrix failed: start again from the guess with a fresh one
                 a.copy_from_slice(&self.a0);
+                lambda.copy_from_slice(&self.l0);
             }
             if fresh {
                 self.affine(qhat, vhat, beta, gamma, a);
-                if let Err(e) =
+                let made = if nc == 0 {
                     p.iteration_matrix(t, &self.q, &self.v, a, beta, gamma, &mut self.lu)
-                {
+                } else {
+                    self.index3_matrix(p, t, a, lambda, beta, gamma)
+                        .and_then(|_| {
+                            p.stats.factorizations += 1;
+                            self.lu.factor().map_err(|s| p.singular(INDEX3_MATRIX, s))
+                        })
+                };
+                if let Err(e) = made {
                     self.valid = false;
                     return Err(NewtonFail {
                         iterations: total,
@@ -121,7 +205,12 @@ impl AccelNewton {
             let mut eta = self.eta.max(f64::EPSILON).powf(0.8);
             for it in 0..tol.max_iterations {
                 self.affine(qhat, vhat, beta, gamma, a);
-                if let Err(e) = p.residual(t, &self.q, &self.v, a, &mut self.r) {
+                let n = self.n;
+                let mut res = p.residual(t, &self.q, &self.v, a, &mut self.r[..n]);
+                if nc > 0 && res.is_ok() {
+                    res = self.index3_residual(p, t, lambda, beta);
+                }
+                if let Err(e) = res {
                     self.valid = false;
                     return Err(NewtonFail {
                         iterations: total,
@@ -134,14 +223,24 @@ impl AccelNewton {
                 p.stats.newton_iterations += 1;
                 total += 1;
                 let mut s = 0.0;
-                for i in 0..self.n {
+                for i in 0..n {
                     let d = -self.r[i];
                     a[i] += d;
                     let eq = beta * d / (tol.atol + tol.rtol * self.q[i].abs());
                     let ev = gamma * d / (tol.atol + tol.rtol * self.v[i].abs());
                     s += eq * eq + ev * ev;
                 }
-                let norm = (s / (2 * self.n).max(1) as f64).sqrt();
+                // λ to the Newton tolerance, but not below the rounding of Φ/β' (λ's noise
+                // floor at index 3, ~ε|q|/β')
+                let qmax = self.q.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+                let floor = 10.0 * f64::EPSILON * qmax / beta;
+                for k in 0..nc {
+                    let d = -self.r[n + k];
+                    lambda[k] += d;
+                    let el = d / (tol.atol + tol.rtol * lambda[k].abs() + floor);
+                    s += el * el;
+                }
+                let norm = (s / (2 * n + nc).max(1) as f64).sqrt();
                 last = norm;
                 if !norm.is_finite() {
                     break;
@@ -156,7 +255,9 @@ impl AccelNewton {
                         self.refresh = true;
                     }
                 }
-                if eta * norm <= tol.kappa || norm == 0.0 {
+                // index 3: Φ after this update, predicted from its value before
+                let phi_ok = nc == 0 || self.phi_max * eta.min(1.0) <= self.tol_phi;
+                if (eta * norm <= tol.kappa || norm == 0.0) && phi_ok {
                     self.eta = eta;
                     self.affine(qhat, vhat, beta, gamma, a);
                     return Ok(total);
@@ -169,11 +270,109 @@ impl AccelNewton {
         }
         self.refresh = true;
         a.copy_from_slice(&self.a0);
+        lambda.copy_from_slice(&self.l0);
         Err(NewtonFail {
             iterations: total,
             correction: last,
             cause: None,
         })
+    }
+
+    /// r[..n] −= Bᵀλ at the current q; r[n..] = Φ(q)/β' (scaled) or Φ(q).
+    fn index3_residual<M: Model>(
+        &mut self,
+        p: &mut Problem<M>,
+        t: f64,
+        lambda: &[f64],
+        beta: f64,
+    ) -> Result<(), Failure> {
+        let (n, nc) = (self.n, self.nc);
+        let c = p.con.as_mut().expect("index 3 needs constraints");
+        c.eval_b(&p.model, &mut p.stats, t, &self.q);
+        c.eval_phi(&p.model, &mut p.stats, t, &self.q);
+        for j in 0..n {
+            self.r[j] -= (0..nc).map(|k| c.b[k + nc * j] * lambda[k]).sum::<f64>();
+        }
+        let s = if self.scaled { 1.0 / beta } else { 1.0 };
+        for k in 0..nc {
+            self.r[n + k] = s * c.phi[k];
+        }
+        self.phi_max = c.worst().0;
+        p.check("τ − Bᵀλ", &self.r[..n])
+    }
+
+    /// The index-3 iteration matrix at the current (q, v, a, λ), unfactorised, in `self.lu`.
+    #[allow(clippy::too_many_arguments)]
+    fn index3_matrix<M: Model>(
+        &mut self,
+        p: &mut Problem<M>,
+        t: f64,
+        a: &[f64],
+        lambda: &[f64],
+        beta: f64,
+        gamma: f64,
+    ) -> Result<(), Failure> {
+        let (n, nc) = (self.n, self.nc);
+        let big = n + nc;
+        p.tangent_matrices(
+            t,
+            &self.q,
+            &self.v,
+            a,
+            &mut self.mm,
+            &mut self.cm,
+            &mut self.km,
+        )?;
+        if p.iteration != IterationMatrix::MassOnly {
+            p.model.constraint_tangent(t, &self.q, lambda, &mut self.kc);
+            p.stats.constraints += 1;
+        } else {
+            self.kc.fill(0.0);
+        }
+        let c = p.con.as_mut().expect("index 3 needs constraints");
+        c.eval_b(&p.model, &mut p.stats, t, &self.q);
+        let s = if self.scaled { 1.0 } else { beta };
+        let m = self.lu.matrix_mut();
+        m.fill(0.0);
+        for j in 0..n {
+            for i in 0..n {
+                let x = i + n * j;
+                m[i + big * j] = self.mm[x] + gamma * self.cm[x] + beta * (self.km[x] - self.kc[x]);
+            }
+            for k in 0..nc {
+                let bkj = c.b[k + nc * j];
+                m[j + big * (n + k)] = -bkj;
+                m[(n + k) + big * j] = s * bkj;
+            }
+        }
+        if let Some(i) = m.iter().position(|x| !x.is_finite()) {
+            return Err(Failure::NonFinite {
+                quantity: "iteration matrix",
+                coordinate: p.label((i % big).min(n - 1)),
+            });
+        }
+        Ok(())
+    }
+
+    /// The index-3 iteration matrix (N × N, N = n + nc, column-major) at (t, q̂ + β'a,
+    /// v̂ + γ'a, a, λ), unfactorised: for condition studies.
+    #[allow(clippy::too_many_arguments)]
+    pub fn index3_matrix_at<M: Model>(
+        &mut self,
+        p: &mut Problem<M>,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        a: &[f64],
+        lambda: &[f64],
+        beta: f64,
+        gamma: f64,
+    ) -> Result<Vec<f64>, Failure> {
+        self.q.copy_from_slice(q);
+        self.v.copy_from_slice(v);
+        self.index3_matrix(p, t, a, lambda, beta, gamma)?;
+        self.valid = false;
+        Ok(self.lu.matrix_mut().to_vec())
     }
 
     fn affine(&mut self, qhat: &[f64], vhat: &[f64], beta: f64, gamma: f64, a: &[f64]) {

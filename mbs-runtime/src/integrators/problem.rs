@@ -1,7 +1,15 @@
 //! The model as the schemes see it: evaluations counted, results checked (a non-finite value
 //! is named by its coordinate), forward dynamics by Cholesky, residuals τ, and iteration
 //! matrices M + γ'·C_t + β'·K_t, all on buffers allocated once.
+//!
+//! A constrained model run by a method other than index 3 is, for the schemes, the ODE
+//! qdd = f(t, q, qd) of its index-1 form (projection, Baumgarte, partitioning): `accel` is f,
+//! the residual is a − f, and the iteration matrices are those of that ODE (M = I,
+//! C_t = −∂f/∂qd, K_t = −∂f/∂q), by forward differences of f whatever `iteration` says (the
+//! generated tangents are those of τ, not of f); `MassOnly` keeps I alone.
 
+use super::State;
+use super::constrained::{Constrained, Mode};
 use crate::error::Failure;
 use crate::linalg::{Lu, Singular, cholesky, cholesky_solve};
 use crate::model::Model;
@@ -27,6 +35,21 @@ pub(crate) struct Problem<M: Model> {
     qp: Vec<f64>,
     vp: Vec<f64>,
     ap: Vec<f64>,
+    /// constraints and how they are treated (None: unconstrained)
+    pub con: Option<Constrained>,
+    /// the point f is evaluated at (completed when partitioning), f, and scratch
+    qx: Vec<f64>,
+    vx: Vec<f64>,
+    fa: Vec<f64>,
+    fb: Vec<f64>,
+    dx: Vec<f64>,
+    /// the last index-1 evaluation: (t, q, qd) → (qdd, λ)
+    cache_valid: bool,
+    cache_t: f64,
+    cache_q: Vec<f64>,
+    cache_v: Vec<f64>,
+    cache_a: Vec<f64>,
+    cache_l: Vec<f64>,
 }
 
 impl<M: Model> Problem<M> {
@@ -57,7 +80,24 @@ impl<M: Model> Problem<M> {
             qp: z(),
             vp: z(),
             ap: z(),
+            con: None,
+            qx: z(),
+            vx: z(),
+            fa: z(),
+            fb: z(),
+            dx: z(),
+            cache_valid: false,
+            cache_t: f64::NAN,
+            cache_q: z(),
+            cache_v: z(),
+            cache_a: z(),
+            cache_l: vec![0.0; M::NC],
         }
+    }
+
+    /// The constrained model is integrated as the ODE of its index-1 form.
+    fn ode(&self) -> bool {
+        self.con.as_ref().is_some_and(|c| c.mode.is_ode())
     }
 
     /// Name of coordinate `i` for messages: `q[3]` or `q[3] (knee)`.
@@ -84,8 +124,63 @@ impl<M: Model> Problem<M> {
         }
     }
 
-    /// qdd from M qdd = h at (t, q, qd).
+    /// qdd from M qdd = h at (t, q, qd); for a constrained model, qdd and λ (in
+    /// `con.lambda`) of the index-1 equations, after completing the dependent coordinates
+    /// when partitioning.
     pub fn accel(&mut self, t: f64, q: &[f64], qd: &[f64], qdd: &mut [f64]) -> Result<(), Failure> {
+        let Some(c) = self.con.as_mut() else {
+            return self.plain_accel(t, q, qd, qdd);
+        };
+        if self.cache_valid && self.cache_t == t && self.cache_q == q && self.cache_v == qd {
+            qdd.copy_from_slice(&self.cache_a);
+            c.lambda.copy_from_slice(&self.cache_l);
+            return Ok(());
+        }
+        if c.mode == Mode::Partitioning {
+            c.complete(&self.model, &mut self.stats, t, q, qd)?;
+            self.qx.copy_from_slice(&c.qc);
+            self.vx.copy_from_slice(&c.vc);
+        } else {
+            self.qx.copy_from_slice(q);
+            self.vx.copy_from_slice(qd);
+        }
+        self.model
+            .dynamics(t, &self.qx, &self.vx, &self.u, &mut self.m, &mut self.h);
+        self.stats.dynamics += 1;
+        self.check("h", &self.h)?;
+        self.check("M", &self.m)?;
+        self.chol.copy_from_slice(&self.m);
+        self.stats.factorizations += 1;
+        cholesky(&mut self.chol, self.n).map_err(|s| self.singular("the mass matrix M", s))?;
+        let c = self.con.as_mut().expect("constrained");
+        c.kkt(
+            &self.model,
+            &mut self.stats,
+            &self.chol,
+            t,
+            &self.qx,
+            &self.vx,
+            &self.h,
+            qdd,
+        )?;
+        self.check("qdd", qdd)?;
+        let c = self.con.as_ref().expect("constrained");
+        self.cache_valid = true;
+        self.cache_t = t;
+        self.cache_q.copy_from_slice(q);
+        self.cache_v.copy_from_slice(qd);
+        self.cache_a.copy_from_slice(qdd);
+        self.cache_l.copy_from_slice(&c.lambda);
+        Ok(())
+    }
+
+    fn plain_accel(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &mut [f64],
+    ) -> Result<(), Failure> {
         self.model
             .dynamics(t, q, qd, &self.u, &mut self.m, &mut self.h);
         self.stats.dynamics += 1;
@@ -100,6 +195,80 @@ impl<M: Model> Problem<M> {
         self.check("qdd", qdd)
     }
 
+    /// f(t, q, qd) into `self.fa` (the ODE of the index-1 form).
+    fn f_into_fa(&mut self, t: f64, q: &[f64], qd: &[f64]) -> Result<(), Failure> {
+        let mut f = std::mem::take(&mut self.fa);
+        let r = self.accel(t, q, qd, &mut f);
+        self.fa = f;
+        r
+    }
+
+    /// f(t, q, qd) into `self.fb`.
+    fn f_into_fb(&mut self, t: f64, q: &[f64], qd: &[f64]) -> Result<(), Failure> {
+        let mut f = std::mem::take(&mut self.fb);
+        let r = self.accel(t, q, qd, &mut f);
+        self.fb = f;
+        r
+    }
+
+    /// Completes an accepted state of a constrained model: projection or completion of the
+    /// dependent coordinates (then qdd and λ there), λ of the index-1 form (Baumgarte), a
+    /// new partition when the current one is ill-conditioned, and the drift check (index 3,
+    /// Baumgarte). `next.lambda` is the scheme's for index 3.
+    pub fn after_step(&mut self, next: &mut State) -> Result<(), Failure> {
+        let Some(c) = self.con.as_mut() else {
+            return Ok(());
+        };
+        let t = next.t;
+        let mode = c.mode;
+        match mode {
+            Mode::Index3 => c.check_drift(&self.model, &mut self.stats, t, &next.q),
+            Mode::Baumgarte { .. } => {
+                self.f_into_fa(t, &next.q, &next.qd)?;
+                let c = self.con.as_mut().expect("constrained");
+                next.lambda.copy_from_slice(&c.lambda);
+                c.check_drift(&self.model, &mut self.stats, t, &next.q)
+            }
+            Mode::Projection => {
+                self.model.mass_matrix(t, &next.q, &mut self.chol);
+                self.stats.mass_matrix += 1;
+                self.stats.factorizations += 1;
+                cholesky(&mut self.chol, self.n)
+                    .map_err(|s| self.singular("the mass matrix M", s))?;
+                let c = self.con.as_mut().expect("constrained");
+                c.project(
+                    &self.model,
+                    &mut self.stats,
+                    &self.chol,
+                    t,
+                    &mut next.q,
+                    &mut next.qd,
+                    &mut self.dx,
+                )?;
+                let (q, qd) = (std::mem::take(&mut next.q), std::mem::take(&mut next.qd));
+                let r = self.accel(t, &q, &qd, &mut next.qdd);
+                (next.q, next.qd) = (q, qd);
+                r?;
+                next.lambda
+                    .copy_from_slice(&self.con.as_ref().expect("constrained").lambda);
+                Ok(())
+            }
+            Mode::Partitioning => {
+                c.complete(&self.model, &mut self.stats, t, &next.q, &next.qd)?;
+                next.q.copy_from_slice(&c.qc);
+                next.qd.copy_from_slice(&c.vc);
+                let (q, qd) = (std::mem::take(&mut next.q), std::mem::take(&mut next.qd));
+                let r = self.accel(t, &q, &qd, &mut next.qdd);
+                (next.q, next.qd) = (q, qd);
+                r?;
+                let c = self.con.as_mut().expect("constrained");
+                next.lambda.copy_from_slice(&c.lambda);
+                c.check_partition(&mut self.stats);
+                Ok(())
+            }
+        }
+    }
+
     /// The residual τ(t, q, qd, qdd) = M qdd − h.
     pub fn residual(
         &mut self,
@@ -109,9 +278,124 @@ impl<M: Model> Problem<M> {
         qdd: &[f64],
         r: &mut [f64],
     ) -> Result<(), Failure> {
+        if self.ode() {
+            // the index-1 ODE: a − f(t, q, qd)
+            self.f_into_fa(t, q, qd)?;
+            for i in 0..self.n {
+                r[i] = qdd[i] - self.fa[i];
+            }
+            return Ok(());
+        }
         self.model.inverse_dynamics(t, q, qd, qdd, &self.u, r);
         self.stats.inverse_dynamics += 1;
         self.check("τ", r)
+    }
+
+    /// Iteration matrix of the index-1 ODE, I + γ'·(−∂f/∂qd) + β'·(−∂f/∂q), by forward
+    /// differences of f along (β', γ')·e_j (I alone with `MassOnly`).
+    #[allow(clippy::too_many_arguments)]
+    fn ode_iteration_matrix(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        beta: f64,
+        gamma: f64,
+        lu: &mut Lu<f64>,
+    ) -> Result<(), Failure> {
+        let n = self.n;
+        {
+            let a = lu.matrix_mut();
+            a.fill(0.0);
+            for i in 0..n {
+                a[i + n * i] = 1.0;
+            }
+        }
+        if self.iteration != IterationMatrix::MassOnly {
+            self.f_into_fa(t, q, qd)?;
+            let mut qp = std::mem::take(&mut self.qp);
+            let mut vp = std::mem::take(&mut self.vp);
+            qp.copy_from_slice(q);
+            vp.copy_from_slice(qd);
+            let mut result = Ok(());
+            for j in 0..n {
+                let eps = f64::EPSILON.sqrt() * qdd[j].abs().max(1.0);
+                qp[j] += beta * eps;
+                vp[j] += gamma * eps;
+                result = self.f_into_fb(t, &qp, &vp);
+                qp[j] = q[j];
+                vp[j] = qd[j];
+                if result.is_err() {
+                    break;
+                }
+                let a = lu.matrix_mut();
+                for i in 0..n {
+                    a[i + n * j] -= (self.fb[i] - self.fa[i]) / eps;
+                }
+            }
+            self.qp = qp;
+            self.vp = vp;
+            result?;
+        }
+        self.stats.factorizations += 1;
+        lu.factor()
+            .map_err(|s| self.singular("the iteration matrix I − γ'∂f/∂qd − β'∂f/∂q", s))
+    }
+
+    /// M = I, C_t = −∂f/∂qd, K_t = −∂f/∂q of the index-1 ODE, by forward differences of f
+    /// (2n evaluations; C_t = K_t = 0 with `MassOnly`).
+    #[allow(clippy::too_many_arguments)]
+    fn ode_tangent_matrices(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        m: &mut [f64],
+        c: &mut [f64],
+        k: &mut [f64],
+    ) -> Result<(), Failure> {
+        let n = self.n;
+        m.fill(0.0);
+        for i in 0..n {
+            m[i + n * i] = 1.0;
+        }
+        c.fill(0.0);
+        k.fill(0.0);
+        if self.iteration == IterationMatrix::MassOnly {
+            return Ok(());
+        }
+        self.f_into_fa(t, q, qd)?;
+        let mut qp = std::mem::take(&mut self.qp);
+        let mut vp = std::mem::take(&mut self.vp);
+        qp.copy_from_slice(q);
+        vp.copy_from_slice(qd);
+        let mut result = Ok(());
+        for j in 0..n {
+            let eps = (q[j] + f64::EPSILON.sqrt() * q[j].abs().max(1.0)) - q[j];
+            qp[j] = q[j] + eps;
+            result = self.f_into_fb(t, &qp, qd);
+            qp[j] = q[j];
+            if result.is_err() {
+                break;
+            }
+            for i in 0..n {
+                k[i + n * j] = -(self.fb[i] - self.fa[i]) / eps;
+            }
+            let eps = (qd[j] + f64::EPSILON.sqrt() * qd[j].abs().max(1.0)) - qd[j];
+            vp[j] = qd[j] + eps;
+            result = self.f_into_fb(t, q, &vp);
+            vp[j] = qd[j];
+            if result.is_err() {
+                break;
+            }
+            for i in 0..n {
+                c[i + n * j] = -(self.fb[i] - self.fa[i]) / eps;
+            }
+        }
+        self.qp = qp;
+        self.vp = vp;
+        result
     }
 
     /// Fills and factorises the iteration matrix M + γ'·C_t + β'·K_t at (t, q, qd, qdd): the
@@ -127,6 +411,9 @@ impl<M: Model> Problem<M> {
         gamma: f64,
         lu: &mut Lu<f64>,
     ) -> Result<(), Failure> {
+        if self.ode() {
+            return self.ode_iteration_matrix(t, q, qd, qdd, beta, gamma, lu);
+        }
         let n = self.n;
         match self.iteration {
             IterationMatrix::Exact | IterationMatrix::Auto => {
@@ -212,6 +499,9 @@ impl<M: Model> Problem<M> {
         c: &mut [f64],
         k: &mut [f64],
     ) -> Result<(), Failure> {
+        if self.ode() {
+            return self.ode_tangent_matrices(t, q, qd, m, c, k);
+        }
         let n = self.n;
         self.model.mass_matrix(t, q, m);
         self.stats.mass_matrix += 1;

@@ -1,0 +1,832 @@
+//! Constrained systems `M qdd = h + Bᵀλ`, `Φ(q, t) = 0`, `B = ∂Φ/∂q`: the pieces every
+//! constraint method shares, on buffers allocated once.
+//!
+//! - **Index-1 accelerations** (KKT): with M = L Lᵀ (Cholesky), Y = L⁻¹Bᵀ and the Schur
+//!   complement S = B M⁻¹ Bᵀ = YᵀY (positive definite while B has full rank),
+//!   λ = S⁻¹(γ − Yᵀ L⁻¹h) and qdd = L⁻ᵀ(L⁻¹h + Yλ), so that B qdd = γ and M qdd = h + Bᵀλ.
+//!   Baumgarte replaces γ by γ − 2αΦ̇ − β²Φ.
+//! - **Projection** in the metric of M: q ← q − M⁻¹Bᵀ S⁻¹ Φ(q) (Newton, B re-evaluated,
+//!   M frozen) until |Φ_i| ≤ tolerance, then qd ← qd − M⁻¹Bᵀ S⁻¹ (B qd + Φ_t): the nearest
+//!   consistent state in kinetic-energy distance.
+//! - **Coordinate partitioning** (Wehage & Haug 1982): q = (dependent d, independent i); for
+//!   given independent q_i, qd_i, Newton on Φ(q) = 0 over q_d with B_d (nc × nc), then
+//!   B_d qd_d = −Φ_t − B_i qd_i. The dependent set is the one complete pivoting on B picks;
+//!   it is chosen again when the condition of B_d falls ten times below that of the best set.
+//! - **Assembly** ([`assemble`]): Newton on Φ(q₀) = 0 moving only the coordinates not marked
+//!   `independent` (minimal correction in the metric of M, halved until |Φ| decreases), with
+//!   a branch check: the sign of det B over a square set of dependent coordinates must not
+//!   change, since two assembly branches are separated by singular configurations; then the
+//!   velocity projection with the marked velocities kept. The residuals before and after are
+//!   reported in [`Assembly`].
+
+use crate::error::Failure;
+use crate::linalg::{Lu, Singular, backward, cholesky, cholesky_solve, forward, norm1};
+use crate::model::Model;
+use crate::options::ConstraintOptions;
+use crate::stats::Stats;
+use serde::Serialize;
+use std::fmt;
+
+/// How a run treats the constraints (the resolved [`crate::ConstraintMethod`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Mode {
+    Index3,
+    Baumgarte { alpha: f64, beta: f64 },
+    Projection,
+    Partitioning,
+}
+
+impl Mode {
+    /// The scheme integrates the ODE qdd = f(t, q, qd) of the index-1 form (all but index 3).
+    pub fn is_ode(&self) -> bool {
+        !matches!(self, Mode::Index3)
+    }
+}
+
+pub(crate) struct Constrained {
+    pub mode: Mode,
+    n: usize,
+    pub nc: usize,
+    names: Vec<String>,
+    dof_labels: Vec<String>,
+    pub tol: f64,
+    /// index 3: scale the constraint rows of the iteration matrix
+    pub scaling: bool,
+    drift_tol: f64,
+    max_iterations: usize,
+    pub phi: Vec<f64>,
+    /// B (nc × n, column-major)
+    pub b: Vec<f64>,
+    pub phi_t: Vec<f64>,
+    pub gamma: Vec<f64>,
+    /// λ of the last index-1 solve
+    pub lambda: Vec<f64>,
+    /// Y = L⁻¹Bᵀ (n × nc) and the Cholesky factor of S = YᵀY (nc × nc)
+    y: Vec<f64>,
+    s: Vec<f64>,
+    w: Vec<f64>,
+    r: Vec<f64>,
+    /// partitioning: dependent and independent coordinates, B_d's LU, completed q and qd
+    pub dep: Vec<usize>,
+    pub ind: Vec<usize>,
+    lu_d: Lu<f64>,
+    pivot: Vec<f64>,
+    used: Vec<bool>,
+    best: Vec<usize>,
+    pub qc: Vec<f64>,
+    pub vc: Vec<f64>,
+}
+
+impl Constrained {
+    pub fn new<M: Model>(model: &M, mode: Mode, o: &ConstraintOptions) -> Constrained {
+        let (n, nc) = (M::NQ, M::NC);
+        let info = model.info();
+        let z = |k: usize| vec![0.0; k];
+        Constrained {
+            mode,
+            n,
+            nc,
+            names: info.constraints.iter().map(|s| s.to_string()).collect(),
+            dof_labels: (0..n).map(|i| info.dof_label(i)).collect(),
+            tol: o.tolerance,
+            scaling: o.scaling,
+            drift_tol: o.drift_tol,
+            max_iterations: o.max_iterations,
+            phi: z(nc),
+            b: z(nc * n),
+            phi_t: z(nc),
+            gamma: z(nc),
+            lambda: z(nc),
+            y: z(n * nc),
+            s: z(nc * nc),
+            w: z(n),
+            r: z(nc),
+            dep: Vec::with_capacity(nc),
+            ind: Vec::with_capacity(n),
+            lu_d: Lu::new(nc),
+            pivot: z(nc * n),
+            used: vec![false; n],
+            best: Vec::with_capacity(nc),
+            qc: z(n),
+            vc: z(n),
+        }
+    }
+
+    /// Name of constraint `i`.
+    pub fn name(&self, i: usize) -> String {
+        self.names
+            .get(i)
+            .cloned()
+            .unwrap_or_else(|| format!("#{i}"))
+    }
+
+    pub fn eval_phi<M: Model>(&mut self, m: &M, st: &mut Stats, t: f64, q: &[f64]) {
+        m.constraints(t, q, &mut self.phi);
+        st.constraints += 1;
+    }
+
+    pub fn eval_b<M: Model>(&mut self, m: &M, st: &mut Stats, t: f64, q: &[f64]) {
+        m.constraint_jacobian(t, q, &mut self.b);
+        st.constraints += 1;
+    }
+
+    fn eval_phi_t<M: Model>(&mut self, m: &M, st: &mut Stats, t: f64, q: &[f64]) {
+        m.constraint_rate(t, q, &mut self.phi_t);
+        st.constraints += 1;
+    }
+
+    /// Largest |Φ_i| of `self.phi`, and i.
+    pub fn worst(&self) -> (f64, usize) {
+        worst(&self.phi)
+    }
+
+    /// Y = L⁻¹Bᵀ and the Cholesky factor of S = YᵀY, with L the Cholesky factor of M.
+    fn schur(&mut self, l: &[f64], st: &mut Stats) -> Result<(), Singular> {
+        let (n, nc) = (self.n, self.nc);
+        for i in 0..nc {
+            let yi = &mut self.y[i * n..(i + 1) * n];
+            for j in 0..n {
+                yi[j] = self.b[i + nc * j];
+            }
+            forward(l, n, yi);
+        }
+        for i in 0..nc {
+            for j in 0..=i {
+                let mut x = 0.0;
+                for k in 0..n {
+                    x += self.y[k + n * i] * self.y[k + n * j];
+                }
+                self.s[i + nc * j] = x;
+                self.s[j + nc * i] = x;
+            }
+        }
+        st.factorizations += 1;
+        cholesky(&mut self.s, nc)
+    }
+
+    /// x = M⁻¹Bᵀ S⁻¹ r after [`Constrained::schur`]; `self.r` holds r on entry.
+    fn correction(&mut self, l: &[f64], st: &mut Stats, x: &mut [f64]) {
+        let (n, nc) = (self.n, self.nc);
+        cholesky_solve(&self.s, nc, &mut self.r);
+        for k in 0..n {
+            x[k] = (0..nc).map(|i| self.y[k + n * i] * self.r[i]).sum();
+        }
+        backward(l, n, x);
+        st.solves += 1;
+    }
+
+    /// The failure for a singular S at (t, q): rank, smallest singular value and the
+    /// constraints involved, from the SVD of B (the run stops: allocating is fine).
+    pub fn rank_failure<M: Model>(&mut self, m: &M, st: &mut Stats, t: f64, q: &[f64]) -> Failure {
+        self.eval_b(m, st, t, q);
+        rank_failure(&self.b, self.nc, self.n, &self.names)
+    }
+
+    /// qdd and λ of the index-1 equations at (t, q, qd), with L the Cholesky factor of M(q)
+    /// and `h` = h(q, qd); Baumgarte's terms when the mode has them.
+    #[allow(clippy::too_many_arguments)]
+    pub fn kkt<M: Model>(
+        &mut self,
+        m: &M,
+        st: &mut Stats,
+        l: &[f64],
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        h: &[f64],
+        qdd: &mut [f64],
+    ) -> Result<(), Failure> {
+        let (n, nc) = (self.n, self.nc);
+        self.eval_b(m, st, t, q);
+        m.constraint_bias(t, q, qd, &mut self.gamma);
+        st.constraints += 1;
+        if let Mode::Baumgarte { alpha, beta } = self.mode {
+            if alpha != 0.0 || beta != 0.0 {
+                self.eval_phi(m, st, t, q);
+                self.eval_phi_t(m, st, t, q);
+                for i in 0..nc {
+                    let rate =
+                        self.phi_t[i] + (0..n).map(|j| self.b[i + nc * j] * qd[j]).sum::<f64>();
+                    self.gamma[i] -= 2.0 * alpha * rate + beta * beta * self.phi[i];
+                }
+            }
+        }
+        if self.schur(l, st).is_err() {
+            return Err(self.rank_failure(m, st, t, q));
+        }
+        self.w.copy_from_slice(h);
+        forward(l, n, &mut self.w);
+        for i in 0..nc {
+            let yz: f64 = (0..n).map(|k| self.y[k + n * i] * self.w[k]).sum();
+            self.lambda[i] = self.gamma[i] - yz;
+        }
+        cholesky_solve(&self.s, nc, &mut self.lambda);
+        for k in 0..n {
+            qdd[k] = self.w[k]
+                + (0..nc)
+                    .map(|i| self.y[k + n * i] * self.lambda[i])
+                    .sum::<f64>();
+        }
+        backward(l, n, qdd);
+        st.solves += 2;
+        Ok(())
+    }
+
+    /// Projects q onto Φ(q, t) = 0 and qd onto Φ̇ = 0 in the metric of M (L its Cholesky
+    /// factor at the unprojected q).
+    #[allow(clippy::too_many_arguments)]
+    pub fn project<M: Model>(
+        &mut self,
+        m: &M,
+        st: &mut Stats,
+        l: &[f64],
+        t: f64,
+        q: &mut [f64],
+        qd: &mut [f64],
+        dx: &mut [f64],
+    ) -> Result<(), Failure> {
+        let (n, nc) = (self.n, self.nc);
+        st.projections += 1;
+        let mut it = 0;
+        loop {
+            self.eval_phi(m, st, t, q);
+            let (worst, at) = self.worst();
+            if worst <= self.tol {
+                break;
+            }
+            if it == self.max_iterations || !worst.is_finite() {
+                return Err(Failure::ClosureFailed {
+                    what: "all coordinates (projection)",
+                    constraint: self.name(at),
+                    residual: worst,
+                    iterations: it,
+                });
+            }
+            self.eval_b(m, st, t, q);
+            if self.schur(l, st).is_err() {
+                return Err(self.rank_failure(m, st, t, q));
+            }
+            self.r.copy_from_slice(&self.phi);
+            self.correction(l, st, dx);
+            for k in 0..n {
+                q[k] -= dx[k];
+            }
+            it += 1;
+        }
+        self.eval_b(m, st, t, q);
+        self.eval_phi_t(m, st, t, q);
+        if self.schur(l, st).is_err() {
+            return Err(self.rank_failure(m, st, t, q));
+        }
+        for i in 0..nc {
+            self.r[i] = self.phi_t[i] + (0..n).map(|j| self.b[i + nc * j] * qd[j]).sum::<f64>();
+        }
+        self.correction(l, st, dx);
+        for k in 0..n {
+            qd[k] -= dx[k];
+        }
+        Ok(())
+    }
+
+    /// Partitioning: q_d and qd_d completed from q_i, qd_i (starting from the given q_d)
+    /// into `self.qc`, `self.vc`.
+    pub fn complete<M: Model>(
+        &mut self,
+        m: &M,
+        st: &mut Stats,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+    ) -> Result<(), Failure> {
+        let nc = self.nc;
+        st.projections += 1;
+        let mut qc = std::mem::take(&mut self.qc);
+        qc.copy_from_slice(q);
+        let mut it = 0;
+        let result = loop {
+            self.eval_phi(m, st, t, &qc);
+            let (worst, at) = self.worst();
+            self.eval_b(m, st, t, &qc);
+            if let Err(e) = self.factor_dependent(st) {
+                break Err(self.singular_partition(e));
+            }
+            if worst <= self.tol {
+                break Ok(());
+            }
+            if it == self.max_iterations || !worst.is_finite() {
+                break Err(Failure::ClosureFailed {
+                    what: "the dependent coordinates (partitioning)",
+                    constraint: self.name(at),
+                    residual: worst,
+                    iterations: it,
+                });
+            }
+            self.r.copy_from_slice(&self.phi);
+            self.lu_d.solve(&mut self.r);
+            st.solves += 1;
+            for (k, &d) in self.dep.iter().enumerate() {
+                qc[d] -= self.r[k];
+            }
+            it += 1;
+        };
+        self.qc = qc;
+        result?;
+        // B_d qd_d = −Φ_t − B_i qd_i with B at the closed q
+        let qc = std::mem::take(&mut self.qc);
+        self.eval_phi_t(m, st, t, &qc);
+        self.qc = qc;
+        self.vc.copy_from_slice(qd);
+        for i in 0..nc {
+            self.r[i] = -self.phi_t[i]
+                - self
+                    .ind
+                    .iter()
+                    .map(|&j| self.b[i + nc * j] * qd[j])
+                    .sum::<f64>();
+        }
+        self.lu_d.solve(&mut self.r);
+        st.solves += 1;
+        for (k, &d) in self.dep.iter().enumerate() {
+            self.vc[d] = self.r[k];
+        }
+        Ok(())
+    }
+
+    /// LU of B_d = B[:, dep].
+    fn factor_dependent(&mut self, st: &mut Stats) -> Result<(), Singular> {
+        let nc = self.nc;
+        let a = self.lu_d.matrix_mut();
+        for (k, &d) in self.dep.iter().enumerate() {
+            a[k * nc..(k + 1) * nc].copy_from_slice(&self.b[d * nc..(d + 1) * nc]);
+        }
+        st.factorizations += 1;
+        self.lu_d.factor()
+    }
+
+    fn singular_partition(&self, e: Singular) -> Failure {
+        Failure::SingularMatrix {
+            matrix: "B over the dependent coordinates (partitioning)",
+            rcond: e.rcond,
+            coordinates: vec![self.dof_labels[self.dep[e.column.min(self.dep.len() - 1)]].clone()],
+        }
+    }
+
+    /// Reciprocal condition (1-norm estimate) of B over `cols`, with B evaluated.
+    fn rcond_of(&mut self, cols: &[usize], st: &mut Stats) -> f64 {
+        let nc = self.nc;
+        let a = self.lu_d.matrix_mut();
+        for (k, &d) in cols.iter().enumerate() {
+            a[k * nc..(k + 1) * nc].copy_from_slice(&self.b[d * nc..(d + 1) * nc]);
+        }
+        let anorm = norm1(a, nc);
+        st.factorizations += 1;
+        if self.lu_d.factor().is_err() || anorm == 0.0 {
+            return 0.0;
+        }
+        let (inv, _) = self.lu_d.inverse_norm_estimate();
+        if inv > 0.0 { 1.0 / (anorm * inv) } else { 0.0 }
+    }
+
+    /// The dependent set complete pivoting on B picks (into `self.best`), B evaluated.
+    fn pivot_choice(&mut self) {
+        let (n, nc) = (self.n, self.nc);
+        self.pivot.copy_from_slice(&self.b);
+        self.used.fill(false);
+        self.best.clear();
+        let mut rows_left: u64 = if nc >= 64 { u64::MAX } else { (1u64 << nc) - 1 };
+        for _ in 0..nc {
+            let (mut bi, mut bj, mut bv) = (usize::MAX, usize::MAX, -1.0);
+            for j in 0..n {
+                if self.used[j] {
+                    continue;
+                }
+                for i in 0..nc {
+                    if rows_left & (1 << i) == 0 {
+                        continue;
+                    }
+                    let v = self.pivot[i + nc * j].abs();
+                    if v > bv {
+                        (bi, bj, bv) = (i, j, v);
+                    }
+                }
+            }
+            if bj == usize::MAX {
+                break;
+            }
+            self.used[bj] = true;
+            self.best.push(bj);
+            rows_left &= !(1 << bi);
+            let p = self.pivot[bi + nc * bj];
+            if p == 0.0 {
+                continue;
+            }
+            for i in 0..nc {
+                if rows_left & (1 << i) == 0 {
+                    continue;
+                }
+                let f = self.pivot[i + nc * bj] / p;
+                for j in 0..n {
+                    self.pivot[i + nc * j] -= f * self.pivot[bi + nc * j];
+                }
+            }
+        }
+        self.best.sort_unstable();
+    }
+
+    /// Sets the partition: `preferred` independent coordinates when B over the others is
+    /// not ten times worse conditioned than the pivoting choice, else that choice. B must be
+    /// evaluated. Returns whether the dependent set changed.
+    pub fn choose_partition(&mut self, preferred: Option<&[bool]>, st: &mut Stats) -> bool {
+        let (n, nc) = (self.n, self.nc);
+        self.pivot_choice();
+        let best = std::mem::take(&mut self.best);
+        let r_best = self.rcond_of(&best, st);
+        let mut cand: Vec<usize> = Vec::new();
+        if let Some(p) = preferred {
+            cand.extend((0..n).filter(|&j| !p[j]));
+        } else {
+            cand.extend_from_slice(&self.dep);
+        }
+        let keep = cand.len() == nc && self.rcond_of(&cand, st) >= 0.1 * r_best;
+        let chosen = if keep { cand } else { best.clone() };
+        self.best = best;
+        let changed = chosen != self.dep;
+        self.dep.clear();
+        self.dep.extend_from_slice(&chosen);
+        self.ind.clear();
+        self.ind.extend((0..n).filter(|j| !self.dep.contains(j)));
+        changed
+    }
+
+    /// After an accepted step with partitioning (B evaluated at the completed q): a new
+    /// partition when the current one has become ill-conditioned.
+    pub fn check_partition(&mut self, st: &mut Stats) {
+        let r_cur = {
+            let dep = std::mem::take(&mut self.dep);
+            let r = self.rcond_of(&dep, st);
+            self.dep = dep;
+            r
+        };
+        self.pivot_choice();
+        let best = std::mem::take(&mut self.best);
+        let r_best = self.rcond_of(&best, st);
+        if best != self.dep && r_cur < 0.1 * r_best {
+            self.dep.clear();
+            self.dep.extend_from_slice(&best);
+            self.ind.clear();
+            let n = self.n;
+            self.ind.extend((0..n).filter(|j| !best.contains(j)));
+            st.repartitions += 1;
+        }
+        self.best = best;
+    }
+
+    /// The independent coordinates' labels.
+    pub fn independent_labels(&self) -> Vec<String> {
+        self.ind
+            .iter()
+            .map(|&j| self.dof_labels[j].clone())
+            .collect()
+    }
+
+    /// `ConstraintDrift` when some |Φ_i(t, q)| exceeds the drift tolerance.
+    pub fn check_drift<M: Model>(
+        &mut self,
+        m: &M,
+        st: &mut Stats,
+        t: f64,
+        q: &[f64],
+    ) -> Result<(), Failure> {
+        self.eval_phi(m, st, t, q);
+        let (worst, at) = self.worst();
+        if worst > self.drift_tol || !worst.is_finite() {
+            return Err(Failure::ConstraintDrift {
+                constraint: self.name(at),
+                value: worst,
+                tolerance: self.drift_tol,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Largest |x_i| and i.
+fn worst(x: &[f64]) -> (f64, usize) {
+    let mut best = (0.0, 0);
+    for (i, v) in x.iter().enumerate() {
+        if !(v.abs() <= best.0) {
+            best = (v.abs(), i);
+            if !v.is_finite() {
+                return (f64::INFINITY, i);
+            }
+        }
+    }
+    best
+}
+
+/// Rank, smallest singular value and the constraints involved in B's deficiency.
+fn rank_failure(b: &[f64], nc: usize, n: usize, names: &[String]) -> Failure {
+    let (rank, sigma_min, involved) = rank_of(b, nc, n);
+    Failure::RankDeficientConstraints {
+        rank,
+        nc,
+        sigma_min,
+        constraints: involved.iter().map(|&i| names[i].clone()).collect(),
+    }
+}
+
+/// Numerical rank of B (nc × n, column-major; σ ≤ 1e-10·σ_max counts as zero), its smallest
+/// singular value, and the constraints with large components in the left singular vectors
+/// of the vanishing singular values (the equations that repeat or cancel each other).
+fn rank_of(b: &[f64], nc: usize, n: usize) -> (usize, f64, Vec<usize>) {
+    let mat = nalgebra::DMatrix::from_column_slice(nc, n, b);
+    // Bᵀ's SVD when nc > n keeps the thin factors square enough for U
+    let bbt = &mat * mat.transpose();
+    let eig = nalgebra::SymmetricEigen::new(bbt);
+    let mut order: Vec<usize> = (0..nc).collect();
+    order.sort_by(|&i, &j| eig.eigenvalues[i].total_cmp(&eig.eigenvalues[j]));
+    let smax = eig
+        .eigenvalues
+        .iter()
+        .fold(0.0f64, |a, &v| a.max(v))
+        .max(0.0)
+        .sqrt();
+    let sigma = |i: usize| eig.eigenvalues[i].max(0.0).sqrt();
+    let rank = (0..nc).filter(|&i| sigma(i) > 1e-10 * smax).count();
+    let sigma_min = sigma(order[0]);
+    let mut involved = Vec::new();
+    for &k in order
+        .iter()
+        .take(nc - rank.min(nc))
+        .chain(order.iter().take(1))
+    {
+        let u = eig.eigenvectors.column(k);
+        let umax = u.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        for i in 0..nc {
+            if u[i].abs() >= 0.3 * umax && !involved.contains(&i) {
+                involved.push(i);
+            }
+        }
+    }
+    involved.sort_unstable();
+    (rank, sigma_min, involved)
+}
+
+/// The consistent start of a constrained model, as found by [`assemble`].
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Assembly {
+    /// largest |Φ_i| at the given q₀, and after assembly
+    pub residual_before: f64,
+    pub residual_after: f64,
+    /// largest |Φ̇_i| at the given qd₀, and after the velocity projection
+    pub rate_residual_before: f64,
+    pub rate_residual_after: f64,
+    /// Newton iterations on the positions
+    pub iterations: usize,
+    /// the coordinate that moved most, and by how much (positions)
+    pub largest_change: (String, f64),
+    /// the coordinates kept as given (marked `independent`)
+    pub kept: Vec<String>,
+}
+
+impl fmt::Display for Assembly {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "assembly: max |Φ| {:.2e} → {:.2e} in {} iterations (largest change {} by {:.3e}), max |Φ̇| {:.2e} → {:.2e}; kept {}",
+            self.residual_before,
+            self.residual_after,
+            self.iterations,
+            self.largest_change.0,
+            self.largest_change.1,
+            self.rate_residual_before,
+            self.rate_residual_after,
+            if self.kept.is_empty() {
+                "none".to_string()
+            } else {
+                self.kept.join(", ")
+            }
+        )
+    }
+}
+
+/// Makes (q, qd) consistent with Φ(q, t) = 0 and Φ̇ = 0: Newton on the coordinates not
+/// marked `independent` (minimal correction in the metric of M, step halved until max |Φ|
+/// decreases), refusing a result on another assembly branch; then the velocities of those
+/// coordinates from B qd = −Φ_t. Typed errors: redundant constraints (rank of B), too many
+/// coordinates marked independent, no convergence, a change of branch.
+pub fn assemble<M: Model>(
+    model: &M,
+    t: f64,
+    q: &mut [f64],
+    qd: &mut [f64],
+    o: &ConstraintOptions,
+) -> Result<Assembly, Failure> {
+    use nalgebra::{DMatrix, DVector};
+    let (n, nc) = (M::NQ, M::NC);
+    let info = model.info();
+    let names: Vec<String> = info.constraints.iter().map(|s| s.to_string()).collect();
+    let label = |i: usize| info.dof_label(i);
+    let kept: Vec<usize> = (0..n)
+        .filter(|&i| info.independent.get(i) == Some(&true))
+        .collect();
+    let free: Vec<usize> = (0..n).filter(|i| !kept.contains(i)).collect();
+    let mut phi = vec![0.0; nc];
+    let mut b = vec![0.0; nc * n];
+    let mut mm = vec![0.0; n * n];
+    let eval = |q: &[f64], phi: &mut [f64]| {
+        model.constraints(t, q, phi);
+        worst(phi)
+    };
+    let (before, at0) = eval(q, &mut phi);
+    let fail = |reason: String, phi: &[f64], it: usize| {
+        let (r, at) = worst(phi);
+        Failure::InconsistentStart {
+            reason,
+            constraint: names.get(at).cloned().unwrap_or_default(),
+            residual: r,
+            iterations: it,
+        }
+    };
+    if !before.is_finite() {
+        return Err(fail(
+            format!("Φ is not finite at q₀ (constraint `{}`)", names[at0]),
+            &phi,
+            0,
+        ));
+    }
+    if free.len() < nc {
+        return Err(fail(
+            format!(
+                "{} coordinates are marked independent, so only {} are left to close {} constraints: mark at most {}",
+                kept.len(),
+                free.len(),
+                nc,
+                n.saturating_sub(nc)
+            ),
+            &phi,
+            0,
+        ));
+    }
+    // B over the free coordinates, the metric M_ff and the correction −W⁻¹B_fᵀ(B_f W⁻¹B_fᵀ)⁻¹r
+    let restricted = |b: &[f64]| DMatrix::from_fn(nc, free.len(), |i, k| b[i + nc * free[k]]);
+    let metric =
+        |mm: &[f64]| DMatrix::from_fn(free.len(), free.len(), |a, c| mm[free[a] + n * free[c]]);
+    let correction = |bf: &DMatrix<f64>, w: &DMatrix<f64>, r: &[f64]| -> Option<DVector<f64>> {
+        let winv_bt = w.clone().cholesky()?.solve(&bf.transpose());
+        let s = bf * &winv_bt;
+        let x = s.cholesky()?.solve(&DVector::from_column_slice(r));
+        Some(winv_bt * x)
+    };
+    let deficient = |b: &[f64], phi: &[f64], it: usize| -> Failure {
+        let (rank, _, _) = rank_of(b, nc, n);
+        if rank < nc {
+            rank_failure(b, nc, n, &names)
+        } else {
+            fail(
+                format!(
+                    "the coordinates marked independent ({}) leave B over the others rank-deficient: the loop cannot close by moving {}; mark other coordinates",
+                    kept.iter()
+                        .map(|&i| label(i))
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                    free.iter()
+                        .map(|&i| label(i))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+                phi,
+                it,
+            )
+        }
+    };
+    model.constraint_jacobian(t, q, &mut b);
+    // a square set of free coordinates for the branch check (complete pivoting)
+    let square: Vec<usize> = {
+        let bf = restricted(&b);
+        let mut piv = bf;
+        let mut cols = Vec::new();
+        let mut rows: Vec<usize> = (0..nc).collect();
+        for _ in 0..nc {
+            let mut best = (0.0, 0, 0);
+            for &i in &rows {
+                for k in 0..free.len() {
+                    if !cols.contains(&k) && piv[(i, k)].abs() > best.0 {
+                        best = (piv[(i, k)].abs(), i, k);
+                    }
+                }
+            }
+            let (v, bi, bk) = best;
+            if v == 0.0 {
+                break;
+            }
+            cols.push(bk);
+            rows.retain(|&i| i != bi);
+            for &i in &rows {
+                let f = piv[(i, bk)] / piv[(bi, bk)];
+                for k in 0..free.len() {
+                    let x = piv[(bi, k)];
+                    piv[(i, k)] -= f * x;
+                }
+            }
+        }
+        cols.sort_unstable();
+        cols
+    };
+    let det_sign = |b: &[f64]| -> f64 {
+        if square.len() < nc {
+            return 0.0;
+        }
+        DMatrix::from_fn(nc, nc, |i, k| b[i + nc * free[square[k]]])
+            .determinant()
+            .signum()
+    };
+    let sign0 = det_sign(&b);
+    let q_start = q.to_vec();
+    let mut it = 0;
+    let mut res = before;
+    while res > o.tolerance {
+        if it == o.max_iterations {
+            return Err(fail(
+                "Newton on the positions did not converge".into(),
+                &phi,
+                it,
+            ));
+        }
+        model.constraint_jacobian(t, q, &mut b);
+        model.mass_matrix(t, q, &mut mm);
+        let bf = restricted(&b);
+        let Some(dx) = correction(&bf, &metric(&mm), &phi) else {
+            return Err(deficient(&b, &phi, it));
+        };
+        let mut step = 1.0;
+        let mut trial = q.to_vec();
+        let mut phi_trial = vec![0.0; nc];
+        loop {
+            for (k, &j) in free.iter().enumerate() {
+                trial[j] = q[j] - step * dx[k];
+            }
+            let (r, _) = eval(&trial, &mut phi_trial);
+            if r < res || step < 1e-3 {
+                res = r;
+                break;
+            }
+            step *= 0.5;
+        }
+        if !res.is_finite() {
+            return Err(fail(
+                "Φ became non-finite during Newton".into(),
+                &phi_trial,
+                it + 1,
+            ));
+        }
+        q.copy_from_slice(&trial);
+        phi.copy_from_slice(&phi_trial);
+        it += 1;
+    }
+    model.constraint_jacobian(t, q, &mut b);
+    let (rank, _, _) = rank_of(&b, nc, n);
+    if rank < nc {
+        return Err(rank_failure(&b, nc, n, &names));
+    }
+    let sign1 = det_sign(&b);
+    if sign0 != 0.0 && sign1 != sign0 {
+        q.copy_from_slice(&q_start);
+        return Err(fail(
+            "Newton closed the loop on another assembly branch (det B over the dependent coordinates changed sign): start closer to the intended configuration".into(),
+            &phi,
+            it,
+        ));
+    }
+    // velocities: B qd = −Φ_t with the kept velocities unchanged
+    let mut phi_t = vec![0.0; nc];
+    model.constraint_rate(t, q, &mut phi_t);
+    let rate = |qd: &[f64]| -> Vec<f64> {
+        (0..nc)
+            .map(|i| phi_t[i] + (0..n).map(|j| b[i + nc * j] * qd[j]).sum::<f64>())
+            .collect()
+    };
+    let r0 = rate(qd);
+    let (rate_before, _) = worst(&r0);
+    model.mass_matrix(t, q, &mut mm);
+    let bf = restricted(&b);
+    let Some(dv) = correction(&bf, &metric(&mm), &r0) else {
+        return Err(deficient(&b, &phi, it));
+    };
+    for (k, &j) in free.iter().enumerate() {
+        qd[j] -= dv[k];
+    }
+    let (rate_after, _) = worst(&rate(qd));
+    let (change, moved) = (0..n)
+        .map(|j| ((q[j] - q_start[j]).abs(), j))
+        .fold((0.0, 0), |a, b| if b.0 > a.0 { b } else { a });
+    Ok(Assembly {
+        residual_before: before,
+        residual_after: res,
+        rate_residual_before: rate_before,
+        rate_residual_after: rate_after,
+        iterations: it,
+        largest_change: (label(moved), change),
+        kept: kept.iter().map(|&i| label(i)).collect(),
+    })
+}

@@ -6,11 +6,16 @@
 //! --h H           fixed step (s); without it the scheme controls its step by --rtol/--atol
 //! --rtol R --atol A
 //! --dt DT         output every DT seconds (default: every step)
+//! --constraints M auto, index3, projection, partitioning, baumgarte:ALPHA,BETA
+//!                 (constrained models; default auto)
 //! --out DIR       write DIR/trajectory.csv
 //! --quiet         print nothing but errors
 //! ```
 
-use crate::{Model, Options, Output, Scheme, SimError, Stats, StepControl, Trajectory, simulate};
+use crate::{
+    ConstraintMethod, ConstraintOptions, Model, Options, Output, Scheme, SimError, Simulation,
+    Stats, StepControl, Trajectory,
+};
 use clap::Parser;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -40,6 +45,10 @@ pub struct RunArgs {
     /// write DIR/trajectory.csv
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// constraint method of constrained models: auto, index3, projection, partitioning or
+    /// baumgarte:ALPHA,BETA (1/s)
+    #[arg(long, default_value = "auto", value_parser = parse_constraint_method)]
+    pub constraints: ConstraintMethod,
     /// print nothing but errors
     #[arg(long)]
     pub quiet: bool,
@@ -83,6 +92,29 @@ pub enum RunError {
     },
 }
 
+/// `auto`, `index3`, `projection`, `partitioning` or `baumgarte:ALPHA,BETA`.
+pub fn parse_constraint_method(s: &str) -> Result<ConstraintMethod, String> {
+    let bad = || {
+        format!(
+            "unknown constraint method `{s}`: use auto, index3, projection, partitioning or baumgarte:ALPHA,BETA"
+        )
+    };
+    Ok(match s {
+        "auto" => ConstraintMethod::Auto,
+        "index3" => ConstraintMethod::Index3,
+        "projection" => ConstraintMethod::Projection,
+        "partitioning" => ConstraintMethod::Partitioning,
+        _ => {
+            let rest = s.strip_prefix("baumgarte:").ok_or_else(bad)?;
+            let (a, b) = rest.split_once(',').ok_or_else(bad)?;
+            ConstraintMethod::Baumgarte {
+                alpha: a.trim().parse().map_err(|_| bad())?,
+                beta: b.trim().parse().map_err(|_| bad())?,
+            }
+        }
+    })
+}
+
 impl RunArgs {
     /// The options these arguments describe, with `t_end` as the default end time.
     pub fn options(&self, t_end: f64) -> Options {
@@ -103,6 +135,10 @@ impl RunArgs {
             t_end,
             step,
             output,
+            constraints: ConstraintOptions {
+                method: self.constraints,
+                ..ConstraintOptions::default()
+            },
             ..Options::default()
         }
     }
@@ -117,8 +153,15 @@ impl RunArgs {
             .ok_or_else(|| RunError::UnknownScheme(self.scheme.clone()))?;
         let name = model.info().name;
         let start = Instant::now();
-        let (trajectory, stats) = simulate(model, scheme, self.options(default_t_end))
-            .map_err(|e| RunError::Simulation(Box::new(e)))?;
+        let options = self.options(default_t_end);
+        let t_end = options.t_end;
+        let fail = |e| RunError::Simulation(Box::new(e));
+        let mut sim = Simulation::new(model, scheme, options).map_err(fail)?;
+        if let (Some(a), false) = (sim.assembly(), self.quiet) {
+            println!("{a}");
+        }
+        crate::Integrator::integrate_to(&mut sim, t_end).map_err(fail)?;
+        let (trajectory, stats) = sim.finish();
         let report = RunReport {
             scheme,
             trajectory,

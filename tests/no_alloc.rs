@@ -1,10 +1,23 @@
 //! No allocation per step after warm-up: a counting global allocator watches every scheme
-//! take 200 steps after its first 20, with fixed steps and, where it has them, adaptive ones.
+//! take 200 steps after its first 20, with fixed steps and, where it has them, adaptive ones;
+//! then a constrained model with every constraint method. (One test: the allocator counts
+//! every thread.)
 
 #[path = "../examples/models/dpend.rs"]
 mod dpend;
 
-use mbs::{Integrator, Options, Output, Scheme, Simulation};
+use mbs::{ConstraintMethod, GenAlphaParams, Integrator, Options, Output, Scheme, Simulation};
+
+mbs::multibody! {
+    /// Cash's pendulum in Cartesian coordinates (MODELS.md pendulum3).
+    model Pendulum3 {
+        dof x = 1.0, qd = 0.0; dof y = 0.0, qd = 1.0;
+        body m { mass = 1.0; }
+        TOG[m] = Tdisp(x, y, 0);
+        gravity(0, -1, 0);
+        constraint rod = -(x * x + y * y - 1.0) / 2.0;
+    }
+}
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -61,5 +74,49 @@ fn steps_allocate_nothing_after_warm_up() {
                 scheme.name()
             );
         }
+    }
+    let gen_alpha = Scheme::GenAlpha(GenAlphaParams::from_rho_inf(0.8));
+    for (scheme, method) in [
+        (gen_alpha, ConstraintMethod::Index3),
+        (Scheme::Dopri5, ConstraintMethod::Projection),
+        (
+            Scheme::Bdf(Default::default()),
+            ConstraintMethod::Projection,
+        ),
+        (Scheme::Rk4, ConstraintMethod::Partitioning),
+        (
+            Scheme::Rk4,
+            ConstraintMethod::Baumgarte {
+                alpha: 5.0,
+                beta: 5.0,
+            },
+        ),
+    ] {
+        let base = if scheme.is_adaptive() {
+            Options::adaptive(100.0, 1e-7)
+        } else {
+            Options::fixed(100.0, 1e-3)
+        };
+        let mut opts = Options {
+            output: Output::Every { dt: 0.01 },
+            ..base
+        };
+        opts.constraints.method = method;
+        let mut sim = Simulation::new(Pendulum3::default(), scheme, opts).unwrap();
+        for _ in 0..20 {
+            sim.step().unwrap();
+        }
+        let before = ALLOCATIONS.load(Ordering::Relaxed);
+        for _ in 0..200 {
+            sim.step().unwrap();
+        }
+        let allocated = ALLOCATIONS.load(Ordering::Relaxed) - before;
+        assert_eq!(
+            allocated,
+            0,
+            "{} with {} allocated {allocated} times in 200 steps",
+            scheme.name(),
+            method.name()
+        );
     }
 }

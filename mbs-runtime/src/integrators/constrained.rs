@@ -288,6 +288,27 @@ impl Constrained {
         Ok(())
     }
 
+    /// e ← e − M⁻¹Bᵀ S⁻¹ B e: the part of e tangent to the constraints in the metric of M
+    /// (L its Cholesky factor, B evaluated), which removes any M⁻¹Bᵀx component.
+    pub fn tangent_part(
+        &mut self,
+        st: &mut Stats,
+        l: &[f64],
+        e: &mut [f64],
+        dx: &mut [f64],
+    ) -> Result<(), Singular> {
+        let (n, nc) = (self.n, self.nc);
+        self.schur(l, st)?;
+        for i in 0..nc {
+            self.r[i] = (0..n).map(|j| self.b[i + nc * j] * e[j]).sum();
+        }
+        self.correction(l, st, dx);
+        for k in 0..n {
+            e[k] -= dx[k];
+        }
+        Ok(())
+    }
+
     /// Partitioning: q_d and qd_d completed from q_i, qd_i (starting from the given q_d)
     /// into `self.qc`, `self.vc`.
     pub fn complete<M: Model>(

@@ -74,8 +74,6 @@ pub(crate) struct AccelNewton {
     l0: Vec<f64>,
     phi_max: f64,
     mm: Vec<f64>,
-    cm: Vec<f64>,
-    km: Vec<f64>,
     kc: Vec<f64>,
     valid: bool,
     /// (β', γ') the factorisation was made with
@@ -99,8 +97,6 @@ impl AccelNewton {
             l0: Vec::new(),
             phi_max: 0.0,
             mm: Vec::new(),
-            cm: Vec::new(),
-            km: Vec::new(),
             kc: Vec::new(),
             valid: false,
             coeffs: (f64::NAN, f64::NAN),
@@ -123,7 +119,7 @@ impl AccelNewton {
         self.lu = Lu::new(n + nc);
         self.r = z(n + nc);
         self.l0 = z(nc);
-        (self.mm, self.cm, self.km, self.kc) = (z(n * n), z(n * n), z(n * n), z(n * n));
+        (self.mm, self.kc) = (z(n * n), z(n * n));
         self.valid = false;
     }
 
@@ -314,15 +310,7 @@ impl AccelNewton {
     ) -> Result<(), Failure> {
         let (n, nc) = (self.n, self.nc);
         let big = n + nc;
-        p.tangent_matrices(
-            t,
-            &self.q,
-            &self.v,
-            a,
-            &mut self.mm,
-            &mut self.cm,
-            &mut self.km,
-        )?;
+        p.iteration_block(t, &self.q, &self.v, a, beta, gamma, &mut self.mm)?;
         if p.iteration != IterationMatrix::MassOnly {
             p.model.constraint_tangent(t, &self.q, lambda, &mut self.kc);
             p.stats.constraints += 1;
@@ -337,7 +325,7 @@ impl AccelNewton {
         for j in 0..n {
             for i in 0..n {
                 let x = i + n * j;
-                m[i + big * j] = self.mm[x] + gamma * self.cm[x] + beta * (self.km[x] - self.kc[x]);
+                m[i + big * j] = self.mm[x] - beta * self.kc[x];
             }
             for k in 0..nc {
                 let bkj = c.b[k + nc * j];

@@ -211,6 +211,29 @@ impl<M: Model> Problem<M> {
         r
     }
 
+    /// The part of `e` tangent to the constraints at (t, q) in the metric of M(q): index-3
+    /// error estimates leave out the components M⁻¹Bᵀx that only the multipliers move.
+    pub fn tangent_part(&mut self, t: f64, q: &[f64], e: &mut [f64]) -> Result<(), Failure> {
+        if self.con.is_none() {
+            return Ok(());
+        }
+        self.model.mass_matrix(t, q, &mut self.chol);
+        self.stats.mass_matrix += 1;
+        self.stats.factorizations += 1;
+        if let Err(s) = cholesky(&mut self.chol, self.n) {
+            return Err(self.singular("the mass matrix M", s));
+        }
+        let c = self.con.as_mut().expect("constrained");
+        c.eval_b(&self.model, &mut self.stats, t, q);
+        if c.tangent_part(&mut self.stats, &self.chol, e, &mut self.dx)
+            .is_err()
+        {
+            let c = self.con.as_mut().expect("constrained");
+            return Err(c.rank_failure(&self.model, &mut self.stats, t, q));
+        }
+        Ok(())
+    }
+
     /// Completes an accepted state of a constrained model: projection or completion of the
     /// dependent coordinates (then qdd and λ there), λ of the index-1 form (Baumgarte), a
     /// new partition when the current one is ill-conditioned, and the drift check (index 3,
@@ -414,6 +437,26 @@ impl<M: Model> Problem<M> {
         if self.ode() {
             return self.ode_iteration_matrix(t, q, qd, qdd, beta, gamma, lu);
         }
+        self.iteration_block(t, q, qd, qdd, beta, gamma, lu.matrix_mut())?;
+        self.stats.factorizations += 1;
+        lu.factor()
+            .map_err(|s| self.singular("the iteration matrix M + γ'C + β'K", s))
+    }
+
+    /// M + γ'·C_t + β'·K_t of the model's τ at (t, q, qd, qdd) into `a` (n × n, column-major),
+    /// unfactorised, as `self.iteration` says: exact (M and the generated tangents), mass
+    /// only, or forward differences of τ along (β', γ', 1)·e_j (n + 1 evaluations).
+    #[allow(clippy::too_many_arguments)]
+    pub fn iteration_block(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        beta: f64,
+        gamma: f64,
+        a: &mut [f64],
+    ) -> Result<(), Failure> {
         let n = self.n;
         match self.iteration {
             IterationMatrix::Exact | IterationMatrix::Auto => {
@@ -431,7 +474,6 @@ impl<M: Model> Problem<M> {
                     });
                 }
                 self.stats.tangents += 1;
-                let a = lu.matrix_mut();
                 for i in 0..n * n {
                     a[i] = self.m[i] + gamma * self.c[i] + beta * self.k[i];
                 }
@@ -439,7 +481,7 @@ impl<M: Model> Problem<M> {
             IterationMatrix::MassOnly => {
                 self.model.mass_matrix(t, q, &mut self.m);
                 self.stats.mass_matrix += 1;
-                lu.matrix_mut().copy_from_slice(&self.m);
+                a.copy_from_slice(&self.m);
             }
             IterationMatrix::FiniteDifferences => {
                 self.model
@@ -465,22 +507,19 @@ impl<M: Model> Problem<M> {
                     self.qp[j] = q[j];
                     self.vp[j] = qd[j];
                     self.ap[j] = qdd[j];
-                    let a = lu.matrix_mut();
                     for i in 0..n {
                         a[i + n * j] = (self.tau1[i] - self.tau0[i]) / eps;
                     }
                 }
             }
         }
-        if let Some(i) = lu.matrix_mut().iter().position(|x| !x.is_finite()) {
+        if let Some(i) = a.iter().position(|x| !x.is_finite()) {
             return Err(Failure::NonFinite {
                 quantity: "iteration matrix",
                 coordinate: self.label(i % n),
             });
         }
-        self.stats.factorizations += 1;
-        lu.factor()
-            .map_err(|s| self.singular("the iteration matrix M + γ'C + β'K", s))
+        Ok(())
     }
 
     /// The pieces of the iteration matrix, unfactorised, for schemes that combine them with

@@ -151,3 +151,41 @@ fn four_bar_constraints_match_central_differences() {
         }
     }
 }
+
+#[test]
+fn constraint_functions_have_op_counts_in_the_model_info() {
+    use mbs::Model;
+    let info = FourBar::default().info();
+    let labels: Vec<&str> = info.ops.iter().map(|(l, _)| *l).collect();
+    for l in [
+        "constraints Φ",
+        "constraint_jacobian B",
+        "constraint_rate Φ_t",
+        "constraint_bias γ",
+        "constraint_tangent",
+    ] {
+        let ops = info.ops.iter().find(|(k, _)| *k == l);
+        let Some((_, c)) = ops else {
+            panic!("no op count for {l} in {labels:?}")
+        };
+        // a closed loop's Φ, B, γ and tangent all involve the angles
+        if l != "constraint_rate Φ_t" {
+            assert!(c.flops() > 0 && c.funcs > 0, "{l}: {c:?}");
+        }
+    }
+    // an unconstrained model lists none
+    mbs::multibody! {
+        model Free {
+            dof x = 0.0;
+            body b { mass = 1.0; }
+            TOG[b] = Tdisp(x, 0, 0);
+        }
+    }
+    let free = Free::default();
+    assert!(
+        free.info()
+            .ops
+            .iter()
+            .all(|(l, _)| !l.starts_with("constraint"))
+    );
+}

@@ -103,9 +103,17 @@ pub fn generate(sys: System, vis: &str) -> Result<Generated, Vec<MissingDerivati
     let mut code = String::new();
     let mut reports = Vec::new();
     let mut missing = Vec::new();
-    emit_params(&model, vis, &mut code, &mut missing);
+    let shared = emit_params(&model, vis, &mut code, &mut missing);
     for eq in &model.scenes {
-        emit_scene(&model, eq, vis, &mut code, &mut reports, &mut missing);
+        emit_scene(
+            &model,
+            eq,
+            vis,
+            &shared,
+            &mut code,
+            &mut reports,
+            &mut missing,
+        );
     }
     if !missing.is_empty() {
         missing.dedup();
@@ -142,12 +150,14 @@ fn collect<T>(
     }
 }
 
+/// The parameter struct with its derived values and the constraint functions (shared by
+/// every scene); returns the op counts of the constraint functions when there are any.
 fn emit_params(
     model: &SymbolicModel,
     vis: &str,
     code: &mut String,
     missing: &mut Vec<MissingDerivative>,
-) {
+) -> Vec<(String, OpCount)> {
     let sys = &model.sys;
     let a = &sys.arena;
     let ty = format!("{}Params", sys.name);
@@ -247,9 +257,20 @@ fn emit_params(
     );
     f.matrix(a, "k", &c.tangent);
     specs.push(f);
-    for spec in &specs {
-        if let Some(s) = collect(emit_fn(a, spec, &names), missing, |s, _| s) {
+    let labels = [
+        "constraints Φ",
+        "constraint_jacobian B",
+        "constraint_rate Φ_t",
+        "constraint_bias γ",
+        "constraint_tangent",
+    ];
+    let mut ops = Vec::new();
+    for (spec, label) in specs.iter().zip(labels) {
+        if let Some((s, count)) = collect(emit_fn(a, spec, &names), missing, |s, c| (s, c)) {
             derived.push_str(&s);
+            if !c.phi.is_empty() {
+                ops.push((label.to_string(), count));
+            }
         }
     }
     let _ = writeln!(
@@ -294,6 +315,7 @@ Ok(())
         sets = sets.join("\n"),
         checks = checks.join("\n"),
     );
+    ops
 }
 
 fn dense3(a: &crate::expr::Arena, cols: &world::Cols, n: usize) -> Vec<Vec<ExprId>> {
@@ -306,6 +328,7 @@ fn emit_scene(
     model: &SymbolicModel,
     eq: &SceneEquations,
     vis: &str,
+    shared: &[(String, OpCount)],
     code: &mut String,
     reports: &mut Vec<FunctionReport>,
     missing: &mut Vec<MissingDerivative>,
@@ -455,6 +478,15 @@ fn emit_scene(
                 });
             }
         }
+    }
+    // the constraint functions, emitted once on the parameters, serve every scene
+    for (label, c) in shared {
+        ops.push((label.clone(), *c));
+        reports.push(FunctionReport {
+            model: ty.clone(),
+            function: label.clone(),
+            ops: *c,
+        });
     }
 
     // the type, its docs and the trait impl

@@ -560,31 +560,27 @@ fn rank_failure(b: &[f64], nc: usize, n: usize, names: &[String]) -> Failure {
 /// singular value, and the constraints with large components in the left singular vectors
 /// of the vanishing singular values (the equations that repeat or cancel each other).
 fn rank_of(b: &[f64], nc: usize, n: usize) -> (usize, f64, Vec<usize>) {
-    let mat = nalgebra::DMatrix::from_column_slice(nc, n, b);
-    // Bᵀ's SVD when nc > n keeps the thin factors square enough for U
-    let bbt = &mat * mat.transpose();
-    let eig = nalgebra::SymmetricEigen::new(bbt);
-    let mut order: Vec<usize> = (0..nc).collect();
-    order.sort_by(|&i, &j| eig.eigenvalues[i].total_cmp(&eig.eigenvalues[j]));
-    let smax = eig
-        .eigenvalues
-        .iter()
-        .fold(0.0f64, |a, &v| a.max(v))
-        .max(0.0)
-        .sqrt();
-    let sigma = |i: usize| eig.eigenvalues[i].max(0.0).sqrt();
-    let rank = (0..nc).filter(|&i| sigma(i) > 1e-10 * smax).count();
-    let sigma_min = sigma(order[0]);
+    // B padded with zero columns to at least nc × nc, so that U is square
+    let cols = n.max(nc);
+    let mat = nalgebra::DMatrix::from_fn(nc, cols, |i, j| if j < n { b[i + nc * j] } else { 0.0 });
+    let svd = mat.svd(true, false);
+    let u = svd.u.expect("U requested");
+    let sigma = &svd.singular_values;
+    let smax = sigma.iter().fold(0.0f64, |a, &v| a.max(v));
+    let mut order: Vec<usize> = (0..sigma.len()).collect();
+    order.sort_by(|&i, &j| sigma[i].total_cmp(&sigma[j]));
+    let rank = (0..sigma.len())
+        .filter(|&i| sigma[i] > 1e-10 * smax)
+        .count()
+        .min(nc);
+    let sigma_min = sigma[order[0]];
     let mut involved = Vec::new();
-    for &k in order
-        .iter()
-        .take(nc - rank.min(nc))
-        .chain(order.iter().take(1))
-    {
-        let u = eig.eigenvectors.column(k);
-        let umax = u.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    // the left singular vectors of the vanishing singular values (or of the smallest one)
+    for &k in order.iter().take((nc - rank).max(1)) {
+        let uk = u.column(k);
+        let umax = uk.iter().fold(0.0f64, |a, v| a.max(v.abs()));
         for i in 0..nc {
-            if u[i].abs() >= 0.3 * umax && !involved.contains(&i) {
+            if uk[i].abs() >= 0.3 * umax && !involved.contains(&i) {
                 involved.push(i);
             }
         }
@@ -850,4 +846,34 @@ pub fn assemble<M: Model>(
         largest_change: (label(moved), change),
         kept: kept.iter().map(|&i| label(i)).collect(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::rank_of;
+
+    /// B (nc × n) from rows.
+    fn cols(rows: &[&[f64]]) -> Vec<f64> {
+        let (nc, n) = (rows.len(), rows[0].len());
+        (0..nc * n).map(|k| rows[k % nc][k / nc]).collect()
+    }
+
+    #[test]
+    fn rank_finds_zero_and_repeated_rows() {
+        // full rank
+        let b = cols(&[&[1.0, 0.0, 2.0], &[0.0, 1.0, -1.0]]);
+        assert_eq!(rank_of(&b, 2, 3).0, 2);
+        // a vanishing row (an out-of-plane equation of a planar loop): that row is named
+        let b = cols(&[&[1.0, 0.0, 2.0], &[0.0, 0.0, 0.0], &[0.0, 1.0, -1.0]]);
+        let (rank, smin, involved) = rank_of(&b, 3, 3);
+        assert_eq!((rank, involved), (2, vec![1]));
+        assert!(smin < 1e-12);
+        // the same equation twice, scaled: both are named
+        let b = cols(&[&[1.0, 2.0, 0.0], &[0.0, 0.0, 1.0], &[-2.0, -4.0, 0.0]]);
+        let (rank, _, involved) = rank_of(&b, 3, 3);
+        assert_eq!((rank, involved), (2, vec![0, 2]));
+        // more equations than coordinates
+        let b = cols(&[&[1.0], &[2.0]]);
+        assert_eq!(rank_of(&b, 2, 1).0, 1);
+    }
 }

@@ -331,10 +331,8 @@ impl Constrained {
             if let Err(e) = self.factor_dependent(st) {
                 break Err(self.singular_partition(e));
             }
-            if worst <= self.tol {
-                break Ok(());
-            }
-            if it == self.max_iterations || !worst.is_finite() {
+            let converged = worst <= self.tol;
+            if it == self.max_iterations && !converged || !worst.is_finite() {
                 break Err(Failure::ClosureFailed {
                     what: "the dependent coordinates (partitioning)",
                     constraint: self.name(at),
@@ -347,6 +345,14 @@ impl Constrained {
             st.solves += 1;
             for (k, &d) in self.dep.iter().enumerate() {
                 qc[d] -= self.r[k];
+            }
+            if converged {
+                // the last correction too: with an ill-conditioned B_d, |Φ| ≤ tolerance alone
+                // leaves q_d off by cond·tolerance; then B at the final q for the velocities
+                self.eval_b(m, st, t, &qc);
+                break self
+                    .factor_dependent(st)
+                    .map_err(|e| self.singular_partition(e));
             }
             it += 1;
         };
@@ -589,6 +595,9 @@ fn rank_of(b: &[f64], nc: usize, n: usize) -> (usize, f64, Vec<usize>) {
     (rank, sigma_min, involved)
 }
 
+/// Largest move of a coordinate in one assembly step (rad or m).
+const MAX_MOVE: f64 = 0.5;
+
 /// The consistent start of a constrained model, as found by [`assemble`].
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Assembly {
@@ -628,8 +637,9 @@ impl fmt::Display for Assembly {
 }
 
 /// Makes (q, qd) consistent with Φ(q, t) = 0 and Φ̇ = 0: Newton on the coordinates not
-/// marked `independent` (minimal correction in the metric of M, step halved until max |Φ|
-/// decreases), refusing a result on another assembly branch; then the velocities of those
+/// marked `independent` (minimal correction in the metric of M, no coordinate moved by more
+/// than 0.5 per step, step halved until max |Φ| decreases), refusing a result on another
+/// assembly branch; then the velocities of those
 /// coordinates from B qd = −Φ_t. Typed errors: redundant constraints (rank of B), too many
 /// coordinates marked independent, no convergence, a change of branch.
 pub fn assemble<M: Model>(
@@ -673,6 +683,11 @@ pub fn assemble<M: Model>(
         ));
     }
     if free.len() < nc {
+        // redundant equations first: no marking would close them
+        model.constraint_jacobian(t, q, &mut b);
+        if rank_of(&b, nc, n).0 < nc {
+            return Err(rank_failure(&b, nc, n, &names));
+        }
         return Err(fail(
             format!(
                 "{} coordinates are marked independent, so only {} are left to close {} constraints: mark at most {}",
@@ -776,7 +791,10 @@ pub fn assemble<M: Model>(
         let Some(dx) = correction(&bf, &metric(&mm), &phi) else {
             return Err(deficient(&b, &phi, it));
         };
-        let mut step = 1.0;
+        // at most MAX_MOVE per coordinate and step, so that a far start does not wander off
+        // by whole turns
+        let biggest = dx.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let mut step = (MAX_MOVE / biggest).min(1.0);
         let mut trial = q.to_vec();
         let mut phi_trial = vec![0.0; nc];
         loop {
@@ -784,7 +802,7 @@ pub fn assemble<M: Model>(
                 trial[j] = q[j] - step * dx[k];
             }
             let (r, _) = eval(&trial, &mut phi_trial);
-            if r < res || step < 1e-3 {
+            if r < res || step < 1e-4 {
                 res = r;
                 break;
             }

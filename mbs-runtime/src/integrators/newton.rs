@@ -18,9 +18,10 @@
 //! Dividing the constraint rows by β' = O(h²) is the scaling of Bottasso, Dopico & Trainelli
 //! (2008) written for acceleration unknowns: unscaled (rows β'B, residual Φ) the condition
 //! number grows as h⁻², scaled it stays bounded as h → 0. The λ corrections count in the
-//! convergence norm with the Newton tolerance, floored at λ's rounding noise 10ε·max|q|/β'
-//! (a rounding error ε in Φ moves λ by ε/β'); convergence also requires the predicted |Φ_i|
-//! after the update to be below the constraint tolerance. The matrix is made afresh at every
+//! convergence norm with the Newton tolerance; every weight is floored at the variable's
+//! rounding noise (a rounding error ε|q| in Φ moves λ by ε|q|/β' and v by ε|q|γ'/β'), so that
+//! tight tolerances at small steps do not ask for digits that do not exist. Convergence also
+//! requires the predicted |Φ_i| after the update to be below the constraint tolerance. The matrix is made afresh at every
 //! step (kept only within it): on the index-3 pendulum, matrices kept across steps needed
 //! 2–3 times the iterations of fresh ones and left λ less converged.
 
@@ -218,22 +219,27 @@ impl AccelNewton {
                 p.stats.solves += 1;
                 p.stats.newton_iterations += 1;
                 total += 1;
+                // index 3: no variable resolves below the rounding of Φ: q to ~ε|q|, λ to
+                // ~ε|q|/β' (Φ/β' is solved for), v = v̂ + γ'a to ~ε|q|γ'/β'
+                let (fq, fv, fl) = if nc > 0 {
+                    let qmax = self.q.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+                    let fq = 10.0 * f64::EPSILON * qmax;
+                    (fq, fq * gamma / beta, fq / beta)
+                } else {
+                    (0.0, 0.0, 0.0)
+                };
                 let mut s = 0.0;
                 for i in 0..n {
                     let d = -self.r[i];
                     a[i] += d;
-                    let eq = beta * d / (tol.atol + tol.rtol * self.q[i].abs());
-                    let ev = gamma * d / (tol.atol + tol.rtol * self.v[i].abs());
+                    let eq = beta * d / (tol.atol + tol.rtol * self.q[i].abs() + fq);
+                    let ev = gamma * d / (tol.atol + tol.rtol * self.v[i].abs() + fv);
                     s += eq * eq + ev * ev;
                 }
-                // λ to the Newton tolerance, but not below the rounding of Φ/β' (λ's noise
-                // floor at index 3, ~ε|q|/β')
-                let qmax = self.q.iter().fold(1.0f64, |m, x| m.max(x.abs()));
-                let floor = 10.0 * f64::EPSILON * qmax / beta;
                 for k in 0..nc {
                     let d = -self.r[n + k];
                     lambda[k] += d;
-                    let el = d / (tol.atol + tol.rtol * lambda[k].abs() + floor);
+                    let el = d / (tol.atol + tol.rtol * lambda[k].abs() + fl);
                     s += el * el;
                 }
                 let norm = (s / (2 * n + nc).max(1) as f64).sqrt();

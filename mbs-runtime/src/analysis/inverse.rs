@@ -1,9 +1,19 @@
 //! Inverse dynamics along a motion: the generalised forces τ(t) = M qdd − h that make a model
 //! follow a given q(t), qd(t), qdd(t) — e.g. the joint torques that drive an arm along a path.
+//!
+//! For a constrained model (`M qdd = h + Bᵀλ + S τ_a`, `Φ = 0`), only some coordinates are
+//! actuated: [`inverse_dynamics_actuated_along`] solves `S τ_a + Bᵀλ = M qdd − h` for the
+//! actuator efforts τ_a and the multipliers λ at each time, S selecting the actuated
+//! coordinates. The system is square when #actuated + NC = NQ, and regular when B has full
+//! rank and B over the unactuated coordinates is invertible (the actuators can drive the
+//! mechanism there). Exact: one LU of [S Bᵀ] per time, no differences. The motion should be
+//! consistent (Φ = 0, Φ̇ = 0, B qdd = γ); the largest violations are reported per time, not
+//! refused.
 
-use super::AnalysisError;
 use super::statics::check;
+use super::{AnalysisError, reduce};
 use crate::error::Failure;
+use crate::linalg::Lu;
 use crate::model::Model;
 use crate::trajectory::Trajectory;
 use serde::Serialize;
@@ -90,6 +100,220 @@ pub fn inverse_dynamics_of<M: Model>(
 ) -> Result<Efforts, AnalysisError> {
     let mut i = 0;
     inverse_dynamics_along(model, &trajectory.t, u, |_| {
+        let s = (
+            trajectory.q(i).to_vec(),
+            trajectory.qd(i).to_vec(),
+            trajectory.qdd(i).to_vec(),
+        );
+        i += 1;
+        s
+    })
+}
+
+/// Actuator efforts and constraint reactions along a motion of a constrained model
+/// ([`inverse_dynamics_actuated_along`]): per time, τ_a (one per actuated coordinate) and λ
+/// (one per constraint) with `S τ_a + Bᵀλ = M qdd − h`.
+#[derive(Clone, Debug, Serialize)]
+#[non_exhaustive]
+pub struct ActuatedEfforts {
+    /// labels of the actuated coordinates, and their indices in q
+    pub actuated: Vec<String>,
+    pub actuated_indices: Vec<usize>,
+    /// constraint names (`pin.x`, …)
+    pub constraint_names: Vec<String>,
+    pub t: Vec<f64>,
+    /// τ_a, one row of `actuated.len()` values per time (N or N·m: generalised forces)
+    pub tau: Vec<f64>,
+    /// λ, one row of `constraint_names.len()` values per time (for `coincide(a, b, along =
+    /// [x])` the force along x the closure applies to b)
+    pub lambda: Vec<f64>,
+    /// largest |Φ_i|, |Φ̇_i| = |B qd + ∂Φ/∂t| and |B qdd − γ| per time: how consistent the
+    /// given motion is
+    pub phi: Vec<f64>,
+    pub phi_dot: Vec<f64>,
+    pub phi_ddot: Vec<f64>,
+}
+
+impl ActuatedEfforts {
+    /// τ_a at time index `i`.
+    pub fn tau_at(&self, i: usize) -> &[f64] {
+        let n = self.actuated.len();
+        &self.tau[i * n..(i + 1) * n]
+    }
+
+    /// λ at time index `i`.
+    pub fn lambda_at(&self, i: usize) -> &[f64] {
+        let n = self.constraint_names.len();
+        &self.lambda[i * n..(i + 1) * n]
+    }
+
+    /// λ of constraint `name` along the motion.
+    pub fn lambda_of(&self, name: &str) -> Option<Vec<f64>> {
+        let k = self.constraint_names.iter().position(|n| n == name)?;
+        Some((0..self.t.len()).map(|i| self.lambda_at(i)[k]).collect())
+    }
+
+    /// CSV: `t`, one column per actuated coordinate (its label), `NAME.lambda` per
+    /// constraint, then `phi, phi_dot, phi_ddot` (the largest violations).
+    pub fn write_csv(&self, mut w: impl Write) -> io::Result<()> {
+        let mut header = vec!["t".to_string()];
+        header.extend(self.actuated.iter().cloned());
+        header.extend(self.constraint_names.iter().map(|n| format!("{n}.lambda")));
+        header.extend(["phi".into(), "phi_dot".into(), "phi_ddot".into()]);
+        writeln!(w, "{}", header.join(","))?;
+        for i in 0..self.t.len() {
+            write!(w, "{:e}", self.t[i])?;
+            for v in self.tau_at(i).iter().chain(self.lambda_at(i)) {
+                write!(w, ",{v:e}")?;
+            }
+            writeln!(
+                w,
+                ",{:e},{:e},{:e}",
+                self.phi[i], self.phi_dot[i], self.phi_ddot[i]
+            )?;
+        }
+        Ok(())
+    }
+}
+
+/// Actuator efforts τ_a on the coordinates `actuated` (indices, NQ − NC of them) and the
+/// constraint reactions λ along the motion `path(t) → (q, qd, qdd)` sampled at `times`, with
+/// inputs `u`: `S τ_a + Bᵀλ = M qdd − h`. Without constraints, with every coordinate
+/// actuated, it is [`inverse_dynamics_along`] in the order of `actuated`.
+pub fn inverse_dynamics_actuated_along<M: Model>(
+    model: &M,
+    times: &[f64],
+    u: &[f64],
+    actuated: &[usize],
+    mut path: impl FnMut(f64) -> (Vec<f64>, Vec<f64>, Vec<f64>),
+) -> Result<ActuatedEfforts, AnalysisError> {
+    let (n, nc) = (M::NQ, M::NC);
+    let info = model.info();
+    let names = info.constraints;
+    let invalid = |name: &'static str, value: String, reason: &'static str| {
+        AnalysisError::from(Failure::InvalidOption {
+            name,
+            value,
+            reason,
+        })
+    };
+    if u.len() != M::NU {
+        return Err(invalid(
+            "u",
+            u.len().to_string(),
+            "must have one value per input",
+        ));
+    }
+    if let Some(&i) = actuated.iter().find(|&&i| i >= n) {
+        return Err(invalid(
+            "actuated",
+            i.to_string(),
+            "is not a coordinate index",
+        ));
+    }
+    if (1..actuated.len()).any(|k| actuated[..k].contains(&actuated[k])) {
+        return Err(invalid(
+            "actuated",
+            format!("{actuated:?}"),
+            "names a coordinate twice",
+        ));
+    }
+    if actuated.len() + nc != n {
+        return Err(invalid(
+            "actuated",
+            format!(
+                "{} coordinates ({} constraints, {} coordinates)",
+                actuated.len(),
+                nc,
+                n
+            ),
+            "the actuated coordinates and the constraints must number NQ together: actuate NQ − NC coordinates (one per degree of freedom)",
+        ));
+    }
+    let unactuated: Vec<usize> = (0..n).filter(|i| !actuated.contains(i)).collect();
+    let na = actuated.len();
+    let mut out = ActuatedEfforts {
+        actuated: actuated.iter().map(|&i| info.dof_label(i)).collect(),
+        actuated_indices: actuated.to_vec(),
+        constraint_names: names.iter().map(|s| s.to_string()).collect(),
+        t: times.to_vec(),
+        tau: Vec::with_capacity(na * times.len()),
+        lambda: Vec::with_capacity(nc * times.len()),
+        phi: Vec::with_capacity(times.len()),
+        phi_dot: Vec::with_capacity(times.len()),
+        phi_ddot: Vec::with_capacity(times.len()),
+    };
+    let mut lu = Lu::<f64>::new(n);
+    let mut tau = vec![0.0; n];
+    let (mut phi, mut phi_t, mut gamma) = (vec![0.0; nc], vec![0.0; nc], vec![0.0; nc]);
+    for &t in times {
+        let (q, qd, qdd) = path(t);
+        if q.len() != n || qd.len() != n || qdd.len() != n {
+            return Err(invalid(
+                "path",
+                t.to_string(),
+                "must give q, qd and qdd with one value per coordinate",
+            ));
+        }
+        for v in [&q, &qd, &qdd] {
+            check(model, "path", v)?;
+        }
+        model.inverse_dynamics(t, &q, &qd, &qdd, u, &mut tau);
+        check(model, "τ", &tau)?;
+        let b = if nc > 0 {
+            reduce::jacobian(model, t, &q)?
+        } else {
+            nalgebra::DMatrix::zeros(0, n)
+        };
+        // [S Bᵀ] (n × n): column k < na is e_actuated[k], column na + i is row i of B
+        let a = lu.matrix_mut();
+        a.fill(0.0);
+        for (k, &j) in actuated.iter().enumerate() {
+            a[j + n * k] = 1.0;
+        }
+        for i in 0..nc {
+            for j in 0..n {
+                a[j + n * (na + i)] = b[(i, j)];
+            }
+        }
+        if let Err(s) = lu.factor() {
+            reduce::rank_check(&b, names)?;
+            return Err(Failure::SingularMatrix {
+                matrix: "[S Bᵀ]: B over the unactuated coordinates (the actuated coordinates cannot drive the mechanism here)",
+                rcond: s.rcond,
+                coordinates: unactuated.iter().map(|&i| info.dof_label(i)).collect(),
+            }
+            .into());
+        }
+        let mut x = tau.clone();
+        lu.solve(&mut x);
+        check(model, "[τ_a, λ]", &x)?;
+        out.tau.extend_from_slice(&x[..na]);
+        out.lambda.extend_from_slice(&x[na..]);
+        // how consistent the motion is
+        if nc > 0 {
+            model.constraints(t, &q, &mut phi);
+            model.constraint_rate(t, &q, &mut phi_t);
+            model.constraint_bias(t, &q, &qd, &mut gamma);
+        }
+        let row = |i: usize, v: &[f64]| (0..n).map(|j| b[(i, j)] * v[j]).sum::<f64>();
+        let worst = |f: &dyn Fn(usize) -> f64| (0..nc).map(f).fold(0.0, |m: f64, v| m.max(v.abs()));
+        out.phi.push(worst(&|i| phi[i]));
+        out.phi_dot.push(worst(&|i| row(i, &qd) + phi_t[i]));
+        out.phi_ddot.push(worst(&|i| row(i, &qdd) - gamma[i]));
+    }
+    Ok(out)
+}
+
+/// [`inverse_dynamics_actuated_along`] along a recorded trajectory (its t, q, qd, qdd).
+pub fn inverse_dynamics_actuated_of<M: Model>(
+    model: &M,
+    trajectory: &Trajectory,
+    u: &[f64],
+    actuated: &[usize],
+) -> Result<ActuatedEfforts, AnalysisError> {
+    let mut i = 0;
+    inverse_dynamics_actuated_along(model, &trajectory.t, u, actuated, |_| {
         let s = (
             trajectory.q(i).to_vec(),
             trajectory.qd(i).to_vec(),

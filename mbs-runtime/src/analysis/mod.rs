@@ -1,14 +1,31 @@
 //! Analyses from the generated exact tangents: static equilibrium, linearisation, poles and
 //! modes, inverse dynamics along a motion (EasyDyn's StaticEquilibrium, SaveLinearizedSystem,
 //! ComputePoles; here without finite differences when the model has `option tangents`).
+//!
+//! Constrained models (`M qdd = h + Bᵀλ`, `Φ = 0`) are analysed on the constraint manifold:
+//! the statics solve for q and λ together and judge stability on the null space of B; the
+//! linearisation is in the independent coordinates (NQ − NC of them); the inverse dynamics
+//! split M qdd − h into actuator efforts and constraint reactions. What is exact and what
+//! uses central differences is said in each module:
+//!
+//! | analysis | exact | central differences |
+//! |---|---|---|
+//! | statics | h, B, ∂(Bᵀλ)/∂q; K with tangents | K without tangents |
+//! | linearisation | M, B_u, B, Hessians of Φ, G; K, C with tangents | K, C without tangents; with constraints ∂γ/∂q and ∂(∂Φ/∂t)/∂q (identically zero at rest with scleronomic constraints, then exact) |
+//! | modes | eigen-decomposition of A | — |
+//! | inverse dynamics | τ, and τ_a, λ from one LU of [S Bᵀ] | — |
 
 mod inverse;
 mod linearize;
 mod modes;
+mod reduce;
 mod statics;
 
-pub use inverse::{Efforts, inverse_dynamics_along, inverse_dynamics_of};
-pub use linearize::{Linearization, linearize};
+pub use inverse::{
+    ActuatedEfforts, Efforts, inverse_dynamics_actuated_along, inverse_dynamics_actuated_of,
+    inverse_dynamics_along, inverse_dynamics_of,
+};
+pub use linearize::{CONSISTENCY_TOLERANCE, Linearization, linearize};
 pub use modes::{Mode, Modes, modes};
 pub use statics::{Equilibrium, Stability, StaticsOptions, static_equilibrium};
 
@@ -23,11 +40,15 @@ pub enum AnalysisError {
     #[error(transparent)]
     Failure(#[from] Failure),
     #[error(
-        "no static equilibrium found in {iterations} iterations: the largest free force is still {residual:e} at q = {q:?} (start closer, lock the coordinates that have no stiffness, or check that an equilibrium exists)"
+        "no static equilibrium found in {iterations} iterations: the largest free force is still {residual:e}{} at q = {q:?} (start closer, lock the coordinates that have no stiffness, or check that an equilibrium exists)",
+        if *constraint_residual > 0.0 { format!(" and the largest |Φ| {constraint_residual:e}") } else { String::new() }
     )]
     NotConverged {
         iterations: usize,
+        /// largest free generalised force (with the constraint forces Bᵀλ)
         residual: f64,
+        /// largest |Φ_i| (0 without constraints)
+        constraint_residual: f64,
         q: Vec<f64>,
     },
 }

@@ -1,8 +1,11 @@
 //! Poles and modes of a linearisation (EasyDyn's ComputePoles): the eigenvalues λ of A,
 //! one mode per complex pair (Im λ > 0) or real eigenvalue, with natural frequency |λ|/2π,
-//! damping ratio −Re λ/|λ|, the mode shape (the q part of the eigenvector, scaled so that its
-//! largest component is 1) named by coordinate, and the modal mass φᴴMφ of that shape.
+//! damping ratio −Re λ/|λ|, the mode shape (the position part of the eigenvector, scaled so
+//! that its largest component is 1) named by coordinate, and the modal mass φᴴMφ of that shape.
 //! Eigenvalues come from nalgebra's Schur decomposition, eigenvectors from inverse iteration.
+//! For a constrained model the shapes are in the independent coordinates z of the
+//! linearisation (named by [`Linearization::coordinates`], modal mass φᴴM_zφ), and also given
+//! in every coordinate as N φ.
 
 use super::AnalysisError;
 use super::linearize::Linearization;
@@ -23,15 +26,21 @@ pub struct Mode {
     pub frequency_hz: f64,
     /// −Re λ/|λ| (0 for undamped, negative for unstable oscillations, ±1 for real λ)
     pub damping_ratio: f64,
-    /// φᴴ M φ for the shape below
+    /// φᴴ M φ for the shape below (φᴴ M_z φ with constraints)
     pub modal_mass: f64,
-    /// shape: per coordinate, (real, imaginary) parts, largest magnitude 1
+    /// shape: per coordinate of [`Modes::dof_names`], (real, imaginary) parts, largest
+    /// magnitude 1
     pub shape: Vec<(f64, f64)>,
+    /// the same shape in every coordinate q (N φ; equal to `shape` without constraints),
+    /// named by the linearisation's `dof_names`
+    pub shape_q: Vec<(f64, f64)>,
 }
 
 /// The modes of a linearised model, sorted by frequency.
 #[derive(Clone, Debug, Serialize)]
 pub struct Modes {
+    /// names of the coordinates of the shapes: the linearisation's `coordinates` (the
+    /// independent ones of a constrained model)
     pub dof_names: Vec<String>,
     pub modes: Vec<Mode>,
 }
@@ -46,6 +55,13 @@ pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, A
             coordinate: String::new(),
         }
         .into());
+    }
+    if n2 == 0 {
+        // no degree of freedom (every coordinate fixed by the constraints)
+        return Ok(Modes {
+            dof_names: lin.coordinates.clone(),
+            modes: Vec::new(),
+        });
     }
     let eig = lin.a.clone().complex_eigenvalues();
     let scale = lin.a.iter().fold(1.0f64, |m, x| m.max(x.abs()));
@@ -104,11 +120,19 @@ pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, A
         for i in 0..n {
             for j in 0..n {
                 let p =
-                    C64::new(shape[i].re, -shape[i].im) * C64::new(lin.m[(i, j)], 0.0) * shape[j];
+                    C64::new(shape[i].re, -shape[i].im) * C64::new(lin.mz[(i, j)], 0.0) * shape[j];
                 modal_mass += p.re;
             }
         }
         let damping_ratio = if mag > 0.0 { -re / mag } else { 0.0 };
+        let shape_q = (0..lin.basis.nrows())
+            .map(|i| {
+                (0..n).fold((0.0, 0.0), |(re, im), k| {
+                    let w = lin.basis[(i, k)];
+                    (re + w * shape[k].re, im + w * shape[k].im)
+                })
+            })
+            .collect();
         out.push(Mode {
             re,
             im,
@@ -116,11 +140,12 @@ pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, A
             damping_ratio,
             modal_mass,
             shape: shape.iter().map(|z| (z.re, z.im)).collect(),
+            shape_q,
         });
     }
     out.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
     Ok(Modes {
-        dof_names: lin.dof_names.clone(),
+        dof_names: lin.coordinates.clone(),
         modes: out,
     })
 }

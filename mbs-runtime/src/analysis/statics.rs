@@ -3,12 +3,25 @@
 //! differences of the static forces), a backtracking line search on ‖h‖, and coordinates that
 //! can be held at their starting value (EasyDyn's `doflocked`). The stability of the
 //! equilibrium is read from the eigenvalues of the stiffness restricted to the free coordinates.
+//!
+//! With constraints (`M::NC > 0`) the unknowns are the free coordinates and the multipliers
+//! λ: Newton on h(q, 0) + Bᵀλ = 0 (free rows) and Φ(q, t) = 0, with the Jacobian
+//! `[−K + ∂(Bᵀλ)/∂q, Bᵀ; B, 0]` over the free coordinates (∂(Bᵀλ)/∂q is the generated
+//! `constraint_tangent`, exact; K as above), λ started at the least-squares fit of Bᵀλ = −h,
+//! and a backtracking line search on ‖h + Bᵀλ‖∞ + μ‖Φ‖∞ (μ = ‖K − ∂(Bᵀλ)/∂q‖∞/‖B‖∞ over the
+//! free coordinates, which turns a constraint violation into the force that closing it
+//! costs). The stability is read from the reduced stiffness Nᵀ(K − ∂(Bᵀλ)/∂q)N, N an
+//! orthonormal basis of the null space of B over the free coordinates (one column per
+//! degree of freedom of the mechanism): the Hessian of the potential on the constraint
+//! manifold, where the curvature of the constraints enters through λ. Everything is exact
+//! except K without tangents.
 
-use super::AnalysisError;
+use super::{AnalysisError, reduce};
 use crate::error::Failure;
 use crate::linalg::Lu;
 use crate::model::Model;
 use crate::options::IterationMatrix;
+use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 use std::fmt;
 
@@ -23,8 +36,11 @@ pub struct StaticsOptions {
     pub u: Option<Vec<f64>>,
     /// indices of coordinates held at their starting value (default none)
     pub locked: Vec<usize>,
-    /// converged when every free generalised force is below this (N or N·m), default 1e-9
+    /// converged when every free generalised force (with the constraint forces Bᵀλ) is
+    /// below this (N or N·m), default 1e-9
     pub tolerance: f64,
+    /// constrained models: and every |Φ_i| below this (m or rad), default 1e-11
+    pub constraint_tolerance: f64,
     /// Newton iterations before `NotConverged` (default 50)
     pub max_iterations: usize,
     /// how the stiffness is obtained: exact tangents (`Auto` when generated), or central
@@ -40,6 +56,7 @@ impl Default for StaticsOptions {
             u: None,
             locked: Vec::new(),
             tolerance: 1e-9,
+            constraint_tolerance: 1e-11,
             max_iterations: 50,
             stiffness: IterationMatrix::Auto,
         }
@@ -62,14 +79,31 @@ pub enum Stability {
 #[non_exhaustive]
 pub struct Equilibrium {
     pub q: Vec<f64>,
-    /// largest |h| over the free coordinates at `q`
+    /// largest |h| over the free coordinates at `q` (|h + Bᵀλ| with constraints)
     pub residual: f64,
     pub iterations: usize,
     /// names of the free coordinates
     pub free: Vec<String>,
-    /// eigenvalues of the (symmetrised) stiffness on the free coordinates, ascending
+    /// eigenvalues of the (symmetrised) stiffness on the free coordinates, ascending; with
+    /// constraints, of the reduced stiffness Nᵀ(K − ∂(Bᵀλ)/∂q)N on the constraint manifold,
+    /// one per degree of freedom left (free coordinates − constraints)
     pub stiffness_eigenvalues: Vec<f64>,
     pub stability: Stability,
+    /// names of the constraints (empty without constraints)
+    pub constraint_names: Vec<String>,
+    /// the multipliers at `q`, one per constraint: for `coincide(a, b, along = [x])` the
+    /// force along x that the closure applies to b
+    pub lambda: Vec<f64>,
+    /// largest |Φ_i| at `q` (0 without constraints)
+    pub constraint_residual: f64,
+}
+
+impl Equilibrium {
+    /// λ of the constraint `name` (`pin.x`, …).
+    pub fn lambda_of(&self, name: &str) -> Option<f64> {
+        let i = self.constraint_names.iter().position(|n| n == name)?;
+        Some(self.lambda[i])
+    }
 }
 
 impl fmt::Display for Equilibrium {
@@ -79,7 +113,17 @@ impl fmt::Display for Equilibrium {
             "static equilibrium ({:?}) after {} iterations, residual {:.2e}",
             self.stability, self.iterations, self.residual
         )?;
+        if !self.constraint_names.is_empty() {
+            write!(f, "max |Φ| {:.2e}, λ:", self.constraint_residual)?;
+            for (n, l) in self.constraint_names.iter().zip(&self.lambda) {
+                write!(f, " {n} = {l:.6e}")?;
+            }
+            writeln!(f)?;
+        }
         write!(f, "stiffness eigenvalues:")?;
+        if self.stiffness_eigenvalues.is_empty() {
+            write!(f, " none (no degree of freedom left)")?;
+        }
         for e in &self.stiffness_eigenvalues {
             write!(f, " {e:.6e}")?;
         }
@@ -162,13 +206,13 @@ pub(super) fn stiffness<M: Model>(
     Ok(())
 }
 
-/// Finds q with h(q, 0, t, u) = 0 on the free coordinates, from `options.q0`.
+/// Finds q with h(q, 0, t, u) = 0 on the free coordinates, from `options.q0`; with
+/// constraints, q and λ with h(q, 0, t, u) + Bᵀλ = 0 on the free coordinates and Φ(q, t) = 0.
 pub fn static_equilibrium<M: Model>(
     model: &M,
     options: &StaticsOptions,
 ) -> Result<Equilibrium, AnalysisError> {
     let n = M::NQ;
-    let info = model.info();
     let invalid = |name: &'static str, value: String, reason: &'static str| {
         AnalysisError::from(Failure::InvalidOption {
             name,
@@ -176,7 +220,7 @@ pub fn static_equilibrium<M: Model>(
             reason,
         })
     };
-    let mut q = match &options.q0 {
+    let q = match &options.q0 {
         Some(q0) if q0.len() != n => {
             return Err(invalid(
                 "q0",
@@ -206,21 +250,40 @@ pub fn static_equilibrium<M: Model>(
             "is not a coordinate index",
         ));
     }
-    if !(options.tolerance > 0.0) || options.max_iterations == 0 {
+    if !(options.tolerance > 0.0)
+        || options.max_iterations == 0
+        || (M::NC > 0 && !(options.constraint_tolerance > 0.0))
+    {
         return Err(invalid(
             "tolerance",
             options.tolerance.to_string(),
-            "must be > 0, with max_iterations > 0",
+            "must be > 0, with constraint_tolerance > 0 and max_iterations > 0",
         ));
     }
     check(model, "q0", &q)?;
     let free: Vec<usize> = (0..n).filter(|i| !options.locked.contains(i)).collect();
+    if M::NC == 0 {
+        unconstrained(model, options, q, &u, &free)
+    } else {
+        constrained(model, options, q, &u, &free)
+    }
+}
+
+fn unconstrained<M: Model>(
+    model: &M,
+    options: &StaticsOptions,
+    mut q: Vec<f64>,
+    u: &[f64],
+    free: &[usize],
+) -> Result<Equilibrium, AnalysisError> {
+    let n = M::NQ;
+    let info = model.info();
     let nf = free.len();
     let (mut h, mut k, mut trial, mut ht) =
         (vec![0.0; n], vec![0.0; n * n], vec![0.0; n], vec![0.0; n]);
     let mut lu = Lu::<f64>::new(nf);
     let norm = |h: &[f64]| free.iter().map(|&i| h[i].abs()).fold(0.0, f64::max);
-    forces(model, options.t, &q, &u, &mut h)?;
+    forces(model, options.t, &q, u, &mut h)?;
     let mut residual = norm(&h);
     let mut iterations = 0;
     while residual > options.tolerance {
@@ -228,11 +291,12 @@ pub fn static_equilibrium<M: Model>(
             return Err(AnalysisError::NotConverged {
                 iterations,
                 residual,
+                constraint_residual: 0.0,
                 q,
             });
         }
         iterations += 1;
-        stiffness(model, options.t, &q, &u, options.stiffness, &mut k)?;
+        stiffness(model, options.t, &q, u, options.stiffness, &mut k)?;
         let a = lu.matrix_mut();
         for (c, &j) in free.iter().enumerate() {
             for (r, &i) in free.iter().enumerate() {
@@ -254,7 +318,7 @@ pub fn static_equilibrium<M: Model>(
             for (c, &i) in free.iter().enumerate() {
                 trial[i] += alpha * delta[c];
             }
-            let ok = forces(model, options.t, &trial, &u, &mut ht).is_ok();
+            let ok = forces(model, options.t, &trial, u, &mut ht).is_ok();
             if ok && norm(&ht) < residual * (1.0 - 1e-4 * alpha) {
                 break;
             }
@@ -263,6 +327,7 @@ pub fn static_equilibrium<M: Model>(
                 return Err(AnalysisError::NotConverged {
                     iterations,
                     residual,
+                    constraint_residual: 0.0,
                     q,
                 });
             }
@@ -272,10 +337,30 @@ pub fn static_equilibrium<M: Model>(
         residual = norm(&h);
     }
     // stability from the symmetrised stiffness on the free coordinates
-    stiffness(model, options.t, &q, &u, options.stiffness, &mut k)?;
+    stiffness(model, options.t, &q, u, options.stiffness, &mut k)?;
     let ks = nalgebra::DMatrix::from_fn(nf, nf, |r, c| {
         0.5 * (k[free[r] + n * free[c]] + k[free[c] + n * free[r]])
     });
+    let (stiffness_eigenvalues, stability) = classify(&ks);
+    Ok(Equilibrium {
+        q,
+        residual,
+        iterations,
+        free: free.iter().map(|&i| info.dof_label(i)).collect(),
+        stiffness_eigenvalues,
+        stability,
+        constraint_names: Vec::new(),
+        lambda: Vec::new(),
+        constraint_residual: 0.0,
+    })
+}
+
+/// Eigenvalues (ascending) of a symmetric stiffness and the stability they mean (`Stable`
+/// with no eigenvalue: nothing left free to move).
+fn classify(ks: &DMatrix<f64>) -> (Vec<f64>, Stability) {
+    if ks.nrows() == 0 {
+        return (Vec::new(), Stability::Stable);
+    }
     let mut eig: Vec<f64> = ks.symmetric_eigenvalues().iter().copied().collect();
     eig.sort_by(f64::total_cmp);
     let scale = eig.iter().fold(0.0f64, |m, e| m.max(e.abs()));
@@ -286,12 +371,287 @@ pub fn static_equilibrium<M: Model>(
     } else {
         Stability::Stable
     };
+    (eig, stability)
+}
+
+/// The residuals of the constrained statics at q, λ: F = (h + Bᵀλ) on the free coordinates
+/// and Φ; with h and B at q.
+struct ConstrainedState {
+    h: Vec<f64>,
+    b: DMatrix<f64>,
+    f: Vec<f64>,
+    phi: Vec<f64>,
+}
+
+impl ConstrainedState {
+    fn new<M: Model>(
+        model: &M,
+        t: f64,
+        q: &[f64],
+        u: &[f64],
+        lambda: &[f64],
+        free: &[usize],
+    ) -> Result<ConstrainedState, AnalysisError> {
+        let mut h = vec![0.0; M::NQ];
+        forces(model, t, q, u, &mut h)?;
+        let b = reduce::jacobian(model, t, q)?;
+        let phi = reduce::constraints(model, t, q)?;
+        let mut s = ConstrainedState {
+            h,
+            b,
+            f: Vec::new(),
+            phi,
+        };
+        s.set_lambda(lambda, free);
+        Ok(s)
+    }
+
+    fn set_lambda(&mut self, lambda: &[f64], free: &[usize]) {
+        self.f = free
+            .iter()
+            .map(|&j| {
+                self.h[j]
+                    + (0..lambda.len())
+                        .map(|i| self.b[(i, j)] * lambda[i])
+                        .sum::<f64>()
+            })
+            .collect();
+    }
+
+    fn force_residual(&self) -> f64 {
+        reduce::worst(&self.f).0
+    }
+
+    fn constraint_residual(&self) -> f64 {
+        reduce::worst(&self.phi).0
+    }
+}
+
+/// Newton on (q_free, λ); see the module documentation.
+fn constrained<M: Model>(
+    model: &M,
+    options: &StaticsOptions,
+    mut q: Vec<f64>,
+    u: &[f64],
+    free: &[usize],
+) -> Result<Equilibrium, AnalysisError> {
+    let (n, nc, t) = (M::NQ, M::NC, options.t);
+    let info = model.info();
+    let names = info.constraints;
+    let nf = free.len();
+    let locked_reason = "leaves the constraints no coordinates to satisfy them: B over the free coordinates has rank below the number of constraints (lock fewer coordinates)";
+    if nf < nc {
+        return Err(Failure::InvalidOption {
+            name: "locked",
+            value: format!("{:?}", options.locked),
+            reason: locked_reason,
+        }
+        .into());
+    }
+    let restricted = |b: &DMatrix<f64>| b.select_columns(free);
+    let mut st = ConstrainedState::new(model, t, &q, u, &vec![0.0; nc], free)?;
+    // B must have full rank, and keep it over the free coordinates
+    let rank = |b: &DMatrix<f64>| -> Result<(), AnalysisError> {
+        reduce::rank_check(b, names)?;
+        if reduce::rank_of(&restricted(b)).0 < nc {
+            return Err(Failure::InvalidOption {
+                name: "locked",
+                value: format!("{:?}", options.locked),
+                reason: locked_reason,
+            }
+            .into());
+        }
+        Ok(())
+    };
+    rank(&st.b)?;
+    // λ₀: the least-squares fit of B_fᵀλ = −h_f
+    let mut lambda = {
+        let bf = restricted(&st.b);
+        let hf = DVector::from_iterator(nf, free.iter().map(|&i| st.h[i]));
+        let rhs = -(&bf * hf);
+        (&bf * bf.transpose())
+            .cholesky()
+            .map(|c| c.solve(&rhs))
+            .ok_or_else(|| AnalysisError::from(reduce::rank_check(&st.b, names).unwrap_err()))?
+    }
+    .as_slice()
+    .to_vec();
+    st.set_lambda(&lambda, free);
+    let mut k = vec![0.0; n * n];
+    let mut lu = Lu::<f64>::new(nf + nc);
+    let mut iterations = 0;
+    let converged = |st: &ConstrainedState| {
+        st.force_residual() <= options.tolerance
+            && st.constraint_residual() <= options.constraint_tolerance
+    };
+    while !converged(&st) {
+        if iterations == options.max_iterations {
+            return Err(AnalysisError::NotConverged {
+                iterations,
+                residual: st.force_residual(),
+                constraint_residual: st.constraint_residual(),
+                q,
+            });
+        }
+        iterations += 1;
+        stiffness(model, t, &q, u, options.stiffness, &mut k)?;
+        let g = reduce::constraint_tangent(model, t, &q, &lambda)?;
+        // J = [−K + G, B_fᵀ; B_f, 0] over the free coordinates
+        let m = nf + nc;
+        let a = lu.matrix_mut();
+        a.fill(0.0);
+        let (mut kg_norm, mut b_norm) = (0.0f64, 0.0f64);
+        for (r, &i) in free.iter().enumerate() {
+            let mut row = 0.0;
+            for (c, &j) in free.iter().enumerate() {
+                let v = -k[i + n * j] + g[(i, j)];
+                a[r + m * c] = v;
+                row += v.abs();
+            }
+            kg_norm = kg_norm.max(row);
+            for p in 0..nc {
+                a[r + m * (nf + p)] = st.b[(p, i)];
+                a[(nf + p) + m * r] = st.b[(p, i)];
+            }
+        }
+        for p in 0..nc {
+            b_norm = b_norm.max(free.iter().map(|&j| st.b[(p, j)].abs()).sum::<f64>());
+        }
+        if let Err(s) = lu.factor() {
+            return Err(singular_reduced(
+                model, t, &q, u, options, &lambda, free, &st.b, s.rcond,
+            )?);
+        }
+        let mut delta: Vec<f64> = st.f.iter().chain(&st.phi).map(|v| -v).collect();
+        lu.solve(&mut delta);
+        // backtracking on ‖F‖∞ + μ‖Φ‖∞
+        let mu = if kg_norm > 0.0 && b_norm > 0.0 && (kg_norm / b_norm).is_finite() {
+            kg_norm / b_norm
+        } else {
+            1.0
+        };
+        let merit = |st: &ConstrainedState| st.force_residual() + mu * st.constraint_residual();
+        let current = merit(&st);
+        let mut alpha = 1.0;
+        let (mut trial, mut trial_lambda) = (q.clone(), lambda.clone());
+        loop {
+            trial.copy_from_slice(&q);
+            for (c, &i) in free.iter().enumerate() {
+                trial[i] += alpha * delta[c];
+            }
+            for p in 0..nc {
+                trial_lambda[p] = lambda[p] + alpha * delta[nf + p];
+            }
+            if let Ok(next) = ConstrainedState::new(model, t, &trial, u, &trial_lambda, free) {
+                if merit(&next) < current * (1.0 - 1e-4 * alpha) {
+                    st = next;
+                    break;
+                }
+            }
+            alpha *= 0.5;
+            if alpha < 1e-6 {
+                return Err(AnalysisError::NotConverged {
+                    iterations,
+                    residual: st.force_residual(),
+                    constraint_residual: st.constraint_residual(),
+                    q,
+                });
+            }
+        }
+        q.copy_from_slice(&trial);
+        lambda.copy_from_slice(&trial_lambda);
+    }
+    rank(&st.b)?;
+    // stability from the reduced stiffness Nᵀ(K − G)N, N orthonormal over the free coordinates
+    let kr = reduced_stiffness(model, t, &q, u, options, &lambda, free, &st.b)?;
+    let (stiffness_eigenvalues, stability) = classify(&kr.0);
     Ok(Equilibrium {
+        residual: st.force_residual(),
+        constraint_residual: st.constraint_residual(),
         q,
-        residual,
         iterations,
         free: free.iter().map(|&i| info.dof_label(i)).collect(),
-        stiffness_eigenvalues: eig,
+        stiffness_eigenvalues,
         stability,
+        constraint_names: names.iter().map(|s| s.to_string()).collect(),
+        lambda,
     })
+}
+
+/// The symmetrised reduced stiffness Nᵀ(K − ∂(Bᵀλ)/∂q)N over the free coordinates, and N
+/// (free × dof, orthonormal).
+#[allow(clippy::too_many_arguments)]
+fn reduced_stiffness<M: Model>(
+    model: &M,
+    t: f64,
+    q: &[f64],
+    u: &[f64],
+    options: &StaticsOptions,
+    lambda: &[f64],
+    free: &[usize],
+    b: &DMatrix<f64>,
+) -> Result<(DMatrix<f64>, DMatrix<f64>), AnalysisError> {
+    let n = M::NQ;
+    let mut k = vec![0.0; n * n];
+    stiffness(model, t, q, u, options.stiffness, &mut k)?;
+    let g = reduce::constraint_tangent(model, t, q, lambda)?;
+    let kf = DMatrix::from_fn(free.len(), free.len(), |r, c| {
+        let (i, j) = (free[r], free[c]);
+        k[i + n * j] - g[(i, j)]
+    });
+    let basis = reduce::orthonormal_null_basis(&b.select_columns(free)).ok_or_else(|| {
+        AnalysisError::from(
+            reduce::rank_check(b, model.info().constraints)
+                .err()
+                .unwrap_or(Failure::InvalidOption {
+                    name: "locked",
+                    value: format!("{:?}", options.locked),
+                    reason: "leaves B over the free coordinates rank-deficient",
+                }),
+        )
+    })?;
+    let kr = basis.transpose() * kf * &basis;
+    Ok(((&kr + kr.transpose()) * 0.5, basis))
+}
+
+/// Why the Newton matrix of the constrained statics is singular: redundant constraints, or
+/// a reduced stiffness with a zero eigenvalue (a mechanism direction with no stiffness),
+/// named by the coordinates that move most along it.
+#[allow(clippy::too_many_arguments)]
+fn singular_reduced<M: Model>(
+    model: &M,
+    t: f64,
+    q: &[f64],
+    u: &[f64],
+    options: &StaticsOptions,
+    lambda: &[f64],
+    free: &[usize],
+    b: &DMatrix<f64>,
+    rcond: f64,
+) -> Result<AnalysisError, AnalysisError> {
+    let (kr, basis) = reduced_stiffness(model, t, q, u, options, lambda, free, b)?;
+    let eig = nalgebra::SymmetricEigen::new(kr);
+    let k = (0..eig.eigenvalues.len())
+        .min_by(|&i, &j| {
+            eig.eigenvalues[i]
+                .abs()
+                .total_cmp(&eig.eigenvalues[j].abs())
+        })
+        .unwrap_or(0);
+    let mut coordinates = Vec::new();
+    if basis.ncols() > 0 {
+        let w = &basis * eig.eigenvectors.column(k);
+        let wmax = w.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        for (r, &i) in free.iter().enumerate() {
+            if w[r].abs() >= 0.3 * wmax {
+                coordinates.push(model.info().dof_label(i));
+            }
+        }
+    }
+    Ok(Failure::SingularMatrix {
+        matrix: "the reduced stiffness Nᵀ(K − ∂(Bᵀλ)/∂q)N on the constraint manifold",
+        rcond,
+        coordinates,
+    }
+    .into())
 }

@@ -537,8 +537,8 @@ impl Constrained {
     }
 }
 
-/// Largest |x_i| and i.
-fn worst(x: &[f64]) -> (f64, usize) {
+/// Largest |x_i| and i (infinite at the first non-finite x_i).
+pub(crate) fn worst(x: &[f64]) -> (f64, usize) {
     let mut best = (0.0, 0);
     for (i, v) in x.iter().enumerate() {
         if !(v.abs() <= best.0) {
@@ -565,7 +565,7 @@ fn rank_failure(b: &[f64], nc: usize, n: usize, names: &[String]) -> Failure {
 /// Numerical rank of B (nc × n, column-major; σ ≤ 1e-10·σ_max counts as zero), its smallest
 /// singular value, and the constraints with large components in the left singular vectors
 /// of the vanishing singular values (the equations that repeat or cancel each other).
-fn rank_of(b: &[f64], nc: usize, n: usize) -> (usize, f64, Vec<usize>) {
+pub(crate) fn rank_of(b: &[f64], nc: usize, n: usize) -> (usize, f64, Vec<usize>) {
     // B padded with zero columns to at least nc × nc, so that U is square
     let cols = n.max(nc);
     let mat = nalgebra::DMatrix::from_fn(nc, cols, |i, j| if j < n { b[i + nc * j] } else { 0.0 });

@@ -203,7 +203,11 @@ impl Scheme {
     pub fn solves_index3(&self) -> bool {
         matches!(
             self,
-            Scheme::Newmark(_) | Scheme::Hht(_) | Scheme::GenAlpha(_)
+            Scheme::Newmark(_)
+                | Scheme::Hht(_)
+                | Scheme::GenAlpha(_)
+                | Scheme::Radau3
+                | Scheme::Radau5
         )
     }
 
@@ -305,14 +309,19 @@ impl Default for NewtonOptions {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, Default)]
 #[non_exhaustive]
 pub enum ConstraintMethod {
-    /// `Index3` for the schemes that solve it (generalized-α, HHT, Newmark), `Projection`
-    /// for the others and for adaptive steps of the undamped members (ρ∞ = 1: Newmark's
-    /// trapezoidal rule, generalized-α at ρ∞ = 1, HHT at α = 0) — the default
+    /// `Index3` for the Newmark family (generalized-α, HHT, Newmark), whose natural form it
+    /// is, except for adaptive steps of its undamped members (ρ∞ = 1: Newmark's trapezoidal
+    /// rule, generalized-α at ρ∞ = 1, HHT at α = 0); `Projection` for every other scheme,
+    /// Radau included: at index 3 Radau's λ is only of order s − 1 and its error control
+    /// does not aim at it, while projection gives λ of the index-1 form at the accuracy of q
+    /// and qd — the default
     #[default]
     Auto,
     /// the index-3 DAE solved directly: Φ(q₁) = 0 and the dynamics with λ₁ as unknowns
     /// (generalized-α, HHT, Newmark with the scaled iteration matrix of Bottasso, Dopico &
-    /// Trainelli 2008); refused for the undamped members with adaptive steps
+    /// Trainelli 2008; refused for the undamped members with adaptive steps), or at every
+    /// stage with (A_i, Λ_i) as unknowns (radau3, radau5, as Hairer's RADAU5 solves index-3
+    /// DAEs: positions of order 2s − 1, velocities s, λ s − 1)
     Index3,
     /// the index-1 form (B qdd = γ, λ eliminated) with Baumgarte's stabilisation
     /// Φ̈ + 2αΦ̇ + β²Φ = 0 (α, β in 1/s; α = β = 0 is the plain index-1 form, which drifts);
@@ -353,7 +362,8 @@ pub struct ConstraintOptions {
     /// Newton iterations for assembly, projection and completion (default 50)
     pub max_iterations: usize,
     /// index-3 Newmark family: scale the constraint rows of the iteration matrix by 1/β'
-    /// (default true; false keeps the unscaled matrix whose condition grows as 1/h²)
+    /// (default true; false keeps the unscaled matrix whose condition grows as 1/h²); the
+    /// index-3 Radau blocks are always scaled (by 1/(h²μ²))
     pub scaling: bool,
 }
 

@@ -200,6 +200,7 @@ impl<M: Model> Stepper<M> for Dopri5 {
                 + (2.0 * th - 6.0 * th * th + 4.0 * th * th * th) * d5[i];
             out.qdd[i] = if h == 0.0 { cur.qdd[i] } else { dp / h };
         }
+        super::lerp_lambda(prev, cur, t, out);
     }
 }
 

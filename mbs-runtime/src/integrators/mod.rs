@@ -204,7 +204,13 @@ pub(crate) fn hermite5(s0: &State, s1: &State, t: f64, out: &mut State) {
         out.qd[i] = dot(&d) / h;
         out.qdd[i] = dot(&dd) / (h * h);
     }
-    // λ between steps: linear (λ has no derivative information here)
+    lerp_lambda(s0, s1, t, out);
+}
+
+/// λ between two states: linear (the states carry no derivative of λ).
+pub(crate) fn lerp_lambda(s0: &State, s1: &State, t: f64, out: &mut State) {
+    let h = s1.t - s0.t;
+    let s = if h == 0.0 { 1.0 } else { (t - s0.t) / h };
     for i in 0..s0.lambda.len() {
         out.lambda[i] = (1.0 - s) * s0.lambda[i] + s * s1.lambda[i];
     }
@@ -714,7 +720,10 @@ fn constraint_mode(
     // without numerical damping, index 3 and step control do not go together
     let undamped = adaptive && scheme.spectral_radius_at_infinity() == Some(1.0);
     Ok(match method {
-        ConstraintMethod::Auto if scheme.solves_index3() && !undamped => Mode::Index3,
+        // the Newmark family (the schemes with a ρ∞) by default, Radau only on request
+        ConstraintMethod::Auto if scheme.spectral_radius_at_infinity().is_some() && !undamped => {
+            Mode::Index3
+        }
         ConstraintMethod::Auto | ConstraintMethod::Projection => Mode::Projection,
         ConstraintMethod::Index3 if !scheme.solves_index3() => {
             return Err(Failure::ConstraintsUnsupported {
@@ -737,7 +746,7 @@ fn constraint_mode(
 }
 
 /// The schemes that solve the index-3 equations, for messages.
-const INDEX3_SCHEMES: &str = "index-3 constraints are solved by gen-alpha, hht and newmark; every scheme takes them with Projection, Baumgarte or Partitioning";
+const INDEX3_SCHEMES: &str = "index-3 constraints are solved by gen-alpha, hht, newmark, radau3 and radau5; every scheme takes them with Projection, Baumgarte or Partitioning";
 
 fn stepper_for<M: Model>(scheme: &Scheme, n: usize) -> Box<dyn Stepper<M>> {
     match *scheme {

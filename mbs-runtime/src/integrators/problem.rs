@@ -116,11 +116,23 @@ impl<M: Model> Problem<M> {
         }
     }
 
+    /// The failure for a singular matrix whose pivot column `s.column` names a coordinate,
+    /// or, past the coordinates (index-3 matrices), the multiplier of a constraint.
     pub(crate) fn singular(&self, matrix: &'static str, s: Singular) -> Failure {
+        let coordinate = if s.column < self.n {
+            self.label(s.column)
+        } else {
+            let k = s.column - self.n;
+            let name = self
+                .con
+                .as_ref()
+                .map_or_else(|| format!("#{k}"), |c| c.name(k));
+            format!("λ of constraint `{name}`")
+        };
         Failure::SingularMatrix {
             matrix,
             rcond: s.rcond,
-            coordinates: vec![self.label(s.column)],
+            coordinates: vec![coordinate],
         }
     }
 

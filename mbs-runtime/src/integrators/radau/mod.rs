@@ -78,7 +78,7 @@
 //! after a rejection fails the test, the estimate is recomputed once with f(y₀ + err) in place
 //! of f(y₀) (one more evaluation of M and h), which removes its spurious O(1) part on stiff
 //! components. The error is measured on (q, qd) with the plain weights atol + rtol·|y| of
-//! every component (an ODE: no index-dependent scaling).
+//! every component (an ODE: no index-dependent scaling; for index 3 see below).
 //!
 //! ## Step control
 //! RADAU5's: tolerances transformed as rtol' = 0.1·rtol^((s+1)/(2s)), atol' = rtol'·atol/rtol
@@ -94,14 +94,79 @@
 //! the early give-up, retried once with fresh matrices when stale ones fail; no error test.
 //! Outputs between steps use the driver's quintic Hermite interpolant, more accurate here
 //! than the collocation polynomial (degree s).
+//!
+//! ## Index 3
+//! A constrained model `M qdd = h + Bᵀλ`, `Φ(q, t) = 0`, `B = ∂Φ/∂q`, run with
+//! `ConstraintMethod::Index3` (or `Auto`), is solved as the index-3 DAE, as Hairer's RADAU5
+//! solves it: the stage multipliers Λ_i are unknowns with the stage accelerations, and the
+//! stage equations are
+//!
+//! ```text
+//! τ(t_i, Q_i, V_i, A_i) − B(Q_i)ᵀ Λ_i = 0,   Φ(Q_i, t_i) = 0,   i = 1..s
+//! ```
+//!
+//! with Q_i, V_i as above; q₁ = Q_s, qd₁ = V_s, qdd₁ = A_s, λ₁ = Λ_s (stiffly accurate). Simplified
+//! Newton freezes M, C_t, K_t, B and K_c = ∂(Bᵀλ)/∂q at the start of the step (at λ₀; K̃ = K_t −
+//! K_c, and K_c = 0 with `MassOnly`). With δA = (T ⊗ I) W and δΛ = (T ⊗ I) U the system splits
+//! again, one (n + nc) × (n + nc) system per eigenvalue μ of A:
+//!
+//! ```text
+//! [ M + hμC_t + h²μ²K̃   −Bᵀ ] [W_μ]     [ [(T⁻¹ ⊗ I) r]_μ          ]
+//! [ B                    0  ] [U_μ] = − [ [(T⁻¹ ⊗ I) Φ]_μ / (h²μ²) ]
+//! ```
+//!
+//! (complex for the pair, real for s = 3's γ₀). The constraint rows are those of h²μ²B, the
+//! derivative of Φ(Q_i) through Q_i = … + h²(A² A)_i, divided by h²μ²: the scaling that keeps the
+//! matrix's condition bounded as h → 0 (unscaled it grows as h⁻²), the counterpart of
+//! [`super::newton`]'s 1/β' (`ConstraintOptions::scaling` concerns the Newmark family only: the
+//! Radau blocks are always scaled). Start values of Λ_i: the previous step's stage multipliers
+//! extrapolated like the accelerations, λ₀ at the first step.
+//!
+//! Newton's norm adds the λ corrections to the stage position and velocity corrections, and
+//! convergence also requires the predicted max |Φ_i(Q_j)| after the update to be below
+//! `ConstraintOptions::tolerance`. At index 3 rounding errors ε·max|q| in the stage values of Φ
+//! move the stage λ by up to ‖A⁻²‖∞ ε max|q|/h² (22 and 125 ε/h² for s = 2, 3, with (BM⁻¹Bᵀ)⁻¹
+//! taken as 1) and, through δA = M⁻¹Bᵀ δΛ, the stage velocities by ‖A⁻¹‖∞ ε max|q|/h (7 and 18
+//! ε/h); the weights of λ and velocity corrections are floored at these noise levels over κ, so
+//! that Newton stops at the noise instead of stalling on it (without the floors the pendulum's
+//! step collapsed at rtol 1e-13).
+//!
+//! Error estimate: RADAU5's for E y' = f(y) with a singular E, on y = (q, v, λ), E = diag(I, M,
+//! 0), f = (v, h + Bᵀλ, Φ): err = (E − gJ)⁻¹[γ₀h f(y₀) + E Σ e_i Z_i], g = hγ₀, whose λ row is
+//! −gB e_q = γ₀hΦ(q₀) ≈ 0. In second-order form, with K̃ in place of K and ẽ = g e_λ,
+//!
+//! ```text
+//! [ M + gC_t + g²K̃   −Bᵀ ] [e_v]   [ M r_v − gK̃ r_q     ]
+//! [ B                 0  ] [ẽ  ] = [ −(Φ(q₀) + B r_q)/g ],    e_q = r_q + g e_v,
+//! ```
+//!
+//! Newton's real block for s = 3 (an extra factorisation for s = 2, as before), Φ(q₀) taken as 0
+//! (it is below the constraint tolerance). As RADAU5 does for index-2 and index-3 components
+//! (its NIND2, NIND3), the norm weights the velocity errors by h and the λ errors by h²: it is
+//! taken on (e_q, h e_v, h² e_λ) against atol + rtol·max(|y₀|, |y₁|) of q, qd and λ, so that each
+//! part is O(h^(s+1)) like the position part. The second estimate after a rejection uses f(y₀ +
+//! err): velocity row −(τ(q₀ + e_q, v₀ + e_v, qdd₀) − B(q₀ + e_q)ᵀ(λ₀ + e_λ)) in place of 0,
+//! constraint row Φ(q₀ + e_q).
+//!
+//! Orders (Hairer, Lubich & Roche 1989; Jay 1993; Hairer & Wanner §VII.4): for index-3 systems
+//! Radau IIA with s stages gives positions of order 2s − 1, velocities of order s, λ of order
+//! s − 1 (Radau5: 5, 3, 2; Radau3: 3, 2, 1), as measured on the pendulum with fixed steps
+//! (`tests/radau_index3.rs`; Radau3's positions 2.8–2.9 at h = 1/80..1/640). The velocity and λ
+//! errors are local (those of the last step) and, since the step control weights them by h
+//! and h², follow the step size rather than rtol: λ within 1e-6 takes h ≲ 2e-3 with Radau5;
+//! with Radau3 (first order in λ, about 0.12h on the pendulum) only near h = 1e-5, where the
+//! rounding noise of λ (∝ ε/h²) is already as large (fixed steps of 1/80 000: 8.9e-7; of
+//! 1/160 000: 3.6e-5).
 
 mod tableau;
 
+use super::constrained::Mode;
 use super::problem::Problem;
 use super::{Attempt, Control, State, Stepper};
 use crate::error::Failure;
-use crate::linalg::{C64, Lu};
+use crate::linalg::{C64, Field, Lu, Singular};
 use crate::model::Model;
+use crate::options::IterationMatrix;
 use tableau::{Coefficients, re};
 
 /// θ below which M, C_t, K_t are kept for the next step (RADAU5's THET)
@@ -116,6 +181,10 @@ const FACR: f64 = 0.125;
 
 const MATRIX_C: &str = "the Radau iteration matrix M + hλC + h²λ²K (complex λ)";
 const MATRIX_R: &str = "the Radau iteration matrix M + hγ₀C + h²γ₀²K (real γ₀)";
+const MATRIX_C3: &str =
+    "the Radau index-3 iteration matrix [M + hλC + h²λ²(K − ∂(Bᵀλ)/∂q), −Bᵀ; B, 0] (complex λ)";
+const MATRIX_R3: &str =
+    "the Radau index-3 iteration matrix [M + hγ₀C + h²γ₀²(K − ∂(Bᵀλ)/∂q), −Bᵀ; B, 0] (real γ₀)";
 
 /// Newton's κ and its iteration limit.
 struct Tol {
@@ -212,6 +281,29 @@ pub(crate) struct Radau {
     naccpt: usize,
     hacc: f64,
     erracc: f64,
+    /// index 3 (enabled in `start`): the number of constraints (0 otherwise) and |Φ_i| to
+    /// reach in Newton
+    nc: usize,
+    tol_phi: f64,
+    /// ‖A⁻¹‖∞ and ‖A⁻²‖∞: the stage λ's response to stage values of Φ is
+    /// (h²A²)⁻¹ ⊗ (BM⁻¹Bᵀ)⁻¹, the stage velocities' (hA)⁻¹ ⊗ M⁻¹Bᵀ(BM⁻¹Bᵀ)⁻¹
+    ainv: f64,
+    a2inv: f64,
+    /// B (nc × n) and ∂(Bᵀλ)/∂q frozen with M, C_t, K_t (`km` then holds K_t − ∂(Bᵀλ)/∂q)
+    bm: Vec<f64>,
+    kc: Vec<f64>,
+    /// stage multipliers (stage i at i·nc..), those of the last accepted step, Φ at the
+    /// stages, Newton's λ corrections and their weights, the largest |Φ_i| of the iteration
+    lam: Vec<f64>,
+    lam_prev: Vec<f64>,
+    phis: Vec<f64>,
+    dlam: Vec<f64>,
+    scl: Vec<f64>,
+    phi_max: f64,
+    /// error estimate: the velocity row's bracket, Φ in the constraint row, λ₀ + e_λ
+    bv: Vec<f64>,
+    phix: Vec<f64>,
+    lx: Vec<f64>,
 }
 
 impl Radau {
@@ -259,7 +351,53 @@ impl Radau {
             naccpt: 0,
             hacc: 0.0,
             erracc: 1e-2,
+            nc: 0,
+            tol_phi: f64::INFINITY,
+            ainv: 0.0,
+            a2inv: 0.0,
+            bm: Vec::new(),
+            kc: Vec::new(),
+            lam: Vec::new(),
+            lam_prev: Vec::new(),
+            phis: Vec::new(),
+            dlam: Vec::new(),
+            scl: Vec::new(),
+            phi_max: 0.0,
+            bv: Vec::new(),
+            phix: Vec::new(),
+            lx: Vec::new(),
         }
+    }
+
+    /// Solves for (A_i, Λ_i) at index 3 from now on: `nc` constraints, |Φ_i| ≤ `tol_phi` at
+    /// convergence. The only allocation: the augmented matrices and their buffers.
+    fn enable_index3(&mut self, nc: usize, tol_phi: f64) {
+        let (n, s) = (self.n, self.k.s);
+        let z = |k: usize| vec![0.0; k];
+        self.nc = nc;
+        self.tol_phi = tol_phi;
+        self.ainv = inverse_row_norm(&self.k.a, s);
+        self.a2inv = inverse_row_norm(&self.k.a2, s);
+        self.lu_r = Lu::new(n + nc);
+        self.lu_c = Lu::new(n + nc);
+        self.h_c = f64::NAN;
+        self.h_r = f64::NAN;
+        self.rho_r = z(n + nc);
+        self.rho_c = vec![C64::default(); n + nc];
+        self.tmp = z(n + nc);
+        self.bm = z(nc * n);
+        self.kc = z(n * n);
+        self.lam = z(s * nc);
+        self.lam_prev = z(s * nc);
+        self.phis = z(s * nc);
+        self.dlam = z(s * nc);
+        self.scl = z(nc);
+        self.err = z(2 * n + nc);
+        self.y0 = z(2 * n + nc);
+        self.y1 = z(2 * n + nc);
+        self.bv = z(n);
+        self.phix = z(nc);
+        self.lx = z(nc);
     }
 
     /// Radau IIA, 2 stages, order 3.
@@ -273,43 +411,100 @@ impl Radau {
     }
 
     /// Factorises the complex block (and the real one when `real`) for step h, unless
-    /// factorised for this h already.
+    /// factorised for this h already. At index 3 the blocks are bordered by −Bᵀ and B.
     fn factor<M: Model>(&mut self, p: &mut Problem<M>, h: f64, real: bool) -> Result<(), Failure> {
         let close = |x: f64, y: f64| (x - y).abs() <= 1e-10 * x.abs().max(y.abs());
+        let (n, nc) = (self.n, self.nc);
+        let big = n + nc;
         if !close(self.h_c, h) {
             self.h_c = f64::NAN;
             let lam = self.k.lambda[self.k.complex];
             let g1 = lam * re(h);
             let g2 = lam * lam * re(h * h);
             let a = self.lu_c.matrix_mut();
-            for i in 0..a.len() {
-                a[i] = C64::new(
-                    self.m[i] + g1.re * self.cm[i] + g2.re * self.km[i],
-                    g1.im * self.cm[i] + g2.im * self.km[i],
-                );
+            for j in 0..n {
+                for i in 0..n {
+                    let x = i + n * j;
+                    a[i + big * j] = C64::new(
+                        self.m[x] + g1.re * self.cm[x] + g2.re * self.km[x],
+                        g1.im * self.cm[x] + g2.im * self.km[x],
+                    );
+                }
             }
+            border(a, &self.bm, n, nc);
             p.stats.factorizations += 1;
-            self.lu_c.factor().map_err(|e| p.singular(MATRIX_C, e))?;
+            if let Err(e) = self.lu_c.factor() {
+                return Err(self.singular(p, e, MATRIX_C, MATRIX_C3));
+            }
             self.h_c = h;
         }
         if real && !close(self.h_r, h) {
             self.h_r = f64::NAN;
             let g = self.k.gamma0 * h;
             let a = self.lu_r.matrix_mut();
-            for i in 0..a.len() {
-                a[i] = self.m[i] + g * self.cm[i] + g * g * self.km[i];
+            for j in 0..n {
+                for i in 0..n {
+                    let x = i + n * j;
+                    a[i + big * j] = self.m[x] + g * self.cm[x] + g * g * self.km[x];
+                }
             }
+            border(a, &self.bm, n, nc);
             p.stats.factorizations += 1;
-            self.lu_r.factor().map_err(|e| p.singular(MATRIX_R, e))?;
+            if let Err(e) = self.lu_r.factor() {
+                return Err(self.singular(p, e, MATRIX_R, MATRIX_R3));
+            }
             self.h_r = h;
         }
         Ok(())
     }
 
-    /// Starting stage accelerations: the previous step's collocation polynomial of the
-    /// acceleration (degree s − 1 through its stages), extrapolated; qdd₀ at the first step.
+    /// The failure for a singular iteration matrix: its pivot column names a coordinate, or
+    /// (index 3) the multiplier of a constraint.
+    fn singular<M: Model>(
+        &self,
+        p: &Problem<M>,
+        e: Singular,
+        plain: &'static str,
+        index3: &'static str,
+    ) -> Failure {
+        p.singular(if self.nc == 0 { plain } else { index3 }, e)
+    }
+
+    /// Index 3: ∂(Bᵀλ)/∂q and B at the start of the step (with λ₀), frozen with M, C_t, K_t;
+    /// K_t − ∂(Bᵀλ)/∂q replaces K_t in `km`.
+    fn constraint_matrices<M: Model>(
+        &mut self,
+        p: &mut Problem<M>,
+        cur: &State,
+    ) -> Result<(), Failure> {
+        let (n, nc) = (self.n, self.nc);
+        if p.iteration != IterationMatrix::MassOnly {
+            p.model
+                .constraint_tangent(cur.t, &cur.q, &cur.lambda, &mut self.kc);
+            p.stats.constraints += 1;
+            p.check("∂(Bᵀλ)/∂q", &self.kc)?;
+            for (k, c) in self.km.iter_mut().zip(&self.kc) {
+                *k -= c;
+            }
+        }
+        if let Some(c) = p.con.as_mut() {
+            c.eval_b(&p.model, &mut p.stats, cur.t, &cur.q);
+            self.bm.copy_from_slice(&c.b);
+        }
+        match self.bm.iter().position(|x| !x.is_finite()) {
+            None => Ok(()),
+            Some(i) => Err(Failure::NonFinite {
+                quantity: "B = ∂Φ/∂q",
+                coordinate: p.label((i / nc).min(n - 1)),
+            }),
+        }
+    }
+
+    /// Starting stage accelerations (and multipliers): the previous step's collocation
+    /// polynomial of the acceleration (degree s − 1 through its stages), extrapolated; qdd₀
+    /// (λ₀) at the first step.
     fn start_values(&mut self, cur: &State, h: f64) {
-        let (s, n) = (self.k.s, self.n);
+        let (s, n, nc) = (self.k.s, self.n, self.nc);
         let c = self.k.c;
         if self.h_prev > 0.0 {
             for i in 0..s {
@@ -324,10 +519,14 @@ impl Radau {
                 for r in 0..n {
                     self.acc[i * n + r] = (0..s).map(|j| w[j] * self.acc_prev[j * n + r]).sum();
                 }
+                for r in 0..nc {
+                    self.lam[i * nc + r] = (0..s).map(|j| w[j] * self.lam_prev[j * nc + r]).sum();
+                }
             }
         } else {
             for i in 0..s {
                 self.acc[i * n..(i + 1) * n].copy_from_slice(&cur.qdd);
+                self.lam[i * nc..(i + 1) * nc].copy_from_slice(&cur.lambda[..nc]);
             }
         }
     }
@@ -349,15 +548,27 @@ impl Radau {
         }
     }
 
-    /// Newton's correction δ = −(I ⊗ M + hA ⊗ C + h²A² ⊗ K)⁻¹ r through the eigen-blocks.
-    fn correction<M: Model>(&mut self, p: &mut Problem<M>) {
-        let (s, n) = (self.k.s, self.n);
+    /// Newton's correction δ = −(I ⊗ M + hA ⊗ C + h²A² ⊗ K)⁻¹ r through the eigen-blocks; at
+    /// index 3 also the λ corrections, the constraint rows of block μ being
+    /// B W_μ = −[(T⁻¹ ⊗ I) Φ]_μ / (h²μ²).
+    fn correction<M: Model>(&mut self, p: &mut Problem<M>, h: f64) {
+        let (s, n, nc) = (self.k.s, self.n, self.nc);
         let (t, ti, kc) = (&self.k.t, &self.k.ti, self.k.complex);
         if let Some(kr) = self.k.real {
             for r in 0..n {
                 self.rho_r[r] = -(0..s)
                     .map(|j| ti[kr][j].re * self.res[j * n + r])
                     .sum::<f64>();
+            }
+            if nc > 0 {
+                let g = self.k.lambda[kr].re * h;
+                let scale = 1.0 / (g * g);
+                for r in 0..nc {
+                    self.rho_r[n + r] = -scale
+                        * (0..s)
+                            .map(|j| ti[kr][j].re * self.phis[j * nc + r])
+                            .sum::<f64>();
+                }
             }
             self.lu_r.solve(&mut self.rho_r);
             p.stats.solves += 1;
@@ -369,6 +580,17 @@ impl Radau {
             }
             self.rho_c[r] = z;
         }
+        if nc > 0 {
+            let lam = self.k.lambda[kc];
+            let g2 = lam * lam * re(h * h);
+            for r in 0..nc {
+                let mut z = C64::default();
+                for j in 0..s {
+                    z = z - ti[kc][j] * re(self.phis[j * nc + r]);
+                }
+                self.rho_c[n + r] = z / g2;
+            }
+        }
         self.lu_c.solve(&mut self.rho_c);
         p.stats.solves += 1;
         for i in 0..s {
@@ -379,12 +601,20 @@ impl Radau {
                 }
                 self.delta[i * n + r] = d;
             }
+            for r in 0..nc {
+                let mut d = 2.0 * (t[i][kc] * self.rho_c[n + r]).re;
+                if let Some(kr) = self.k.real {
+                    d += t[i][kr].re * self.rho_r[n + r];
+                }
+                self.dlam[i * nc + r] = d;
+            }
         }
     }
 
-    /// Weighted RMS norm of the stage position and velocity corrections h²A²δ, hAδ.
+    /// Weighted RMS norm of the stage position and velocity corrections h²A²δ, hAδ (and, at
+    /// index 3, of the λ corrections).
     fn correction_norm(&self, h: f64) -> f64 {
-        let (s, n) = (self.k.s, self.n);
+        let (s, n, nc) = (self.k.s, self.n, self.nc);
         let (a, a2) = (&self.k.a, &self.k.a2);
         let mut sum = 0.0;
         for i in 0..s {
@@ -397,8 +627,34 @@ impl Radau {
                 let (eq, ev) = (h * h * dq / self.scq[r], h * dv / self.scv[r]);
                 sum += eq * eq + ev * ev;
             }
+            for r in 0..nc {
+                let el = self.dlam[i * nc + r] / self.scl[r];
+                sum += el * el;
+            }
         }
-        (sum / (2 * s * n).max(1) as f64).sqrt()
+        (sum / (2 * s * n + s * nc).max(1) as f64).sqrt()
+    }
+
+    /// Index 3, stage i: r_i −= B(Q_i)ᵀΛ_i, Φ(Q_i, t) into `phis`, the largest |Φ_i| kept.
+    fn constraint_residual<M: Model>(
+        &mut self,
+        p: &mut Problem<M>,
+        i: usize,
+        t: f64,
+    ) -> Result<(), Failure> {
+        let (n, nc) = (self.n, self.nc);
+        let (lo, hi) = (i * n, (i + 1) * n);
+        if let Some(c) = p.con.as_mut() {
+            c.eval_b(&p.model, &mut p.stats, t, &self.qs[lo..hi]);
+            c.eval_phi(&p.model, &mut p.stats, t, &self.qs[lo..hi]);
+            let lam = &self.lam[i * nc..(i + 1) * nc];
+            for j in 0..n {
+                self.res[lo + j] -= (0..nc).map(|k| c.b[k + nc * j] * lam[k]).sum::<f64>();
+            }
+            self.phis[i * nc..(i + 1) * nc].copy_from_slice(&c.phi);
+            self.phi_max = self.phi_max.max(c.worst().0);
+        }
+        p.check("τ − Bᵀλ", &self.res[lo..hi])
     }
 
     /// Simplified Newton on the stage accelerations (RADAU5's iteration and stopping rules).
@@ -426,19 +682,25 @@ impl Radau {
                 return Err(fail(0.5 * h, newt, last, None));
             }
             self.stages(cur, h);
+            self.phi_max = 0.0;
             for i in 0..s {
                 let (lo, hi) = (i * n, (i + 1) * n);
-                if let Err(e) = p.residual(
-                    cur.t + self.k.c[i] * h,
+                let ti = cur.t + self.k.c[i] * h;
+                let mut r = p.residual(
+                    ti,
                     &self.qs[lo..hi],
                     &self.vs[lo..hi],
                     &self.acc[lo..hi],
                     &mut self.res[lo..hi],
-                ) {
+                );
+                if self.nc > 0 && r.is_ok() {
+                    r = self.constraint_residual(p, i, ti);
+                }
+                if let Err(e) = r {
                     return Err(fail(0.5 * h, newt, last, Some(e)));
                 }
             }
-            self.correction(p);
+            self.correction(p, h);
             newt += 1;
             p.stats.newton_iterations += 1;
             let dyno = self.correction_norm(h);
@@ -472,7 +734,12 @@ impl Radau {
             for (x, d) in self.acc.iter_mut().zip(&self.delta) {
                 *x += d;
             }
-            if self.faccon * dyno <= tol.kappa {
+            for (x, d) in self.lam.iter_mut().zip(&self.dlam) {
+                *x += d;
+            }
+            // index 3: the largest |Φ_i| after this update, predicted from its value before
+            let phi_ok = self.nc == 0 || self.phi_max * self.faccon.min(1.0) <= self.tol_phi;
+            if self.faccon * dyno <= tol.kappa && phi_ok {
                 self.stages(cur, h);
                 return Ok(newt);
             }
@@ -548,10 +815,125 @@ impl Radau {
         }
         err.max(1e-10)
     }
+
+    /// Index 3: the filter (E − gJ)⁻¹ on y = (q, v, λ), E = diag(I, M, 0), in second-order
+    /// form with the real block: [M + gC + g²K̃, −Bᵀ; B, 0] (e_v, g e_λ) =
+    /// (b_v − gK̃ r_q, −(Φ + B r_q)/g), e_q = r_q + g e_v; into `err` as (e_q, h e_v, h² e_λ).
+    fn filter3<M: Model>(&mut self, p: &mut Problem<M>, g: f64, h: f64) {
+        let (n, nc) = (self.n, self.nc);
+        for i in 0..n {
+            let mut x = self.bv[i];
+            for j in 0..n {
+                x -= g * self.km[i + n * j] * self.rq[j];
+            }
+            self.tmp[i] = x;
+        }
+        for k in 0..nc {
+            let brq: f64 = (0..n).map(|j| self.bm[k + nc * j] * self.rq[j]).sum();
+            self.tmp[n + k] = -(self.phix[k] + brq) / g;
+        }
+        self.lu_r.solve(&mut self.tmp);
+        p.stats.solves += 1;
+        for i in 0..n {
+            self.err[i] = self.rq[i] + g * self.tmp[i];
+            self.err[n + i] = h * self.tmp[i];
+        }
+        for k in 0..nc {
+            self.err[2 * n + k] = h * h * self.tmp[n + k] / g;
+        }
+    }
+
+    /// Index 3: RADAU5's estimate for the DAE E y' = f(y), y = (q, v, λ), f = (v, h + Bᵀλ,
+    /// Φ), with the velocity errors weighted by h and the multipliers' by h² (RADAU5's
+    /// scaling of index-2 and index-3 components).
+    fn estimate3<M: Model>(
+        &mut self,
+        p: &mut Problem<M>,
+        cur: &State,
+        next: &State,
+        h: f64,
+        ctl: &Control,
+        tol: &Tol,
+    ) -> f64 {
+        let (s, n, nc) = (self.k.s, self.n, self.nc);
+        let g0 = self.k.gamma0;
+        let g = g0 * self.h_r;
+        for r in 0..n {
+            let (mut x, mut y) = (0.0, 0.0);
+            for j in 0..s {
+                x += self.k.dq[j] * self.acc[j * n + r];
+                y += self.k.db[j] * self.acc[j * n + r];
+            }
+            self.rq[r] = h * h * x;
+            self.rv[r] = h * (g0 * cur.qdd[r] + y);
+        }
+        // the velocity row's bracket M r_v (γ₀h f_v(y₀) = g M qdd₀ with qdd₀, λ₀ consistent);
+        // the constraint row's γ₀h Φ(q₀) ≈ 0 (|Φ(q₀)| is within the Newton tolerance)
+        for i in 0..n {
+            self.bv[i] = (0..n).map(|j| self.m[i + n * j] * self.rv[j]).sum();
+        }
+        self.phix.fill(0.0);
+        self.filter3(p, g, h);
+        self.y0[..n].copy_from_slice(&cur.q);
+        self.y0[n..2 * n].copy_from_slice(&cur.qd);
+        self.y0[2 * n..].copy_from_slice(&cur.lambda[..nc]);
+        self.y1[..n].copy_from_slice(&next.q);
+        self.y1[n..2 * n].copy_from_slice(&next.qd);
+        self.y1[2 * n..].copy_from_slice(&next.lambda[..nc]);
+        let norm_ctl = Control {
+            adaptive: Some((tol.rtol, tol.atol)),
+            ..*ctl
+        };
+        let mut err = norm_ctl.error_norm(&self.err, &self.y0, &self.y1);
+        if err >= 1.0 && (self.first || self.reject) {
+            // RADAU5: f(y₀ + err) in place of f(y₀); its velocity row, less M qdd₀, is
+            // −(τ(q₀ + e_q, v₀ + e_v, qdd₀) − Bᵀ(λ₀ + e_λ)) up to O(e_q) terms
+            let hr = 1.0 / h;
+            for r in 0..n {
+                self.qx[r] = cur.q[r] + self.err[r];
+                self.vx[r] = cur.qd[r] + self.err[n + r] * hr;
+            }
+            for k in 0..nc {
+                self.lx[k] = cur.lambda[k] + self.err[2 * n + k] * hr * hr;
+            }
+            if self.residual_at(p, cur) {
+                for r in 0..n {
+                    self.rq[r] += g * self.err[n + r] * hr;
+                    self.bv[r] -= g * self.ax[r];
+                }
+                self.filter3(p, g, h);
+                err = norm_ctl.error_norm(&self.err, &self.y0, &self.y1);
+            }
+        }
+        err.max(1e-10)
+    }
+
+    /// τ(t₀, qx, vx, qdd₀) − B(qx)ᵀ lx into `ax` and Φ(qx) into `phix`; false when an
+    /// evaluation fails or is not finite.
+    fn residual_at<M: Model>(&mut self, p: &mut Problem<M>, cur: &State) -> bool {
+        let (n, nc) = (self.n, self.nc);
+        if p.residual(cur.t, &self.qx, &self.vx, &cur.qdd, &mut self.ax)
+            .is_err()
+        {
+            return false;
+        }
+        if let Some(c) = p.con.as_mut() {
+            c.eval_b(&p.model, &mut p.stats, cur.t, &self.qx);
+            c.eval_phi(&p.model, &mut p.stats, cur.t, &self.qx);
+            for j in 0..n {
+                self.ax[j] -= (0..nc).map(|k| c.b[k + nc * j] * self.lx[k]).sum::<f64>();
+            }
+            self.phix.copy_from_slice(&c.phi);
+        }
+        self.ax.iter().chain(&self.phix).all(|x| x.is_finite())
+    }
 }
 
 impl<M: Model> Stepper<M> for Radau {
-    fn start(&mut self, _p: &mut Problem<M>, _s: &State, _ctl: &Control) -> Result<(), Failure> {
+    fn start(&mut self, p: &mut Problem<M>, _s: &State, _ctl: &Control) -> Result<(), Failure> {
+        if let Some(c) = p.con.as_ref().filter(|c| c.mode == Mode::Index3) {
+            self.enable_index3(c.nc, c.tol);
+        }
         self.jac_valid = false;
         self.need_jac = true;
         self.h_prev = 0.0;
@@ -576,6 +958,21 @@ impl<M: Model> Stepper<M> for Radau {
             self.scq[r] = tol.atol + tol.rtol * cur.q[r].abs();
             self.scv[r] = tol.atol + tol.rtol * cur.qd[r].abs();
         }
+        if self.nc > 0 {
+            // λ and the velocities to the Newton tolerance, but not below their rounding
+            // noise (Newton stops when its predicted error is below κ times the weights):
+            // rounding errors ε·max|q| in the stage values of Φ move the stage λ by up to
+            // ‖A⁻²‖∞ ε max|q|/h² (times (BM⁻¹Bᵀ)⁻¹, taken as 1) and, through
+            // δA = M⁻¹Bᵀ δΛ, the stage velocities by up to ‖A⁻¹‖∞ ε max|q|/h
+            let qmax = cur.q.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+            let noise = f64::EPSILON * qmax / (tol.kappa * h);
+            for r in 0..n {
+                self.scv[r] += noise * self.ainv;
+            }
+            for r in 0..self.nc {
+                self.scl[r] = tol.atol + tol.rtol * cur.lambda[r].abs() + noise * self.a2inv / h;
+            }
+        }
         self.h_try = h;
         // the real factorisation: Newton's block (s = 3) or only the error filter (s = 2)
         let real = s == 3 || tol.adaptive;
@@ -593,6 +990,9 @@ impl<M: Model> Stepper<M> for Radau {
                     &mut self.cm,
                     &mut self.km,
                 )?;
+                if self.nc > 0 {
+                    self.constraint_matrices(p, cur)?;
+                }
                 self.jac_valid = true;
                 self.jac_fresh = true;
                 self.need_jac = false;
@@ -635,6 +1035,8 @@ impl<M: Model> Stepper<M> for Radau {
         next.q.copy_from_slice(&self.qs[last..]);
         next.qd.copy_from_slice(&self.vs[last..]);
         next.qdd.copy_from_slice(&self.acc[last..]);
+        let nc = self.nc;
+        next.lambda[..nc].copy_from_slice(&self.lam[(s - 1) * nc..]);
         let keep_matrices = ctl.newton.reuse && self.theta <= THET;
         if !tol.adaptive {
             self.first = false;
@@ -642,7 +1044,11 @@ impl<M: Model> Stepper<M> for Radau {
             self.need_jac = !keep_matrices;
             return Ok(Attempt::Accepted { h_next: h });
         }
-        let err = self.estimate(p, cur, next, h, ctl, &tol);
+        let err = if nc > 0 {
+            self.estimate3(p, cur, next, h, ctl, &tol)
+        } else {
+            self.estimate(p, cur, next, h, ctl, &tol)
+        };
         let nit = tol.max_iterations as f64;
         let expo = 1.0 / (s as f64 + 1.0);
         let fac = SAFE.min(SAFE * (1.0 + 2.0 * nit) / (newt as f64 + 2.0 * nit));
@@ -679,6 +1085,56 @@ impl<M: Model> Stepper<M> for Radau {
 
     fn accepted(&mut self, _p: &mut Problem<M>, _prev: &State, _cur: &State) {
         std::mem::swap(&mut self.acc, &mut self.acc_prev);
+        std::mem::swap(&mut self.lam, &mut self.lam_prev);
         self.h_prev = self.h_try;
     }
+}
+
+/// Borders the n × n block of the (n + nc) × (n + nc) column-major matrix `a` with −Bᵀ
+/// (columns n..) and B (rows n..), and zeroes the corner (B nc × n, column-major).
+fn border<T: Field>(a: &mut [T], b: &[f64], n: usize, nc: usize) {
+    let big = n + nc;
+    for j in 0..n {
+        for k in 0..nc {
+            let bkj = b[k + nc * j];
+            a[j + big * (n + k)] = T::from_f64(-bkj);
+            a[(n + k) + big * j] = T::from_f64(bkj);
+        }
+    }
+    for j in n..big {
+        for i in n..big {
+            a[i + big * j] = T::default();
+        }
+    }
+}
+
+/// ‖X⁻¹‖∞ (largest absolute row sum) of an invertible s × s matrix X, s ≤ 3 (Gauss–Jordan).
+fn inverse_row_norm(x: &[[f64; 3]; 3], s: usize) -> f64 {
+    let mut a = *x;
+    let mut inv = [[0.0; 3]; 3];
+    for (i, row) in inv.iter_mut().enumerate().take(s) {
+        row[i] = 1.0;
+    }
+    for k in 0..s {
+        let p = (k..s)
+            .max_by(|&i, &j| a[i][k].abs().total_cmp(&a[j][k].abs()))
+            .unwrap_or(k);
+        a.swap(k, p);
+        inv.swap(k, p);
+        let d = a[k][k];
+        for j in 0..s {
+            a[k][j] /= d;
+            inv[k][j] /= d;
+        }
+        for i in (0..s).filter(|&i| i != k) {
+            let f = a[i][k];
+            for j in 0..s {
+                a[i][j] -= f * a[k][j];
+                inv[i][j] -= f * inv[k][j];
+            }
+        }
+    }
+    (0..s)
+        .map(|i| (0..s).map(|j| inv[i][j].abs()).sum::<f64>())
+        .fold(0.0, f64::max)
 }

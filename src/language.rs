@@ -148,7 +148,10 @@
 //! | `constraint NAME: align(A, B);` | bodies `A` and `B` keep their relative orientation (3 equations) |
 //! | `… align(A, B, about = [z]);` | only the listed rotations: each equation is the antisymmetric part of `R_Aᵀ R_B` about that axis (the sine of the relative angle for a single rotation), so keep the start within ±90° of aligned |
 //!
-//! `dof …, independent` marks the coordinates kept when the initial state is assembled.
+//! `dof …, independent` marks the coordinates kept when the initial state is assembled (and
+//! preferred as independent coordinates by partitioning). How a run treats the constraints —
+//! at index 3, by projection, Baumgarte or coordinate partitioning — is an option of the
+//! run: [`ConstraintMethod`](crate::ConstraintMethod).
 //!
 //! ## Errors
 //!

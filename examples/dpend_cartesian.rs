@@ -22,36 +22,7 @@ mod dpend;
 mod model;
 
 use clap::Parser;
-use mbs::{Model, Output, Trajectory};
-
-/// The multipliers of the named constraints at six times of the run.
-fn print_multipliers(tr: &Trajectory) {
-    print!("\n{:>8}", "t");
-    for name in &tr.constraint_names {
-        print!(" {:>12}", format!("λ {name}"));
-    }
-    println!();
-    for k in 0..6 {
-        let i = k * (tr.len() - 1) / 5;
-        print!("{:>8.4}", tr.t[i]);
-        for l in tr.lambda(i) {
-            print!(" {l:>12.6}");
-        }
-        println!();
-    }
-}
-
-/// max |Φ_i| over the outputs (the integrator's own states with `Output::Steps`; with
-/// `--dt`, interpolated between them).
-fn max_phi<M: Model>(model: &M, tr: &Trajectory) -> f64 {
-    let mut phi = vec![0.0; M::NC];
-    let mut worst = 0.0f64;
-    for i in 0..tr.len() {
-        model.constraints(tr.t[i], tr.q(i), &mut phi);
-        worst = phi.iter().fold(worst, |w, p| w.max(p.abs()));
-    }
-    worst
-}
+use mbs::Output;
 
 fn main() {
     let args = mbs::cli::RunArgs::parse();
@@ -81,10 +52,10 @@ fn main() {
     if args.quiet {
         return;
     }
-    print_multipliers(tr);
+    common::print_multipliers(tr);
     println!(
         "\nconstraint drift: max |Φ| = {:.2e} over {} outputs",
-        max_phi(&model::DoublePendulumCartesian::default(), tr),
+        tr.constraint_residual(&model::DoublePendulumCartesian::default()),
         tr.len()
     );
     let mut gap = 0.0f64;

@@ -20,36 +20,7 @@ mod common;
 mod model;
 
 use clap::Parser;
-use mbs::{Model, Trajectory};
-
-/// The multipliers of the named constraints at six times of the run.
-fn print_multipliers(tr: &Trajectory) {
-    print!("\n{:>8}", "t");
-    for name in &tr.constraint_names {
-        print!(" {:>14}", format!("λ {name}"));
-    }
-    println!();
-    for k in 0..6 {
-        let i = k * (tr.len() - 1) / 5;
-        print!("{:>8.4}", tr.t[i]);
-        for l in tr.lambda(i) {
-            print!(" {l:>14.6}");
-        }
-        println!();
-    }
-}
-
-/// max |Φ_i| over the outputs (the integrator's own states with `Output::Steps`; with
-/// `--dt`, interpolated between them).
-fn max_phi<M: Model>(model: &M, tr: &Trajectory) -> f64 {
-    let mut phi = vec![0.0; M::NC];
-    let mut worst = 0.0f64;
-    for i in 0..tr.len() {
-        model.constraints(tr.t[i], tr.q(i), &mut phi);
-        worst = phi.iter().fold(worst, |w, p| w.max(p.abs()));
-    }
-    worst
-}
+use mbs::Model;
 
 fn main() {
     let args = mbs::cli::RunArgs::parse();
@@ -80,10 +51,10 @@ fn main() {
         "\nassembled start: b = {:.9}, c = {:.9} (closed form {b:.9}, {c:.9}); b' = {:.6}, c' = {:.6}",
         q[1], q[2], qd[1], qd[2]
     );
-    print_multipliers(tr);
+    common::print_multipliers(tr);
     println!(
         "\nconstraint drift: max |Φ| = {:.2e} over {} outputs; the crank turned {:.1} times",
-        max_phi(&model::FourBar::default(), tr),
+        tr.constraint_residual(&model::FourBar::default()),
         tr.len(),
         (tr.q(tr.len() - 1)[0] - q[0]) / std::f64::consts::TAU
     );

@@ -21,36 +21,7 @@ mod common;
 mod model;
 
 use clap::Parser;
-use mbs::{Model, Output, Trajectory};
-
-/// The multipliers of the named constraints at six times of the run.
-fn print_multipliers(tr: &Trajectory) {
-    print!("\n{:>8}", "t");
-    for name in &tr.constraint_names {
-        print!(" {:>14}", format!("λ {name}"));
-    }
-    println!();
-    for k in 0..6 {
-        let i = k * (tr.len() - 1) / 5;
-        print!("{:>8.4}", tr.t[i]);
-        for l in tr.lambda(i) {
-            print!(" {l:>14.6}");
-        }
-        println!();
-    }
-}
-
-/// max |Φ_i| over the outputs (the integrator's own states with `Output::Steps`; with
-/// `--dt`, interpolated between them).
-fn max_phi<M: Model>(model: &M, tr: &Trajectory) -> f64 {
-    let mut phi = vec![0.0; M::NC];
-    let mut worst = 0.0f64;
-    for i in 0..tr.len() {
-        model.constraints(tr.t[i], tr.q(i), &mut phi);
-        worst = phi.iter().fold(worst, |w, p| w.max(p.abs()));
-    }
-    worst
-}
+use mbs::Output;
 
 fn main() {
     let args = mbs::cli::RunArgs::parse();
@@ -84,10 +55,10 @@ fn main() {
     if args.quiet {
         return;
     }
-    print_multipliers(ta);
+    common::print_multipliers(ta);
     println!(
         "\nconstraint drift: max |Φ| = {:.2e} over {} outputs",
-        max_phi(&model::SliderCrank::default(), ta),
+        ta.constraint_residual(&model::SliderCrank::default()),
         ta.len()
     );
     let (mut dth, mut ds) = (0.0f64, 0.0f64);

@@ -6,23 +6,14 @@
 
 mod common;
 
+#[path = "../examples/models/pendulum3.rs"]
+mod pendulum3;
 use mbs::integrators::index3_iteration_matrix;
 use mbs::{
     ConstraintMethod, GenAlphaParams, Model, NewmarkParams, Options, Output, Scheme, State, Stats,
     simulate,
 };
-
-mbs::multibody! {
-    /// A unit point mass on a rigid rod of length 1, Cartesian coordinates, g = 1: x'' = −xλ,
-    /// y'' = −yλ − 1 with the sign of Φ chosen so that λ is the test set's.
-    model Pendulum3 {
-        dof x = 1.0, qd = 0.0; dof y = 0.0, qd = 1.0;
-        body m { mass = 1.0; }
-        TOG[m] = Tdisp(x, y, 0);
-        gravity(0, -1, 0);
-        constraint rod = -(x * x + y * y - 1.0) / 2.0;
-    }
-}
+use pendulum3::Pendulum3;
 
 /// (x, y, ẋ, ẏ, λ) at t = 1 from tests/reference/pendulum3.json.
 fn reference() -> [f64; 5] {

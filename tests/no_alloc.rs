@@ -6,18 +6,11 @@
 #[path = "../examples/models/dpend.rs"]
 mod dpend;
 
+#[path = "../examples/models/pendulum3.rs"]
+mod pendulum3;
 use mbs::{ConstraintMethod, GenAlphaParams, Integrator, Options, Output, Scheme, Simulation};
+use pendulum3::Pendulum3;
 
-mbs::multibody! {
-    /// Cash's pendulum in Cartesian coordinates (MODELS.md pendulum3).
-    model Pendulum3 {
-        dof x = 1.0, qd = 0.0; dof y = 0.0, qd = 1.0;
-        body m { mass = 1.0; }
-        TOG[m] = Tdisp(x, y, 0);
-        gravity(0, -1, 0);
-        constraint rod = -(x * x + y * y - 1.0) / 2.0;
-    }
-}
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -55,24 +48,11 @@ fn steps_allocate_nothing_after_warm_up() {
                 output: Output::Every { dt: 0.01 },
                 ..base
             };
-            let mut sim = match Simulation::new(dpend::DoublePendulum::default(), scheme, opts) {
+            let sim = match Simulation::new(dpend::DoublePendulum::default(), scheme, opts) {
                 Ok(s) => s,
                 Err(e) => panic!("{}: {e}", scheme.name()),
             };
-            for _ in 0..20 {
-                sim.step().unwrap();
-            }
-            let before = ALLOCATIONS.load(Ordering::Relaxed);
-            for _ in 0..200 {
-                sim.step().unwrap();
-            }
-            let allocated = ALLOCATIONS.load(Ordering::Relaxed) - before;
-            assert_eq!(
-                allocated,
-                0,
-                "{} allocated {allocated} times in 200 steps",
-                scheme.name()
-            );
+            assert_no_allocation(sim, scheme.name());
         }
     }
     let gen_alpha = Scheme::GenAlpha(GenAlphaParams::from_rho_inf(0.8));
@@ -102,21 +82,23 @@ fn steps_allocate_nothing_after_warm_up() {
             ..base
         };
         opts.constraints.method = method;
-        let mut sim = Simulation::new(Pendulum3::default(), scheme, opts).unwrap();
-        for _ in 0..20 {
-            sim.step().unwrap();
-        }
-        let before = ALLOCATIONS.load(Ordering::Relaxed);
-        for _ in 0..200 {
-            sim.step().unwrap();
-        }
-        let allocated = ALLOCATIONS.load(Ordering::Relaxed) - before;
-        assert_eq!(
-            allocated,
-            0,
-            "{} with {} allocated {allocated} times in 200 steps",
-            scheme.name(),
-            method.name()
-        );
+        let sim = Simulation::new(Pendulum3::default(), scheme, opts).unwrap();
+        assert_no_allocation(sim, &format!("{} with {}", scheme.name(), method.name()));
     }
+}
+
+/// 20 steps of warm-up, then 200 steps that must not allocate.
+fn assert_no_allocation<M: mbs::Model + 'static>(mut sim: Simulation<M>, what: &str) {
+    for _ in 0..20 {
+        sim.step().unwrap();
+    }
+    let before = ALLOCATIONS.load(Ordering::Relaxed);
+    for _ in 0..200 {
+        sim.step().unwrap();
+    }
+    let allocated = ALLOCATIONS.load(Ordering::Relaxed) - before;
+    assert_eq!(
+        allocated, 0,
+        "{what} allocated {allocated} times in 200 steps"
+    );
 }

@@ -59,3 +59,21 @@ pub fn show<M: Model>(model: &M) {
     }
     println!("\noperations per generated function:\n{}", info.ops_table());
 }
+
+/// The multipliers of the named constraints at six times of a run.
+#[allow(dead_code)]
+pub fn print_multipliers(tr: &mbs::Trajectory) {
+    print!("\n{:>8}", "t");
+    for name in &tr.constraint_names {
+        print!(" {:>14}", format!("λ {name}"));
+    }
+    println!();
+    for k in 0..6 {
+        let i = k * (tr.len() - 1) / 5;
+        print!("{:>8.4}", tr.t[i]);
+        for l in tr.lambda(i) {
+            print!(" {l:>14.6}");
+        }
+        println!();
+    }
+}

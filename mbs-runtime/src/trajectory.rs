@@ -137,6 +137,19 @@ impl Trajectory {
         self.lambda_data.extend_from_slice(lambda);
     }
 
+    /// Largest |Φ_i(t, q)| of `model`'s constraints over the outputs (0 without constraints):
+    /// the drift of a run, on the integrator's own states with `Output::Steps`, on
+    /// interpolated ones between them otherwise.
+    pub fn constraint_residual<M: crate::model::Model>(&self, model: &M) -> f64 {
+        let mut phi = vec![0.0; M::NC];
+        let mut worst = 0.0f64;
+        for i in 0..self.len() {
+            model.constraints(self.t[i], self.q(i), &mut phi);
+            worst = phi.iter().fold(worst, |w, p| w.max(p.abs()));
+        }
+        worst
+    }
+
     /// Energy drift: max |E(t) − E(t0)| over the outputs (`None` when energy was not recorded).
     pub fn energy_drift(&self) -> Option<f64> {
         let e0 = self.energy.first()?.total();

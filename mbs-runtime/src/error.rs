@@ -120,6 +120,8 @@ pub enum Failure {
         residual: f64,
         iterations: usize,
     },
+    #[error("user effort failed at t = {t}: {message}")]
+    UserEffort { t: f64, message: String },
     #[error("{scheme} cannot integrate constraints by {method}: {supported}")]
     ConstraintsUnsupported {
         scheme: &'static str,

@@ -12,6 +12,7 @@
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod analysis;
+pub mod efforts;
 pub mod error;
 pub mod inertia;
 pub mod integrators;
@@ -25,8 +26,11 @@ pub use analysis::{
     AnalysisError, Equilibrium, Linearization, Modes, Stability, StaticsOptions, linearize, modes,
     static_equilibrium,
 };
+pub use efforts::{Effort, Efforts, WithEfforts};
 pub use error::{Failure, ModelError, ParamError, SimError, check_inertia};
-pub use integrators::{Assembly, Integrator, Simulation, State, assemble, simulate};
+pub use integrators::{
+    Assembly, Controller, Inputs, Integrator, Simulation, State, assemble, simulate, simulate_with,
+};
 pub use model::{
     Energy, FrameKinematics, Kinematics, Model, ModelInfo, OpCount, OpsTable, Parameters,
     PointKinematics, Pose,

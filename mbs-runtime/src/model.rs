@@ -114,6 +114,16 @@ impl ModelInfo {
         self.is_body.iter().filter(|&&b| b).count()
     }
 
+    /// Index of the body or frame named `name`, for efforts written in Rust.
+    pub fn frame_index(&self, name: &str) -> Option<usize> {
+        self.frames.iter().position(|f| *f == name)
+    }
+
+    /// Index of the declared point named `name`.
+    pub fn point_index(&self, name: &str) -> Option<usize> {
+        self.points.iter().position(|p| *p == name)
+    }
+
     /// "q[3] (knee)" for a named coordinate, "q[3]" otherwise.
     pub fn dof_label(&self, i: usize) -> String {
         match self.dofs.get(i) {
@@ -303,4 +313,15 @@ pub trait Model {
 
     /// Poses, velocities, Jacobians and bias accelerations of every frame and point.
     fn kinematics(&self, t: f64, q: &[f64], qd: &[f64], out: &mut Kinematics);
+
+    /// A failure of user code during the evaluations since the last call (efforts written in
+    /// Rust, [`crate::WithEfforts`]), taken once; generated models have none.
+    fn take_failure(&self) -> Option<crate::error::Failure> {
+        None
+    }
+
+    /// Evaluations of user code so far (efforts written in Rust and their differences).
+    fn user_evaluations(&self) -> usize {
+        0
+    }
 }

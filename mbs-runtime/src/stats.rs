@@ -28,6 +28,8 @@ pub struct Stats {
     pub projections: usize,
     /// changes of the independent coordinates (coordinate partitioning)
     pub repartitions: usize,
+    /// calls of sampled controllers
+    pub samples: usize,
     /// evaluations of user efforts (none yet: reserved for user force hooks)
     pub user_efforts: usize,
     /// evaluations of energy (for outputs)

@@ -216,6 +216,50 @@ pub(crate) fn lerp_lambda(s0: &State, s1: &State, t: f64, out: &mut State) {
     }
 }
 
+/// u(t), written into its argument.
+pub(crate) type InputFn = Box<dyn FnMut(f64, &mut [f64])>;
+
+/// A controller sampled every period: it reads the state at the sample instant and writes
+/// the inputs it drives into `u`, held until its next sample (zero-order hold).
+pub trait Controller {
+    fn sample(&mut self, t: f64, state: &State, u: &mut [f64]);
+}
+
+impl<F: FnMut(f64, &State, &mut [f64])> Controller for F {
+    fn sample(&mut self, t: f64, state: &State, u: &mut [f64]) {
+        self(t, state, u)
+    }
+}
+
+/// What drives a model's inputs u: a function of time and sampled controllers. At every
+/// evaluation u = (the function's value) + (the outputs the controllers hold, zero until
+/// they write them). The integrators stop exactly at every sample instant t₀ + k·T, call the
+/// controllers there, and restart from that state (a held output jumps: multistep histories
+/// and predictors do not survive it).
+#[derive(Default)]
+pub struct Inputs {
+    function: Option<InputFn>,
+    controllers: Vec<(f64, Box<dyn Controller>)>,
+}
+
+impl Inputs {
+    pub fn new() -> Inputs {
+        Inputs::default()
+    }
+
+    /// u(t) (it adds to the controllers' outputs).
+    pub fn function(mut self, f: impl FnMut(f64, &mut [f64]) + 'static) -> Inputs {
+        self.function = Some(Box::new(f));
+        self
+    }
+
+    /// A controller sampled every `period` seconds from t₀.
+    pub fn controller(mut self, period: f64, c: impl Controller + 'static) -> Inputs {
+        self.controllers.push((period, Box::new(c)));
+        self
+    }
+}
+
 /// Runs `scheme` on `model` with `options` to the end; on failure, the error keeps the
 /// trajectory up to the failure.
 pub fn simulate<M: Model + 'static>(
@@ -223,7 +267,17 @@ pub fn simulate<M: Model + 'static>(
     scheme: Scheme,
     options: Options,
 ) -> Result<(Trajectory, Stats), SimError> {
-    let mut sim = Simulation::new(model, scheme, options)?;
+    simulate_with(model, scheme, options, Inputs::default())
+}
+
+/// [`simulate`] with inputs driven by time functions and sampled controllers.
+pub fn simulate_with<M: Model + 'static>(
+    model: M,
+    scheme: Scheme,
+    options: Options,
+    inputs: Inputs,
+) -> Result<(Trajectory, Stats), SimError> {
+    let mut sim = Simulation::with_inputs(model, scheme, options, inputs)?;
     let t_end = sim.options.t_end;
     sim.integrate_to(t_end)?;
     Ok(sim.finish())
@@ -251,12 +305,25 @@ pub struct Simulation<M: Model> {
     poses: Vec<Pose>,
     observers: Vec<Box<dyn Observer>>,
     assembly: Option<Assembly>,
+    /// sampled controllers: period, samples taken, the controller
+    controllers: Vec<(f64, u64, Box<dyn Controller>)>,
 }
 
 impl<M: Model + 'static> Simulation<M> {
     /// Validates everything, then starts from a consistent state: the given or declared q0,
     /// qd0 and qdd0 from M qdd = h.
     pub fn new(model: M, scheme: Scheme, options: Options) -> Result<Simulation<M>, SimError> {
+        Simulation::with_inputs(model, scheme, options, Inputs::default())
+    }
+
+    /// [`Simulation::new`] with inputs driven by a time function and sampled controllers
+    /// (sampled a first time at t₀, before the start's accelerations).
+    pub fn with_inputs(
+        model: M,
+        scheme: Scheme,
+        options: Options,
+        inputs: Inputs,
+    ) -> Result<Simulation<M>, SimError> {
         let n = M::NQ;
         let info = model.info();
         let dof_names: Vec<String> = info.dofs.iter().map(|s| s.to_string()).collect();
@@ -283,7 +350,38 @@ impl<M: Model + 'static> Simulation<M> {
         if let Err(e) = crate::model::Parameters::validate(model.params()) {
             return Err(early(Failure::InvalidParameters(e), Stats::default()));
         }
+        let driven = inputs.function.is_some() || !inputs.controllers.is_empty();
+        if driven && M::NU == 0 {
+            return Err(early(
+                Failure::InvalidOption {
+                    name: "inputs",
+                    value: format!("{} controllers", inputs.controllers.len()),
+                    reason: "the model has no inputs u: use `u[k]` in its forces, torques or generalised forces",
+                },
+                Stats::default(),
+            ));
+        }
+        if let Some((p, _)) = inputs
+            .controllers
+            .iter()
+            .find(|(p, _)| !(*p > 0.0) || !p.is_finite())
+        {
+            return Err(early(
+                Failure::InvalidOption {
+                    name: "controller period",
+                    value: p.to_string(),
+                    reason: "must be > 0 and finite",
+                },
+                Stats::default(),
+            ));
+        }
         let mut problem = Problem::new(model, options.iteration_matrix);
+        problem.input_fn = inputs.function;
+        let mut controllers: Vec<(f64, u64, Box<dyn Controller>)> = inputs
+            .controllers
+            .into_iter()
+            .map(|(p, c)| (p, 0, c))
+            .collect();
         if let Scheme::Bdf(p) = scheme {
             // the order history is counted per order: sized now, not while stepping
             problem.stats.order_steps = vec![0; p.max_order];
@@ -325,6 +423,13 @@ impl<M: Model + 'static> Simulation<M> {
                 Err(e) => return Err(early(e, problem.stats.clone())),
             }
         }
+        // the controllers' first sample, on the consistent positions and velocities
+        for (_, count, c) in controllers.iter_mut() {
+            c.sample(cur.t, &cur, &mut problem.held);
+            *count = 1;
+            problem.stats.samples += 1;
+        }
+        problem.inputs_changed();
         let start = problem.accel(cur.t, &cur.q.clone(), &cur.qd.clone(), &mut cur.qdd);
         if let Err(e) = start {
             return Err(early(e, problem.stats.clone()));
@@ -402,6 +507,7 @@ impl<M: Model + 'static> Simulation<M> {
             observers: Vec::new(),
             options,
             assembly,
+            controllers,
         };
         // outputs at t0
         match sim.options.output {
@@ -458,6 +564,7 @@ impl<M: Model + 'static> Simulation<M> {
         if self.options.output == Output::Last && self.traj.is_empty() {
             self.record_cur();
         }
+        self.problem.stats.user_efforts = self.problem.model.user_evaluations();
         (self.traj, self.problem.stats)
     }
 
@@ -483,11 +590,13 @@ impl<M: Model + 'static> Simulation<M> {
     }
 
     fn fail(&self, kind: Failure, h: f64) -> SimError {
+        let mut stats = self.problem.stats.clone();
+        stats.user_efforts = self.problem.model.user_evaluations();
         SimError {
             kind,
             t: self.cur.t,
             h,
-            stats: Box::new(self.problem.stats.clone()),
+            stats: Box::new(stats),
             trajectory: Box::new(self.traj.clone()),
         }
     }
@@ -516,9 +625,46 @@ impl<M: Model + 'static> Simulation<M> {
         }
     }
 
+    /// The next sample instant of any controller (infinite without).
+    fn next_sample(&self) -> f64 {
+        let t0 = self.options.t0;
+        self.controllers
+            .iter()
+            .map(|(p, k, _)| t0 + *k as f64 * p)
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// At a sample instant: the due controllers write their outputs, then qdd and λ of the
+    /// current state are computed again and the scheme restarts from it.
+    fn sample(&mut self) -> Result<(), Failure> {
+        let (t0, t) = (self.options.t0, self.cur.t);
+        let mut any = false;
+        for (p, k, c) in self.controllers.iter_mut() {
+            let due = t0 + *k as f64 * *p;
+            if due <= t + 1e-12 * t.abs().max(1.0) {
+                c.sample(t, &self.cur, &mut self.problem.held);
+                *k += 1;
+                self.problem.stats.samples += 1;
+                any = true;
+            }
+        }
+        if !any {
+            return Ok(());
+        }
+        self.problem.inputs_changed();
+        self.problem
+            .accel(t, &self.cur.q, &self.cur.qd, &mut self.cur.qdd)?;
+        if let Some(c) = &self.problem.con {
+            self.cur.lambda.copy_from_slice(&c.lambda);
+        }
+        self.stepper.start(&mut self.problem, &self.cur, &self.ctl)
+    }
+
     fn step_until(&mut self, t_stop: f64) -> Result<(), SimError> {
         let h_min = self.options.h_min();
         let fixed = matches!(self.options.step, StepControl::Fixed { .. });
+        // controllers are sampled exactly at their instants
+        let t_stop = t_stop.min(self.next_sample());
         loop {
             if self.attempts >= self.options.max_steps {
                 return Err(self.fail(
@@ -575,12 +721,18 @@ impl<M: Model + 'static> Simulation<M> {
                         return Err(self.fail(kind, h));
                     }
                     self.problem.stats.record_step(h);
+                    self.problem.stats.user_efforts = self.problem.model.user_evaluations();
                     self.last_cause = None;
                     self.prev.copy_from(&self.cur);
                     std::mem::swap(&mut self.cur, &mut self.next);
                     self.stepper
                         .accepted(&mut self.problem, &self.prev, &self.cur);
                     self.outputs_after_step();
+                    if self.cur.t == t_stop && !self.controllers.is_empty() {
+                        if let Err(kind) = self.sample() {
+                            return Err(self.fail(kind, h));
+                        }
+                    }
                     if !fixed {
                         // a shortened last step says nothing about the next one
                         self.h = if last {
@@ -603,7 +755,16 @@ impl<M: Model + 'static> Simulation<M> {
                     cause,
                 }) => {
                     self.problem.stats.rejected_newton += 1;
-                    if fixed || h <= h_min {
+                    // a user effort's own error does not go away with a smaller step
+                    let fatal = matches!(
+                        cause,
+                        Some(Failure::UserEffort { .. })
+                            | Some(Failure::NonFinite {
+                                quantity: "user effort",
+                                ..
+                            })
+                    );
+                    if fixed || h <= h_min || fatal {
                         let kind = cause.unwrap_or(Failure::NewtonDiverged {
                             iterations,
                             correction,

@@ -104,7 +104,9 @@ impl<M: Model> Stepper<M> for AlphaFamily {
         self.a.copy_from_slice(&s.qdd);
         if let Some(c) = p.con.as_ref().filter(|c| c.mode == Mode::Index3) {
             self.newton.enable_index3(c.nc, c.scaling, c.tol);
-            self.lam = vec![0.0; c.nc];
+            if self.lam.len() != c.nc {
+                self.lam = vec![0.0; c.nc];
+            }
         }
         Ok(())
     }

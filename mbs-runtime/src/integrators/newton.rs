@@ -114,9 +114,14 @@ impl AccelNewton {
     /// scaled by 1/β' when `scaled`, |Φ_i| ≤ `tol_phi` at convergence.
     pub fn enable_index3(&mut self, nc: usize, scaled: bool, tol_phi: f64) {
         let (n, z) = (self.n, |k: usize| vec![0.0; k]);
-        self.nc = nc;
         self.scaled = scaled;
         self.tol_phi = tol_phi;
+        self.valid = false;
+        if self.nc == nc {
+            // a restart: the buffers are there
+            return;
+        }
+        self.nc = nc;
         self.lu = Lu::new(n + nc);
         self.r = z(n + nc);
         self.l0 = z(nc);

@@ -19,8 +19,16 @@ use crate::stats::Stats;
 pub(crate) struct Problem<M: Model> {
     pub model: M,
     pub n: usize,
-    /// inputs u (zero until input functions exist)
+    /// inputs u at the time of the last evaluation: the time function's value plus the
+    /// outputs the sampled controllers hold
     pub u: Vec<f64>,
+    /// u(t), when given
+    pub input_fn: Option<super::InputFn>,
+    /// the outputs of the sampled controllers (held between samples)
+    pub held: Vec<f64>,
+    u_fn: Vec<f64>,
+    /// the time `u` holds the inputs of (NaN: to compute)
+    u_t: f64,
     pub stats: Stats,
     /// how iteration matrices are built (never `Auto` here)
     pub iteration: IterationMatrix,
@@ -67,6 +75,10 @@ impl<M: Model> Problem<M> {
             model,
             n,
             u: vec![0.0; M::NU],
+            input_fn: None,
+            held: vec![0.0; M::NU],
+            u_fn: vec![0.0; M::NU],
+            u_t: f64::NAN,
             stats: Stats::default(),
             iteration,
             labels,
@@ -95,6 +107,38 @@ impl<M: Model> Problem<M> {
         }
     }
 
+    /// u at time t: the input function (if any) plus the held controller outputs.
+    fn inputs_at(&mut self, t: f64) -> Result<(), Failure> {
+        if self.u.is_empty() || self.u_t == t {
+            return Ok(());
+        }
+        self.u_t = t;
+        self.u.copy_from_slice(&self.held);
+        if let Some(f) = self.input_fn.as_mut() {
+            self.u_fn.fill(0.0);
+            f(t, &mut self.u_fn);
+            for (u, x) in self.u.iter_mut().zip(&self.u_fn) {
+                *u += x;
+            }
+        }
+        match self.u.iter().position(|x| !x.is_finite()) {
+            None => Ok(()),
+            Some(i) => {
+                self.u_t = f64::NAN;
+                Err(Failure::NonFinite {
+                    quantity: "input",
+                    coordinate: format!("u[{i}] at t = {t}"),
+                })
+            }
+        }
+    }
+
+    /// The held controller outputs changed: u and the cached index-1 solution are stale.
+    pub fn inputs_changed(&mut self) {
+        self.u_t = f64::NAN;
+        self.cache_valid = false;
+    }
+
     /// The constrained model is integrated as the ODE of its index-1 form.
     fn ode(&self) -> bool {
         self.con.as_ref().is_some_and(|c| c.mode.is_ode())
@@ -107,6 +151,10 @@ impl<M: Model> Problem<M> {
 
     /// The first non-finite entry of `v`, as a failure naming its coordinate.
     pub fn check(&self, quantity: &'static str, v: &[f64]) -> Result<(), Failure> {
+        // user code reports its own failure first (a NaN it caused is only its symptom)
+        if let Some(f) = self.model.take_failure() {
+            return Err(f);
+        }
         match v.iter().position(|x| !x.is_finite()) {
             None => Ok(()),
             Some(i) => Err(Failure::NonFinite {
@@ -140,6 +188,7 @@ impl<M: Model> Problem<M> {
     /// `con.lambda`) of the index-1 equations, after completing the dependent coordinates
     /// when partitioning.
     pub fn accel(&mut self, t: f64, q: &[f64], qd: &[f64], qdd: &mut [f64]) -> Result<(), Failure> {
+        self.inputs_at(t)?;
         let Some(c) = self.con.as_mut() else {
             return self.plain_accel(t, q, qd, qdd);
         };
@@ -313,6 +362,7 @@ impl<M: Model> Problem<M> {
         qdd: &[f64],
         r: &mut [f64],
     ) -> Result<(), Failure> {
+        self.inputs_at(t)?;
         if self.ode() {
             // the index-1 ODE: a − f(t, q, qd)
             self.f_into_fa(t, q, qd)?;
@@ -469,6 +519,7 @@ impl<M: Model> Problem<M> {
         gamma: f64,
         a: &mut [f64],
     ) -> Result<(), Failure> {
+        self.inputs_at(t)?;
         let n = self.n;
         match self.iteration {
             IterationMatrix::Exact | IterationMatrix::Auto => {
@@ -525,6 +576,9 @@ impl<M: Model> Problem<M> {
                 }
             }
         }
+        if let Some(f) = self.model.take_failure() {
+            return Err(f);
+        }
         if let Some(i) = a.iter().position(|x| !x.is_finite()) {
             return Err(Failure::NonFinite {
                 quantity: "iteration matrix",
@@ -550,6 +604,7 @@ impl<M: Model> Problem<M> {
         c: &mut [f64],
         k: &mut [f64],
     ) -> Result<(), Failure> {
+        self.inputs_at(t)?;
         if self.ode() {
             return self.ode_tangent_matrices(t, q, qd, m, c, k);
         }

@@ -373,6 +373,13 @@ impl Radau {
     /// convergence. The only allocation: the augmented matrices and their buffers.
     fn enable_index3(&mut self, nc: usize, tol_phi: f64) {
         let (n, s) = (self.n, self.k.s);
+        self.tol_phi = tol_phi;
+        if self.nc == nc {
+            // a restart (after a controller's sample): the buffers are there
+            self.h_c = f64::NAN;
+            self.h_r = f64::NAN;
+            return;
+        }
         let z = |k: usize| vec![0.0; k];
         self.nc = nc;
         self.tol_phi = tol_phi;

@@ -1,0 +1,542 @@
+//! Efforts written in Rust and extra first-order states, around a generated model (EasyDyn's
+//! `AddAppliedEfforts` and its extra differential equations).
+//!
+//! [`WithEfforts`] wraps a model `M` and a user part `E: Efforts` into a model of its own, so
+//! every scheme, constraint method and analysis runs it unchanged:
+//!
+//! - at every evaluation the generated kinematics of `M` (poses, velocities and Jacobians of
+//!   its frames and points) are handed to [`Efforts::efforts`], which adds forces and torques
+//!   in world axes at points of bodies ([`Effort`]); they are projected to generalised forces
+//!   through the Jacobians, Q = Σ J_vᵀF + J_ωᵀT, and added to h;
+//! - `E::NX` extra states x with ẋ = f(t, q, qd, x, u) ([`Efforts::state_derivatives`]: motor
+//!   currents, PID integrators, activation dynamics) ride along as auxiliary coordinates s
+//!   with ṡ = x and s̈ = f: unit mass, no other coupling. Every scheme integrates them with its
+//!   own velocity update (for the Newmark family, its first-order form: the trapezoidal rule
+//!   at γ = ½); the states are the velocities `qd[NQ_M + k]` of the coordinates named
+//!   `x:NAME`, their integrals s are not used;
+//! - tangents: the generated ones of `M` plus forward differences of the user part only
+//!   (2·NQ evaluations of it), counted in `Stats::user_efforts`; without generated tangents
+//!   the schemes difference the whole of τ as usual.
+//!
+//! The user part must be a function of (t, q, qd, x, u): it is called at trial states, for
+//! differences and several times per step. Memory belongs in extra states or in sampled
+//! controllers ([`crate::Inputs`]). A user error (`Err`) or a non-finite effort stops the run
+//! with [`Failure::UserEffort`] or [`Failure::NonFinite`] naming the coordinate or state.
+
+use crate::error::{Failure, ModelError, ParamError};
+use crate::model::{Energy, FrameKinematics, Kinematics, Model, ModelInfo, PointKinematics, Pose};
+use std::any::TypeId;
+use std::cell::{Cell, Ref, RefCell, RefMut};
+use std::collections::HashMap;
+use std::sync::{Mutex, OnceLock};
+
+/// The user part of a [`WithEfforts`] model.
+pub trait Efforts: 'static {
+    /// number of extra first-order states x
+    const NX: usize = 0;
+    /// their names (NX of them)
+    const STATE_NAMES: &'static [&'static str] = &[];
+    /// x(0) (NX)
+    fn initial_states(&self, _x: &mut [f64]) {}
+    /// Adds the efforts at the state in `e` (world axes). An `Err` stops the run.
+    fn efforts(&mut self, e: &mut Effort) -> Result<(), String>;
+    /// ẋ (NX) at the state in `e`.
+    fn state_derivatives(&mut self, _e: &Effort, _xd: &mut [f64]) -> Result<(), String> {
+        Ok(())
+    }
+}
+
+/// The state handed to the user part, and where it adds its efforts.
+pub struct Effort<'a> {
+    pub t: f64,
+    /// coordinates and velocities of the wrapped model
+    pub q: &'a [f64],
+    pub qd: &'a [f64],
+    /// extra states
+    pub x: &'a [f64],
+    /// inputs
+    pub u: &'a [f64],
+    /// kinematics of the wrapped model's frames and points at (t, q, qd)
+    pub kin: &'a Kinematics,
+    qg: &'a mut [f64],
+}
+
+impl Effort<'_> {
+    /// Kinematics of frame (or body) `i` (`ModelInfo::frame_index`).
+    pub fn frame(&self, i: usize) -> &FrameKinematics {
+        &self.kin.frames[i]
+    }
+
+    /// Kinematics of declared point `i` (`ModelInfo::point_index`).
+    pub fn point(&self, i: usize) -> &PointKinematics {
+        &self.kin.points[i]
+    }
+
+    /// A force (world axes) at declared point `i`.
+    pub fn force_at_point(&mut self, i: usize, f: [f64; 3]) {
+        let jv = &self.kin.points[i].jv;
+        add_jt(self.qg, jv, f);
+    }
+
+    /// A force (world axes) applied at the world position `at` of a point of frame `i`.
+    pub fn force_on_frame(&mut self, i: usize, at: [f64; 3], f: [f64; 3]) {
+        let k = &self.kin.frames[i];
+        let o = k.pose.position;
+        let r = [at[0] - o[0], at[1] - o[1], at[2] - o[2]];
+        add_jt(self.qg, &k.jv, f);
+        add_jt(self.qg, &k.jw, cross(r, f));
+    }
+
+    /// A torque (world axes) on frame `i`.
+    pub fn torque_on_frame(&mut self, i: usize, torque: [f64; 3]) {
+        add_jt(self.qg, &self.kin.frames[i].jw, torque);
+    }
+
+    /// A generalised force on coordinate `i` of the wrapped model.
+    pub fn generalized_force(&mut self, i: usize, value: f64) {
+        self.qg[i] += value;
+    }
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// qg += Jᵀ f for a 3 × n Jacobian stored column-major (`j[3k + i]`).
+fn add_jt(qg: &mut [f64], j: &[f64], f: [f64; 3]) {
+    for (k, g) in qg.iter_mut().enumerate() {
+        *g += j[3 * k] * f[0] + j[3 * k + 1] * f[1] + j[3 * k + 2] * f[2];
+    }
+}
+
+/// Buffers of the wrapper, allocated once.
+struct Scratch {
+    kin: Kinematics,
+    m: Vec<f64>,
+    h: Vec<f64>,
+    b: Vec<f64>,
+    bu: Vec<f64>,
+    k: Vec<f64>,
+    c: Vec<f64>,
+    qg: Vec<f64>,
+    xd: Vec<f64>,
+    qg1: Vec<f64>,
+    xd1: Vec<f64>,
+    qp: Vec<f64>,
+    vp: Vec<f64>,
+    up: Vec<f64>,
+}
+
+/// A generated model with efforts and extra states written in Rust: a [`Model`] with
+/// NQ = M::NQ + E::NX coordinates.
+pub struct WithEfforts<M: Model, E: Efforts> {
+    pub model: M,
+    user: RefCell<E>,
+    scratch: RefCell<Scratch>,
+    failure: RefCell<Option<Failure>>,
+    evaluations: Cell<usize>,
+    info: &'static ModelInfo,
+}
+
+impl<M: Model + 'static, E: Efforts> WithEfforts<M, E> {
+    pub fn new(model: M, efforts: E) -> WithEfforts<M, E> {
+        let (n, nx) = (M::NQ, E::NX);
+        let big = n + nx;
+        let z = |k: usize| vec![0.0; k];
+        let scratch = Scratch {
+            kin: Kinematics::new::<M>(),
+            m: z(n * n),
+            h: z(n),
+            b: z(M::NC * n),
+            bu: z(n * M::NU),
+            k: z(n * n),
+            c: z(n * n),
+            qg: z(n),
+            xd: z(nx),
+            qg1: z(n),
+            xd1: z(nx),
+            qp: z(big),
+            vp: z(big),
+            up: z(M::NU),
+        };
+        let info = extended_info::<M, E>(model.info());
+        WithEfforts {
+            model,
+            user: RefCell::new(efforts),
+            scratch: RefCell::new(scratch),
+            failure: RefCell::new(None),
+            evaluations: Cell::new(0),
+            info,
+        }
+    }
+
+    /// The user part.
+    pub fn efforts(&self) -> Ref<'_, E> {
+        self.user.borrow()
+    }
+
+    /// The user part, mutably (between runs: it must not change during one).
+    pub fn efforts_mut(&self) -> RefMut<'_, E> {
+        self.user.borrow_mut()
+    }
+}
+
+/// One leaked `ModelInfo` per (model type, user type): the wrapped model's with the extra
+/// states appended as coordinates `x:NAME`.
+fn extended_info<M: Model + 'static, E: Efforts>(inner: &'static ModelInfo) -> &'static ModelInfo {
+    if E::NX == 0 {
+        return inner;
+    }
+    static CACHE: OnceLock<Mutex<HashMap<(TypeId, TypeId), &'static ModelInfo>>> = OnceLock::new();
+    let key = (TypeId::of::<M>(), TypeId::of::<E>());
+    let mut cache = CACHE
+        .get_or_init(|| Mutex::new(HashMap::new()))
+        .lock()
+        .unwrap_or_else(|e| e.into_inner());
+    cache.entry(key).or_insert_with(|| {
+        let leak = |v: Vec<&'static str>| -> &'static [&'static str] { Vec::leak(v) };
+        let mut dofs: Vec<&'static str> = inner.dofs.to_vec();
+        for k in 0..E::NX {
+            let name = E::STATE_NAMES.get(k).copied().unwrap_or("state");
+            dofs.push(String::leak(format!("x:{name}")));
+        }
+        let mut independent = inner.independent.to_vec();
+        independent.resize(dofs.len(), true);
+        Box::leak(Box::new(ModelInfo {
+            dofs: leak(dofs),
+            independent: Vec::leak(independent),
+            ..*inner
+        }))
+    })
+}
+
+impl<M: Model, E: Efforts> WithEfforts<M, E> {
+    /// The user part at (t, q, qd, u) (q, qd of length NQ_M + NX) into `qg` (NQ_M) and `xd`
+    /// (NX); false (with the failure kept) when it fails or gives a non-finite value.
+    fn user(
+        &self,
+        s: &mut Scratch,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        u: &[f64],
+        into_1: bool,
+    ) -> bool {
+        let n = M::NQ;
+        self.evaluations.set(self.evaluations.get() + 1);
+        self.model.kinematics(t, &q[..n], &qd[..n], &mut s.kin);
+        let (qg, xd) = if into_1 {
+            (&mut s.qg1, &mut s.xd1)
+        } else {
+            (&mut s.qg, &mut s.xd)
+        };
+        qg.fill(0.0);
+        xd.fill(0.0);
+        let mut user = self.user.borrow_mut();
+        let mut e = Effort {
+            t,
+            q: &q[..n],
+            qd: &qd[..n],
+            x: &qd[n..],
+            u,
+            kin: &s.kin,
+            qg,
+        };
+        let r = user
+            .efforts(&mut e)
+            .and_then(|_| user.state_derivatives(&e, xd));
+        if let Err(message) = r {
+            self.fail(Failure::UserEffort { t, message });
+            return false;
+        }
+        let bad = qg
+            .iter()
+            .position(|v| !v.is_finite())
+            .map(|i| self.info.dof_label(i))
+            .or_else(|| {
+                xd.iter()
+                    .position(|v| !v.is_finite())
+                    .map(|k| self.info.dof_label(n + k))
+            });
+        if let Some(coordinate) = bad {
+            self.fail(Failure::NonFinite {
+                quantity: "user effort",
+                coordinate,
+            });
+            return false;
+        }
+        true
+    }
+
+    fn fail(&self, f: Failure) {
+        let mut slot = self.failure.borrow_mut();
+        if slot.is_none() {
+            *slot = Some(f);
+        }
+    }
+}
+
+impl<M: Model, E: Efforts> Model for WithEfforts<M, E> {
+    type Params = M::Params;
+    const NQ: usize = M::NQ + E::NX;
+    const NU: usize = M::NU;
+    const NFRAMES: usize = M::NFRAMES;
+    const NPOINTS: usize = M::NPOINTS;
+    const NC: usize = M::NC;
+
+    fn info(&self) -> &'static ModelInfo {
+        self.info
+    }
+
+    fn params(&self) -> &Self::Params {
+        self.model.params()
+    }
+
+    fn set_params(&mut self, params: Self::Params) -> Result<(), ParamError> {
+        self.model.set_params(params)
+    }
+
+    fn initial_state(&self, q: &mut [f64], qd: &mut [f64]) {
+        let n = M::NQ;
+        self.model.initial_state(&mut q[..n], &mut qd[..n]);
+        q[n..].fill(0.0);
+        self.user.borrow().initial_states(&mut qd[n..]);
+    }
+
+    fn mass_matrix(&self, t: f64, q: &[f64], m: &mut [f64]) {
+        let s = &mut *self.scratch.borrow_mut();
+        self.model.mass_matrix(t, &q[..M::NQ], &mut s.m);
+        embed(&s.m, m, M::NQ, Self::NQ, 1.0);
+    }
+
+    fn dynamics(&self, t: f64, q: &[f64], qd: &[f64], u: &[f64], m: &mut [f64], h: &mut [f64]) {
+        let n = M::NQ;
+        let s = &mut *self.scratch.borrow_mut();
+        self.model
+            .dynamics(t, &q[..n], &qd[..n], u, &mut s.m, &mut s.h);
+        embed(&s.m, m, n, Self::NQ, 1.0);
+        if !self.user(s, t, q, qd, u, false) {
+            h.fill(f64::NAN);
+            return;
+        }
+        for i in 0..n {
+            h[i] = s.h[i] + s.qg[i];
+        }
+        h[n..].copy_from_slice(&s.xd);
+    }
+
+    fn inverse_dynamics(
+        &self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        u: &[f64],
+        tau: &mut [f64],
+    ) {
+        let n = M::NQ;
+        let s = &mut *self.scratch.borrow_mut();
+        self.model
+            .inverse_dynamics(t, &q[..n], &qd[..n], &qdd[..n], u, &mut tau[..n]);
+        if !self.user(s, t, q, qd, u, false) {
+            tau.fill(f64::NAN);
+            return;
+        }
+        for i in 0..n {
+            tau[i] -= s.qg[i];
+        }
+        for k in 0..E::NX {
+            tau[n + k] = qdd[n + k] - s.xd[k];
+        }
+    }
+
+    fn tangents(
+        &self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        u: &[f64],
+        k: &mut [f64],
+        c: &mut [f64],
+    ) -> Result<(), ModelError> {
+        let (n, big) = (M::NQ, Self::NQ);
+        let s = &mut *self.scratch.borrow_mut();
+        self.model
+            .tangents(t, &q[..n], &qd[..n], &qdd[..n], u, &mut s.k, &mut s.c)?;
+        embed(&s.k, k, n, big, 0.0);
+        embed(&s.c, c, n, big, 0.0);
+        // the user part by forward differences: −∂Q/∂q, −∂ẋ/∂q (and qd)
+        if !self.user(s, t, q, qd, u, false) {
+            k.fill(f64::NAN);
+            return Ok(());
+        }
+        s.qp.copy_from_slice(q);
+        s.vp.copy_from_slice(qd);
+        for j in 0..big {
+            for (which, x, out) in [(0, q[j], &mut *k), (1, qd[j], &mut *c)] {
+                let eps = (x + f64::EPSILON.sqrt() * x.abs().max(1.0)) - x;
+                let ok = if which == 0 {
+                    s.qp[j] = x + eps;
+                    let qp = std::mem::take(&mut s.qp);
+                    let ok = self.user(s, t, &qp, qd, u, true);
+                    s.qp = qp;
+                    s.qp[j] = x;
+                    ok
+                } else {
+                    s.vp[j] = x + eps;
+                    let vp = std::mem::take(&mut s.vp);
+                    let ok = self.user(s, t, q, &vp, u, true);
+                    s.vp = vp;
+                    s.vp[j] = x;
+                    ok
+                };
+                if !ok {
+                    out.fill(f64::NAN);
+                    return Ok(());
+                }
+                for i in 0..n {
+                    out[i + big * j] -= (s.qg1[i] - s.qg[i]) / eps;
+                }
+                for r in 0..E::NX {
+                    out[n + r + big * j] -= (s.xd1[r] - s.xd[r]) / eps;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn static_forces(&self, t: f64, q: &[f64], u: &[f64], h: &mut [f64]) {
+        let n = M::NQ;
+        let s = &mut *self.scratch.borrow_mut();
+        self.model.static_forces(t, &q[..n], u, &mut s.h);
+        // at rest: qd = 0 and the extra states x = 0
+        s.vp.fill(0.0);
+        let vp = std::mem::take(&mut s.vp);
+        let ok = self.user(s, t, q, &vp, u, false);
+        s.vp = vp;
+        if !ok {
+            h.fill(f64::NAN);
+            return;
+        }
+        for i in 0..n {
+            h[i] = s.h[i] + s.qg[i];
+        }
+        h[n..].copy_from_slice(&s.xd);
+    }
+
+    fn input_matrix(&self, t: f64, q: &[f64], qd: &[f64], u: &[f64], b: &mut [f64]) {
+        let (n, big, nu) = (M::NQ, Self::NQ, M::NU);
+        let s = &mut *self.scratch.borrow_mut();
+        self.model.input_matrix(t, &q[..n], &qd[..n], u, &mut s.bu);
+        for j in 0..nu {
+            for i in 0..big {
+                b[i + big * j] = if i < n { s.bu[i + n * j] } else { 0.0 };
+            }
+        }
+        if !self.user(s, t, q, qd, u, false) {
+            b.fill(f64::NAN);
+            return;
+        }
+        s.up.copy_from_slice(u);
+        for j in 0..nu {
+            let x = u[j];
+            let eps = (x + f64::EPSILON.sqrt() * x.abs().max(1.0)) - x;
+            s.up[j] = x + eps;
+            let up = std::mem::take(&mut s.up);
+            let ok = self.user(s, t, q, qd, &up, true);
+            s.up = up;
+            s.up[j] = x;
+            if !ok {
+                b.fill(f64::NAN);
+                return;
+            }
+            for i in 0..n {
+                b[i + big * j] += (s.qg1[i] - s.qg[i]) / eps;
+            }
+            for r in 0..E::NX {
+                b[n + r + big * j] += (s.xd1[r] - s.xd[r]) / eps;
+            }
+        }
+    }
+
+    fn energy(&self, t: f64, q: &[f64], qd: &[f64]) -> Energy {
+        let n = M::NQ;
+        self.model.energy(t, &q[..n], &qd[..n])
+    }
+
+    fn power(&self, t: f64, q: &[f64], qd: &[f64], u: &[f64]) -> f64 {
+        let n = M::NQ;
+        let p = self.model.power(t, &q[..n], &qd[..n], u);
+        let s = &mut *self.scratch.borrow_mut();
+        if !self.user(s, t, q, qd, u, false) {
+            return f64::NAN;
+        }
+        p + (0..n).map(|i| s.qg[i] * qd[i]).sum::<f64>()
+    }
+
+    fn constraints(&self, t: f64, q: &[f64], phi: &mut [f64]) {
+        self.model.constraints(t, &q[..M::NQ], phi);
+    }
+
+    fn constraint_jacobian(&self, t: f64, q: &[f64], b: &mut [f64]) {
+        let (n, nc) = (M::NQ, M::NC);
+        let s = &mut *self.scratch.borrow_mut();
+        self.model.constraint_jacobian(t, &q[..n], &mut s.b);
+        b[..nc * n].copy_from_slice(&s.b);
+        b[nc * n..].fill(0.0);
+    }
+
+    fn constraint_rate(&self, t: f64, q: &[f64], phi_t: &mut [f64]) {
+        self.model.constraint_rate(t, &q[..M::NQ], phi_t);
+    }
+
+    fn constraint_bias(&self, t: f64, q: &[f64], qd: &[f64], gamma: &mut [f64]) {
+        let n = M::NQ;
+        self.model.constraint_bias(t, &q[..n], &qd[..n], gamma);
+    }
+
+    fn constraint_tangent(&self, t: f64, q: &[f64], lambda: &[f64], k: &mut [f64]) {
+        let n = M::NQ;
+        let s = &mut *self.scratch.borrow_mut();
+        self.model.constraint_tangent(t, &q[..n], lambda, &mut s.k);
+        embed(&s.k, k, n, Self::NQ, 0.0);
+    }
+
+    fn frames(&self, t: f64, q: &[f64], out: &mut [Pose]) {
+        self.model.frames(t, &q[..M::NQ], out);
+    }
+
+    fn kinematics(&self, t: f64, q: &[f64], qd: &[f64], out: &mut Kinematics) {
+        let n = M::NQ;
+        self.model.kinematics(t, &q[..n], &qd[..n], out);
+    }
+
+    fn take_failure(&self) -> Option<Failure> {
+        self.failure.borrow_mut().take()
+    }
+
+    fn user_evaluations(&self) -> usize {
+        self.evaluations.get()
+    }
+}
+
+/// An n × n matrix into the top-left of a big × big one, `diag` on the rest of the diagonal
+/// and zero elsewhere.
+fn embed(inner: &[f64], out: &mut [f64], n: usize, big: usize, diag: f64) {
+    for j in 0..big {
+        for i in 0..big {
+            out[i + big * j] = if i < n && j < n {
+                inner[i + n * j]
+            } else if i == j {
+                diag
+            } else {
+                0.0
+            };
+        }
+    }
+}

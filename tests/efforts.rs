@@ -1,0 +1,285 @@
+//! Efforts written in Rust and extra first-order states ([`mbs::WithEfforts`]): the same
+//! force through the hook and in the DSL gives the same motion; extra states follow their
+//! exact solution with every scheme; the wrapper's tangents match differences of its τ; a
+//! failing user effort stops every scheme with its typed error and a trajectory free of NaN.
+
+use mbs::{Effort, Efforts, Failure, Model, Options, Output, Scheme, Stats, WithEfforts, simulate};
+
+mbs::multibody! {
+    /// A double pendulum with a damper between the bars and a horizontal push at the tip,
+    /// both in the DSL (scene `Full`) or left out (scene `Bare`) for the hook to add.
+    model Dp {
+        param c = 0.3; param push = 2.0;
+        dof q[0] = 0.6; dof q[1] = -0.3, qd = 1.0;
+        option tangents;
+        body bar1 { mass = 1.0; inertia = (1.0 / 12.0, 0, 1.0 / 12.0); }
+        body bar2 { mass = 1.0; inertia = (1.0 / 12.0, 0, 1.0 / 12.0); }
+        point tip on bar2 at (0, -0.5, 0);
+        TOG[bar1] = Trotz(q[0]) * Tdisp(0, -0.5, 0);
+        TOG[bar2] = TOG[bar1] * Tdisp(0, -0.5, 0) * Trotz(q[1]) * Tdisp(0, -0.5, 0);
+        gravity(0, -9.81, 0);
+        effect extra {
+            torque(bar2, relative_to = bar1, axis = z, -c * qd[1]);
+            force(tip, (push * cos(t), 0, 0));
+        }
+        scene Bare = []; scene Full = [extra];
+    }
+}
+
+/// The DSL's `extra` effect written in Rust.
+struct Extra {
+    bar1: usize,
+    bar2: usize,
+    tip: usize,
+    c: f64,
+    push: f64,
+}
+
+impl Extra {
+    fn new(info: &mbs::ModelInfo) -> Extra {
+        Extra {
+            bar1: info.frame_index("bar1").expect("bar1"),
+            bar2: info.frame_index("bar2").expect("bar2"),
+            tip: info.point_index("tip").expect("tip"),
+            c: 0.3,
+            push: 2.0,
+        }
+    }
+}
+
+impl Efforts for Extra {
+    fn efforts(&mut self, e: &mut Effort) -> Result<(), String> {
+        // the damper's torque on bar2 about z, the reaction on bar1
+        let tau = -self.c * e.qd[1];
+        e.torque_on_frame(self.bar2, [0.0, 0.0, tau]);
+        e.torque_on_frame(self.bar1, [0.0, 0.0, -tau]);
+        e.force_at_point(self.tip, [self.push * e.t.cos(), 0.0, 0.0]);
+        Ok(())
+    }
+}
+
+fn hooked() -> WithEfforts<DpBare, Extra> {
+    let bare = DpBare::default();
+    let extra = Extra::new(bare.info());
+    WithEfforts::new(bare, extra)
+}
+
+#[test]
+fn hook_and_dsl_give_the_same_motion() {
+    // fixed steps for the implicit schemes, with Newton to a tight tolerance: the two models
+    // have the same equations but not the same iteration matrices (generated tangents against
+    // differences of the hook), so Newton stops at different points within its tolerance, and
+    // an adaptive scheme's discrete choices (BDF's order) can then differ: 1e-7 apart
+    let newton = mbs::NewtonOptions {
+        tolerance_factor: 1e-5,
+        atol: 1e-14,
+        rtol: 1e-14,
+        max_iterations: 12,
+        ..Default::default()
+    };
+    for (scheme, step) in [
+        (Scheme::Dopri5, Options::adaptive(3.0, 1e-8).step),
+        (Scheme::Rk4, Options::fixed(3.0, 1e-3).step),
+        (
+            Scheme::from_name("gen-alpha").unwrap(),
+            Options::fixed(3.0, 1e-3).step,
+        ),
+        (Scheme::Radau5, Options::fixed(3.0, 1e-2).step),
+        (
+            Scheme::from_name("bdf").unwrap(),
+            Options::fixed(3.0, 1e-3).step,
+        ),
+    ] {
+        let o = || Options {
+            t_end: 3.0,
+            step,
+            output: Output::Every { dt: 0.05 },
+            newton,
+            ..Options::default()
+        };
+        let (a, sa) = simulate(DpFull::default(), scheme, o()).unwrap();
+        let (b, sb) = simulate(hooked(), scheme, o()).unwrap();
+        let d = (0..a.len())
+            .flat_map(|i| (0..2).map(move |k| (i, k)))
+            .map(|(i, k)| {
+                (a.q(i)[k] - b.q(i)[k])
+                    .abs()
+                    .max((a.qd(i)[k] - b.qd(i)[k]).abs())
+            })
+            .fold(0.0, f64::max);
+        println!(
+            "{:>10}: max |Δ| {d:.1e}; DSL {} steps, hook {} steps, {} user evaluations",
+            scheme.name(),
+            sa.steps,
+            sb.steps,
+            sb.user_efforts
+        );
+        assert_eq!(a.len(), b.len());
+        assert!(d < 1e-10, "{}: {d:e}", scheme.name());
+        assert!(sb.user_efforts > 0 && sa.user_efforts == 0);
+    }
+}
+
+/// τ of the wrapper at a state, for differences.
+fn tau<M: Model>(m: &M, q: &[f64], qd: &[f64], qdd: &[f64]) -> Vec<f64> {
+    let mut t = vec![0.0; M::NQ];
+    m.inverse_dynamics(0.7, q, qd, qdd, &[], &mut t);
+    t
+}
+
+#[test]
+fn tangents_of_the_hooked_model_match_differences() {
+    let m = hooked();
+    let (q, qd, qdd) = ([0.3, -0.8], [1.1, -0.6], [0.2, 0.5]);
+    let (mut k, mut c) = ([0.0; 4], [0.0; 4]);
+    m.tangents(0.7, &q, &qd, &qdd, &[], &mut k, &mut c).unwrap();
+    let eps = 1e-6;
+    let mut worst = 0.0f64;
+    for j in 0..2 {
+        for (which, exact) in [(0, &k), (1, &c)] {
+            let (mut a, mut b) = ((q, qd), (q, qd));
+            if which == 0 {
+                a.0[j] += eps;
+                b.0[j] -= eps;
+            } else {
+                a.1[j] += eps;
+                b.1[j] -= eps;
+            }
+            let (ta, tb) = (tau(&m, &a.0, &a.1, &qdd), tau(&m, &b.0, &b.1, &qdd));
+            for i in 0..2 {
+                let cd = (ta[i] - tb[i]) / (2.0 * eps);
+                worst = worst.max((exact[i + 2 * j] - cd).abs());
+            }
+        }
+    }
+    println!("tangents vs central differences: {worst:.1e}");
+    assert!(worst < 1e-6);
+}
+
+/// A unit mass pushed by a force x that decays by ẋ = −x/T: y(t) = x₀T²(e^(−t/T) − 1 + t/T).
+struct Decaying {
+    body: usize,
+}
+
+impl Efforts for Decaying {
+    const NX: usize = 1;
+    const STATE_NAMES: &'static [&'static str] = &["force"];
+    fn initial_states(&self, x: &mut [f64]) {
+        x[0] = 2.0;
+    }
+    fn efforts(&mut self, e: &mut Effort) -> Result<(), String> {
+        let at = e.frame(self.body).pose.position;
+        e.force_on_frame(self.body, at, [e.x[0], 0.0, 0.0]);
+        Ok(())
+    }
+    fn state_derivatives(&mut self, e: &Effort, xd: &mut [f64]) -> Result<(), String> {
+        xd[0] = -e.x[0] / 0.5;
+        Ok(())
+    }
+}
+
+mbs::multibody! {
+    model Slider {
+        dof y = 0.0;
+        body block { mass = 1.0; }
+        TOG[block] = Tdisp(y, 0, 0);
+    }
+}
+
+#[test]
+fn extra_states_follow_their_exact_solution() {
+    let exact = |t: f64| {
+        let (x0, tt) = (2.0, 0.5);
+        x0 * tt * tt * ((-t / tt).exp() - 1.0 + t / tt)
+    };
+    let model = || {
+        let s = Slider::default();
+        let body = s.info().frame_index("block").unwrap();
+        WithEfforts::new(s, Decaying { body })
+    };
+    assert_eq!(model().info().dofs, ["y", "x:force"]);
+    for (scheme, o, tol) in [
+        (Scheme::Dopri5, Options::adaptive(2.0, 1e-10), 1e-8),
+        (Scheme::Radau5, Options::adaptive(2.0, 1e-10), 1e-8),
+        (
+            Scheme::from_name("gen-alpha").unwrap(),
+            Options::fixed(2.0, 1e-3),
+            1e-5,
+        ),
+        (
+            Scheme::from_name("newmark").unwrap(),
+            Options::fixed(2.0, 1e-3),
+            1e-6,
+        ),
+        (Scheme::Rk4, Options::fixed(2.0, 1e-2), 1e-8),
+    ] {
+        let (tr, st): (_, Stats) = simulate(model(), scheme, o).unwrap();
+        let k = tr.len() - 1;
+        let (y, x) = (tr.q(k)[0], tr.qd(k)[1]);
+        let (ey, ex) = (
+            (y - exact(2.0)).abs(),
+            (x - 2.0 * (-2.0f64 / 0.5).exp()).abs(),
+        );
+        println!(
+            "{:>10}: |Δy| {ey:.1e}, |Δx| {ex:.1e}, {} steps",
+            scheme.name(),
+            st.steps
+        );
+        assert!(ey < tol && ex < tol, "{}", scheme.name());
+    }
+}
+
+/// A push that turns into NaN, or into an error, from t = 0.5 on.
+struct Breaks {
+    tip: usize,
+    nan: bool,
+}
+
+impl Efforts for Breaks {
+    fn efforts(&mut self, e: &mut Effort) -> Result<(), String> {
+        if e.t >= 0.5 {
+            if self.nan {
+                e.force_at_point(self.tip, [f64::NAN, 0.0, 0.0]);
+            } else {
+                return Err("sensor lost at t ≥ 0.5".into());
+            }
+        }
+        Ok(())
+    }
+}
+
+#[test]
+fn failing_user_efforts_stop_every_scheme_with_a_typed_error() {
+    for nan in [true, false] {
+        for scheme in Scheme::all() {
+            let bare = DpBare::default();
+            let tip = bare.info().point_index("tip").unwrap();
+            let model = WithEfforts::new(bare, Breaks { tip, nan });
+            let o = if scheme.is_adaptive() {
+                Options::adaptive(1.0, 1e-6)
+            } else {
+                Options::fixed(1.0, 1e-3)
+            };
+            let e = simulate(model, scheme, o).expect_err("fails after 0.5");
+            let tr = &e.trajectory;
+            let clean = tr.q_data.iter().chain(&tr.qd_data).all(|x| x.is_finite());
+            let ok = match &e.kind {
+                Failure::NonFinite { quantity, .. } => nan && *quantity == "user effort",
+                Failure::UserEffort { t, message } => {
+                    !nan && *t >= 0.5 && message.contains("sensor")
+                }
+                _ => false,
+            };
+            assert!(ok, "{} (nan {nan}): {e}", scheme.name());
+            assert!(clean, "{}: NaN in the trajectory", scheme.name());
+            // stopped within one step of 0.5
+            assert!(
+                e.t <= 0.5 && e.t >= 0.5 - 0.05,
+                "{}: stopped at {}",
+                scheme.name(),
+                e.t
+            );
+            assert!(tr.t.last().is_some_and(|&t| t <= 0.5));
+        }
+    }
+}

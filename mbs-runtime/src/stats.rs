@@ -89,6 +89,9 @@ impl fmt::Display for Stats {
             self.user_efforts,
             self.energy
         )?;
+        if self.samples > 0 {
+            writeln!(f, "controllers: {} samples", self.samples)?;
+        }
         if self.constraints > 0 {
             writeln!(
                 f,

@@ -144,3 +144,38 @@ fn inputs_on_a_model_without_inputs_are_refused() {
         }
     ));
 }
+
+#[path = "../examples/models/dc_motor.rs"]
+mod dc_motor;
+
+/// The DC-motor arm of `examples/dc_motor.rs`: the PI controller (sampled at 1 kHz) brings the
+/// arm to 20 rad/s; the current (an extra state) settles to the friction torque's share.
+#[test]
+fn dc_motor_reaches_its_speed_set_point() {
+    let period = 1e-3;
+    for scheme in [
+        Scheme::Radau5,
+        Scheme::from_name("bdf").unwrap(),
+        Scheme::Dopri5,
+    ] {
+        let model = mbs::WithEfforts::new(dc_motor::Arm::default(), dc_motor::Motor::default());
+        let inputs = Inputs::new().controller(period, dc_motor::PiSpeed::new(20.0, period));
+        let o = Options {
+            output: Output::Last,
+            ..Options::adaptive(1.5, 1e-8)
+        };
+        let (tr, st) = simulate_with(model, scheme, o, inputs).unwrap();
+        let (w, i) = (tr.qd(0)[0], tr.qd(0)[1]);
+        // at steady speed the motor torque N k i balances the friction 0.01 ω
+        let i_steady = 0.01 * 20.0 / (10.0 * 0.05);
+        println!(
+            "{:>8}: ω(1.5) = {w:.6}, i = {i:.6} A (steady {i_steady}), {} steps, {} samples",
+            scheme.name(),
+            st.steps,
+            st.samples
+        );
+        assert!((w - 20.0).abs() < 1e-4, "{}: ω = {w}", scheme.name());
+        assert!((i - i_steady).abs() < 1e-3, "{}: i = {i}", scheme.name());
+        assert_eq!(st.samples, 1501);
+    }
+}

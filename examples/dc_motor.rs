@@ -69,10 +69,9 @@ fn main() {
     }
     let w_end = tr.qd(tr.len() - 1)[0];
     println!(
-        "\nspeed error at t = {}: {:.2e} rad/s; {} with {}, {:.1?}:\n{stats}",
+        "\nspeed error at t = {}: {:.2e} rad/s; arm + motor + PI with {}, {:.1?}:\n{stats}",
         args.t_end,
         (w_end - 20.0).abs(),
-        "arm + motor + PI",
         scheme.name(),
         cpu
     );

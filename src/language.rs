@@ -93,8 +93,12 @@
 //!
 //! Rust syntax and precedence: numbers, names, `+ - * /`, unary `-`, parentheses, `q[i]`,
 //! `qd[i]`, `qdd[i]`, `u[k]`, `t`, the constants `PI`, `E`, `TAU`, and the functions `sin cos
-//! tan asin acos atan atan2(y, x) sinh cosh tanh exp ln sqrt abs sign powi(x, n) pow(x, y)`
-//! (also as methods: `x.sin()`). `^` is not a power; write `powi(x, 2)`.
+//! tan asin acos atan atan2(y, x) sinh cosh tanh exp ln sqrt abs sign pos step powi(x, n)
+//! pow(x, y)` (also as methods: `x.sin()`). `^` is not a power; write `powi(x, 2)`.
+//! `pos(x)` = max(x, 0) is the positive part (derivative `step(x)`) and `step(x)` is 1 for
+//! x > 0, 0 otherwise (derivative 0): one-sided forces, such as a stop that only pushes,
+//! `generalized_force(q[0], -k * pos(q[0] - 0.1))`. Exact tangents see their derivatives
+//! away from the kink, not the jump.
 //!
 //! ## Effects
 //!
@@ -102,6 +106,7 @@
 //! |---|---|
 //! | `gravity(gx, gy, gz);` | uniform gravity, world axes (constants and parameters) |
 //! | `spring(a, b, k = …, l0 = …);` | point-to-point spring between points or body origins (`ground` is the world origin); `c = …` adds a damper |
+//! | `spring(a, b, k = …, l0 = …, preload = F0);` | tension F0 + k (l − l0) (F0 > 0 pulls the ends together at the rest length); potential F0 (l − l0) + ½ k (l − l0)² |
 //! | `spring(a, b, k = …, l0 = …, axis = x);` | a linear spring along a fixed world direction (`x`, `y`, `z` or a unit `(nx, ny, nz)`): its length is the signed distance along the axis, linear for any motion (1-D models) |
 //! | `damper(a, b, c = …);` | point-to-point linear damper |
 //! | `damper(a, b, c = …, axis = x);` | a linear damper along a fixed world direction |
@@ -109,9 +114,66 @@
 //! | `torque(b, (mx, my, mz));` | a torque on a body, world axes; `frame = body`, `relative_to = other` (reaction on `other`) |
 //! | `torque(b, axis = z, value, relative_to = other);` | a torque about one of `b`'s axes, reaction on `other` |
 //! | `generalized_force(q[i], value);` | a generalised force on a coordinate |
+//! | `contact(p, k = …, c = …, mu = …);` | penalty contact of a point or body origin with the ground plane z = 0 (below) |
+//! | `contact(p, k = …, plane = y, offset = h0);` | with the fixed plane n·x = h0: `plane` is its unit normal pointing out of the ground, `x`, `y`, `z` (default), `-z`, … or `(nx, ny, nz)`; `offset` default 0 |
+//! | `contact(body, sphere = r, k = …, …);` | a sphere of radius r centred at the body's origin (or at a point) |
+//! | `bushing(A, B, k = (kx, ky, kz), kr = (…), c = (…), cr = (…));` | six-axis linear spring–damper between the origins and axes of two bodies or frames (either may be `ground`), coefficients along A's axes; one value sets all three axes; each of `k kr c cr` defaults to 0 (at least one) |
 //!
-//! Force and torque values may depend on `q`, `qd`, `t`, parameters and inputs `u[k]`.
-//! Gravity and springs are conservative (potential energy); the others count in `power()`.
+//! Force and torque values may depend on `q`, `qd`, `t`, parameters and inputs `u[k]`; the
+//! coefficients of springs, dampers, contacts and bushings are constants or parameters.
+//! Gravity and springs are conservative (potential energy); the others count in `power()`;
+//! contacts and bushings have both: their elastic parts are in the potential, their
+//! damping and friction (whose power is never positive) in `power()`.
+//!
+//! **Contacts** are penalty forces generated with the rest of the equations (so M, h, τ, exact
+//! tangents, energy and power include them). With the penetration δ = h0 + r − n·x of the
+//! point (or sphere centre) x, r = 0 for a point, and its rate δ̇ = −n·v:
+//!
+//! - normal force F_n = step(δ)·pos(k δ + c δ̇) along n: zero out of contact, and the damping
+//!   never pulls (non-adhesive);
+//! - friction F_t = −μ F_n v_t / sqrt(|v_t|² + eps²), regularised Coulomb with v_t the
+//!   tangential velocity of the contact point x − r n (for a sphere it includes ω × (−r n));
+//!   `mu` default 0, `eps` default 1e-4 m/s (below it, friction is viscous);
+//! - potential ½ k pos(δ)², the potential of the elastic part k pos(δ) (a contact without
+//!   `c` and `mu` is conservative: its normal force is k pos(δ)).
+//!
+//! `k` is required and positive; `c` ≥ 0 (default 0), `mu` ≥ 0, `eps` > 0, `sphere` > 0. A
+//! point contact applies no moment about the point; a sphere with friction rolls. At first
+//! touch the normal force jumps to c δ̇ (integrators with error control take small steps
+//! there); c ≈ 2 ζ √(k m) gives a damping ratio ζ for a mass m on the contact.
+//!
+//! **Bushings**: with d = p_B − p_A, Δp = R_Aᵀ d, Δv = R_Aᵀ (v_B − v_A − ω_A × d) (B's origin
+//! relative to the point of A it coincides with, in A's axes), R = R_Aᵀ R_B,
+//! θ = ½ (R₃₂ − R₂₃, R₁₃ − R₃₁, R₂₁ − R₁₂) (the rotation vector of B relative to A for small
+//! angles, as in `align`) and Ω = R_Aᵀ (ω_B − ω_A), B receives the force −K Δp − C Δv at its
+//! origin and the torque −Eᵀ K_r θ − C_r Ω (A's axes), A the opposite force at the same point
+//! and the opposite torque. E = ½ (tr R · I − R) makes the elastic torque the exact gradient
+//! of the potential ½ Δpᵀ K Δp + ½ θᵀ K_r θ; it equals −K_r θ to first order in the angle.
+//! Keep relative rotations well below 90°.
+//!
+//! ```
+//! mbs::multibody! {
+//!     /// A ball on a table, tied to a post by a preloaded spring and a bushing.
+//!     model Table {
+//!         param k = 1e5; param m = 1.0;
+//!         dof x = 0.0; dof y = 0.0; dof z = 0.1; dof a = 0.0;
+//!         body ball { mass = m; inertia = (0.004, 0.004, 0.004); }
+//!         body post { mass = 0.5; inertia = (0.01, 0.01, 0.01); }
+//!         TOG[ball] = Tdisp(x, y, z) * Trotz(a);
+//!         TOG[post] = Tdisp(1, 0, 0.5);
+//!         gravity(0, 0, -9.81);
+//!         contact(ball, sphere = 0.1, k = k, c = 2 * sqrt(k * m), mu = 0.4);
+//!         spring(ball, post, k = 20, l0 = 0.8, preload = 5);
+//!         bushing(ground, ball, kr = (0, 0, 2), cr = 0.1);
+//!     }
+//! }
+//! use mbs::Model;
+//! let model = Table::default();
+//! let (mut m, mut h) = ([0.0; 16], [0.0; 4]);
+//! // 1 mm deep, the contact pushes up with k δ = 100 N (less the weight, plus the spring)
+//! model.dynamics(0.0, &[0.0, 0.0, 0.099, 0.0], &[0.0; 4], &[], &mut m, &mut h);
+//! assert!(h[2] > 90.0 && h[2] < 100.0);
+//! ```
 //!
 //! ## Constraints
 //!

@@ -1,9 +1,10 @@
-//! Energy balance on random scleronomic trees with gravity, springs, dampers, forces, torques
-//! and generalised forces: along the motion qdd = M⁻¹ h, the exact time derivative of the
-//! generated T + V equals the generated power of the non-conservative effects. The energy
-//! balance cannot see a load that is wrong but consistently so in h and in the power (a
-//! reaction torque's sign, a force's axes), so h with every load is also checked against the
-//! independent oracle, which applies the loads to its own kinematics.
+//! Energy balance on random scleronomic trees with gravity, springs (with preloads), dampers,
+//! forces, torques and generalised forces, and then also with penalty contacts (points and
+//! spheres, with friction) and bushings: along the motion qdd = M⁻¹ h, the exact time
+//! derivative of the generated T + V equals the generated power of the non-conservative
+//! effects. The energy balance cannot see a load that is wrong but consistently so in h and
+//! in the power (a reaction torque's sign, a force's axes), so h with every load is also
+//! checked against the independent oracle, which applies the loads to its own kinematics.
 
 mod common;
 
@@ -25,6 +26,7 @@ fn oracle_h(
     t: f64,
     q: &[f64],
     qd: &[f64],
+    regimes: &mut [usize; 3],
 ) -> Vec<f64> {
     let poses = oracle.link_poses(q, t);
     let vels = oracle.link_velocities(q, qd, t);
@@ -78,17 +80,25 @@ fn oracle_h(
         for load in &model.sys.effects[e].loads {
             match load {
                 Load::Gravity(_) => {}
-                Load::Spring { a, b, k, l0, axis } => {
+                Load::Spring {
+                    a,
+                    b,
+                    k,
+                    l0,
+                    axis,
+                    preload,
+                } => {
                     let (pa, _, la) = point(a);
                     let (pb, _, lb) = point(b);
                     let d = sub(pb, pa);
-                    let kv = ev(&[*k, *l0]);
-                    // along the line of the ends, or a fixed axis (signed length)
+                    let kv = ev(&[*k, *l0, *preload]);
+                    // tension F0 + k (l − l0), along the line of the ends, or a fixed axis
+                    // (signed length)
                     let f = match axis {
-                        None => scale(kv[0] * (norm(d) - kv[1]) / norm(d), d),
+                        None => scale((kv[2] + kv[0] * (norm(d) - kv[1])) / norm(d), d),
                         Some(n) => {
                             let n = ev3(n);
-                            scale(kv[0] * (dot(n, d) - kv[1]), n)
+                            scale(kv[2] + kv[0] * (dot(n, d) - kv[1]), n)
                         }
                     };
                     force(&mut ext, la, f);
@@ -127,6 +137,91 @@ fn oracle_h(
                     }
                 }
                 Load::GenForce { dof, value } => qgen[*dof] += ev(&[*value])[0],
+                Load::Contact {
+                    at,
+                    radius,
+                    normal,
+                    offset,
+                    k,
+                    c,
+                    mu,
+                    eps,
+                } => {
+                    let (x, v, la) = point(at);
+                    let (l, rl) = la.expect("contacts are on bodies");
+                    let n = ev3(normal);
+                    let p = ev(&[*radius, *offset, *k, *c, *mu, *eps]);
+                    let (r, h0, k, c, mu, eps) = (p[0], p[1], p[2], p[3], p[4], p[5]);
+                    let delta = h0 + r - dot(n, x);
+                    let nv = dot(n, v);
+                    let raw = k * delta - c * nv;
+                    regimes[if delta <= 0.0 {
+                        0
+                    } else if raw > 0.0 {
+                        1
+                    } else {
+                        2
+                    }] += 1;
+                    let f_n = if delta > 0.0 { raw.max(0.0) } else { 0.0 };
+                    // the force acts at the contact point x − r n, a material point of link l
+                    let rot = poses[l].0;
+                    let w = mv(&rot, [vels[l][0], vels[l][1], vels[l][2]]);
+                    let arm = scale(-r, n);
+                    let vc = add(v, cross(w, arm));
+                    let vt = sub(vc, scale(nv, n));
+                    let ft = scale(-mu * f_n / (dot(vt, vt) + eps * eps).sqrt(), vt);
+                    let at_contact = add(rl, mv(&tr(&rot), arm));
+                    force(&mut ext, Some((l, at_contact)), add(scale(f_n, n), ft));
+                }
+                Load::Bushing { a, b, k, kr, c, cr } => {
+                    // pose, velocity and angular velocity of a frame (world), and its link and
+                    // offset in link axes (frames have their link's axes)
+                    let frame = |f: Option<usize>| match f {
+                        None => (eye3(), [0.0; 3], [0.0; 3], [0.0; 3], None),
+                        Some(f) => {
+                            let (l, off) = frame_link[f];
+                            let (rot, o) = poses[l];
+                            let v = vels[l];
+                            let (w, vo) = ([v[0], v[1], v[2]], [v[3], v[4], v[5]]);
+                            (
+                                rot,
+                                add(o, mv(&rot, off)),
+                                mv(&rot, add(vo, cross(w, off))),
+                                mv(&rot, w),
+                                Some((l, off)),
+                            )
+                        }
+                    };
+                    let (ra, pa, va, wa, la) = frame(*a);
+                    let (rb, pb, vb, wb, lb) = frame(*b);
+                    let (k, kr, c, cr) = (ev3(k), ev3(kr), ev3(c), ev3(cr));
+                    let mul = |x: V3, y: V3| [x[0] * y[0], x[1] * y[1], x[2] * y[2]];
+                    let d = sub(pb, pa);
+                    let dp = mv(&tr(&ra), d);
+                    let dv = mv(&tr(&ra), sub(sub(vb, va), cross(wa, d)));
+                    let r = mm(&tr(&ra), &rb);
+                    let th = scale(
+                        0.5,
+                        [r[2][1] - r[1][2], r[0][2] - r[2][0], r[1][0] - r[0][1]],
+                    );
+                    let om = mv(&tr(&ra), sub(wb, wa));
+                    let f = scale(-1.0, add(mul(k, dp), mul(c, dv)));
+                    // −Eᵀ K_r θ with E = ½ (tr R I − R), then the damping
+                    let kth = mul(kr, th);
+                    let tr_r = r[0][0] + r[1][1] + r[2][2];
+                    let el = scale(0.5, sub(scale(tr_r, kth), mv(&tr(&r), kth)));
+                    let m = scale(-1.0, add(el, mul(cr, om)));
+                    let (fw, mw) = (mv(&ra, f), mv(&ra, m));
+                    force(&mut ext, lb, fw);
+                    torque(&mut ext, *b, mw);
+                    // A: the opposite force at its point where B's origin is
+                    force(
+                        &mut ext,
+                        la.map(|(l, off)| (l, add(off, dp))),
+                        scale(-1.0, fw),
+                    );
+                    torque(&mut ext, *a, scale(-1.0, mw));
+                }
             }
         }
     }
@@ -135,15 +230,34 @@ fn oracle_h(
     tau.iter().zip(&qgen).map(|(a, b)| b - a).collect()
 }
 
-#[test]
-fn energy_balance_with_loads() {
-    let mut w_cons = Worst::default();
-    let mut w_full = Worst::default();
-    let mut w_vp_rec = Worst::default();
-    let mut w_oracle = Worst::default();
-    let mut tally = [0usize; 7];
+#[derive(Default)]
+struct Balance {
+    cons: Worst,
+    full: Worst,
+    vp_rec: Worst,
+    oracle: Worst,
+    /// contacts seen separated, pressing, and penetrating with the damping clipped (F_n = 0)
+    regimes: [usize; 3],
+    /// largest power of contacts and damped bushings alone, relative to the other terms
+    max_power: f64,
+}
+
+/// Builds `TREES` random trees from `seed0` with the loads of `add_loads` (and the force
+/// elements of `add_force_elements` when `elements`) in two scenes, Conservative and Full
+/// (and Contacts: the lossy force elements alone, with gravity), and checks the energy
+/// balance and h against the oracle at `STATES` states of each.
+fn balance(
+    seed0: u64,
+    elements: bool,
+    tally: &mut [usize; 7],
+    el_tally: &mut [usize; 4],
+) -> Balance {
+    let mut out = Balance {
+        max_power: f64::NEG_INFINITY,
+        ..Balance::default()
+    };
     for seed in 0..TREES {
-        let mut rng = Rng::new(3000 + seed);
+        let mut rng = Rng::new(seed0 + seed);
         let desc = random_desc(
             &mut rng,
             GenOpts {
@@ -155,7 +269,13 @@ fn energy_balance_with_loads() {
         );
         let n = desc.ndof;
         let mut built = to_system(&desc, &mut rng);
-        let (springs, losses) = add_loads(&mut rng, &mut built.sys, n, &mut tally);
+        let (springs, losses) = add_loads(&mut rng, &mut built.sys, n, tally);
+        let (mut cons, mut full) = (vec![springs], vec![springs, losses]);
+        if elements {
+            let (elastic, contacts) = add_force_elements(&mut rng, &mut built.sys, el_tally);
+            cons.push(elastic);
+            full.extend([elastic, contacts]);
+        }
         let oracle = Oracle::new(&desc);
         // every system frame is a link frame or a body (at the link's G), in link axes
         let mut frame_link = vec![(usize::MAX, [0.0; 3]); built.sys.frames.len()];
@@ -165,11 +285,15 @@ fn energy_balance_with_loads() {
                 frame_link[f] = (i, [0.0; 3]);
             }
         }
-        built.sys.scene("Conservative", vec![springs]);
-        built.sys.scene("Full", vec![springs, losses]);
+        built.sys.scene("Conservative", cons);
+        built.sys.scene("Full", full.clone());
+        if elements {
+            // contacts and the damped bushing alone: damping and friction only dissipate
+            built.sys.scene("Contacts", full[2..].to_vec());
+        }
         let mut model = SymbolicModel::build(built.sys);
-        assert_eq!(model.scenes.len(), 2);
-        for sc in 0..2 {
+        assert_eq!(model.scenes.len(), 2 + elements as usize);
+        for sc in 0..model.scenes.len() {
             let eq = model.scenes[sc].clone();
             if sc == 0 {
                 assert!(
@@ -197,36 +321,88 @@ fn energy_balance_with_loads() {
                     (m, v[o + n * n..o + n * n + n].to_vec())
                 };
                 let ((m_vp, h_vp), (m_rec, h_rec)) = (mh(0), mh(1));
-                let at = || format!("seed {}, scene {sc}, state {s}, {n} dof", 3000 + seed);
-                w_vp_rec.see(
+                let at = || format!("seed {}, scene {sc}, state {s}, {n} dof", seed0 + seed);
+                out.vp_rec.see(
                     rel_err(&m_vp.concat(), &m_rec.concat()).max(rel_err(&h_vp, &h_rec)),
                     at,
                 );
-                let h_ref = oracle_h(&model, &oracle, &frame_link, &eq.effects, t, &q, &qd);
-                w_oracle.see(rel_err(&h_vp, &h_ref).max(rel_err(&h_rec, &h_ref)), at);
+                let h_ref = oracle_h(
+                    &model,
+                    &oracle,
+                    &frame_link,
+                    &eq.effects,
+                    t,
+                    &q,
+                    &qd,
+                    &mut out.regimes,
+                );
+                out.oracle
+                    .see(rel_err(&h_vp, &h_ref).max(rel_err(&h_rec, &h_ref)), at);
                 for (m, h) in [(&m_vp, &h_vp), (&m_rec, &h_rec)] {
                     let qdd = solve_spd(m, h);
                     let v = eval(&model, &roots[..4], t, &q, &qd, &qdd);
                     let (de, dk, dp, p) = (v[0], v[1], v[2], v[3]);
                     let scale = p.abs().max(dk.abs()).max(dp.abs());
                     let err = (de - p).abs() / scale;
+                    if sc == 2 {
+                        out.max_power = out.max_power.max(p / scale);
+                    }
                     if sc == 0 {
-                        w_cons.see(err, at);
+                        out.cons.see(err, at);
                     } else {
-                        w_full.see(err, at);
+                        out.full.see(err, at);
                     }
                 }
             }
         }
     }
+    out
+}
+
+#[test]
+fn energy_balance_with_loads() {
+    let mut tally = [0usize; 7];
+    let b = balance(3000, false, &mut tally, &mut [0; 4]);
     println!(
         "{TREES} trees x {STATES} states x 2 scenes; loads: {} springs, {} dampers, {} world \
          forces, {} body-frame forces, {} torques, {} torques with reaction, {} generalised forces",
         tally[0], tally[1], tally[2], tally[3], tally[4], tally[5], tally[6]
     );
-    w_vp_rec.check("M, h with loads: virtual power vs recursive", 1e-10);
-    w_oracle.check("h with loads vs oracle", 1e-10);
-    w_cons.check("gravity + springs: d(T+V)/dt = 0", 1e-9);
-    w_full.check("all loads: d(T+V)/dt = power", 1e-9);
+    b.vp_rec
+        .check("M, h with loads: virtual power vs recursive", 1e-10);
+    b.oracle.check("h with loads vs oracle", 1e-10);
+    b.cons.check("gravity + springs: d(T+V)/dt = 0", 1e-9);
+    b.full.check("all loads: d(T+V)/dt = power", 1e-9);
     assert!(tally.iter().all(|&c| c >= 5), "{tally:?}");
+}
+
+/// The same with contacts (points and spheres, damping, friction) and bushings: an undamped
+/// bushing and an undamped, frictionless contact join the conservative scene (the bushing's
+/// elastic torque must be exactly the gradient of ½ θᵀ K_r θ for the balance to hold),
+/// damped contacts with friction and a damped bushing the full one.
+#[test]
+fn energy_balance_with_contacts_and_bushings() {
+    let mut el = [0usize; 4];
+    let b = balance(5000, true, &mut [0; 7], &mut el);
+    println!(
+        "{TREES} trees x {STATES} states x 3 scenes; {} point contacts, {} sphere contacts, \
+         {} bushings to the ground, {} between frames; contact states: {} separated, {} \
+         pressing, {} penetrating with F_n clipped to 0",
+        el[0], el[1], el[2], el[3], b.regimes[0], b.regimes[1], b.regimes[2]
+    );
+    b.vp_rec.check(
+        "M, h with force elements: virtual power vs recursive",
+        1e-10,
+    );
+    b.oracle.check("h with force elements vs oracle", 1e-10);
+    b.cons
+        .check("gravity + springs + bushings: d(T+V)/dt = 0", 1e-9);
+    b.full.check("with contacts: d(T+V)/dt = power", 1e-9);
+    assert!(el.iter().all(|&c| c >= 5), "{el:?}");
+    assert!(b.regimes.iter().all(|&c| c >= 5), "{:?}", b.regimes);
+    println!(
+        "power of contacts and damped bushings: max {:.3e} (relative)",
+        b.max_power
+    );
+    assert!(b.max_power <= 1e-12, "contacts or bushings gave energy");
 }

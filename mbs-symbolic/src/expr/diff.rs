@@ -193,7 +193,8 @@ impl Arena {
                 self.div(h, fa)
             }
             Func::Abs => self.func(Func::Sign, a),
-            Func::Sign => self.zero(),
+            Func::Pos => self.func(Func::Step, a),
+            Func::Sign | Func::Step => self.zero(),
         }
     }
 
@@ -272,6 +273,51 @@ mod tests {
         let num_y = central(|yv| val(&a, f, x0, yv), y0);
         assert!((val(&a, dfx, x0, y0) - num_x).abs() < 1e-8);
         assert!((val(&a, dfy, x0, y0) - num_y).abs() < 1e-8);
+    }
+
+    #[test]
+    fn positive_part_and_step_derivatives() {
+        use super::Func;
+        let mut a = Arena::new();
+        let x = a.var(Var::Q(0));
+        let y = a.var(Var::Qd(0));
+        // f = pos(x² − y) · step(x) + pos(y)
+        let x2 = a.powi(x, 2);
+        let d = a.sub(x2, y);
+        let p = a.func(Func::Pos, d);
+        let s = a.func(Func::Step, x);
+        let ps = a.mul(p, s);
+        let py = a.func(Func::Pos, y);
+        let f = a.add(ps, py);
+        let dfx = a.diff(f, Var::Q(0));
+        let dfy = a.diff(f, Var::Qd(0));
+        // d pos(u) = step(u) du; d step = 0
+        assert_eq!(a.diff(s, Var::Q(0)), a.zero());
+        let su = a.func(Func::Step, d);
+        let want = a.diff(d, Var::Q(0));
+        let want = a.mul(su, want);
+        assert_eq!(a.diff(p, Var::Q(0)), want);
+        let val = |a: &Arena, e, xv: f64, yv: f64| {
+            let env = SliceEnv {
+                q: &[xv],
+                qd: &[yv],
+                ..SliceEnv::default()
+            };
+            a.eval(&[e], &env)[0]
+        };
+        // away from the kinks, on each side of them
+        for (x0, y0) in [
+            (0.9, 0.3),
+            (0.9, -0.3),
+            (-0.4, 0.5),
+            (0.3, 0.5),
+            (-0.8, -0.2),
+        ] {
+            let num_x = central(|xv| val(&a, f, xv, y0), x0);
+            let num_y = central(|yv| val(&a, f, x0, yv), y0);
+            assert!((val(&a, dfx, x0, y0) - num_x).abs() < 1e-8, "({x0}, {y0})");
+            assert!((val(&a, dfy, x0, y0) - num_y).abs() < 1e-8, "({x0}, {y0})");
+        }
     }
 
     #[test]

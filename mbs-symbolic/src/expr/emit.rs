@@ -104,7 +104,7 @@ impl Writer<'_> {
                     Prec::Atom
                 }
             }
-            Node::Add(..) | Node::Sub(..) | Node::Func(Func::Sign, _) => Prec::Add,
+            Node::Add(..) | Node::Sub(..) | Node::Func(Func::Sign | Func::Step, _) => Prec::Add,
             Node::Mul(..) | Node::Div(..) | Node::Powi(_, 2) => Prec::Mul,
             Node::Neg(_) => Prec::Unary,
             _ => Prec::Atom,
@@ -176,6 +176,15 @@ impl Writer<'_> {
                 let mut s = String::new();
                 self.expr(a, Prec::Atom, &mut s);
                 let _ = write!(out, "if {s} == 0.0 {{ 0.0 }} else {{ {s}.signum() }}");
+            }
+            Node::Func(Func::Step, a) => {
+                let mut s = String::new();
+                self.expr(a, Prec::Atom, &mut s);
+                let _ = write!(out, "if {s} > 0.0 {{ 1.0 }} else {{ 0.0 }}");
+            }
+            Node::Func(Func::Pos, a) => {
+                self.expr(a, Prec::Atom, out);
+                out.push_str(".max(0.0)");
             }
             Node::Func(f, a) => {
                 self.expr(a, Prec::Atom, out);
@@ -403,6 +412,25 @@ mod tests {
         assert!(code.contains("let sin_q0 = q0.sin();"), "{code}");
         assert!(code.contains("out[0] = q1 - (q0 - q1) * sin_q0;"), "{code}");
         assert!(code.contains("out[1] = sin_q0;"), "{code}");
+    }
+
+    #[test]
+    fn emits_positive_part_and_step() {
+        use super::super::Func;
+        let mut a = Arena::new();
+        let x = a.var(Var::Q(0));
+        let y = a.var(Var::Q(1));
+        let d = a.sub(x, y);
+        let p = a.func(Func::Pos, d);
+        let s = a.func(Func::Step, x);
+        let f = a.mul(s, p);
+        let g = a.add(s, y);
+        let sch = Schedule::new(&a, &[f, g]);
+        let e = emit(&a, &sch, &["out[0]".into(), "out[1]".into()], &N).unwrap();
+        let code = &e.chunks[0];
+        assert!(code.contains("(q0 - q1).max(0.0)"), "{code}");
+        assert!(code.contains("if q0 > 0.0 { 1.0 } else { 0.0 }"), "{code}");
+        assert_eq!(e.count.funcs, 2, "{code}");
     }
 
     #[test]

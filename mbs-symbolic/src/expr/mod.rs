@@ -95,11 +95,15 @@ pub enum Func {
     Sqrt,
     Abs,
     Sign,
+    /// `pos(x)` = max(x, 0), the positive part (derivative `step(x)`)
+    Pos,
+    /// `step(x)` = 1 if x > 0, else 0 (derivative 0)
+    Step,
 }
 
 impl Func {
     /// All functions, for name lookup.
-    pub const ALL: [Func; 14] = [
+    pub const ALL: [Func; 16] = [
         Func::Sin,
         Func::Cos,
         Func::Tan,
@@ -114,6 +118,8 @@ impl Func {
         Func::Sqrt,
         Func::Abs,
         Func::Sign,
+        Func::Pos,
+        Func::Step,
     ];
 
     /// The name used in the DSL, in s-expressions and (as an `f64` method) in emitted code.
@@ -133,6 +139,8 @@ impl Func {
             Func::Sqrt => "sqrt",
             Func::Abs => "abs",
             Func::Sign => "sign",
+            Func::Pos => "pos",
+            Func::Step => "step",
         }
     }
 
@@ -164,6 +172,15 @@ impl Func {
                     1.0
                 } else if x < 0.0 {
                     -1.0
+                } else {
+                    0.0
+                }
+            }
+            // as emitted: `x.max(0.0)` (0 for NaN)
+            Func::Pos => x.max(0.0),
+            Func::Step => {
+                if x > 0.0 {
+                    1.0
                 } else {
                     0.0
                 }

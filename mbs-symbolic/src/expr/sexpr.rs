@@ -1,6 +1,6 @@
 //! S-expression printing and parsing, for tests and debugging:
 //! `(+ (* 2 (sin q0)) p1)`. Leaves are numbers, `q0 qd0 qdd0 t p0 u0`; operators are
-//! `+ - * / neg powi pow atan2 call` and the function names of [`Func`]. Parsing goes
+//! `+ - * / neg powi pow atan2 call` and the function names of [`Func`] (`pos`, `step`, …). Parsing goes
 //! through the canonicalising constructors, so `parse(print(e)) == e` for every node `e`.
 //!
 //! Printing expands shared nodes, so the text can be exponentially larger than the DAG.
@@ -193,6 +193,7 @@ mod tests {
             "(- (atan2 qd1 q0) (/ t (cos q1)))",
             "(neg (* (powi 3 q2) (sqrt u0)))",
             "(* (call 0 1 q0) (pow q1 p0))",
+            "(* (step (- p0 q0)) (pos (+ (* p1 (- p0 q0)) qd0)))",
         ] {
             let e = a.parse_sexpr(text).unwrap();
             let printed = a.to_sexpr(e);

@@ -5,7 +5,9 @@
 //! - products carry at most one positive numeric factor, in front (`Mul(Num c, x)`, c > 0);
 //! - signs float outwards (`Neg` above `Mul`/`Div`/odd functions) and are absorbed by
 //!   `Add`/`Sub`: `a + (-b)` is `a - b`, `-(a - b)` is `b - a`;
-//! - like terms merge: `c1·x + c2·x` is `(c1 + c2)·x`, `x - x` is 0.
+//! - like terms merge: `c1·x + c2·x` is `(c1 + c2)·x`, `x - x` is 0;
+//! - `pos` and `step` absorb each other and positive factors: `pos(pos x)` is `pos x`,
+//!   `step(pos x)` is `step x`, `pos(c·x)` is `c·pos x` and `step(c·x)` is `step x` (c > 0).
 //!
 //! Each rule strictly shrinks or reorders, so construction terminates.
 
@@ -259,6 +261,29 @@ impl Arena {
         if let Some(v) = self.as_num(x) {
             return self.num(f.apply(v));
         }
+        // positive part and step of a non-negative or 0/1-valued argument, and of c·x (c > 0)
+        if let Node::Func(g, y) = self.node(x) {
+            match (f, g) {
+                // pos(pos y) = pos y, pos(step y) = step y, step(step y) = step y
+                (Func::Pos, Func::Pos | Func::Step) | (Func::Step, Func::Step) => return x,
+                // step(pos y) = step y
+                (Func::Step, Func::Pos) => return self.func(Func::Step, y),
+                _ => {}
+            }
+        }
+        if let Node::Mul(c, y) = self.node(x) {
+            if let Some(c) = self.as_num(c).filter(|c| *c > 0.0 && c.is_finite()) {
+                // canonical products carry c > 0: pos(c y) = c pos(y), step(c y) = step(y)
+                match f {
+                    Func::Pos => {
+                        let p = self.func(Func::Pos, y);
+                        return self.scale(c, p);
+                    }
+                    Func::Step => return self.func(Func::Step, y),
+                    _ => {}
+                }
+            }
+        }
         if let Node::Neg(y) = self.node(x) {
             match f {
                 Func::Sin
@@ -375,6 +400,60 @@ mod tests {
         // commutative canonical order
         assert_eq!(a.mul(y, x), a.mul(x, y));
         assert_eq!(a.add(y, x), a.add(x, y));
+    }
+
+    #[test]
+    fn positive_part_and_step_fold() {
+        use super::super::{Func, SliceEnv};
+        let mut a = Arena::new();
+        let x = a.var(Var::Q(0));
+        let m = a.num(-2.5);
+        let r = a.func(Func::Pos, m);
+        assert!(a.is_num(r, 0.0));
+        let three = a.num(3.0);
+        let r = a.func(Func::Pos, three);
+        assert!(a.is_num(r, 3.0));
+        let r = a.func(Func::Step, m);
+        assert!(a.is_num(r, 0.0));
+        let r = a.func(Func::Step, three);
+        assert!(a.is_num(r, 1.0));
+        let z = a.zero();
+        let r = a.func(Func::Step, z);
+        assert!(a.is_num(r, 0.0), "step(0) = 0");
+        let p = a.func(Func::Pos, x);
+        let s = a.func(Func::Step, x);
+        for (f, arg, want) in [
+            (Func::Pos, p, p),
+            (Func::Pos, s, s),
+            (Func::Step, s, s),
+            (Func::Step, p, s),
+        ] {
+            let r = a.func(f, arg);
+            assert_eq!(r, want, "{f:?}");
+        }
+        // positive factors come out of pos and vanish in step
+        let x3 = a.mul(three, x);
+        let p3 = a.func(Func::Pos, x3);
+        let want = a.scale(3.0, p);
+        assert_eq!(p3, want);
+        let s3 = a.func(Func::Step, x3);
+        assert_eq!(s3, s);
+        // a negated argument stays inside: pos(−x) is not −pos(x)
+        let nx = a.neg(x);
+        let pn = a.func(Func::Pos, nx);
+        assert_eq!(a.node(pn), Node::Func(Func::Pos, nx));
+        for (xv, want) in [
+            (-1.5, [0.0, 0.0, 1.5]),
+            (0.0, [0.0, 0.0, 0.0]),
+            (2.0, [2.0, 1.0, 0.0]),
+        ] {
+            let q = [xv];
+            let env = SliceEnv {
+                q: &q,
+                ..SliceEnv::default()
+            };
+            assert_eq!(a.eval(&[p, s, pn], &env), want.to_vec(), "x = {xv}");
+        }
     }
 
     #[test]

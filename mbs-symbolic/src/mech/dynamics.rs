@@ -171,15 +171,15 @@ impl SceneEquations {
     }
 }
 
-/// Kinetic energy Σ ½ m v_G² + ½ ωᵀ Φ ω, and potential energy of gravity and springs
-/// (gravity's measured from the world origin).
+/// Kinetic energy Σ ½ m v_G² + ½ ωᵀ Φ ω, and potential energy of gravity, springs, contacts
+/// and bushings (gravity's measured from the world origin).
 fn energies(sys: &mut System, tree: &Tree, world: &World, loads: &Loads) -> (ExprId, ExprId) {
     let bk = body_kinematics(&mut sys.arena, tree, None, false);
     let spinning = spinning_frames(sys, tree);
     let a = &mut sys.arena;
     let half = a.num(0.5);
     let mut t = a.zero();
-    let mut v = loads.spring_potential.unwrap_or(a.zero());
+    let mut v = loads.elastic_potential.unwrap_or(a.zero());
     for (n, node) in tree.nodes.iter().enumerate().skip(1) {
         for &f in &node.frames {
             let Some(inr) = sys.frames[f].inertia else {

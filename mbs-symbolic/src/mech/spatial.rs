@@ -56,6 +56,15 @@ pub fn mul_mtv(a: &mut Arena, m: &M3, x: V3) -> V3 {
     [a.dot(&col(0), &x), a.dot(&col(1), &x), a.dot(&col(2), &x)]
 }
 
+/// Mᵀ
+pub fn transpose(m: &M3) -> M3 {
+    [
+        [m[0][0], m[1][0], m[2][0]],
+        [m[0][1], m[1][1], m[2][1]],
+        [m[0][2], m[1][2], m[2][2]],
+    ]
+}
+
 /// A B
 pub fn mul_mm(a: &mut Arena, x: &M3, y: &M3) -> M3 {
     let mut r = identity(a);

@@ -94,15 +94,18 @@ pub struct Attach {
 pub enum Load {
     /// uniform gravity (world components); conservative
     Gravity([ExprId; 3]),
-    /// spring with stiffness `k` and rest length `l0` between two points, acting along the
-    /// line between them, or along the fixed world direction `axis` (a linear spring whose
-    /// length is the signed distance along the axis); conservative
+    /// spring with stiffness `k`, rest length `l0` and preload `preload` between two points,
+    /// acting along the line between them, or along the fixed world direction `axis` (a
+    /// linear spring whose length is the signed distance along the axis): tension
+    /// F0 + k (l − l0), potential F0 (l − l0) + ½ k (l − l0)²; conservative
     Spring {
         a: Attach,
         b: Attach,
         k: ExprId,
         l0: ExprId,
         axis: Option<[ExprId; 3]>,
+        /// tension at the rest length, F0 (0: none)
+        preload: ExprId,
     },
     /// linear damper between two points, along their line or the world direction `axis`
     Damper {
@@ -127,10 +130,41 @@ pub enum Load {
     },
     /// a generalised force on one coordinate
     GenForce { dof: usize, value: ExprId },
+    /// penalty contact of a point, or of a sphere of radius `radius` centred at it, with the
+    /// fixed world plane n·x = `offset` (n unit, pointing out of the ground). With the
+    /// penetration δ = offset + radius − n·x and its rate δ̇ = −n·v: normal force
+    /// F_n = step(δ) pos(k δ + c δ̇) along n (never pulling), regularised Coulomb friction
+    /// F_t = −μ F_n v_t / sqrt(|v_t|² + eps²) at the contact point x − radius·n (v_t its
+    /// velocity less its normal part). The elastic part k pos(δ) derives from the potential
+    /// ½ k pos(δ)²; damping and friction count in the power
+    Contact {
+        at: Attach,
+        /// 0 for a point
+        radius: ExprId,
+        normal: [ExprId; 3],
+        offset: ExprId,
+        k: ExprId,
+        c: ExprId,
+        mu: ExprId,
+        eps: ExprId,
+    },
+    /// six-axis linear spring–damper between the origins and orientations of frames `a` and
+    /// `b` (`None`: the ground), diagonal stiffnesses and dampings in `a`'s axes; see
+    /// `mech::effects` for the formulas. The elastic part derives from the potential
+    /// ½ Δpᵀ K Δp + ½ θᵀ K_r θ; damping counts in the power
+    Bushing {
+        a: Option<usize>,
+        b: Option<usize>,
+        k: [ExprId; 3],
+        kr: [ExprId; 3],
+        c: [ExprId; 3],
+        cr: [ExprId; 3],
+    },
 }
 
 impl Load {
-    /// Gravity and springs derive from a potential; the rest do work counted as power.
+    /// Gravity and springs derive from a potential; the rest do work counted as power
+    /// (contacts and bushings have both a potential and a power).
     pub fn is_conservative(&self) -> bool {
         matches!(self, Load::Gravity(_) | Load::Spring { .. })
     }

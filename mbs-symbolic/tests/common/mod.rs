@@ -885,7 +885,7 @@ pub fn value3(rng: &mut Rng, a: &mut Arena, n: usize) -> [ExprId; 3] {
 }
 
 /// A random unit vector as expressions.
-fn random_unit(rng: &mut Rng, sys: &mut System) -> [ExprId; 3] {
+pub fn random_unit(rng: &mut Rng, sys: &mut System) -> [ExprId; 3] {
     let v = [
         rng.range(-1.0, 1.0),
         rng.range(-1.0, 1.0),
@@ -909,11 +909,21 @@ pub fn add_loads(
     for _ in 0..1 + rng.below(2) {
         let a = attach(rng, sys, true);
         let b = attach(rng, sys, false);
-        let k = sys.num(rng.range(5.0, 50.0));
-        let l0 = sys.num(rng.range(0.1, 0.8));
+        let (kv, l0v) = (rng.range(5.0, 50.0), rng.range(0.1, 0.8));
+        let (k, l0) = (sys.num(kv), sys.num(l0v));
+        // a preload of either sign, from the values drawn (no draw of its own, so the random
+        // sequence of the tests sharing this function is unchanged)
+        let preload = sys.num(kv * (0.45 - l0v));
         // half the springs act along a fixed unit direction (linear springs)
         let axis = (rng.below(2) == 0).then(|| random_unit(rng, sys));
-        cons.push(Load::Spring { a, b, k, l0, axis });
+        cons.push(Load::Spring {
+            a,
+            b,
+            k,
+            l0,
+            axis,
+            preload,
+        });
         tally[0] += 1;
     }
     let mut nc = Vec::new();
@@ -964,6 +974,84 @@ pub fn add_loads(
     (
         sys.effect(Some("springs"), cons),
         sys.effect(Some("losses"), nc),
+    )
+}
+
+/// Adds random force elements: an effect `elastic` (a bushing without damping and a contact
+/// without damping or friction, conservative) and an effect `contacts` (1 to 3 penalty
+/// contacts of points or spheres with friction, and a damped bushing). The planes are placed so that most contacts penetrate at the random
+/// states. Returns the two effects; `tally` counts point contacts, sphere contacts, bushings
+/// to the ground and bushings between two frames.
+pub fn add_force_elements(
+    rng: &mut Rng,
+    sys: &mut System,
+    tally: &mut [usize; 4],
+) -> (usize, usize) {
+    let nf = sys.frames.len();
+    let mut bushing = |rng: &mut Rng, sys: &mut System, damped: bool| {
+        let a = (!rng.chance(0.25)).then(|| rng.below(nf));
+        let b = loop {
+            let b = (!rng.chance(0.25)).then(|| rng.below(nf));
+            if b != a {
+                break b;
+            }
+        };
+        tally[if a.is_none() || b.is_none() { 2 } else { 3 }] += 1;
+        let mut v = |lo: f64, hi: f64| {
+            let x = [rng.range(lo, hi), rng.range(lo, hi), rng.range(lo, hi)];
+            sys.vec3(x)
+        };
+        let (k, kr) = (v(5.0, 60.0), v(1.0, 20.0));
+        let (c, cr) = if damped {
+            (v(0.2, 3.0), v(0.05, 1.0))
+        } else {
+            let z = [sys.arena.zero(); 3];
+            (z, z)
+        };
+        Load::Bushing { a, b, k, kr, c, cr }
+    };
+    let mut elastic = vec![bushing(rng, sys, false)];
+    let mut lossy = vec![bushing(rng, sys, true)];
+    // the first contact without damping and friction: conservative
+    for i in 0..2 + rng.below(3) {
+        let at = attach(rng, sys, false);
+        let radius = if rng.chance(0.5) {
+            tally[1] += 1;
+            sys.num(rng.range(0.05, 0.3))
+        } else {
+            tally[0] += 1;
+            sys.arena.zero()
+        };
+        let normal = random_unit(rng, sys);
+        let offset = sys.num(rng.range(-0.3, 1.5));
+        let k = sys.num(rng.range(50.0, 500.0));
+        let c = sys.num(rng.range(5.0, 300.0));
+        let mu = sys.num(if rng.chance(0.2) {
+            0.0
+        } else {
+            rng.range(0.1, 0.8)
+        });
+        let eps = sys.num(rng.range(0.01, 0.3));
+        let (c, mu, to) = if i == 0 {
+            let z = sys.arena.zero();
+            (z, z, &mut elastic)
+        } else {
+            (c, mu, &mut lossy)
+        };
+        to.push(Load::Contact {
+            at,
+            radius,
+            normal,
+            offset,
+            k,
+            c,
+            mu,
+            eps,
+        });
+    }
+    (
+        sys.effect(Some("elastic"), elastic),
+        sys.effect(Some("contacts"), lossy),
     )
 }
 

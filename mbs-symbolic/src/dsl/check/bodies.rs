@@ -376,7 +376,12 @@ impl Checker {
                     self.lower(args[2], pa),
                 ];
                 let axis_tokens = range(args[0], args[2]);
-                if !self.unit_axis(&n, &axis_tokens, "Trotn", "Trotn(nx, ny, nz, angle)") {
+                if !self.unit_axis(
+                    &n,
+                    &axis_tokens,
+                    "the axis of Trotn",
+                    "Trotn(nx, ny, nz, angle)",
+                ) {
                     return None;
                 }
                 rot(self, n)
@@ -421,7 +426,12 @@ impl Checker {
                     ..PARAMS_ONLY
                 };
                 self.triple(axis, what, "an axis").filter(|n| {
-                    self.unit_axis(n, &axis.to_token_stream(), &format!("the {of}"), usage)
+                    self.unit_axis(
+                        n,
+                        &axis.to_token_stream(),
+                        &format!("the axis of the {of}"),
+                        usage,
+                    )
                 })
             }
             _ => {
@@ -431,6 +441,8 @@ impl Checker {
         }
     }
 
+    /// Whether `n` is a unit vector (with the default parameters); reports it on `at` if not.
+    /// `of` names the vector: "the axis of Trotn".
     pub(super) fn unit_axis(
         &mut self,
         n: &[ExprId; 3],
@@ -451,7 +463,7 @@ impl Checker {
             self.error_at(
                 at,
                 format!(
-                    "the axis of {of} is zero{how}: give a unit vector, e.g. `{}`",
+                    "{of} is zero{how}: give a unit vector, e.g. `{}`",
                     usage.replace("nx, ny, nz", "0, 0, 1")
                 ),
             );
@@ -479,7 +491,7 @@ impl Checker {
             };
             self.error_at(
                 at,
-                format!("the axis of {of} must be a unit vector, but ({x}, {y}, {z}) has norm {norm}{how}: divide it by its norm{example}"),
+                format!("{of} must be a unit vector, but ({x}, {y}, {z}) has norm {norm}{how}: divide it by its norm{example}"),
             );
             return false;
         }

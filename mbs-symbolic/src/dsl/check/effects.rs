@@ -1,5 +1,5 @@
 //! Effects: attachment points, gravity, springs, dampers, forces, torques, generalised
-//! forces.
+//! forces (contacts and bushings in `force_elements.rs`).
 
 use super::*;
 
@@ -80,7 +80,9 @@ impl Checker {
         let kind = s.kind.to_string();
         let named = |key: &str| s.named.iter().find(|(k, _)| k == key).map(|(_, v)| v);
         let known_named: &[&str] = match kind.as_str() {
-            "spring" => &["k", "l0", "c", "axis"],
+            "spring" => &["k", "l0", "c", "axis", "preload"],
+            "contact" => &["k", "c", "mu", "eps", "plane", "offset", "sphere"],
+            "bushing" => &["k", "kr", "c", "cr"],
             "damper" => &["c", "axis"],
             "force" => &["frame"],
             "torque" => &["frame", "relative_to", "axis"],
@@ -92,7 +94,11 @@ impl Checker {
                     k.span(),
                     format!("argument `{k}` is given twice: remove one"),
                 );
-            } else if !known_named.contains(&k.to_string().as_str()) {
+            } else if !known_named.contains(&k.to_string().as_str())
+                // reported below, with what to write instead
+                && kind != "friction"
+                && (kind.as_str(), k.to_string().as_str()) != ("damper", "preload")
+            {
                 let list = match known_named {
                     [] => format!("`{kind}` takes no named argument"),
                     [one] => format!("its only named argument is `{one}`"),
@@ -210,7 +216,24 @@ impl Checker {
                         }
                         None => self.sys.arena.zero(),
                     };
-                    out.push(Load::Spring { a, b, k, l0, axis });
+                    let preload = match named("preload") {
+                        Some(e) => self.lower(
+                            e,
+                            Allow {
+                                what: "a spring preload",
+                                ..pa
+                            },
+                        ),
+                        None => self.sys.arena.zero(),
+                    };
+                    out.push(Load::Spring {
+                        a,
+                        b,
+                        k,
+                        l0,
+                        axis,
+                        preload,
+                    });
                 }
                 let c_expr = named("c");
                 if kind == "damper" && c_expr.is_none() {
@@ -218,6 +241,11 @@ impl Checker {
                         s.kind.span(),
                         "a damper needs its coefficient: add `c = …`, as in `damper(a, b, c = …)`",
                     );
+                }
+                if let (Some((key, _)), "damper") =
+                    (s.named.iter().find(|(k, _)| k == "preload"), kind.as_str())
+                {
+                    self.error(key.span(), "a damper has no preload: for a constant force between two points use `spring(a, b, k = 0, preload = F0)`");
                 }
                 if let Some(e) = c_expr {
                     let c = self.lower(
@@ -318,6 +346,14 @@ impl Checker {
                     out.push(Load::GenForce { dof, value: v });
                 }
             }
+            "contact" => out.extend(self.lower_contact(s)),
+            "bushing" => out.extend(self.lower_bushing(s)),
+            "friction" => {
+                self.error(
+                    s.kind.span(),
+                    "friction acts only where a body touches the ground: give the contact its friction coefficient, `contact(point, k = …, mu = …);`",
+                );
+            }
             other => {
                 let known = [
                     "gravity",
@@ -326,8 +362,10 @@ impl Checker {
                     "force",
                     "torque",
                     "generalized_force",
+                    "contact",
+                    "bushing",
                 ];
-                self.error(s.kind.span(), format!("unknown effect `{other}`{}", did_you_mean(other, known.into_iter(), "the effects are gravity, spring, damper, force, torque and generalized_force")));
+                self.error(s.kind.span(), format!("unknown effect `{other}`{}", did_you_mean(other, known.into_iter(), "the effects are gravity, spring, damper, force, torque, generalized_force, contact and bushing")));
             }
         }
         out

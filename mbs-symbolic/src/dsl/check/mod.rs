@@ -649,3 +649,4 @@ mod bodies;
 mod constraints;
 mod effects;
 mod expr;
+mod force_elements;

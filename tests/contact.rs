@@ -1,0 +1,370 @@
+//! Force elements of the DSL: penalty contacts with a plane (points and spheres, damping,
+//! regularised friction), bushings and preloaded springs, generated with the equations.
+//!
+//! - exact tangents against central differences of τ at states in contact;
+//! - the energy identity dE/dt = power along a run with every force element;
+//! - a box dropped on its 8 corners comes to rest, carried by its weight;
+//! - E(t) never grows during the drop;
+//! - small oscillations on a bushing at √(k/m) and √(k_r/I);
+//! - the static position of a mass on a preloaded spring.
+
+use mbs::{Kinematics, Model, Options, Output, Scheme, simulate};
+use nalgebra::{DMatrix, DVector};
+
+const G: f64 = 9.81;
+
+mbs::multibody! {
+    /// A box of side 0.2 m (1 kg) on the ground z = 0, touching it with its 8 corners.
+    pub model Block {
+        param k = 2e4; param c = 100.0; param mu = 0.5; param eps = 1e-4;
+        dof x = 0.0, qd = 0.8; dof y = 0.0, qd = -0.3; dof z = 0.3;
+        dof a = 0.3, qd = 2.0; dof b = 0.2; dof r = -0.15, qd = 1.0;
+        body box1 { mass = 1.0; inertia = (0.2 * 0.2 / 6, 0.2 * 0.2 / 6, 0.2 * 0.2 / 6); }
+        point c0 on box1 at (-0.1, -0.1, -0.1);
+        point c1 on box1 at (0.1, -0.1, -0.1);
+        point c2 on box1 at (0.1, 0.1, -0.1);
+        point c3 on box1 at (-0.1, 0.1, -0.1);
+        point c4 on box1 at (-0.1, -0.1, 0.1);
+        point c5 on box1 at (0.1, -0.1, 0.1);
+        point c6 on box1 at (0.1, 0.1, 0.1);
+        point c7 on box1 at (-0.1, 0.1, 0.1);
+        TOG[box1] = Tdisp(x, y, z) * Trotz(a) * Troty(b) * Trotx(r);
+        gravity(0, 0, -9.81);
+        contact(c0, k = k, c = c, mu = mu, eps = eps);
+        contact(c1, k = k, c = c, mu = mu, eps = eps);
+        contact(c2, k = k, c = c, mu = mu, eps = eps);
+        contact(c3, k = k, c = c, mu = mu, eps = eps);
+        contact(c4, k = k, c = c, mu = mu, eps = eps);
+        contact(c5, k = k, c = c, mu = mu, eps = eps);
+        contact(c6, k = k, c = c, mu = mu, eps = eps);
+        contact(c7, k = k, c = c, mu = mu, eps = eps);
+        option tangents;
+    }
+}
+
+mbs::multibody! {
+    /// Every force element at once: a ball (sphere contact with friction) carrying an arm on
+    /// a bushing, the arm hung from the ground by a preloaded, damped spring and touching a
+    /// tilted wall with its tip.
+    pub model Rig {
+        param k = 1e4; param c = 30.0; param mu = 0.4; param eps = 1e-2;
+        dof x = 0.0, qd = 1.0; dof y = 0.0; dof z = 0.2, qd = -1.0;
+        dof a = 0.0, qd = 3.0; dof b = 0.1; dof r = 0.0, qd = -2.0;
+        dof du = 0.3; dof dv = 0.0; dof dw = 0.02; dof s = 0.05;
+        body ball { mass = 1.0; inertia = (0.004, 0.004, 0.004); }
+        body arm { mass = 0.5; inertia = (0.001, 0.01, 0.01, 0.0005, 0.0, 0.0); }
+        point tip on arm at (0.2, 0, 0);
+        point hook on ground at (0.5, 0.2, 1.0);
+        TOG[ball] = Tdisp(x, y, z) * Trotz(a) * Troty(b) * Trotx(r);
+        TOG[arm] = TOG[ball] * Tdisp(du, dv, dw) * Trotz(s);
+        gravity(0, 0, -9.81);
+        contact(ball, sphere = 0.1, k = k, c = c, mu = mu, eps = eps);
+        contact(tip, plane = (-0.6, 0, 0.8), offset = -0.13, k = k, c = c, mu = mu, eps = eps);
+        bushing(ball, arm, k = (300, 200, 400), kr = (3, 2, 1), c = 0.5, cr = (0.01, 0.02, 0.03));
+        spring(hook, arm, k = 10, l0 = 0.6, c = 0.3, preload = 2);
+        option tangents;
+    }
+}
+
+mbs::multibody! {
+    /// A body on a bushing to the ground: translation x and rotation a about z.
+    pub model Mount {
+        param m = 2.0; param izz = 0.05;
+        dof x = 0.01; dof a = 0.001;
+        body block { mass = m; inertia = (0.03, 0.04, izz); }
+        TOG[block] = Tdisp(x, 0, 0) * Trotz(a);
+        bushing(ground, block, k = (800, 500, 900), kr = (7, 6, 5));
+    }
+}
+
+mbs::multibody! {
+    /// A mass hanging from the origin on a preloaded spring (tension F0 at the rest length).
+    pub model Hang {
+        param m = 2.0; param k = 50.0; param l0 = 0.4; param f0 = 6.0;
+        dof z = -1.0;
+        body bob { mass = m; }
+        TOG[bob] = Tdisp(0, 0, z);
+        gravity(0, 0, -9.81);
+        spring(ground, bob, k = k, l0 = l0, c = 3.0, preload = f0);
+    }
+}
+
+/// Central differences of τ(q, qd, qdd) at fixed qdd: (K, C), column-major like the model's.
+fn fd_tangents<M: Model>(m: &M, q: &[f64], qd: &[f64], qdd: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    let n = M::NQ;
+    let (mut k, mut c) = (vec![0.0; n * n], vec![0.0; n * n]);
+    let (mut tp, mut tm) = (vec![0.0; n], vec![0.0; n]);
+    for j in 0..n {
+        for (var, out) in [(0, &mut k), (1, &mut c)] {
+            let (mut qp, mut qm, mut vp, mut vm) =
+                (q.to_vec(), q.to_vec(), qd.to_vec(), qd.to_vec());
+            let h = 1e-6;
+            if var == 0 {
+                qp[j] += h;
+                qm[j] -= h;
+            } else {
+                vp[j] += h;
+                vm[j] -= h;
+            }
+            m.inverse_dynamics(0.0, &qp, &vp, qdd, &[], &mut tp);
+            m.inverse_dynamics(0.0, &qm, &vm, qdd, &[], &mut tm);
+            for i in 0..n {
+                out[i + n * j] = (tp[i] - tm[i]) / (2.0 * h);
+            }
+        }
+    }
+    (k, c)
+}
+
+fn max_abs(v: &[f64]) -> f64 {
+    v.iter().fold(0.0, |m, x| m.max(x.abs()))
+}
+
+/// Penetrations δ and normal forces F_n = step(δ)·pos(k δ + c δ̇) of the Block's corners,
+/// from its kinematics (plane z = 0: δ = −z, δ̇ = −ż).
+fn corner_forces(m: &Block, q: &[f64], qd: &[f64]) -> Vec<(f64, f64)> {
+    let p = m.params();
+    let mut kin = Kinematics::new::<Block>();
+    m.kinematics(0.0, q, qd, &mut kin);
+    kin.points
+        .iter()
+        .map(|pt| {
+            let (d, dd) = (-pt.position[2], -pt.velocity[2]);
+            let f = if d > 0.0 {
+                (p.k * d + p.c * dd).max(0.0)
+            } else {
+                0.0
+            };
+            (d, f)
+        })
+        .collect()
+}
+
+fn check_tangents<M: Model>(m: &M, q: &[f64], qd: &[f64], qdd: &[f64], what: &str) -> f64 {
+    let n = M::NQ;
+    let (mut k, mut c) = (vec![0.0; n * n], vec![0.0; n * n]);
+    m.tangents(0.0, q, qd, qdd, &[], &mut k, &mut c).unwrap();
+    let (kf, cf) = fd_tangents(m, q, qd, qdd);
+    let rel = |x: &[f64], y: &[f64]| {
+        let d: Vec<f64> = x.iter().zip(y).map(|(a, b)| a - b).collect();
+        max_abs(&d) / max_abs(y).max(1e-300)
+    };
+    let (ek, ec) = (rel(&k, &kf), rel(&c, &cf));
+    println!(
+        "{what}: K_t {ek:.2e}, C_t {ec:.2e} (max |K| {:.3e}, |C| {:.3e})",
+        max_abs(&kf),
+        max_abs(&cf)
+    );
+    assert!(ek < 1e-6 && ec < 1e-6, "{what}: K_t {ek:.2e}, C_t {ec:.2e}");
+    ek.max(ec)
+}
+
+#[test]
+fn exact_tangents_in_contact_match_central_differences() {
+    // the box tilted with three corners penetrating, sliding fast (|v_t| ≫ eps) …
+    let block = Block::default();
+    let q = [0.1, -0.2, 0.0985, 0.4, 0.05, -0.03];
+    let qd = [0.7, -0.4, -0.05, 1.5, 0.3, -0.6];
+    let qdd = [0.3, -1.0, 2.0, 0.5, -0.2, 0.1];
+    let f = corner_forces(&block, &q, &qd);
+    let pressing = f.iter().filter(|(d, fn_)| *d > 0.0 && *fn_ > 0.0).count();
+    assert!(pressing >= 2, "{f:?}");
+    check_tangents(&block, &q, &qd, &qdd, "block sliding on 3 corners");
+    // … and creeping, |v_t| of the order of eps (the regularised part of friction), with a
+    // larger eps so that the differences resolve the curvature of sqrt(|v_t|² + eps²)
+    let mut creep = Block::default();
+    let mut p = creep.params().clone();
+    p.eps = 1e-2;
+    creep.set_params(p).unwrap();
+    let qd = [0.004, -0.006, -0.01, 0.02, 0.01, -0.01];
+    check_tangents(&creep, &q, &qd, &qdd, "block creeping on 3 corners");
+    // the rig: the ball penetrating and spinning (friction at the contact point, ω × (−r n)),
+    // the tip in the tilted wall, the bushing deformed, the spring stretched
+    let rig = Rig::default();
+    let q = [0.1, 0.05, 0.097, 0.3, 0.1, -0.2, 0.32, 0.01, 0.03, 0.1];
+    let qd = [0.8, -0.2, -0.3, 2.0, -1.0, 0.5, 0.1, -0.2, 0.05, 0.4];
+    let qdd = [0.1; 10];
+    let mut kin = Kinematics::new::<Rig>();
+    rig.kinematics(0.0, &q, &qd, &mut kin);
+    let tip = kin.points[0].position;
+    assert!(
+        0.1 - kin.frames[0].pose.position[2] > 0.0,
+        "ball in contact"
+    );
+    assert!(
+        -0.13 - (-0.6 * tip[0] + 0.8 * tip[2]) > 0.0,
+        "tip in the wall: {tip:?}"
+    );
+    check_tangents(&rig, &q, &qd, &qdd, "rig: sphere, tip, bushing, spring");
+}
+
+/// ∂/∂s of E along the motion: E(q + s qd + ½ s² qdd, qd + s qdd) by central differences.
+fn energy_rate<M: Model>(m: &M, t: f64, q: &[f64], qd: &[f64], qdd: &[f64]) -> f64 {
+    let s = 1e-6;
+    let at = |s: f64| {
+        let qs: Vec<f64> = (0..q.len())
+            .map(|i| q[i] + s * qd[i] + 0.5 * s * s * qdd[i])
+            .collect();
+        let vs: Vec<f64> = (0..q.len()).map(|i| qd[i] + s * qdd[i]).collect();
+        m.energy(t, &qs, &vs).total()
+    };
+    (at(s) - at(-s)) / (2.0 * s)
+}
+
+/// qdd = M⁻¹ h.
+fn accelerations<M: Model>(m: &M, t: f64, q: &[f64], qd: &[f64]) -> Vec<f64> {
+    let n = M::NQ;
+    let (mut mm, mut h) = (vec![0.0; n * n], vec![0.0; n]);
+    m.dynamics(t, q, qd, &[], &mut mm, &mut h);
+    let mm = DMatrix::from_column_slice(n, n, &mm);
+    mm.cholesky()
+        .expect("M positive definite")
+        .solve(&DVector::from_column_slice(&h))
+        .as_slice()
+        .to_vec()
+}
+
+#[test]
+fn energy_identity_along_a_run_with_every_force_element() {
+    let rig = Rig::default();
+    let opts = Options {
+        output: Output::Every { dt: 2e-3 },
+        ..Options::adaptive(1.5, 1e-7)
+    };
+    let (tr, st) = simulate(Rig::default(), Scheme::Radau5, opts).unwrap();
+    let (mut worst, mut in_contact, mut dissipated) = (0.0f64, [0usize; 2], 0.0f64);
+    let mut kin = Kinematics::new::<Rig>();
+    for i in 0..tr.len() {
+        let (t, q, qd) = (tr.t[i], tr.q(i), tr.qd(i));
+        let qdd = accelerations(&rig, t, q, qd);
+        let de = energy_rate(&rig, t, q, qd, &qdd);
+        let p = rig.power(t, q, qd, &[]);
+        // relative to the size of the power and of the kinetic energy's rate
+        let scale = p.abs().max(de.abs()).max(1.0);
+        worst = worst.max((de - p).abs() / scale);
+        assert!(p <= 1e-12 * scale, "power {p} > 0 at t = {t}");
+        dissipated = dissipated.min(p);
+        rig.kinematics(t, q, qd, &mut kin);
+        let tip = kin.points[0].position;
+        in_contact[0] += (0.1 - kin.frames[0].pose.position[2] > 0.0) as usize;
+        in_contact[1] += (-0.13 - (-0.6 * tip[0] + 0.8 * tip[2]) > 0.0) as usize;
+    }
+    println!(
+        "rig, radau5 rtol 1e-7, {} steps: {} outputs, ball in contact at {}, tip at {}; \
+         max |dE/dt − P| / max(|P|, |dE/dt|, 1 W) = {worst:.2e}; most negative power {dissipated:.2} W",
+        st.steps,
+        tr.len(),
+        in_contact[0],
+        in_contact[1]
+    );
+    assert!(in_contact[0] > 50 && in_contact[1] > 50, "{in_contact:?}");
+    assert!(worst < 1e-5, "energy identity: {worst:.2e}");
+}
+
+#[test]
+fn a_dropped_box_comes_to_rest_on_its_weight_and_never_gains_energy() {
+    let block = Block::default();
+    let opts = Options {
+        output: Output::Steps,
+        ..Options::adaptive(3.0, 1e-8)
+    };
+    let (tr, st) = simulate(Block::default(), Scheme::Radau5, opts).unwrap();
+    // E(t) = kinetic + potential (gravity, contacts) never grows beyond the integrator's error
+    let e: Vec<f64> = tr.energy.iter().map(|e| e.total()).collect();
+    let e0 = e[0];
+    let growth = e.windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max);
+    // the largest rise between any two outputs, earlier to later
+    let mut min_so_far = f64::INFINITY;
+    let mut rise = 0.0f64;
+    for &ei in &e {
+        min_so_far = min_so_far.min(ei);
+        rise = rise.max(ei - min_so_far);
+    }
+    let n = tr.len();
+    let (q, qd) = (tr.q(n - 1), tr.qd(n - 1));
+    let f = corner_forces(&block, q, qd);
+    let total: f64 = f.iter().map(|(_, fn_)| fn_).sum();
+    let touching = f.iter().filter(|(d, _)| *d > 0.0).count();
+    println!(
+        "box drop, radau5 rtol 1e-8: {} steps ({} rejected); E {:.4} J → {:.6} J, largest \
+         rise of E {rise:.2e} J (step to step {growth:.2e} J); at t = 3: max |qd| {:.2e}, \
+         {touching} corners touching, Σ F_n = {total:.9} N (m g = {G})",
+        st.steps,
+        st.rejected_error + st.rejected_newton,
+        e0,
+        e[n - 1],
+        max_abs(qd)
+    );
+    // measured 9e-12 J with radau5 at rtol 1e-8 (E0 = 3.3 J): a margin of 1000
+    assert!(rise < 1e-8, "E grew by {rise:.2e} J");
+    assert!(max_abs(qd) < 1e-6, "still moving: {qd:?}");
+    assert_eq!(touching, 4, "resting on a face: {f:?}");
+    assert!((total - G).abs() < 1e-6 * G, "Σ F_n = {total}");
+}
+
+/// Times of the upward zero crossings of a sampled signal (linear interpolation).
+fn upward_crossings(t: &[f64], x: &[f64]) -> Vec<f64> {
+    (1..x.len())
+        .filter(|&i| x[i - 1] < 0.0 && x[i] >= 0.0)
+        .map(|i| t[i - 1] + (t[i] - t[i - 1]) * (-x[i - 1]) / (x[i] - x[i - 1]))
+        .collect()
+}
+
+#[test]
+fn bushing_small_oscillations_at_sqrt_k_over_m() {
+    let mount = Mount::default();
+    let p = mount.params().clone();
+    let opts = Options {
+        output: Output::Every { dt: 1e-4 },
+        energy: false,
+        ..Options::adaptive(5.0, 1e-10)
+    };
+    let (tr, _) = simulate(Mount::default(), Scheme::Dopri5, opts).unwrap();
+    for (i, (what, want)) in [
+        ("translation x", (800.0 / p.m).sqrt()),
+        ("rotation about z", (5.0 / p.izz).sqrt()),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let x: Vec<f64> = (0..tr.len()).map(|k| tr.q(k)[i]).collect();
+        let c = upward_crossings(&tr.t, &x);
+        let periods = (c.len() - 1) as f64;
+        let omega = 2.0 * std::f64::consts::PI * periods / (c[c.len() - 1] - c[0]);
+        // the rotation's elastic torque is −½ k_r sin 2a (the gradient of ½ k_r sin² a): at
+        // amplitude A its frequency is lower by A²/4 = 2.5e-7 relative
+        let err = (omega - want).abs() / want;
+        println!("bushing {what}: ω = {omega:.8} rad/s, √(k/m) = {want:.8} ({err:.1e})");
+        assert!(err < 1e-6, "{what}: {omega} vs {want}");
+    }
+}
+
+#[test]
+fn a_mass_hangs_where_the_preloaded_spring_carries_its_weight() {
+    let hang = Hang::default();
+    let p = hang.params().clone();
+    // tension F0 + k (l − l0) = m g at l = −z
+    let z_star = -(p.l0 + (p.m * G - p.f0) / p.k);
+    let mut h = [0.0];
+    hang.static_forces(0.0, &[z_star], &[], &mut h);
+    println!("preloaded spring: z* = {z_star}, h(z*) = {:.2e}", h[0]);
+    assert!(h[0].abs() < 1e-12 * p.m * G);
+    // and a damped run settles there
+    let opts = Options {
+        output: Output::Last,
+        ..Options::adaptive(30.0, 1e-10)
+    };
+    let (tr, _) = simulate(Hang::default(), Scheme::Dopri5, opts).unwrap();
+    let z = tr.q(tr.len() - 1)[0];
+    println!("settled at z = {z:.12} (z* = {z_star:.12})");
+    assert!((z - z_star).abs() < 1e-8);
+    // potential F0 (l − l0) + ½ k (l − l0)² − m g z, from the generated energy
+    let e = hang.energy(0.0, &[z_star], &[0.0]);
+    let s = -z_star - p.l0;
+    let want = p.f0 * s + 0.5 * p.k * s * s + p.m * G * z_star;
+    assert!(
+        (e.potential - want).abs() < 1e-12 * want.abs(),
+        "{} vs {want}",
+        e.potential
+    );
+}

@@ -13,6 +13,7 @@
 
 pub mod analysis;
 pub mod efforts;
+pub mod elements;
 pub mod error;
 pub mod inertia;
 pub mod integrators;

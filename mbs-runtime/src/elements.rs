@@ -1,0 +1,269 @@
+//! Force elements for efforts written in Rust ([`crate::Efforts`]): the same laws as the
+//! DSL's `contact`, `bushing` and preloaded `spring` (see `mbs::language`), evaluated on the
+//! generated kinematics and applied through an [`Effort`].
+//!
+//! - [`PlaneContact`]: a point, or a sphere of radius r centred at a frame's origin, against
+//!   the plane n·x = h0: δ = h0 + r − n·x, F_n = step(δ)·pos(k δ − c n·v),
+//!   F_t = −μ F_n v_t / √(v_t·v_t + eps²) with v_t the tangential velocity of the contact
+//!   point x − r n; the force F_n n + F_t at the centre and the torque (−r n) × F_t.
+//! - [`SpringDamper`]: tension F0 + k(l − l0) + c l̇ along the line between two anchors
+//!   (declared points or body origins).
+//! - [`Bushing`]: between frames A (or the ground) and B, in A's axes: force on B
+//!   f = −K Δp − C Δv with Δp = R_Aᵀ(p_B − p_A), Δv its rate; torque on B
+//!   m = −Eᵀ K_r θ − C_r Ω with θ = ½(R₃₂ − R₂₃, R₁₃ − R₃₁, R₂₁ − R₁₂), R = R_Aᵀ R_B,
+//!   E = ½(tr R·I − R), Ω = R_Aᵀ(ω_B − ω_A); the opposite on A.
+
+use crate::efforts::Effort;
+
+type V3 = [f64; 3];
+
+fn dot(a: V3, b: V3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn sub(a: V3, b: V3) -> V3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn add(a: V3, b: V3) -> V3 {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+fn scale(k: f64, a: V3) -> V3 {
+    [k * a[0], k * a[1], k * a[2]]
+}
+
+fn cross(a: V3, b: V3) -> V3 {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// Rᵀ x for a rotation stored `r[i][j]` (columns: the frame's axes in world axes).
+fn rt(r: &[[f64; 3]; 3], x: V3) -> V3 {
+    [
+        r[0][0] * x[0] + r[1][0] * x[1] + r[2][0] * x[2],
+        r[0][1] * x[0] + r[1][1] * x[1] + r[2][1] * x[2],
+        r[0][2] * x[0] + r[1][2] * x[1] + r[2][2] * x[2],
+    ]
+}
+
+/// R x.
+fn rx(r: &[[f64; 3]; 3], x: V3) -> V3 {
+    [dot(r[0], x), dot(r[1], x), dot(r[2], x)]
+}
+
+/// Contact of a point or a sphere with a fixed plane (penalty, non-adhesive damping,
+/// regularised Coulomb friction).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlaneContact {
+    /// unit normal out of the ground, and the plane n·x = offset
+    pub normal: V3,
+    pub offset: f64,
+    /// sphere radius (0: a point)
+    pub radius: f64,
+    /// stiffness (N/m), damping (N s/m), friction coefficient, regularising speed (m/s)
+    pub k: f64,
+    pub c: f64,
+    pub mu: f64,
+    pub eps: f64,
+}
+
+impl Default for PlaneContact {
+    /// The ground z = 0, a point, k = 1e5 N/m, c = 500 N s/m, μ = 0.8, eps = 1e-4 m/s.
+    fn default() -> Self {
+        PlaneContact {
+            normal: [0.0, 0.0, 1.0],
+            offset: 0.0,
+            radius: 0.0,
+            k: 1e5,
+            c: 500.0,
+            mu: 0.8,
+            eps: 1e-4,
+        }
+    }
+}
+
+/// What a contact did: penetration, normal force, and the force and torque (about the
+/// centre) it applied, world axes.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ContactForce {
+    pub penetration: f64,
+    pub normal_force: f64,
+    pub force: V3,
+    pub torque: V3,
+}
+
+impl PlaneContact {
+    /// The contact force on a centre at `x` moving with `v`, the body turning at `w`.
+    pub fn force(&self, x: V3, v: V3, w: V3) -> ContactForce {
+        let n = self.normal;
+        let delta = self.offset + self.radius - dot(n, x);
+        let nv = dot(n, v);
+        let f_n = if delta > 0.0 {
+            (self.k * delta - self.c * nv).max(0.0)
+        } else {
+            0.0
+        };
+        let mut force = scale(f_n, n);
+        let mut torque = [0.0; 3];
+        if self.mu != 0.0 {
+            let arm = scale(-self.radius, n);
+            let vc = add(v, cross(w, arm));
+            let vt = sub(vc, scale(nv, n));
+            let coef = -self.mu * f_n / (dot(vt, vt) + self.eps * self.eps).sqrt();
+            let ft = scale(coef, vt);
+            force = add(force, ft);
+            torque = cross(arm, ft);
+        }
+        ContactForce {
+            penetration: delta,
+            normal_force: f_n,
+            force,
+            torque,
+        }
+    }
+
+    /// A contact at declared point `i` (a point: no rotation of its own).
+    pub fn apply_to_point(&self, e: &mut Effort, i: usize) -> ContactForce {
+        let p = e.point(i);
+        let f = self.force(p.position, p.velocity, [0.0; 3]);
+        e.force_at_point(i, f.force);
+        f
+    }
+
+    /// A sphere centred at frame `i`'s origin.
+    pub fn apply_to_frame(&self, e: &mut Effort, i: usize) -> ContactForce {
+        let k = e.frame(i);
+        let (x, v, w) = (k.pose.position, k.velocity, k.angular_velocity);
+        let f = self.force(x, v, w);
+        e.force_on_frame(i, x, f.force);
+        e.torque_on_frame(i, f.torque);
+        f
+    }
+}
+
+/// Where an element attaches: a declared point, or a body's (frame's) origin.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Anchor {
+    Point(usize),
+    Frame(usize),
+}
+
+impl Anchor {
+    /// Position and velocity, world axes.
+    fn state(self, e: &Effort) -> (V3, V3) {
+        match self {
+            Anchor::Point(i) => (e.point(i).position, e.point(i).velocity),
+            Anchor::Frame(i) => (e.frame(i).pose.position, e.frame(i).velocity),
+        }
+    }
+
+    fn push(self, e: &mut Effort, at: V3, f: V3) {
+        match self {
+            Anchor::Point(i) => e.force_at_point(i, f),
+            Anchor::Frame(i) => e.force_on_frame(i, at, f),
+        }
+    }
+}
+
+/// A spring–damper with preload between two anchors: tension F0 + k(l − l0) + c l̇.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SpringDamper {
+    pub k: f64,
+    pub l0: f64,
+    pub c: f64,
+    pub preload: f64,
+}
+
+impl SpringDamper {
+    /// Applies the tension between `a` and `b`; returns it.
+    pub fn apply(&self, e: &mut Effort, a: Anchor, b: Anchor) -> f64 {
+        let ((pa, va), (pb, vb)) = (a.state(e), b.state(e));
+        let d = sub(pb, pa);
+        let l = dot(d, d).sqrt();
+        let u = scale(1.0 / l, d);
+        let ldot = dot(u, sub(vb, va));
+        let tension = self.preload + self.k * (l - self.l0) + self.c * ldot;
+        // tension pulls b towards a and a towards b
+        b.push(e, pb, scale(-tension, u));
+        a.push(e, pa, scale(tension, u));
+        tension
+    }
+}
+
+/// A 6-axis linear spring–damper between two frames, in the first frame's axes.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Bushing {
+    pub k: V3,
+    pub kr: V3,
+    pub c: V3,
+    pub cr: V3,
+}
+
+impl Bushing {
+    /// Applies the bushing between frame `a` (`None`: the ground) and frame `b`; returns the
+    /// force and torque on `b` in `a`'s axes.
+    pub fn apply(&self, e: &mut Effort, a: Option<usize>, b: usize) -> (V3, V3) {
+        let ident = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        let (ra, pa, va, wa) = match a {
+            Some(i) => {
+                let k = e.frame(i);
+                (
+                    k.pose.rotation,
+                    k.pose.position,
+                    k.velocity,
+                    k.angular_velocity,
+                )
+            }
+            None => (ident, [0.0; 3], [0.0; 3], [0.0; 3]),
+        };
+        let kb = e.frame(b);
+        let (rb, pb, vb, wb) = (
+            kb.pose.rotation,
+            kb.pose.position,
+            kb.velocity,
+            kb.angular_velocity,
+        );
+        let d = sub(pb, pa);
+        let dp = rt(&ra, d);
+        let dv = rt(&ra, sub(sub(vb, va), cross(wa, d)));
+        // R = R_Aᵀ R_B
+        let mut r = [[0.0; 3]; 3];
+        for i in 0..3 {
+            for j in 0..3 {
+                r[i][j] = (0..3).map(|k| ra[k][i] * rb[k][j]).sum();
+            }
+        }
+        let theta = [
+            0.5 * (r[2][1] - r[1][2]),
+            0.5 * (r[0][2] - r[2][0]),
+            0.5 * (r[1][0] - r[0][1]),
+        ];
+        let omega = rt(&ra, sub(wb, wa));
+        let tr = r[0][0] + r[1][1] + r[2][2];
+        // Eᵀ = ½ (tr R·I − Rᵀ)
+        let krt = [
+            self.kr[0] * theta[0],
+            self.kr[1] * theta[1],
+            self.kr[2] * theta[2],
+        ];
+        let et_krt = [
+            0.5 * (tr * krt[0] - (r[0][0] * krt[0] + r[1][0] * krt[1] + r[2][0] * krt[2])),
+            0.5 * (tr * krt[1] - (r[0][1] * krt[0] + r[1][1] * krt[1] + r[2][1] * krt[2])),
+            0.5 * (tr * krt[2] - (r[0][2] * krt[0] + r[1][2] * krt[1] + r[2][2] * krt[2])),
+        ];
+        let f: V3 = std::array::from_fn(|i| -self.k[i] * dp[i] - self.c[i] * dv[i]);
+        let m: V3 = std::array::from_fn(|i| -et_krt[i] - self.cr[i] * omega[i]);
+        let (fw, mw) = (rx(&ra, f), rx(&ra, m));
+        e.force_on_frame(b, pb, fw);
+        e.torque_on_frame(b, mw);
+        if let Some(i) = a {
+            e.force_on_frame(i, pb, scale(-1.0, fw));
+            e.torque_on_frame(i, scale(-1.0, mw));
+        }
+        (f, m)
+    }
+}

@@ -368,3 +368,35 @@ fn a_mass_hangs_where_the_preloaded_spring_carries_its_weight() {
         e.potential
     );
 }
+
+/// Parameters that make a force element unphysical are refused at run time too (the
+/// defaults are checked at compile time).
+#[test]
+fn unphysical_coefficients_from_parameters_are_typed_errors() {
+    use mbs::{ParamError, Parameters};
+    let mut block = Block::default();
+    let mut p = block.params().clone();
+    p.set("k", -1.0).unwrap();
+    let e = block.set_params(p).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            ParamError::InvalidCoefficient {
+                element: "contact 0",
+                name: "k",
+                ..
+            }
+        ),
+        "{e:?}"
+    );
+    println!("{e}");
+    let mut p = block.params().clone();
+    p.set("mu", -0.2).unwrap();
+    assert!(matches!(
+        block.set_params(p),
+        Err(ParamError::InvalidCoefficient { name: "mu", .. })
+    ));
+    let mut p = block.params().clone();
+    p.set("eps", 0.0).unwrap();
+    assert!(block.set_params(p).is_err());
+}

@@ -18,6 +18,13 @@ pub enum ParamError {
     InvalidInertia { body: &'static str, reason: String },
     #[error("spring number {index} has stiffness {value}: a stiffness must not be negative")]
     NegativeStiffness { index: usize, value: f64 },
+    #[error("{element} (in declaration order) has {name} = {value}: it {rule}")]
+    InvalidCoefficient {
+        element: &'static str,
+        name: &'static str,
+        value: f64,
+        rule: &'static str,
+    },
 }
 
 /// A model asked for something it does not have.

@@ -214,16 +214,65 @@ fn emit_params(
             ));
         }
     }
-    let mut spring = 0;
+    let (mut spring, mut contact, mut bushing) = (0, 0, 0);
     for e in &sys.effects {
         for l in &e.loads {
-            if let Load::Spring { k: stiff, .. } = l {
-                spec.outputs.push((format!("v[{k}]"), *stiff));
+            // coefficients that parameters may make unphysical: (element, name, value, strict)
+            let mut coefficients: Vec<(String, &str, ExprId, bool)> = Vec::new();
+            match l {
+                Load::Spring { k: stiff, .. } => {
+                    spec.outputs.push((format!("v[{k}]"), *stiff));
+                    checks.push(format!(
+                        "if v[{k}] < 0.0 {{ return Err(::mbs::ParamError::NegativeStiffness {{ index: {spring}, value: v[{k}] }}); }}"
+                    ));
+                    k += 1;
+                    spring += 1;
+                }
+                Load::Contact {
+                    radius,
+                    k: stiff,
+                    c,
+                    mu,
+                    eps,
+                    ..
+                } => {
+                    let el = format!("contact {contact}");
+                    contact += 1;
+                    coefficients.push((el.clone(), "k", *stiff, true));
+                    coefficients.push((el.clone(), "c", *c, false));
+                    coefficients.push((el.clone(), "mu", *mu, false));
+                    coefficients.push((el.clone(), "eps", *eps, true));
+                    coefficients.push((el, "radius", *radius, false));
+                }
+                Load::Bushing {
+                    k: kk, kr, c, cr, ..
+                } => {
+                    let el = format!("bushing {bushing}");
+                    bushing += 1;
+                    for (name, v) in [("k", kk), ("kr", kr), ("c", c), ("cr", cr)] {
+                        for e in v {
+                            coefficients.push((el.clone(), name, *e, false));
+                        }
+                    }
+                }
+                _ => {}
+            }
+            for (el, name, value, strict) in coefficients {
+                if a.is_const(value) {
+                    // checked at compile time
+                    continue;
+                }
+                spec.outputs.push((format!("v[{k}]"), value));
+                let (bad, rule) = if strict {
+                    ("!(v[{k}] > 0.0)", "must be positive")
+                } else {
+                    ("!(v[{k}] >= 0.0)", "must not be negative")
+                };
                 checks.push(format!(
-                    "if v[{k}] < 0.0 {{ return Err(::mbs::ParamError::NegativeStiffness {{ index: {spring}, value: v[{k}] }}); }}"
+                    "if {} {{ return Err(::mbs::ParamError::InvalidCoefficient {{ element: {el:?}, name: {name:?}, value: v[{k}], rule: {rule:?} }}); }}",
+                    bad.replace("{k}", &k.to_string())
                 ));
                 k += 1;
-                spring += 1;
             }
         }
     }

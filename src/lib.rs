@@ -32,6 +32,7 @@
 //! ```
 
 pub mod cli;
+pub mod plot;
 pub mod language;
 
 pub use mbs_macros::multibody;

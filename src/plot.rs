@@ -1,0 +1,235 @@
+//! Line charts as SVG (plotters' SVG backend: no system libraries), for the work–precision
+//! and spectral figures.
+
+use plotters::prelude::*;
+use std::path::Path;
+
+/// One line of a chart: its legend and its points (x, y); points with a non-finite or, on a
+/// logarithmic axis, non-positive coordinate are left out.
+#[derive(Clone, Debug, Default)]
+pub struct Series {
+    pub name: String,
+    pub points: Vec<(f64, f64)>,
+}
+
+/// A chart: title, axis labels and scales.
+#[derive(Clone, Debug)]
+pub struct Chart {
+    pub title: String,
+    pub x_label: String,
+    pub y_label: String,
+    pub log_x: bool,
+    pub log_y: bool,
+    /// width and height in pixels
+    pub size: (u32, u32),
+}
+
+impl Default for Chart {
+    fn default() -> Self {
+        Chart {
+            title: String::new(),
+            x_label: String::new(),
+            y_label: String::new(),
+            log_x: true,
+            log_y: true,
+            size: (900, 600),
+        }
+    }
+}
+
+/// Why a chart could not be drawn.
+#[derive(Debug, thiserror::Error)]
+pub enum PlotError {
+    #[error("nothing to plot: every series is empty (or has no point valid on a log axis)")]
+    Empty,
+    #[error("drawing the chart failed: {0}")]
+    Draw(String),
+}
+
+fn kept(c: &Chart, p: (f64, f64)) -> bool {
+    p.0.is_finite() && p.1.is_finite() && (!c.log_x || p.0 > 0.0) && (!c.log_y || p.1 > 0.0)
+}
+
+/// The range of the kept values along one axis, widened a little (by a factor on a log axis).
+fn range(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
+    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+        (a.min(v), b.max(v))
+    });
+    if log {
+        let (lo, hi) = if lo == hi {
+            (lo / 2.0, hi * 2.0)
+        } else {
+            (lo, hi)
+        };
+        (lo / 1.5, hi * 1.5)
+    } else {
+        let pad = if lo == hi { 1.0 } else { 0.05 * (hi - lo) };
+        (lo - pad, hi + pad)
+    }
+}
+
+/// Draws `series` as lines with markers into an SVG file at `path`.
+pub fn line_chart(path: &Path, chart: &Chart, series: &[Series]) -> Result<(), PlotError> {
+    let svg = line_chart_svg(chart, series)?;
+    std::fs::write(path, svg).map_err(|e| PlotError::Draw(format!("{}: {e}", path.display())))
+}
+
+/// The SVG text of [`line_chart`].
+pub fn line_chart_svg(chart: &Chart, series: &[Series]) -> Result<String, PlotError> {
+    let pts = || {
+        series
+            .iter()
+            .flat_map(|s| s.points.iter().copied())
+            .filter(|&p| kept(chart, p))
+    };
+    if pts().next().is_none() {
+        return Err(PlotError::Empty);
+    }
+    let (x0, x1) = range(pts().map(|p| p.0), chart.log_x);
+    let (y0, y1) = range(pts().map(|p| p.1), chart.log_y);
+    let mut out = String::new();
+    {
+        let root = SVGBackend::with_string(&mut out, chart.size).into_drawing_area();
+        draw(&root, chart, series, (x0, x1), (y0, y1)).map_err(PlotError::Draw)?;
+        root.present().map_err(|e| PlotError::Draw(e.to_string()))?;
+    }
+    Ok(out)
+}
+
+/// A tick label: 1e-6, 0.25, 40, 3e5.
+fn tick(v: f64) -> String {
+    let a = v.abs();
+    if v == 0.0 {
+        "0".into()
+    } else if !(1e-2..1e4).contains(&a) {
+        let s = format!("{v:.1e}");
+        s.replace(".0e", "e")
+    } else {
+        let s = format!("{v:.3}");
+        let s = s.trim_end_matches('0').trim_end_matches('.');
+        s.to_string()
+    }
+}
+
+const COLORS: [RGBColor; 10] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+    RGBColor(188, 189, 34),
+    RGBColor(23, 190, 207),
+];
+
+fn draw<DB: DrawingBackend>(
+    root: &DrawingArea<DB, plotters::coord::Shift>,
+    chart: &Chart,
+    series: &[Series],
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+) -> Result<(), String> {
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    root.fill(&WHITE).map_err(err)?;
+    let mut builder = ChartBuilder::on(root);
+    builder
+        .caption(&chart.title, ("sans-serif", 22))
+        .margin(12)
+        .x_label_area_size(45)
+        .y_label_area_size(70);
+    macro_rules! body {
+        ($ctx:expr) => {{
+            let mut ctx = $ctx;
+            ctx.configure_mesh()
+                .x_desc(chart.x_label.as_str())
+                .y_desc(chart.y_label.as_str())
+                .x_label_formatter(&|v| tick(*v))
+                .y_label_formatter(&|v| tick(*v))
+                .draw()
+                .map_err(err)?;
+            for (i, s) in series.iter().enumerate() {
+                let color = COLORS[i % COLORS.len()];
+                let points: Vec<(f64, f64)> = s
+                    .points
+                    .iter()
+                    .copied()
+                    .filter(|&p| kept(chart, p))
+                    .collect();
+                ctx.draw_series(LineSeries::new(points.clone(), color.stroke_width(2)))
+                    .map_err(err)?
+                    .label(s.name.as_str())
+                    .legend(move |(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
+                    });
+                ctx.draw_series(
+                    points
+                        .into_iter()
+                        .map(|p| Circle::new(p, 3, color.filled())),
+                )
+                .map_err(err)?;
+            }
+            ctx.configure_series_labels()
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .position(SeriesLabelPosition::UpperRight)
+                .draw()
+                .map_err(err)?;
+        }};
+    }
+    match (chart.log_x, chart.log_y) {
+        (true, true) => body!(
+            builder
+                .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
+                .map_err(err)?
+        ),
+        (true, false) => body!(
+            builder
+                .build_cartesian_2d((x0..x1).log_scale(), y0..y1)
+                .map_err(err)?
+        ),
+        (false, true) => body!(
+            builder
+                .build_cartesian_2d(x0..x1, (y0..y1).log_scale())
+                .map_err(err)?
+        ),
+        (false, false) => body!(builder.build_cartesian_2d(x0..x1, y0..y1).map_err(err)?),
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn draws_lines_and_refuses_nothing_to_plot() {
+        let c = Chart {
+            title: "t".into(),
+            ..Chart::default()
+        };
+        let s = [
+            Series {
+                name: "a".into(),
+                points: vec![(1e-3, 1e-2), (1e-2, 1e-4), (0.0, 1.0), (1e-1, f64::NAN)],
+            },
+            Series {
+                name: "b".into(),
+                points: vec![(2e-3, 1e-3), (3e-2, 1e-6)],
+            },
+        ];
+        let svg = line_chart_svg(&c, &s).unwrap();
+        assert!(svg.starts_with("<svg") && svg.contains("\na\n") && svg.contains("\nb\n"));
+        assert!(svg.contains("\n1e-6\n") && !svg.contains("9.99999"));
+        assert_eq!(
+            (tick(0.25), tick(40.0), tick(3e5), tick(0.0)),
+            ("0.25".into(), "40".into(), "3e5".into(), "0".into())
+        );
+        let empty = [Series {
+            name: "x".into(),
+            points: vec![(0.0, 1.0)],
+        }];
+        assert!(matches!(line_chart_svg(&c, &empty), Err(PlotError::Empty)));
+    }
+}

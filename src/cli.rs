@@ -8,16 +8,26 @@
 //! --dt DT         output every DT seconds (default: every step)
 //! --constraints M auto, index3, projection, partitioning, baumgarte:ALPHA,BETA
 //!                 (constrained models; default auto)
-//! --out DIR       write DIR/trajectory.csv
+//! --scene NAME    the scene to run (programs whose model has several)
+//! --out DIR       write DIR/trajectory.csv, coordinates.svg, energy.svg, animation.html
+//!                 (offline, in any browser) and motion.gltf (Blender, glTF viewers)
 //! --quiet         print nothing but errors
 //! ```
+//!
+//! Runs longer than about a second show a progress bar (on standard error); every run ends
+//! with a summary table: steps, evaluations, energy error, CPU time.
+//!
+//! ```text
+//! ```
 
+use crate::plot::{Chart, Series, line_chart};
 use crate::{
     ConstraintMethod, ConstraintOptions, Model, Options, Output, Scheme, SimError, Simulation,
     Stats, StepControl, Trajectory,
 };
 use clap::Parser;
-use std::path::PathBuf;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 /// How to run a simulation from the command line.
@@ -42,7 +52,7 @@ pub struct RunArgs {
     /// output every DT seconds (default: every step)
     #[arg(long)]
     pub dt: Option<f64>,
-    /// write DIR/trajectory.csv
+    /// write DIR/trajectory.csv, coordinates.svg, energy.svg, animation.html and motion.gltf
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// constraint method of constrained models: auto, index3, projection, partitioning or
@@ -52,6 +62,9 @@ pub struct RunArgs {
     /// print nothing but errors
     #[arg(long)]
     pub quiet: bool,
+    /// the scene to run, for programs whose model has several (each program lists its own)
+    #[arg(long)]
+    pub scene: Option<String>,
 }
 
 /// What a run gives: the outputs, the work, the wall time.
@@ -85,6 +98,10 @@ pub enum RunError {
     UnknownScheme(String),
     #[error("{0}")]
     Simulation(Box<SimError>),
+    #[error("unknown scene `{given}`: this program has {known}")]
+    UnknownScene { given: String, known: String },
+    #[error("cannot draw or export {path}: {reason}")]
+    Plot { path: PathBuf, reason: String },
     #[error("cannot write {path}: {source}")]
     Io {
         path: PathBuf,
@@ -135,6 +152,8 @@ impl RunArgs {
             t_end,
             step,
             output,
+            // poses for the animation and the glTF file
+            frames: self.out.is_some(),
             constraints: ConstraintOptions {
                 method: self.constraints,
                 ..ConstraintOptions::default()
@@ -151,16 +170,43 @@ impl RunArgs {
     ) -> Result<RunReport, RunError> {
         let scheme = Scheme::from_name(&self.scheme)
             .ok_or_else(|| RunError::UnknownScheme(self.scheme.clone()))?;
-        let name = model.info().name;
+        let info = model.info();
+        let name = info.name;
         let start = Instant::now();
         let options = self.options(default_t_end);
-        let t_end = options.t_end;
+        let (t0, t_end) = (options.t0, options.t_end);
         let fail = |e| RunError::Simulation(Box::new(e));
         let mut sim = Simulation::new(model, scheme, options).map_err(fail)?;
         if let (Some(a), false) = (sim.assembly(), self.quiet) {
             println!("{a}");
         }
-        crate::Integrator::integrate_to(&mut sim, t_end).map_err(fail)?;
+        // in hundredths of the interval, with a progress bar once the run passes a second
+        let bar = ProgressBar::hidden();
+        bar.set_length(100);
+        bar.set_style(
+            ProgressStyle::with_template("{prefix} [{bar:40}] {percent:>3}% {msg}")
+                .unwrap_or_else(|_| ProgressStyle::default_bar())
+                .progress_chars("=> "),
+        );
+        bar.set_prefix(format!("{name} ({})", scheme.name()));
+        for k in 1..=100 {
+            let t = if k == 100 {
+                t_end
+            } else {
+                t0 + (t_end - t0) * k as f64 / 100.0
+            };
+            let step = crate::Integrator::integrate_to(&mut sim, t);
+            if bar.is_hidden() && !self.quiet && start.elapsed() > Duration::from_secs(1) {
+                bar.set_draw_target(ProgressDrawTarget::stderr());
+            }
+            bar.set_position(k);
+            bar.set_message(format!("t = {t:.3} s"));
+            if let Err(e) = step {
+                bar.abandon();
+                return Err(fail(e));
+            }
+        }
+        bar.finish_and_clear();
         let (trajectory, stats) = sim.finish();
         let report = RunReport {
             scheme,
@@ -169,33 +215,133 @@ impl RunArgs {
             cpu: start.elapsed(),
         };
         if let Some(dir) = &self.out {
-            let path = dir.join("trajectory.csv");
-            let io = |source| RunError::Io {
-                path: path.clone(),
-                source,
-            };
-            std::fs::create_dir_all(dir).map_err(io)?;
-            let file = std::fs::File::create(&path).map_err(io)?;
-            report
-                .trajectory
-                .write_csv(std::io::BufWriter::new(file))
-                .map_err(io)?;
-            if !self.quiet {
-                println!("wrote {}", path.display());
-            }
+            self.write_outputs(dir, info, &report)?;
         }
         if !self.quiet {
-            let t_end = report.trajectory.t.last().copied().unwrap_or(0.0);
-            println!(
-                "{name} with {} to t = {t_end} s in {:.3?}:",
-                scheme.name(),
-                report.cpu
-            );
             println!("{}", report.stats);
-            if let Some(e) = report.energy_error() {
-                println!("energy error: {e:.3e} (max |E − E₀|, relative)");
-            }
+            println!("{}", report.summary(name));
         }
         Ok(report)
+    }
+
+    /// `DIR/trajectory.csv`, `coordinates.svg` (q over time), `energy.svg`, `animation.html`
+    /// and `motion.gltf`.
+    fn write_outputs(
+        &self,
+        dir: &Path,
+        info: &crate::ModelInfo,
+        report: &RunReport,
+    ) -> Result<(), RunError> {
+        let io = |path: &Path| {
+            let path = path.to_path_buf();
+            move |source| RunError::Io {
+                path: path.clone(),
+                source,
+            }
+        };
+        std::fs::create_dir_all(dir).map_err(io(dir))?;
+        let tr = &report.trajectory;
+        let path = dir.join("trajectory.csv");
+        let file = std::fs::File::create(&path).map_err(io(&path))?;
+        tr.write_csv(std::io::BufWriter::new(file))
+            .map_err(io(&path))?;
+        let mut written = vec![path];
+        let chart = |title: &str, y: &str| Chart {
+            title: title.to_string(),
+            x_label: "t (s)".into(),
+            y_label: y.into(),
+            log_x: false,
+            log_y: false,
+            ..Chart::default()
+        };
+        let coordinates: Vec<Series> = (0..tr.nq())
+            .map(|k| Series {
+                name: tr.dof_names[k].clone(),
+                points: (0..tr.len()).map(|i| (tr.t[i], tr.q(i)[k])).collect(),
+            })
+            .collect();
+        let mut plots = vec![(
+            "coordinates.svg",
+            chart("coordinates", "q (m or rad)"),
+            coordinates,
+        )];
+        if tr.energy.len() == tr.len() && !tr.is_empty() {
+            let e = |f: fn(&crate::Energy) -> f64, name: &str| Series {
+                name: name.into(),
+                points: (0..tr.len()).map(|i| (tr.t[i], f(&tr.energy[i]))).collect(),
+            };
+            plots.push((
+                "energy.svg",
+                chart("energy", "E (J)"),
+                vec![
+                    e(|e| e.kinetic, "kinetic"),
+                    e(|e| e.potential, "potential"),
+                    e(|e| e.total(), "total"),
+                ],
+            ));
+        }
+        for (file, chart, series) in plots {
+            let path = dir.join(file);
+            line_chart(&path, &chart, &series).map_err(|e| RunError::Plot {
+                path: path.clone(),
+                reason: e.to_string(),
+            })?;
+            written.push(path);
+        }
+        let export = |path: PathBuf, e: crate::anim::ExportError| RunError::Plot {
+            path,
+            reason: e.to_string(),
+        };
+        let path = dir.join("animation.html");
+        crate::anim::write_html(&path, info, tr).map_err(|e| export(path.clone(), e))?;
+        written.push(path);
+        let path = dir.join("motion.gltf");
+        crate::gltf::write_gltf(&path, info, tr).map_err(|e| export(path.clone(), e))?;
+        written.push(path);
+        if !self.quiet {
+            for p in written {
+                println!("wrote {}", p.display());
+            }
+        }
+        Ok(())
+    }
+
+    /// The error for a `--scene` this program does not have.
+    pub fn unknown_scene(&self, known: &[&str]) -> RunError {
+        RunError::UnknownScene {
+            given: self.scene.clone().unwrap_or_default(),
+            known: if known.is_empty() {
+                "no scenes".into()
+            } else {
+                format!("the scenes {}", known.join(", "))
+            },
+        }
+    }
+}
+
+impl RunReport {
+    /// One-line table of the run: steps, evaluations, energy error, CPU time.
+    pub fn summary(&self, name: &str) -> String {
+        let t_end = self.trajectory.t.last().copied().unwrap_or(0.0);
+        let energy = self
+            .energy_error()
+            .map_or("—".to_string(), |e| format!("{e:.2e}"));
+        format!(
+            "{:<28} {:>10} {:>9} {:>9} {:>12} {:>12} {:>10}\n{:<28} {:>10} {:>9} {:>9} {:>12} {:>12} {:>10}",
+            "model",
+            "scheme",
+            "t_end",
+            "steps",
+            "evaluations",
+            "energy err",
+            "CPU",
+            name,
+            self.scheme.name(),
+            format!("{t_end}"),
+            self.stats.steps,
+            self.stats.evaluations(),
+            energy,
+            format!("{:.1?}", self.cpu)
+        )
     }
 }

@@ -53,6 +53,7 @@
 //! | `dof crank = PI/3, independent;` | kept at its value when a closed loop is assembled |
 //! | `option tangents;` | also generate exact K_t = ∂τ/∂q and C_t = ∂τ/∂qd |
 //! | `option formulation = recursive;` | force `recursive` or `virtual_power` (default: the cheaper by op count) |
+//! | `shape arm: box(0.3, 0.05, 0.05);` | what to draw with a body, a frame or the `ground` (below); no effect on the dynamics |
 //!
 //! Without scenes the model type is named after the model and has every effect. With scenes,
 //! each scene is a type `{Model}{Scene}`; an effect a scene does not name has no code in it.
@@ -214,6 +215,59 @@
 //! preferred as independent coordinates by partitioning). How a run treats the constraints —
 //! at index 3, by projection, Baumgarte or coordinate partitioning — is an option of the
 //! run: [`ConstraintMethod`](crate::ConstraintMethod).
+//!
+//! ## Shapes
+//!
+//! `shape` statements say how a body looks in the animations ([`anim`](crate::anim), an HTML
+//! page, and [`gltf`](crate::gltf), a glTF 2.0 file); they change nothing in the equations.
+//! Positions and sizes are in the axes of the body (origin at G) or frame they are drawn with,
+//! or of the world for `ground`; a body may have several shapes.
+//!
+//! | shape | what |
+//! |---|---|
+//! | `shape B: box(lx, ly, lz);` | a box with sides lx, ly, lz along B's x, y, z, centred at B's origin |
+//! | `shape B: cylinder(radius, length, axis = y);` | a cylinder along B's `x`, `y` or `z` (default `z`) |
+//! | `shape B: sphere(radius);` | a sphere |
+//! | `shape B: line(from = (x, y, z), to = (x, y, z));` | a segment between two points of B (a rod, a cable) |
+//! | `…, at = (x, y, z)` | the centre of a box, cylinder or sphere (default the origin) |
+//! | `…, color = "#rrggbb"` | its colour (default one per body; grey on the ground) |
+//!
+//! Their values are constants: numbers and parameters, taken **at their default values** when
+//! the model is compiled (a shape does not follow a parameter changed at run time). Sizes
+//! must be positive and a line's ends distinct. A body without `shape` is drawn as its
+//! *equivalent box*: the box of the same mass and principal moments of inertia (sides
+//! a² = 6 (I_y + I_z − I_x)/m along the principal axes), its thin sides at least 4 % of its
+//! longest so that a slender body is a bar; a point mass is a sphere of water's density. A
+//! massless frame without `shape` is not drawn. [`ModelInfo::shapes`](crate::ModelInfo)
+//! lists the declared shapes then these defaults ([`ShapeInfo`](crate::ShapeInfo)).
+//!
+//! ```
+//! mbs::multibody! {
+//!     /// A pendulum on a cart, drawn.
+//!     model Crane {
+//!         param l = 0.8;
+//!         dof x = 0.0; dof theta = 0.3;
+//!         body cart { mass = 2.0; inertia = (0.01, 0.03, 0.03); }
+//!         body bob { mass = 1.0; inertia = (0.004, 0.004, 0.004); }
+//!         TOG[cart] = Tdisp(x, 0, 0);
+//!         TOG[bob] = TOG[cart] * Trotx(theta) * Tdisp(0, 0, -l);
+//!         shape cart: box(0.4, 0.2, 0.1, color = "#3366cc");
+//!         shape cart: cylinder(0.05, 0.25, axis = y, at = (0.15, 0, -0.05));
+//!         shape bob: sphere(0.08);
+//!         shape bob: line(from = (0, 0, 0), to = (0, 0, l));
+//!         shape ground: box(4, 0.05, 0.02, at = (0, 0, -0.06));
+//!         gravity(0, 0, -9.81);
+//!     }
+//! }
+//! use mbs::Model;
+//! let info = Crane::default().info();
+//! assert_eq!(info.shapes.len(), 5);
+//! assert_eq!(info.shapes[2].kind, mbs::ShapeKind::Sphere { radius: 0.08 });
+//! ```
+//!
+//! Simulate with `Options { frames: true, .. }` to record the poses, then
+//! `mbs::anim::write_html(path, model.info(), &trajectory)` or
+//! `mbs::gltf::write_gltf(path, model.info(), &trajectory)`.
 //!
 //! ## Errors
 //!

@@ -31,7 +31,9 @@
 //! assert!((h[0] / m[0] + 10.0).abs() < 1e-12); // x'' = -k x / m
 //! ```
 
+pub mod anim;
 pub mod cli;
+pub mod gltf;
 pub mod plot;
 pub mod language;
 

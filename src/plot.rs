@@ -96,6 +96,18 @@ pub fn line_chart_svg(chart: &Chart, series: &[Series]) -> Result<String, PlotEr
     Ok(out)
 }
 
+/// Points drawn per series at most: longer series are thinned evenly (first and last kept),
+/// which a chart of a few hundred pixels cannot tell apart.
+const MAX_POINTS: usize = 1500;
+
+fn thin(points: Vec<(f64, f64)>, max: usize) -> Vec<(f64, f64)> {
+    if points.len() <= max {
+        return points;
+    }
+    let last = points.len() - 1;
+    (0..max).map(|k| points[k * last / (max - 1)]).collect()
+}
+
 /// A tick label: 1e-6, 0.25, 40, 3e5.
 fn tick(v: f64) -> String {
     let a = v.abs();
@@ -151,24 +163,29 @@ fn draw<DB: DrawingBackend>(
                 .map_err(err)?;
             for (i, s) in series.iter().enumerate() {
                 let color = COLORS[i % COLORS.len()];
-                let points: Vec<(f64, f64)> = s
-                    .points
-                    .iter()
-                    .copied()
-                    .filter(|&p| kept(chart, p))
-                    .collect();
+                let points = thin(
+                    s.points
+                        .iter()
+                        .copied()
+                        .filter(|&p| kept(chart, p))
+                        .collect(),
+                    MAX_POINTS,
+                );
                 ctx.draw_series(LineSeries::new(points.clone(), color.stroke_width(2)))
                     .map_err(err)?
                     .label(s.name.as_str())
                     .legend(move |(x, y)| {
                         PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
                     });
-                ctx.draw_series(
-                    points
-                        .into_iter()
-                        .map(|p| Circle::new(p, 3, color.filled())),
-                )
-                .map_err(err)?;
+                // markers only where they stay distinct
+                if points.len() <= 60 {
+                    ctx.draw_series(
+                        points
+                            .into_iter()
+                            .map(|p| Circle::new(p, 3, color.filled())),
+                    )
+                    .map_err(err)?;
+                }
             }
             ctx.configure_series_labels()
                 .background_style(WHITE.mix(0.85))

@@ -34,7 +34,7 @@ pub use integrators::{
 };
 pub use model::{
     Energy, FrameKinematics, Kinematics, Model, ModelInfo, OpCount, OpsTable, Parameters,
-    PointKinematics, Pose,
+    PointKinematics, Pose, ShapeInfo, ShapeKind,
 };
 pub use options::{
     BdfParams, ConstraintMethod, ConstraintOptions, GenAlphaParams, HhtParams, IterationMatrix,

@@ -75,6 +75,61 @@ pub struct ModelInfo {
     pub has_tangents: bool,
     /// op counts per generated function
     pub ops: &'static [(&'static str, OpCount)],
+    /// what to draw: the declared `shape` statements in order, then one default shape for
+    /// each body that declares none (its equivalent box, `declared: false`)
+    pub shapes: &'static [ShapeInfo],
+}
+
+/// A shape drawn with a body or frame (or the ground): a DSL `shape` statement, or the
+/// default of a body that declares none. Lengths in the model's units, in the axes of the
+/// frame, whose origin is G for a body; values are those of the default parameters.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct ShapeInfo {
+    /// the body or frame it moves with (an index into [`ModelInfo::frames`]); `None`: the
+    /// ground
+    pub frame: Option<usize>,
+    pub kind: ShapeKind,
+    /// centre of the shape in the frame's axes (`at = (x, y, z)`); zero for a line, whose
+    /// ends are given in the frame's axes
+    pub at: [f64; 3],
+    /// orientation: `rotation[i][j]`, column j is the shape's axis j in the frame's axes
+    /// (the identity for declared shapes; the principal axes of inertia for a default box)
+    pub rotation: [[f64; 3]; 3],
+    /// `color = "#rrggbb"`; `None`: the viewer's choice
+    pub color: Option<[u8; 3]>,
+    /// false for the default shape of a body without `shape` statements
+    pub declared: bool,
+}
+
+/// The geometry of a [`ShapeInfo`], in the shape's own axes, centred at its origin.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub enum ShapeKind {
+    /// a box with edges `size` along the shape's x, y and z
+    Box {
+        size: [f64; 3],
+    },
+    /// a cylinder of `radius` and `length` along the shape's axis `axis` (0: x, 1: y, 2: z)
+    Cylinder {
+        radius: f64,
+        length: f64,
+        axis: usize,
+    },
+    Sphere {
+        radius: f64,
+    },
+    /// a segment between two points of the frame (a rod, a cable: drawn as a line)
+    Line {
+        from: [f64; 3],
+        to: [f64; 3],
+    },
+}
+
+impl ShapeInfo {
+    /// The point `p` of the shape's axes in the frame's axes: `at + rotation · p`.
+    pub fn to_frame(&self, p: [f64; 3]) -> [f64; 3] {
+        let r = &self.rotation;
+        [0, 1, 2].map(|i| self.at[i] + r[i][0] * p[0] + r[i][1] * p[1] + r[i][2] * p[2])
+    }
 }
 
 /// The op-count table of a model's generated functions, for printing.
@@ -155,6 +210,57 @@ impl Energy {
 pub struct Pose {
     pub rotation: [[f64; 3]; 3],
     pub position: [f64; 3],
+}
+
+impl Pose {
+    /// The point `p` of the frame's axes in world axes: `position + rotation · p`.
+    pub fn apply(&self, p: [f64; 3]) -> [f64; 3] {
+        let r = &self.rotation;
+        [0, 1, 2].map(|i| self.position[i] + r[i][0] * p[0] + r[i][1] * p[1] + r[i][2] * p[2])
+    }
+
+    /// The rotation as a unit quaternion `[x, y, z, w]` (w ≥ 0), as glTF writes it.
+    pub fn quaternion(&self) -> [f64; 4] {
+        let r = &self.rotation;
+        let tr = r[0][0] + r[1][1] + r[2][2];
+        // Shepperd: divide by the largest of 4w², 4x², 4y², 4z²
+        let q = if tr > r[0][0].max(r[1][1]).max(r[2][2]) {
+            let s = 2.0 * (1.0 + tr).sqrt();
+            [
+                (r[2][1] - r[1][2]) / s,
+                (r[0][2] - r[2][0]) / s,
+                (r[1][0] - r[0][1]) / s,
+                0.25 * s,
+            ]
+        } else if r[0][0] >= r[1][1] && r[0][0] >= r[2][2] {
+            let s = 2.0 * (1.0 + r[0][0] - r[1][1] - r[2][2]).sqrt();
+            [
+                0.25 * s,
+                (r[0][1] + r[1][0]) / s,
+                (r[0][2] + r[2][0]) / s,
+                (r[2][1] - r[1][2]) / s,
+            ]
+        } else if r[1][1] >= r[2][2] {
+            let s = 2.0 * (1.0 - r[0][0] + r[1][1] - r[2][2]).sqrt();
+            [
+                (r[0][1] + r[1][0]) / s,
+                0.25 * s,
+                (r[1][2] + r[2][1]) / s,
+                (r[0][2] - r[2][0]) / s,
+            ]
+        } else {
+            let s = 2.0 * (1.0 - r[0][0] - r[1][1] + r[2][2]).sqrt();
+            [
+                (r[0][2] + r[2][0]) / s,
+                (r[1][2] + r[2][1]) / s,
+                0.25 * s,
+                (r[1][0] - r[0][1]) / s,
+            ]
+        };
+        let n = q.iter().map(|c| c * c).sum::<f64>().sqrt();
+        let sign = if q[3] < 0.0 { -1.0 } else { 1.0 };
+        q.map(|c| sign * c / n)
+    }
 }
 
 /// Kinematics of a body or frame, world axes.

@@ -3,6 +3,7 @@
 //! The text is what the macro emits (parsed into tokens) and what `mbs expand` prints.
 
 pub mod function;
+pub mod shapes;
 
 use crate::expr::emit::MissingDerivative;
 use crate::expr::{ExprId, OpCount};
@@ -632,7 +633,7 @@ fn emit_scene(
     }
     let pty = format!("{}Params", sys.name);
     let info = format!(
-        "static INFO: ::mbs::ModelInfo = ::mbs::ModelInfo {{ name: {name:?}, scene: {scene:?}, dofs: {dofs}, inputs: {inputs}, frames: {frames}, is_body: &[{is_body}], points: {points}, params: {params}, effects: {effects}, constraints: {constraints}, independent: &[{independent}], formulation: {form:?}, has_tangents: {tan}, ops: &[{ops}] }};",
+        "static INFO: ::mbs::ModelInfo = ::mbs::ModelInfo {{ name: {name:?}, scene: {scene:?}, dofs: {dofs}, inputs: {inputs}, frames: {frames}, is_body: &[{is_body}], points: {points}, params: {params}, effects: {effects}, constraints: {constraints}, independent: &[{independent}], formulation: {form:?}, has_tangents: {tan}, ops: &[{ops}], shapes: {shapes} }};",
         name = ty,
         scene = scene_name,
         dofs = str_list(sys.dofs.iter().map(|d| d.name.clone())),
@@ -655,6 +656,7 @@ fn emit_scene(
             .collect::<Vec<_>>()
             .join(", "),
         tan = eq.tangents.is_some(),
+        shapes = shapes::literal(&shapes::shapes(sys)),
         ops = ops
             .iter()
             .map(|(n, c)| format!("({n:?}, {})", runtime_ops(*c)))

@@ -96,6 +96,8 @@ pub enum Item {
     Constraint { name: Ident, body: ConstraintBody },
     /// `option tangents;`, `option formulation = recursive;`
     Option { key: Ident, value: Option<Expr> },
+    /// `shape bar: box(lx, ly, lz, at = (x, y, z), color = "#rrggbb");`: what to draw
+    Shape { body: Ident, shape: EffectStmt },
 }
 
 /// The body of a `constraint` statement.

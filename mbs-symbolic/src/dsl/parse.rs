@@ -3,6 +3,7 @@
 
 use super::ast::{BodyRef, ConstraintBody, DofName, EffectStmt, Item, ModelDef};
 use proc_macro2::TokenTree;
+use syn::ext::IdentExt;
 use syn::parse::discouraged::Speculative;
 use syn::parse::{Parse, ParseStream};
 use syn::punctuated::Punctuated;
@@ -392,6 +393,29 @@ fn parse_item(input: ParseStream) -> syn::Result<Item> {
             };
             Ok(Item::Constraint { name, body })
         }
+        "shape" => {
+            input.parse::<Ident>()?;
+            let usage = "write `shape BODY: box(lx, ly, lz);`, `cylinder(radius, length, axis = z)`, `sphere(radius)` or `line(from = (x, y, z), to = (x, y, z))`";
+            let body: Ident = input.parse().map_err(|e| {
+                syn::Error::new(
+                    e.span(),
+                    format!(
+                        "expected the name of a body, a frame or `ground` after `shape`: {usage}"
+                    ),
+                )
+            })?;
+            if !input.peek(Token![:]) {
+                return Err(input.error(format!("expected `:` after `shape {body}`: {usage}")));
+            }
+            input.parse::<Token![:]>()?;
+            if !(input.peek(Ident::peek_any) && input.peek2(syn::token::Paren)) {
+                return Err(input.error(format!("expected a shape after `shape {body}:`: {usage}")));
+            }
+            // `box` is a Rust keyword: take any identifier
+            let kind = input.call(Ident::parse_any)?;
+            let shape = parse_call(input, kind)?;
+            Ok(Item::Shape { body, shape })
+        }
         "option" => {
             input.parse::<Ident>()?;
             let key: Ident = input.parse()?;
@@ -418,6 +442,11 @@ fn parse_item(input: ParseStream) -> syn::Result<Item> {
 
 fn parse_effect(input: ParseStream) -> syn::Result<EffectStmt> {
     let kind: Ident = input.parse()?;
+    parse_call(input, kind)
+}
+
+/// The arguments of a call `kind(…);` and its `;`.
+fn parse_call(input: ParseStream, kind: Ident) -> syn::Result<EffectStmt> {
     let args;
     parenthesized!(args in input);
     let list: Punctuated<Expr, Token![,]> = args.parse_terminated(Expr::parse, Token![,])?;

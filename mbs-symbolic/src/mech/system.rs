@@ -24,8 +24,40 @@ pub struct System {
     pub scenes: Vec<SceneDef>,
     /// holonomic constraints Φ(q, t) = 0 (closed loops, driving constraints)
     pub constraints: Vec<ConstraintDef>,
+    /// shapes to draw (`shape` statements), evaluated with the default parameters
+    pub shapes: Vec<ShapeDef>,
     pub options: Options,
 }
+
+/// A shape drawn with a frame (`shape BODY: box(…);`): numbers, the values of its
+/// expressions with the default parameters. Lengths in the frame's axes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ShapeDef {
+    /// `None`: the ground
+    pub frame: Option<usize>,
+    pub geometry: Geometry,
+    /// centre in the frame's axes (zero for a line)
+    pub at: [f64; 3],
+    /// columns: the shape's axes in the frame's axes
+    pub rotation: [[f64; 3]; 3],
+    pub color: Option<[u8; 3]>,
+    /// false for a body's default shape (its equivalent box)
+    pub declared: bool,
+}
+
+/// What a [`ShapeDef`] is, in its own axes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Geometry {
+    Box([f64; 3]),
+    /// radius, length, axis (0, 1, 2)
+    Cylinder(f64, f64, usize),
+    Sphere(f64),
+    /// from, to
+    Line([f64; 3], [f64; 3]),
+}
+
+/// The identity rotation.
+pub const IDENTITY: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 
 #[derive(Clone, Debug)]
 pub struct ParamDef {
@@ -246,6 +278,7 @@ impl System {
             effects: Vec::new(),
             scenes: Vec::new(),
             constraints: Vec::new(),
+            shapes: Vec::new(),
             options: Options::default(),
         }
     }

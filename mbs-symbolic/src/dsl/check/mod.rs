@@ -590,6 +590,7 @@ impl Checker {
                 }
                 Item::Constraint { name, body } => self.lower_constraint(name, body),
                 Item::Option { key, value } => self.lower_option(key, value.as_ref()),
+                Item::Shape { body, shape } => self.lower_shape(body, shape),
                 _ => {}
             }
         }
@@ -650,3 +651,4 @@ mod constraints;
 mod effects;
 mod expr;
 mod force_elements;
+mod shapes;

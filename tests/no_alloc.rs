@@ -1,7 +1,7 @@
 //! No allocation per step after warm-up: a counting global allocator watches every scheme
 //! take 200 steps after its first 20, with fixed steps and, where it has them, adaptive ones;
-//! then a constrained model with every constraint method. (One test: the allocator counts
-//! every thread.)
+//! then a constrained model with every constraint method. The allocator counts this thread's
+//! allocations (`tests/common/alloc.rs`).
 
 #[path = "../examples/models/dpend.rs"]
 mod dpend;
@@ -11,32 +11,15 @@ mod pendulum3;
 use mbs::{ConstraintMethod, GenAlphaParams, Integrator, Options, Output, Scheme, Simulation};
 use pendulum3::Pendulum3;
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
-
-struct Counting;
-
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
+#[path = "common/alloc.rs"]
+mod alloc;
 
 #[test]
 fn steps_allocate_nothing_after_warm_up() {
+    // the counter sees this thread's allocations
+    let before = alloc::allocations();
+    let v = std::hint::black_box(vec![1u8; 16]);
+    assert!(alloc::allocations() > before && v.len() == 16);
     for scheme in Scheme::all() {
         // outputs every 10 ms: their buffers are reserved up front
         let mut modes = vec![Options::fixed(100.0, 1e-3)];
@@ -92,11 +75,11 @@ fn assert_no_allocation<M: mbs::Model + 'static>(mut sim: Simulation<M>, what: &
     for _ in 0..20 {
         sim.step().unwrap();
     }
-    let before = ALLOCATIONS.load(Ordering::Relaxed);
+    let before = alloc::allocations();
     for _ in 0..200 {
         sim.step().unwrap();
     }
-    let allocated = ALLOCATIONS.load(Ordering::Relaxed) - before;
+    let allocated = alloc::allocations() - before;
     assert_eq!(
         allocated, 0,
         "{what} allocated {allocated} times in 200 steps"

@@ -23,36 +23,8 @@ use mbs::{
     Trajectory, simulate,
 };
 use pendulum3::Pendulum3;
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
-
-/// Counts the allocations of the current thread (tests run on several threads).
-struct Counting;
-
-thread_local! {
-    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
-}
-
-fn count() {
-    let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
-}
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        count();
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        count();
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
+#[path = "common/alloc.rs"]
+mod alloc;
 
 /// (x, y, ẋ, ẏ, λ) at t = 1 from `tests/reference/pendulum3.json`.
 fn reference() -> [f64; 5] {
@@ -288,11 +260,11 @@ fn index3_steps_allocate_nothing_after_warm_up() {
             for _ in 0..20 {
                 sim.step().unwrap();
             }
-            let before = ALLOCATIONS.with(|c| c.get());
+            let before = alloc::allocations();
             for _ in 0..200 {
                 sim.step().unwrap();
             }
-            let allocated = ALLOCATIONS.with(|c| c.get()) - before;
+            let allocated = alloc::allocations() - before;
             assert_eq!(
                 allocated,
                 0,

@@ -35,6 +35,7 @@ pub mod anim;
 pub mod cli;
 pub mod gltf;
 pub mod plot;
+pub mod spectral;
 pub mod language;
 
 pub use mbs_macros::multibody;

@@ -22,6 +22,18 @@ pub struct Chart {
     pub log_y: bool,
     /// width and height in pixels
     pub size: (u32, u32),
+    /// where the legend goes (inside the plot area)
+    pub legend: Legend,
+}
+
+/// A corner of the plot area for the legend.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Legend {
+    #[default]
+    UpperRight,
+    UpperLeft,
+    LowerLeft,
+    LowerRight,
 }
 
 impl Default for Chart {
@@ -33,6 +45,7 @@ impl Default for Chart {
             log_x: true,
             log_y: true,
             size: (900, 600),
+            legend: Legend::UpperRight,
         }
     }
 }
@@ -190,7 +203,12 @@ fn draw<DB: DrawingBackend>(
             ctx.configure_series_labels()
                 .background_style(WHITE.mix(0.85))
                 .border_style(BLACK)
-                .position(SeriesLabelPosition::UpperRight)
+                .position(match chart.legend {
+                    Legend::UpperRight => SeriesLabelPosition::UpperRight,
+                    Legend::UpperLeft => SeriesLabelPosition::UpperLeft,
+                    Legend::LowerLeft => SeriesLabelPosition::LowerLeft,
+                    Legend::LowerRight => SeriesLabelPosition::LowerRight,
+                })
                 .draw()
                 .map_err(err)?;
         }};

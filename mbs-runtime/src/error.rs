@@ -76,6 +76,23 @@ pub enum Failure {
         rcond: f64,
         coordinates: Vec<String>,
     },
+    #[error(
+        "the coordinates reach a singular configuration at {coordinate} = {value:.6} (Euler angles at gimbal lock, joint axes lining up, a coordinate that stops moving mass): the mass matrix is nearly singular along {} (a Cholesky pivot fell to {ratio:.1e} of its start value, below singularity_tol = {tolerance:.0e}); describe this motion with other coordinates",
+        dependent.join(", ")
+    )]
+    SingularConfiguration {
+        /// the coordinate the singularity depends on: the largest |∂ log det M/∂q_j|
+        coordinate: String,
+        /// its value
+        value: f64,
+        /// the coordinates of the near-null vector of M (scaled by its start diagonal): the
+        /// ones that move the bodies alike, or no longer move them
+        dependent: Vec<String>,
+        /// the Cholesky pivot of M that fell most, over its start value
+        ratio: f64,
+        /// `Options::singularity_tol`
+        tolerance: f64,
+    },
     #[error("{quantity} of coordinate {coordinate} is not finite")]
     NonFinite {
         quantity: &'static str,

@@ -403,6 +403,23 @@ pub struct Options {
     /// evaluation every 8 steps) and stop with `UnstableStep` when h·ρ leaves the scheme's
     /// stability region (default true)
     pub stability_check: bool,
+    /// stop with `Failure::SingularConfiguration` when the coordinates approach a singular
+    /// configuration (Euler angles at gimbal lock, joint axes lining up, a coordinate that
+    /// stops moving mass): when a Cholesky pivot L_jj² of the mass matrix falls below this
+    /// fraction of its value at the start (default 1e-4; 0 disables). L_jj² is the inertia of
+    /// coordinate j that the coordinates before it cannot produce; each is compared with its
+    /// own start value, so metres and radians do not mix. Watched wherever M is factorised
+    /// (the start, every evaluation of the explicit schemes and implicit midpoint, index-1
+    /// forms) and, for the other implicit schemes, at every iteration matrix that evaluates M
+    /// (one Cholesky factorisation of M each, counted in `Stats::condition_checks`; iteration
+    /// matrices by finite differences of τ in the Newmark family and BDF do not evaluate M and
+    /// are not watched). Healthy models stay far above 1e-4: over 20,000 random
+    /// configurations the pivots stay above 1.5e-2 of their start values for chain16, chain24
+    /// and arm3d_6, 8.9e-2 for the hexapod (pitch within ±1.3 rad), while a body on ZYX
+    /// Euler angles crosses 1e-4 between 0.01 and 0.05 rad from gimbal lock (depending on
+    /// the spread of its inertia)
+    #[serde(default = "default_singularity_tol")]
+    pub singularity_tol: f64,
     /// record the poses of every body and frame at each output (default false)
     pub frames: bool,
     /// record kinetic and potential energy at each output (default true)
@@ -426,11 +443,16 @@ impl Default for Options {
             newton: NewtonOptions::default(),
             iteration_matrix: IterationMatrix::default(),
             stability_check: true,
+            singularity_tol: default_singularity_tol(),
             frames: false,
             energy: true,
             constraints: ConstraintOptions::default(),
         }
     }
+}
+
+fn default_singularity_tol() -> f64 {
+    1e-4
 }
 
 fn invalid(name: &'static str, value: impl ToString, reason: &'static str) -> Failure {
@@ -535,6 +557,13 @@ impl Options {
             if !(h > 0.0) || !h.is_finite() {
                 return Err(invalid("h_min", h, "must be > 0 and finite"));
             }
+        }
+        if !(0.0..1.0).contains(&self.singularity_tol) {
+            return Err(invalid(
+                "singularity_tol",
+                self.singularity_tol,
+                "must be in [0, 1) (0 disables the check)",
+            ));
         }
         if self.max_steps == 0 {
             return Err(invalid("max_steps", 0, "must be > 0"));

@@ -38,6 +38,9 @@ pub struct Stats {
     pub factorizations: usize,
     /// solves with a factorisation
     pub solves: usize,
+    /// Cholesky factorisations of M made only to watch for a singular configuration
+    /// (implicit schemes, at each iteration matrix that evaluates M: `Options::singularity_tol`)
+    pub condition_checks: usize,
     /// Newton iterations, all steps together
     pub newton_iterations: usize,
     /// smallest and largest accepted step
@@ -104,6 +107,13 @@ impl fmt::Display for Stats {
             "linear algebra: {} factorisations, {} solves; {} Newton iterations",
             self.factorizations, self.solves, self.newton_iterations
         )?;
+        if self.condition_checks > 0 {
+            write!(
+                f,
+                "; {} Cholesky factorisations of M to watch its conditioning",
+                self.condition_checks
+            )?;
+        }
         if !self.order_steps.is_empty() {
             let orders: Vec<String> = self
                 .order_steps

@@ -434,6 +434,8 @@ impl<M: Model + 'static> Simulation<M> {
         if let Err(e) = start {
             return Err(early(e, problem.stats.clone()));
         }
+        // singular configurations are judged against the factor of M at the start
+        problem.watch_from_start(options.singularity_tol);
         if let Some(c) = &problem.con {
             cur.lambda.copy_from_slice(&c.lambda);
         }
@@ -755,7 +757,9 @@ impl<M: Model + 'static> Simulation<M> {
                     cause,
                 }) => {
                     self.problem.stats.rejected_newton += 1;
-                    // a user effort's own error does not go away with a smaller step
+                    // a user effort's own error does not go away with a smaller step (a
+                    // singular configuration met by a trial iterate may: the step shrinks,
+                    // and the failure is reported if it collapses)
                     let fatal = matches!(
                         cause,
                         Some(Failure::UserEffort { .. })

@@ -1,0 +1,85 @@
+//! fourbar (MODELS.md) started 1e-3 rad off closure (both dependent angles, each sign): the
+//! start is assembled back onto the user's branch with the residuals before and after
+//! reported (`Simulation::assembly`), then runs of 1 s keep |Φ| at the tolerance at every
+//! step: gen-α at index 3 (h = 1 ms) and DOPRI5 with projection (rtol 1e-8; between steps
+//! its dense output is not projected, up to 5e-10 off). `tests/loops.rs` covers
+//! the branch choice and the typed errors of impossible starts.
+
+use crate::fourbar::{FourBar, closed_loop};
+use crate::support::{Work, all_finite, check_work, work};
+use mbs::{Integrator, Model, Options, Output, Scheme, Simulation};
+use std::f64::consts::PI;
+
+#[test]
+fn fourbar_started_off_closure_is_assembled_with_its_residual_reported() {
+    let a = PI / 3.0;
+    let (b, c) = closed_loop(a);
+    let mut phi = [0.0; 2];
+    let mut snapshots: Vec<(String, Work)> = Vec::new();
+    for (db, dc) in [(1e-3, 1e-3), (1e-3, -1e-3), (-1e-3, 1e-3), (-1e-3, -1e-3)] {
+        for (scheme, o) in [
+            (
+                Scheme::from_name("gen-alpha").unwrap(),
+                Options::fixed(1.0, 1e-3),
+            ),
+            (Scheme::Dopri5, Options::adaptive(1.0, 1e-8)),
+        ] {
+            let o = Options {
+                q0: Some(vec![a, b + db, c + dc]),
+                output: Output::Steps,
+                ..o
+            };
+            let mut sim = Simulation::new(FourBar::default(), scheme, o).unwrap();
+            let asm = sim.assembly().unwrap().clone();
+            let q = sim.state().q.clone();
+            assert!(asm.residual_before > 1e-4 && asm.residual_before < 1e-2);
+            assert!(asm.residual_after <= 1e-11 && asm.rate_residual_after < 1e-12);
+            assert_eq!(q[0], a, "the crank, marked independent, is kept");
+            assert!(
+                (q[1] - b).abs() < 1e-9 && (q[2] - c).abs() < 1e-9,
+                "the user's branch"
+            );
+            sim.integrate_to(1.0).unwrap();
+            let (tr, st) = sim.finish();
+            assert!(all_finite(&tr) && tr.t[tr.len() - 1] == 1.0);
+            let mut worst = 0.0f64;
+            for i in 0..tr.len() {
+                FourBar::default().constraints(tr.t[i], tr.q(i), &mut phi);
+                worst = worst.max(phi[0].abs()).max(phi[1].abs());
+            }
+            let e0 = tr.energy[0].total();
+            let de = tr
+                .energy
+                .iter()
+                .map(|e| (e.total() - e0).abs())
+                .fold(0.0, f64::max);
+            println!(
+                "b {db:+.0e}, c {dc:+.0e}, {:<9}: |Φ| {:.1e} → {:.1e} in {} iterations; over 1 s max |Φ| {worst:.1e}, max |E − E0| {de:.1e} J, {} steps",
+                scheme.name(),
+                asm.residual_before,
+                asm.residual_after,
+                asm.iterations,
+                st.steps
+            );
+            assert!(worst <= 1e-10, "{}: {worst:e}", scheme.name());
+            snapshots.push((
+                format!("b {db:+.0e} c {dc:+.0e} {}", scheme.name()),
+                work(&st),
+            ));
+        }
+    }
+    check_work(
+        "fourbar",
+        &snapshots,
+        &[
+            [1000, 0, 0, 1, 0, 5832, 0, 1002, 1834, 1832, 0], // b +1e-3 c +1e-3 gen-alpha
+            [180, 17, 0, 1364, 180, 0, 0, 3186, 3006, 0, 0],  // b +1e-3 c +1e-3 dopri5
+            [1000, 0, 0, 1, 0, 5833, 0, 1002, 1835, 1833, 0], // b +1e-3 c -1e-3 gen-alpha
+            [180, 17, 0, 1364, 180, 0, 0, 3186, 3006, 0, 0],  // b +1e-3 c -1e-3 dopri5
+            [1000, 0, 0, 1, 0, 5840, 0, 1002, 1842, 1840, 0], // b -1e-3 c +1e-3 gen-alpha
+            [180, 17, 0, 1364, 180, 0, 0, 3186, 3006, 0, 0],  // b -1e-3 c +1e-3 dopri5
+            [1000, 0, 0, 1, 0, 5826, 0, 1002, 1828, 1826, 0], // b -1e-3 c -1e-3 gen-alpha
+            [180, 17, 0, 1364, 180, 0, 0, 3186, 3006, 0, 0],  // b -1e-3 c -1e-3 dopri5
+        ],
+    );
+}

@@ -1,0 +1,25 @@
+//! Hard cases (issue "prove that hard cases stay numerically stable", item 3): each case
+//! asserts stability or the typed error, prints its figures and snapshots its work counters
+//! as `tests/work_counters.rs` does. `cargo test --release --test hard_cases -- --nocapture`
+//! prints the tables.
+#![allow(clippy::needless_range_loop)]
+
+#[path = "../common/mod.rs"]
+mod common;
+#[path = "../../examples/models/dpend.rs"]
+mod dpend;
+#[path = "../../examples/models/fourbar.rs"]
+mod fourbar;
+mod models;
+#[path = "../../examples/models/seed2dof.rs"]
+mod seed2dof;
+mod support;
+
+mod chain16;
+mod dpend_drift;
+mod fourbar_start;
+mod seed2dof_long_run;
+mod springpend;
+mod structural;
+mod tumble;
+mod user_force;

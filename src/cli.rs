@@ -180,7 +180,7 @@ impl RunArgs {
         if let (Some(a), false) = (sim.assembly(), self.quiet) {
             println!("{a}");
         }
-        // in hundredths of the interval, with a progress bar once the run passes a second
+        // step by step (no artificial stops), with a progress bar once the run passes a second
         let bar = ProgressBar::hidden();
         bar.set_length(100);
         bar.set_style(
@@ -189,21 +189,21 @@ impl RunArgs {
                 .progress_chars("=> "),
         );
         bar.set_prefix(format!("{name} ({})", scheme.name()));
-        for k in 1..=100 {
-            let t = if k == 100 {
-                t_end
-            } else {
-                t0 + (t_end - t0) * k as f64 / 100.0
-            };
-            let step = crate::Integrator::integrate_to(&mut sim, t);
-            if bar.is_hidden() && !self.quiet && start.elapsed() > Duration::from_secs(1) {
-                bar.set_draw_target(ProgressDrawTarget::stderr());
-            }
-            bar.set_position(k);
-            bar.set_message(format!("t = {t:.3} s"));
-            if let Err(e) = step {
+        let mut shown = 0;
+        while crate::Integrator::state(&sim).t < t_end {
+            if let Err(e) = crate::Integrator::step(&mut sim) {
                 bar.abandon();
                 return Err(fail(e));
+            }
+            let t = crate::Integrator::state(&sim).t;
+            let done = (100.0 * (t - t0) / (t_end - t0)).floor() as u64;
+            if done > shown {
+                shown = done;
+                if bar.is_hidden() && !self.quiet && start.elapsed() > Duration::from_secs(1) {
+                    bar.set_draw_target(ProgressDrawTarget::stderr());
+                }
+                bar.set_position(done);
+                bar.set_message(format!("t = {t:.3} s"));
             }
         }
         bar.finish_and_clear();
@@ -333,7 +333,7 @@ impl RunReport {
             "t_end",
             "steps",
             "evaluations",
-            "energy err",
+            "max|ΔE|/E",
             "CPU",
             name,
             self.scheme.name(),

@@ -1,6 +1,8 @@
 //! The hexapod of `tests/reference/MODELS.md` (the model of `examples/hexapod.rs`): no reference
 //! data, so physical checks at the test state — M symmetric positive definite, h finite, the
-//! base's translational block carrying the total mass, gravity's resultant on the base.
+//! base's translational block carrying the total mass, gravity's resultant on the base. These
+//! are on the contact-free scene `Free` (the type `Hexapod`), whose operation counts stay
+//! those of the README; the scene `Standing` (contact, PD joints) is in `hexapod_standing.rs`.
 
 use mbs::Model;
 
@@ -116,4 +118,24 @@ fn hexapod_feet_hang_above_the_ground_at_the_start() {
         let z = foot.position[2];
         assert!((0.0..0.02).contains(&z), "foot {k} at height {z}");
     }
+}
+
+/// The contact-free scene carries no code of the `contact` and `pd` effects: its counts are
+/// the README's (M+h 5,868 flops, 42 sin/cos), as before the effects existed.
+#[test]
+fn hexapod_free_scene_keeps_the_contact_free_op_counts() {
+    let info = Hexapod::default().info();
+    assert_eq!((info.name, info.scene), ("HexapodFree", "Free"));
+    let count = |f: &str| {
+        info.ops
+            .iter()
+            .find(|(name, _)| name.starts_with(f))
+            .map(|(_, ops)| *ops)
+            .unwrap_or_else(|| panic!("no {f} in {:?}", info.ops))
+    };
+    let dynamics = count("dynamics");
+    println!("Hexapod (Free) M+h: {dynamics}");
+    assert_eq!((dynamics.flops(), dynamics.funcs), (5868, 42));
+    assert_eq!(count("static_forces").flops(), 985);
+    assert_eq!(count("power").flops(), 0);
 }

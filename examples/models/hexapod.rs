@@ -1,11 +1,40 @@
 //! hexapod: a 24-dof, 49-body walking robot in the spirit of the seed's AMRU5
-//! (`tests/reference/MODELS.md`). Shared by `examples/hexapod.rs` and `tests/hexapod_model.rs`.
+//! (`tests/reference/MODELS.md`). Shared by `examples/hexapod.rs`, `tests/hexapod_model.rs`,
+//! `tests/hexapod_standing.rs` and the benchmarks.
 //!
 //! Legs are numbered k = 2i + j with the hip at (hx_i, hy_j, 0) in the base frame,
 //! hx = (0.4, 0, −0.4), hy = (0.3, −0.3): 0 front left, 1 front right, 2 middle left, … 5 rear
 //! right. Every leg has the dofs a_k (hip yaw), b_k (thigh pitch), c_k (knee pitch) and eight
 //! bodies; the pantograph link and coupler follow their products literally (no closed loop),
-//! the motor rotors turn 100 times as fast as their joints. No ground contact yet.
+//! the motor rotors turn 100 times as fast as their joints.
+//!
+//! Two scenes: `Free` (gravity only; also named `Hexapod`, the type of the contact-free
+//! figures) and `Standing` (`HexapodStanding`: the feet's ground contact and a PD controller
+//! on every leg joint). Dropped from the start, the standing robot comes to rest in about
+//! 2.5 s on its middle and rear feet: every leg points forward (+x) from its hip, so the feet
+//! stand in rows at x ≈ 0.78, 0.38, −0.01 m and the centre of mass (x ≈ 0.09 m) is behind the
+//! middle row; the front feet hang 0.6 mm above the ground.
+//!
+//! Choice of the coefficients (poles of the linearisation at rest and 5 s runs with Radau5 at
+//! rtol 1e-6, as in `tests/hexapod_standing.rs`):
+//!
+//! - `eps` = 1e-2 m/s. Regularised friction has no static friction: at rest it is a viscous
+//!   damper μ F_n/eps per foot, and the legs' tangential preloads left by the landing relax
+//!   by creep at about K_h·eps/(μ F_n), K_h ≈ 4e4 N/m the horizontal stiffness of a leg at
+//!   its foot (Kp/0.49²), F_n ≈ 120 N: 4/s here (the slowest pole of the linearisation at
+//!   rest, −3.98/s), so the velocities fall below 1e-6 within 2.5 s. With eps = 3e-3 the
+//!   slowest pole is −1.3/s (max |qd| 3e-6 at t = 5 s), with 1e-3 −0.46/s (7e-5 at 5 s).
+//! - Kp = 1e4 N m/rad on every joint. At rest the rear thighs hold 32 N m (122 N on a foot
+//!   0.29 m ahead of the pitch axis, less the leg's own weight), the middle ones 10 N m, the
+//!   hanging front ones −3.5 N m; the knees almost nothing (the shank is vertical) and the hip
+//!   yaws nothing. The rear thighs give 3.2 mrad (1 mm at the foot); the knees' stiffness is
+//!   200 times the geometric softening F_n·l_shank ≈ 50 N m/rad. A softer servo creeps longer
+//!   (Kp = 2000: slowest pole −0.77/s, max |qd| 4e-5 at t = 5 s); a stiffer one gains little
+//!   (3e4: −5.4/s, but the least damped mode of the base falls to ζ = 0.16).
+//! - Kd = 400 N m s/rad: a joint alone (J = 0.23–0.45 kg m², of which the geared rotor's
+//!   2e-5 × 100² = 0.2) is critically damped at 2 sqrt(Kp J) ≈ 100–130; what limits the
+//!   settling are the base's modes on its legs (pitch 5 Hz, roll 9 Hz, heave 17 Hz), whose
+//!   smallest damping ratio is 0.16, 0.22, 0.28, 0.25 at Kd = 100, 200, 400, 800.
 
 mbs::multibody! {
     /// Hexapod walking robot: floating base (x, y, z, psi, theta, phi) and six 3-dof legs.
@@ -18,6 +47,25 @@ mbs::multibody! {
         param m_panto = 0.2;
         param m_coupler = 0.1;
         param m_rotor = 0.05;
+
+        // Ground contact (MODELS.md): penalty k, damping c, regularised Coulomb friction mu
+        // (viscous below eps; eps chosen above, in the module's documentation).
+        param k_contact = 1e5;
+        param c_contact = 500.0;
+        param mu = 0.8;
+        param eps = 1e-2;
+        // PD joint controllers: references (the start angles) and gains per joint kind
+        // (a hip yaw, b thigh pitch, c knee pitch), N m/rad and N m s/rad; the generalised
+        // force on each joint is −Kp (q − q_ref) − Kd qd.
+        param a_ref = 0.0;
+        param b_ref = 0.3;
+        param c_ref = -0.3;
+        param kp_a = 1e4;
+        param kd_a = 400.0;
+        param kp_b = 1e4;
+        param kd_b = 400.0;
+        param kp_c = 1e4;
+        param kd_c = 400.0;
 
         // Centroidal inertias: base box 1.0 × 0.6 × 0.15 m, support cube 0.1 m, uniform bars
         // (m l²/12 about both transverse axes, 0 about their own axis).
@@ -156,5 +204,44 @@ mbs::multibody! {
         point foot5 on shank5 at (0, 0, -0.2);
 
         gravity(0, 0, -g);
+
+        // Ground contact of the six feet with the plane z = 0 (MODELS.md).
+        effect contact {
+            contact(foot0, k = k_contact, c = c_contact, mu = mu, eps = eps);
+            contact(foot1, k = k_contact, c = c_contact, mu = mu, eps = eps);
+            contact(foot2, k = k_contact, c = c_contact, mu = mu, eps = eps);
+            contact(foot3, k = k_contact, c = c_contact, mu = mu, eps = eps);
+            contact(foot4, k = k_contact, c = c_contact, mu = mu, eps = eps);
+            contact(foot5, k = k_contact, c = c_contact, mu = mu, eps = eps);
+        }
+
+        // A PD controller on each of the 18 leg joints, holding the start angles.
+        effect pd {
+            generalized_force(a0, -kp_a * (a0 - a_ref) - kd_a * qd[a0]);
+            generalized_force(b0, -kp_b * (b0 - b_ref) - kd_b * qd[b0]);
+            generalized_force(c0, -kp_c * (c0 - c_ref) - kd_c * qd[c0]);
+            generalized_force(a1, -kp_a * (a1 - a_ref) - kd_a * qd[a1]);
+            generalized_force(b1, -kp_b * (b1 - b_ref) - kd_b * qd[b1]);
+            generalized_force(c1, -kp_c * (c1 - c_ref) - kd_c * qd[c1]);
+            generalized_force(a2, -kp_a * (a2 - a_ref) - kd_a * qd[a2]);
+            generalized_force(b2, -kp_b * (b2 - b_ref) - kd_b * qd[b2]);
+            generalized_force(c2, -kp_c * (c2 - c_ref) - kd_c * qd[c2]);
+            generalized_force(a3, -kp_a * (a3 - a_ref) - kd_a * qd[a3]);
+            generalized_force(b3, -kp_b * (b3 - b_ref) - kd_b * qd[b3]);
+            generalized_force(c3, -kp_c * (c3 - c_ref) - kd_c * qd[c3]);
+            generalized_force(a4, -kp_a * (a4 - a_ref) - kd_a * qd[a4]);
+            generalized_force(b4, -kp_b * (b4 - b_ref) - kd_b * qd[b4]);
+            generalized_force(c4, -kp_c * (c4 - c_ref) - kd_c * qd[c4]);
+            generalized_force(a5, -kp_a * (a5 - a_ref) - kd_a * qd[a5]);
+            generalized_force(b5, -kp_b * (b5 - b_ref) - kd_b * qd[b5]);
+            generalized_force(c5, -kp_c * (c5 - c_ref) - kd_c * qd[c5]);
+        }
+
+        scene Free = [];
+        scene Standing = [contact, pd];
     }
 }
+
+/// The hexapod without contact or controllers (gravity only): the type of the contact-free
+/// figures (M+h 5,868 flops).
+pub type Hexapod = HexapodFree;

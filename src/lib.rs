@@ -34,9 +34,10 @@
 pub mod anim;
 pub mod cli;
 pub mod gltf;
+pub mod language;
 pub mod plot;
 pub mod spectral;
-pub mod language;
+pub mod work_precision;
 
 pub use mbs_macros::multibody;
 pub use mbs_runtime::*;

@@ -883,10 +883,13 @@ fn constraint_mode(
     adaptive: bool,
 ) -> Result<Mode, Failure> {
     // without numerical damping, index 3 and step control do not go together
-    let undamped = adaptive && scheme.spectral_radius_at_infinity() == Some(1.0);
+    let no_damping = scheme.spectral_radius_at_infinity() == Some(1.0);
+    let undamped = adaptive && no_damping;
     Ok(match method {
-        // the Newmark family (the schemes with a ρ∞) by default, Radau only on request
-        ConstraintMethod::Auto if scheme.spectral_radius_at_infinity().is_some() && !undamped => {
+        // the damped members of the Newmark family by default, Radau only on request; the
+        // undamped ones (trapezoidal Newmark, ρ∞ = 1) diverge at index 3 on fast loops even
+        // at fixed steps (slider-crank at h ≥ 1 ms: `examples/work_precision.rs`)
+        ConstraintMethod::Auto if scheme.spectral_radius_at_infinity().is_some() && !no_damping => {
             Mode::Index3
         }
         ConstraintMethod::Auto | ConstraintMethod::Projection => Mode::Projection,

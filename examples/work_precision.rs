@@ -1,0 +1,379 @@
+//! Work–precision diagrams: what accuracy costs in CPU time, per scheme, on the canonical
+//! models of `tests/reference/MODELS.md` (the tool is `mbs::work_precision`).
+//!
+//! ```text
+//! cargo run --release --example work_precision -- --model dpend --out docs/figures
+//! ```
+//!
+//! `--model` is seed2dof, dpend, chain8, slidercrank, hexapod or all; `--out DIR` writes
+//! `DIR/wp_MODEL.csv` and `DIR/wp_MODEL.svg`; `--repeats N` times each run N times and keeps
+//! the best (default 5; fewer for a run past 1 s). Each model in its natural setting:
+//!
+//! - seed2dof to 10 s against its exact modal solution (100 samples, every 0.1 s);
+//! - dpend to 2 s against `tests/reference/dpend.json` (SciPy DOP853 at rtol = atol = 1e-13)
+//!   at t = 0.5, 1, 2 s, where that reference is reproducible to 1e-11;
+//! - chain8 to 2 s against a self-computed reference (DOPRI5 at rtol 1e-13, checked by RK4
+//!   at h = 5e-5), every 0.05 s;
+//! - slidercrank, form (a) (three coordinates, two loop constraints) to 2 s: projection for
+//!   the explicit schemes, BDF and Radau5, index 3 for the Newmark family and Radau5; against
+//!   form (b) (θ alone, the loop in closed form) computed by DOPRI5 at rtol 1e-13 (checked by
+//!   RK4 at h = 5e-5) and mapped to (θ, ψ, s) and their rates, every 0.05 s;
+//! - hexapod, free-floating, no contact, to 1 s, tumbling: the declared pose with the
+//!   MODELS.md test-state velocities qd_i = 0.7 cos(0.9 i + 0.2) (from rest it would fall
+//!   with its legs still, exactly for every scheme of order ≥ 2); against a self-computed
+//!   reference (DOPRI5 at rtol 1e-13, checked by RK4 at h = 5e-5), every 0.05 s.
+//!
+//! Every study prints its table (failures included), the cheapest run per scheme to 3, 5, 7
+//! and 9 significant digits, and how long it took. Points with no correct digit (error ≥ 1)
+//! are in the table and the CSV but not on the chart.
+
+#[path = "models/chain8.rs"]
+mod chain8;
+#[path = "models/dpend.rs"]
+mod dpend;
+#[path = "models/hexapod.rs"]
+mod hexapod;
+#[path = "models/seed2dof.rs"]
+mod seed2dof;
+#[path = "models/slidercrank.rs"]
+mod slidercrank;
+
+use clap::Parser;
+use mbs::work_precision::{Reference, Setting, Study, Sweep, WorkPrecision, decades, halvings};
+use mbs::{BdfParams, ConstraintMethod, GenAlphaParams, HhtParams, NewmarkParams, Scheme};
+use std::path::PathBuf;
+use std::time::Instant;
+
+#[derive(Parser, Debug)]
+struct Args {
+    /// seed2dof, dpend, chain8, slidercrank, hexapod or all
+    #[arg(long, default_value = "all")]
+    model: String,
+    /// write DIR/wp_MODEL.csv and DIR/wp_MODEL.svg
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// timed repeats per run, the best kept
+    #[arg(long, default_value_t = 5)]
+    repeats: usize,
+}
+
+const MODELS: [&str; 5] = ["seed2dof", "dpend", "chain8", "slidercrank", "hexapod"];
+
+fn newmark() -> Scheme {
+    Scheme::Newmark(NewmarkParams::default())
+}
+fn hht() -> Scheme {
+    Scheme::Hht(HhtParams::default())
+}
+fn gen_alpha() -> Scheme {
+    Scheme::GenAlpha(GenAlphaParams::default())
+}
+fn bdf() -> Scheme {
+    Scheme::Bdf(BdfParams::default())
+}
+
+/// Times t_end/n, 2 t_end/n, … t_end.
+fn samples(t_end: f64, n: usize) -> Vec<f64> {
+    (1..=n).map(|k| t_end * k as f64 / n as f64).collect()
+}
+
+/// seed2dof's exact (q, qd) from q0 = (0, 1), qd0 = 0: q(t) = V cos(Wt) Vᵀ q0.
+fn seed2dof_exact(t: f64) -> Vec<f64> {
+    let (k1, k2): (f64, f64) = (79.15, 1961.0);
+    let (a, b, d) = (k1 + k2, -k2, k2);
+    let disc = ((a - d) * (a - d) / 4.0 + b * b).sqrt();
+    let mut y = vec![0.0; 4];
+    for lam in [(a + d) / 2.0 - disc, (a + d) / 2.0 + disc] {
+        let w = lam.sqrt();
+        let (v0, v1) = (b, lam - a);
+        let nv = v0.hypot(v1);
+        let v = [v0 / nv, v1 / nv];
+        let c = v[1]; // q0 = (0, 1) on this mode
+        for i in 0..2 {
+            y[i] += v[i] * c * (w * t).cos();
+            y[2 + i] -= v[i] * c * w * (w * t).sin();
+        }
+    }
+    y
+}
+
+/// States of `tests/reference/dpend.json` at `times` (q then qd).
+fn dpend_reference(times: &[f64]) -> Vec<Vec<f64>> {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/reference/dpend.json");
+    let text = std::fs::read_to_string(path).expect("tests/reference/dpend.json");
+    let json: serde_json::Value = serde_json::from_str(&text).expect("json");
+    let states = json["states"].as_array().expect("states");
+    times
+        .iter()
+        .map(|&t| {
+            let s = states
+                .iter()
+                .find(|s| (s["t"].as_f64().expect("t") - t).abs() < 1e-12)
+                .unwrap_or_else(|| panic!("dpend.json has no state at t = {t}"));
+            ["q", "qd"]
+                .iter()
+                .flat_map(|k| s[*k].as_array().expect("array").iter())
+                .map(|x| x.as_f64().expect("number"))
+                .collect()
+        })
+        .collect()
+}
+
+/// The sweeps of an unconstrained model: adaptive schemes over decades of rtol, fixed-step
+/// ones over halvings of h.
+struct Plan {
+    dopri5: (i32, i32),
+    bdf: (i32, i32),
+    radau3: (i32, i32),
+    radau5: (i32, i32),
+    order2: (i32, i32),
+    rk4: (f64, usize),
+    midpoint: (f64, usize),
+    euler: Option<(f64, usize)>,
+}
+
+fn sweeps(p: &Plan) -> Vec<Sweep> {
+    let mut v = vec![
+        Sweep::adaptive(Scheme::Dopri5, &decades(p.dopri5.0, p.dopri5.1)),
+        Sweep::fixed(Scheme::Rk4, &halvings(p.rk4.0, p.rk4.1)),
+        Sweep::adaptive(bdf(), &decades(p.bdf.0, p.bdf.1)),
+        Sweep::adaptive(Scheme::Radau3, &decades(p.radau3.0, p.radau3.1)),
+        Sweep::adaptive(Scheme::Radau5, &decades(p.radau5.0, p.radau5.1)),
+        Sweep::adaptive(gen_alpha(), &decades(p.order2.0, p.order2.1)),
+        Sweep::adaptive(hht(), &decades(p.order2.0, p.order2.1)),
+        Sweep::adaptive(newmark(), &decades(p.order2.0, p.order2.1)),
+        Sweep::fixed(
+            Scheme::ImplicitMidpoint,
+            &halvings(p.midpoint.0, p.midpoint.1),
+        ),
+    ];
+    if let Some((h, n)) = p.euler {
+        v.push(Sweep::fixed(Scheme::ExplicitEuler, &halvings(h, n)));
+    }
+    v
+}
+
+fn study(name: &str, repeats: usize) -> WorkPrecision {
+    let finish = |s: Study| Study { repeats, ..s };
+    match name {
+        "seed2dof" => {
+            let r = Reference::exact(
+                "modal solution q(t) = V cos(Wt) Vᵀ q0 (tests/common)",
+                samples(10.0, 100),
+                seed2dof_exact,
+            );
+            let plan = Plan {
+                dopri5: (3, 12),
+                bdf: (3, 11),
+                radau3: (3, 11),
+                radau5: (3, 12),
+                order2: (3, 8),
+                rk4: (0.08, 9),
+                midpoint: (4e-3, 6),
+                euler: Some((1e-3, 3)),
+            };
+            let s = finish(Study {
+                sweeps: sweeps(&plan),
+                ..Study::new("seed2dof", r)
+            });
+            s.run(&seed2dof::Seed2dof::default()).expect("study")
+        }
+        "dpend" => {
+            let times = vec![0.5, 1.0, 2.0];
+            let states = dpend_reference(&times);
+            let r = Reference::data(
+                "tests/reference/dpend.json (SymPy equations, SciPy DOP853 at rtol = atol = 1e-13; reproducible to 8e-12 at t = 2 s)",
+                times,
+                states,
+            );
+            let plan = Plan {
+                dopri5: (3, 12),
+                bdf: (3, 12),
+                radau3: (3, 12),
+                radau5: (3, 12),
+                order2: (3, 9),
+                rk4: (0.02, 8),
+                midpoint: (0.01, 7),
+                euler: None,
+            };
+            let s = finish(Study {
+                sweeps: sweeps(&plan),
+                ..Study::new("dpend", r)
+            });
+            s.run(&dpend::DoublePendulum::default()).expect("study")
+        }
+        "chain8" => {
+            let model = chain8::Chain8::default();
+            let r = Reference::compute(
+                &model,
+                samples(2.0, 40),
+                (Scheme::Dopri5, Setting::Rtol(1e-13)),
+                Some((Scheme::Rk4, Setting::Step(5e-5))),
+                &mbs::Options::default(),
+            )
+            .expect("reference run");
+            let plan = Plan {
+                dopri5: (3, 11),
+                bdf: (3, 12),
+                radau3: (3, 10),
+                radau5: (3, 12),
+                order2: (3, 8),
+                rk4: (0.01, 7),
+                midpoint: (0.005, 6),
+                euler: None,
+            };
+            let s = finish(Study {
+                sweeps: sweeps(&plan),
+                ..Study::new("chain8", r)
+            });
+            s.run(&model).expect("study")
+        }
+        "slidercrank" => {
+            let closed = slidercrank::SliderCrankClosed::default();
+            let r = Reference::compute(
+                &closed,
+                samples(2.0, 40),
+                (Scheme::Dopri5, Setting::Rtol(1e-13)),
+                Some((Scheme::Rk4, Setting::Step(5e-5))),
+                &mbs::Options::default(),
+            )
+            .expect("reference run")
+            .map(
+                "form (b) (θ alone, loop in closed form) mapped to form (a)'s (θ, ψ, s) and rates",
+                |_, y| {
+                    let (r, l) = (0.1, 0.3);
+                    let (th, thd) = (y[0], y[1]);
+                    let (psi, s) = slidercrank::closed_loop(th);
+                    let psid = -r * th.cos() * thd / (l * psi.cos());
+                    let sd = -r * th.sin() * thd - l * psi.sin() * psid;
+                    vec![th, psi, s, thd, psid, sd]
+                },
+            );
+            let proj = ConstraintMethod::Projection;
+            let idx3 = ConstraintMethod::Index3;
+            let sweeps = vec![
+                Sweep::adaptive(Scheme::Dopri5, &decades(3, 11)).with_constraints(proj),
+                Sweep::fixed(Scheme::Rk4, &halvings(0.01, 7)).with_constraints(proj),
+                Sweep::adaptive(bdf(), &decades(3, 10)).with_constraints(proj),
+                Sweep::adaptive(Scheme::Radau5, &decades(3, 11)).with_constraints(proj),
+                Sweep::adaptive(Scheme::Radau5, &decades(3, 11)).with_constraints(idx3),
+                Sweep::adaptive(gen_alpha(), &decades(3, 8)).with_constraints(idx3),
+                Sweep::fixed(gen_alpha(), &halvings(2e-3, 6))
+                    .with_constraints(idx3)
+                    .labelled("gen-alpha (index3, fixed h)"),
+                Sweep::adaptive(hht(), &decades(3, 8)).with_constraints(idx3),
+                Sweep::fixed(newmark(), &halvings(4e-3, 6)).with_constraints(idx3),
+            ];
+            let s = finish(Study {
+                sweeps,
+                ..Study::new("slidercrank (a)", r)
+            });
+            s.run(&slidercrank::SliderCrank::default()).expect("study")
+        }
+        "hexapod" => {
+            let model = hexapod::Hexapod::default();
+            // tumbling: the declared pose with the MODELS.md test-state velocities (from rest
+            // it would fall freely with its legs still, q quadratic in t: exact for every
+            // scheme of order ≥ 2)
+            let options = mbs::Options {
+                qd0: Some(
+                    (0..24)
+                        .map(|i| 0.7 * (0.9 * i as f64 + 0.2).cos())
+                        .collect(),
+                ),
+                ..mbs::Options::default()
+            };
+            let r = Reference::compute(
+                &model,
+                samples(1.0, 20),
+                (Scheme::Dopri5, Setting::Rtol(1e-13)),
+                Some((Scheme::Rk4, Setting::Step(5e-5))),
+                &options,
+            )
+            .expect("reference run");
+            let plan = Plan {
+                dopri5: (3, 11),
+                bdf: (3, 10),
+                radau3: (3, 10),
+                radau5: (3, 11),
+                order2: (3, 8),
+                rk4: (0.08, 7),
+                midpoint: (0.02, 6),
+                euler: None,
+            };
+            let s = finish(Study {
+                sweeps: sweeps(&plan),
+                options,
+                ..Study::new("hexapod (free, tumbling)", r)
+            });
+            s.run(&model).expect("study")
+        }
+        other => {
+            eprintln!("unknown model `{other}`: use {} or all", MODELS.join(", "));
+            std::process::exit(2);
+        }
+    }
+}
+
+/// The cheapest run per label reaching `digits` (mescd), sorted by CPU time.
+fn summary(wp: &WorkPrecision, digits: f64) {
+    let mut best: Vec<(&str, String, f64)> = Vec::new();
+    for r in &wp.rows {
+        let Ok(a) = &r.outcome else { continue };
+        if a.mescd < digits {
+            continue;
+        }
+        let cpu = r.cpu.as_secs_f64() * 1e3;
+        match best.iter_mut().find(|b| b.0 == r.label) {
+            Some(b) if b.2 <= cpu => {}
+            Some(b) => *b = (&r.label, r.setting.to_string(), cpu),
+            None => best.push((&r.label, r.setting.to_string(), cpu)),
+        }
+    }
+    best.sort_by(|a, b| a.2.total_cmp(&b.2));
+    let list: Vec<String> = best
+        .iter()
+        .map(|(l, s, c)| format!("{l} {c:.2} ms ({s})"))
+        .collect();
+    println!(
+        "  {digits} digits: {}",
+        if list.is_empty() {
+            "none".into()
+        } else {
+            list.join(", ")
+        }
+    );
+}
+
+fn main() {
+    let args = Args::parse();
+    let names: Vec<&str> = if args.model == "all" {
+        MODELS.to_vec()
+    } else {
+        vec![args.model.as_str()]
+    };
+    if let Some(dir) = &args.out {
+        std::fs::create_dir_all(dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
+    }
+    for name in names {
+        let start = Instant::now();
+        let wp = study(name, args.repeats);
+        println!("{wp}");
+        println!("cheapest run per scheme to d significant digits at t_end:");
+        for d in [3.0, 5.0, 7.0, 9.0] {
+            summary(&wp, d);
+        }
+        if let Some(dir) = &args.out {
+            let csv = dir.join(format!("wp_{name}.csv"));
+            std::fs::write(&csv, wp.to_csv()).unwrap_or_else(|e| panic!("{}: {e}", csv.display()));
+            let svg = dir.join(format!("wp_{name}.svg"));
+            wp.write_svg(&svg)
+                .unwrap_or_else(|e| panic!("{}: {e}", svg.display()));
+            println!("wrote {} and {}", csv.display(), svg.display());
+        }
+        println!(
+            "{name}: study done in {:.1} s\n",
+            start.elapsed().as_secs_f64()
+        );
+    }
+}

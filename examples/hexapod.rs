@@ -8,8 +8,9 @@
 //! drops the standing robot from the MODELS.md start (feet ~1 cm above the ground) for 5 s
 //! (`--scheme`, default radau5; `--rtol`, `--t-end`, `--out DIR`; `--help` for all) and prints
 //! the base height and the largest velocity over time, the feet's normal forces at the end
-//! against the weight, the work done, and the static equilibrium of the standing robot. The
-//! model itself is in `examples/models/hexapod.rs`.
+//! against the weight, the work done, and the static equilibrium of the standing robot.
+//! `--scene Free` runs the other scene instead: no ground, a free fall for 1 s. The model
+//! itself is in `examples/models/hexapod.rs`.
 //!
 //! Run with `cargo run --release --example hexapod`.
 
@@ -201,6 +202,22 @@ fn main() {
         println!();
     }
 
+    match args.scene.as_deref() {
+        None | Some("Standing") => {}
+        Some("Free") => {
+            // no ground: the robot falls freely with its legs still (exactly, for every
+            // scheme of order ≥ 2: q is quadratic in t)
+            if let Err(e) = args.run(Hexapod::default(), 1.0) {
+                eprintln!("error: {e}");
+                std::process::exit(1);
+            }
+            return;
+        }
+        Some(_) => {
+            eprintln!("error: {}", args.unknown_scene(&["Free", "Standing"]));
+            std::process::exit(2);
+        }
+    }
     let standing = HexapodStanding::default();
     if !args.quiet {
         let p = standing.params();

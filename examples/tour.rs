@@ -1,11 +1,28 @@
-//! A tour of mbs as it stands: write a machine once in the words of CAGeM, read what the
-//! generator made of it, and integrate it with two schemes.
+//! A tour of mbs: write a machine once in the words of CAGeM, read what the generator made of
+//! it, find its static equilibria and poles, integrate it with two schemes (CSV, plots, an
+//! HTML animation and a glTF file), and see what accuracy costs in a small work–precision
+//! study.
 //!
 //! ```text
-//! cargo run --release --example tour
+//! cargo run --release --example tour                 # writes to target/tour
+//! cargo run --release --example tour -- --out DIR
 //! ```
 
-use mbs::{Kinematics, Model, Parameters};
+use clap::Parser;
+use mbs::analysis::{AnalysisError, StaticsOptions, linearize, modes, static_equilibrium};
+use mbs::cli::{RunArgs, RunError};
+use mbs::work_precision::{Reference, Setting, Study, Sweep, decades};
+use mbs::{IterationMatrix, Kinematics, Model, Parameters, Scheme};
+use std::f64::consts::PI;
+use std::path::{Path, PathBuf};
+
+/// The showcase of mbs on a double pendulum.
+#[derive(Parser, Debug)]
+struct Args {
+    /// where the plots, the CSV files, the animation and the glTF file go
+    #[arg(long, default_value = "target/tour")]
+    out: PathBuf,
+}
 
 mbs::multibody! {
     /// Planar double pendulum of two uniform bars, hinged at the origin.
@@ -25,6 +42,7 @@ mbs::multibody! {
 }
 
 fn main() {
+    let args = Args::parse();
     let model = DoublePendulumFull::default();
     let info = model.info();
     println!(
@@ -116,34 +134,138 @@ fn main() {
     let mut heavier = model.clone();
     println!("\nsetting m = -1: {}", heavier.set_params(p).unwrap_err());
 
-    // integrate the swinging pendulum with an explicit and an implicit scheme
-    println!("\nswinging for 10 s from the horizontal:");
-    for (scheme, options) in [
-        (mbs::Scheme::Dopri5, mbs::Options::adaptive(10.0, 1e-8)),
-        (
-            mbs::Scheme::GenAlpha(mbs::GenAlphaParams::from_rho_inf(0.9)),
-            mbs::Options::adaptive(10.0, 1e-6),
-        ),
-    ] {
-        match mbs::simulate(DoublePendulumSwing::default(), scheme, options) {
-            Ok((tr, st)) => {
-                let drift = tr.energy_drift().unwrap_or(f64::NAN);
-                let last = tr.len() - 1;
-                println!(
-                    "  {:<9} q(10) = [{:9.5} {:9.5}], {} steps, {} evaluations, energy drift {drift:.2e} J",
-                    scheme.name(),
-                    tr.q(last)[0],
-                    tr.q(last)[1],
-                    st.steps,
-                    st.evaluations()
-                );
-            }
-            Err(e) => println!("  {:<9} failed: {e}", scheme.name()),
+    if let Err(e) = statics_and_poles(&model) {
+        eprintln!("error: {e}");
+        std::process::exit(1);
+    }
+    if let Err(e) = simulate_and_write(&args.out) {
+        eprintln!("error: {e}");
+        std::process::exit(1);
+    }
+    work_precision(&args.out);
+    println!("\nread the generated code with: cargo run --bin mbs -- expand examples/tour.rs");
+}
+
+/// EasyDyn's StaticEquilibrium → ComputePoles, with the generated exact stiffness.
+fn statics_and_poles(model: &DoublePendulumFull) -> Result<(), AnalysisError> {
+    println!("\nstatic equilibria (Newton with the exact stiffness K = ∂τ/∂q at qd = 0):");
+    let mut hanging = Vec::new();
+    for (name, q0) in [("hanging", [0.4, -0.3]), ("upright", [PI - 0.2, 0.3])] {
+        let options = StaticsOptions {
+            q0: Some(q0.to_vec()),
+            ..Default::default()
+        };
+        let eq = static_equilibrium(model, &options)?;
+        println!(
+            "  {name:<8} from q = [{:.2}, {:.2}] to [{:.6}, {:.6}]: {eq}",
+            q0[0], q0[1], eq.q[0], eq.q[1]
+        );
+        if name == "hanging" {
+            hanging = eq.q;
         }
     }
+    let lin = linearize(model, 0.0, &hanging, &[0.0; 2], &[], IterationMatrix::Auto)?;
     println!(
-        "  (the double pendulum is chaotic: at these tolerances the two runs part after a few"
+        "\npoles of the linearisation about the hanging equilibrium (damper c = {} N·m·s):\n{}",
+        model.params().c,
+        modes(&lin, None)?
     );
-    println!("   seconds; the energy drift tells which stayed closer to the physics)");
-    println!("\nread the generated code with: cargo run --bin mbs -- expand examples/tour.rs");
+    Ok(())
+}
+
+/// The swinging pendulum with an explicit and an implicit scheme; plots, CSV, the animation
+/// and the glTF file of each run go to `out/SCHEME/`.
+fn simulate_and_write(out: &Path) -> Result<(), RunError> {
+    println!(
+        "\nswinging for 10 s from the horizontal (scene Swing: gravity alone, so the energy error is the scheme's):"
+    );
+    let mut ends = Vec::new();
+    for (scheme, rtol) in [("dopri5", 1e-8), ("gen-alpha", 1e-6)] {
+        println!("\n{scheme} at rtol {rtol:e}:");
+        let args = RunArgs::parse_from([
+            "tour",
+            "--scheme",
+            scheme,
+            "--rtol",
+            &rtol.to_string(),
+            "--dt",
+            "0.01",
+            "--out",
+            &out.join(scheme).to_string_lossy(),
+        ]);
+        let report = args.run(DoublePendulumSwing::default(), 10.0)?;
+        let last = report.trajectory.len() - 1;
+        ends.push((scheme, report.trajectory.q(last).to_vec()));
+    }
+    println!(
+        "\nq(10): dopri5 [{:.5}, {:.5}], gen-alpha [{:.5}, {:.5}]; the double pendulum is \
+         chaotic, so the two part as their errors grow: how fast, the work–precision study says",
+        ends[0].1[0], ends[0].1[1], ends[1].1[0], ends[1].1[1]
+    );
+    Ok(())
+}
+
+/// A small work–precision study of the swinging pendulum over 2 s: three schemes, each over
+/// a sweep of tolerances, against a reference computed at rtol 1e-13 and checked by Radau5.
+fn work_precision(out: &Path) {
+    println!("\nwhat accuracy costs (scene Swing, 2 s):");
+    let model = DoublePendulumSwing::default();
+    let times: Vec<f64> = (1..=20).map(|k| 0.1 * k as f64).collect();
+    let reference = match Reference::compute(
+        &model,
+        times,
+        (Scheme::Dopri5, Setting::Rtol(1e-13)),
+        Some((Scheme::Radau5, Setting::Rtol(1e-12))),
+        &mbs::Options::default(),
+    ) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("error: the reference run failed: {e}");
+            std::process::exit(1);
+        }
+    };
+    let study = Study {
+        repeats: 3,
+        ..Study::new("tour: double pendulum", reference)
+    }
+    .sweep(Sweep::adaptive(Scheme::Dopri5, &decades(3, 10)))
+    .sweep(Sweep::adaptive(Scheme::Radau5, &decades(3, 10)))
+    .sweep(Sweep::adaptive(
+        Scheme::GenAlpha(mbs::GenAlphaParams::from_rho_inf(0.9)),
+        &decades(3, 8),
+    ));
+    let wp = match study.run(&model) {
+        Ok(wp) => wp,
+        Err(e) => {
+            eprintln!("error: {e}");
+            std::process::exit(1);
+        }
+    };
+    println!("{wp}");
+    for digits in [3.0, 6.0] {
+        if let Some(r) = wp.cheapest(digits) {
+            println!(
+                "cheapest run to {digits} digits: {} at {} in {:.2} ms",
+                r.label,
+                r.setting,
+                r.cpu.as_secs_f64() * 1e3
+            );
+        }
+    }
+    let (csv, svg) = (
+        out.join("work_precision.csv"),
+        out.join("work_precision.svg"),
+    );
+    let written = std::fs::write(&csv, wp.to_csv())
+        .map_err(|e| e.to_string())
+        .and_then(|()| wp.write_svg(&svg).map_err(|e| e.to_string()));
+    match written {
+        Ok(()) => println!("wrote {} and {}", csv.display(), svg.display()),
+        Err(e) => eprintln!("error: cannot write the study to {}: {e}", out.display()),
+    }
+    println!(
+        "\nopen {} in a browser (offline) to watch the motion; {} in Blender or any glTF viewer",
+        out.join("dopri5").join("animation.html").display(),
+        out.join("dopri5").join("motion.gltf").display()
+    );
 }

@@ -77,26 +77,6 @@ fn samples(t_end: f64, n: usize) -> Vec<f64> {
     (1..=n).map(|k| t_end * k as f64 / n as f64).collect()
 }
 
-/// seed2dof's exact (q, qd) from q0 = (0, 1), qd0 = 0: q(t) = V cos(Wt) Vᵀ q0.
-fn seed2dof_exact(t: f64) -> Vec<f64> {
-    let (k1, k2): (f64, f64) = (79.15, 1961.0);
-    let (a, b, d) = (k1 + k2, -k2, k2);
-    let disc = ((a - d) * (a - d) / 4.0 + b * b).sqrt();
-    let mut y = vec![0.0; 4];
-    for lam in [(a + d) / 2.0 - disc, (a + d) / 2.0 + disc] {
-        let w = lam.sqrt();
-        let (v0, v1) = (b, lam - a);
-        let nv = v0.hypot(v1);
-        let v = [v0 / nv, v1 / nv];
-        let c = v[1]; // q0 = (0, 1) on this mode
-        for i in 0..2 {
-            y[i] += v[i] * c * (w * t).cos();
-            y[2 + i] -= v[i] * c * w * (w * t).sin();
-        }
-    }
-    y
-}
-
 /// States of `tests/reference/dpend.json` at `times` (q then qd).
 fn dpend_reference(times: &[f64]) -> Vec<Vec<f64>> {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/reference/dpend.json");
@@ -158,9 +138,9 @@ fn study(name: &str, repeats: usize) -> WorkPrecision {
     match name {
         "seed2dof" => {
             let r = Reference::exact(
-                "modal solution q(t) = V cos(Wt) Vᵀ q0 (tests/common)",
+                "modal solution q(t) = V cos(Wt) Vᵀ q0 (examples/models/seed2dof.rs)",
                 samples(10.0, 100),
-                seed2dof_exact,
+                seed2dof::exact_state,
             );
             let plan = Plan {
                 dopri5: (3, 12),

@@ -18,6 +18,7 @@
 //! with a summary table: steps, evaluations, energy error, CPU time.
 //!
 //! ```text
+//! cargo run --release --example dpend -- --scheme radau5 --rtol 1e-10 --t-end 20 --out out
 //! ```
 
 use crate::plot::{Chart, Series, line_chart};
@@ -73,6 +74,10 @@ pub struct RunReport {
     pub trajectory: Trajectory,
     pub stats: Stats,
     pub cpu: Duration,
+    /// whether the model's generated power of non-conservative effects is identically zero
+    /// (no damper, friction or driving effect): then E(t) − E(0) measures the scheme's error;
+    /// otherwise it also holds the work those effects did
+    pub conservative: bool,
 }
 
 impl RunReport {
@@ -171,6 +176,17 @@ impl RunArgs {
         let scheme = Scheme::from_name(&self.scheme)
             .ok_or_else(|| RunError::UnknownScheme(self.scheme.clone()))?;
         let info = model.info();
+        // a program with several scenes picks the model by --scene; any other must refuse it
+        if let Some(scene) = &self.scene {
+            if *scene != info.scene {
+                let known: &[&str] = if info.scene.is_empty() {
+                    &[]
+                } else {
+                    &[info.scene]
+                };
+                return Err(self.unknown_scene(known));
+            }
+        }
         let name = info.name;
         let start = Instant::now();
         let options = self.options(default_t_end);
@@ -208,11 +224,16 @@ impl RunArgs {
         }
         bar.finish_and_clear();
         let (trajectory, stats) = sim.finish();
+        let conservative = info
+            .ops
+            .iter()
+            .any(|(f, ops)| *f == "power" && ops.flops() == 0);
         let report = RunReport {
             scheme,
             trajectory,
             stats,
             cpu: start.elapsed(),
+            conservative,
         };
         if let Some(dir) = &self.out {
             self.write_outputs(dir, info, &report)?;
@@ -320,14 +341,20 @@ impl RunArgs {
 }
 
 impl RunReport {
-    /// One-line table of the run: steps, evaluations, energy error, CPU time.
+    /// One-line table of the run: steps, evaluations, energy error (or, for a model with
+    /// dissipative or driving effects, the energy change), CPU time.
     pub fn summary(&self, name: &str) -> String {
         let t_end = self.trajectory.t.last().copied().unwrap_or(0.0);
         let energy = self
             .energy_error()
             .map_or("—".to_string(), |e| format!("{e:.2e}"));
+        let note = if self.conservative || self.energy_error().is_none() {
+            ""
+        } else {
+            "\n(ΔE includes the work of the model's dissipative or driving effects: not an error)"
+        };
         format!(
-            "{:<28} {:>10} {:>9} {:>9} {:>12} {:>12} {:>10}\n{:<28} {:>10} {:>9} {:>9} {:>12} {:>12} {:>10}",
+            "{:<28} {:>10} {:>9} {:>9} {:>12} {:>12} {:>10}\n{:<28} {:>10} {:>9} {:>9} {:>12} {:>12} {:>10}{note}",
             "model",
             "scheme",
             "t_end",

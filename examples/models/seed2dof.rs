@@ -17,3 +17,40 @@ mbs::multibody! {
         spring(mass1, mass2, k = k2, l0 = 1, axis = x);
     }
 }
+
+/// The exact modes of seed2dof with the default parameters (unit masses, so M = I): circular
+/// frequencies ω (rad/s, ascending) and unit mode shapes from K = [k1 + k2, −k2; −k2, k2].
+#[allow(dead_code)] // not every program that includes the model uses it
+pub fn exact_modes() -> ([f64; 2], [[f64; 2]; 2]) {
+    let (k1, k2): (f64, f64) = (79.15, 1961.0);
+    let (a, b, d) = (k1 + k2, -k2, k2);
+    let disc = ((a - d) * (a - d) / 4.0 + b * b).sqrt();
+    let mut w = [0.0; 2];
+    let mut v = [[0.0; 2]; 2];
+    for (k, lam) in [(a + d) / 2.0 - disc, (a + d) / 2.0 + disc]
+        .into_iter()
+        .enumerate()
+    {
+        w[k] = lam.sqrt();
+        let (v0, v1) = (b, lam - a);
+        let n = v0.hypot(v1);
+        v[k] = [v0 / n, v1 / n];
+    }
+    (w, v)
+}
+
+/// The exact (q, qd) at time t from the declared start q0 = (0, 1), qd0 = 0:
+/// q(t) = Σ_k v_k (v_kᵀ q0) cos(ω_k t).
+#[allow(dead_code)]
+pub fn exact_state(t: f64) -> Vec<f64> {
+    let (w, v) = exact_modes();
+    let mut y = vec![0.0; 4];
+    for k in 0..2 {
+        let c = v[k][1]; // v_kᵀ q0 with q0 = (0, 1)
+        for i in 0..2 {
+            y[i] += v[k][i] * c * (w[k] * t).cos();
+            y[2 + i] -= v[k][i] * c * w[k] * (w[k] * t).sin();
+        }
+    }
+    y
+}

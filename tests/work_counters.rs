@@ -42,12 +42,13 @@ fn counts(s: &Stats) -> [usize; 9] {
 #[test]
 fn work_counters_of_reference_runs() {
     let cases: [(Scheme, [usize; 9]); 7] = [
-        // 1000 steps, 1 evaluation each + the start + 2 every 16 steps for the stability check
+        // 1000 steps, 1 evaluation each + the start + 2 every 16 steps for the stability check,
+        // + 2 per extra power iteration at the first step (3 until the estimate settles)
         (
             Scheme::ExplicitEuler,
-            [1000, 0, 0, 1127, 0, 0, 1127, 1127, 0],
+            [1000, 0, 0, 1133, 0, 0, 1133, 1133, 0],
         ),
-        (Scheme::Rk4, [1000, 0, 0, 4127, 0, 0, 4127, 4127, 0]),
+        (Scheme::Rk4, [1000, 0, 0, 4133, 0, 0, 4133, 4133, 0]),
         // 93 attempts × 6 evaluations (first same as last) + the start + the initial-step probe
         (Scheme::Dopri5, [80, 13, 0, 560, 0, 0, 560, 560, 0]),
         // about 2.4 Newton iterations per step; a factorisation every 4–5 steps

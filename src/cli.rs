@@ -77,8 +77,9 @@ pub struct RunReport {
     /// written after it), wall time where the thread's clock cannot be read
     pub cpu: Duration,
     /// whether the model's generated power of non-conservative effects is identically zero
-    /// (no damper, friction or driving effect): then E(t) − E(0) measures the scheme's error;
-    /// otherwise it also holds the work those effects did
+    /// (no damper, friction or driving effect) and no effort written in Rust was evaluated:
+    /// then E(t) − E(0) measures the scheme's error; otherwise it also holds the work those
+    /// effects did
     pub conservative: bool,
 }
 
@@ -227,10 +228,12 @@ impl RunArgs {
         }
         bar.finish_and_clear();
         let (trajectory, stats) = sim.finish();
-        let conservative = info
-            .ops
-            .iter()
-            .any(|(f, ops)| *f == "power" && ops.flops() == 0);
+        // forces written in Rust (`mbs::WithEfforts`) may do work the model cannot tell
+        let conservative = stats.user_efforts == 0
+            && info
+                .ops
+                .iter()
+                .any(|(f, ops)| *f == "power" && ops.flops() == 0);
         let report = RunReport {
             scheme,
             trajectory,

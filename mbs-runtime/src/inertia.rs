@@ -23,9 +23,17 @@ pub fn inertia_problem(t: [f64; 6]) -> Option<String> {
     None
 }
 
-/// Eigenvalues of the symmetric tensor (xx, yy, zz, xy, xz, yz), by cyclic Jacobi rotations.
+/// Eigenvalues of the symmetric tensor (xx, yy, zz, xy, xz, yz).
 pub fn principal_moments(t: [f64; 6]) -> [f64; 3] {
+    principal_axes(t).0
+}
+
+/// Eigenvalues of the symmetric tensor (xx, yy, zz, xy, xz, yz) and its eigenvectors as the
+/// columns of a rotation (determinant +1), by cyclic Jacobi rotations; a diagonal tensor
+/// gives the identity.
+pub fn principal_axes(t: [f64; 6]) -> ([f64; 3], [[f64; 3]; 3]) {
     let mut a = [[t[0], t[3], t[4]], [t[3], t[1], t[5]], [t[4], t[5], t[2]]];
+    let mut v = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
     for _ in 0..50 {
         let off = a[0][1].abs() + a[0][2].abs() + a[1][2].abs();
         let diag = a[0][0].abs() + a[1][1].abs() + a[2][2].abs();
@@ -54,9 +62,22 @@ pub fn principal_moments(t: [f64; 6]) -> [f64; 3] {
                 a[p][k] = c * apk - s * aqk;
                 a[q][k] = s * apk + c * aqk;
             }
+            for row in v.iter_mut() {
+                let (vkp, vkq) = (row[p], row[q]);
+                row[p] = c * vkp - s * vkq;
+                row[q] = s * vkp + c * vkq;
+            }
         }
     }
-    [a[0][0], a[1][1], a[2][2]]
+    let det = v[0][0] * (v[1][1] * v[2][2] - v[1][2] * v[2][1])
+        - v[0][1] * (v[1][0] * v[2][2] - v[1][2] * v[2][0])
+        + v[0][2] * (v[1][0] * v[2][1] - v[1][1] * v[2][0]);
+    if det < 0.0 {
+        for row in v.iter_mut() {
+            row[2] = -row[2];
+        }
+    }
+    ([a[0][0], a[1][1], a[2][2]], v)
 }
 
 #[cfg(test)]

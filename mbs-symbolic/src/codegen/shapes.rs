@@ -44,7 +44,7 @@ pub fn default_shape(frame: usize, m: f64, tensor: [f64; 6]) -> Option<ShapeDef>
     if m.is_nan() || m <= 0.0 || !m.is_finite() || tensor.iter().any(|x| !x.is_finite()) {
         return None;
     }
-    let (moments, axes) = principal_axes(tensor);
+    let (moments, axes) = crate::dsl::inertia::principal_axes(tensor);
     // a box a × b × c has I_x = m (b² + c²) / 12: a² = 6 (I_y + I_z − I_x) / m
     let side = |i: usize| {
         let (a, b, c) = (moments[i], moments[(i + 1) % 3], moments[(i + 2) % 3]);
@@ -69,58 +69,6 @@ pub fn default_shape(frame: usize, m: f64, tensor: [f64; 6]) -> Option<ShapeDef>
         *s = s.max(MIN_ASPECT * longest);
     }
     Some(shape(Geometry::Box(size), axes))
-}
-
-/// Eigenvalues of the symmetric tensor (xx, yy, zz, xy, xz, yz) and its eigenvectors as the
-/// columns of a rotation (determinant +1), by cyclic Jacobi rotations; a diagonal tensor
-/// gives the identity.
-pub fn principal_axes(t: [f64; 6]) -> ([f64; 3], [[f64; 3]; 3]) {
-    let mut a = [[t[0], t[3], t[4]], [t[3], t[1], t[5]], [t[4], t[5], t[2]]];
-    let mut v = IDENTITY;
-    for _ in 0..50 {
-        let off = a[0][1].abs() + a[0][2].abs() + a[1][2].abs();
-        let diag = a[0][0].abs() + a[1][1].abs() + a[2][2].abs();
-        if off == 0.0 || off <= 1e-17 * diag {
-            break;
-        }
-        for (p, q) in [(0, 1), (0, 2), (1, 2)] {
-            if a[p][q] == 0.0 {
-                continue;
-            }
-            let theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
-            let tt = if theta == 0.0 {
-                1.0
-            } else {
-                theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt())
-            };
-            let c = 1.0 / (tt * tt + 1.0).sqrt();
-            let s = tt * c;
-            for row in a.iter_mut() {
-                let (akp, akq) = (row[p], row[q]);
-                row[p] = c * akp - s * akq;
-                row[q] = s * akp + c * akq;
-            }
-            for k in 0..3 {
-                let (apk, aqk) = (a[p][k], a[q][k]);
-                a[p][k] = c * apk - s * aqk;
-                a[q][k] = s * apk + c * aqk;
-            }
-            for row in v.iter_mut() {
-                let (vkp, vkq) = (row[p], row[q]);
-                row[p] = c * vkp - s * vkq;
-                row[q] = s * vkp + c * vkq;
-            }
-        }
-    }
-    let det = v[0][0] * (v[1][1] * v[2][2] - v[1][2] * v[2][1])
-        - v[0][1] * (v[1][0] * v[2][2] - v[1][2] * v[2][0])
-        + v[0][2] * (v[1][0] * v[2][1] - v[1][1] * v[2][0]);
-    if det < 0.0 {
-        for row in v.iter_mut() {
-            row[2] = -row[2];
-        }
-    }
-    ([a[0][0], a[1][1], a[2][2]], v)
 }
 
 /// `&[::mbs::ShapeInfo { … }, …]`, the Rust text of the list.

@@ -297,23 +297,17 @@ fn study(name: &str, repeats: usize) -> WorkPrecision {
 
 /// The cheapest run per label reaching `digits` (mescd), sorted by CPU time.
 fn summary(wp: &WorkPrecision, digits: f64) {
-    let mut best: Vec<(&str, String, f64)> = Vec::new();
-    for r in &wp.rows {
-        let Ok(a) = &r.outcome else { continue };
-        if a.mescd < digits {
-            continue;
-        }
-        let cpu = r.cpu.as_secs_f64() * 1e3;
-        match best.iter_mut().find(|b| b.0 == r.label) {
-            Some(b) if b.2 <= cpu => {}
-            Some(b) => *b = (&r.label, r.setting.to_string(), cpu),
-            None => best.push((&r.label, r.setting.to_string(), cpu)),
-        }
-    }
-    best.sort_by(|a, b| a.2.total_cmp(&b.2));
-    let list: Vec<String> = best
+    let list: Vec<String> = wp
+        .cheapest_per_label(digits)
         .iter()
-        .map(|(l, s, c)| format!("{l} {c:.2} ms ({s})"))
+        .map(|r| {
+            format!(
+                "{} {:.2} ms ({})",
+                r.label,
+                r.cpu.as_secs_f64() * 1e3,
+                r.setting
+            )
+        })
         .collect();
     println!(
         "  {digits} digits: {}",

@@ -880,10 +880,25 @@ impl WorkPrecision {
 
     /// The cheapest successful run reaching `digits` significant digits (mescd) at t_end.
     pub fn cheapest(&self, digits: f64) -> Option<&Row> {
-        self.rows
-            .iter()
-            .filter(|r| matches!(&r.outcome, Ok(a) if a.mescd >= digits))
-            .min_by(|a, b| a.cpu.cmp(&b.cpu))
+        self.cheapest_per_label(digits).into_iter().next()
+    }
+
+    /// For each sweep label that reaches `digits` significant digits at t_end, its cheapest
+    /// such run; sorted by CPU time, cheapest first.
+    pub fn cheapest_per_label(&self, digits: f64) -> Vec<&Row> {
+        let mut best: Vec<&Row> = Vec::new();
+        for r in &self.rows {
+            if !matches!(&r.outcome, Ok(a) if a.mescd >= digits) {
+                continue;
+            }
+            match best.iter_mut().find(|b| b.label == r.label) {
+                Some(b) if b.cpu <= r.cpu => {}
+                Some(b) => *b = r,
+                None => best.push(r),
+            }
+        }
+        best.sort_by_key(|r| r.cpu);
+        best
     }
 }
 

@@ -49,6 +49,7 @@
 
 use super::newton::AccelNewton;
 use super::problem::Problem;
+use super::step_control::{elementary_factor, optimal_factor};
 use super::{Attempt, Control, State, Stepper};
 use crate::error::Failure;
 use crate::model::Model;
@@ -238,7 +239,7 @@ impl<M: Model> Stepper<M> for Bdf {
             self.corr[i] = next.q[i] - self.ypred[i];
             self.corr[n + i] = next.qd[i] - self.ypred[n + i];
         }
-        let Some(_) = ctl.adaptive else {
+        let Some(tol) = ctl.adaptive else {
             // fixed steps: raise the order by one per step, no error test
             self.next_order = (k + 1).min(self.max_order);
             self.reselected = self.next_order != k;
@@ -255,13 +256,9 @@ impl<M: Model> Stepper<M> for Bdf {
         for i in 0..m {
             self.err[i] = error_const(k) * self.corr[i];
         }
-        let err = ctl.error_norm(&self.err, &self.y0, &self.y1);
+        let err = tol.error_norm(&self.err, &self.y0, &self.y1);
         if !(err <= 1.0) {
-            let fac = if err.is_finite() {
-                (safety * err.powf(-1.0 / (k as f64 + 1.0))).max(MIN_FACTOR)
-            } else {
-                MIN_FACTOR
-            };
+            let fac = elementary_factor(err, k, safety, MIN_FACTOR, f64::INFINITY);
             return Ok(Attempt::RejectedError { h_next: h * fac });
         }
         self.next_order = k;
@@ -274,7 +271,7 @@ impl<M: Model> Stepper<M> for Bdf {
                 for i in 0..m {
                     self.err[i] = error_const(k - 1) * (self.d[k * m + i] + self.corr[i]);
                 }
-                ctl.error_norm(&self.err, &self.y0, &self.y1)
+                tol.error_norm(&self.err, &self.y0, &self.y1)
             } else {
                 f64::INFINITY
             };
@@ -282,15 +279,15 @@ impl<M: Model> Stepper<M> for Bdf {
                 for i in 0..m {
                     self.err[i] = error_const(k + 1) * (self.corr[i] - self.d[(k + 1) * m + i]);
                 }
-                ctl.error_norm(&self.err, &self.y0, &self.y1)
+                tol.error_norm(&self.err, &self.y0, &self.y1)
             } else {
                 f64::INFINITY
             };
             // step factors err^(−1/(order+1)); the first of the largest wins
             let facs = [
-                err_m.powf(-1.0 / k as f64),
-                err.powf(-1.0 / (k as f64 + 1.0)),
-                err_p.powf(-1.0 / (k as f64 + 2.0)),
+                optimal_factor(err_m, k - 1),
+                optimal_factor(err, k),
+                optimal_factor(err_p, k + 1),
             ];
             let mut best = 0;
             for (i, f) in facs.iter().enumerate() {

@@ -1,10 +1,11 @@
 //! Dormand–Prince 5(4) (Dormand & Prince 1980) on y = (q, qd): seven stages, first same as
 //! last (six evaluations per step), error estimated by the embedded order-4 solution, step
-//! chosen by Hairer's PI controller (β = 0.04), dense output by the order-4 continuous
-//! extension of Shampine (1986), as in Hairer's DOPRI5. Stability interval on the negative
-//! real axis ≈ 3.3; not for stiff problems.
+//! chosen by Hairer's PI controller (β = 0.04, `step_control::PiController`), dense output
+//! by the order-4 continuous extension of Shampine (1986), as in Hairer's DOPRI5. Stability
+//! interval on the negative real axis ≈ 3.3; not for stiff problems.
 
 use super::problem::Problem;
+use super::step_control::{Decision, PiController};
 use super::{Attempt, Control, State, Stepper};
 use crate::error::Failure;
 use crate::model::Model;
@@ -71,13 +72,11 @@ pub(crate) struct Dopri5 {
     err: Vec<f64>,
     y0: Vec<f64>,
     y1: Vec<f64>,
-    /// previous error norm, for the PI controller
-    err_old: f64,
+    /// step control: Hairer's PI controller
+    pi: PiController,
     /// dense output of the last accepted step: 5 coefficient vectors for q and for qd
     cont_q: [Vec<f64>; 5],
     cont_v: [Vec<f64>; 5],
-    /// whether the last attempt was rejected (no step growth right after a rejection)
-    last_rejected: bool,
 }
 
 impl Dopri5 {
@@ -94,10 +93,9 @@ impl Dopri5 {
             err: vec![0.0; 2 * n],
             y0: vec![0.0; 2 * n],
             y1: vec![0.0; 2 * n],
-            err_old: 1e-4,
+            pi: PiController::new(4, 0.04),
             cont_q: s5(),
             cont_v: s5(),
-            last_rejected: false,
         }
     }
 }
@@ -129,7 +127,7 @@ impl<M: Model> Stepper<M> for Dopri5 {
             if let Err(e) = r {
                 // a non-finite stage: too large a step when adaptive, fatal when fixed
                 if ctl.adaptive.is_some() && matches!(e, Failure::NonFinite { .. }) {
-                    self.last_rejected = true;
+                    self.pi.rejected_otherwise();
                     return Ok(Attempt::RejectedNewton {
                         h_next: 0.25 * h,
                         iterations: 0,
@@ -144,7 +142,7 @@ impl<M: Model> Stepper<M> for Dopri5 {
         next.q.copy_from_slice(&self.q);
         next.qd.copy_from_slice(&self.v);
         next.qdd.copy_from_slice(&self.ka[6]);
-        let Some(_) = ctl.adaptive else {
+        let Some(tol) = ctl.adaptive else {
             self.dense(cur, next, h);
             return Ok(Attempt::Accepted { h_next: h });
         };
@@ -161,25 +159,13 @@ impl<M: Model> Stepper<M> for Dopri5 {
             self.y1[i] = next.q[i];
             self.y1[n + i] = next.qd[i];
         }
-        let err = ctl.error_norm(&self.err, &self.y0, &self.y1);
-        // PI control (Hairer): fac = err^(0.2 − 0.75β) / err_old^β, β = 0.04
-        let beta = 0.04;
-        let fac11 = err.powf(0.2 - 0.75 * beta);
-        let fac = (fac11 / self.err_old.powf(beta) / 0.9).clamp(0.1, 5.0);
-        if err <= 1.0 {
-            self.err_old = err.max(1e-4);
-            let mut h_next = h / fac;
-            if self.last_rejected {
-                h_next = h_next.min(h);
+        let err = tol.error_norm(&self.err, &self.y0, &self.y1);
+        match self.pi.decide(h, err) {
+            Decision::Accept { h_next } => {
+                self.dense(cur, next, h);
+                Ok(Attempt::Accepted { h_next })
             }
-            self.last_rejected = false;
-            self.dense(cur, next, h);
-            Ok(Attempt::Accepted { h_next })
-        } else {
-            self.last_rejected = true;
-            Ok(Attempt::RejectedError {
-                h_next: h / (fac11 / 0.9).min(5.0),
-            })
+            Decision::Reject { h_next } => Ok(Attempt::RejectedError { h_next }),
         }
     }
 

@@ -22,6 +22,7 @@ mod newmark;
 pub(crate) mod newton;
 pub(crate) mod problem;
 mod radau;
+pub(crate) mod step_control;
 
 pub use constrained::{Assembly, assemble};
 pub use newmark::index3_iteration_matrix;
@@ -34,6 +35,7 @@ use crate::trajectory::{Observer, Trajectory};
 use constrained::{Constrained, Mode};
 use newton::NewtonTol;
 use problem::Problem;
+use step_control::{StepBounds, Tolerances, initial_step};
 
 /// A state of the motion.
 #[derive(Clone, Debug, PartialEq)]
@@ -99,36 +101,11 @@ pub(crate) enum Attempt {
 /// Step control and Newton settings handed to the schemes.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Control {
-    /// (rtol, atol) when adaptive
-    pub adaptive: Option<(f64, f64)>,
+    /// the local error's tolerances when adaptive
+    pub adaptive: Option<Tolerances>,
     pub newton: NewtonTol,
     /// explicit fixed-step schemes check h·ρ against their stability region
     pub stability_check: bool,
-}
-
-impl Control {
-    /// Weighted RMS norm of an error vector e against the state scales y0, y1:
-    /// sqrt(mean (e_i / (atol + rtol·max(|y0_i|, |y1_i|)))²).
-    pub fn error_norm(&self, e: &[f64], y0: &[f64], y1: &[f64]) -> f64 {
-        let (rtol, atol) = self.adaptive.unwrap_or((1.0, 1.0));
-        let mut s = 0.0;
-        for i in 0..e.len() {
-            let w = atol + rtol * y0[i].abs().max(y1[i].abs());
-            s += (e[i] / w) * (e[i] / w);
-        }
-        (s / e.len().max(1) as f64).sqrt()
-    }
-}
-
-/// Next step from an error norm (≤ 1 accepted) of a method whose error estimate is of order
-/// `order` (local error ∝ h^(order+1)): h·min(fmax, max(0.2, 0.9·err^(−1/(order+1)))).
-pub(crate) fn next_step(h: f64, err: f64, order: usize, fmax: f64) -> f64 {
-    let fac = if err == 0.0 {
-        fmax
-    } else {
-        (0.9 * err.powf(-1.0 / (order as f64 + 1.0))).clamp(0.2, fmax)
-    };
-    h * fac
 }
 
 /// A scheme, as the driver sees it.
@@ -449,7 +426,7 @@ impl<M: Model + 'static> Simulation<M> {
         let (adaptive, newton) = match options.step {
             StepControl::Fixed { .. } => (None, newton),
             StepControl::Adaptive { rtol, atol, .. } => (
-                Some((rtol, atol)),
+                Some(Tolerances { rtol, atol }),
                 NewtonTol {
                     atol,
                     rtol,
@@ -470,9 +447,13 @@ impl<M: Model + 'static> Simulation<M> {
         let h = match options.step {
             StepControl::Fixed { h } => h,
             StepControl::Adaptive { h0: Some(h0), .. } => h0,
-            StepControl::Adaptive { rtol, atol, .. } => {
-                initial_step(&mut problem, &cur, rtol, atol, scheme.order(), &options)
-            }
+            StepControl::Adaptive { rtol, atol, .. } => initial_step(
+                &cur,
+                Tolerances { rtol, atol },
+                scheme.order(),
+                StepBounds::of(&options),
+                |t, q, qd, qdd| problem.accel(t, q, qd, qdd).is_ok(),
+            ),
         };
         let out_times: Vec<f64> = match &options.output {
             Output::Times(ts) => ts.clone(),
@@ -827,53 +808,6 @@ impl<M: Model + 'static> Integrator for Simulation<M> {
     fn trajectory(&self) -> &Trajectory {
         &self.traj
     }
-}
-
-/// First step of adaptive schemes (Hairer, Nørsett & Wanner, II.4): from the sizes of y, f
-/// and of f's change over a trial Euler step.
-fn initial_step<M: Model>(
-    p: &mut Problem<M>,
-    s: &State,
-    rtol: f64,
-    atol: f64,
-    order: usize,
-    o: &Options,
-) -> f64 {
-    let n = s.q.len();
-    let w = |y: f64| atol + rtol * y.abs();
-    let norm = |a: &[f64], b: &[f64], ya: &[f64], yb: &[f64]| {
-        let ss: f64 = (0..n)
-            .map(|i| (a[i] / w(ya[i])).powi(2) + (b[i] / w(yb[i])).powi(2))
-            .sum();
-        (ss / (2 * n).max(1) as f64).sqrt()
-    };
-    let d0 = norm(&s.q, &s.qd, &s.q, &s.qd);
-    let d1 = norm(&s.qd, &s.qdd, &s.q, &s.qd);
-    let mut h0 = if d0 < 1e-5 || d1 < 1e-5 {
-        1e-6
-    } else {
-        0.01 * d0 / d1
-    };
-    h0 = h0.min(o.t_end - o.t0).min(o.h_max);
-    let q1: Vec<f64> = (0..n).map(|i| s.q[i] + h0 * s.qd[i]).collect();
-    let v1: Vec<f64> = (0..n).map(|i| s.qd[i] + h0 * s.qdd[i]).collect();
-    let mut a1 = vec![0.0; n];
-    if p.accel(s.t + h0, &q1, &v1, &mut a1).is_err() {
-        return h0;
-    }
-    let dv: Vec<f64> = (0..n).map(|i| (v1[i] - s.qd[i]) / h0).collect();
-    let da: Vec<f64> = (0..n).map(|i| (a1[i] - s.qdd[i]) / h0).collect();
-    let d2 = norm(&dv, &da, &s.q, &s.qd);
-    let h1 = if d1.max(d2) <= 1e-15 {
-        (h0 * 1e-3).max(1e-6)
-    } else {
-        (0.01 / d1.max(d2)).powf(1.0 / (order as f64 + 1.0))
-    };
-    (100.0 * h0)
-        .min(h1)
-        .min(o.t_end - o.t0)
-        .min(o.h_max)
-        .max(o.h_min())
 }
 
 /// The constraint method a scheme runs: `Auto` resolved, unsupported pairs refused.

@@ -37,7 +37,8 @@
 use super::constrained::Mode;
 use super::newton::AccelNewton;
 use super::problem::Problem;
-use super::{Attempt, Control, State, Stepper, next_step};
+use super::step_control::next_step;
+use super::{Attempt, Control, State, Stepper};
 use crate::error::Failure;
 use crate::model::Model;
 use crate::options::{GenAlphaParams, HhtParams, NewmarkParams};
@@ -155,7 +156,7 @@ impl<M: Model> Stepper<M> for AlphaFamily {
             self.a_next[i] = c * self.qdd[i] + (af * cur.qdd[i] - am * self.a[i]) / (1.0 - am);
         }
         next.lambda[..self.lam.len()].copy_from_slice(&self.lam);
-        let Some(_) = ctl.adaptive else {
+        let Some(tol) = ctl.adaptive else {
             return Ok(Attempt::Accepted { h_next: h });
         };
         let k = h * h * (b - 1.0 / 6.0);
@@ -167,7 +168,7 @@ impl<M: Model> Stepper<M> for AlphaFamily {
             // Φ(q₁) = 0 holds anyway; the error is measured along them
             p.tangent_part(cur.t + h, &next.q, &mut self.err)?;
         }
-        let err = ctl.error_norm(&self.err, &cur.q, &next.q);
+        let err = tol.error_norm(&self.err, &cur.q, &next.q);
         if err <= 1.0 {
             Ok(Attempt::Accepted {
                 h_next: next_step(h, err, 2, 2.0),

@@ -169,6 +169,7 @@ mod tableau;
 
 use super::constrained::Mode;
 use super::problem::Problem;
+use super::step_control::{Predictive, Tolerances};
 use super::{Attempt, Control, State, Stepper};
 use crate::error::Failure;
 use crate::linalg::{C64, Field, Lu, Singular};
@@ -181,10 +182,6 @@ const THET: f64 = 0.001;
 /// h is kept (and the factorisations with it) when the proposed h_new/h is in [QUOT1, QUOT2]
 const QUOT1: f64 = 1.0;
 const QUOT2: f64 = 1.2;
-const SAFE: f64 = 0.9;
-/// bounds of q = h/h_new: h shrinks by at most 5 and grows by at most 8 per step
-const FACL: f64 = 5.0;
-const FACR: f64 = 0.125;
 
 const MATRIX_C: &str = "the Radau iteration matrix M + hλC + h²λ²K (complex λ)";
 const MATRIX_R: &str = "the Radau iteration matrix M + hγ₀C + h²γ₀²K (real γ₀)";
@@ -193,10 +190,9 @@ const MATRIX_C3: &str =
 const MATRIX_R3: &str =
     "the Radau index-3 iteration matrix [M + hγ₀C + h²γ₀²(K − ∂(Bᵀλ)/∂q), −Bᵀ; B, 0] (real γ₀)";
 
-/// Newton's κ and its iteration limit.
+/// The weights of Newton and of the error test, Newton's κ and its iteration limit.
 struct Tol {
-    rtol: f64,
-    atol: f64,
+    weights: Tolerances,
     kappa: f64,
     max_iterations: usize,
     adaptive: bool,
@@ -205,22 +201,26 @@ struct Tol {
 impl Tol {
     fn new(ctl: &Control, s: usize) -> Tol {
         match ctl.adaptive {
-            Some((rtol, atol)) => {
+            Some(Tolerances { rtol, atol }) => {
                 // RADAU5's transformation, generalised: the estimate is O(h^(s+1)), the error
                 // O(h^(2s))
                 let expm = (s + 1) as f64 / (2 * s) as f64;
                 let r = 0.1 * rtol.powf(expm);
                 Tol {
-                    rtol: r,
-                    atol: r * atol / rtol,
+                    weights: Tolerances {
+                        rtol: r,
+                        atol: r * atol / rtol,
+                    },
                     kappa: (10.0 * f64::EPSILON / r).max(ctl.newton.kappa.min(r.sqrt())),
                     max_iterations: ctl.newton.max_iterations,
                     adaptive: true,
                 }
             }
             None => Tol {
-                rtol: ctl.newton.rtol,
-                atol: ctl.newton.atol,
+                weights: Tolerances {
+                    rtol: ctl.newton.rtol,
+                    atol: ctl.newton.atol,
+                },
                 kappa: ctl.newton.kappa,
                 // a failure is final at a fixed step: twice the iterations before giving up
                 max_iterations: 2 * ctl.newton.max_iterations,
@@ -286,9 +286,7 @@ pub(crate) struct Radau {
     /// step control
     first: bool,
     reject: bool,
-    naccpt: usize,
-    hacc: f64,
-    erracc: f64,
+    control: Predictive,
     /// index 3 (enabled in `start`): the number of constraints (0 otherwise) and |Φ_i| to
     /// reach in Newton
     nc: usize,
@@ -356,9 +354,7 @@ impl Radau {
             theta: THET,
             first: true,
             reject: false,
-            naccpt: 0,
-            hacc: 0.0,
-            erracc: 1e-2,
+            control: Predictive::new(s),
             nc: 0,
             tol_phi: f64::INFINITY,
             ainv: 0.0,
@@ -799,7 +795,6 @@ impl Radau {
         cur: &State,
         next: &State,
         h: f64,
-        ctl: &Control,
         tol: &Tol,
     ) -> f64 {
         let (s, n) = (self.k.s, self.n);
@@ -820,11 +815,7 @@ impl Radau {
         self.y0[n..].copy_from_slice(&cur.qd);
         self.y1[..n].copy_from_slice(&next.q);
         self.y1[n..].copy_from_slice(&next.qd);
-        let norm_ctl = Control {
-            adaptive: Some((tol.rtol, tol.atol)),
-            ..*ctl
-        };
-        let mut err = norm_ctl.error_norm(&self.err, &self.y0, &self.y1);
+        let mut err = tol.weights.error_norm(&self.err, &self.y0, &self.y1);
         if err >= 1.0 && (self.first || self.reject) {
             // RADAU5: replace f(y₀) by f(y₀ + err), which damps the estimate's stiff part
             for r in 0..n {
@@ -837,7 +828,7 @@ impl Radau {
                     self.rv[r] += g * (self.ax[r] - cur.qdd[r]);
                 }
                 self.filter(p, g);
-                err = norm_ctl.error_norm(&self.err, &self.y0, &self.y1);
+                err = tol.weights.error_norm(&self.err, &self.y0, &self.y1);
             }
         }
         err.max(1e-10)
@@ -879,7 +870,6 @@ impl Radau {
         cur: &State,
         next: &State,
         h: f64,
-        ctl: &Control,
         tol: &Tol,
     ) -> f64 {
         let (s, n, nc) = (self.k.s, self.n, self.nc);
@@ -907,11 +897,7 @@ impl Radau {
         self.y1[..n].copy_from_slice(&next.q);
         self.y1[n..2 * n].copy_from_slice(&next.qd);
         self.y1[2 * n..].copy_from_slice(&next.lambda[..nc]);
-        let norm_ctl = Control {
-            adaptive: Some((tol.rtol, tol.atol)),
-            ..*ctl
-        };
-        let mut err = norm_ctl.error_norm(&self.err, &self.y0, &self.y1);
+        let mut err = tol.weights.error_norm(&self.err, &self.y0, &self.y1);
         if err >= 1.0 && (self.first || self.reject) {
             // RADAU5: f(y₀ + err) in place of f(y₀); its velocity row, less M qdd₀, is
             // −(τ(q₀ + e_q, v₀ + e_v, qdd₀) − Bᵀ(λ₀ + e_λ)) up to O(e_q) terms
@@ -929,7 +915,7 @@ impl Radau {
                     self.bv[r] -= g * self.ax[r];
                 }
                 self.filter3(p, g, h);
-                err = norm_ctl.error_norm(&self.err, &self.y0, &self.y1);
+                err = tol.weights.error_norm(&self.err, &self.y0, &self.y1);
             }
         }
         err.max(1e-10)
@@ -966,7 +952,7 @@ impl<M: Model> Stepper<M> for Radau {
         self.h_prev = 0.0;
         self.first = true;
         self.reject = false;
-        self.naccpt = 0;
+        self.control.restart();
         self.faccon = 1.0;
         Ok(())
     }
@@ -982,8 +968,8 @@ impl<M: Model> Stepper<M> for Radau {
         let (s, n) = (self.k.s, self.n);
         let tol = Tol::new(ctl, s);
         for r in 0..n {
-            self.scq[r] = tol.atol + tol.rtol * cur.q[r].abs();
-            self.scv[r] = tol.atol + tol.rtol * cur.qd[r].abs();
+            self.scq[r] = tol.weights.atol + tol.weights.rtol * cur.q[r].abs();
+            self.scv[r] = tol.weights.atol + tol.weights.rtol * cur.qd[r].abs();
         }
         if self.nc > 0 {
             // λ and the velocities to the Newton tolerance, but not below their rounding
@@ -997,7 +983,9 @@ impl<M: Model> Stepper<M> for Radau {
                 self.scv[r] += noise * self.ainv;
             }
             for r in 0..self.nc {
-                self.scl[r] = tol.atol + tol.rtol * cur.lambda[r].abs() + noise * self.a2inv / h;
+                self.scl[r] = tol.weights.atol
+                    + tol.weights.rtol * cur.lambda[r].abs()
+                    + noise * self.a2inv / h;
             }
         }
         self.h_try = h;
@@ -1072,25 +1060,16 @@ impl<M: Model> Stepper<M> for Radau {
             return Ok(Attempt::Accepted { h_next: h });
         }
         let err = if nc > 0 {
-            self.estimate3(p, cur, next, h, ctl, &tol)
+            self.estimate3(p, cur, next, h, &tol)
         } else {
-            self.estimate(p, cur, next, h, ctl, &tol)
+            self.estimate(p, cur, next, h, &tol)
         };
         let nit = tol.max_iterations as f64;
-        let expo = 1.0 / (s as f64 + 1.0);
-        let fac = SAFE.min(SAFE * (1.0 + 2.0 * nit) / (newt as f64 + 2.0 * nit));
-        let mut quot = (err.powf(expo) / fac).clamp(FACR, FACL);
-        let mut h_new = h / quot;
+        let safe = Predictive::SAFETY;
+        let fac = safe.min(safe * (1.0 + 2.0 * nit) / (newt as f64 + 2.0 * nit));
+        let quot = self.control.quotient(err, fac);
         if err < 1.0 {
-            self.naccpt += 1;
-            if self.naccpt > 1 {
-                // Gustafsson's predictive controller
-                let facgus = (self.hacc / h) * (err * err / self.erracc).powf(expo) / SAFE;
-                quot = quot.max(facgus.clamp(FACR, FACL));
-                h_new = h / quot;
-            }
-            self.hacc = h;
-            self.erracc = err.max(1e-2);
+            let mut h_new = self.control.accept(h, err, quot);
             if self.reject {
                 h_new = h_new.min(h);
             }
@@ -1103,7 +1082,7 @@ impl<M: Model> Stepper<M> for Radau {
             self.need_jac = !keep_matrices;
             Ok(Attempt::Accepted { h_next: h_new })
         } else {
-            let h_next = if self.first { 0.1 * h } else { h_new };
+            let h_next = if self.first { 0.1 * h } else { h / quot };
             self.reject = true;
             self.need_jac = !self.jac_fresh;
             Ok(Attempt::RejectedError { h_next })

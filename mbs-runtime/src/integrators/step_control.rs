@@ -1,0 +1,422 @@
+//! Step-size control, shared by every adaptive scheme: the tolerances and the weighted error
+//! norm they define, the controllers that turn an error norm into the next step, and the
+//! first step.
+//!
+//! | controller | used by | rule |
+//! |---|---|---|
+//! | [`elementary_factor`] | Newmark family, BDF | h·safety·err^(−1/(k+1)) within bounds |
+//! | [`PiController`] | DOPRI5 | Hairer's PI form, err^(α)/err_old^β |
+//! | [`Predictive`] | Radau | RADAU5's, with Gustafsson's predictive correction |
+//! | [`initial_step`] | the driver | Hairer, Nørsett & Wanner, II.4 |
+//!
+//! An error norm ≤ 1 accepts the step; k is the order of the error estimate (local error
+//! ∝ h^(k+1)).
+
+use super::State;
+use crate::options::Options;
+
+/// Relative and absolute tolerance of the local error: a component y_i of error e_i counts as
+/// e_i / (atol + rtol·|y_i|).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Tolerances {
+    pub rtol: f64,
+    pub atol: f64,
+}
+
+impl Tolerances {
+    /// Weighted RMS norm of an error vector e against the state scales y0, y1:
+    /// sqrt(mean (e_i / (atol + rtol·max(|y0_i|, |y1_i|)))²).
+    pub fn error_norm(&self, e: &[f64], y0: &[f64], y1: &[f64]) -> f64 {
+        let (rtol, atol) = (self.rtol, self.atol);
+        let mut s = 0.0;
+        for i in 0..e.len() {
+            let w = atol + rtol * y0[i].abs().max(y1[i].abs());
+            s += (e[i] / w) * (e[i] / w);
+        }
+        (s / e.len().max(1) as f64).sqrt()
+    }
+}
+
+/// err^(−1/(k+1)): the factor on h that brings the error of an estimate of order k to 1.
+pub(crate) fn optimal_factor(err: f64, order: usize) -> f64 {
+    err.powf(-1.0 / (order as f64 + 1.0))
+}
+
+/// The elementary controller: h_new/h = safety·err^(−1/(k+1)) within [min, max]; an error
+/// of zero gives `max`, a non-finite one `min`.
+pub(crate) fn elementary_factor(err: f64, order: usize, safety: f64, min: f64, max: f64) -> f64 {
+    if err.is_nan() {
+        return min;
+    }
+    (safety * optimal_factor(err, order)).clamp(min, max)
+}
+
+/// Next step from an error norm with the elementary controller at safety 0.9, shrinking at
+/// most 5-fold and growing at most `fmax`-fold.
+pub(crate) fn next_step(h: f64, err: f64, order: usize, fmax: f64) -> f64 {
+    h * elementary_factor(err, order, 0.9, 0.2, fmax)
+}
+
+/// What a controller decided on an attempt, with the step to try next.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Decision {
+    Accept { h_next: f64 },
+    Reject { h_next: f64 },
+}
+
+/// Hairer's PI controller (DOPRI5, Hairer, Nørsett & Wanner I, II.4):
+/// h_new = h·0.9·err^(−α)·err_old^β, α = 1/(k+1) − 0.75β, the factor h/h_new within
+/// [0.1, 5]; no growth right after a rejection. A rejected step uses the elementary part only.
+#[derive(Clone, Debug)]
+pub(crate) struct PiController {
+    alpha: f64,
+    beta: f64,
+    /// error norm of the last accepted step (floored at 1e-4)
+    err_old: f64,
+    /// the last attempt was rejected
+    rejected: bool,
+}
+
+impl PiController {
+    /// For an error estimate of order `order`, with integral gain `beta` (DOPRI5: 4, 0.04).
+    pub fn new(order: usize, beta: f64) -> PiController {
+        PiController {
+            alpha: 1.0 / (order as f64 + 1.0) - 0.75 * beta,
+            beta,
+            err_old: 1e-4,
+            rejected: false,
+        }
+    }
+
+    /// The verdict on a step of size h with error norm `err`.
+    pub fn decide(&mut self, h: f64, err: f64) -> Decision {
+        let fac11 = err.powf(self.alpha);
+        let fac = (fac11 / self.err_old.powf(self.beta) / 0.9).clamp(0.1, 5.0);
+        if err <= 1.0 {
+            self.err_old = err.max(1e-4);
+            let mut h_next = h / fac;
+            if self.rejected {
+                h_next = h_next.min(h);
+            }
+            self.rejected = false;
+            Decision::Accept { h_next }
+        } else {
+            self.rejected = true;
+            Decision::Reject {
+                h_next: h / (fac11 / 0.9).min(5.0),
+            }
+        }
+    }
+
+    /// The attempt was rejected for another reason than its error (no growth after it).
+    pub fn rejected_otherwise(&mut self) {
+        self.rejected = true;
+    }
+}
+
+/// RADAU5's controller (Hairer & Wanner II, IV.8): the quotient q = h/h_new =
+/// err^(1/(k+1))/fac within [1/8, 5], fac the safety factor the caller gives (RADAU5 lowers it
+/// with the Newton iterations), and on accepted steps after the first Gustafsson's predictive
+/// correction (ACM TOMS 20, 1994): q ← max(q, (h_acc/h)(err²/err_acc)^(1/(k+1))/0.9), h_acc
+/// and err_acc those of the previous accepted step.
+#[derive(Clone, Debug)]
+pub(crate) struct Predictive {
+    expo: f64,
+    accepted: usize,
+    h_acc: f64,
+    err_acc: f64,
+}
+
+impl Predictive {
+    pub const SAFETY: f64 = 0.9;
+    /// bounds of q = h/h_new: h shrinks by at most 5 and grows by at most 8 per step
+    const MAX_QUOT: f64 = 5.0;
+    const MIN_QUOT: f64 = 0.125;
+
+    /// For an error estimate of order `order`.
+    pub fn new(order: usize) -> Predictive {
+        Predictive {
+            expo: 1.0 / (order as f64 + 1.0),
+            accepted: 0,
+            h_acc: 0.0,
+            err_acc: 1e-2,
+        }
+    }
+
+    /// Forgets the accepted steps (a restart).
+    pub fn restart(&mut self) {
+        self.accepted = 0;
+    }
+
+    /// The elementary quotient h/h_new for an error norm `err` with safety factor `fac`.
+    pub fn quotient(&self, err: f64, fac: f64) -> f64 {
+        (err.powf(self.expo) / fac).clamp(Self::MIN_QUOT, Self::MAX_QUOT)
+    }
+
+    /// An accepted step h of error `err` whose elementary quotient is `quot`: the step to
+    /// try next, with the predictive correction from the second accepted step on.
+    pub fn accept(&mut self, h: f64, err: f64, quot: f64) -> f64 {
+        let mut quot = quot;
+        self.accepted += 1;
+        if self.accepted > 1 {
+            let facgus =
+                (self.h_acc / h) * (err * err / self.err_acc).powf(self.expo) / Self::SAFETY;
+            quot = quot.max(facgus.clamp(Self::MIN_QUOT, Self::MAX_QUOT));
+        }
+        self.h_acc = h;
+        self.err_acc = err.max(1e-2);
+        h / quot
+    }
+}
+
+/// The bounds of a first step: the span of the run, h_max and h_min.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct StepBounds {
+    pub span: f64,
+    pub h_max: f64,
+    pub h_min: f64,
+}
+
+impl StepBounds {
+    pub fn of(o: &Options) -> StepBounds {
+        StepBounds {
+            span: o.t_end - o.t0,
+            h_max: o.h_max,
+            h_min: o.h_min(),
+        }
+    }
+}
+
+/// First step of adaptive schemes (Hairer, Nørsett & Wanner I, II.4): from the sizes of y, f
+/// and of f's change over a trial Euler step, for a method of order `order`, within `b`.
+/// `accel(t, q, qd, qdd)` evaluates the accelerations (false when it fails: the trial step's
+/// size is then taken). Allocates: called once per run.
+pub(crate) fn initial_step(
+    s: &State,
+    tol: Tolerances,
+    order: usize,
+    b: StepBounds,
+    mut accel: impl FnMut(f64, &[f64], &[f64], &mut [f64]) -> bool,
+) -> f64 {
+    let Tolerances { rtol, atol } = tol;
+    let n = s.q.len();
+    let w = |y: f64| atol + rtol * y.abs();
+    let norm = |a: &[f64], b: &[f64], ya: &[f64], yb: &[f64]| {
+        let ss: f64 = (0..n)
+            .map(|i| (a[i] / w(ya[i])).powi(2) + (b[i] / w(yb[i])).powi(2))
+            .sum();
+        (ss / (2 * n).max(1) as f64).sqrt()
+    };
+    let d0 = norm(&s.q, &s.qd, &s.q, &s.qd);
+    let d1 = norm(&s.qd, &s.qdd, &s.q, &s.qd);
+    let mut h0 = if d0 < 1e-5 || d1 < 1e-5 {
+        1e-6
+    } else {
+        0.01 * d0 / d1
+    };
+    h0 = h0.min(b.span).min(b.h_max);
+    let q1: Vec<f64> = (0..n).map(|i| s.q[i] + h0 * s.qd[i]).collect();
+    let v1: Vec<f64> = (0..n).map(|i| s.qd[i] + h0 * s.qdd[i]).collect();
+    let mut a1 = vec![0.0; n];
+    if !accel(s.t + h0, &q1, &v1, &mut a1) {
+        return h0;
+    }
+    let dv: Vec<f64> = (0..n).map(|i| (v1[i] - s.qd[i]) / h0).collect();
+    let da: Vec<f64> = (0..n).map(|i| (a1[i] - s.qdd[i]) / h0).collect();
+    let d2 = norm(&dv, &da, &s.q, &s.qd);
+    let h1 = if d1.max(d2) <= 1e-15 {
+        (h0 * 1e-3).max(1e-6)
+    } else {
+        (0.01 / d1.max(d2)).powf(1.0 / (order as f64 + 1.0))
+    };
+    (100.0 * h0).min(h1).min(b.span).min(b.h_max).max(b.h_min)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn close(a: f64, b: f64) -> bool {
+        (a - b).abs() <= 1e-14 * a.abs().max(b.abs())
+    }
+
+    #[test]
+    fn error_norm_weighs_each_component_by_the_larger_state() {
+        let tol = Tolerances {
+            rtol: 1e-3,
+            atol: 1e-6,
+        };
+        // weights 1e-6 + 1e-3·2 and 1e-6 + 1e-3·0.5
+        let e = [2.001e-3, -1.002e-3];
+        let n = tol.error_norm(&e, &[2.0, -0.5], &[1.0, 0.25]);
+        assert!(close(n, ((1.0 + 4.0) / 2.0f64).sqrt()), "{n}");
+        assert_eq!(tol.error_norm(&[], &[], &[]), 0.0);
+    }
+
+    #[test]
+    fn elementary_controller_scales_with_the_order_and_stays_in_bounds() {
+        // an error 2^(k+1) asks for half the step, times the safety factor
+        for k in 1..=5 {
+            let err = 2f64.powi(k as i32 + 1);
+            assert!(close(elementary_factor(err, k, 0.9, 0.2, 5.0), 0.45));
+        }
+        assert!(close(elementary_factor(1.0, 3, 0.9, 0.2, 5.0), 0.9));
+        assert_eq!(elementary_factor(0.0, 2, 0.9, 0.2, 2.0), 2.0);
+        assert_eq!(elementary_factor(1e30, 2, 0.9, 0.2, 2.0), 0.2);
+        assert_eq!(elementary_factor(f64::INFINITY, 2, 0.9, 0.2, 2.0), 0.2);
+        assert_eq!(elementary_factor(f64::NAN, 2, 0.9, 0.2, 2.0), 0.2);
+        assert!(close(next_step(0.1, 8.0, 2, 1.0), 0.1 * 0.45));
+        assert_eq!(next_step(0.1, 1e-12, 2, 2.0), 0.2);
+    }
+
+    #[test]
+    fn pi_controller_is_hairers() {
+        let mut pi = PiController::new(4, 0.04);
+        let alpha = 0.2 - 0.75 * 0.04;
+        // the first step remembers err_old = 1e-4
+        let err = 0.5f64;
+        let fac = (err.powf(alpha) / 1e-4f64.powf(0.04) / 0.9).clamp(0.1, 5.0);
+        assert_eq!(
+            pi.decide(0.01, err),
+            Decision::Accept { h_next: 0.01 / fac }
+        );
+        // then err_old = 0.5: a smaller error grows the step less than without memory
+        let err2 = 0.1f64;
+        let fac2 = (err2.powf(alpha) / 0.5f64.powf(0.04) / 0.9).clamp(0.1, 5.0);
+        assert_eq!(
+            pi.decide(0.02, err2),
+            Decision::Accept {
+                h_next: 0.02 / fac2
+            }
+        );
+        // a rejection: the elementary part only, shrinking at most 5-fold
+        let Decision::Reject { h_next } = pi.decide(0.02, 3.0) else {
+            panic!("an error of 3 is rejected")
+        };
+        assert!(close(h_next, 0.02 / (3f64.powf(alpha) / 0.9)));
+        assert_eq!(
+            pi.decide(0.02, 1e12),
+            Decision::Reject { h_next: 0.02 / 5.0 }
+        );
+        // no growth right after a rejection, even for a tiny error
+        assert_eq!(pi.decide(0.004, 1e-8), Decision::Accept { h_next: 0.004 });
+        // growth is bounded by 10 per step
+        let Decision::Accept { h_next } = pi.decide(0.004, 1e-12) else {
+            panic!("a tiny error is accepted")
+        };
+        assert!(close(h_next, 0.04));
+        pi.rejected_otherwise();
+        assert_eq!(pi.decide(0.01, 1e-12), Decision::Accept { h_next: 0.01 });
+    }
+
+    #[test]
+    fn predictive_controller_is_radau5s() {
+        let mut c = Predictive::new(3);
+        let expo = 0.25;
+        // the quotient h/h_new, within [1/8, 5]
+        assert!(close(c.quotient(0.5, 0.9), 0.5f64.powf(expo) / 0.9));
+        assert_eq!(c.quotient(1e-30, 0.9), 0.125);
+        assert_eq!(c.quotient(1e30, 0.9), 5.0);
+        // first accepted step: the elementary quotient
+        let q1 = c.quotient(0.5, 0.9);
+        assert_eq!(c.accept(0.01, 0.5, q1), 0.01 / q1);
+        // second: Gustafsson's correction, (h_acc/h)(err²/err_acc)^(1/(k+1))/0.9, when larger
+        let q2 = c.quotient(0.8, 0.9);
+        let gus = (0.01 / 0.02) * (0.8f64 * 0.8 / 0.5).powf(expo) / 0.9;
+        assert!(gus < q2);
+        assert_eq!(c.accept(0.02, 0.8, q2), 0.02 / q2);
+        // an error that grew a lot since the last step: the prediction cuts harder
+        let q3 = c.quotient(0.9, 0.9);
+        let gus = (0.02 / 0.01) * (0.9f64 * 0.9 / 0.8).powf(expo) / 0.9;
+        assert!(gus > q3);
+        assert!(close(c.accept(0.01, 0.9, q3), 0.01 / gus));
+        // a restart forgets the history
+        c.restart();
+        assert_eq!(c.accept(0.01, 0.9, q3), 0.01 / q3);
+    }
+
+    fn state(q: f64, qd: f64, qdd: f64) -> State {
+        State {
+            t: 0.0,
+            q: vec![q],
+            qd: vec![qd],
+            qdd: vec![qdd],
+            lambda: vec![],
+        }
+    }
+
+    const WIDE: StepBounds = StepBounds {
+        span: 10.0,
+        h_max: f64::INFINITY,
+        h_min: 0.0,
+    };
+
+    #[test]
+    fn first_step_follows_hairer_norsett_wanner() {
+        let tol = Tolerances {
+            rtol: 1e-3,
+            atol: 1e-6,
+        };
+        // y'' = −y from q = 1, qd = 0: y = (1, 0), f = (0, −1), weights (1.001e-3, 1e-6)
+        let s = state(1.0, 0.0, -1.0);
+        let d0 = (1.0 / 1.001e-3) / 2f64.sqrt();
+        let d1 = (1.0 / 1e-6) / 2f64.sqrt();
+        let h0 = 0.01 * d0 / d1;
+        // after the Euler step (1, −h0): f changes by (−h0, 0)/h0 = (−1, 0)
+        let d2 = (1.0 / 1.001e-3) / 2f64.sqrt();
+        let h1 = (0.01 / d1.max(d2)).powf(1.0 / 5.0);
+        let h = initial_step(&s, tol, 4, WIDE, |_, q, _, a| {
+            a[0] = -q[0];
+            true
+        });
+        assert!(close(h, (100.0 * h0).min(h1)), "{h}");
+        // order 1: h1 = (0.01/d1)^(1/2) is now the smaller one
+        let h = initial_step(&s, tol, 1, WIDE, |_, q, _, a| {
+            a[0] = -q[0];
+            true
+        });
+        let h1 = (0.01 / d1).sqrt();
+        assert!(h1 < 100.0 * h0 && close(h, h1), "{h}");
+    }
+
+    #[test]
+    fn first_step_respects_its_bounds_and_a_failed_trial() {
+        let tol = Tolerances {
+            rtol: 1e-6,
+            atol: 1e-8,
+        };
+        let s = state(0.0, 0.0, 0.0);
+        // a state at rest: the trial step is 1e-6, f does not change: h = max(1e-9, 1e-6)
+        let h = initial_step(&s, tol, 2, WIDE, |_, _, _, a| {
+            a[0] = 0.0;
+            true
+        });
+        assert_eq!(h, 1e-6);
+        let b = StepBounds {
+            span: 10.0,
+            h_max: f64::INFINITY,
+            h_min: 1e-3,
+        };
+        assert_eq!(initial_step(&s, tol, 2, b, |_, _, _, _| true), 1e-3);
+        // a failed trial evaluation: the trial step itself
+        let s = state(1.0, 1.0, 1.0);
+        let h = initial_step(&s, tol, 2, WIDE, |_, _, _, _| false);
+        assert_eq!(h, 0.01);
+        let b = StepBounds {
+            span: 1e-4,
+            h_max: f64::INFINITY,
+            h_min: 0.0,
+        };
+        assert_eq!(initial_step(&s, tol, 2, b, |_, _, _, _| false), 1e-4);
+        let b = StepBounds {
+            span: 10.0,
+            h_max: 1e-5,
+            h_min: 0.0,
+        };
+        let h = initial_step(&s, tol, 2, b, |_, _, _, a| {
+            a[0] = 1.0;
+            true
+        });
+        assert_eq!(h, 1e-5);
+    }
+}

@@ -1,0 +1,652 @@
+//! The driver every scheme runs under: `Simulation` validates the options, starts from a
+//! consistent state, proposes steps, lands on stop and sample times, records outputs and
+//! turns failures into `SimError`s.
+
+use super::constrained::{Assembly, Constrained, Mode, assemble};
+use super::dispatch::{constraint_mode, stepper_for};
+use super::inputs::{Controller, Inputs};
+use super::newton::NewtonTol;
+use super::problem::Problem;
+use super::step_control::{StepBounds, Tolerances, initial_step};
+use super::stepper::{Attempt, Control, Stepper};
+use super::{Integrator, State};
+use crate::error::{Failure, SimError};
+use crate::model::{Model, Pose};
+use crate::options::{Options, Output, Scheme, StepControl};
+use crate::stats::Stats;
+use crate::trajectory::{Observer, Trajectory};
+
+/// Runs `scheme` on `model` with `options` to the end; on failure, the error keeps the
+/// trajectory up to the failure.
+pub fn simulate<M: Model + 'static>(
+    model: M,
+    scheme: Scheme,
+    options: Options,
+) -> Result<(Trajectory, Stats), SimError> {
+    simulate_with(model, scheme, options, Inputs::default())
+}
+
+/// [`simulate`] with inputs driven by time functions and sampled controllers.
+pub fn simulate_with<M: Model + 'static>(
+    model: M,
+    scheme: Scheme,
+    options: Options,
+    inputs: Inputs,
+) -> Result<(Trajectory, Stats), SimError> {
+    let mut sim = Simulation::with_inputs(model, scheme, options, inputs)?;
+    let t_end = sim.options.t_end;
+    sim.integrate_to(t_end)?;
+    Ok(sim.finish())
+}
+
+/// A running simulation: the model, the scheme, the state, the outputs and the work done.
+pub struct Simulation<M: Model> {
+    problem: Problem<M>,
+    stepper: Box<dyn Stepper<M>>,
+    scheme: Scheme,
+    options: Options,
+    ctl: Control,
+    cur: State,
+    next: State,
+    prev: State,
+    scratch: State,
+    h: f64,
+    attempts: usize,
+    /// why the last attempt was rejected, when an evaluation failed (reported if h collapses)
+    last_cause: Option<Failure>,
+    traj: Trajectory,
+    /// pending output times (for `Output::Every` and `Times`), next one first
+    out_times: Vec<f64>,
+    out_next: usize,
+    poses: Vec<Pose>,
+    observers: Vec<Box<dyn Observer>>,
+    assembly: Option<Assembly>,
+    /// sampled controllers: period, samples taken, the controller
+    controllers: Vec<(f64, u64, Box<dyn Controller>)>,
+}
+
+impl<M: Model + 'static> Simulation<M> {
+    /// Validates everything, then starts from a consistent state: the given or declared q0,
+    /// qd0 and qdd0 from M qdd = h.
+    pub fn new(model: M, scheme: Scheme, options: Options) -> Result<Simulation<M>, SimError> {
+        Simulation::with_inputs(model, scheme, options, Inputs::default())
+    }
+
+    /// [`Simulation::new`] with inputs driven by a time function and sampled controllers
+    /// (sampled a first time at t₀, before the start's accelerations).
+    pub fn with_inputs(
+        model: M,
+        scheme: Scheme,
+        options: Options,
+        inputs: Inputs,
+    ) -> Result<Simulation<M>, SimError> {
+        let names = Names::of(&model);
+        let early = |kind: Failure, stats: Stats| names.failure_at_start(kind, options.t0, stats);
+        validate(&model, &scheme, &options, &inputs).map_err(|e| early(e, Stats::default()))?;
+        let mut problem = Problem::new(model, options.iteration_matrix);
+        problem.input_fn = inputs.function;
+        let mut controllers: Vec<(f64, u64, Box<dyn Controller>)> = inputs
+            .controllers
+            .into_iter()
+            .map(|(p, c)| (p, 0, c))
+            .collect();
+        if let Scheme::Bdf(p) = scheme {
+            // the order history is counted per order: sized now, not while stepping
+            problem.stats.order_steps = vec![0; p.max_order];
+        }
+        let mut cur = State::zeros(M::NQ, M::NC);
+        let start = initial_state(&mut problem, &options, &mut cur)
+            .and_then(|_| consistent_start(&mut problem, &scheme, &options, &mut cur))
+            .and_then(|assembly| {
+                first_sample(
+                    &mut problem,
+                    &mut controllers,
+                    options.singularity_tol,
+                    &mut cur,
+                )?;
+                Ok(assembly)
+            });
+        let assembly = start.map_err(|e| early(e, problem.stats.clone()))?;
+        let ctl = control(&options);
+        let mut stepper = stepper_for::<M>(&scheme, M::NQ);
+        if let Err(e) = stepper.start(&mut problem, &cur, &ctl) {
+            return Err(early(e, problem.stats.clone()));
+        }
+        let h = match options.step {
+            StepControl::Fixed { h } => h,
+            StepControl::Adaptive { h0: Some(h0), .. } => h0,
+            StepControl::Adaptive { rtol, atol, .. } => initial_step(
+                &cur,
+                Tolerances { rtol, atol },
+                scheme.order(),
+                StepBounds::of(&options),
+                |t, q, qd, qdd| problem.accel(t, q, qd, qdd).is_ok(),
+            ),
+        };
+        let out_times = output_times(&options);
+        let mut traj = names.trajectory();
+        let expected = match &options.output {
+            Output::Steps => 1024,
+            Output::Last => 1,
+            _ => out_times.len(),
+        };
+        traj.reserve(expected, options.energy, options.frames);
+        let mut sim = Simulation {
+            problem,
+            stepper,
+            scheme,
+            ctl,
+            next: cur.clone(),
+            prev: cur.clone(),
+            scratch: cur.clone(),
+            cur,
+            h: h.min(options.h_max),
+            attempts: 0,
+            last_cause: None,
+            traj,
+            out_times,
+            out_next: 0,
+            poses: vec![Pose::default(); M::NFRAMES],
+            observers: Vec::new(),
+            options,
+            assembly,
+            controllers,
+        };
+        sim.outputs_at_start();
+        Ok(sim)
+    }
+
+    /// Outputs at t₀.
+    fn outputs_at_start(&mut self) {
+        match self.options.output {
+            Output::Steps => self.record_cur(),
+            Output::Last => {}
+            _ => {
+                while self.out_next < self.out_times.len()
+                    && self.out_times[self.out_next] <= self.cur.t
+                {
+                    self.out_next += 1;
+                    self.record_cur();
+                }
+            }
+        }
+    }
+
+    /// Adds an observer that sees every output as it is recorded.
+    pub fn observe(&mut self, o: impl Observer + 'static) {
+        self.observers.push(Box::new(o));
+    }
+
+    /// The scheme.
+    pub fn scheme(&self) -> Scheme {
+        self.scheme
+    }
+
+    /// The model.
+    pub fn model(&self) -> &M {
+        &self.problem.model
+    }
+
+    /// How the start was made consistent (constrained models only): residuals before and
+    /// after, iterations, the largest change.
+    pub fn assembly(&self) -> Option<&Assembly> {
+        self.assembly.as_ref()
+    }
+
+    /// The independent coordinates of coordinate partitioning, as they are now (empty for
+    /// other methods).
+    pub fn independent_coordinates(&self) -> Vec<String> {
+        match &self.problem.con {
+            Some(c) if c.mode == Mode::Partitioning => c.independent_labels(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// The step the next attempt will use.
+    pub fn h(&self) -> f64 {
+        self.h
+    }
+
+    /// Trajectory and work counters (records the final state for `Output::Last`).
+    pub fn finish(mut self) -> (Trajectory, Stats) {
+        if self.options.output == Output::Last && self.traj.is_empty() {
+            self.record_cur();
+        }
+        self.problem.stats.user_efforts = self.problem.model.user_evaluations();
+        (self.traj, self.problem.stats)
+    }
+
+    fn record(&mut self, s: &State) {
+        self.traj.push(s.t, &s.q, &s.qd, &s.qdd, &s.lambda);
+        if self.options.energy {
+            let e = self.problem.energy(s.t, &s.q, &s.qd);
+            self.traj.energy.push(e);
+        }
+        if self.options.frames {
+            self.problem.model.frames(s.t, &s.q, &mut self.poses);
+            self.traj.poses.extend_from_slice(&self.poses);
+        }
+        for o in self.observers.iter_mut() {
+            o.observe(s.t, &s.q, &s.qd, &s.qdd);
+        }
+    }
+
+    fn record_cur(&mut self) {
+        let s = std::mem::replace(&mut self.cur, State::zeros(0, 0));
+        self.record(&s);
+        self.cur = s;
+    }
+
+    fn fail(&self, kind: Failure, h: f64) -> SimError {
+        let mut stats = self.problem.stats.clone();
+        stats.user_efforts = self.problem.model.user_evaluations();
+        SimError {
+            kind,
+            t: self.cur.t,
+            h,
+            stats: Box::new(stats),
+            trajectory: Box::new(self.traj.clone()),
+        }
+    }
+
+    /// Outputs in (prev.t, cur.t] after an accepted step.
+    fn outputs_after_step(&mut self) {
+        match self.options.output {
+            Output::Steps => self.record_cur(),
+            Output::Last => {}
+            _ => {
+                while self.out_next < self.out_times.len()
+                    && self.out_times[self.out_next] <= self.cur.t
+                {
+                    let t = self.out_times[self.out_next];
+                    self.out_next += 1;
+                    let mut s = std::mem::replace(&mut self.scratch, State::zeros(0, 0));
+                    if t == self.cur.t {
+                        s.copy_from(&self.cur);
+                    } else {
+                        self.stepper.interpolate(&self.prev, &self.cur, t, &mut s);
+                    }
+                    self.record(&s);
+                    self.scratch = s;
+                }
+            }
+        }
+    }
+
+    /// The next sample instant of any controller (infinite without).
+    fn next_sample(&self) -> f64 {
+        let t0 = self.options.t0;
+        self.controllers
+            .iter()
+            .map(|(p, k, _)| t0 + *k as f64 * p)
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// At a sample instant: the due controllers write their outputs, then qdd and λ of the
+    /// current state are computed again and the scheme restarts from it.
+    fn sample(&mut self) -> Result<(), Failure> {
+        let (t0, t) = (self.options.t0, self.cur.t);
+        let mut any = false;
+        for (p, k, c) in self.controllers.iter_mut() {
+            let due = t0 + *k as f64 * *p;
+            if due <= t + 1e-12 * t.abs().max(1.0) {
+                c.sample(t, &self.cur, &mut self.problem.held);
+                *k += 1;
+                self.problem.stats.samples += 1;
+                any = true;
+            }
+        }
+        if !any {
+            return Ok(());
+        }
+        self.problem.inputs_changed();
+        self.problem
+            .accel(t, &self.cur.q, &self.cur.qd, &mut self.cur.qdd)?;
+        if let Some(c) = &self.problem.con {
+            self.cur.lambda.copy_from_slice(&c.lambda);
+        }
+        self.stepper.start(&mut self.problem, &self.cur, &self.ctl)
+    }
+
+    fn step_until(&mut self, t_stop: f64) -> Result<(), SimError> {
+        let h_min = self.options.h_min();
+        let fixed = matches!(self.options.step, StepControl::Fixed { .. });
+        // controllers are sampled exactly at their instants
+        let t_stop = t_stop.min(self.next_sample());
+        loop {
+            if self.attempts >= self.options.max_steps {
+                return Err(self.fail(
+                    Failure::TooMuchWork {
+                        max_steps: self.options.max_steps,
+                    },
+                    self.h,
+                ));
+            }
+            let remaining = t_stop - self.cur.t;
+            let mut h = self.h.min(self.options.h_max);
+            let t_next = if fixed {
+                // fixed steps stay on the grid t0 + k h, whatever the rounding of sums
+                let k = ((self.cur.t - self.options.t0) / h + 1e-9).floor();
+                self.options.t0 + (k + 1.0) * h
+            } else {
+                self.cur.t + h
+            };
+            // land on t_stop exactly, without leaving a sliver of a step behind
+            let last = t_next >= t_stop - 1e-9 * h
+                || (!fixed && h > 0.5 * remaining && remaining - h < 0.1 * h);
+            if last {
+                h = remaining;
+            } else if fixed {
+                h = t_next - self.cur.t;
+            }
+            if h < h_min && !last {
+                // the cause of the rejections that shrank the step, when there is one
+                let kind = self
+                    .last_cause
+                    .take()
+                    .unwrap_or(Failure::StepTooSmall { h_min });
+                return Err(self.fail(kind, h));
+            }
+            self.attempts += 1;
+            let result =
+                self.stepper
+                    .attempt(&mut self.problem, &self.cur, h, &self.ctl, &mut self.next);
+            match result {
+                Err(kind) => return Err(self.fail(kind, h)),
+                Ok(Attempt::Accepted { h_next }) => {
+                    self.next.t = if last {
+                        t_stop
+                    } else if fixed {
+                        t_next
+                    } else {
+                        self.cur.t + h
+                    };
+                    if let Err(kind) = self
+                        .problem
+                        .after_step(&mut self.next)
+                        .and_then(|_| self.check_next())
+                    {
+                        return Err(self.fail(kind, h));
+                    }
+                    self.problem.stats.record_step(h);
+                    self.problem.stats.user_efforts = self.problem.model.user_evaluations();
+                    self.last_cause = None;
+                    self.prev.copy_from(&self.cur);
+                    std::mem::swap(&mut self.cur, &mut self.next);
+                    self.stepper
+                        .accepted(&mut self.problem, &self.prev, &self.cur);
+                    self.outputs_after_step();
+                    if self.cur.t == t_stop && !self.controllers.is_empty() {
+                        if let Err(kind) = self.sample() {
+                            return Err(self.fail(kind, h));
+                        }
+                    }
+                    if !fixed {
+                        // a shortened last step says nothing about the next one
+                        self.h = if last {
+                            self.h.max(h_next.min(self.h * 5.0))
+                        } else {
+                            h_next
+                        };
+                    }
+                    return Ok(());
+                }
+                Ok(Attempt::RejectedError { h_next }) => {
+                    // only adaptive schemes test errors
+                    self.problem.stats.rejected_error += 1;
+                    self.h = h_next;
+                }
+                Ok(Attempt::RejectedNewton {
+                    h_next,
+                    iterations,
+                    correction,
+                    cause,
+                }) => {
+                    self.problem.stats.rejected_newton += 1;
+                    // a user effort's own error does not go away with a smaller step (a
+                    // singular configuration met by a trial iterate may: the step shrinks,
+                    // and the failure is reported if it collapses)
+                    let fatal = matches!(
+                        cause,
+                        Some(Failure::UserEffort { .. })
+                            | Some(Failure::NonFinite {
+                                quantity: "user effort",
+                                ..
+                            })
+                    );
+                    if fixed || h <= h_min || fatal {
+                        let kind = cause.unwrap_or(Failure::NewtonDiverged {
+                            iterations,
+                            correction,
+                        });
+                        return Err(self.fail(kind, h));
+                    }
+                    self.last_cause = cause;
+                    self.h = h_next.max(h_min);
+                }
+            }
+        }
+    }
+
+    fn check_next(&self) -> Result<(), Failure> {
+        self.problem.check("q", &self.next.q)?;
+        self.problem.check("qd", &self.next.qd)?;
+        self.problem.check("qdd", &self.next.qdd)?;
+        match self.next.lambda.iter().position(|x| !x.is_finite()) {
+            None => Ok(()),
+            Some(i) => Err(Failure::NonFinite {
+                quantity: "λ",
+                coordinate: format!(
+                    "of constraint `{}`",
+                    self.problem.model.info().constraints[i]
+                ),
+            }),
+        }
+    }
+}
+
+impl<M: Model + 'static> Integrator for Simulation<M> {
+    fn step(&mut self) -> Result<(), SimError> {
+        if self.cur.t >= self.options.t_end {
+            return Ok(());
+        }
+        let t_end = self.options.t_end;
+        self.step_until(t_end)
+    }
+
+    fn integrate_to(&mut self, t: f64) -> Result<(), SimError> {
+        let t = t.min(self.options.t_end);
+        while self.cur.t < t {
+            self.step_until(t)?;
+        }
+        Ok(())
+    }
+
+    fn state(&self) -> &State {
+        &self.cur
+    }
+
+    fn stats(&self) -> &Stats {
+        &self.problem.stats
+    }
+
+    fn trajectory(&self) -> &Trajectory {
+        &self.traj
+    }
+}
+
+/// The names a trajectory carries: coordinates, frames, constraints.
+struct Names {
+    dofs: Vec<String>,
+    frames: Vec<String>,
+    constraints: Vec<String>,
+}
+
+impl Names {
+    fn of<M: Model>(model: &M) -> Names {
+        let info = model.info();
+        let own = |v: &[&str]| v.iter().map(|s| s.to_string()).collect();
+        Names {
+            dofs: own(info.dofs),
+            frames: own(info.frames),
+            constraints: own(info.constraints),
+        }
+    }
+
+    fn trajectory(&self) -> Trajectory {
+        Trajectory::new(
+            self.dofs.clone(),
+            self.frames.clone(),
+            self.constraints.clone(),
+        )
+    }
+
+    /// A failure before the first step: at t₀, with an empty trajectory.
+    fn failure_at_start(&self, kind: Failure, t0: f64, stats: Stats) -> SimError {
+        SimError {
+            kind,
+            t: t0,
+            h: 0.0,
+            stats: Box::new(stats),
+            trajectory: Box::new(self.trajectory()),
+        }
+    }
+}
+
+/// The options against the scheme and the model, the parameters, and the inputs against the
+/// model.
+fn validate<M: Model>(
+    model: &M,
+    scheme: &Scheme,
+    options: &Options,
+    inputs: &Inputs,
+) -> Result<(), Failure> {
+    options.validate(scheme, M::NQ, model.info().has_tangents)?;
+    crate::model::Parameters::validate(model.params()).map_err(Failure::InvalidParameters)?;
+    let driven = inputs.function.is_some() || !inputs.controllers.is_empty();
+    if driven && M::NU == 0 {
+        return Err(Failure::InvalidOption {
+            name: "inputs",
+            value: format!("{} controllers", inputs.controllers.len()),
+            reason: "the model has no inputs u: use `u[k]` in its forces, torques or generalised forces",
+        });
+    }
+    if let Some((p, _)) = inputs
+        .controllers
+        .iter()
+        .find(|(p, _)| !(*p > 0.0) || !p.is_finite())
+    {
+        return Err(Failure::InvalidOption {
+            name: "controller period",
+            value: p.to_string(),
+            reason: "must be > 0 and finite",
+        });
+    }
+    Ok(())
+}
+
+/// t₀ and the given or declared q₀, qd₀ into `cur`, checked finite.
+fn initial_state<M: Model>(
+    problem: &mut Problem<M>,
+    options: &Options,
+    cur: &mut State,
+) -> Result<(), Failure> {
+    cur.t = options.t0;
+    problem.model.initial_state(&mut cur.q, &mut cur.qd);
+    if let Some(q0) = &options.q0 {
+        cur.q.copy_from_slice(q0);
+    }
+    if let Some(qd0) = &options.qd0 {
+        cur.qd.copy_from_slice(qd0);
+    }
+    problem.check("q0", &cur.q)?;
+    problem.check("qd0", &cur.qd)
+}
+
+/// A constrained model: the constraint method, the assembly of q₀ and qd₀, the partition
+/// when partitioning; the model's constraints are then set in `problem`.
+fn consistent_start<M: Model>(
+    problem: &mut Problem<M>,
+    scheme: &Scheme,
+    options: &Options,
+    cur: &mut State,
+) -> Result<Option<Assembly>, Failure> {
+    if M::NC == 0 {
+        return Ok(None);
+    }
+    let oc = &options.constraints;
+    let adaptive = matches!(options.step, StepControl::Adaptive { .. });
+    let mode = constraint_mode(oc.method, scheme, adaptive)?;
+    let a = assemble(&problem.model, cur.t, &mut cur.q, &mut cur.qd, oc)?;
+    let mut c = Constrained::new(&problem.model, mode, oc);
+    if mode == Mode::Partitioning {
+        c.eval_b(&problem.model, &mut problem.stats, cur.t, &cur.q);
+        let marks = problem.model.info().independent;
+        let marked = marks.iter().any(|&m| m);
+        c.choose_partition(marked.then_some(marks), &mut problem.stats);
+    }
+    problem.con = Some(c);
+    Ok(Some(a))
+}
+
+/// The controllers' first sample on the consistent positions and velocities, then qdd₀
+/// (and λ₀) there; singular configurations are judged against the factor of M found now.
+fn first_sample<M: Model>(
+    problem: &mut Problem<M>,
+    controllers: &mut [(f64, u64, Box<dyn Controller>)],
+    singularity_tol: f64,
+    cur: &mut State,
+) -> Result<(), Failure> {
+    for (_, count, c) in controllers.iter_mut() {
+        c.sample(cur.t, cur, &mut problem.held);
+        *count = 1;
+        problem.stats.samples += 1;
+    }
+    problem.inputs_changed();
+    problem.accel(cur.t, &cur.q.clone(), &cur.qd.clone(), &mut cur.qdd)?;
+    problem.watch_from_start(singularity_tol);
+    if let Some(c) = &problem.con {
+        cur.lambda.copy_from_slice(&c.lambda);
+    }
+    Ok(())
+}
+
+/// Step control and Newton settings from the options.
+fn control(options: &Options) -> Control {
+    let newton = NewtonTol {
+        atol: options.newton.atol,
+        rtol: options.newton.rtol,
+        kappa: 1.0,
+        max_iterations: options.newton.max_iterations,
+        reuse: options.newton.reuse,
+    };
+    let (adaptive, newton) = match options.step {
+        StepControl::Fixed { .. } => (None, newton),
+        StepControl::Adaptive { rtol, atol, .. } => (
+            Some(Tolerances { rtol, atol }),
+            NewtonTol {
+                atol,
+                rtol,
+                kappa: options.newton.tolerance_factor,
+                ..newton
+            },
+        ),
+    };
+    Control {
+        adaptive,
+        newton,
+        stability_check: options.stability_check,
+    }
+}
+
+/// The output instants of `Output::Every` and `Output::Times` (none for the others).
+fn output_times(options: &Options) -> Vec<f64> {
+    match &options.output {
+        Output::Times(ts) => ts.clone(),
+        Output::Every { dt } => {
+            let k = ((options.t_end - options.t0) / dt + 1e-9).floor() as usize;
+            (0..=k).map(|i| options.t0 + i as f64 * dt).collect()
+        }
+        Output::Steps | Output::Last => Vec::new(),
+    }
+}

@@ -1,0 +1,48 @@
+//! What drives a model's inputs u: a function of time and controllers sampled at fixed
+//! periods.
+
+use super::State;
+
+/// u(t), written into its argument.
+pub(crate) type InputFn = Box<dyn FnMut(f64, &mut [f64])>;
+
+/// A controller sampled every period: it reads the state at the sample instant and writes
+/// the inputs it drives into `u`, held until its next sample (zero-order hold).
+pub trait Controller {
+    fn sample(&mut self, t: f64, state: &State, u: &mut [f64]);
+}
+
+impl<F: FnMut(f64, &State, &mut [f64])> Controller for F {
+    fn sample(&mut self, t: f64, state: &State, u: &mut [f64]) {
+        self(t, state, u)
+    }
+}
+
+/// What drives a model's inputs u: a function of time and sampled controllers. At every
+/// evaluation u = (the function's value) + (the outputs the controllers hold, zero until
+/// they write them). The integrators stop exactly at every sample instant t₀ + k·T, call the
+/// controllers there, and restart from that state (a held output jumps: multistep histories
+/// and predictors do not survive it).
+#[derive(Default)]
+pub struct Inputs {
+    pub(super) function: Option<InputFn>,
+    pub(super) controllers: Vec<(f64, Box<dyn Controller>)>,
+}
+
+impl Inputs {
+    pub fn new() -> Inputs {
+        Inputs::default()
+    }
+
+    /// u(t) (it adds to the controllers' outputs).
+    pub fn function(mut self, f: impl FnMut(f64, &mut [f64]) + 'static) -> Inputs {
+        self.function = Some(Box::new(f));
+        self
+    }
+
+    /// A controller sampled every `period` seconds from t₀.
+    pub fn controller(mut self, period: f64, c: impl Controller + 'static) -> Inputs {
+        self.controllers.push((period, Box::new(c)));
+        self
+    }
+}

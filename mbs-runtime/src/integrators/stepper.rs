@@ -1,0 +1,58 @@
+//! The interface between the driver and a scheme: `Stepper`, what an attempt gives
+//! (`Attempt`), and the settings every attempt is handed (`Control`).
+
+use super::State;
+use super::newton::NewtonTol;
+use super::problem::Problem;
+use super::step_control::Tolerances;
+use crate::error::Failure;
+use crate::model::Model;
+
+/// What one attempted step gave.
+pub(crate) enum Attempt {
+    /// `next` holds the state at t + h
+    Accepted { h_next: f64 },
+    /// the local error test failed
+    RejectedError { h_next: f64 },
+    /// Newton did not converge (or an evaluation failed inside the step)
+    RejectedNewton {
+        h_next: f64,
+        iterations: usize,
+        correction: f64,
+        cause: Option<Failure>,
+    },
+}
+
+/// Step control and Newton settings handed to the schemes.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Control {
+    /// the local error's tolerances when adaptive
+    pub adaptive: Option<Tolerances>,
+    pub newton: NewtonTol,
+    /// explicit fixed-step schemes check h·ρ against their stability region
+    pub stability_check: bool,
+}
+
+/// A scheme, as the driver sees it.
+pub(crate) trait Stepper<M: Model> {
+    /// Called once with the consistent initial state.
+    fn start(&mut self, _p: &mut Problem<M>, _s: &State, _ctl: &Control) -> Result<(), Failure> {
+        Ok(())
+    }
+    /// Attempts a step of size `h` from `cur`; on acceptance fills `next`.
+    fn attempt(
+        &mut self,
+        p: &mut Problem<M>,
+        cur: &State,
+        h: f64,
+        ctl: &Control,
+        next: &mut State,
+    ) -> Result<Attempt, Failure>;
+    /// Called once the driver has accepted the step from `prev` to `cur`.
+    fn accepted(&mut self, _p: &mut Problem<M>, _prev: &State, _cur: &State) {}
+    /// Dense output on [prev.t, cur.t]: by default the quintic Hermite interpolant of
+    /// (q, qd, qdd) at both ends, accurate beyond every scheme's order here.
+    fn interpolate(&self, prev: &State, cur: &State, t: f64, out: &mut State) {
+        super::dense::hermite5(prev, cur, t, out);
+    }
+}

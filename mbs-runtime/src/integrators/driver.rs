@@ -6,7 +6,7 @@ use super::constrained::{Assembly, Constrained, Mode, assemble};
 use super::dispatch::{constraint_mode, stepper_for};
 use super::inputs::{Controller, Inputs};
 use super::newton::NewtonTol;
-use super::problem::Problem;
+use super::problem::{Loops, Problem};
 use super::step_control::{StepBounds, Tolerances, initial_step};
 use super::stepper::{Attempt, Control, Stepper};
 use super::{Integrator, State};
@@ -196,7 +196,7 @@ impl<M: Model + 'static> Simulation<M> {
     /// The independent coordinates of coordinate partitioning, as they are now (empty for
     /// other methods).
     pub fn independent_coordinates(&self) -> Vec<String> {
-        match &self.problem.con {
+        match self.problem.loops.closed() {
             Some(c) if c.mode == Mode::Partitioning => c.independent_labels(),
             _ => Vec::new(),
         }
@@ -302,7 +302,7 @@ impl<M: Model + 'static> Simulation<M> {
         self.problem.inputs_changed();
         self.problem
             .accel(t, &self.cur.q, &self.cur.qd, &mut self.cur.qdd)?;
-        if let Some(c) = &self.problem.con {
+        if let Some(c) = self.problem.loops.closed() {
             self.cur.lambda.copy_from_slice(&c.lambda);
         }
         self.stepper.start(&mut self.problem, &self.cur, &self.ctl)
@@ -585,7 +585,7 @@ fn consistent_start<M: Model>(
         let marked = marks.iter().any(|&m| m);
         c.choose_partition(marked.then_some(marks), &mut problem.stats);
     }
-    problem.con = Some(c);
+    problem.loops = Loops::Closed(Box::new(c));
     Ok(Some(a))
 }
 
@@ -605,7 +605,7 @@ fn first_sample<M: Model>(
     problem.inputs_changed();
     problem.accel(cur.t, &cur.q.clone(), &cur.qd.clone(), &mut cur.qdd)?;
     problem.watch_from_start(singularity_tol);
-    if let Some(c) = &problem.con {
+    if let Some(c) = problem.loops.closed() {
         cur.lambda.copy_from_slice(&c.lambda);
     }
     Ok(())

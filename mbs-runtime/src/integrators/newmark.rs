@@ -34,9 +34,9 @@
 //! balance between that error and λ depends on h), measured up to 1e-3 on the pendulum at
 //! rtol 1e-10. For accurate multipliers use fixed steps (λ of order 2 for ρ∞ < 1).
 
-use super::constrained::Mode;
+use super::constrained::{Constrained, Mode};
 use super::newton::AccelNewton;
-use super::problem::Problem;
+use super::problem::{Loops, Problem};
 use super::step_control::next_step;
 use super::{Attempt, Control, State, Stepper};
 use crate::error::Failure;
@@ -103,7 +103,7 @@ impl AlphaFamily {
 impl<M: Model> Stepper<M> for AlphaFamily {
     fn start(&mut self, p: &mut Problem<M>, s: &State, _ctl: &Control) -> Result<(), Failure> {
         self.a.copy_from_slice(&s.qdd);
-        if let Some(c) = p.con.as_ref().filter(|c| c.mode == Mode::Index3) {
+        if let Some(c) = p.loops.index3() {
             self.newton.enable_index3(c.nc, c.scaling, c.tol);
             if self.lam.len() != c.nc {
                 self.lam = vec![0.0; c.nc];
@@ -200,11 +200,7 @@ pub fn index3_iteration_matrix<M: Model>(
         ..Default::default()
     };
     let mut p = Problem::new(model, crate::options::IterationMatrix::Auto);
-    p.con = Some(super::constrained::Constrained::new(
-        &p.model,
-        Mode::Index3,
-        &options,
-    ));
+    p.loops = Loops::Closed(Box::new(Constrained::new(&p.model, Mode::Index3, &options)));
     let mut newton = AccelNewton::new(M::NQ);
     newton.enable_index3(M::NC, scaled, options.tolerance);
     let c = (1.0 - params.alpha_f) / (1.0 - params.alpha_m);

@@ -294,17 +294,19 @@ impl AccelNewton {
         beta: f64,
     ) -> Result<(), Failure> {
         let (n, nc) = (self.n, self.nc);
-        let c = p.con.as_mut().expect("index 3 needs constraints");
-        c.eval_b(&p.model, &mut p.stats, t, &self.q);
-        c.eval_phi(&p.model, &mut p.stats, t, &self.q);
-        for j in 0..n {
-            self.r[j] -= (0..nc).map(|k| c.b[k + nc * j] * lambda[k]).sum::<f64>();
+        // open loops have no multipliers and no constraint rows
+        if let Some(c) = p.loops.closed_mut() {
+            c.eval_b(&p.model, &mut p.stats, t, &self.q);
+            c.eval_phi(&p.model, &mut p.stats, t, &self.q);
+            for j in 0..n {
+                self.r[j] -= (0..nc).map(|k| c.b[k + nc * j] * lambda[k]).sum::<f64>();
+            }
+            let s = if self.scaled { 1.0 / beta } else { 1.0 };
+            for k in 0..nc {
+                self.r[n + k] = s * c.phi[k];
+            }
+            self.phi_max = c.worst().0;
         }
-        let s = if self.scaled { 1.0 / beta } else { 1.0 };
-        for k in 0..nc {
-            self.r[n + k] = s * c.phi[k];
-        }
-        self.phi_max = c.worst().0;
         p.check("τ − Bᵀλ", &self.r[..n])
     }
 
@@ -328,8 +330,14 @@ impl AccelNewton {
         } else {
             self.kc.fill(0.0);
         }
-        let c = p.con.as_mut().expect("index 3 needs constraints");
-        c.eval_b(&p.model, &mut p.stats, t, &self.q);
+        // B borders the matrix (nothing for open loops)
+        let b: &[f64] = match p.loops.closed_mut() {
+            Some(c) => {
+                c.eval_b(&p.model, &mut p.stats, t, &self.q);
+                &c.b
+            }
+            None => &[],
+        };
         let s = if self.scaled { 1.0 } else { beta };
         let m = self.lu.matrix_mut();
         m.fill(0.0);
@@ -339,7 +347,7 @@ impl AccelNewton {
                 m[i + big * j] = self.mm[x] - beta * self.kc[x];
             }
             for k in 0..nc {
-                let bkj = c.b[k + nc * j];
+                let bkj = b[k + nc * j];
                 m[j + big * (n + k)] = -bkj;
                 m[(n + k) + big * j] = s * bkj;
             }

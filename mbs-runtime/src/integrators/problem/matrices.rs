@@ -1,0 +1,203 @@
+//! Iteration matrices M + γ'·C_t + β'·K_t and the tangents C_t, K_t: generated, by finite
+//! differences of τ, or M alone.
+
+use super::Problem;
+use crate::error::Failure;
+use crate::linalg::Lu;
+use crate::model::Model;
+use crate::options::IterationMatrix;
+
+impl<M: Model> Problem<M> {
+    /// Fills and factorises the iteration matrix M + γ'·C_t + β'·K_t at (t, q, qd, qdd): the
+    /// derivative of τ(q̂ + β'a, v̂ + γ'a, a) with respect to a.
+    #[allow(clippy::too_many_arguments)]
+    pub fn iteration_matrix(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        beta: f64,
+        gamma: f64,
+        lu: &mut Lu<f64>,
+    ) -> Result<(), Failure> {
+        if self.ode() {
+            return self.ode_iteration_matrix(t, q, qd, qdd, beta, gamma, lu);
+        }
+        self.iteration_block(t, q, qd, qdd, beta, gamma, lu.matrix_mut())?;
+        self.stats.factorizations += 1;
+        lu.factor()
+            .map_err(|s| self.singular("the iteration matrix M + γ'C + β'K", s))
+    }
+
+    /// M + γ'·C_t + β'·K_t of the model's τ at (t, q, qd, qdd) into `a` (n × n, column-major),
+    /// unfactorised, as `self.iteration` says: exact (M and the generated tangents), mass
+    /// only, or forward differences of τ along (β', γ', 1)·e_j (n + 1 evaluations).
+    #[allow(clippy::too_many_arguments)]
+    pub fn iteration_block(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        beta: f64,
+        gamma: f64,
+        a: &mut [f64],
+    ) -> Result<(), Failure> {
+        self.inputs_at(t)?;
+        let n = self.n;
+        match self.iteration {
+            IterationMatrix::Exact | IterationMatrix::Auto => {
+                self.model.mass_matrix(t, q, &mut self.m);
+                self.stats.mass_matrix += 1;
+                // validated up front against `ModelInfo::has_tangents`
+                if let Err(e) =
+                    self.model
+                        .tangents(t, q, qd, qdd, &self.u, &mut self.k, &mut self.c)
+                {
+                    return Err(Failure::InvalidOption {
+                        name: "iteration_matrix",
+                        value: "Exact".into(),
+                        reason: model_error_reason(&e),
+                    });
+                }
+                self.stats.tangents += 1;
+                for i in 0..n * n {
+                    a[i] = self.m[i] + gamma * self.c[i] + beta * self.k[i];
+                }
+            }
+            IterationMatrix::MassOnly => {
+                self.model.mass_matrix(t, q, &mut self.m);
+                self.stats.mass_matrix += 1;
+                a.copy_from_slice(&self.m);
+            }
+            IterationMatrix::FiniteDifferences => {
+                self.model
+                    .inverse_dynamics(t, q, qd, qdd, &self.u, &mut self.tau0);
+                self.stats.inverse_dynamics += 1;
+                self.qp.copy_from_slice(q);
+                self.vp.copy_from_slice(qd);
+                self.ap.copy_from_slice(qdd);
+                for j in 0..n {
+                    let eps = f64::EPSILON.sqrt() * qdd[j].abs().max(1.0);
+                    self.qp[j] += beta * eps;
+                    self.vp[j] += gamma * eps;
+                    self.ap[j] += eps;
+                    self.model.inverse_dynamics(
+                        t,
+                        &self.qp,
+                        &self.vp,
+                        &self.ap,
+                        &self.u,
+                        &mut self.tau1,
+                    );
+                    self.stats.inverse_dynamics += 1;
+                    self.qp[j] = q[j];
+                    self.vp[j] = qd[j];
+                    self.ap[j] = qdd[j];
+                    for i in 0..n {
+                        a[i + n * j] = (self.tau1[i] - self.tau0[i]) / eps;
+                    }
+                }
+            }
+        }
+        if let Some(f) = self.model.take_failure() {
+            return Err(f);
+        }
+        if let Some(i) = a.iter().position(|x| !x.is_finite()) {
+            return Err(Failure::NonFinite {
+                quantity: "iteration matrix",
+                coordinate: self.label(i % n),
+            });
+        }
+        if self.iteration != IterationMatrix::FiniteDifferences && self.watching() {
+            self.mchk.copy_from_slice(&self.m);
+            self.watch_mchk(t, q)?;
+        }
+        Ok(())
+    }
+
+    /// The pieces of the iteration matrix, unfactorised, for schemes that combine them with
+    /// several (or complex) coefficients: M, C_t = ∂τ/∂qd and K_t = ∂τ/∂q at
+    /// (t, q, qd, qdd), n × n column-major each, as `self.iteration` says: exact (M and the
+    /// generated tangents: one evaluation of each), finite differences (M exact, C_t and K_t
+    /// by forward differences of τ: 2n + 1 evaluations of τ), or mass only (C_t = K_t = 0).
+    #[allow(clippy::too_many_arguments)]
+    pub fn tangent_matrices(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        m: &mut [f64],
+        c: &mut [f64],
+        k: &mut [f64],
+    ) -> Result<(), Failure> {
+        self.inputs_at(t)?;
+        if self.ode() {
+            return self.ode_tangent_matrices(t, q, qd, m, c, k);
+        }
+        let n = self.n;
+        self.model.mass_matrix(t, q, m);
+        self.stats.mass_matrix += 1;
+        match self.iteration {
+            IterationMatrix::Exact | IterationMatrix::Auto => {
+                if let Err(e) = self.model.tangents(t, q, qd, qdd, &self.u, k, c) {
+                    return Err(Failure::InvalidOption {
+                        name: "iteration_matrix",
+                        value: "Exact".into(),
+                        reason: model_error_reason(&e),
+                    });
+                }
+                self.stats.tangents += 1;
+            }
+            IterationMatrix::MassOnly => {
+                c.fill(0.0);
+                k.fill(0.0);
+            }
+            IterationMatrix::FiniteDifferences => {
+                self.model
+                    .inverse_dynamics(t, q, qd, qdd, &self.u, &mut self.tau0);
+                self.stats.inverse_dynamics += 1;
+                self.qp.copy_from_slice(q);
+                self.vp.copy_from_slice(qd);
+                for j in 0..n {
+                    // the increment actually represented in floating point
+                    let eps = (q[j] + f64::EPSILON.sqrt() * q[j].abs().max(1.0)) - q[j];
+                    self.qp[j] = q[j] + eps;
+                    self.model
+                        .inverse_dynamics(t, &self.qp, qd, qdd, &self.u, &mut self.tau1);
+                    self.qp[j] = q[j];
+                    for i in 0..n {
+                        k[i + n * j] = (self.tau1[i] - self.tau0[i]) / eps;
+                    }
+                    let eps = (qd[j] + f64::EPSILON.sqrt() * qd[j].abs().max(1.0)) - qd[j];
+                    self.vp[j] = qd[j] + eps;
+                    self.model
+                        .inverse_dynamics(t, q, &self.vp, qdd, &self.u, &mut self.tau1);
+                    self.vp[j] = qd[j];
+                    for i in 0..n {
+                        c[i + n * j] = (self.tau1[i] - self.tau0[i]) / eps;
+                    }
+                }
+                self.stats.inverse_dynamics += 2 * n;
+            }
+        }
+        self.check("M", m)?;
+        self.check("C_t", c)?;
+        self.check("K_t", k)?;
+        if self.watching() {
+            self.mchk.copy_from_slice(m);
+            self.watch_mchk(t, q)?;
+        }
+        Ok(())
+    }
+}
+
+pub(super) fn model_error_reason(e: &crate::error::ModelError) -> &'static str {
+    match e {
+        crate::error::ModelError::TangentsNotGenerated { .. } => {
+            "the model has no tangents: add `option tangents;` to its multibody! block"
+        }
+    }
+}

@@ -1,0 +1,181 @@
+//! RADAU5's error estimates: the embedded formula filtered by (I − hγ₀J)⁻¹ for the ODE, and
+//! its form for the index-3 DAE E y' = f(y).
+
+use super::super::State;
+use super::super::problem::Problem;
+use super::{Radau, Tol};
+use crate::model::Model;
+
+impl Radau {
+    /// err = (I − gJ)⁻¹ (r_q, r_v) in second-order form, into `err` = (e_q, e_v):
+    /// (M + gC + g²K) e_v = M r_v − g K r_q, e_q = r_q + g e_v.
+    pub(super) fn filter<M: Model>(&mut self, p: &mut Problem<M>, g: f64) {
+        let n = self.n;
+        for i in 0..n {
+            let mut x = 0.0;
+            for j in 0..n {
+                x += self.m[i + n * j] * self.rv[j] - g * self.km[i + n * j] * self.rq[j];
+            }
+            self.tmp[i] = x;
+        }
+        self.lu_r.solve(&mut self.tmp);
+        p.stats.solves += 1;
+        for i in 0..n {
+            self.err[n + i] = self.tmp[i];
+            self.err[i] = self.rq[i] + g * self.tmp[i];
+        }
+    }
+
+    /// RADAU5's error estimate of the converged step (`next` holds y₁), as a weighted norm.
+    pub(super) fn estimate<M: Model>(
+        &mut self,
+        p: &mut Problem<M>,
+        cur: &State,
+        next: &State,
+        h: f64,
+        tol: &Tol,
+    ) -> f64 {
+        let (s, n) = (self.k.s, self.n);
+        let g0 = self.k.gamma0;
+        // the filter matrix was factorised with h_r (equal to h up to rounding)
+        let g = g0 * self.h_r;
+        for r in 0..n {
+            let (mut x, mut y) = (0.0, 0.0);
+            for j in 0..s {
+                x += self.k.dq[j] * self.acc[j * n + r];
+                y += self.k.db[j] * self.acc[j * n + r];
+            }
+            self.rq[r] = h * h * x;
+            self.rv[r] = h * (g0 * cur.qdd[r] + y);
+        }
+        self.filter(p, g);
+        self.y0[..n].copy_from_slice(&cur.q);
+        self.y0[n..].copy_from_slice(&cur.qd);
+        self.y1[..n].copy_from_slice(&next.q);
+        self.y1[n..].copy_from_slice(&next.qd);
+        let mut err = tol.weights.error_norm(&self.err, &self.y0, &self.y1);
+        if err >= 1.0 && (self.first || self.reject) {
+            // RADAU5: replace f(y₀) by f(y₀ + err), which damps the estimate's stiff part
+            for r in 0..n {
+                self.qx[r] = cur.q[r] + self.err[r];
+                self.vx[r] = cur.qd[r] + self.err[n + r];
+            }
+            if p.accel(cur.t, &self.qx, &self.vx, &mut self.ax).is_ok() {
+                for r in 0..n {
+                    self.rq[r] += g * self.err[n + r];
+                    self.rv[r] += g * (self.ax[r] - cur.qdd[r]);
+                }
+                self.filter(p, g);
+                err = tol.weights.error_norm(&self.err, &self.y0, &self.y1);
+            }
+        }
+        err.max(1e-10)
+    }
+
+    /// Index 3: the filter (E − gJ)⁻¹ on y = (q, v, λ), E = diag(I, M, 0), in second-order
+    /// form with the real block: [M + gC + g²K̃, −Bᵀ; B, 0] (e_v, g e_λ) =
+    /// (b_v − gK̃ r_q, −(Φ + B r_q)/g), e_q = r_q + g e_v; into `err` as (e_q, h e_v, h² e_λ).
+    pub(super) fn filter3<M: Model>(&mut self, p: &mut Problem<M>, g: f64, h: f64) {
+        let (n, nc) = (self.n, self.nc);
+        for i in 0..n {
+            let mut x = self.bv[i];
+            for j in 0..n {
+                x -= g * self.km[i + n * j] * self.rq[j];
+            }
+            self.tmp[i] = x;
+        }
+        for k in 0..nc {
+            let brq: f64 = (0..n).map(|j| self.bm[k + nc * j] * self.rq[j]).sum();
+            self.tmp[n + k] = -(self.phix[k] + brq) / g;
+        }
+        self.lu_r.solve(&mut self.tmp);
+        p.stats.solves += 1;
+        for i in 0..n {
+            self.err[i] = self.rq[i] + g * self.tmp[i];
+            self.err[n + i] = h * self.tmp[i];
+        }
+        for k in 0..nc {
+            self.err[2 * n + k] = h * h * self.tmp[n + k] / g;
+        }
+    }
+
+    /// Index 3: RADAU5's estimate for the DAE E y' = f(y), y = (q, v, λ), f = (v, h + Bᵀλ,
+    /// Φ), with the velocity errors weighted by h and the multipliers' by h² (RADAU5's
+    /// scaling of index-2 and index-3 components).
+    pub(super) fn estimate3<M: Model>(
+        &mut self,
+        p: &mut Problem<M>,
+        cur: &State,
+        next: &State,
+        h: f64,
+        tol: &Tol,
+    ) -> f64 {
+        let (s, n, nc) = (self.k.s, self.n, self.nc);
+        let g0 = self.k.gamma0;
+        let g = g0 * self.h_r;
+        for r in 0..n {
+            let (mut x, mut y) = (0.0, 0.0);
+            for j in 0..s {
+                x += self.k.dq[j] * self.acc[j * n + r];
+                y += self.k.db[j] * self.acc[j * n + r];
+            }
+            self.rq[r] = h * h * x;
+            self.rv[r] = h * (g0 * cur.qdd[r] + y);
+        }
+        // the velocity row's bracket M r_v (γ₀h f_v(y₀) = g M qdd₀ with qdd₀, λ₀ consistent);
+        // the constraint row's γ₀h Φ(q₀) ≈ 0 (|Φ(q₀)| is within the Newton tolerance)
+        for i in 0..n {
+            self.bv[i] = (0..n).map(|j| self.m[i + n * j] * self.rv[j]).sum();
+        }
+        self.phix.fill(0.0);
+        self.filter3(p, g, h);
+        self.y0[..n].copy_from_slice(&cur.q);
+        self.y0[n..2 * n].copy_from_slice(&cur.qd);
+        self.y0[2 * n..].copy_from_slice(&cur.lambda[..nc]);
+        self.y1[..n].copy_from_slice(&next.q);
+        self.y1[n..2 * n].copy_from_slice(&next.qd);
+        self.y1[2 * n..].copy_from_slice(&next.lambda[..nc]);
+        let mut err = tol.weights.error_norm(&self.err, &self.y0, &self.y1);
+        if err >= 1.0 && (self.first || self.reject) {
+            // RADAU5: f(y₀ + err) in place of f(y₀); its velocity row, less M qdd₀, is
+            // −(τ(q₀ + e_q, v₀ + e_v, qdd₀) − Bᵀ(λ₀ + e_λ)) up to O(e_q) terms
+            let hr = 1.0 / h;
+            for r in 0..n {
+                self.qx[r] = cur.q[r] + self.err[r];
+                self.vx[r] = cur.qd[r] + self.err[n + r] * hr;
+            }
+            for k in 0..nc {
+                self.lx[k] = cur.lambda[k] + self.err[2 * n + k] * hr * hr;
+            }
+            if self.residual_at(p, cur) {
+                for r in 0..n {
+                    self.rq[r] += g * self.err[n + r] * hr;
+                    self.bv[r] -= g * self.ax[r];
+                }
+                self.filter3(p, g, h);
+                err = tol.weights.error_norm(&self.err, &self.y0, &self.y1);
+            }
+        }
+        err.max(1e-10)
+    }
+
+    /// τ(t₀, qx, vx, qdd₀) − B(qx)ᵀ lx into `ax` and Φ(qx) into `phix`; false when an
+    /// evaluation fails or is not finite.
+    pub(super) fn residual_at<M: Model>(&mut self, p: &mut Problem<M>, cur: &State) -> bool {
+        let (n, nc) = (self.n, self.nc);
+        if p.residual(cur.t, &self.qx, &self.vx, &cur.qdd, &mut self.ax)
+            .is_err()
+        {
+            return false;
+        }
+        if let Some(c) = p.loops.closed_mut() {
+            c.eval_b(&p.model, &mut p.stats, cur.t, &self.qx);
+            c.eval_phi(&p.model, &mut p.stats, cur.t, &self.qx);
+            for j in 0..n {
+                self.ax[j] -= (0..nc).map(|k| c.b[k + nc * j] * self.lx[k]).sum::<f64>();
+            }
+            self.phix.copy_from_slice(&c.phi);
+        }
+        self.ax.iter().chain(&self.phix).all(|x| x.is_finite())
+    }
+}

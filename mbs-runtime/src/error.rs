@@ -46,7 +46,8 @@ pub fn check_inertia(body: &'static str, t: [f64; 6]) -> Result<(), ParamError> 
 }
 
 /// Why a simulation stopped early. Each variant carries what is needed to act on it; the
-/// time, step, work done and the trajectory so far travel with it in [`SimError`].
+/// time, step, work done and the trajectory so far travel with it in
+/// [`SimError`](crate::SimError).
 #[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]
 pub enum Failure {
@@ -154,16 +155,20 @@ pub enum Failure {
     },
 }
 
-/// A simulation that stopped early, with what it had computed until then: every recorded
-/// output before the failure (never a non-finite value) and the work counters.
-#[derive(Debug, Clone, Error)]
-#[error("{kind} (at t = {t}, h = {h:e})")]
-pub struct SimError {
-    pub kind: Failure,
-    /// time of the last accepted state
-    pub t: f64,
-    /// step being attempted
-    pub h: f64,
-    pub stats: Box<crate::stats::Stats>,
-    pub trajectory: Box<crate::trajectory::Trajectory>,
+impl Failure {
+    /// `Ok` when every entry of `v` is finite, else the [`Failure::NonFinite`] of `quantity`
+    /// at the first entry i that is not, named by `name(i)`.
+    pub(crate) fn non_finite(
+        quantity: &'static str,
+        v: &[f64],
+        name: impl FnOnce(usize) -> String,
+    ) -> Result<(), Failure> {
+        match v.iter().position(|x| !x.is_finite()) {
+            None => Ok(()),
+            Some(i) => Err(Failure::NonFinite {
+                quantity,
+                coordinate: name(i),
+            }),
+        }
+    }
 }

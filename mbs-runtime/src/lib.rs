@@ -28,9 +28,10 @@ pub use analysis::{
     static_equilibrium,
 };
 pub use efforts::{Effort, Efforts, WithEfforts};
-pub use error::{Failure, ModelError, ParamError, SimError, check_inertia};
+pub use error::{Failure, ModelError, ParamError, check_inertia};
 pub use integrators::{
-    Assembly, Controller, Inputs, Integrator, Simulation, State, assemble, simulate, simulate_with,
+    Assembly, Controller, Inputs, Integrator, SimError, Simulation, State, assemble, simulate,
+    simulate_with,
 };
 pub use model::{
     Energy, FrameKinematics, Kinematics, Model, ModelInfo, OpCount, OpsTable, Parameters,

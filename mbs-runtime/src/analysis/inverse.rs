@@ -10,8 +10,7 @@
 //! consistent (Φ = 0, Φ̇ = 0, B qdd = γ); the largest violations are reported per time, not
 //! refused.
 
-use super::statics::check;
-use super::{AnalysisError, reduce};
+use super::{AnalysisError, check, reduce};
 use crate::error::Failure;
 use crate::linalg::Lu;
 use crate::model::Model;

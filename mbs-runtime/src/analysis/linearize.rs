@@ -33,8 +33,7 @@
 //! linearisation of the reduced ODE z̈ = f(z, ż) (the dependent coordinates completed from
 //! Φ = 0, Φ̇ = 0): `tests/analysis_constrained.rs` checks A against its central differences.
 
-use super::statics::check;
-use super::{AnalysisError, reduce};
+use super::{AnalysisError, check, reduce};
 use crate::error::Failure;
 use crate::linalg::{cholesky, cholesky_solve};
 use crate::model::Model;

@@ -30,6 +30,7 @@ pub use modes::{Mode, Modes, modes};
 pub use statics::{Equilibrium, Stability, StaticsOptions, static_equilibrium};
 
 use crate::error::Failure;
+use crate::model::Model;
 use thiserror::Error;
 
 /// Why an analysis failed.
@@ -51,4 +52,10 @@ pub enum AnalysisError {
         constraint_residual: f64,
         q: Vec<f64>,
     },
+}
+
+/// The first non-finite entry of `v` (NQ-periodic, named by its coordinate) as an error.
+fn check<M: Model>(model: &M, quantity: &'static str, v: &[f64]) -> Result<(), AnalysisError> {
+    let info = model.info();
+    Failure::non_finite(quantity, v, |i| info.dof_label(i % M::NQ)).map_err(AnalysisError::from)
 }

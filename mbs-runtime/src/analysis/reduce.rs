@@ -6,8 +6,7 @@
 //! an orthonormal null-space basis, the Hessians of the constraints and the index-1
 //! accelerations. Dense nalgebra matrices throughout: the analyses are not in a time loop.
 
-use super::AnalysisError;
-use super::statics::check;
+use super::{AnalysisError, check};
 use crate::error::Failure;
 use crate::linalg::{cholesky, cholesky_solve};
 use crate::model::Model;
@@ -62,17 +61,11 @@ pub(super) fn check_constraints<M: Model>(
     quantity: &'static str,
     v: &[f64],
 ) -> Result<(), AnalysisError> {
-    match v.iter().position(|x| !x.is_finite()) {
-        None => Ok(()),
-        Some(i) => Err(Failure::NonFinite {
-            quantity,
-            coordinate: format!(
-                "(constraint `{}`)",
-                model.info().constraints.get(i).copied().unwrap_or("?")
-            ),
-        }
-        .into()),
-    }
+    let names = model.info().constraints;
+    Failure::non_finite(quantity, v, |i| {
+        format!("(constraint `{}`)", names.get(i).copied().unwrap_or("?"))
+    })
+    .map_err(AnalysisError::from)
 }
 
 /// Numerical rank of B (nc × n), its smallest singular value and the constraints involved

@@ -16,7 +16,7 @@
 //! manifold, where the curvature of the constraints enters through λ. Everything is exact
 //! except K without tangents.
 
-use super::{AnalysisError, reduce};
+use super::{AnalysisError, check, reduce};
 use crate::error::Failure;
 use crate::linalg::Lu;
 use crate::model::Model;
@@ -141,21 +141,6 @@ fn forces<M: Model>(
 ) -> Result<(), AnalysisError> {
     model.static_forces(t, q, u, h);
     check(model, "static forces", h)
-}
-
-pub(super) fn check<M: Model>(
-    model: &M,
-    quantity: &'static str,
-    v: &[f64],
-) -> Result<(), AnalysisError> {
-    match v.iter().position(|x| !x.is_finite()) {
-        None => Ok(()),
-        Some(i) => Err(Failure::NonFinite {
-            quantity,
-            coordinate: model.info().dof_label(i % M::NQ),
-        }
-        .into()),
-    }
 }
 
 /// The stiffness K = ∂τ/∂q at rest (column-major NQ × NQ): exact when the model has tangents

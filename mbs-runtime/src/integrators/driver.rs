@@ -7,10 +7,11 @@ use super::dispatch::{constraint_mode, stepper_for};
 use super::inputs::{Controller, Inputs};
 use super::newton::NewtonTol;
 use super::problem::{Loops, Problem};
+use super::sim_error::SimError;
 use super::step_control::{StepBounds, Tolerances, initial_step};
 use super::stepper::{Attempt, Control, Stepper};
 use super::{Integrator, State};
-use crate::error::{Failure, SimError};
+use crate::error::Failure;
 use crate::model::{Model, Pose};
 use crate::options::{Options, Output, Scheme, StepControl};
 use crate::stats::Stats;
@@ -432,16 +433,12 @@ impl<M: Model + 'static> Simulation<M> {
         self.problem.check("q", &self.next.q)?;
         self.problem.check("qd", &self.next.qd)?;
         self.problem.check("qdd", &self.next.qdd)?;
-        match self.next.lambda.iter().position(|x| !x.is_finite()) {
-            None => Ok(()),
-            Some(i) => Err(Failure::NonFinite {
-                quantity: "λ",
-                coordinate: format!(
-                    "of constraint `{}`",
-                    self.problem.model.info().constraints[i]
-                ),
-            }),
-        }
+        Failure::non_finite("λ", &self.next.lambda, |i| {
+            format!(
+                "of constraint `{}`",
+                self.problem.model.info().constraints[i]
+            )
+        })
     }
 }
 

@@ -32,6 +32,7 @@ mod newmark;
 pub(crate) mod newton;
 pub(crate) mod problem;
 mod radau;
+mod sim_error;
 pub(crate) mod step_control;
 mod stepper;
 
@@ -39,12 +40,12 @@ pub use constrained::{Assembly, assemble};
 pub use driver::{Simulation, simulate, simulate_with};
 pub use inputs::{Controller, Inputs};
 pub use newmark::index3_iteration_matrix;
+pub use sim_error::SimError;
 
 pub(crate) use dense::lerp_lambda;
 pub(crate) use inputs::InputFn;
 pub(crate) use stepper::{Attempt, Control, Stepper};
 
-use crate::error::SimError;
 use crate::stats::Stats;
 use crate::trajectory::Trajectory;
 

@@ -352,13 +352,7 @@ impl AccelNewton {
                 m[(n + k) + big * j] = s * bkj;
             }
         }
-        if let Some(i) = m.iter().position(|x| !x.is_finite()) {
-            return Err(Failure::NonFinite {
-                quantity: "iteration matrix",
-                coordinate: p.label((i % big).min(n - 1)),
-            });
-        }
-        Ok(())
+        Failure::non_finite("iteration matrix", m, |i| p.label((i % big).min(n - 1)))
     }
 
     /// The index-3 iteration matrix (N × N, N = n + nc, column-major) at (t, q̂ + β'a,

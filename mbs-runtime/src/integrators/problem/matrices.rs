@@ -104,12 +104,7 @@ impl<M: Model> Problem<M> {
         if let Some(f) = self.model.take_failure() {
             return Err(f);
         }
-        if let Some(i) = a.iter().position(|x| !x.is_finite()) {
-            return Err(Failure::NonFinite {
-                quantity: "iteration matrix",
-                coordinate: self.label(i % n),
-            });
-        }
+        Failure::non_finite("iteration matrix", a, |i| self.label(i % n))?;
         if self.iteration != IterationMatrix::FiniteDifferences && self.watching() {
             self.mchk.copy_from_slice(&self.m);
             self.watch_mchk(t, q)?;

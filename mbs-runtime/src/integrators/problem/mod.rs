@@ -204,13 +204,7 @@ impl<M: Model> Problem<M> {
         if let Some(f) = self.model.take_failure() {
             return Err(f);
         }
-        match v.iter().position(|x| !x.is_finite()) {
-            None => Ok(()),
-            Some(i) => Err(Failure::NonFinite {
-                quantity,
-                coordinate: self.label(i % self.n),
-            }),
-        }
+        Failure::non_finite(quantity, v, |i| self.label(i % self.n))
     }
 
     /// qdd from M qdd = h at (t, q, qd); for a constrained model, qdd and λ (in the

@@ -69,13 +69,7 @@ impl Radau {
             c.eval_b(&p.model, &mut p.stats, cur.t, &cur.q);
             self.bm.copy_from_slice(&c.b);
         }
-        match self.bm.iter().position(|x| !x.is_finite()) {
-            None => Ok(()),
-            Some(i) => Err(Failure::NonFinite {
-                quantity: "B = ∂Φ/∂q",
-                coordinate: p.label((i / nc).min(n - 1)),
-            }),
-        }
+        Failure::non_finite("B = ∂Φ/∂q", &self.bm, |i| p.label((i / nc).min(n - 1)))
     }
 
     /// Index 3, stage i: r_i −= B(Q_i)ᵀΛ_i, Φ(Q_i, t) into `phis`, the largest |Φ_i| kept.

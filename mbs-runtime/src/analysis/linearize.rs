@@ -95,7 +95,6 @@ pub struct Linearization {
 }
 
 /// K = ∂τ/∂q and C = ∂τ/∂qd at (q, qd, qdd), exact or by central differences of τ.
-#[allow(clippy::too_many_arguments)]
 fn tangents<M: Model>(
     model: &M,
     t: f64,

@@ -503,9 +503,13 @@ fn constrained<M: Model>(
             b_norm = b_norm.max(free.iter().map(|&j| st.b[(p, j)].abs()).sum::<f64>());
         }
         if let Err(s) = lu.factor() {
-            return Err(singular_reduced(
-                model, t, &q, u, options, &lambda, free, &st.b, s.rcond,
-            )?);
+            let at = Rest {
+                t,
+                q: &q,
+                u,
+                lambda: &lambda,
+            };
+            return Err(singular_reduced(model, at, options, free, &st.b, s.rcond)?);
         }
         let mut delta: Vec<f64> = st.f.iter().chain(&st.phi).map(|v| -v).collect();
         lu.solve(&mut delta);
@@ -548,7 +552,13 @@ fn constrained<M: Model>(
     }
     rank(&st.b)?;
     // stability from the reduced stiffness Nᵀ(K − G)N, N orthonormal over the free coordinates
-    let kr = reduced_stiffness(model, t, &q, u, options, &lambda, free, &st.b)?;
+    let at = Rest {
+        t,
+        q: &q,
+        u,
+        lambda: &lambda,
+    };
+    let kr = reduced_stiffness(model, at, options, free, &st.b)?;
     let (stiffness_eigenvalues, stability) = classify(&kr.0);
     Ok(Equilibrium {
         residual: st.force_residual(),
@@ -563,19 +573,25 @@ fn constrained<M: Model>(
     })
 }
 
+/// A configuration at rest of a constrained model: time, positions, inputs, multipliers.
+#[derive(Clone, Copy)]
+struct Rest<'a> {
+    t: f64,
+    q: &'a [f64],
+    u: &'a [f64],
+    lambda: &'a [f64],
+}
+
 /// The symmetrised reduced stiffness Nᵀ(K − ∂(Bᵀλ)/∂q)N over the free coordinates, and N
 /// (free × dof, orthonormal).
-#[allow(clippy::too_many_arguments)]
 fn reduced_stiffness<M: Model>(
     model: &M,
-    t: f64,
-    q: &[f64],
-    u: &[f64],
+    at: Rest,
     options: &StaticsOptions,
-    lambda: &[f64],
     free: &[usize],
     b: &DMatrix<f64>,
 ) -> Result<(DMatrix<f64>, DMatrix<f64>), AnalysisError> {
+    let Rest { t, q, u, lambda } = at;
     let n = M::NQ;
     let mut k = vec![0.0; n * n];
     stiffness(model, t, q, u, options.stiffness, &mut k)?;
@@ -602,19 +618,15 @@ fn reduced_stiffness<M: Model>(
 /// Why the Newton matrix of the constrained statics is singular: redundant constraints, or
 /// a reduced stiffness with a zero eigenvalue (a mechanism direction with no stiffness),
 /// named by the coordinates that move most along it.
-#[allow(clippy::too_many_arguments)]
 fn singular_reduced<M: Model>(
     model: &M,
-    t: f64,
-    q: &[f64],
-    u: &[f64],
+    at: Rest,
     options: &StaticsOptions,
-    lambda: &[f64],
     free: &[usize],
     b: &DMatrix<f64>,
     rcond: f64,
 ) -> Result<AnalysisError, AnalysisError> {
-    let (kr, basis) = reduced_stiffness(model, t, q, u, options, lambda, free, b)?;
+    let (kr, basis) = reduced_stiffness(model, at, options, free, b)?;
     let eig = nalgebra::SymmetricEigen::new(kr);
     let k = (0..eig.eigenvalues.len())
         .min_by(|&i, &j| {

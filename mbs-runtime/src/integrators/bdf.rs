@@ -47,6 +47,7 @@
 //!
 //! Every buffer is allocated in [`Bdf::new`]; steps allocate nothing.
 
+use super::at::{Affine, Weights};
 use super::newton::AccelNewton;
 use super::problem::Problem;
 use super::step_control::{elementary_factor, optimal_factor};
@@ -216,16 +217,16 @@ impl<M: Model> Stepper<M> for Bdf {
             self.vhat[i] = yv;
             self.a[i] = self.psi[n + i] / c;
         }
-        let r = self.newton.solve(
-            p,
-            cur.t + h,
-            &self.qhat,
-            &self.vhat,
-            c * c,
-            c,
-            &mut self.a,
-            &ctl.newton,
-        );
+        let step = Affine {
+            t: cur.t + h,
+            qhat: &self.qhat,
+            vhat: &self.vhat,
+            w: Weights {
+                beta: c * c,
+                gamma: c,
+            },
+        };
+        let r = self.newton.solve(p, step, &mut self.a, &ctl.newton);
         let iterations = match r {
             Ok(it) => it,
             Err(f) => {

@@ -19,6 +19,8 @@
 //!   velocity projection with the marked velocities kept. The residuals before and after are
 //!   reported in [`Assembly`].
 
+use super::State;
+use super::at::At;
 use crate::error::Failure;
 use crate::linalg::{Lu, Singular, backward, cholesky, cholesky_solve, forward, norm1};
 use crate::model::Model;
@@ -184,18 +186,16 @@ impl Constrained {
 
     /// qdd and λ of the index-1 equations at (t, q, qd), with L the Cholesky factor of M(q)
     /// and `h` = h(q, qd); Baumgarte's terms when the mode has them.
-    #[allow(clippy::too_many_arguments)]
     pub fn kkt<M: Model>(
         &mut self,
         m: &M,
         st: &mut Stats,
         l: &[f64],
-        t: f64,
-        q: &[f64],
-        qd: &[f64],
+        at: At,
         h: &[f64],
         qdd: &mut [f64],
     ) -> Result<(), Failure> {
+        let At { t, q, qd } = at;
         let (n, nc) = (self.n, self.nc);
         self.eval_b(m, st, t, q);
         m.constraint_bias(t, q, qd, &mut self.gamma);
@@ -232,19 +232,17 @@ impl Constrained {
         Ok(())
     }
 
-    /// Projects q onto Φ(q, t) = 0 and qd onto Φ̇ = 0 in the metric of M (L its Cholesky
-    /// factor at the unprojected q).
-    #[allow(clippy::too_many_arguments)]
+    /// Projects the state's q onto Φ(q, t) = 0 and qd onto Φ̇ = 0 in the metric of M (L its
+    /// Cholesky factor at the unprojected q).
     pub fn project<M: Model>(
         &mut self,
         m: &M,
         st: &mut Stats,
         l: &[f64],
-        t: f64,
-        q: &mut [f64],
-        qd: &mut [f64],
+        s: &mut State,
         dx: &mut [f64],
     ) -> Result<(), Failure> {
+        let (t, q, qd) = (s.t, &mut s.q[..], &mut s.qd[..]);
         let (n, nc) = (self.n, self.nc);
         st.projections += 1;
         let mut it = 0;

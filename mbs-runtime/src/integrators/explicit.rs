@@ -33,9 +33,7 @@ pub(crate) struct Explicit {
     dv: Vec<f64>,
     jq: Vec<f64>,
     jv: Vec<f64>,
-    pq: Vec<f64>,
-    pv: Vec<f64>,
-    pa: Vec<f64>,
+    probe: Probe,
     steps: usize,
     rho: f64,
 }
@@ -67,9 +65,11 @@ impl Explicit {
             dv,
             jq: z(),
             jv: z(),
-            pq: z(),
-            pv: z(),
-            pa: z(),
+            probe: Probe {
+                q: z(),
+                v: z(),
+                a: z(),
+            },
             steps: 0,
             rho: 0.0,
         }
@@ -100,19 +100,44 @@ impl Explicit {
         }
     }
 
+    /// One power-iteration step on J²; returns the estimate of ρ(J).
+    fn estimate_rho<M: Model>(&mut self, p: &mut Problem<M>, s: &State) -> Result<f64, Failure> {
+        let n0 = norm2(&self.dq, &self.dv);
+        self.probe
+            .apply_j(p, s, &self.dq, &self.dv, &mut self.jq, &mut self.jv)?;
+        self.probe
+            .apply_j(p, s, &self.jq, &self.jv, &mut self.dq, &mut self.dv)?;
+        let n2 = norm2(&self.dq, &self.dv);
+        if !(n2 > 0.0) || !n2.is_finite() || !(n0 > 0.0) {
+            seed_direction(&mut self.dq, &mut self.dv);
+            return Ok(self.rho);
+        }
+        for x in self.dq.iter_mut().chain(self.dv.iter_mut()) {
+            *x /= n2;
+        }
+        Ok((n2 / n0).sqrt())
+    }
+}
+
+/// The point a Jacobian-vector product is probed at: q, qd and the accelerations there.
+struct Probe {
+    q: Vec<f64>,
+    v: Vec<f64>,
+    a: Vec<f64>,
+}
+
+impl Probe {
     /// (oq, ov) = J·(iq, iv) at `s`, by a forward difference of the accelerations.
-    #[allow(clippy::too_many_arguments)]
     fn apply_j<M: Model>(
+        &mut self,
         p: &mut Problem<M>,
         s: &State,
         iq: &[f64],
         iv: &[f64],
         oq: &mut [f64],
         ov: &mut [f64],
-        pq: &mut [f64],
-        pv: &mut [f64],
-        pa: &mut [f64],
     ) -> Result<(), Failure> {
+        let (pq, pv, pa) = (&mut self.q, &mut self.v, &mut self.a);
         let norm = norm2(iq, iv).max(f64::MIN_POSITIVE);
         let scale =
             s.q.iter()
@@ -130,42 +155,6 @@ impl Explicit {
             ov[i] = (pa[i] - s.qdd[i]) / eps;
         }
         Ok(())
-    }
-
-    /// One power-iteration step on J²; returns the estimate of ρ(J).
-    fn estimate_rho<M: Model>(&mut self, p: &mut Problem<M>, s: &State) -> Result<f64, Failure> {
-        let n0 = norm2(&self.dq, &self.dv);
-        Self::apply_j(
-            p,
-            s,
-            &self.dq,
-            &self.dv,
-            &mut self.jq,
-            &mut self.jv,
-            &mut self.pq,
-            &mut self.pv,
-            &mut self.pa,
-        )?;
-        Self::apply_j(
-            p,
-            s,
-            &self.jq,
-            &self.jv,
-            &mut self.dq,
-            &mut self.dv,
-            &mut self.pq,
-            &mut self.pv,
-            &mut self.pa,
-        )?;
-        let n2 = norm2(&self.dq, &self.dv);
-        if !(n2 > 0.0) || !n2.is_finite() || !(n0 > 0.0) {
-            seed_direction(&mut self.dq, &mut self.dv);
-            return Ok(self.rho);
-        }
-        for x in self.dq.iter_mut().chain(self.dv.iter_mut()) {
-            *x /= n2;
-        }
-        Ok((n2 / n0).sqrt())
     }
 }
 

@@ -6,6 +6,7 @@
 //! matrix M + (h/2)·C_t + (h²/4)·K_t; then q₁ = q₀ + h qd₀ + h²/2 a, qd₁ = qd₀ + h a, and qdd₁
 //! from M qdd = h at the new state (one more evaluation, so that outputs are consistent).
 
+use super::at::{Affine, Weights};
 use super::newton::AccelNewton;
 use super::problem::Problem;
 use super::{Attempt, Control, State, Stepper};
@@ -52,16 +53,16 @@ impl<M: Model> Stepper<M> for Midpoint {
             self.vhat[i] = cur.qd[i];
         }
         // the previous midpoint acceleration is the better guess
-        let r = self.newton.solve(
-            p,
-            cur.t + 0.5 * h,
-            &self.qhat,
-            &self.vhat,
-            0.25 * h * h,
-            0.5 * h,
-            &mut self.a,
-            &ctl.newton,
-        );
+        let step = Affine {
+            t: cur.t + 0.5 * h,
+            qhat: &self.qhat,
+            vhat: &self.vhat,
+            w: Weights {
+                beta: 0.25 * h * h,
+                gamma: 0.5 * h,
+            },
+        };
+        let r = self.newton.solve(p, step, &mut self.a, &ctl.newton);
         if let Err(f) = r {
             return Ok(f.reject(h));
         }

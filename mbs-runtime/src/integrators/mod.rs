@@ -13,12 +13,15 @@
 //! | BDF 1–5 | `bdf.rs` | 1–5 | adaptive, variable order |
 //! | Radau IIA 3, 5 | `radau/` | 3, 5 | adaptive or fixed |
 //!
-//! The driver's parts: `driver.rs` (`Simulation`, `simulate`), `stepper.rs` (the `Stepper`
-//! trait, `Attempt`, `Control`), `step_control.rs` (tolerances, error norm, controllers, the
-//! first step), `dense.rs` (the default dense output), `inputs.rs` (input functions and
-//! sampled controllers), `dispatch.rs` (the scheme's `Stepper` and constraint method),
-//! `problem/` (the model as the schemes see it), `constrained.rs` (closed loops).
+//! The driver's parts: `driver.rs` (`Simulation`, `simulate`), `sim_error.rs` (`SimError`),
+//! `stepper.rs` (the `Stepper` trait, `Attempt`, `Control`), `step_control.rs` (tolerances,
+//! error norm, controllers, the first step), `dense.rs` (the default dense output),
+//! `inputs.rs` (input functions and sampled controllers), `dispatch.rs` (the scheme's
+//! `Stepper` and constraint method), `at.rs` (evaluation points, iteration-matrix weights,
+//! affine steps), `problem/` (the model as the schemes see it), `constrained.rs` (closed
+//! loops).
 
+mod at;
 mod bdf;
 pub(crate) mod constrained;
 mod dense;

@@ -34,6 +34,7 @@
 //! balance between that error and λ depends on h), measured up to 1e-3 on the pendulum at
 //! rtol 1e-10. For accurate multipliers use fixed steps (λ of order 2 for ρ∞ < 1).
 
+use super::at::{Affine, At, Weights};
 use super::constrained::{Constrained, Mode};
 use super::newton::AccelNewton;
 use super::problem::{Loops, Problem};
@@ -132,17 +133,18 @@ impl<M: Model> Stepper<M> for AlphaFamily {
         let nl = self.lam.len();
         self.lam.copy_from_slice(&cur.lambda[..nl]);
         let (bp, gp) = (b * h * h * c, g * h * c);
-        let result = self.newton.solve_index3(
-            p,
-            cur.t + h,
-            &self.qhat,
-            &self.vhat,
-            bp,
-            gp,
-            &mut self.qdd,
-            &mut self.lam,
-            &ctl.newton,
-        );
+        let step = Affine {
+            t: cur.t + h,
+            qhat: &self.qhat,
+            vhat: &self.vhat,
+            w: Weights {
+                beta: bp,
+                gamma: gp,
+            },
+        };
+        let result = self
+            .newton
+            .solve_index3(p, step, &mut self.qdd, &mut self.lam, &ctl.newton);
         match result {
             Ok(_) => {}
             Err(f) => {
@@ -207,12 +209,12 @@ pub fn index3_iteration_matrix<M: Model>(
     let (bp, gp) = (params.beta * h * h * c, params.gamma * h * c);
     newton.index3_matrix_at(
         &mut p,
-        state.t,
-        &state.q,
-        &state.qd,
+        At::new(state.t, &state.q, &state.qd),
         &state.qdd,
         &state.lambda,
-        bp,
-        gp,
+        Weights {
+            beta: bp,
+            gamma: gp,
+        },
     )
 }

@@ -25,6 +25,7 @@
 //! step (kept only within it): on the index-3 pendulum, matrices kept across steps needed
 //! 2–3 times the iterations of fresh ones and left λ less converged.
 
+use super::at::{Affine, At, Weights};
 use super::problem::Problem;
 use crate::error::Failure;
 use crate::linalg::Lu;
@@ -132,36 +133,28 @@ impl AccelNewton {
     /// Solves τ(t, q̂ + β'a, v̂ + γ'a, a) = 0; `a` holds the guess and receives the solution.
     /// Returns the iterations used. `q` and `v` of the solution are then in [`AccelNewton::q`]
     /// and [`AccelNewton::v`].
-    #[allow(clippy::too_many_arguments)]
     pub fn solve<M: Model>(
         &mut self,
         p: &mut Problem<M>,
-        t: f64,
-        qhat: &[f64],
-        vhat: &[f64],
-        beta: f64,
-        gamma: f64,
+        step: Affine,
         a: &mut [f64],
         tol: &NewtonTol,
     ) -> Result<usize, NewtonFail> {
-        self.solve_index3(p, t, qhat, vhat, beta, gamma, a, &mut [], tol)
+        self.solve_index3(p, step, a, &mut [], tol)
     }
 
     /// [`AccelNewton::solve`] with the multipliers λ as unknowns too (after
     /// [`AccelNewton::enable_index3`]; `lambda` empty otherwise).
-    #[allow(clippy::too_many_arguments)]
     pub fn solve_index3<M: Model>(
         &mut self,
         p: &mut Problem<M>,
-        t: f64,
-        qhat: &[f64],
-        vhat: &[f64],
-        beta: f64,
-        gamma: f64,
+        step: Affine,
         a: &mut [f64],
         lambda: &mut [f64],
         tol: &NewtonTol,
     ) -> Result<usize, NewtonFail> {
+        let (t, w) = (step.t, step.w);
+        let Weights { beta, gamma } = w;
         let nc = lambda.len();
         debug_assert_eq!(nc, self.nc);
         self.a0.copy_from_slice(a);
@@ -181,15 +174,14 @@ impl AccelNewton {
                 lambda.copy_from_slice(&self.l0);
             }
             if fresh {
-                self.affine(qhat, vhat, beta, gamma, a);
+                self.affine(step, a);
                 let made = if nc == 0 {
-                    p.iteration_matrix(t, &self.q, &self.v, a, beta, gamma, &mut self.lu)
+                    p.iteration_matrix(At::new(t, &self.q, &self.v), a, w, &mut self.lu)
                 } else {
-                    self.index3_matrix(p, t, a, lambda, beta, gamma)
-                        .and_then(|_| {
-                            p.stats.factorizations += 1;
-                            self.lu.factor().map_err(|s| p.singular(INDEX3_MATRIX, s))
-                        })
+                    self.index3_matrix(p, t, a, lambda, w).and_then(|_| {
+                        p.stats.factorizations += 1;
+                        self.lu.factor().map_err(|s| p.singular(INDEX3_MATRIX, s))
+                    })
                 };
                 if let Err(e) = made {
                     self.valid = false;
@@ -206,7 +198,7 @@ impl AccelNewton {
             let mut prev = f64::NAN;
             let mut eta = self.eta.max(f64::EPSILON).powf(0.8);
             for it in 0..tol.max_iterations {
-                self.affine(qhat, vhat, beta, gamma, a);
+                self.affine(step, a);
                 let n = self.n;
                 let mut res = p.residual(t, &self.q, &self.v, a, &mut self.r[..n]);
                 if nc > 0 && res.is_ok() {
@@ -266,7 +258,7 @@ impl AccelNewton {
                 let phi_ok = nc == 0 || self.phi_max * eta.min(1.0) <= self.tol_phi;
                 if (eta * norm <= tol.kappa || norm == 0.0) && phi_ok {
                     self.eta = eta;
-                    self.affine(qhat, vhat, beta, gamma, a);
+                    self.affine(step, a);
                     return Ok(total);
                 }
                 prev = norm;
@@ -311,19 +303,18 @@ impl AccelNewton {
     }
 
     /// The index-3 iteration matrix at the current (q, v, a, λ), unfactorised, in `self.lu`.
-    #[allow(clippy::too_many_arguments)]
     fn index3_matrix<M: Model>(
         &mut self,
         p: &mut Problem<M>,
         t: f64,
         a: &[f64],
         lambda: &[f64],
-        beta: f64,
-        gamma: f64,
+        w: Weights,
     ) -> Result<(), Failure> {
         let (n, nc) = (self.n, self.nc);
         let big = n + nc;
-        p.iteration_block(t, &self.q, &self.v, a, beta, gamma, &mut self.mm)?;
+        let beta = w.beta;
+        p.iteration_block(At::new(t, &self.q, &self.v), a, w, &mut self.mm)?;
         if p.iteration != IterationMatrix::MassOnly {
             p.model.constraint_tangent(t, &self.q, lambda, &mut self.kc);
             p.stats.constraints += 1;
@@ -357,26 +348,28 @@ impl AccelNewton {
 
     /// The index-3 iteration matrix (N × N, N = n + nc, column-major) at (t, q̂ + β'a,
     /// v̂ + γ'a, a, λ), unfactorised: for condition studies.
-    #[allow(clippy::too_many_arguments)]
     pub fn index3_matrix_at<M: Model>(
         &mut self,
         p: &mut Problem<M>,
-        t: f64,
-        q: &[f64],
-        v: &[f64],
+        at: At,
         a: &[f64],
         lambda: &[f64],
-        beta: f64,
-        gamma: f64,
+        w: Weights,
     ) -> Result<Vec<f64>, Failure> {
-        self.q.copy_from_slice(q);
-        self.v.copy_from_slice(v);
-        self.index3_matrix(p, t, a, lambda, beta, gamma)?;
+        self.q.copy_from_slice(at.q);
+        self.v.copy_from_slice(at.qd);
+        self.index3_matrix(p, at.t, a, lambda, w)?;
         self.valid = false;
         Ok(self.lu.matrix_mut().to_vec())
     }
 
-    fn affine(&mut self, qhat: &[f64], vhat: &[f64], beta: f64, gamma: f64, a: &[f64]) {
+    fn affine(&mut self, step: Affine, a: &[f64]) {
+        let Affine {
+            qhat,
+            vhat,
+            w: Weights { beta, gamma },
+            ..
+        } = step;
         for i in 0..self.n {
             self.q[i] = qhat[i] + beta * a[i];
             self.v[i] = vhat[i] + gamma * a[i];

@@ -2,6 +2,7 @@
 //! ODE qdd = f(t, q, qd) of its index-1 form: its accelerations and multipliers, and its
 //! iteration matrices by forward differences of f.
 
+use super::super::at::{At, Weights};
 use super::super::constrained::{Constrained, Mode};
 use super::{Problem, worst_pivot};
 use crate::error::Failure;
@@ -53,9 +54,7 @@ impl<M: Model> Problem<M> {
             &self.model,
             &mut self.stats,
             &self.chol,
-            t,
-            &self.qx,
-            &self.vx,
+            At::new(t, &self.qx, &self.vx),
             &self.h,
             qdd,
         )?;
@@ -92,17 +91,14 @@ impl<M: Model> Problem<M> {
 
     /// Iteration matrix of the index-1 ODE, I + γ'·(−∂f/∂qd) + β'·(−∂f/∂q), by forward
     /// differences of f along (β', γ')·e_j (I alone with `MassOnly`).
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn ode_iteration_matrix(
         &mut self,
-        t: f64,
-        q: &[f64],
-        qd: &[f64],
+        at: At,
         qdd: &[f64],
-        beta: f64,
-        gamma: f64,
+        w: Weights,
         lu: &mut Lu<f64>,
     ) -> Result<(), Failure> {
+        let (At { t, q, qd }, Weights { beta, gamma }) = (at, w);
         let n = self.n;
         {
             let a = lu.matrix_mut();
@@ -144,16 +140,14 @@ impl<M: Model> Problem<M> {
 
     /// M = I, C_t = −∂f/∂qd, K_t = −∂f/∂q of the index-1 ODE, by forward differences of f
     /// (2n evaluations; C_t = K_t = 0 with `MassOnly`).
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn ode_tangent_matrices(
         &mut self,
-        t: f64,
-        q: &[f64],
-        qd: &[f64],
+        at: At,
         m: &mut [f64],
         c: &mut [f64],
         k: &mut [f64],
     ) -> Result<(), Failure> {
+        let At { t, q, qd } = at;
         let n = self.n;
         m.fill(0.0);
         for i in 0..n {

@@ -1,6 +1,7 @@
 //! Iteration matrices M + γ'·C_t + β'·K_t and the tangents C_t, K_t: generated, by finite
 //! differences of τ, or M alone.
 
+use super::super::at::{At, Weights};
 use super::Problem;
 use crate::error::Failure;
 use crate::linalg::Lu;
@@ -10,21 +11,17 @@ use crate::options::IterationMatrix;
 impl<M: Model> Problem<M> {
     /// Fills and factorises the iteration matrix M + γ'·C_t + β'·K_t at (t, q, qd, qdd): the
     /// derivative of τ(q̂ + β'a, v̂ + γ'a, a) with respect to a.
-    #[allow(clippy::too_many_arguments)]
     pub fn iteration_matrix(
         &mut self,
-        t: f64,
-        q: &[f64],
-        qd: &[f64],
+        at: At,
         qdd: &[f64],
-        beta: f64,
-        gamma: f64,
+        w: Weights,
         lu: &mut Lu<f64>,
     ) -> Result<(), Failure> {
         if self.ode() {
-            return self.ode_iteration_matrix(t, q, qd, qdd, beta, gamma, lu);
+            return self.ode_iteration_matrix(at, qdd, w, lu);
         }
-        self.iteration_block(t, q, qd, qdd, beta, gamma, lu.matrix_mut())?;
+        self.iteration_block(at, qdd, w, lu.matrix_mut())?;
         self.stats.factorizations += 1;
         lu.factor()
             .map_err(|s| self.singular("the iteration matrix M + γ'C + β'K", s))
@@ -33,17 +30,14 @@ impl<M: Model> Problem<M> {
     /// M + γ'·C_t + β'·K_t of the model's τ at (t, q, qd, qdd) into `a` (n × n, column-major),
     /// unfactorised, as `self.iteration` says: exact (M and the generated tangents), mass
     /// only, or forward differences of τ along (β', γ', 1)·e_j (n + 1 evaluations).
-    #[allow(clippy::too_many_arguments)]
     pub fn iteration_block(
         &mut self,
-        t: f64,
-        q: &[f64],
-        qd: &[f64],
+        at: At,
         qdd: &[f64],
-        beta: f64,
-        gamma: f64,
+        w: Weights,
         a: &mut [f64],
     ) -> Result<(), Failure> {
+        let (At { t, q, qd }, Weights { beta, gamma }) = (at, w);
         self.inputs_at(t)?;
         let n = self.n;
         match self.iteration {
@@ -117,20 +111,18 @@ impl<M: Model> Problem<M> {
     /// (t, q, qd, qdd), n × n column-major each, as `self.iteration` says: exact (M and the
     /// generated tangents: one evaluation of each), finite differences (M exact, C_t and K_t
     /// by forward differences of τ: 2n + 1 evaluations of τ), or mass only (C_t = K_t = 0).
-    #[allow(clippy::too_many_arguments)]
     pub fn tangent_matrices(
         &mut self,
-        t: f64,
-        q: &[f64],
-        qd: &[f64],
+        at: At,
         qdd: &[f64],
         m: &mut [f64],
         c: &mut [f64],
         k: &mut [f64],
     ) -> Result<(), Failure> {
+        let At { t, q, qd } = at;
         self.inputs_at(t)?;
         if self.ode() {
-            return self.ode_tangent_matrices(t, q, qd, m, c, k);
+            return self.ode_tangent_matrices(at, m, c, k);
         }
         let n = self.n;
         self.model.mass_matrix(t, q, m);

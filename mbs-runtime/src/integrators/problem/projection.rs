@@ -76,15 +76,7 @@ impl<M: Model> Problem<M> {
                 self.stats.mass_matrix += 1;
                 self.stats.factorizations += 1;
                 cholesky(&mut self.chol, self.n).map_err(|s| self.singular_mass(&self.chol, s))?;
-                c.project(
-                    &self.model,
-                    &mut self.stats,
-                    &self.chol,
-                    t,
-                    &mut next.q,
-                    &mut next.qd,
-                    &mut self.dx,
-                )?;
+                c.project(&self.model, &mut self.stats, &self.chol, next, &mut self.dx)?;
                 self.closed_accel(c, t, &next.q, &next.qd, &mut next.qdd)?;
                 next.lambda.copy_from_slice(&c.lambda);
                 Ok(())

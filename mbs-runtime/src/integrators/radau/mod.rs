@@ -175,6 +175,7 @@ mod index3;
 mod newton;
 mod tableau;
 
+use super::at::At;
 use super::problem::Problem;
 use super::step_control::{Predictive, Tolerances};
 use super::{Attempt, Control, State, Stepper};
@@ -445,9 +446,7 @@ impl<M: Model> Stepper<M> for Radau {
                 // independent of h: a failure here ends the simulation
                 self.jac_valid = false;
                 p.tangent_matrices(
-                    cur.t,
-                    &cur.q,
-                    &cur.qd,
+                    At::new(cur.t, &cur.q, &cur.qd),
                     &cur.qdd,
                     &mut self.m,
                     &mut self.cm,

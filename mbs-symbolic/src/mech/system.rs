@@ -182,7 +182,7 @@ pub enum Load {
     },
     /// six-axis linear spring–damper between the origins and orientations of frames `a` and
     /// `b` (`None`: the ground), diagonal stiffnesses and dampings in `a`'s axes; see
-    /// `mech::effects` for the formulas. The elastic part derives from the potential
+    /// `mech::effects::bushing` for the formulas. The elastic part derives from the potential
     /// ½ Δpᵀ K Δp + ½ θᵀ K_r θ; damping counts in the power
     Bushing {
         a: Option<usize>,

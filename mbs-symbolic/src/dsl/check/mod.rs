@@ -650,5 +650,4 @@ mod bodies;
 mod constraints;
 mod effects;
 mod expr;
-mod force_elements;
 mod shapes;

@@ -346,3 +346,28 @@ pub fn expand(input: TokenStream) -> TokenStream {
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Frames are declared in any order; poses start from poses defined above them.
+    #[test]
+    fn a_body_may_be_declared_before_the_frame_its_pose_starts_from() {
+        let src: TokenStream = "model M {
+            dof q[0] = 0.1;
+            body b { mass = 1.0; inertia = (0.1, 0.1, 0.1); }
+            frame f;
+            TOG[f] = Trotz(q[0]);
+            TOG[b] = TOG[f] * Tdisp(1, 0, 0);
+            gravity(0, -9.81, 0);
+        }"
+        .parse()
+        .unwrap();
+        let out = expand_models(src).unwrap();
+        match &out[0] {
+            Expansion::Ok { generated, .. } => assert!(generated.code.contains("struct M ")),
+            Expansion::Err { error, .. } => panic!("{error}"),
+        }
+    }
+}

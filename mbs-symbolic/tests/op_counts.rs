@@ -1,7 +1,7 @@
 //! Work guards on generated code: operation counts are deterministic, so they are asserted.
 
 use mbs_symbolic::SymbolicModel;
-use mbs_symbolic::expr::OpCount;
+use mbs_symbolic::expr::ops;
 use mbs_symbolic::mech::system::{Load, System};
 
 /// chainN of MODELS.md: N uniform bars (l = 0.5 m, 1 kg), relative angles, gravity.
@@ -49,9 +49,9 @@ fn mass_and_bias(model: &SymbolicModel) -> (usize, usize, usize) {
             .flat_map(|(r, row)| row[..=r].to_vec())
             .collect();
     (
-        OpCount::of(a, &lower).flops(),
-        OpCount::of(a, &mb.h).flops(),
-        OpCount::of(a, &mb.roots()).flops(),
+        ops(a, &lower).flops(),
+        ops(a, &mb.h).flops(),
+        ops(a, &mb.roots()).flops(),
     )
 }
 
@@ -90,8 +90,8 @@ fn both_formulations_are_built_and_the_cheaper_is_chosen() {
         let model = chain(n);
         let e = &model.scenes[0];
         let a = &model.sys.arena;
-        let vp = OpCount::of(a, &e.vp.roots()).flops();
-        let rec = OpCount::of(a, &e.rec.roots()).flops();
-        assert_eq!(OpCount::of(a, &e.chosen().roots()).flops(), vp.min(rec));
+        let vp = ops(a, &e.vp.roots()).flops();
+        let rec = ops(a, &e.rec.roots()).flops();
+        assert_eq!(ops(a, &e.chosen().roots()).flops(), vp.min(rec));
     }
 }

@@ -10,7 +10,7 @@ use super::system::{Factor, Formulation, System};
 use super::tree::Tree;
 use super::virtual_power::virtual_power;
 use super::world::World;
-use crate::expr::{Arena, ExprId, OpCount, Var};
+use crate::expr::{Arena, ExprId, Var};
 use rustc_hash::FxHashMap;
 
 /// M (dense, row-major) and h of one formulation.
@@ -103,7 +103,7 @@ impl SceneEquations {
                 a.sub(mq, vp.h[i])
             })
             .collect();
-        let cost = |a: &Arena, r: &[ExprId]| OpCount::of(a, r).flops();
+        let cost = |a: &Arena, r: &[ExprId]| crate::expr::ops(a, r).flops();
         let formulation = sys.options.formulation.unwrap_or_else(|| {
             if cost(a, &vp.roots()) < cost(a, &rec.roots()) {
                 Formulation::VirtualPower

@@ -8,18 +8,19 @@ use crate::error::{ModelError, ParamError};
 use serde::{Deserialize, Serialize, de::DeserializeOwned};
 use std::fmt;
 
-/// Operation counts of one generated function, as reported by `mbs expand`.
+/// Operation counts of one generated function, as reported by `mbs expand`. The generator
+/// (`mbs-symbolic`) counts in this type too, so there is one definition.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 pub struct OpCount {
-    /// additions and subtractions
+    /// additions, subtractions and negations
     pub adds: usize,
-    /// multiplications
+    /// multiplications (an integer power `x^n` counts n − 1)
     pub muls: usize,
     /// divisions
     pub divs: usize,
     /// square roots, trigonometric and other elementary or user functions
     pub funcs: usize,
-    /// `let` temporaries
+    /// `let` temporaries in the emitted code
     pub lets: usize,
 }
 

@@ -2,6 +2,7 @@
 //! types so that the user's code does not cascade into more errors. The macro and
 //! `mbs expand` share this function, so they produce the same code.
 
+use crate::codegen::api::{Sizes, model_impl};
 use crate::codegen::{Generated, generate};
 use crate::dsl::ast::{Item, ModelDef};
 use crate::dsl::check::check;
@@ -234,6 +235,13 @@ fn validate(&self) -> ::core::result::Result<(), ::mbs::ParamError> {{ {never} }
 }}
 "
     );
+    let sizes = Sizes {
+        nq,
+        nu,
+        nframes,
+        npoints,
+        nc: 0,
+    };
     for ty in scenes {
         code.push_str(&format!(
             "#[derive(Clone, Debug, Default, PartialEq)]
@@ -242,35 +250,13 @@ impl {ty} {{
 pub const GENERATED_HASH: u64 = 0;
 pub fn new(_: {pty}) -> ::core::result::Result<Self, ::mbs::ParamError> {{ {never} }}
 }}
-impl ::mbs::Model for {ty} {{
-type Params = {pty};
-const NQ: usize = {nq};
-const NU: usize = {nu};
-const NFRAMES: usize = {nframes};
-const NPOINTS: usize = {npoints};
-const NC: usize = 0;
-fn info(&self) -> &'static ::mbs::ModelInfo {{ {never} }}
-fn params(&self) -> &{pty} {{ &self.params }}
-fn set_params(&mut self, _: {pty}) -> ::core::result::Result<(), ::mbs::ParamError> {{ {never} }}
-fn initial_state(&self, _: &mut [f64], _: &mut [f64]) {{ {never} }}
-fn mass_matrix(&self, _: f64, _: &[f64], _: &mut [f64]) {{ {never} }}
-fn dynamics(&self, _: f64, _: &[f64], _: &[f64], _: &[f64], _: &mut [f64], _: &mut [f64]) {{ {never} }}
-fn inverse_dynamics(&self, _: f64, _: &[f64], _: &[f64], _: &[f64], _: &[f64], _: &mut [f64]) {{ {never} }}
-fn tangents(&self, _: f64, _: &[f64], _: &[f64], _: &[f64], _: &[f64], _: &mut [f64], _: &mut [f64]) -> ::core::result::Result<(), ::mbs::ModelError> {{ {never} }}
-fn static_forces(&self, _: f64, _: &[f64], _: &[f64], _: &mut [f64]) {{ {never} }}
-fn input_matrix(&self, _: f64, _: &[f64], _: &[f64], _: &[f64], _: &mut [f64]) {{ {never} }}
-fn constraints(&self, _: f64, _: &[f64], _: &mut [f64]) {{ {never} }}
-fn constraint_jacobian(&self, _: f64, _: &[f64], _: &mut [f64]) {{ {never} }}
-fn constraint_rate(&self, _: f64, _: &[f64], _: &mut [f64]) {{ {never} }}
-fn constraint_bias(&self, _: f64, _: &[f64], _: &[f64], _: &mut [f64]) {{ {never} }}
-fn constraint_tangent(&self, _: f64, _: &[f64], _: &[f64], _: &mut [f64]) {{ {never} }}
-fn energy(&self, _: f64, _: &[f64], _: &[f64]) -> ::mbs::Energy {{ {never} }}
-fn power(&self, _: f64, _: &[f64], _: &[f64], _: &[f64]) -> f64 {{ {never} }}
-fn frames(&self, _: f64, _: &[f64], _: &mut [::mbs::Pose]) {{ {never} }}
-fn kinematics(&self, _: f64, _: &[f64], _: &[f64], _: &mut ::mbs::Kinematics) {{ {never} }}
-}}
+#[allow(unused_variables)]
 "
         ));
+        code.push_str(&model_impl(&ty, &pty, &sizes, |m| match m.name {
+            "params" => "&self.params".into(),
+            _ => never.clone(),
+        }));
     }
     code
 }
@@ -359,4 +345,29 @@ pub fn expand(input: TokenStream) -> TokenStream {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Frames are declared in any order; poses start from poses defined above them.
+    #[test]
+    fn a_body_may_be_declared_before_the_frame_its_pose_starts_from() {
+        let src: TokenStream = "model M {
+            dof q[0] = 0.1;
+            body b { mass = 1.0; inertia = (0.1, 0.1, 0.1); }
+            frame f;
+            TOG[f] = Trotz(q[0]);
+            TOG[b] = TOG[f] * Tdisp(1, 0, 0);
+            gravity(0, -9.81, 0);
+        }"
+        .parse()
+        .unwrap();
+        let out = expand_models(src).unwrap();
+        match &out[0] {
+            Expansion::Ok { generated, .. } => assert!(generated.code.contains("struct M ")),
+            Expansion::Err { error, .. } => panic!("{error}"),
+        }
+    }
 }

@@ -2,7 +2,7 @@
 //! operation in that scene's code, and every operation a scene has beyond a smaller one
 //! depends on the effect it adds.
 
-use mbs_symbolic::expr::{Arena, ExprId, Node, OpCount, Var};
+use mbs_symbolic::expr::{Arena, ExprId, Node, Var};
 use mbs_symbolic::{SymbolicModel, systems_from_str};
 use std::collections::HashSet;
 
@@ -32,7 +32,8 @@ fn roots(model: &SymbolicModel, scene: usize) -> Vec<ExprId> {
 }
 
 fn ops(a: &Arena, r: &[ExprId]) -> usize {
-    OpCount::of(a, r).flops() + OpCount::of(a, r).funcs
+    let c = mbs_symbolic::expr::ops(a, r);
+    c.flops() + c.funcs
 }
 
 /// Nodes (operations, not leaves) reachable from `r`.

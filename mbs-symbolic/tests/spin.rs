@@ -176,7 +176,7 @@ fn spinning_bodies_have_the_same_equations_as_without_the_shortcut() {
     }
     // and the shortcut saves work
     let flops = |m: &SymbolicModel| {
-        mbs_symbolic::expr::OpCount::of(&m.sys.arena, &m.scenes[0].chosen().roots()).flops()
+        mbs_symbolic::expr::ops(&m.sys.arena, &m.scenes[0].chosen().roots()).flops()
     };
     assert!(
         flops(&fast) < flops(&slow),

@@ -57,13 +57,7 @@ pub struct FnSpec {
 
 impl FnSpec {
     pub fn new(name: &str, args: &str) -> FnSpec {
-        let call = args
-            .split(',')
-            .filter_map(|a| a.split(':').next())
-            .map(str::trim)
-            .filter(|a| !a.is_empty())
-            .collect::<Vec<_>>()
-            .join(", ");
+        let call = super::api::call_of(args);
         FnSpec {
             name: name.into(),
             args: args.into(),

@@ -2,6 +2,7 @@
 //! implementing `mbs::Model`, docs listing bodies, coordinates, effects and op counts.
 //! The text is what the macro emits (parsed into tokens) and what `mbs expand` prints.
 
+pub mod api;
 pub mod function;
 pub mod shapes;
 
@@ -10,6 +11,7 @@ use crate::expr::{ExprId, OpCount};
 use crate::mech::dynamics::SceneEquations;
 use crate::mech::system::{Formulation, Load, System};
 use crate::mech::{SymbolicModel, world};
+use api::{Sizes, args};
 use function::{FnSpec, RustNames, emit_fn};
 use std::fmt::Write;
 use std::time::{Duration, Instant};
@@ -284,27 +286,18 @@ fn emit_params(
     let mut derived = collect(emit_fn(a, &spec, &names), missing, |s, _| s).unwrap_or_default();
     // the constraints are the same in every scene: emitted once, here
     let c = &model.constraints;
-    let mut specs = vec![FnSpec::new(
-        "__constraints",
-        "t: f64, q: &[f64], phi: &mut [f64]",
-    )];
+    let mut specs = vec![FnSpec::new("__constraints", args("constraints"))];
     specs[0].vector("phi", &c.phi);
-    let mut f = FnSpec::new("__constraint_jacobian", "t: f64, q: &[f64], b: &mut [f64]");
+    let mut f = FnSpec::new("__constraint_jacobian", args("constraint_jacobian"));
     f.matrix(a, "b", &c.b);
     specs.push(f);
-    let mut f = FnSpec::new("__constraint_rate", "t: f64, q: &[f64], phi_t: &mut [f64]");
+    let mut f = FnSpec::new("__constraint_rate", args("constraint_rate"));
     f.vector("phi_t", &c.phi_t);
     specs.push(f);
-    let mut f = FnSpec::new(
-        "__constraint_bias",
-        "t: f64, q: &[f64], qd: &[f64], gamma: &mut [f64]",
-    );
+    let mut f = FnSpec::new("__constraint_bias", args("constraint_bias"));
     f.vector("gamma", &c.gamma);
     specs.push(f);
-    let mut f = FnSpec::new(
-        "__constraint_tangent",
-        "t: f64, q: &[f64], lambda: &[f64], k: &mut [f64]",
-    );
+    let mut f = FnSpec::new("__constraint_tangent", args("constraint_tangent"));
     f.matrix(a, "k", &c.tangent);
     specs.push(f);
     let labels = [
@@ -394,58 +387,37 @@ fn emit_scene(
     // the methods to emit, with the label of their op-count row (none for initial_state)
     let mut specs: Vec<(FnSpec, Option<&str>)> = Vec::new();
     let mb = eq.chosen();
-    let mut f = FnSpec::new(
-        "__dynamics",
-        "t: f64, q: &[f64], qd: &[f64], u: &[f64], m: &mut [f64], h: &mut [f64]",
-    );
+    let mut f = FnSpec::new("__dynamics", args("dynamics"));
     f.matrix(a, "m", &mb.m);
     f.vector("h", &mb.h);
     specs.push((f, Some("dynamics (M, h)")));
-    let mut f = FnSpec::new("__mass_matrix", "t: f64, q: &[f64], m: &mut [f64]");
+    let mut f = FnSpec::new("__mass_matrix", args("mass_matrix"));
     f.matrix(a, "m", &mb.m);
     specs.push((f, Some("mass_matrix")));
-    let mut f = FnSpec::new(
-        "__inverse_dynamics",
-        "t: f64, q: &[f64], qd: &[f64], qdd: &[f64], u: &[f64], tau: &mut [f64]",
-    );
+    let mut f = FnSpec::new("__inverse_dynamics", args("inverse_dynamics"));
     f.vector("tau", eq.tau());
     specs.push((f, Some("inverse_dynamics")));
     if let Some((kt, ct)) = &eq.tangents {
-        let mut f = FnSpec::new(
-            "__tangents",
-            "t: f64, q: &[f64], qd: &[f64], qdd: &[f64], u: &[f64], k: &mut [f64], c: &mut [f64]",
-        );
+        let mut f = FnSpec::new("__tangents", args("tangents"));
         f.matrix(a, "k", kt);
         f.matrix(a, "c", ct);
         specs.push((f, Some("tangents (K, C)")));
     }
-    let mut f = FnSpec::new(
-        "__static_forces",
-        "t: f64, q: &[f64], u: &[f64], h: &mut [f64]",
-    );
+    let mut f = FnSpec::new("__static_forces", args("static_forces"));
     f.vector("h", &eq.static_h);
     specs.push((f, Some("static_forces")));
-    let mut f = FnSpec::new(
-        "__input_matrix",
-        "t: f64, q: &[f64], qd: &[f64], u: &[f64], b: &mut [f64]",
-    );
+    let mut f = FnSpec::new("__input_matrix", args("input_matrix"));
     f.matrix(a, "b", &eq.input_matrix);
     specs.push((f, Some("input_matrix")));
-    let mut f = FnSpec::new("__energy", "t: f64, q: &[f64], qd: &[f64], e: &mut [f64]");
+    let mut f = FnSpec::new("__energy", &format!("{}, e: &mut [f64]", args("energy")));
     f.vector("e", &[eq.kinetic, eq.potential]);
     specs.push((f, Some("energy")));
-    let mut f = FnSpec::new(
-        "__power",
-        "t: f64, q: &[f64], qd: &[f64], u: &[f64], e: &mut [f64]",
-    );
+    let mut f = FnSpec::new("__power", &format!("{}, e: &mut [f64]", args("power")));
     f.vector("e", &[eq.power]);
     specs.push((f, Some("power")));
     // poses and kinematics of frames and points
-    let mut f = FnSpec::new("__frames", "t: f64, q: &[f64], out: &mut [::mbs::Pose]");
-    let mut fk = FnSpec::new(
-        "__kinematics",
-        "t: f64, q: &[f64], qd: &[f64], out: &mut ::mbs::Kinematics",
-    );
+    let mut f = FnSpec::new("__frames", args("frames"));
+    let mut fk = FnSpec::new("__kinematics", args("kinematics"));
     for (i, &node) in model.tree.frame_node.iter().enumerate() {
         let k = &model.world.nodes[node];
         for r in 0..3 {
@@ -493,7 +465,7 @@ fn emit_scene(
         );
     }
     specs.push((fk, Some("kinematics")));
-    let mut f = FnSpec::new("__initial_state", "q: &mut [f64], qd: &mut [f64]");
+    let mut f = FnSpec::new("__initial_state", args("initial_state"));
     let q0: Vec<ExprId> = sys.dofs.iter().map(|d| d.q0).collect();
     let qd0: Vec<ExprId> = sys.dofs.iter().map(|d| d.qd0).collect();
     f.vector("q", &q0);
@@ -670,6 +642,30 @@ fn emit_scene(
             "let _ = (t, q, qd, qdd, u, k, c);\nErr(::mbs::ModelError::TangentsNotGenerated {{ model: {ty:?} }})"
         )
     };
+    let sizes = Sizes {
+        nq: n,
+        nu: sys.inputs.len(),
+        nframes: sys.frames.len(),
+        npoints: sys.points.len(),
+        nc: sys.constraints.len(),
+    };
+    let model_impl = api::model_impl(&ty, &pty, &sizes, |m| {
+        match m.name {
+        "info" => format!("{info}\n&INFO"),
+        "params" => "&self.params".into(),
+        "set_params" => {
+            "::mbs::Parameters::validate(&params)?;\nself.params = params;\nOk(())".into()
+        }
+        "tangents" => tangents_body.clone(),
+        "energy" => "let mut e = [0.0f64; 2];\nself.__energy(t, q, qd, &mut e);\n::mbs::Energy { kinetic: e[0], potential: e[1] }".into(),
+        "power" => "let mut e = [0.0f64; 1];\nself.__power(t, q, qd, u, &mut e);\ne[0]".into(),
+        // the constraint functions live on the parameter struct, shared by every scene
+        name if name.starts_with("constraint") => {
+            format!("self.params.__{name}({})", m.call())
+        }
+        name => format!("self.__{name}({})", m.call()),
+    }
+    });
     let _ = write!(
         code,
         "{doc}#[derive(Clone, Debug, Default, PartialEq)]
@@ -689,54 +685,6 @@ impl {ty} {{
 {methods}}}
 #[automatically_derived]
 #[allow(unused_variables, clippy::all)]
-impl ::mbs::Model for {ty} {{
-type Params = {pty};
-const NQ: usize = {n};
-const NU: usize = {nu};
-const NFRAMES: usize = {nf};
-const NPOINTS: usize = {np};
-const NC: usize = {nc};
-fn info(&self) -> &'static ::mbs::ModelInfo {{
-{info}
-&INFO
-}}
-fn params(&self) -> &{pty} {{ &self.params }}
-fn set_params(&mut self, params: {pty}) -> ::core::result::Result<(), ::mbs::ParamError> {{
-::mbs::Parameters::validate(&params)?;
-self.params = params;
-Ok(())
-}}
-fn initial_state(&self, q: &mut [f64], qd: &mut [f64]) {{ self.__initial_state(q, qd) }}
-fn mass_matrix(&self, t: f64, q: &[f64], m: &mut [f64]) {{ self.__mass_matrix(t, q, m) }}
-fn dynamics(&self, t: f64, q: &[f64], qd: &[f64], u: &[f64], m: &mut [f64], h: &mut [f64]) {{ self.__dynamics(t, q, qd, u, m, h) }}
-fn inverse_dynamics(&self, t: f64, q: &[f64], qd: &[f64], qdd: &[f64], u: &[f64], tau: &mut [f64]) {{ self.__inverse_dynamics(t, q, qd, qdd, u, tau) }}
-fn tangents(&self, t: f64, q: &[f64], qd: &[f64], qdd: &[f64], u: &[f64], k: &mut [f64], c: &mut [f64]) -> ::core::result::Result<(), ::mbs::ModelError> {{
-{tangents_body}
-}}
-fn static_forces(&self, t: f64, q: &[f64], u: &[f64], h: &mut [f64]) {{ self.__static_forces(t, q, u, h) }}
-fn input_matrix(&self, t: f64, q: &[f64], qd: &[f64], u: &[f64], b: &mut [f64]) {{ self.__input_matrix(t, q, qd, u, b) }}
-fn energy(&self, t: f64, q: &[f64], qd: &[f64]) -> ::mbs::Energy {{
-let mut e = [0.0f64; 2];
-self.__energy(t, q, qd, &mut e);
-::mbs::Energy {{ kinetic: e[0], potential: e[1] }}
-}}
-fn power(&self, t: f64, q: &[f64], qd: &[f64], u: &[f64]) -> f64 {{
-let mut e = [0.0f64; 1];
-self.__power(t, q, qd, u, &mut e);
-e[0]
-}}
-fn frames(&self, t: f64, q: &[f64], out: &mut [::mbs::Pose]) {{ self.__frames(t, q, out) }}
-fn constraints(&self, t: f64, q: &[f64], phi: &mut [f64]) {{ self.params.__constraints(t, q, phi) }}
-fn constraint_jacobian(&self, t: f64, q: &[f64], b: &mut [f64]) {{ self.params.__constraint_jacobian(t, q, b) }}
-fn constraint_rate(&self, t: f64, q: &[f64], phi_t: &mut [f64]) {{ self.params.__constraint_rate(t, q, phi_t) }}
-fn constraint_bias(&self, t: f64, q: &[f64], qd: &[f64], gamma: &mut [f64]) {{ self.params.__constraint_bias(t, q, qd, gamma) }}
-fn constraint_tangent(&self, t: f64, q: &[f64], lambda: &[f64], k: &mut [f64]) {{ self.params.__constraint_tangent(t, q, lambda, k) }}
-fn kinematics(&self, t: f64, q: &[f64], qd: &[f64], out: &mut ::mbs::Kinematics) {{ self.__kinematics(t, q, qd, out) }}
-}}
-",
-        nu = sys.inputs.len(),
-        nf = sys.frames.len(),
-        np = sys.points.len(),
-        nc = sys.constraints.len(),
+{model_impl}"
     );
 }

@@ -368,7 +368,7 @@ pub fn emit(
     if !w.missing.is_empty() {
         return Err(w.missing);
     }
-    let mut count = OpCount::of_nodes(arena, &sch.order);
+    let mut count = super::ops_of_nodes(arena, &sch.order);
     count.lets = sch.lets.len();
     Ok(Emitted {
         chunks,

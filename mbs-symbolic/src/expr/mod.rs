@@ -12,7 +12,7 @@ pub mod sexpr;
 mod simplify;
 
 pub use arena::Arena;
-pub use count::OpCount;
+pub use count::{OpCount, ops, ops_of_nodes};
 pub use eval::{Env, SliceEnv};
 
 use std::fmt;

@@ -3,8 +3,7 @@
 //! the total time derivative of Φ̇ = B qd + Φ_t with the accelerations set to zero), and
 //! ∂(Bᵀλ)/∂q for Newton, with λ as symbols.
 
-use super::dynamics::Matrix;
-use super::spatial as s;
+use super::spatial::{self as s, Matrix};
 use super::system::{Attach, ConstraintKind, System};
 use super::tree::Tree;
 use super::world::World;

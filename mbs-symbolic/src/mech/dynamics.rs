@@ -5,16 +5,13 @@ use super::effects::Loads;
 use super::recursive::{body_kinematics, crba, newton_euler, spinning_body_motion};
 use super::spin::spinning_frames;
 
-use super::spatial as s;
+use super::spatial::{self as s, Matrix};
 use super::system::{Factor, Formulation, System};
 use super::tree::Tree;
 use super::virtual_power::virtual_power;
-use super::world::{Cols, World};
-use crate::expr::{Arena, ExprId, OpCount, Var};
+use super::world::World;
+use crate::expr::{Arena, ExprId, Var};
 use rustc_hash::FxHashMap;
-
-/// A dense matrix of expressions, row-major.
-pub type Matrix = Vec<Vec<ExprId>>;
 
 /// M (dense, row-major) and h of one formulation.
 #[derive(Clone, Debug)]
@@ -106,7 +103,7 @@ impl SceneEquations {
                 a.sub(mq, vp.h[i])
             })
             .collect();
-        let cost = |a: &Arena, r: &[ExprId]| OpCount::of(a, r).flops();
+        let cost = |a: &Arena, r: &[ExprId]| crate::expr::ops(a, r).flops();
         let formulation = sys.options.formulation.unwrap_or_else(|| {
             if cost(a, &vp.roots()) < cost(a, &rec.roots()) {
                 Formulation::VirtualPower
@@ -211,75 +208,4 @@ fn energies(sys: &mut System, tree: &Tree, world: &World, loads: &Loads) -> (Exp
         }
     }
     (t, v)
-}
-
-/// Kinematics of a declared point, world axes.
-#[derive(Clone, Debug)]
-pub struct PointKin {
-    pub position: s::V3,
-    pub velocity: s::V3,
-    pub jacobian: Cols,
-    /// acceleration at qdd = 0
-    pub bias: s::V3,
-}
-
-/// The symbolic model: system, tree, world kinematics and the equations of every scene.
-pub struct SymbolicModel {
-    pub sys: System,
-    pub tree: Tree,
-    pub world: World,
-    pub points: Vec<PointKin>,
-    pub scenes: Vec<SceneEquations>,
-    /// Φ, B, Φ_t, γ, ∂(Bᵀλ)/∂q of the constraints (empty without constraints)
-    pub constraints: super::constraints::ConstraintEquations,
-}
-
-impl SymbolicModel {
-    pub fn build(mut sys: System) -> SymbolicModel {
-        let tree = Tree::build(&mut sys);
-        let world = World::build(&mut sys.arena, &tree);
-        let scenes: Vec<Option<usize>> = if sys.scenes.is_empty() {
-            vec![None]
-        } else {
-            (0..sys.scenes.len()).map(Some).collect()
-        };
-        let scenes = scenes
-            .into_iter()
-            .map(|s| SceneEquations::build(&mut sys, &tree, &world, s))
-            .collect();
-        let points = sys
-            .points
-            .clone()
-            .iter()
-            .map(|pt| {
-                let a = &mut sys.arena;
-                match pt.frame {
-                    Some(fr) => {
-                        let node = tree.frame_node[fr];
-                        PointKin {
-                            position: world.point_position(a, node, pt.pos),
-                            velocity: world.point_velocity(a, node, pt.pos),
-                            jacobian: world.point_jacobian(a, node, pt.pos),
-                            bias: world.point_bias(a, node, pt.pos),
-                        }
-                    }
-                    None => PointKin {
-                        position: pt.pos,
-                        velocity: s::zero3(a),
-                        jacobian: Vec::new(),
-                        bias: s::zero3(a),
-                    },
-                }
-            })
-            .collect();
-        let constraints = super::constraints::ConstraintEquations::build(&mut sys, &tree, &world);
-        SymbolicModel {
-            sys,
-            tree,
-            world,
-            points,
-            scenes,
-            constraints,
-        }
-    }
 }

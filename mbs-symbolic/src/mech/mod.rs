@@ -4,6 +4,7 @@
 pub mod constraints;
 pub mod dynamics;
 pub mod effects;
+pub mod model;
 pub mod recursive;
 pub mod spatial;
 pub mod spin;
@@ -12,5 +13,6 @@ pub mod tree;
 pub mod virtual_power;
 pub mod world;
 
-pub use dynamics::{SceneEquations, SymbolicModel};
+pub use dynamics::SceneEquations;
+pub use model::{PointKin, SymbolicModel};
 pub use system::System;

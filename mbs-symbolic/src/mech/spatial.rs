@@ -6,6 +6,8 @@ use crate::expr::{Arena, ExprId};
 pub type V3 = [ExprId; 3];
 /// Row-major: `m[i][j]`.
 pub type M3 = [[ExprId; 3]; 3];
+/// A dense matrix of expressions of any size, row-major.
+pub type Matrix = Vec<Vec<ExprId>>;
 
 pub fn zero3(a: &Arena) -> V3 {
     [a.zero(); 3]

@@ -182,7 +182,7 @@ pub enum Load {
     },
     /// six-axis linear spring–damper between the origins and orientations of frames `a` and
     /// `b` (`None`: the ground), diagonal stiffnesses and dampings in `a`'s axes; see
-    /// `mech::effects` for the formulas. The elastic part derives from the potential
+    /// `mech::effects::bushing` for the formulas. The elastic part derives from the potential
     /// ½ Δpᵀ K Δp + ½ θᵀ K_r θ; damping counts in the power
     Bushing {
         a: Option<usize>,
@@ -285,6 +285,28 @@ impl System {
 
     pub fn ndof(&self) -> usize {
         self.dofs.len()
+    }
+
+    /// The frames, parents before children. A body may be declared before the frame its
+    /// pose starts from; poses refer only to poses defined above them, so there is no cycle.
+    pub fn frames_parents_first(&self) -> Vec<usize> {
+        let n = self.frames.len();
+        let mut order = Vec::with_capacity(n);
+        let mut placed = vec![false; n];
+        for i in 0..n {
+            let mut chain = Vec::new();
+            let mut f = Some(i);
+            while let Some(j) = f.filter(|&j| !placed[j]) {
+                assert!(chain.len() < n, "the poses of frames form a cycle");
+                chain.push(j);
+                f = self.frames[j].parent;
+            }
+            for &j in chain.iter().rev() {
+                placed[j] = true;
+                order.push(j);
+            }
+        }
+        order
     }
 
     /// The effects active in scene `s` (`None`: the model without scenes, every effect).

@@ -34,8 +34,10 @@ impl Tree {
             frames: Vec::new(),
             children: Vec::new(),
         }];
-        let mut frame_node = Vec::with_capacity(sys.frames.len());
-        for (i, f) in sys.frames.iter().enumerate() {
+        let n = sys.frames.len();
+        let mut frame_node = vec![0; n];
+        for i in sys.frames_parents_first() {
+            let f = &sys.frames[i];
             let mut cur = f.parent.map_or(0, |p| frame_node[p]);
             for fac in &f.factors {
                 let existing = nodes[cur]
@@ -59,7 +61,7 @@ impl Tree {
                 };
             }
             nodes[cur].frames.push(i);
-            frame_node.push(cur);
+            frame_node[i] = cur;
         }
         let mut t = Tree { nodes, frame_node };
         t.fuse(&mut sys.arena);

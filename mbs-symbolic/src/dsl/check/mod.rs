@@ -615,7 +615,8 @@ impl Checker {
         // every coordinate must move some mass, or M is singular
         let n = self.sys.dofs.len();
         let mut moves = vec![vec![false; n]; self.sys.frames.len()];
-        for (i, f) in self.sys.frames.iter().enumerate() {
+        for i in self.sys.frames_parents_first() {
+            let f = &self.sys.frames[i];
             if let Some(p) = f.parent {
                 moves[i] = moves[p].clone();
             }
@@ -650,5 +651,4 @@ mod bodies;
 mod constraints;
 mod effects;
 mod expr;
-mod force_elements;
 mod shapes;

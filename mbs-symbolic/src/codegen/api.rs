@@ -1,0 +1,175 @@
+//! The `mbs::Model` trait as generated code implements it: one table of its methods, from
+//! which both a generated model's `impl` and the placeholder of a model with errors are
+//! written. Compiling either against the trait is the check that the table is right
+//! (`tests/ui/cascade` compiles placeholders, every `multibody!` model the full impl).
+
+/// A method of `mbs::Model`: `fn {name}({receiver}, {args}) -> {ret}`.
+pub struct Method {
+    pub name: &'static str,
+    /// `&self` or `&mut self`
+    pub receiver: &'static str,
+    /// parameters after `&self`; `{P}` stands for the model's parameter struct
+    pub args: &'static str,
+    /// return type; empty for `()`; `{P}` as in `args`
+    pub ret: &'static str,
+}
+
+const fn method(name: &'static str, args: &'static str, ret: &'static str) -> Method {
+    Method {
+        name,
+        receiver: "&self",
+        args,
+        ret,
+    }
+}
+
+/// Every method of `mbs::Model` without a default, in the order generated code lists them.
+pub const METHODS: &[Method] = &[
+    method("info", "", "&'static ::mbs::ModelInfo"),
+    method("params", "", "&{P}"),
+    Method {
+        name: "set_params",
+        receiver: "&mut self",
+        args: "params: {P}",
+        ret: "::core::result::Result<(), ::mbs::ParamError>",
+    },
+    method("initial_state", "q: &mut [f64], qd: &mut [f64]", ""),
+    method("mass_matrix", "t: f64, q: &[f64], m: &mut [f64]", ""),
+    method(
+        "dynamics",
+        "t: f64, q: &[f64], qd: &[f64], u: &[f64], m: &mut [f64], h: &mut [f64]",
+        "",
+    ),
+    method(
+        "inverse_dynamics",
+        "t: f64, q: &[f64], qd: &[f64], qdd: &[f64], u: &[f64], tau: &mut [f64]",
+        "",
+    ),
+    method(
+        "tangents",
+        "t: f64, q: &[f64], qd: &[f64], qdd: &[f64], u: &[f64], k: &mut [f64], c: &mut [f64]",
+        "::core::result::Result<(), ::mbs::ModelError>",
+    ),
+    method(
+        "static_forces",
+        "t: f64, q: &[f64], u: &[f64], h: &mut [f64]",
+        "",
+    ),
+    method(
+        "input_matrix",
+        "t: f64, q: &[f64], qd: &[f64], u: &[f64], b: &mut [f64]",
+        "",
+    ),
+    method("energy", "t: f64, q: &[f64], qd: &[f64]", "::mbs::Energy"),
+    method("power", "t: f64, q: &[f64], qd: &[f64], u: &[f64]", "f64"),
+    method("frames", "t: f64, q: &[f64], out: &mut [::mbs::Pose]", ""),
+    method("constraints", "t: f64, q: &[f64], phi: &mut [f64]", ""),
+    method(
+        "constraint_jacobian",
+        "t: f64, q: &[f64], b: &mut [f64]",
+        "",
+    ),
+    method(
+        "constraint_rate",
+        "t: f64, q: &[f64], phi_t: &mut [f64]",
+        "",
+    ),
+    method(
+        "constraint_bias",
+        "t: f64, q: &[f64], qd: &[f64], gamma: &mut [f64]",
+        "",
+    ),
+    method(
+        "constraint_tangent",
+        "t: f64, q: &[f64], lambda: &[f64], k: &mut [f64]",
+        "",
+    ),
+    method(
+        "kinematics",
+        "t: f64, q: &[f64], qd: &[f64], out: &mut ::mbs::Kinematics",
+        "",
+    ),
+];
+
+/// The method `name` of the table.
+pub fn method_named(name: &str) -> &'static Method {
+    METHODS
+        .iter()
+        .find(|m| m.name == name)
+        .unwrap_or_else(|| panic!("`{name}` is not a method of mbs::Model"))
+}
+
+/// The parameter list of method `name` (for the inner functions that share it).
+pub fn args(name: &str) -> &'static str {
+    method_named(name).args
+}
+
+impl Method {
+    /// The argument names as a call passes them: `t, q, m`.
+    pub fn call(&self) -> String {
+        call_of(self.args)
+    }
+}
+
+/// The names of a parameter list as a call's arguments: `t: f64, q: &[f64]` → `t, q`.
+pub fn call_of(args: &str) -> String {
+    args.split(',')
+        .filter_map(|a| a.split(':').next())
+        .map(str::trim)
+        .filter(|a| !a.is_empty())
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The sizes of a model, its associated constants.
+pub struct Sizes {
+    pub nq: usize,
+    pub nu: usize,
+    pub nframes: usize,
+    pub npoints: usize,
+    pub nc: usize,
+}
+
+/// `impl ::mbs::Model for {ty}` with parameter struct `pty`: the constants, then every method
+/// of [`METHODS`] with the body `body(method)`.
+pub fn model_impl(
+    ty: &str,
+    pty: &str,
+    sizes: &Sizes,
+    mut body: impl FnMut(&Method) -> String,
+) -> String {
+    let Sizes {
+        nq,
+        nu,
+        nframes,
+        npoints,
+        nc,
+    } = sizes;
+    let mut s = format!(
+        "impl ::mbs::Model for {ty} {{
+type Params = {pty};
+const NQ: usize = {nq};
+const NU: usize = {nu};
+const NFRAMES: usize = {nframes};
+const NPOINTS: usize = {npoints};
+const NC: usize = {nc};
+"
+    );
+    for m in METHODS {
+        let args = m.args.replace("{P}", pty);
+        let ret = if m.ret.is_empty() {
+            String::new()
+        } else {
+            format!(" -> {}", m.ret.replace("{P}", pty))
+        };
+        let sep = if args.is_empty() { "" } else { ", " };
+        s.push_str(&format!(
+            "fn {}({}{sep}{args}){ret} {{\n{}\n}}\n",
+            m.name,
+            m.receiver,
+            body(m)
+        ));
+    }
+    s.push_str("}\n");
+    s
+}

@@ -18,16 +18,16 @@ const STATES: usize = 3;
 
 /// Generalised forces h(q, qd, t) of a scene by the oracle: the loads' values (expressions of
 /// q and qd) are evaluated, then applied as external spatial forces on the oracle's links.
+/// `state` is (t, q, qd).
 fn oracle_h(
     model: &SymbolicModel,
     oracle: &Oracle,
     frame_link: &[(usize, V3)],
     effects: &[usize],
-    t: f64,
-    q: &[f64],
-    qd: &[f64],
+    state: (f64, &[f64], &[f64]),
     regimes: &mut [usize; 3],
 ) -> Vec<f64> {
+    let (t, q, qd) = state;
     let poses = oracle.link_poses(q, t);
     let vels = oracle.link_velocities(q, qd, t);
     let mut ext = vec![[0.0; 6]; poses.len()];
@@ -331,9 +331,7 @@ fn balance(
                     &oracle,
                     &frame_link,
                     &eq.effects,
-                    t,
-                    &q,
-                    &qd,
+                    (t, &q, &qd),
                     &mut out.regimes,
                 );
                 out.oracle

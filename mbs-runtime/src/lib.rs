@@ -19,6 +19,7 @@ pub mod inertia;
 pub mod integrators;
 pub mod linalg;
 pub mod model;
+mod op_count;
 pub mod options;
 pub mod stats;
 pub mod trajectory;

@@ -8,40 +8,20 @@ use crate::error::{ModelError, ParamError};
 use serde::{Deserialize, Serialize, de::DeserializeOwned};
 use std::fmt;
 
-/// Operation counts of one generated function, as reported by `mbs expand`. The generator
-/// (`mbs-symbolic`) counts in this type too, so there is one definition.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
-pub struct OpCount {
-    /// additions, subtractions and negations
-    pub adds: usize,
-    /// multiplications (an integer power `x^n` counts n − 1)
-    pub muls: usize,
-    /// divisions
-    pub divs: usize,
-    /// square roots, trigonometric and other elementary or user functions
-    pub funcs: usize,
-    /// `let` temporaries in the emitted code
-    pub lets: usize,
-}
+pub use crate::op_count::OpCount;
 
-impl OpCount {
-    /// adds + muls + divs
-    pub fn flops(&self) -> usize {
-        self.adds + self.muls + self.divs
-    }
-}
-
-impl fmt::Display for OpCount {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "{} flops ({} adds, {} muls, {} divs), {} funcs",
-            self.flops(),
-            self.adds,
-            self.muls,
-            self.divs,
-            self.funcs
-        )
+/// Serialized as a map of its five counts (the struct lives in a file the generator shares,
+/// which has no serde).
+impl Serialize for OpCount {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeStruct;
+        let mut st = s.serialize_struct("OpCount", 5)?;
+        st.serialize_field("adds", &self.adds)?;
+        st.serialize_field("muls", &self.muls)?;
+        st.serialize_field("divs", &self.divs)?;
+        st.serialize_field("funcs", &self.funcs)?;
+        st.serialize_field("lets", &self.lets)?;
+        st.end()
     }
 }
 

@@ -1,9 +1,13 @@
 //! Operation counts of straight-line code: every node reachable from the outputs is computed
 //! exactly once (hash-consing shares equal subexpressions), so counting nodes counts work.
-//! The counts are the runtime's [`OpCount`], the type generated models report them in.
+//! [`OpCount`] is the runtime's own file, included here: one definition for the counts the
+//! generator makes and the type generated models report them in.
 
 use super::{Arena, ExprId, Node};
-pub use mbs_runtime::OpCount;
+
+#[path = "../../../mbs-runtime/src/op_count.rs"]
+mod op_count;
+pub use op_count::OpCount;
 
 /// Counts the work to compute all of `roots` (no `let`s: scheduling fills them in).
 pub fn ops(arena: &Arena, roots: &[ExprId]) -> OpCount {

@@ -46,7 +46,7 @@ fn a_run_writes_every_output_with_named_columns() {
     assert!(e > 0.0 && e < 1e-6, "{e:e}");
     let csv = std::fs::read_to_string(dir.join("trajectory.csv")).unwrap();
     let header = csv.lines().next().unwrap();
-    assert!(header.starts_with("t,q[0],q[0].d,q[0].dd"), "{header}");
+    assert!(header.starts_with("t,q[0],qd[0],qdd[0]"), "{header}");
     assert_eq!(csv.lines().count(), 22);
     for file in ["coordinates.svg", "energy.svg"] {
         let svg = std::fs::read_to_string(dir.join(file)).unwrap();

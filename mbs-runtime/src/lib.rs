@@ -41,4 +41,4 @@ pub use options::{
     NewmarkParams, NewtonOptions, Options, Output, Scheme, StepControl,
 };
 pub use stats::Stats;
-pub use trajectory::{Observer, Trajectory};
+pub use trajectory::{CsvWriter, Observer, Trajectory};

@@ -201,7 +201,7 @@ fn failure_text(e: &SimError) -> String {
             None => e.to_string(),
         },
         Failure::TooMuchWork { max_steps } => format!(
-            "more than {max_steps} steps {at}: raise --max-steps, loosen --rtol, or use a scheme suited to the stiffness (--scheme radau5 or bdf)"
+            "more than {max_steps} steps {at}: raise --max-steps, take larger steps (a larger --h or a looser --rtol), or use a scheme suited to the stiffness (--scheme radau5 or bdf)"
         ),
         Failure::StepTooSmall { h_min } => format!(
             "the step fell below {h_min:e} s {at}: the solution may be singular or too stiff for the scheme (try --scheme radau5 or bdf)"
@@ -603,7 +603,11 @@ impl RunArgs {
         if stopped {
             // what was computed until the stop is written: say so, then report the stop
             let t = report.trajectory.t.last().copied().unwrap_or(t0);
-            let why = if interrupted { "interrupted" } else { "failed" };
+            let why = if interrupted {
+                "was interrupted"
+            } else {
+                "failed"
+            };
             match &written {
                 Ok(files) if !files.is_empty() => {
                     eprintln!(

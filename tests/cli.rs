@@ -338,8 +338,16 @@ fn ctrl_c_stops_a_program_which_keeps_its_outputs() {
         let _ = child.kill();
         panic!("{} did not start its run within 120 s", program.display());
     }
-    // let it take some steps, then Ctrl-C
-    std::thread::sleep(Duration::from_millis(500));
+    // let it write some rows (the file grows by buffers of several kB), then Ctrl-C
+    let csv = dir.join("trajectory.csv");
+    let deadline = Instant::now() + Duration::from_secs(120);
+    while std::fs::metadata(&csv).map_or(0, |m| m.len()) == 0 {
+        if Instant::now() > deadline {
+            let _ = child.kill();
+            panic!("{} wrote no rows within 120 s", csv.display());
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
     let kill = Command::new("kill")
         .args(["-INT", &child.id().to_string()])
         .status()
@@ -360,7 +368,7 @@ fn ctrl_c_stops_a_program_which_keeps_its_outputs() {
     std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut stderr).unwrap();
     assert!(!status.success(), "{status:?}: {stderr}");
     assert!(stderr.contains("interrupted"), "{stderr}");
-    let (last, rows) = csv_rows(&dir.join("trajectory.csv"));
+    let (last, rows) = csv_rows(&csv);
     assert!(rows > 1, "{rows} rows");
     assert!(last > 0.0 && last < 1e6, "{last}");
     let stats = std::fs::read_to_string(dir.join("stats.json")).unwrap();

@@ -6,58 +6,39 @@
 //! the final tracking error and the work done. The electrical time constant (L/R = 1 ms) is
 //! far shorter than the mechanical one: the default scheme is Radau5.
 //!
-//! Run with `cargo run --release --example dc_motor` or `-- --scheme bdf --rtol 1e-8`.
+//! The shared command line (`mbs::cli`, `--help` for all) runs it with the controller as its
+//! input, Radau5 at rtol 1e-8 and outputs every 50 ms unless told otherwise: `cargo run
+//! --release --example dc_motor` or `-- --scheme bdf --rtol 1e-6 --out out`.
 
 #[path = "models/dc_motor.rs"]
 mod model;
 
-use clap::Parser;
-use mbs::{Inputs, Integrator, Options, Output, Scheme, Simulation, WithEfforts};
-
-/// Simulation settings.
-#[derive(Parser, Debug)]
-struct Args {
-    /// integration scheme
-    #[arg(long, default_value = "radau5")]
-    scheme: String,
-    /// relative tolerance
-    #[arg(long, default_value_t = 1e-8)]
-    rtol: f64,
-    /// end time (s)
-    #[arg(long, default_value_t = 1.0)]
-    t_end: f64,
-}
+use mbs::cli::{RunArgs, RunError};
+use mbs::{Inputs, WithEfforts};
 
 fn main() {
-    let args = Args::parse();
-    let Some(scheme) = Scheme::from_name(&args.scheme) else {
-        eprintln!("unknown scheme `{}`", args.scheme);
-        std::process::exit(2);
-    };
+    let args =
+        RunArgs::parse_with_defaults(&[("scheme", "radau5"), ("rtol", "1e-8"), ("dt", "0.05")]);
     let period = 1e-3;
     let model = WithEfforts::new(model::Arm::default(), model::Motor::default());
     let inputs = Inputs::new().controller(period, model::PiSpeed::new(20.0, period));
-    let options = Options {
-        output: Output::Every { dt: 0.05 },
-        ..Options::adaptive(args.t_end, args.rtol)
-    };
-    let start = std::time::Instant::now();
-    let mut sim = match Simulation::with_inputs(model, scheme, options, inputs) {
-        Ok(sim) => sim,
+    let report = match args.run_with(model, 1.0, inputs) {
+        Ok(report) => report,
         Err(e) => {
             eprintln!("error: {e}");
-            std::process::exit(1);
+            std::process::exit(match e {
+                RunError::UnknownScheme(_) => 2,
+                _ => 1,
+            });
         }
     };
-    if let Err(e) = sim.integrate_to(args.t_end) {
-        eprintln!("error: {e}");
-        std::process::exit(1);
+    if args.quiet {
+        return;
     }
-    let cpu = start.elapsed();
-    let (tr, stats) = sim.finish();
+    let tr = &report.trajectory;
     let motor = model::Motor::default();
     println!(
-        "{:>6} {:>12} {:>12} {:>12}",
+        "\n{:>6} {:>12} {:>12} {:>12}",
         "t", "ω (rad/s)", "i (A)", "V (V)"
     );
     for i in (0..tr.len()).step_by(2) {
@@ -67,12 +48,10 @@ fn main() {
         let v = motor.l * didt + motor.r * current + motor.k * motor.gear * w;
         println!("{:>6.2} {w:>12.6} {current:>12.6} {v:>12.4}", tr.t[i]);
     }
-    let w_end = tr.qd(tr.len() - 1)[0];
+    let last = tr.len() - 1;
     println!(
-        "\nspeed error at t = {}: {:.2e} rad/s; arm + motor + PI with {}, {:.1?}:\n{stats}",
-        args.t_end,
-        (w_end - 20.0).abs(),
-        scheme.name(),
-        cpu
+        "\nspeed error at t = {}: {:.2e} rad/s",
+        tr.t[last],
+        (tr.qd(last)[0] - 20.0).abs()
     );
 }

@@ -5,17 +5,28 @@
 //! --t-end T       end time (s)
 //! --h H           fixed step (s); without it the scheme controls its step by --rtol/--atol
 //! --rtol R --atol A
+//! --max-steps N   attempted steps before the run gives up (default 1000000)
 //! --dt DT         output every DT seconds (default: every step)
 //! --constraints M auto, index3, projection, partitioning, baumgarte:ALPHA,BETA
 //!                 (constrained models; default auto)
 //! --scene NAME    the scene to run (programs whose model has several)
-//! --out DIR       write DIR/trajectory.csv, coordinates.svg, energy.svg, animation.html
-//!                 (offline, in any browser) and motion.gltf (Blender, glTF viewers)
+//! --out DIR       write DIR/trajectory.csv (every output, written as the run goes),
+//!                 coordinates.svg, energy.svg, animation.html (offline, in any browser),
+//!                 motion.gltf (Blender, glTF viewers) and stats.json
 //! --quiet         print nothing but errors
 //! ```
 //!
 //! Runs longer than about a second show a progress bar (on standard error); every run ends
 //! with a summary table: steps, evaluations, energy error, CPU time.
+//!
+//! A run that fails (a typed [`SimError`]) or is stopped with Ctrl-C still writes what it
+//! computed until then — the CSV up to the last output, the plots, the animation and the
+//! work counters — says so on standard error and returns [`RunError::Stopped`], so the
+//! program exits with a non-zero status. A second Ctrl-C ends the program at once.
+//!
+//! Memory stays flat in the number of steps: the CSV is written as the outputs come, and
+//! only a thinned series is kept for the summary, the plots, the animation and the glTF file
+//! (at most [`FRAMES_PER_SECOND`] outputs per simulated second and [`MAX_KEPT`] in all).
 //!
 //! ```text
 //! cargo run --release --example dpend -- --scheme radau5 --rtol 1e-10 --t-end 20 --out out
@@ -23,15 +34,28 @@
 
 use crate::plot::{Chart, Series, line_chart};
 use crate::{
-    ConstraintMethod, ConstraintOptions, Model, Options, Output, Scheme, SimError, Simulation,
-    Stats, StepControl, Trajectory,
+    ConstraintMethod, ConstraintOptions, CsvWriter, Failure, Inputs, Model, Options, Output,
+    Scheme, SimError, Simulation, Stats, StepControl, Trajectory,
 };
-use clap::Parser;
+/// `RunArgs::parse()` needs this trait in scope: programs can name it without depending on
+/// clap themselves (`use mbs::cli::Parser;`).
+pub use clap::Parser;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::fs::File;
+use std::io::BufWriter;
 use std::path::{Path, PathBuf};
+use std::sync::Once;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
-/// How to run a simulation from the command line.
+/// At most this many outputs per simulated second are kept in memory for the summary, the
+/// plots, the animation and the glTF file (the CSV has every output).
+pub const FRAMES_PER_SECOND: f64 = 60.0;
+/// At most this many outputs in all are kept in memory (plus the last one).
+pub const MAX_KEPT: usize = 6000;
+
+/// How to run a simulation from the command line. Numbers may be negative (`--t-end -1`,
+/// `--rtol -1e-6`): the option check then says what is wrong with them.
 #[derive(Parser, Debug, Clone)]
 pub struct RunArgs {
     /// integration scheme: euler, rk4, dopri5, newmark, hht, gen-alpha, bdf, radau3, radau5,
@@ -39,21 +63,25 @@ pub struct RunArgs {
     #[arg(long, default_value = "dopri5")]
     pub scheme: String,
     /// end time (s); each program has its own default
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub t_end: Option<f64>,
     /// fixed step (s); without it, the scheme controls its step with --rtol and --atol
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub h: Option<f64>,
     /// relative tolerance of adaptive steps
-    #[arg(long, default_value_t = 1e-6)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 1e-6)]
     pub rtol: f64,
     /// absolute tolerance of adaptive steps (default rtol/100)
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub atol: Option<f64>,
+    /// attempted steps (accepted and rejected) before the run gives up
+    #[arg(long, default_value_t = Options::default().max_steps)]
+    pub max_steps: usize,
     /// output every DT seconds (default: every step)
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub dt: Option<f64>,
-    /// write DIR/trajectory.csv, coordinates.svg, energy.svg, animation.html and motion.gltf
+    /// write DIR/trajectory.csv, coordinates.svg, energy.svg, animation.html, motion.gltf and
+    /// stats.json (also, up to where it stopped, for a run that fails or is stopped by Ctrl-C)
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// constraint method of constrained models: auto, index3, projection, partitioning or
@@ -69,9 +97,18 @@ pub struct RunArgs {
 }
 
 /// What a run gives: the outputs, the work, the time.
+#[derive(Debug)]
 pub struct RunReport {
     pub scheme: Scheme,
+    /// the outputs, thinned to at most [`FRAMES_PER_SECOND`] per simulated second and
+    /// [`MAX_KEPT`] in all, always with the first and the last (every output of a run with
+    /// fewer); `--out` writes every output to the CSV file
     pub trajectory: Trajectory,
+    /// outputs the run produced (the CSV's rows)
+    pub outputs: usize,
+    /// the most outputs held in memory at once (the driver's unwritten ones and the thinned
+    /// series): bounded whatever the number of steps
+    pub peak_held: usize,
     pub stats: Stats,
     /// CPU time of the calling thread over the run (set-up, start, steps; not the outputs
     /// written after it), wall time where the thread's clock cannot be read
@@ -81,31 +118,35 @@ pub struct RunReport {
     /// then E(t) − E(0) measures the scheme's error; otherwise it also holds the work those
     /// effects did
     pub conservative: bool,
+    /// max |E(t) − E(0)| and the scale of energies over every output (not the thinned ones)
+    energy: Option<(f64, f64)>,
 }
 
 impl RunReport {
-    /// max |E(t) − E(0)| relative to max(|E(0)|, max kinetic energy).
+    /// max |E(t) − E(0)| over every output, relative to max(|E(0)|, max kinetic energy).
     pub fn energy_error(&self) -> Option<f64> {
-        let drift = self.trajectory.energy_drift()?;
-        let scale = self
-            .trajectory
-            .energy
-            .iter()
-            .map(|e| e.kinetic.abs())
-            .fold(self.trajectory.energy[0].total().abs(), f64::max);
+        let (drift, scale) = self.energy?;
         Some(if scale > 0.0 { drift / scale } else { drift })
     }
 }
 
-/// Why a run could not be made.
+/// Why a run could not be made or did not reach its end.
 #[derive(Debug, thiserror::Error)]
 pub enum RunError {
     #[error(
         "unknown scheme `{0}`: use euler, rk4, dopri5, newmark, hht, gen-alpha, bdf, radau3, radau5 or midpoint"
     )]
     UnknownScheme(String),
-    #[error("{0}")]
+    /// the run could not start (options, parameters, a consistent start); nothing was written
+    #[error("{}", failure_text(.0))]
     Simulation(Box<SimError>),
+    /// the run stopped before its end, by a typed failure (`failure`) or by Ctrl-C (`None`);
+    /// what it computed until then is in `report` and was written with `--out`
+    #[error("{}", stopped_text(.failure.as_deref(), .report))]
+    Stopped {
+        failure: Option<Box<SimError>>,
+        report: Box<RunReport>,
+    },
     #[error("unknown scene `{given}`: this program has {known}")]
     UnknownScene { given: String, known: String },
     #[error("cannot draw or export {path}: {reason}")]
@@ -115,6 +156,87 @@ pub enum RunError {
         path: PathBuf,
         source: std::io::Error,
     },
+}
+
+fn stopped_text(failure: Option<&SimError>, report: &RunReport) -> String {
+    match failure {
+        Some(e) => failure_text(e),
+        None => format!(
+            "interrupted (Ctrl-C) at t = {} s",
+            report.trajectory.t.last().copied().unwrap_or(f64::NAN)
+        ),
+    }
+}
+
+/// The runtime's message of a failure, with advice in the command line's flags where the
+/// runtime names its Rust API (`StepControl::Fixed`, `max_steps`, …).
+fn failure_text(e: &SimError) -> String {
+    let flag = |name: &str| -> Option<&'static str> {
+        Some(match name {
+            "t_end" => "--t-end",
+            "h" => "--h",
+            "rtol" => "--rtol",
+            "atol" => "--atol",
+            "max_steps" => "--max-steps",
+            "output.dt" => "--dt",
+            "constraints.method" => "--constraints",
+            _ => return None,
+        })
+    };
+    let at = format!("(at t = {}, h = {:e})", e.t, e.h);
+    match &e.kind {
+        Failure::InvalidOption {
+            name: "step",
+            value,
+            ..
+        } => format!(
+            "{value} has no error estimate to control its step: give a fixed step, e.g. --h 1e-3, or use an adaptive scheme (--scheme dopri5, radau5, bdf)"
+        ),
+        Failure::InvalidOption {
+            name,
+            value,
+            reason,
+        } => match flag(name) {
+            Some(f) => format!("{f} {value} is invalid: {reason}"),
+            None => e.to_string(),
+        },
+        Failure::TooMuchWork { max_steps } => format!(
+            "more than {max_steps} steps {at}: raise --max-steps, take larger steps (a larger --h or a looser --rtol), or use a scheme suited to the stiffness (--scheme radau5 or bdf)"
+        ),
+        Failure::StepTooSmall { h_min } => format!(
+            "the step fell below {h_min:e} s {at}: the solution may be singular or too stiff for the scheme (try --scheme radau5 or bdf)"
+        ),
+        Failure::UnstableStep {
+            scheme,
+            rho,
+            h_rho,
+            limit,
+            h_stable,
+        } => format!(
+            "h·ρ = {h_rho:.3} leaves the stability region of {scheme} (limit {limit:.3}; ρ ≈ {rho:.4e} 1/s is the fastest mode) {at}: take --h {:.1e} or smaller, or an implicit scheme (--scheme radau5)",
+            shorten(*h_stable)
+        ),
+        Failure::ConstraintDrift {
+            constraint,
+            value,
+            tolerance,
+        } => format!(
+            "constraint `{constraint}` drifted to |Φ| = {value:.2e}, beyond {tolerance:.1e} {at}: use --constraints projection, index3 or partitioning, or larger baumgarte:ALPHA,BETA"
+        ),
+        Failure::ConstraintsUnsupported { scheme, method, .. } => format!(
+            "{scheme} cannot integrate constraints by {method}: use --constraints projection (any scheme), or index 3 with --scheme gen-alpha, hht or radau5"
+        ),
+        _ => e.to_string(),
+    }
+}
+
+/// A step a little below `h` with two significant digits (advice users can type).
+fn shorten(h: f64) -> f64 {
+    if h <= 0.0 || !h.is_finite() {
+        return h;
+    }
+    let scale = 10f64.powi(h.log10().floor() as i32 - 1);
+    (h / scale).floor() * scale
 }
 
 /// `auto`, `index3`, `projection`, `partitioning` or `baumgarte:ALPHA,BETA`.
@@ -140,7 +262,167 @@ pub fn parse_constraint_method(s: &str) -> Result<ConstraintMethod, String> {
     })
 }
 
+/// Runs in progress in this process, and whether Ctrl-C asked them to stop.
+static RUNNING: AtomicUsize = AtomicUsize::new(0);
+static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+static HANDLER: Once = Once::new();
+
+/// Ctrl-C during a run asks it to stop after the step in progress; a second one, or one
+/// outside a run, ends the program (status 130). A program that installed its own handler
+/// keeps it (then runs are not stopped between steps).
+fn watch_ctrl_c() {
+    HANDLER.call_once(|| {
+        let _ = ctrlc::set_handler(|| {
+            if RUNNING.load(Ordering::SeqCst) == 0 || INTERRUPTED.swap(true, Ordering::SeqCst) {
+                std::process::exit(130);
+            }
+        });
+    });
+}
+
+/// Counts a run as in progress while it lives.
+struct Running;
+
+impl Running {
+    fn start() -> Running {
+        watch_ctrl_c();
+        if RUNNING.fetch_add(1, Ordering::SeqCst) == 0 {
+            INTERRUPTED.store(false, Ordering::SeqCst);
+        }
+        Running
+    }
+}
+
+impl Drop for Running {
+    fn drop(&mut self) {
+        RUNNING.fetch_sub(1, Ordering::SeqCst);
+    }
+}
+
+/// Where a run's outputs go as they come: every one to the CSV file (with `--out`), a thinned
+/// series to memory, and the energy extremes over all of them.
+struct Recorder {
+    csv: Option<(PathBuf, CsvWriter<BufWriter<File>>)>,
+    csv_error: Option<std::io::Error>,
+    kept: Trajectory,
+    t0: f64,
+    keep_dt: f64,
+    next_keep: f64,
+    /// the last output when it was not kept (appended at the end)
+    last: Trajectory,
+    outputs: usize,
+    peak_held: usize,
+    /// E(t0), max |E − E(t0)|, max kinetic energy
+    energy: Option<(f64, f64, f64)>,
+    energy_everywhere: bool,
+}
+
+impl Recorder {
+    fn new(csv: Option<(PathBuf, File)>, t0: f64, t_end: f64) -> Recorder {
+        Recorder {
+            csv: csv.map(|(path, file)| (path, CsvWriter::new(BufWriter::new(file)))),
+            csv_error: None,
+            kept: Trajectory::default(),
+            t0,
+            keep_dt: (1.0 / FRAMES_PER_SECOND).max((t_end - t0) / MAX_KEPT as f64),
+            next_keep: f64::NEG_INFINITY,
+            last: Trajectory::default(),
+            outputs: 0,
+            peak_held: 0,
+            energy: None,
+            energy_everywhere: true,
+        }
+    }
+
+    /// Writes and sorts the outputs of `tr` (recorded since the last call).
+    fn take(&mut self, tr: &Trajectory) {
+        if self.outputs == 0 {
+            for keep in [&mut self.kept, &mut self.last] {
+                keep.dof_names.clone_from(&tr.dof_names);
+                keep.frame_names.clone_from(&tr.frame_names);
+                keep.constraint_names.clone_from(&tr.constraint_names);
+            }
+        }
+        self.peak_held = self
+            .peak_held
+            .max(tr.len() + self.kept.len() + self.last.len());
+        if let (Some((_, csv)), None) = (&mut self.csv, &self.csv_error) {
+            if let Err(e) = csv.write(tr) {
+                self.csv_error = Some(e);
+            }
+        }
+        let with_energy = tr.energy.len() == tr.len();
+        self.energy_everywhere &= with_energy;
+        for i in 0..tr.len() {
+            if with_energy {
+                let e = tr.energy[i];
+                let (e0, drift, kinetic) = self.energy.get_or_insert((e.total(), 0.0, 0.0));
+                *drift = drift.max((e.total() - *e0).abs());
+                *kinetic = kinetic.max(e.kinetic.abs());
+            }
+            let t = tr.t[i];
+            self.last.clear_outputs();
+            if t >= self.next_keep {
+                self.kept.push_output(tr, i);
+                let k = ((t - self.t0) / self.keep_dt).floor().max(0.0);
+                self.next_keep = self.t0 + (k + 1.0) * self.keep_dt;
+            } else {
+                self.last.push_output(tr, i);
+            }
+        }
+        self.outputs += tr.len();
+    }
+
+    /// The thinned series with the last output, and the CSV file's fate.
+    fn finish(mut self) -> (Trajectory, Option<(f64, f64)>, Result<(), RunError>) {
+        if !self.last.is_empty() {
+            self.kept.push_output(&self.last, 0);
+        }
+        let energy = match (self.energy, self.energy_everywhere) {
+            (Some((e0, drift, kinetic)), true) => Some((drift, kinetic.max(e0.abs()))),
+            _ => None,
+        };
+        let csv = match self.csv {
+            None => Ok(()),
+            Some((path, csv)) => match self.csv_error {
+                Some(source) => Err(RunError::Io { path, source }),
+                None => csv
+                    .finish(&self.kept)
+                    .map(|_| ())
+                    .map_err(|source| RunError::Io { path, source }),
+            },
+        };
+        (self.kept, energy, csv)
+    }
+}
+
 impl RunArgs {
+    /// Parses the program's arguments with the program's own defaults, by field name:
+    /// `RunArgs::parse_with_defaults(&[("scheme", "radau5"), ("rtol", "1e-8")])`; `--help`
+    /// shows them. Exits with clap's message on bad arguments, like `RunArgs::parse()`.
+    ///
+    /// Panics if a name is not a field of [`RunArgs`].
+    pub fn parse_with_defaults(defaults: &[(&'static str, &'static str)]) -> RunArgs {
+        RunArgs::try_parse_with_defaults(std::env::args_os(), defaults).unwrap_or_else(|e| e.exit())
+    }
+
+    /// [`RunArgs::parse_with_defaults`] of the given arguments (the program's name first).
+    pub fn try_parse_with_defaults<I, T>(
+        args: I,
+        defaults: &[(&'static str, &'static str)],
+    ) -> Result<RunArgs, clap::Error>
+    where
+        I: IntoIterator<Item = T>,
+        T: Into<std::ffi::OsString> + Clone,
+    {
+        use clap::{CommandFactory, FromArgMatches};
+        let mut command = RunArgs::command();
+        for &(name, value) in defaults {
+            command = command.mut_arg(name, |a| a.default_value(value));
+        }
+        RunArgs::from_arg_matches(&command.try_get_matches_from(args)?)
+    }
+
     /// The options these arguments describe, with `t_end` as the default end time.
     pub fn options(&self, t_end: f64) -> Options {
         let t_end = self.t_end.unwrap_or(t_end);
@@ -160,6 +442,7 @@ impl RunArgs {
             t_end,
             step,
             output,
+            max_steps: self.max_steps,
             // poses for the animation and the glTF file
             frames: self.out.is_some(),
             constraints: ConstraintOptions {
@@ -170,11 +453,24 @@ impl RunArgs {
         }
     }
 
-    /// Runs `model` as asked, prints a summary unless `--quiet`, writes the CSV if `--out`.
+    /// Runs `model` as asked, prints a summary unless `--quiet`, writes the outputs if
+    /// `--out`. A run that fails or is stopped by Ctrl-C writes what it computed until then
+    /// and returns [`RunError::Stopped`] with it.
     pub fn run<M: Model + 'static>(
         &self,
         model: M,
         default_t_end: f64,
+    ) -> Result<RunReport, RunError> {
+        self.run_with(model, default_t_end, Inputs::new())
+    }
+
+    /// [`RunArgs::run`] for a model with inputs u: driven by a function of time and sampled
+    /// controllers ([`Inputs`]).
+    pub fn run_with<M: Model + 'static>(
+        &self,
+        model: M,
+        default_t_end: f64,
+        inputs: Inputs,
     ) -> Result<RunReport, RunError> {
         let scheme = Scheme::from_name(&self.scheme)
             .ok_or_else(|| RunError::UnknownScheme(self.scheme.clone()))?;
@@ -191,14 +487,36 @@ impl RunArgs {
             }
         }
         let name = info.name;
+        let running = Running::start();
         let start = Instant::now();
         let cpu0 = cpu_time::ThreadTime::try_now().ok();
         let options = self.options(default_t_end);
         let (t0, t_end) = (options.t0, options.t_end);
-        let fail = |e| RunError::Simulation(Box::new(e));
-        let mut sim = Simulation::new(model, scheme, options).map_err(fail)?;
+        let mut sim = Simulation::with_inputs(model, scheme, options, inputs)
+            .map_err(|e| RunError::Simulation(Box::new(e)))?;
         if let (Some(a), false) = (sim.assembly(), self.quiet) {
             println!("{a}");
+        }
+        let csv = match &self.out {
+            None => None,
+            Some(dir) => {
+                let io = |path: &Path| {
+                    let path = path.to_path_buf();
+                    move |source| RunError::Io { path, source }
+                };
+                std::fs::create_dir_all(dir).map_err(io(dir))?;
+                let path = dir.join("trajectory.csv");
+                let file = File::create(&path).map_err(io(&path))?;
+                Some((path, file))
+            }
+        };
+        let mut recorder = Recorder::new(csv, t0, t_end);
+        sim.drain_outputs(|tr| recorder.take(tr));
+        if !self.quiet {
+            println!(
+                "running {name} with {} to t = {t_end} s (Ctrl-C stops it and keeps what was computed)",
+                scheme.name()
+            );
         }
         // step by step (no artificial stops), with a progress bar once the run passes a second
         let bar = ProgressBar::hidden();
@@ -210,11 +528,18 @@ impl RunArgs {
         );
         bar.set_prefix(format!("{name} ({})", scheme.name()));
         let mut shown = 0;
+        let mut failure = None;
+        let mut interrupted = false;
         while crate::Integrator::state(&sim).t < t_end {
-            if let Err(e) = crate::Integrator::step(&mut sim) {
-                bar.abandon();
-                return Err(fail(e));
+            if INTERRUPTED.load(Ordering::SeqCst) {
+                interrupted = true;
+                break;
             }
+            if let Err(e) = crate::Integrator::step(&mut sim) {
+                failure = Some(Box::new(e));
+                break;
+            }
+            sim.drain_outputs(|tr| recorder.take(tr));
             let t = crate::Integrator::state(&sim).t;
             let done = (100.0 * (t - t0) / (t_end - t0)).floor() as u64;
             if done > shown {
@@ -226,8 +551,27 @@ impl RunArgs {
                 bar.set_message(format!("t = {t:.3} s"));
             }
         }
-        bar.finish_and_clear();
-        let (trajectory, stats) = sim.finish();
+        drop(running);
+        if failure.is_some() || interrupted {
+            bar.abandon();
+        } else {
+            bar.finish_and_clear();
+        }
+        let stats = match &mut failure {
+            Some(e) => {
+                // the outputs recorded in the failing call, and the work until the failure
+                recorder.take(&e.trajectory);
+                e.trajectory.clear_outputs();
+                (*e.stats).clone()
+            }
+            None => {
+                let (rest, stats) = sim.finish();
+                recorder.take(&rest);
+                stats
+            }
+        };
+        let (outputs, peak_held) = (recorder.outputs, recorder.peak_held);
+        let (trajectory, energy, csv) = recorder.finish();
         // forces written in Rust (`mbs::WithEfforts`) may do work the model cannot tell
         let conservative = stats.user_efforts == 0
             && info
@@ -237,44 +581,95 @@ impl RunArgs {
         let report = RunReport {
             scheme,
             trajectory,
+            outputs,
+            peak_held,
             stats,
             cpu: cpu0
                 .and_then(|t| t.try_elapsed().ok())
                 .unwrap_or_else(|| start.elapsed()),
             conservative,
+            energy,
         };
-        if let Some(dir) = &self.out {
-            self.write_outputs(dir, info, &report)?;
+        let stopped = failure.is_some() || interrupted;
+        let status = match &failure {
+            Some(e) => format!("failed: {}", failure_text(e)),
+            None if interrupted => "interrupted (Ctrl-C)".to_string(),
+            None => "completed".to_string(),
+        };
+        let written = match &self.out {
+            Some(dir) => csv.and_then(|()| self.write_outputs(dir, info, &report, &status)),
+            None => Ok(Vec::new()),
+        };
+        if stopped {
+            // what was computed until the stop is written: say so, then report the stop
+            let t = report.trajectory.t.last().copied().unwrap_or(t0);
+            let why = if interrupted {
+                "was interrupted"
+            } else {
+                "failed"
+            };
+            match &written {
+                Ok(files) if !files.is_empty() => {
+                    eprintln!(
+                        "the run {why} at t = {t} s; the {} outputs computed until then are written:",
+                        report.outputs
+                    );
+                    for p in files {
+                        eprintln!("  {}", p.display());
+                    }
+                }
+                Ok(_) => eprintln!("the run {why} at t = {t} s (--out DIR keeps its outputs)"),
+                Err(e) => eprintln!("the run {why} at t = {t} s; its outputs: {e}"),
+            }
+            if !self.quiet {
+                eprintln!("{}", report.stats);
+                eprintln!("{}", report.summary(name));
+            }
+            return Err(RunError::Stopped {
+                failure,
+                report: Box::new(report),
+            });
         }
+        let written = written?;
         if !self.quiet {
+            for p in written {
+                println!("wrote {}", p.display());
+            }
             println!("{}", report.stats);
             println!("{}", report.summary(name));
         }
         Ok(report)
     }
 
-    /// `DIR/trajectory.csv`, `coordinates.svg` (q over time), `energy.svg`, `animation.html`
-    /// and `motion.gltf`.
+    /// `DIR/coordinates.svg` (q over time), `energy.svg`, `animation.html`, `motion.gltf` and
+    /// `stats.json` (how the run ended, its outputs and work counters), from the thinned
+    /// series; the CSV file, written as the run went, comes first in the list.
     fn write_outputs(
         &self,
         dir: &Path,
         info: &crate::ModelInfo,
         report: &RunReport,
-    ) -> Result<(), RunError> {
-        let io = |path: &Path| {
-            let path = path.to_path_buf();
-            move |source| RunError::Io {
-                path: path.clone(),
-                source,
-            }
-        };
-        std::fs::create_dir_all(dir).map_err(io(dir))?;
+        status: &str,
+    ) -> Result<Vec<PathBuf>, RunError> {
         let tr = &report.trajectory;
-        let path = dir.join("trajectory.csv");
-        let file = std::fs::File::create(&path).map_err(io(&path))?;
-        tr.write_csv(std::io::BufWriter::new(file))
-            .map_err(io(&path))?;
-        let mut written = vec![path];
+        let mut written = vec![dir.join("trajectory.csv")];
+        let path = dir.join("stats.json");
+        let json = serde_json::json!({
+            "status": status,
+            "scheme": report.scheme.name(),
+            "t": tr.t.last(),
+            "outputs": report.outputs,
+            "stats": report.stats,
+        });
+        std::fs::write(&path, format!("{json:#}\n")).map_err(|source| RunError::Io {
+            path: path.clone(),
+            source,
+        })?;
+        written.push(path);
+        if tr.len() < 2 {
+            // nothing to draw or play
+            return Ok(written);
+        }
         let chart = |title: &str, y: &str| Chart {
             title: title.to_string(),
             x_label: "t (s)".into(),
@@ -327,12 +722,7 @@ impl RunArgs {
         let path = dir.join("motion.gltf");
         crate::gltf::write_gltf(&path, info, tr).map_err(|e| export(path.clone(), e))?;
         written.push(path);
-        if !self.quiet {
-            for p in written {
-                println!("wrote {}", p.display());
-            }
-        }
-        Ok(())
+        Ok(written)
     }
 
     /// The error for a `--scene` this program does not have.

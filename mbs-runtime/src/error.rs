@@ -64,7 +64,7 @@ pub enum Failure {
     )]
     StepTooSmall { h_min: f64 },
     #[error(
-        "more than {max_steps} steps (raise max_steps, loosen the tolerance, or use a scheme suited to the stiffness)"
+        "more than {max_steps} steps (raise Options::max_steps, loosen the tolerance, or use a scheme suited to the stiffness)"
     )]
     TooMuchWork { max_steps: usize },
     #[error(

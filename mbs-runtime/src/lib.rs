@@ -38,9 +38,11 @@ pub use model::{
     Energy, FrameKinematics, Kinematics, Model, ModelInfo, OpCount, OpsTable, Parameters,
     PointKinematics, Pose, ShapeInfo, ShapeKind,
 };
+/// The matrices of [`Linearization`] (nalgebra's), named without a dependency of one's own.
+pub use nalgebra::DMatrix;
 pub use options::{
     BdfParams, ConstraintMethod, ConstraintOptions, GenAlphaParams, HhtParams, IterationMatrix,
     NewmarkParams, NewtonOptions, Options, Output, Scheme, StepControl,
 };
 pub use stats::Stats;
-pub use trajectory::{Observer, Trajectory};
+pub use trajectory::{CsvWriter, Observer, Trajectory};

@@ -161,59 +161,146 @@ impl Trajectory {
         )
     }
 
-    /// CSV with a header of named columns: `t`, then `q[…]`, `qd[…]`, `qdd[…]` per coordinate,
-    /// then `NAME.lambda` per constraint, then `kinetic, potential, total` when energy was
-    /// recorded.
-    pub fn write_csv(&self, mut w: impl Write) -> io::Result<()> {
-        let mut header = vec!["t".to_string()];
-        for prefix in ["", "d", "dd"] {
-            for name in &self.dof_names {
-                header.push(if prefix.is_empty() {
-                    name.clone()
-                } else {
-                    format!("{name}.{prefix}")
-                });
-            }
+    /// CSV with a header of named columns: `t`, then per coordinate its name (`q[0]`, or the
+    /// DSL name such as `knee`), then `qd[…]` and `qdd[…]` per coordinate as the DSL writes
+    /// them (`qd[0]`, `qd[knee]`), then `NAME.lambda` per constraint, then `kinetic, potential,
+    /// total` when energy was recorded. [`CsvWriter`] writes the same file as outputs come.
+    pub fn write_csv(&self, w: impl Write) -> io::Result<()> {
+        let mut csv = CsvWriter::new(w);
+        csv.write(self)?;
+        csv.finish(self).map(|_| ())
+    }
+
+    /// Forgets every output, keeping the names (and the memory reserved for outputs).
+    pub fn clear_outputs(&mut self) {
+        self.t.clear();
+        self.q_data.clear();
+        self.qd_data.clear();
+        self.qdd_data.clear();
+        self.lambda_data.clear();
+        self.energy.clear();
+        self.poses.clear();
+    }
+
+    /// Appends output `i` of `from` (a trajectory of the same model): t, q, qd, qdd, λ, and
+    /// energy and poses when `from` recorded them.
+    pub fn push_output(&mut self, from: &Trajectory, i: usize) {
+        self.push(
+            from.t[i],
+            from.q(i),
+            from.qd(i),
+            from.qdd(i),
+            from.lambda(i),
+        );
+        if from.energy.len() == from.len() {
+            self.energy.push(from.energy[i]);
         }
-        for name in &self.constraint_names {
-            header.push(format!("{name}.lambda"));
+        let poses = from.poses_at(i);
+        if !poses.is_empty() {
+            self.poses.extend_from_slice(poses);
         }
-        let with_energy = self.energy.len() == self.len() && !self.is_empty();
-        if with_energy {
-            header.extend(["kinetic", "potential", "total"].map(String::from));
-        }
-        writeln!(
-            w,
-            "{}",
-            header
-                .iter()
-                .map(|h| csv_field(h))
-                .collect::<Vec<_>>()
-                .join(",")
-        )?;
-        for i in 0..self.len() {
-            write!(w, "{:e}", self.t[i])?;
-            for v in self
-                .q(i)
-                .iter()
-                .chain(self.qd(i))
-                .chain(self.qdd(i))
-                .chain(self.lambda(i))
-            {
-                write!(w, ",{v:e}")?;
-            }
-            if with_energy {
-                let e = self.energy[i];
-                write!(w, ",{:e},{:e},{:e}", e.kinetic, e.potential, e.total())?;
-            }
-            writeln!(w)?;
-        }
-        Ok(())
     }
 
     /// The whole trajectory as JSON.
     pub fn write_json(&self, w: impl Write) -> io::Result<()> {
         serde_json::to_writer(w, self).map_err(io::Error::other)
+    }
+}
+
+/// Writes a trajectory's CSV ([`Trajectory::write_csv`]'s columns) as its outputs come: give
+/// it the outputs recorded so far, forget them, give it the next ones. The header is written
+/// with the first outputs; energy columns are there when those outputs carry energy.
+pub struct CsvWriter<W: Write> {
+    w: W,
+    /// whether the header is written, and with energy columns
+    header: Option<bool>,
+    rows: usize,
+}
+
+impl<W: Write> CsvWriter<W> {
+    pub fn new(w: W) -> CsvWriter<W> {
+        CsvWriter {
+            w,
+            header: None,
+            rows: 0,
+        }
+    }
+
+    /// Rows written so far.
+    pub fn rows(&self) -> usize {
+        self.rows
+    }
+
+    /// Writes every output of `tr` (the header first, on the first call).
+    pub fn write(&mut self, tr: &Trajectory) -> io::Result<()> {
+        let with_energy = match self.header {
+            Some(e) => e,
+            // the columns are known with the first outputs
+            None if tr.is_empty() => return Ok(()),
+            None => {
+                let e = tr.energy.len() == tr.len();
+                self.write_header(tr, e)?;
+                e
+            }
+        };
+        let w = &mut self.w;
+        for i in 0..tr.len() {
+            write!(w, "{:e}", tr.t[i])?;
+            for v in tr
+                .q(i)
+                .iter()
+                .chain(tr.qd(i))
+                .chain(tr.qdd(i))
+                .chain(tr.lambda(i))
+            {
+                write!(w, ",{v:e}")?;
+            }
+            if with_energy {
+                let e = tr.energy.get(i).copied().unwrap_or(Energy {
+                    kinetic: f64::NAN,
+                    potential: f64::NAN,
+                });
+                write!(w, ",{:e},{:e},{:e}", e.kinetic, e.potential, e.total())?;
+            }
+            writeln!(w)?;
+        }
+        self.rows += tr.len();
+        Ok(())
+    }
+
+    /// Flushes the file (writing the header alone if no output came; `names` gives the
+    /// columns) and hands back the writer.
+    pub fn finish(mut self, names: &Trajectory) -> io::Result<W> {
+        if self.header.is_none() {
+            self.write_header(names, false)?;
+        }
+        self.w.flush()?;
+        Ok(self.w)
+    }
+
+    fn write_header(&mut self, tr: &Trajectory, with_energy: bool) -> io::Result<()> {
+        let mut header = vec!["t".to_string()];
+        header.extend(tr.dof_names.iter().cloned());
+        for prefix in ["qd", "qdd"] {
+            for name in &tr.dof_names {
+                // `q[0]` → `qd[0]`, `knee` → `qd[knee]`: as the DSL writes them
+                let index = name
+                    .strip_prefix("q[")
+                    .and_then(|r| r.strip_suffix(']'))
+                    .unwrap_or(name);
+                header.push(format!("{prefix}[{index}]"));
+            }
+        }
+        for name in &tr.constraint_names {
+            header.push(format!("{name}.lambda"));
+        }
+        if with_energy {
+            header.extend(["kinetic", "potential", "total"].map(String::from));
+        }
+        let line: Vec<String> = header.iter().map(|h| csv_field(h)).collect();
+        writeln!(self.w, "{}", line.join(","))?;
+        self.header = Some(with_energy);
+        Ok(())
     }
 }
 
@@ -251,7 +338,7 @@ mod tests {
         let lines: Vec<&str> = text.lines().collect();
         assert_eq!(
             lines[0],
-            "t,q[0],knee,q[0].d,knee.d,q[0].dd,knee.dd,pin.lambda,kinetic,potential,total"
+            "t,q[0],knee,qd[0],qd[knee],qdd[0],qdd[knee],pin.lambda,kinetic,potential,total"
         );
         assert_eq!(lines.len(), 3);
         assert_eq!(lines[2].split(',').count(), 11);
@@ -261,5 +348,44 @@ mod tests {
         let back: Trajectory = serde_json::from_slice(&json).unwrap();
         assert_eq!(back, t);
         assert_eq!(t.energy_drift(), Some(0.0));
+    }
+
+    #[test]
+    fn csv_written_as_outputs_come_is_the_whole_file() {
+        let mut whole = Trajectory::new(vec!["q[0]".into()], vec![], vec![]);
+        let mut csv = CsvWriter::new(Vec::new());
+        let mut chunk = whole.clone();
+        // nothing yet: the header waits for the first outputs
+        csv.write(&chunk).unwrap();
+        for k in 0..5 {
+            let t = k as f64 * 0.1;
+            let e = Energy {
+                kinetic: t,
+                potential: 1.0,
+            };
+            for tr in [&mut whole, &mut chunk] {
+                tr.push(t, &[t], &[1.0], &[0.0], &[]);
+                tr.energy.push(e);
+            }
+            if k % 2 == 1 {
+                csv.write(&chunk).unwrap();
+                chunk.clear_outputs();
+            }
+        }
+        csv.write(&chunk).unwrap();
+        assert_eq!(csv.rows(), 5);
+        let streamed = csv.finish(&whole).unwrap();
+        let mut at_once = Vec::new();
+        whole.write_csv(&mut at_once).unwrap();
+        assert_eq!(
+            String::from_utf8(streamed).unwrap(),
+            String::from_utf8(at_once).unwrap()
+        );
+        // a trajectory without outputs still has its header
+        let mut empty = Vec::new();
+        Trajectory::new(vec!["q[0]".into()], vec![], vec![])
+            .write_csv(&mut empty)
+            .unwrap();
+        assert_eq!(String::from_utf8(empty).unwrap(), "t,q[0],qd[0],qdd[0]\n");
     }
 }

@@ -208,6 +208,15 @@ impl<M: Model + 'static> Simulation<M> {
         self.h
     }
 
+    /// Hands the outputs recorded since the last call to `sink`, then forgets them: a long run
+    /// written to disk as it goes keeps flat memory (a later failure's trajectory holds only
+    /// the outputs recorded after this call).
+    pub fn drain_outputs<R>(&mut self, sink: impl FnOnce(&Trajectory) -> R) -> R {
+        let r = sink(&self.traj);
+        self.traj.clear_outputs();
+        r
+    }
+
     /// Trajectory and work counters (records the final state for `Output::Last`).
     pub fn finish(mut self) -> (Trajectory, Stats) {
         if self.options.output == Output::Last && self.traj.is_empty() {

@@ -33,6 +33,7 @@
 
 pub mod anim;
 pub mod cli;
+pub mod export;
 pub mod gltf;
 pub mod language;
 pub mod plot;

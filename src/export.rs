@@ -98,6 +98,8 @@ impl<'a> Frames<'a> {
     }
 
     /// Keeps at most `n` outputs (≥ 2), evenly in index, the first and last among them.
+    /// (Only the HTML page thins; the glTF file keeps every output.)
+    #[cfg(feature = "anim")]
     pub(crate) fn thin(&mut self, n: usize) {
         let n = n.max(2);
         if self.keep.len() > n {

@@ -18,7 +18,7 @@
 //!
 //! The file is self-contained: its one buffer is a base64 `data:` URI. Lengths are the model's
 //! (metres); glTF's up axis is +y, so a model whose up axis is z (see
-//! [`Up`](crate::export::Up)) hangs below a root node turned by −90° about x, and the body
+//! [`Up`]) hangs below a root node turned by −90° about x, and the body
 //! nodes keep the model's world coordinates. Animation times are `t − t₀`.
 
 use crate::export::{ExportError, Frames, Up, palette};

@@ -5,7 +5,7 @@
 //! [`multibody!`] differentiates the positions symbolically and emits a specialised model that
 //! implements [`Model`]: M, h, τ, exact tangents, Jacobians, energies, all straight-line code.
 //!
-//! Main types, in the order you meet them: [`multibody!`] and its [language](language),
+//! Main types, in the order you meet them: [`multibody!`] and its [language],
 //! [`Model`] (what a generated model computes), [`Parameters`] (its parameter struct),
 //! [`ModelInfo`] (names, sizes, op counts), [`Energy`], [`Pose`], [`Kinematics`],
 //! [`ParamError`] and [`ModelError`].

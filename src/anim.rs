@@ -28,64 +28,13 @@
 //! painted (`data-painted`, sampled) and the number of colours seen (`data-colors`); an error
 //! in the script shows there as `error: …`.
 
-use crate::gltf::tessellate;
-use crate::model::{ModelInfo, Pose, ShapeInfo};
+use crate::export::{Frames, tessellate};
+use crate::model::ModelInfo;
 use crate::trajectory::Trajectory;
 use std::fmt::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-/// Why a motion could not be exported.
-#[derive(Debug, thiserror::Error)]
-pub enum ExportError {
-    #[error("the trajectory has no output")]
-    Empty,
-    #[error(
-        "the trajectory has no poses: simulate with `Options {{ frames: true, .. }}` to record them"
-    )]
-    NoPoses,
-    #[error("the trajectory's bodies and frames {found:?} are not the model's {expected:?}")]
-    Frames {
-        expected: Vec<String>,
-        found: Vec<String>,
-    },
-    #[error("cannot write {path}: {source}")]
-    Io {
-        path: PathBuf,
-        source: std::io::Error,
-    },
-    #[error("cannot serialise the document: {0}")]
-    Json(String),
-}
-
-/// Which world axis points up in the views.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Up {
-    /// `Y` when the motion stays in the xy plane (planar models, gravity along −y), `Z`
-    /// otherwise
-    #[default]
-    Auto,
-    Y,
-    Z,
-}
-
-impl Up {
-    /// `Y` or `Z`, deciding `Auto` from the motion.
-    pub(crate) fn resolve(self, frames: &Frames) -> Up {
-        match self {
-            Up::Auto => {
-                let first = frames.pose(0);
-                let planar = (0..frames.len()).all(|k| {
-                    frames.pose(k).iter().zip(first).all(|(p, p0)| {
-                        (p.position[2] - p0.position[2]).abs() < 1e-9
-                            && (p.rotation[2][2] - p0.rotation[2][2]).abs() < 1e-9
-                    })
-                });
-                if planar { Up::Y } else { Up::Z }
-            }
-            u => u,
-        }
-    }
-}
+pub use crate::export::{ExportError, Up, palette};
 
 /// Options of [`write_html_with`].
 #[derive(Clone, Debug)]
@@ -106,85 +55,6 @@ impl Default for AnimOptions {
             title: None,
             max_frames: 20_000,
         }
-    }
-}
-
-/// The outputs of a trajectory that an export plays: validated poses at strictly increasing
-/// times (an output at the time of the previous one is skipped).
-pub(crate) struct Frames<'a> {
-    trajectory: &'a Trajectory,
-    keep: Vec<usize>,
-}
-
-impl<'a> Frames<'a> {
-    pub(crate) fn new(info: &ModelInfo, trajectory: &'a Trajectory) -> Result<Self, ExportError> {
-        if trajectory.is_empty() {
-            return Err(ExportError::Empty);
-        }
-        if trajectory.frame_names.len() != info.frames.len()
-            || trajectory
-                .frame_names
-                .iter()
-                .zip(info.frames)
-                .any(|(a, b)| a != b)
-        {
-            return Err(ExportError::Frames {
-                expected: info.frames.iter().map(|s| s.to_string()).collect(),
-                found: trajectory.frame_names.clone(),
-            });
-        }
-        if trajectory.poses.len() != trajectory.len() * info.frames.len() {
-            return Err(ExportError::NoPoses);
-        }
-        let mut keep: Vec<usize> = Vec::with_capacity(trajectory.len());
-        for (i, &t) in trajectory.t.iter().enumerate() {
-            if keep.last().is_none_or(|&j| t > trajectory.t[j]) {
-                keep.push(i);
-            }
-        }
-        Ok(Frames { trajectory, keep })
-    }
-
-    /// Keeps at most `n` outputs (≥ 2), evenly in index, the first and last among them.
-    fn thin(&mut self, n: usize) {
-        let n = n.max(2);
-        if self.keep.len() > n {
-            let m = self.keep.len() - 1;
-            self.keep = (0..n).map(|k| self.keep[k * m / (n - 1)]).collect();
-        }
-    }
-
-    pub(crate) fn len(&self) -> usize {
-        self.keep.len()
-    }
-
-    pub(crate) fn time(&self, k: usize) -> f64 {
-        self.trajectory.t[self.keep[k]]
-    }
-
-    pub(crate) fn pose(&self, k: usize) -> &[Pose] {
-        self.trajectory.poses_at(self.keep[k])
-    }
-}
-
-/// Colours for shapes without their own, one per body or frame.
-const PALETTE: [[u8; 3]; 8] = [
-    [0x3b, 0x76, 0xc4],
-    [0xe0, 0x7b, 0x39],
-    [0x4a, 0xa8, 0x5e],
-    [0xc8, 0x4b, 0x5b],
-    [0x8e, 0x6c, 0xc0],
-    [0xc9, 0xa2, 0x27],
-    [0x3f, 0xa7, 0xb3],
-    [0x9a, 0x6b, 0x4f],
-];
-
-/// The colour a shape is drawn in: its own, else one per frame (grey for the ground).
-pub fn palette(shape: &ShapeInfo) -> [u8; 3] {
-    match (shape.color, shape.frame) {
-        (Some(c), _) => c,
-        (None, Some(i)) => PALETTE[i % PALETTE.len()],
-        (None, None) => [0x88, 0x88, 0x88],
     }
 }
 

@@ -18,11 +18,11 @@
 //!
 //! The file is self-contained: its one buffer is a base64 `data:` URI. Lengths are the model's
 //! (metres); glTF's up axis is +y, so a model whose up axis is z (see
-//! [`Up`](crate::anim::Up)) hangs below a root node turned by −90° about x, and the body
+//! [`Up`]) hangs below a root node turned by −90° about x, and the body
 //! nodes keep the model's world coordinates. Animation times are `t − t₀`.
 
-use crate::anim::{ExportError, Frames, Up, palette};
-use crate::model::{ModelInfo, ShapeInfo, ShapeKind};
+use crate::export::{ExportError, Frames, Up, palette};
+use crate::model::ModelInfo;
 use crate::trajectory::Trajectory;
 use gltf_json as json;
 use json::validation::{Checked::Valid, USize64};
@@ -30,167 +30,7 @@ use serde_json::json;
 use std::collections::BTreeMap;
 use std::path::Path;
 
-/// Segments around a cylinder and a sphere.
-pub const ROUND_SEGMENTS: usize = 24;
-/// Rings of a sphere from pole to pole.
-pub const SPHERE_RINGS: usize = 12;
-
-/// A shape as polygons in its frame's axes: convex faces, counter-clockwise seen from outside
-/// (indices into `positions`), with per-vertex normals, and segments for lines.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Tessellation {
-    pub positions: Vec<[f64; 3]>,
-    /// outward unit normals, one per position (smooth on round surfaces)
-    pub normals: Vec<[f64; 3]>,
-    pub faces: Vec<Vec<u32>>,
-    pub lines: Vec<[u32; 2]>,
-}
-
-impl Tessellation {
-    /// The faces as triangles (fans), counter-clockwise seen from outside.
-    pub fn triangles(&self) -> Vec<[u32; 3]> {
-        self.faces
-            .iter()
-            .flat_map(|f| (1..f.len().saturating_sub(1)).map(move |k| [f[0], f[k], f[k + 1]]))
-            .collect()
-    }
-}
-
-fn unit(i: usize) -> [f64; 3] {
-    let mut e = [0.0; 3];
-    e[i % 3] = 1.0;
-    e
-}
-
-fn combo(terms: &[(f64, [f64; 3])]) -> [f64; 3] {
-    let mut out = [0.0; 3];
-    for (s, v) in terms {
-        for k in 0..3 {
-            out[k] += s * v[k];
-        }
-    }
-    out
-}
-
-/// Vertices, normals and faces of `shape`, in the axes of its frame.
-pub fn tessellate(shape: &ShapeInfo) -> Tessellation {
-    let mut t = Tessellation::default();
-    let vertex = |t: &mut Tessellation, p: [f64; 3], n: [f64; 3]| -> u32 {
-        t.positions.push(p);
-        t.normals.push(n);
-        (t.positions.len() - 1) as u32
-    };
-    let tau = std::f64::consts::TAU;
-    match shape.kind {
-        ShapeKind::Box { size } => {
-            let h = size.map(|s| s / 2.0);
-            for k in 0..3 {
-                for s in [1.0, -1.0] {
-                    let n = combo(&[(s, unit(k))]);
-                    let (u, v) = if s > 0.0 {
-                        ((k + 1) % 3, (k + 2) % 3)
-                    } else {
-                        ((k + 2) % 3, (k + 1) % 3)
-                    };
-                    let face = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
-                        .map(|(a, b)| {
-                            let p = combo(&[
-                                (s * h[k], unit(k)),
-                                (a * h[u], unit(u)),
-                                (b * h[v], unit(v)),
-                            ]);
-                            vertex(&mut t, p, n)
-                        })
-                        .to_vec();
-                    t.faces.push(face);
-                }
-            }
-        }
-        ShapeKind::Cylinder {
-            radius,
-            length,
-            axis,
-        } => {
-            let (a, u, v) = (unit(axis), unit(axis + 1), unit(axis + 2));
-            let n = ROUND_SEGMENTS;
-            let ring = |j: usize| {
-                let th = tau * j as f64 / n as f64;
-                combo(&[(th.cos(), u), (th.sin(), v)])
-            };
-            let side: Vec<[u32; 2]> = (0..n)
-                .map(|j| {
-                    let d = ring(j);
-                    [-0.5, 0.5].map(|s| vertex(&mut t, combo(&[(radius, d), (s * length, a)]), d))
-                })
-                .collect();
-            for j in 0..n {
-                let (b0, t0) = (side[j][0], side[j][1]);
-                let (b1, t1) = (side[(j + 1) % n][0], side[(j + 1) % n][1]);
-                t.faces.push(vec![b0, b1, t1, t0]);
-            }
-            for s in [1.0, -1.0] {
-                let normal = combo(&[(s, a)]);
-                let mut cap: Vec<u32> = (0..n)
-                    .map(|j| {
-                        vertex(
-                            &mut t,
-                            combo(&[(radius, ring(j)), (s * length / 2.0, a)]),
-                            normal,
-                        )
-                    })
-                    .collect();
-                if s < 0.0 {
-                    cap.reverse();
-                }
-                t.faces.push(cap);
-            }
-        }
-        ShapeKind::Sphere { radius } => {
-            let (n, m) = (ROUND_SEGMENTS, SPHERE_RINGS);
-            let mut grid = vec![vec![0u32; n]; m + 1];
-            for (i, row) in grid.iter_mut().enumerate() {
-                let phi = -std::f64::consts::FRAC_PI_2 + std::f64::consts::PI * i as f64 / m as f64;
-                for (j, idx) in row.iter_mut().enumerate() {
-                    let th = tau * j as f64 / n as f64;
-                    let d = [phi.cos() * th.cos(), phi.cos() * th.sin(), phi.sin()];
-                    *idx = vertex(&mut t, d.map(|c| radius * c), d);
-                }
-            }
-            for i in 0..m {
-                for j in 0..n {
-                    let jj = (j + 1) % n;
-                    let quad = [grid[i][j], grid[i][jj], grid[i + 1][jj], grid[i + 1][j]];
-                    // at the poles a ring is one point: keep a triangle
-                    let face: Vec<u32> = if i == 0 {
-                        vec![quad[0], quad[2], quad[3]]
-                    } else if i + 1 == m {
-                        vec![quad[0], quad[1], quad[2]]
-                    } else {
-                        quad.to_vec()
-                    };
-                    t.faces.push(face);
-                }
-            }
-        }
-        ShapeKind::Line { from, to } => {
-            let d = combo(&[(1.0, to), (-1.0, from)]);
-            let a = vertex(&mut t, from, d);
-            let b = vertex(&mut t, to, d);
-            t.lines.push([a, b]);
-            // a line's ends are already in the frame's axes
-            return t;
-        }
-    }
-    let r = &shape.rotation;
-    let turn = |p: [f64; 3]| [0, 1, 2].map(|i| r[i][0] * p[0] + r[i][1] * p[1] + r[i][2] * p[2]);
-    for p in &mut t.positions {
-        *p = shape.to_frame(*p);
-    }
-    for n in &mut t.normals {
-        *n = turn(*n);
-    }
-    t
-}
+pub use crate::export::{ROUND_SEGMENTS, SPHERE_RINGS, Tessellation, tessellate};
 
 /// Options of [`write_gltf_with`].
 #[derive(Clone, Debug, Default)]
@@ -559,20 +399,6 @@ pub fn base64(data: &[u8]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::ShapeKind;
-
-    const IDENTITY: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-
-    fn shape(kind: ShapeKind, at: [f64; 3]) -> ShapeInfo {
-        ShapeInfo {
-            frame: Some(0),
-            kind,
-            at,
-            rotation: IDENTITY,
-            color: None,
-            declared: true,
-        }
-    }
 
     #[test]
     fn base64_matches_rfc_4648() {
@@ -586,78 +412,6 @@ mod tests {
             ("foobar", "Zm9vYmFy"),
         ] {
             assert_eq!(base64(raw.as_bytes()), enc);
-        }
-    }
-
-    #[test]
-    fn closed_shapes_face_outwards_with_outward_normals() {
-        let at = [0.3, -0.2, 1.0];
-        for kind in [
-            ShapeKind::Box {
-                size: [0.1, 0.2, 0.4],
-            },
-            ShapeKind::Cylinder {
-                radius: 0.1,
-                length: 0.5,
-                axis: 0,
-            },
-            ShapeKind::Cylinder {
-                radius: 0.1,
-                length: 0.5,
-                axis: 2,
-            },
-            ShapeKind::Sphere { radius: 0.2 },
-        ] {
-            let t = tessellate(&shape(kind, at));
-            assert_eq!(t.positions.len(), t.normals.len());
-            for tri in t.triangles() {
-                let [a, b, c] = tri.map(|i| t.positions[i as usize]);
-                let (u, v) = (combo(&[(1.0, b), (-1.0, a)]), combo(&[(1.0, c), (-1.0, a)]));
-                let n = [
-                    u[1] * v[2] - u[2] * v[1],
-                    u[2] * v[0] - u[0] * v[2],
-                    u[0] * v[1] - u[1] * v[0],
-                ];
-                let centroid = combo(&[(1.0 / 3.0, a), (1.0 / 3.0, b), (1.0 / 3.0, c)]);
-                let out = combo(&[(1.0, centroid), (-1.0, at)]);
-                let dot: f64 = (0..3).map(|k| n[k] * out[k]).sum();
-                assert!(dot > 0.0, "{kind:?}: a triangle faces inwards");
-                for i in tri {
-                    let nv = t.normals[i as usize];
-                    let norm: f64 = nv.iter().map(|x| x * x).sum::<f64>().sqrt();
-                    assert!((norm - 1.0).abs() < 1e-12);
-                    let d: f64 = (0..3).map(|k| nv[k] * n[k]).sum();
-                    assert!(d > 0.0, "{kind:?}: a normal points inwards");
-                }
-            }
-            // the extent along each axis
-            let (lo, hi) =
-                t.positions
-                    .iter()
-                    .fold(([f64::MAX; 3], [f64::MIN; 3]), |(lo, hi), p| {
-                        (
-                            [0, 1, 2].map(|k| lo[k].min(p[k])),
-                            [0, 1, 2].map(|k| hi[k].max(p[k])),
-                        )
-                    });
-            let half = match kind {
-                ShapeKind::Box { size } => size.map(|s| s / 2.0),
-                ShapeKind::Cylinder {
-                    radius,
-                    length,
-                    axis,
-                } => {
-                    let mut h = [radius; 3];
-                    h[axis] = length / 2.0;
-                    h
-                }
-                ShapeKind::Sphere { radius } => [radius; 3],
-                ShapeKind::Line { .. } => unreachable!(),
-            };
-            for k in 0..3 {
-                assert!((hi[k] - at[k] - half[k]).abs() < 1e-12, "{kind:?} {hi:?}");
-                assert!((at[k] - lo[k] - half[k]).abs() < 1e-12, "{kind:?} {lo:?}");
-            }
         }
     }
 }

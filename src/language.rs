@@ -266,8 +266,9 @@
 //! ```
 //!
 //! Simulate with `Options { frames: true, .. }` to record the poses, then
-//! `mbs::anim::write_html(path, model.info(), &trajectory)` or
-//! `mbs::gltf::write_gltf(path, model.info(), &trajectory)`.
+//! `mbs::anim::write_html(Path::new("crane.html"), model.info(), &trajectory)` (an HTML page,
+//! feature `anim`) or `mbs::gltf::write_gltf(Path::new("crane.gltf"), model.info(),
+//! &trajectory)` (a glTF file, feature `gltf`); both take a `&std::path::Path`.
 //!
 //! ## Errors
 //!

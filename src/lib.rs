@@ -5,7 +5,7 @@
 //! [`multibody!`] differentiates the positions symbolically and emits a specialised model that
 //! implements [`Model`]: M, h, τ, exact tangents, Jacobians, energies, all straight-line code.
 //!
-//! Main types, in the order you meet them: [`multibody!`] and its [language](language),
+//! Main types, in the order you meet them: [`multibody!`] and its [language],
 //! [`Model`] (what a generated model computes), [`Parameters`] (its parameter struct),
 //! [`ModelInfo`] (names, sizes, op counts), [`Energy`], [`Pose`], [`Kinematics`],
 //! [`ParamError`] and [`ModelError`].
@@ -30,13 +30,43 @@
 //! model.dynamics(0.0, &[0.1], &[0.0], &[], &mut m, &mut h);
 //! assert!((h[0] / m[0] + 10.0).abs() < 1e-12); // x'' = -k x / m
 //! ```
+//!
+//! ## Cargo features
+//!
+//! The tools around the models are behind features, all on by default:
+//!
+//! | feature | what | brings in |
+//! |---|---|---|
+//! | `plot` | `mbs::plot`, SVG line charts | plotters |
+//! | `anim` | `mbs::anim`, the motion as one HTML page | — |
+//! | `gltf` | `mbs::gltf`, the motion as a glTF 2.0 file | gltf-json, serde_json |
+//! | `spectral` | `mbs::spectral`, amplification of one step of each scheme | `plot` |
+//! | `work_precision` | `mbs::work_precision`, work–precision studies | `plot`, cpu-time |
+//! | `cli` | `mbs::cli`, the per-system programs' command line | `plot`, `anim`, `gltf`, clap, indicatif, cpu-time |
+//! | `expand` | the `mbs` program (`mbs expand`) | mbs-symbolic, syn, prettyplease, clap |
+//!
+//! With `default-features = false` you get [`multibody!`], the runtime ([`Model`], the schemes,
+//! [`simulate`], [`analysis`], CSV and JSON output) and this documentation, nothing else:
+//!
+//! ```toml
+//! [dependencies]
+//! mbs = { version = "0.1", default-features = false }
+//! ```
 
+#[cfg(feature = "anim")]
 pub mod anim;
+#[cfg(feature = "cli")]
 pub mod cli;
+#[cfg(any(feature = "anim", feature = "gltf"))]
+pub mod export;
+#[cfg(feature = "gltf")]
 pub mod gltf;
 pub mod language;
+#[cfg(feature = "plot")]
 pub mod plot;
+#[cfg(feature = "spectral")]
 pub mod spectral;
+#[cfg(feature = "work_precision")]
 pub mod work_precision;
 
 pub use mbs_macros::multibody;

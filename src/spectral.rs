@@ -350,7 +350,7 @@ pub fn analyse_with<M: Model + Clone + 'static>(
 }
 
 /// A linear recurrence fitted to sequences: its characteristic polynomial written in
-/// u = ζ − 1, uᵏ + d[k−1] uᵏ⁻¹ + … + d[0] (so Δᵏxₙ + d[k−1] Δᵏ⁻¹xₙ + … + d[0] xₙ = 0).
+/// u = ζ − 1, uᵏ + d\[k−1\] uᵏ⁻¹ + … + d\[0\] (so Δᵏxₙ + d\[k−1\] Δᵏ⁻¹xₙ + … + d\[0\] xₙ = 0).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Recurrence {
     pub shifted: Vec<f64>,

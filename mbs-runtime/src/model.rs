@@ -160,7 +160,7 @@ impl ModelInfo {
         self.points.iter().position(|p| *p == name)
     }
 
-    /// "q[3] (knee)" for a named coordinate, "q[3]" otherwise.
+    /// `"q[3] (knee)"` for a named coordinate, `"q[3]"` otherwise.
     pub fn dof_label(&self, i: usize) -> String {
         match self.dofs.get(i) {
             Some(n) if n.starts_with("q[") => n.to_string(),

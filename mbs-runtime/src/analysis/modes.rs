@@ -2,6 +2,8 @@
 //! one mode per complex pair (Im λ > 0) or real eigenvalue, with natural frequency |λ|/2π,
 //! damping ratio −Re λ/|λ|, the mode shape (the position part of the eigenvector, scaled so
 //! that its largest component is 1) named by coordinate, and the modal mass φᴴMφ of that shape.
+//! A real eigenvalue is no oscillation: [`Mode::time_constant`] gives 1/|λ|, and the table
+//! ([`Modes`]' Display) shows it as a real pole, unstable or decaying, with that time constant.
 //! Eigenvalues come from nalgebra's Schur decomposition, eigenvectors from inverse iteration.
 //! For a constrained model the shapes are in the independent coordinates z of the
 //! linearisation (named by [`Linearization::coordinates`], modal mass φᴴM_zφ), and also given
@@ -72,7 +74,15 @@ pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, A
         if lambda.im < -1e-12 * scale {
             continue;
         }
-        let (re, im) = (lambda.re, lambda.im.max(0.0));
+        // a real eigenvalue has Im λ = 0 exactly, whatever the rounding of the Schur form
+        let (re, im) = (
+            lambda.re,
+            if lambda.im <= 1e-12 * scale {
+                0.0
+            } else {
+                lambda.im
+            },
+        );
         let mag = re.hypot(im);
         let frequency_hz = mag / (2.0 * std::f64::consts::PI);
         if let Some((lo, hi)) = window {
@@ -186,25 +196,68 @@ impl Modes {
     }
 }
 
+impl Mode {
+    /// Whether λ is real: a pole that does not oscillate, which grows or decays as e^(λt).
+    /// Its `frequency_hz` (|λ|/2π) is then no frequency of any motion, and `damping_ratio` is
+    /// ±1 by definition; [`Mode::time_constant`] says more.
+    pub fn is_real(&self) -> bool {
+        self.im == 0.0
+    }
+
+    /// 1/|λ| (s) of a real pole: the time in which the motion grows (λ > 0, unstable) or
+    /// decays (λ < 0) by the factor e; `None` for an oscillating mode and for λ = 0.
+    pub fn time_constant(&self) -> Option<f64> {
+        (self.is_real() && self.re != 0.0).then(|| 1.0 / self.re.abs())
+    }
+}
+
+/// Below this |λ| (1/s) a real pole is shown as zero (a time constant above 30 years).
+const ZERO_POLE: f64 = 1e-9;
+
 impl fmt::Display for Modes {
-    /// A pole list like EasyDyn's: one line per mode, then its shape by coordinate.
+    /// A pole list like EasyDyn's: one line per mode, then its shape by coordinate. A real pole
+    /// has no frequency and no damping ratio to speak of: its line says whether it grows or
+    /// decays, and its time constant.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(
             f,
             "{:>4} {:>14} {:>12} {:>14} {:>14} {:>12}",
-            "mode", "frequency Hz", "damping", "Re λ", "Im λ", "modal mass"
+            "mode", "frequency Hz", "damping", "Re λ (1/s)", "Im λ (1/s)", "modal mass"
         )?;
         for (k, m) in self.modes.iter().enumerate() {
-            writeln!(
-                f,
-                "{:>4} {:>14.6} {:>12.4e} {:>14.6e} {:>14.6e} {:>12.4e}",
-                k + 1,
-                m.frequency_hz,
-                m.damping_ratio,
-                m.re,
-                m.im,
-                m.modal_mass
-            )?;
+            if m.is_real() {
+                let what = if m.re.abs() < ZERO_POLE {
+                    "real pole λ ≈ 0: neutral, no restoring force".to_string()
+                } else {
+                    format!(
+                        "real pole {:+.3} s⁻¹, {}, time constant {:.3} s",
+                        m.re,
+                        if m.re > 0.0 { "unstable" } else { "decaying" },
+                        1.0 / m.re.abs()
+                    )
+                };
+                writeln!(
+                    f,
+                    "{:>4} {:>14} {:>12} {:>14.6e} {:>14.6e} {:>12.4e}   {what}",
+                    k + 1,
+                    "-",
+                    "-",
+                    m.re,
+                    m.im,
+                    m.modal_mass
+                )?;
+            } else {
+                writeln!(
+                    f,
+                    "{:>4} {:>14.6} {:>12.4e} {:>14.6e} {:>14.6e} {:>12.4e}",
+                    k + 1,
+                    m.frequency_hz,
+                    m.damping_ratio,
+                    m.re,
+                    m.im,
+                    m.modal_mass
+                )?;
+            }
             let parts: Vec<String> = self
                 .dof_names
                 .iter()
@@ -220,5 +273,63 @@ impl fmt::Display for Modes {
             writeln!(f, "     shape: {}", parts.join(", "))?;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn mode(re: f64, im: f64) -> Mode {
+        let mag = re.hypot(im);
+        Mode {
+            re,
+            im,
+            frequency_hz: mag / (2.0 * std::f64::consts::PI),
+            damping_ratio: -re / mag,
+            modal_mass: 1.0,
+            shape: vec![(1.0, 0.0)],
+            shape_q: vec![(1.0, 0.0)],
+        }
+    }
+
+    #[test]
+    fn real_poles_are_shown_with_their_time_constant() {
+        let modes = Modes {
+            dof_names: vec!["a".into()],
+            modes: vec![
+                mode(-0.5, 6.0),
+                mode(5.62, 0.0),
+                mode(-2.0, 0.0),
+                mode(0.0, 0.0),
+            ],
+        };
+        let table = modes.to_string();
+        print!("{table}");
+        let rows: Vec<&str> = table.lines().filter(|l| !l.contains("shape:")).collect();
+        assert_eq!(rows.len(), 5);
+        // an oscillation: frequency and damping ratio
+        assert!(
+            rows[1].contains("0.958") && rows[1].contains("8.3045e-2"),
+            "{}",
+            rows[1]
+        );
+        assert!(!rows[1].contains("real pole"));
+        // real poles: no frequency, no damping ratio of ±1
+        assert!(
+            rows[2].ends_with("real pole +5.620 s⁻¹, unstable, time constant 0.178 s"),
+            "{}",
+            rows[2]
+        );
+        assert!(!rows[2].contains("0.894") && !rows[2].contains("-1.0000e0"));
+        assert!(
+            rows[3].ends_with("real pole -2.000 s⁻¹, decaying, time constant 0.500 s"),
+            "{}",
+            rows[3]
+        );
+        assert!(rows[4].ends_with("real pole λ ≈ 0: neutral, no restoring force"));
+        assert_eq!(modes.modes[1].time_constant(), Some(1.0 / 5.62));
+        assert_eq!(modes.modes[0].time_constant(), None);
+        assert_eq!(modes.modes[3].time_constant(), None);
     }
 }

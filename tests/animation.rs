@@ -12,8 +12,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-#[path = "../examples/models/dpend.rs"]
-mod dpend;
+use mbs_models::dpend;
 
 mbs::multibody! {
     /// A cart on a rail carrying a pendulum (a rod and a bob) that swings about x.

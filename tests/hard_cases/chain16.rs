@@ -10,9 +10,9 @@
 //! Radau5 (h ≈ 3e-5…6e-5 s, below its stability bound 3.3/ω_max = 2.5e-4 s): accuracy, not
 //! stability, sets everyone's step on this start.
 
-use crate::models::Chain16Stiff;
 use crate::support::{Work, all_finite, check_work, work};
 use mbs::{IterationMatrix, Model, Options, Output, Scheme, Trajectory, simulate};
+use mbs_models::chain16_stiff::Chain16Stiff;
 use std::time::Instant;
 
 /// Total energy at every output, the joint springs' included (they are generalised forces

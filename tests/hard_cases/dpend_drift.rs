@@ -5,9 +5,9 @@
 //! climb, 90 times its oscillation, ten times larger at 1000 s than at 100 s; trend, sign
 //! and size printed).
 
-use crate::dpend::DoublePendulum;
 use crate::support::{Work, all_finite, check_work, fit_line, work};
 use mbs::{Options, Output, Scheme, Trajectory, simulate};
+use mbs_models::dpend::DoublePendulum;
 use std::time::Instant;
 
 const T_END: f64 = 1000.0;

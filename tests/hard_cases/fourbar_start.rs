@@ -5,9 +5,9 @@
 //! its dense output is not projected, up to 5e-10 off). `tests/loops.rs` covers
 //! the branch choice and the typed errors of impossible starts.
 
-use crate::fourbar::{FourBar, closed_loop};
 use crate::support::{Work, all_finite, check_work, work};
 use mbs::{Integrator, Model, Options, Output, Scheme, Simulation};
+use mbs_models::fourbar::{FourBar, closed_loop};
 use std::f64::consts::PI;
 
 #[test]

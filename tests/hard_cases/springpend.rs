@@ -11,9 +11,9 @@
 //!   k = 1e6, gen-α 183 against 180), and θ(1) tends to the rigid pendulum's as k grows;
 //!   DOPRI5 is held by its stability bound h ≲ 3.3/√k: 67 times the steps for 10⁴ times k.
 
-use crate::models::SpringPend;
 use crate::support::{Work, all_finite, check_work, work};
 use mbs::{Model, Options, Output, Scheme, simulate};
+use mbs_models::springpend::SpringPend;
 
 const KS: [f64; 4] = [1e2, 1e4, 1e6, 1e8];
 

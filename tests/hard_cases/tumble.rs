@@ -26,9 +26,9 @@
 //!   whatever its timing. Every scheme stops with the typed error at t = 7.99 s, about 1°
 //!   from it.
 
-use crate::models::{Tumble, TumbleXyz};
 use crate::support::{Work, all_finite, check_work, work};
 use mbs::{Failure, Model, Options, Scheme, SimError, Stats, Trajectory, simulate};
+use mbs_models::tumble::{Tumble, TumbleXyz};
 
 /// The spin phase that makes the accurate ZYX flip meet the singularity: −π/2 − φ*, φ* =
 /// 3.0587 rad the azimuth (atan2(z, y)) of body x when it crosses the plane x = 0 in the

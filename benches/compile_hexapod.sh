@@ -20,8 +20,8 @@ edition = "2024"
 mbs = { path = "$root" }
 [workspace]
 TOML
-# the hexapod of examples/models with `option tangents;` added before its closing braces
-sed 's/^    }$/        option tangents;\n    }/' "$root/examples/models/hexapod.rs" > "$dir/src/model.rs"
+# the hexapod of models/src with `option tangents;` added before its closing braces
+sed 's/^    }$/        option tangents;\n    }/' "$root/models/src/hexapod.rs" > "$dir/src/model.rs"
 grep -q "option tangents" "$dir/src/model.rs"
 cat > "$dir/src/main.rs" <<'RS'
 mod model;

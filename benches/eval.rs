@@ -11,14 +11,10 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use mbs::Model;
 use std::hint::black_box;
 
-#[path = "../examples/models/arm3d_6.rs"]
-mod arm3d_6;
-#[path = "models/chain24.rs"]
-mod chain24;
-#[path = "../examples/models/dpend.rs"]
-mod dpend;
-#[path = "../examples/models/hexapod.rs"]
-mod hexapod;
+use mbs_models::arm3d_6;
+use mbs_models::chain24;
+use mbs_models::dpend;
+use mbs_models::hexapod;
 
 fn test_state(n: usize) -> (Vec<f64>, Vec<f64>) {
     let q = (0..n).map(|i| 0.5 * (1.3 * i as f64 + 0.4).sin()).collect();

@@ -2,7 +2,7 @@
 //! under gravity along −z: the `arm3d_6` model of `tests/reference/MODELS.md`.
 //!
 //! Prints the model's sizes, M and h at the MODELS.md test state and the operation counts of
-//! the generated functions. The model itself is in `examples/models/arm3d_6.rs`.
+//! the generated functions. The model itself is in `models/src/arm3d_6.rs`.
 //!
 //! Then the inverse dynamics of a smooth joint path (`mbs::analysis::inverse_dynamics_along`):
 //! q_i(t) = q0_i + A (1 − cos(π t / T)) with q0_i = 0.2 rad, A = 0.5 rad, T = 2 s, i.e. every
@@ -18,8 +18,7 @@
 
 #[path = "common/mod.rs"]
 mod common;
-#[path = "models/arm3d_6.rs"]
-mod model;
+use mbs_models::arm3d_6 as model;
 
 use clap::Parser;
 use mbs::Model;

@@ -1,4 +1,4 @@
-//! A DC motor with a PI speed controller driving an arm (`examples/models/dc_motor.rs`): the
+//! A DC motor with a PI speed controller driving an arm (`models/src/dc_motor.rs`): the
 //! motor current is an extra first-order state written in Rust (`WithEfforts`), the
 //! controller is sampled at 1 kHz with zero-order hold (`Inputs::controller`).
 //!
@@ -10,8 +10,7 @@
 //! input, Radau5 at rtol 1e-8 and outputs every 50 ms unless told otherwise: `cargo run
 //! --release --example dc_motor` or `-- --scheme bdf --rtol 1e-6 --out out`.
 
-#[path = "models/dc_motor.rs"]
-mod model;
+use mbs_models::dc_motor as model;
 
 use mbs::cli::{RunArgs, RunError};
 use mbs::{Inputs, WithEfforts};

@@ -2,7 +2,7 @@
 //! about +z, under gravity: the `dpend` model of `tests/reference/MODELS.md`.
 //!
 //! Prints the model's sizes, M and h at the MODELS.md test state and the operation counts of
-//! the generated functions. The model itself is in `examples/models/dpend.rs`.
+//! the generated functions. The model itself is in `models/src/dpend.rs`.
 //!
 //! Then the statics (`mbs::analysis::static_equilibrium`): the equilibria found from near the
 //! hanging position and from near the upright one, with their stability (stable, unstable),
@@ -15,8 +15,7 @@
 
 #[path = "common/mod.rs"]
 mod common;
-#[path = "models/dpend.rs"]
-mod model;
+use mbs_models::dpend as model;
 
 use clap::Parser;
 use mbs::IterationMatrix;

@@ -1,13 +1,13 @@
 //! The double pendulum of `tests/reference/MODELS.md` (dpend) in Cartesian coordinates: each
 //! bar free in the plane (x, y of its centre, θ its absolute angle), the two hinges as four
 //! constraints, `top` (bar 1's top at the origin) and `knee` (bar 2's top at bar 1's bottom).
-//! The model is in `examples/models/dpend_cartesian.rs`.
+//! The model is in `models/src/dpend_cartesian.rs`.
 //!
 //! Prints the model, then runs it as asked (`--scheme`, `--h` or `--rtol`, `--constraints`,
 //! `--t-end`, default 10 s): the assembly report, the work done, the energy error, the hinge
 //! multipliers at a few times (−λ of `top.x`, `top.y` is the force of the hinge on bar 1;
 //! λ of `knee.x`, `knee.y` the force of bar 2 on bar 1), the drift max |Φ|, and how far the
-//! tip of bar 2 is from that of the two-angle dpend (`examples/models/dpend.rs`) run with the
+//! tip of bar 2 is from that of the two-angle dpend (`models/src/dpend.rs`) run with the
 //! same scheme at the same times. dpend is chaotic: the two agree to 1e-7 up to about 8 s at
 //! rtol 1e-10, over 10 s at rtol 1e-12 (`tests/loops.rs`).
 //!
@@ -16,10 +16,8 @@
 
 #[path = "common/mod.rs"]
 mod common;
-#[path = "models/dpend.rs"]
-mod dpend;
-#[path = "models/dpend_cartesian.rs"]
-mod model;
+use mbs_models::dpend;
+use mbs_models::dpend_cartesian as model;
 
 use clap::Parser;
 use mbs::Output;

@@ -1,7 +1,7 @@
 //! The four-bar of `tests/reference/MODELS.md`: a Grashof crank-rocker under gravity, three
 //! absolute angles (crank `a`, coupler `b`, rocker `c`) and one closure,
 //! `close: coincide(coupler_end, rocker_tip, along = [x, y])`. The model is in
-//! `examples/models/fourbar.rs`.
+//! `models/src/fourbar.rs`.
 //!
 //! The model gives only rough values of `b` and `c`; the start is assembled: Newton moves
 //! `b` and `c` (the crank, marked `independent`, stays at π/3) until the loop closes on the
@@ -16,8 +16,7 @@
 
 #[path = "common/mod.rs"]
 mod common;
-#[path = "models/fourbar.rs"]
-mod model;
+use mbs_models::fourbar as model;
 
 use clap::Parser;
 use mbs::Model;

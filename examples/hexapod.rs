@@ -10,14 +10,13 @@
 //! the base height and the largest velocity over time, the feet's normal forces at the end
 //! against the weight, the work done, and the static equilibrium of the standing robot.
 //! `--scene Free` runs the other scene instead: no ground, a free fall for 1 s. The model
-//! itself is in `examples/models/hexapod.rs`.
+//! itself is in `models/src/hexapod.rs`.
 //!
 //! Run with `cargo run --release --example hexapod`.
 
 #[path = "common/mod.rs"]
 mod common;
-#[path = "models/hexapod.rs"]
-mod model;
+use mbs_models::hexapod as model;
 
 use clap::Parser;
 use mbs::analysis::{AnalysisError, StaticsOptions, static_equilibrium};

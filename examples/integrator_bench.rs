@@ -12,10 +12,8 @@
 //!    10 ms, until reached within the default budget of 10⁶ steps; dpend is chaotic, and order-1
 //!    and order-2 schemes do not reach it within that budget.
 
-#[path = "models/dpend.rs"]
-mod dpend;
-#[path = "models/hexapod.rs"]
-mod hexapod;
+use mbs_models::dpend;
+use mbs_models::hexapod;
 
 use mbs::{Model, Options, Output, Scheme, Stats, simulate};
 use std::hint::black_box;

@@ -3,7 +3,7 @@
 //! `seed2dof` model of `tests/reference/MODELS.md`, eigenfrequencies 0.996 Hz and 10.018 Hz.
 //!
 //! Prints the model's sizes, M and h at the MODELS.md test state and the operation counts of
-//! the generated functions. The model itself is in `examples/models/seed2dof.rs`.
+//! the generated functions. The model itself is in `models/src/seed2dof.rs`.
 //!
 //! Then its two modes, from the linearisation at rest (`mbs::analysis::linearize` and
 //! `modes`): frequency, damping ratio, eigenvalue, modal mass and shape of each.
@@ -21,8 +21,7 @@
 
 #[path = "common/mod.rs"]
 mod common;
-#[path = "models/seed2dof.rs"]
-mod model;
+use mbs_models::seed2dof as model;
 
 use clap::Parser;
 use mbs::IterationMatrix;

@@ -1,5 +1,5 @@
 //! The slider-crank of `tests/reference/MODELS.md`, a closed loop with one degree of freedom,
-//! written twice (the models are in `examples/models/slidercrank.rs`):
+//! written twice (the models are in `models/src/slidercrank.rs`):
 //!
 //! - form (a): three coordinates (crank angle θ, rod angle ψ, slider position s) and the
 //!   loop closed at the slider's pin by two constraints, `pin.x` and `pin.y`;
@@ -17,8 +17,7 @@
 
 #[path = "common/mod.rs"]
 mod common;
-#[path = "models/slidercrank.rs"]
-mod model;
+use mbs_models::slidercrank as model;
 
 use clap::Parser;
 use mbs::Output;

@@ -27,16 +27,11 @@
 //! and 9 significant digits, and how long it took. Points with no correct digit (error ≥ 1)
 //! are in the table and the CSV but not on the chart.
 
-#[path = "models/chain8.rs"]
-mod chain8;
-#[path = "models/dpend.rs"]
-mod dpend;
-#[path = "models/hexapod.rs"]
-mod hexapod;
-#[path = "models/seed2dof.rs"]
-mod seed2dof;
-#[path = "models/slidercrank.rs"]
-mod slidercrank;
+use mbs_models::chain8;
+use mbs_models::dpend;
+use mbs_models::hexapod;
+use mbs_models::seed2dof;
+use mbs_models::slidercrank;
 
 use clap::Parser;
 use mbs::work_precision::{Reference, Setting, Study, Sweep, WorkPrecision, decades, halvings};
@@ -138,7 +133,7 @@ fn study(name: &str, repeats: usize) -> WorkPrecision {
     match name {
         "seed2dof" => {
             let r = Reference::exact(
-                "modal solution q(t) = V cos(Wt) Vᵀ q0 (examples/models/seed2dof.rs)",
+                "modal solution q(t) = V cos(Wt) Vᵀ q0 (models/src/seed2dof.rs)",
                 samples(10.0, 100),
                 seed2dof::exact_state,
             );

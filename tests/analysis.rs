@@ -6,12 +6,9 @@
 //! stability, inverse then forward dynamics, a rheonomic damped model, inputs, and the errors.
 #![allow(clippy::needless_range_loop)]
 
-#[path = "../examples/models/arm3d_6.rs"]
-mod arm3d_6;
-#[path = "../examples/models/dpend.rs"]
-mod dpend;
-#[path = "../examples/models/seed2dof.rs"]
-mod seed2dof;
+use mbs_models::arm3d_6;
+use mbs_models::dpend;
+use mbs_models::seed2dof;
 
 use mbs::analysis::{
     AnalysisError, Stability, StaticsOptions, inverse_dynamics_along, linearize, modes,

@@ -145,8 +145,7 @@ fn inputs_on_a_model_without_inputs_are_refused() {
     ));
 }
 
-#[path = "../examples/models/dc_motor.rs"]
-mod dc_motor;
+use mbs_models::dc_motor;
 
 /// The DC-motor arm of `examples/dc_motor.rs`: the PI controller (sampled at 1 kHz) brings the
 /// arm to 20 rad/s; the current (an extra state) settles to the friction torque's share.

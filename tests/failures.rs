@@ -1,8 +1,7 @@
 //! Failures are values: typed errors with the trajectory computed so far, never a panic, never
 //! a non-finite value in a trajectory.
 
-#[path = "../examples/models/seed2dof.rs"]
-mod seed2dof;
+use mbs_models::seed2dof;
 
 use mbs::{
     Failure, GenAlphaParams, HhtParams, Model, NewmarkParams, Options, Output, Scheme, Simulation,

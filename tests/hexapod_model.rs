@@ -6,8 +6,7 @@
 
 use mbs::Model;
 
-#[path = "../examples/models/hexapod.rs"]
-mod hexapod;
+use mbs_models::hexapod;
 
 use hexapod::Hexapod;
 

@@ -1,4 +1,4 @@
-//! The hexapod standing: scene `Standing` of `examples/models/hexapod.rs` (the six feet in
+//! The hexapod standing: scene `Standing` of `models/src/hexapod.rs` (the six feet in
 //! penalty contact with the ground z = 0, a PD controller on each of the 18 leg joints holding
 //! the start angles), dropped from the MODELS.md start (feet ~1 cm above the ground).
 //!
@@ -23,8 +23,7 @@ use mbs::{
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
-#[path = "../examples/models/hexapod.rs"]
-mod hexapod;
+use mbs_models::hexapod;
 
 use hexapod::{Hexapod, HexapodStanding};
 

@@ -6,13 +6,12 @@
 
 mod common;
 
-#[path = "../examples/models/pendulum3.rs"]
-mod pendulum3;
 use mbs::integrators::index3_iteration_matrix;
 use mbs::{
     ConstraintMethod, GenAlphaParams, Model, NewmarkParams, Options, Output, Scheme, State, Stats,
     simulate,
 };
+use mbs_models::pendulum3;
 use pendulum3::Pendulum3;
 
 /// (x, y, ẋ, ẏ, λ) at t = 1 from tests/reference/pendulum3.json.

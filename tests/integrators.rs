@@ -1,8 +1,7 @@
 //! Integrators on the canonical models: observed orders, failures as values, outputs.
 
 mod common;
-#[path = "../examples/models/seed2dof.rs"]
-mod seed2dof;
+use mbs_models::seed2dof;
 
 use common::*;
 use mbs::{GenAlphaParams, HhtParams, NewmarkParams, Options, Output, Scheme, simulate};

@@ -8,14 +8,10 @@
 //! Every test prints its measured table: `cargo test --release --test loops -- --nocapture`.
 #![allow(clippy::needless_range_loop)]
 
-#[path = "../examples/models/dpend.rs"]
-mod dpend;
-#[path = "../examples/models/dpend_cartesian.rs"]
-mod dpend_cartesian;
-#[path = "../examples/models/fourbar.rs"]
-mod fourbar;
-#[path = "../examples/models/slidercrank.rs"]
-mod slidercrank;
+use mbs_models::dpend;
+use mbs_models::dpend_cartesian;
+use mbs_models::fourbar;
+use mbs_models::slidercrank;
 
 use dpend::DoublePendulum;
 use dpend_cartesian::DoublePendulumCartesian;

@@ -3,12 +3,10 @@
 //! then a constrained model with every constraint method. The allocator counts this thread's
 //! allocations (`tests/common/alloc.rs`).
 
-#[path = "../examples/models/dpend.rs"]
-mod dpend;
+use mbs_models::dpend;
 
-#[path = "../examples/models/pendulum3.rs"]
-mod pendulum3;
 use mbs::{ConstraintMethod, GenAlphaParams, Integrator, Options, Output, Scheme, Simulation};
+use mbs_models::pendulum3;
 use pendulum3::Pendulum3;
 
 #[path = "common/alloc.rs"]

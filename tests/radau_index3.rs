@@ -16,12 +16,11 @@
 //! invariant ẋ² + ẏ² − λ − y is λ's error and follows it, not rtol; x ẋ + y ẏ follows the
 //! velocity error of the last step.
 
-#[path = "../examples/models/pendulum3.rs"]
-mod pendulum3;
 use mbs::{
     ConstraintMethod, ConstraintOptions, Integrator, Options, Output, Scheme, Simulation, Stats,
     Trajectory, simulate,
 };
+use mbs_models::pendulum3;
 use pendulum3::Pendulum3;
 #[path = "common/alloc.rs"]
 mod alloc;

@@ -2,18 +2,15 @@
 //! reference data in `tests/reference/*.json`: M and h at the test state to 1e-14 relative, the
 //! identities tying `inverse_dynamics` and `static_forces` to M and h, and the initial energy.
 //!
-//! seed2dof, dpend and arm3d_6 are the models of the examples (`examples/models/`), so the
-//! examples run exactly what is checked here.
+//! seed2dof, dpend and arm3d_6 are the models of the examples (`models/`, crate
+//! `mbs-models`), so the examples run exactly what is checked here.
 
 use mbs::Model;
 use serde_json::Value;
 
-#[path = "../examples/models/arm3d_6.rs"]
-mod arm3d_6;
-#[path = "../examples/models/dpend.rs"]
-mod dpend;
-#[path = "../examples/models/seed2dof.rs"]
-mod seed2dof;
+use mbs_models::arm3d_6;
+use mbs_models::dpend;
+use mbs_models::seed2dof;
 
 mbs::multibody! {
     /// chain4: four uniform bars of 0.5 m and 1 kg hinged end to end, relative angles.

@@ -8,11 +8,9 @@
 //! rtol 1e-12, but about 2e-2 away at t = 10 s even at rtol 1e-10, and no admissible
 //! tolerance brings them to 1e-6 there.
 
-#[path = "../examples/models/arm3d_6.rs"]
-mod arm3d_6;
+use mbs_models::arm3d_6;
 mod common;
-#[path = "../examples/models/dpend.rs"]
-mod dpend;
+use mbs_models::dpend;
 
 use common::*;
 use mbs::{GenAlphaParams, HhtParams, NewmarkParams, Options, Output, Scheme, simulate};

@@ -4,10 +4,8 @@
 //! steps, failures.
 
 mod common;
-#[path = "../examples/models/dpend.rs"]
-mod dpend;
-#[path = "../examples/models/seed2dof.rs"]
-mod seed2dof;
+use mbs_models::dpend;
+use mbs_models::seed2dof;
 
 use common::*;
 use dpend::DoublePendulum;

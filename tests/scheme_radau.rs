@@ -4,19 +4,16 @@
 //! matrices (failures and allocations are checked with every scheme in `failures.rs` and
 //! `no_alloc.rs`).
 
-#[path = "../examples/models/arm3d_6.rs"]
-mod arm3d_6;
+use mbs_models::arm3d_6;
 mod common;
-#[path = "../examples/models/dpend.rs"]
-mod dpend;
-#[path = "../examples/models/seed2dof.rs"]
-mod seed2dof;
+use mbs_models::dpend;
+use mbs_models::seed2dof;
 
 use common::*;
 use mbs::{IterationMatrix, Options, Output, Scheme, Stats, simulate};
 
 mbs::multibody! {
-    /// dpend (`examples/models/dpend.rs`) with generated tangents, for exact iteration matrices.
+    /// dpend (`models/src/dpend.rs`) with generated tangents, for exact iteration matrices.
     pub model DoublePendulumT {
         param l = 1.0; param m = 1.0; param g = 9.81;
         let i_bar = m * l * l / 12;

@@ -15,8 +15,7 @@
 #![allow(clippy::needless_range_loop)]
 
 mod common;
-#[path = "../examples/models/seed2dof.rs"]
-mod seed2dof;
+use mbs_models::seed2dof;
 
 use common::*;
 use mbs::spectral::{

@@ -3,8 +3,7 @@
 //! step ones at h = 2 ms. dpend has no generated tangents, so implicit schemes build their
 //! iteration matrix by finite differences (3 evaluations of τ for 2 coordinates).
 
-#[path = "../examples/models/dpend.rs"]
-mod dpend;
+use mbs_models::dpend;
 
 use mbs::{GenAlphaParams, HhtParams, NewmarkParams, Options, Output, Scheme, Stats, simulate};
 

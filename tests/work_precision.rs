@@ -2,8 +2,7 @@
 //! tolerances and a fixed-step run outside RK4's stability region.
 
 mod common;
-#[path = "../examples/models/seed2dof.rs"]
-mod seed2dof;
+use mbs_models::seed2dof;
 
 use common::seed2dof_exact;
 use mbs::work_precision::{

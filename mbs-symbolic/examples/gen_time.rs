@@ -7,7 +7,7 @@
 //!
 //! It times `expand_models` — parse, check, symbolic model, scheduling and emission: all the
 //! macro does but the compiler's final tokenisation of the emitted text — on chainN written
-//! out in the DSL and on the hexapod of `examples/models/hexapod.rs`, with and without
+//! out in the DSL and on the hexapod of `models/src/hexapod.rs`, with and without
 //! tangents, and prints the best of several runs with the op counts. Arguments select cases
 //! by name (`-- hexapod chain24`).
 
@@ -37,7 +37,7 @@ fn chain(n: usize, tangents: bool) -> String {
 }
 
 fn hexapod(tangents: bool) -> Option<String> {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/models/hexapod.rs");
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../models/src/hexapod.rs");
     let src = std::fs::read_to_string(path).ok()?;
     let blocks = multibody_blocks(&syn::parse_file(&src).ok()?);
     let mut body = blocks.first()?.to_string();
@@ -109,7 +109,7 @@ fn main() {
                 format!("hexapod{}", if tan { " + tangents" } else { "" }),
                 src,
             )),
-            None => println!("(examples/models/hexapod.rs not found: hexapod skipped)"),
+            None => println!("(models/src/hexapod.rs not found: hexapod skipped)"),
         }
     }
     let only: Vec<String> = std::env::args().skip(1).collect();

@@ -5,9 +5,9 @@
 //! climb, 90 times its oscillation, ten times larger at 1000 s than at 100 s; trend, sign
 //! and size printed).
 
-use crate::dpend::DoublePendulum;
 use crate::support::{Work, all_finite, check_work, fit_line, work};
 use mbs::{Options, Output, Scheme, Trajectory, simulate};
+use mbs_models::dpend::DoublePendulum;
 use std::time::Instant;
 
 const T_END: f64 = 1000.0;
@@ -82,13 +82,13 @@ fn dpend_over_1000_s_midpoint_has_no_energy_drift_and_dopri5_drifts() {
     );
     let early = deviation(&tr, 100.0);
     println!("    largest |E − E0|: {early:.2e} J over the first 100 s, {dev:.2e} J over 1000 s");
-    // a secular drift: a trend many standard errors from zero that outgrows the oscillation
-    // and a deviation that grows with the length of the run
+    // a secular drift: a climb many standard errors from zero that outgrows the oscillation
+    // (89 times) and a deviation that grows with the length of the run (11 times)
     assert!(
-        slope.abs() > 10.0 * se && (slope * T_END).abs() > 10.0 * spread,
-        "DOPRI5"
+        slope > 100.0 * se && slope * T_END > 50.0 * spread,
+        "DOPRI5: trend {slope:e} ± {se:e} J/s, oscillation {spread:e} J"
     );
-    assert!(dev > 5.0 * early, "DOPRI5: {early} then {dev}");
+    assert!(dev > 8.0 * early, "DOPRI5: {early} then {dev}");
     snapshots.push(("dopri5 rtol 1e-6".into(), work(&st)));
     check_work(
         "dpend 1000 s",

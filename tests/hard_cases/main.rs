@@ -6,13 +6,6 @@
 
 #[path = "../common/mod.rs"]
 mod common;
-#[path = "../../examples/models/dpend.rs"]
-mod dpend;
-#[path = "../../examples/models/fourbar.rs"]
-mod fourbar;
-mod models;
-#[path = "../../examples/models/seed2dof.rs"]
-mod seed2dof;
 mod support;
 
 mod chain16;

@@ -6,9 +6,9 @@
 //! h = 0.044 s (1000 periods, bounded) and 0.046 s (refused).
 
 use crate::common::seed2dof_modes;
-use crate::seed2dof::Seed2dof;
 use crate::support::{Work, all_finite, check_work, fit_line, work};
 use mbs::{Failure, GenAlphaParams, Options, Output, Scheme, Trajectory, simulate};
+use mbs_models::seed2dof::Seed2dof;
 
 /// Chung & Hulbert's amplification matrix of generalized-α on ẍ = −ω²x (state d, v, a, with
 /// h = 1 and ω = wh): its spectral radius, from the characteristic polynomial (the largest

@@ -4,16 +4,17 @@
 //! - MODELS.md's r = 1 + 9.81/k is not the static stretch at θ = 0.5 (9.81 cos 0.5/k): the
 //!   radial mode starts with an amplitude 1.2/k m and a velocity amplitude 1.2/√k m/s, far
 //!   above atol. That oscillation is part of the solution asked for, and every scheme that
-//!   honours the tolerance resolves it: the work of all of them grows like √k.
+//!   honours the tolerance resolves it: the work of all of them grows with k, 19 (gen-α) to
+//!   45 (DOPRI5) times the steps at k = 1e8 as at 1e4.
 //! - on the slow manifold, r = 1 + 9.81 cos 0.5/k, the radial mode is hardly excited: the
 //!   implicit schemes (Radau5, BDF, gen-α with adaptive steps) take no more steps at
 //!   k = 1e8 than at 1e4 (Radau5 17 against 128, BDF 45 against 313 with a peak of 1885 at
 //!   k = 1e6, gen-α 183 against 180), and θ(1) tends to the rigid pendulum's as k grows;
 //!   DOPRI5 is held by its stability bound h ≲ 3.3/√k: 67 times the steps for 10⁴ times k.
 
-use crate::models::SpringPend;
 use crate::support::{Work, all_finite, check_work, work};
 use mbs::{Model, Options, Output, Scheme, simulate};
+use mbs_models::springpend::SpringPend;
 
 const KS: [f64; 4] = [1e2, 1e4, 1e6, 1e8];
 
@@ -92,12 +93,14 @@ fn springpend_stiffness_sweep() {
             let growth = steps[3] / steps[1];
             println!("    steps at k = 1e8 / at k = 1e4: {growth:.2} (√(1e8/1e4) = 100)");
             if stretch == 1.0 {
-                // the radial oscillation is resolved by every scheme
+                // the radial oscillation is resolved by every scheme (19 to 45 times the steps)
                 assert!(growth > 15.0, "{}: {growth}", scheme.name());
             } else if scheme.is_implicit() {
-                assert!(growth < 5.0, "{}: {growth}", scheme.name());
+                // no more steps (gen-α: 183 against 180)
+                assert!(growth < 1.1, "{}: {growth}", scheme.name());
             } else {
-                assert!((30.0..200.0).contains(&growth), "{growth}");
+                // DOPRI5 held by its stability bound: 67 times the steps
+                assert!((60.0..75.0).contains(&growth), "{growth}");
             }
             // θ(1) approaches the rigid pendulum's as k grows (for the implicit schemes on
             // the slow manifold, until their own error at rtol 1e-6 dominates: still falling)

@@ -18,9 +18,9 @@
 //!     h = 1e-3 steps over that band (from 1.08e-4 at t = 1.000 to the far side), and is
 //!     stopped in time with a looser `Options::singularity_tol` (1e-2).
 
-use crate::models::{CoincidentAxes, SineSlider, SpinningPointMass};
 use crate::support::{Work, check_work, work};
 use mbs::{Failure, Model, Options, Scheme, Simulation, simulate};
+use mbs_models::structural::{CoincidentAxes, SineSlider, SpinningPointMass};
 
 fn refused_at_start<M: Model + Default + 'static>(
     label: &str,

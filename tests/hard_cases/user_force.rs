@@ -3,9 +3,9 @@
 //! approach of `tests/efforts.rs`, on dpend with a horizontal push at the tip written in
 //! Rust ([`mbs::WithEfforts`]).
 
-use crate::dpend::DoublePendulum;
 use crate::support::{Work, all_finite, check_work, work};
 use mbs::{Effort, Efforts, Failure, Model, Options, Scheme, WithEfforts, simulate};
+use mbs_models::dpend::DoublePendulum;
 
 /// A push of 2 N along x at the tip that becomes NaN, or an error, from t = 0.5 on.
 struct Push {

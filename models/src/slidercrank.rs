@@ -1,5 +1,5 @@
 //! slidercrank: a crank, a connecting rod and a slider on the x axis
-//! (`tests/reference/MODELS.md`), written twice. Shared by `examples/slidercrank.rs` and the
+//! (`tests/reference/MODELS.md`), written twice. Used by `examples/slidercrank.rs` and the
 //! tests.
 //!
 //! - [`SliderCrank`], form (a): three coordinates (crank angle θ, the rod's absolute angle
@@ -11,7 +11,6 @@
 //! Crank: uniform bar r = 0.1 m, 0.5 kg, hinged at the origin about z. Rod: uniform bar
 //! l = 0.3 m, 1.0 kg, hinged to the crank tip. Slider: a 2.0 kg point mass on the x axis,
 //! hinged to the rod's end. No gravity, no torque. θ(0) = 0 (dead centre), θ'(0) = 10 rad/s.
-#![allow(dead_code)]
 
 mbs::multibody! {
     /// Slider-crank, form (a): θ (crank), ψ (rod, absolute, from +x), s (slider along x),

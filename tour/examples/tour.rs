@@ -143,7 +143,7 @@ fn main() {
         std::process::exit(1);
     }
     work_precision(&args.out);
-    println!("\nread the generated code with: cargo run --bin mbs -- expand examples/tour.rs");
+    println!("\nread the generated code with: cargo run --bin mbs -- expand tour/examples/tour.rs");
 }
 
 /// EasyDyn's StaticEquilibrium → ComputePoles, with the generated exact stiffness.

@@ -1,5 +1,6 @@
 //! chain24 of MODELS.md: 24 uniform bars (l = 0.5 m, 1 kg), hinged end to end about +z,
-//! relative angles, gravity. Written out link by link (the language has no loops).
+//! relative angles, q(0) = 0.3 rad every joint, gravity. Written out link by link (the language
+//! has no loops). Used by the benchmarks.
 
 mbs::multibody! {
     /// Planar chain of 24 uniform bars.

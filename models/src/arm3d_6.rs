@@ -1,5 +1,5 @@
 //! arm3d_6: spatial serial arm of six revolute joints (`tests/reference/MODELS.md`).
-//! Shared by `examples/arm3d_6.rs` and the tests.
+//! Used by `examples/arm3d_6.rs`, the tests and the benchmarks.
 
 mbs::multibody! {
     /// Six revolute joints, axes z, y, z, y, z, y (each in the previous link's frame), links

@@ -1,21 +1,5 @@
-//! Models of the hard cases that are not in `examples/models/` (MODELS.md's springpend,
-//! chain16 with joint springs, tumble, and two structurally singular models).
-
-mbs::multibody! {
-    /// springpend: a 1 kg point mass on a massless spring of rest length 1 m hinged at the
-    /// origin, in polar coordinates (θ from the downward vertical, r). The start
-    /// (θ, r) = (0.5, 1 + 9.81/k) is set by the runs.
-    pub model SpringPend {
-        param k = 1e4;
-        dof theta = 0.5;
-        dof r = 1.0;
-        option tangents;
-        body mass { mass = 1.0; }
-        TOG[mass] = Trotz(theta) * Tdisp(0, -r, 0);
-        spring(ground, mass, k = k, l0 = 1);
-        gravity(0, -9.81, 0);
-    }
-}
+//! chain16 with stiff joints: MODELS.md's chainN at N = 16 with a torsional spring of
+//! 1e6 N·m/rad in every joint, the hard cases' stiff chain.
 
 mbs::multibody! {
     /// chain16 (MODELS.md chainN, N = 16: uniform bars l = 0.5 m, 1 kg, relative angles,
@@ -91,72 +75,5 @@ mbs::multibody! {
         generalized_force(q[13], -k * (q[13] - q_rest));
         generalized_force(q[14], -k * (q[14] - q_rest));
         generalized_force(q[15], -k * (q[15] - q_rest));
-    }
-}
-
-mbs::multibody! {
-    /// tumble (MODELS.md): a free rigid body, 0.12 kg, principal inertias (1.7231e-4, 6.58e-6,
-    /// 1.7243e-4) kg m² about body x, y, z (x the intermediate axis), ZYX Euler angles,
-    /// spinning at 10 rad/s about body x plus 1e-3 rad/s about body z (at q = 0:
-    /// ω_body = (q̇2, q̇1, q̇0)). Singular at q1 = ±π/2 (body x along world z).
-    pub model Tumble {
-        dof q[0] = 0.0, qd = 1e-3;
-        dof q[1] = 0.0;
-        dof q[2] = 0.0, qd = 10.0;
-        option tangents;
-        body b { mass = 0.12; inertia = (1.7231e-4, 6.58e-6, 1.7243e-4); }
-        TOG[b] = Trotz(q[0]) * Troty(q[1]) * Trotx(q[2]);
-    }
-}
-
-mbs::multibody! {
-    /// tumble's body and spin on XYZ Euler angles: singular at q1 = ±π/2, where body z lies
-    /// along world x. Half-way through its flip the body spins about its z axis, which then
-    /// points along the angular momentum (world x) to within 5e-3 rad: every flip meets
-    /// the singularity, whatever its timing (at q = 0: ω_body = (q̇0, q̇1, q̇2)).
-    pub model TumbleXyz {
-        dof q[0] = 0.0, qd = 10.0;
-        dof q[1] = 0.0;
-        dof q[2] = 0.0, qd = 1e-3;
-        option tangents;
-        body b { mass = 0.12; inertia = (1.7231e-4, 6.58e-6, 1.7243e-4); }
-        TOG[b] = Trotx(q[0]) * Troty(q[1]) * Trotz(q[2]);
-    }
-}
-
-mbs::multibody! {
-    /// Two revolute joints about the same axis at the same point: q0 and q1 move the bar
-    /// exactly alike, M = [[a, a], [a, a]] in every configuration.
-    pub model CoincidentAxes {
-        dof q[0] = 0.3; dof q[1] = 0.2;
-        body bar { mass = 1.0; inertia = (1.0 / 12.0, 0, 1.0 / 12.0); }
-        TOG[bar] = Trotz(q[0]) * Trotz(q[1]) * Tdisp(0, -0.5, 0);
-        gravity(0, -9.81, 0);
-    }
-}
-
-mbs::multibody! {
-    /// A pendulum whose tip is a point mass turned about its own centre by q1: q1 appears in
-    /// the pose of a body with mass (so the generator's "moves no body with mass" check
-    /// passes) but moves no mass, as a coordinate of a massless terminal body would.
-    pub model SpinningPointMass {
-        dof q[0] = 0.3; dof q[1] = 0.0;
-        body bar { mass = 1.0; inertia = (1.0 / 12.0, 0, 1.0 / 12.0); }
-        body tip { mass = 0.5; }
-        TOG[bar] = Trotz(q[0]) * Tdisp(0, -0.5, 0);
-        TOG[tip] = TOG[bar] * Tdisp(0, -0.5, 0) * Trotz(q[1]);
-        gravity(0, -9.81, 0);
-    }
-}
-
-mbs::multibody! {
-    /// A slider driven through a sine, x = sin q0, coasting at 1 m/s from x = 0: at
-    /// q0 = π/2 (t = 1 s) q0 stops moving it (M = cos² q0), a singular configuration reached
-    /// during the run.
-    pub model SineSlider {
-        dof q[0] = 0.0, qd = 1.0;
-        option tangents;
-        body slider { mass = 1.0; }
-        TOG[slider] = Tdisp(sin(q[0]), 0, 0);
     }
 }

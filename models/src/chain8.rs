@@ -1,6 +1,6 @@
 //! chain8 of MODELS.md: 8 uniform bars (l = 0.5 m, 1 kg), hinged end to end about +z,
 //! relative angles, q(0) = 0.3 rad every joint, gravity. Written out link by link (the language
-//! has no loops), as `benches/models/chain24.rs`. Used by `examples/work_precision.rs`.
+//! has no loops), as [`chain24`](crate::chain24). Used by `examples/work_precision.rs`.
 
 mbs::multibody! {
     /// Planar chain of 8 uniform bars.

@@ -1,5 +1,5 @@
 //! hexapod: a 24-dof, 49-body walking robot in the spirit of the seed's AMRU5
-//! (`tests/reference/MODELS.md`). Shared by `examples/hexapod.rs`, `tests/hexapod_model.rs`,
+//! (`tests/reference/MODELS.md`). Used by `examples/hexapod.rs`, `tests/hexapod_model.rs`,
 //! `tests/hexapod_standing.rs` and the benchmarks.
 //!
 //! Legs are numbered k = 2i + j with the hip at (hx_i, hy_j, 0) in the base frame,

@@ -1,4 +1,4 @@
-//! fourbar: a Grashof crank-rocker (`tests/reference/MODELS.md`). Shared by
+//! fourbar: a Grashof crank-rocker (`tests/reference/MODELS.md`). Used by
 //! `examples/fourbar.rs` and the tests.
 //!
 //! Ground link 0.4 m along x (pivots at (0, 0) and (0.4, 0)), crank 0.1 m, coupler 0.35 m,
@@ -7,7 +7,6 @@
 //! closed where the coupler meets the rocker's tip. Crank angle π/3 at t = 0 (kept: marked
 //! `independent`), crank speed 5 rad/s; `b` and `c` are given roughly, on the branch with the
 //! coupler above the x axis, and the assembly closes the loop from them.
-#![allow(dead_code)]
 
 mbs::multibody! {
     /// Four-bar crank-rocker: crank `a` at the origin, coupler `b` hinged at the crank tip,

@@ -1,5 +1,5 @@
 //! seed2dof: two masses on a line, ground —k1— mass 1 —k2— mass 2, no gravity
-//! (`tests/reference/MODELS.md`). Shared by `examples/seed2dof.rs` and the tests.
+//! (`tests/reference/MODELS.md`). Used by `examples/seed2dof.rs` and the tests.
 
 mbs::multibody! {
     /// The 2-dof spring–mass system of the seed course; q = displacements from rest.
@@ -20,7 +20,6 @@ mbs::multibody! {
 
 /// The exact modes of seed2dof with the default parameters (unit masses, so M = I): circular
 /// frequencies ω (rad/s, ascending) and unit mode shapes from K = [k1 + k2, −k2; −k2, k2].
-#[allow(dead_code)] // not every program that includes the model uses it
 pub fn exact_modes() -> ([f64; 2], [[f64; 2]; 2]) {
     let (k1, k2): (f64, f64) = (79.15, 1961.0);
     let (a, b, d) = (k1 + k2, -k2, k2);
@@ -41,7 +40,6 @@ pub fn exact_modes() -> ([f64; 2], [[f64; 2]; 2]) {
 
 /// The exact (q, qd) at time t from the declared start q0 = (0, 1), qd0 = 0:
 /// q(t) = Σ_k v_k (v_kᵀ q0) cos(ω_k t).
-#[allow(dead_code)]
 pub fn exact_state(t: f64) -> Vec<f64> {
     let (w, v) = exact_modes();
     let mut y = vec![0.0; 4];

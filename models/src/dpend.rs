@@ -1,5 +1,5 @@
 //! dpend: planar double pendulum of two uniform bars (`tests/reference/MODELS.md`).
-//! Shared by `examples/dpend.rs` and the tests.
+//! Used by `examples/dpend.rs`, the tests and the benchmarks.
 
 mbs::multibody! {
     /// Planar double pendulum: two uniform bars hinged at the origin and end to end about +z.

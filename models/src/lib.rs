@@ -1,0 +1,36 @@
+//! The models the examples, tests and benchmarks of mbs share, one module per model, so that
+//! each `multibody!` block is expanded and compiled once rather than in every program that
+//! uses it. The canonical models of `tests/reference/MODELS.md` and the hard cases' models:
+//!
+//! | module | model |
+//! |---|---|
+//! | [`seed2dof`] | two masses and two springs on a line, with its exact solution |
+//! | [`dpend`] | planar double pendulum of two uniform bars |
+//! | [`dpend_cartesian`] | the same pendulum in 6 Cartesian coordinates and 4 constraints |
+//! | [`arm3d_6`] | spatial arm of six revolute joints |
+//! | [`chain8`], [`chain24`] | planar chains of 8 and 24 uniform bars |
+//! | [`chain16_stiff`] | a chain of 16 bars with torsional springs of 1e6 N·m/rad in its joints |
+//! | [`hexapod`] | 24-dof walking robot, free and standing on its feet |
+//! | [`pendulum3`] | Cash's index-3 pendulum in Cartesian coordinates |
+//! | [`fourbar`] | a crank-rocker four-bar loop |
+//! | [`slidercrank`] | a slider-crank, with its loop as constraints and in closed form |
+//! | [`dc_motor`] | an arm driven by a DC motor under a sampled PI controller |
+//! | [`springpend`] | a point mass on a stiff spring (polar coordinates) |
+//! | [`tumble`] | a free body tumbling about its intermediate axis, on two sets of Euler angles |
+//! | [`structural`] | models whose mass matrix is singular by construction |
+
+pub mod arm3d_6;
+pub mod chain16_stiff;
+pub mod chain24;
+pub mod chain8;
+pub mod dc_motor;
+pub mod dpend;
+pub mod dpend_cartesian;
+pub mod fourbar;
+pub mod hexapod;
+pub mod pendulum3;
+pub mod seed2dof;
+pub mod slidercrank;
+pub mod springpend;
+pub mod structural;
+pub mod tumble;

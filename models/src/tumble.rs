@@ -1,0 +1,33 @@
+//! tumble (`tests/reference/MODELS.md`): a free rigid body spinning about its intermediate
+//! axis, on ZYX Euler angles ([`Tumble`], MODELS.md's) and on XYZ angles ([`TumbleXyz`]),
+//! which every flip drives through their singularity.
+
+mbs::multibody! {
+    /// tumble (MODELS.md): a free rigid body, 0.12 kg, principal inertias (1.7231e-4, 6.58e-6,
+    /// 1.7243e-4) kg m² about body x, y, z (x the intermediate axis), ZYX Euler angles,
+    /// spinning at 10 rad/s about body x plus 1e-3 rad/s about body z (at q = 0:
+    /// ω_body = (q̇2, q̇1, q̇0)). Singular at q1 = ±π/2 (body x along world z).
+    pub model Tumble {
+        dof q[0] = 0.0, qd = 1e-3;
+        dof q[1] = 0.0;
+        dof q[2] = 0.0, qd = 10.0;
+        option tangents;
+        body b { mass = 0.12; inertia = (1.7231e-4, 6.58e-6, 1.7243e-4); }
+        TOG[b] = Trotz(q[0]) * Troty(q[1]) * Trotx(q[2]);
+    }
+}
+
+mbs::multibody! {
+    /// tumble's body and spin on XYZ Euler angles: singular at q1 = ±π/2, where body z lies
+    /// along world x. Half-way through its flip the body spins about its z axis, which then
+    /// points along the angular momentum (world x) to within 5e-3 rad: every flip meets
+    /// the singularity, whatever its timing (at q = 0: ω_body = (q̇0, q̇1, q̇2)).
+    pub model TumbleXyz {
+        dof q[0] = 0.0, qd = 10.0;
+        dof q[1] = 0.0;
+        dof q[2] = 0.0, qd = 1e-3;
+        option tangents;
+        body b { mass = 0.12; inertia = (1.7231e-4, 6.58e-6, 1.7243e-4); }
+        TOG[b] = Trotx(q[0]) * Troty(q[1]) * Trotz(q[2]);
+    }
+}

@@ -762,7 +762,7 @@ fn typed_errors_of_constrained_runs() {
         .kind;
     println!("a and b independent: {e}");
     assert!(
-        matches!(&e, Failure::InconsistentStart { reason, .. } if reason.contains("2 coordinates are marked independent")),
+        matches!(&e, Failure::InconsistentStart { reason, .. } if reason.contains("2 coordinates are marked independent, so only 1 is left to close 2 constraints")),
         "{e:?}"
     );
 

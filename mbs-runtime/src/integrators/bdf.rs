@@ -51,7 +51,7 @@ use super::at::{Affine, Weights};
 use super::newton::AccelNewton;
 use super::problem::Problem;
 use super::step_control::{elementary_factor, optimal_factor};
-use super::{Attempt, Control, State, Stepper};
+use super::{Attempt, Control, State, Step, Stepper};
 use crate::error::Failure;
 use crate::model::Model;
 
@@ -185,14 +185,14 @@ impl<M: Model> Stepper<M> for Bdf {
         Ok(())
     }
 
-    fn attempt(
-        &mut self,
-        p: &mut Problem<M>,
-        cur: &State,
-        h: f64,
-        ctl: &Control,
-        next: &mut State,
-    ) -> Result<Attempt, Failure> {
+    fn attempt(&mut self, step: Step<'_, M>) -> Result<Attempt, Failure> {
+        let Step {
+            p,
+            cur,
+            h,
+            ctl,
+            next,
+        } = step;
         let (n, m, k) = (self.n, 2 * self.n, self.order);
         // steps on a fixed grid differ from h in the last bits: not a change of step
         if (h - self.h).abs() > 1e-10 * self.h {

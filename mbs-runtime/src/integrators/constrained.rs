@@ -688,10 +688,10 @@ pub fn assemble<M: Model>(
         }
         return Err(fail(
             format!(
-                "{} coordinates are marked independent, so only {} are left to close {} constraints: mark at most {}",
-                kept.len(),
-                free.len(),
-                nc,
+                "{} marked independent, so only {} left to close {}: mark at most {}",
+                counted(kept.len(), "coordinate is", "coordinates are"),
+                counted(free.len(), "is", "are"),
+                counted(nc, "constraint", "constraints"),
                 n.saturating_sub(nc)
             ),
             &phi,
@@ -862,6 +862,11 @@ pub fn assemble<M: Model>(
         largest_change: (label(moved), change),
         kept: kept.iter().map(|&i| label(i)).collect(),
     })
+}
+
+/// "1 coordinate is", "3 coordinates are": a count with the words that agree with it.
+fn counted(n: usize, one: &str, many: &str) -> String {
+    format!("{n} {}", if n == 1 { one } else { many })
 }
 
 #[cfg(test)]

@@ -4,9 +4,8 @@
 //! by the order-4 continuous extension of Shampine (1986), as in Hairer's DOPRI5. Stability
 //! interval on the negative real axis ≈ 3.3; not for stiff problems.
 
-use super::problem::Problem;
 use super::step_control::{Decision, PiController};
-use super::{Attempt, Control, State, Stepper};
+use super::{Attempt, State, Step, Stepper};
 use crate::error::Failure;
 use crate::model::Model;
 
@@ -101,14 +100,14 @@ impl Dopri5 {
 }
 
 impl<M: Model> Stepper<M> for Dopri5 {
-    fn attempt(
-        &mut self,
-        p: &mut Problem<M>,
-        cur: &State,
-        h: f64,
-        ctl: &Control,
-        next: &mut State,
-    ) -> Result<Attempt, Failure> {
+    fn attempt(&mut self, step: Step<'_, M>) -> Result<Attempt, Failure> {
+        let Step {
+            p,
+            cur,
+            h,
+            ctl,
+            next,
+        } = step;
         let n = self.n;
         self.kv[0].copy_from_slice(&cur.qd);
         self.ka[0].copy_from_slice(&cur.qdd);

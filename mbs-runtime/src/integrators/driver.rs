@@ -9,7 +9,7 @@ use super::newton::NewtonTol;
 use super::problem::{Loops, Problem};
 use super::sim_error::SimError;
 use super::step_control::{StepBounds, Tolerances, initial_step};
-use super::stepper::{Attempt, Control, Stepper};
+use super::stepper::{Attempt, Control, Step, Stepper};
 use super::{Integrator, State};
 use crate::error::Failure;
 use crate::model::{Model, Pose};
@@ -358,9 +358,13 @@ impl<M: Model + 'static> Simulation<M> {
                 return Err(self.fail(kind, h));
             }
             self.attempts += 1;
-            let result =
-                self.stepper
-                    .attempt(&mut self.problem, &self.cur, h, &self.ctl, &mut self.next);
+            let result = self.stepper.attempt(Step {
+                p: &mut self.problem,
+                cur: &self.cur,
+                h,
+                ctl: &self.ctl,
+                next: &mut self.next,
+            });
             match result {
                 Err(kind) => return Err(self.fail(kind, h)),
                 Ok(Attempt::Accepted { h_next }) => {

@@ -11,7 +11,7 @@
 //! scheme's stability interval, the step fails with `UnstableStep`.
 
 use super::problem::Problem;
-use super::{Attempt, Control, State, Stepper};
+use super::{Attempt, State, Step, Stepper};
 use crate::error::Failure;
 use crate::model::Model;
 
@@ -159,14 +159,14 @@ impl Probe {
 }
 
 impl<M: Model> Stepper<M> for Explicit {
-    fn attempt(
-        &mut self,
-        p: &mut Problem<M>,
-        cur: &State,
-        h: f64,
-        ctl: &Control,
-        next: &mut State,
-    ) -> Result<Attempt, Failure> {
+    fn attempt(&mut self, step: Step<'_, M>) -> Result<Attempt, Failure> {
+        let Step {
+            p,
+            cur,
+            h,
+            ctl,
+            next,
+        } = step;
         if ctl.stability_check && self.steps % 16 == 0 {
             self.rho = self.estimate_rho(p, cur)?;
             // at the start, and before refusing a step, iterate until the estimate settles:

@@ -9,7 +9,7 @@
 use super::at::{Affine, Weights};
 use super::newton::AccelNewton;
 use super::problem::Problem;
-use super::{Attempt, Control, State, Stepper};
+use super::{Attempt, Control, State, Step, Stepper};
 use crate::error::Failure;
 use crate::model::Model;
 
@@ -40,14 +40,14 @@ impl<M: Model> Stepper<M> for Midpoint {
         Ok(())
     }
 
-    fn attempt(
-        &mut self,
-        p: &mut Problem<M>,
-        cur: &State,
-        h: f64,
-        ctl: &Control,
-        next: &mut State,
-    ) -> Result<Attempt, Failure> {
+    fn attempt(&mut self, step: Step<'_, M>) -> Result<Attempt, Failure> {
+        let Step {
+            p,
+            cur,
+            h,
+            ctl,
+            next,
+        } = step;
         for i in 0..self.n {
             self.qhat[i] = cur.q[i] + 0.5 * h * cur.qd[i];
             self.vhat[i] = cur.qd[i];

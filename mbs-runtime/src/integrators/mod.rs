@@ -47,7 +47,7 @@ pub use sim_error::SimError;
 
 pub(crate) use dense::lerp_lambda;
 pub(crate) use inputs::InputFn;
-pub(crate) use stepper::{Attempt, Control, Stepper};
+pub(crate) use stepper::{Attempt, Control, Step, Stepper};
 
 use crate::stats::Stats;
 use crate::trajectory::Trajectory;

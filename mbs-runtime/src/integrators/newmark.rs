@@ -39,7 +39,7 @@ use super::constrained::{Constrained, Mode};
 use super::newton::AccelNewton;
 use super::problem::{Loops, Problem};
 use super::step_control::next_step;
-use super::{Attempt, Control, State, Stepper};
+use super::{Attempt, Control, State, Step, Stepper};
 use crate::error::Failure;
 use crate::model::Model;
 use crate::options::{GenAlphaParams, HhtParams, NewmarkParams};
@@ -113,14 +113,14 @@ impl<M: Model> Stepper<M> for AlphaFamily {
         Ok(())
     }
 
-    fn attempt(
-        &mut self,
-        p: &mut Problem<M>,
-        cur: &State,
-        h: f64,
-        ctl: &Control,
-        next: &mut State,
-    ) -> Result<Attempt, Failure> {
+    fn attempt(&mut self, step: Step<'_, M>) -> Result<Attempt, Failure> {
+        let Step {
+            p,
+            cur,
+            h,
+            ctl,
+            next,
+        } = step;
         let (am, af, b, g) = (self.alpha_m, self.alpha_f, self.beta, self.gamma);
         // a₁ = c·qdd₁ + a_c, with a_c from the current state
         let c = (1.0 - af) / (1.0 - am);

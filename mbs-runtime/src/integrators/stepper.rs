@@ -33,21 +33,24 @@ pub(crate) struct Control {
     pub stability_check: bool,
 }
 
+/// One attempted step, as the driver hands it to a scheme: the model, the state the step
+/// starts from, its size, the controls, and the state to fill when it is accepted.
+pub(crate) struct Step<'a, M: Model> {
+    pub p: &'a mut Problem<M>,
+    pub cur: &'a State,
+    pub h: f64,
+    pub ctl: &'a Control,
+    pub next: &'a mut State,
+}
+
 /// A scheme, as the driver sees it.
 pub(crate) trait Stepper<M: Model> {
     /// Called once with the consistent initial state.
     fn start(&mut self, _p: &mut Problem<M>, _s: &State, _ctl: &Control) -> Result<(), Failure> {
         Ok(())
     }
-    /// Attempts a step of size `h` from `cur`; on acceptance fills `next`.
-    fn attempt(
-        &mut self,
-        p: &mut Problem<M>,
-        cur: &State,
-        h: f64,
-        ctl: &Control,
-        next: &mut State,
-    ) -> Result<Attempt, Failure>;
+    /// Attempts a step of size `step.h` from `step.cur`; on acceptance fills `step.next`.
+    fn attempt(&mut self, step: Step<'_, M>) -> Result<Attempt, Failure>;
     /// Called once the driver has accepted the step from `prev` to `cur`.
     fn accepted(&mut self, _p: &mut Problem<M>, _prev: &State, _cur: &State) {}
     /// Dense output on [prev.t, cur.t]: by default the quintic Hermite interpolant of

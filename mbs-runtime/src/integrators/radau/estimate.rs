@@ -26,19 +26,10 @@ impl Radau {
         }
     }
 
-    /// RADAU5's error estimate of the converged step (`next` holds y₁), as a weighted norm.
-    pub(super) fn estimate<M: Model>(
-        &mut self,
-        p: &mut Problem<M>,
-        cur: &State,
-        next: &State,
-        h: f64,
-        tol: &Tol,
-    ) -> f64 {
-        let (s, n) = (self.k.s, self.n);
-        let g0 = self.k.gamma0;
-        // the filter matrix was factorised with h_r (equal to h up to rounding)
-        let g = g0 * self.h_r;
+    /// The embedded formula's difference from the step's solution, before filtering, into
+    /// (r_q, r_v): r_q = h² Σ d̂_q,j a_j, r_v = h (γ₀ qdd₀ + Σ d̂_b,j a_j).
+    fn embedded_difference(&mut self, cur: &State, h: f64) {
+        let (s, n, g0) = (self.k.s, self.n, self.k.gamma0);
         for r in 0..n {
             let (mut x, mut y) = (0.0, 0.0);
             for j in 0..s {
@@ -48,6 +39,21 @@ impl Radau {
             self.rq[r] = h * h * x;
             self.rv[r] = h * (g0 * cur.qdd[r] + y);
         }
+    }
+
+    /// RADAU5's error estimate of the converged step (`next` holds y₁), as a weighted norm.
+    pub(super) fn estimate<M: Model>(
+        &mut self,
+        p: &mut Problem<M>,
+        cur: &State,
+        next: &State,
+        h: f64,
+        tol: &Tol,
+    ) -> f64 {
+        let n = self.n;
+        // the filter matrix was factorised with h_r (equal to h up to rounding)
+        let g = self.k.gamma0 * self.h_r;
+        self.embedded_difference(cur, h);
         self.filter(p, g);
         self.y0[..n].copy_from_slice(&cur.q);
         self.y0[n..].copy_from_slice(&cur.qd);
@@ -110,18 +116,9 @@ impl Radau {
         h: f64,
         tol: &Tol,
     ) -> f64 {
-        let (s, n, nc) = (self.k.s, self.n, self.nc);
-        let g0 = self.k.gamma0;
-        let g = g0 * self.h_r;
-        for r in 0..n {
-            let (mut x, mut y) = (0.0, 0.0);
-            for j in 0..s {
-                x += self.k.dq[j] * self.acc[j * n + r];
-                y += self.k.db[j] * self.acc[j * n + r];
-            }
-            self.rq[r] = h * h * x;
-            self.rv[r] = h * (g0 * cur.qdd[r] + y);
-        }
+        let (n, nc) = (self.n, self.nc);
+        let g = self.k.gamma0 * self.h_r;
+        self.embedded_difference(cur, h);
         // the velocity row's bracket M r_v (γ₀h f_v(y₀) = g M qdd₀ with qdd₀, λ₀ consistent);
         // the constraint row's γ₀h Φ(q₀) ≈ 0 (|Φ(q₀)| is within the Newton tolerance)
         for i in 0..n {

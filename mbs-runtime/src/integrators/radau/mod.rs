@@ -178,7 +178,7 @@ mod tableau;
 use super::at::At;
 use super::problem::Problem;
 use super::step_control::{Predictive, Tolerances};
-use super::{Attempt, Control, State, Stepper};
+use super::{Attempt, Control, State, Step, Stepper};
 use crate::error::Failure;
 use crate::linalg::{C64, Lu};
 use crate::model::Model;
@@ -406,14 +406,14 @@ impl<M: Model> Stepper<M> for Radau {
         Ok(())
     }
 
-    fn attempt(
-        &mut self,
-        p: &mut Problem<M>,
-        cur: &State,
-        h: f64,
-        ctl: &Control,
-        next: &mut State,
-    ) -> Result<Attempt, Failure> {
+    fn attempt(&mut self, step: Step<'_, M>) -> Result<Attempt, Failure> {
+        let Step {
+            p,
+            cur,
+            h,
+            ctl,
+            next,
+        } = step;
         let (s, n) = (self.k.s, self.n);
         let tol = Tol::new(ctl, s);
         for r in 0..n {

@@ -124,15 +124,10 @@ impl fmt::Display for OpsTable<'_> {
             "function", "flops", "adds", "muls", "divs", "funcs", "lets"
         )?;
         for (name, c) in self.0.ops {
+            let [flops, adds, muls, divs, funcs, lets] = c.columns();
             writeln!(
                 f,
-                "{name:<18} {:>7} {:>7} {:>7} {:>5} {:>6} {:>6}",
-                c.flops(),
-                c.adds,
-                c.muls,
-                c.divs,
-                c.funcs,
-                c.lets
+                "{name:<18} {flops:>7} {adds:>7} {muls:>7} {divs:>5} {funcs:>6} {lets:>6}"
             )?;
         }
         Ok(())

@@ -25,6 +25,18 @@ impl OpCount {
     pub fn flops(&self) -> usize {
         self.adds + self.muls + self.divs
     }
+
+    /// The columns of an op-count table, in its order: flops, adds, muls, divs, funcs, lets.
+    pub fn columns(&self) -> [usize; 6] {
+        [
+            self.flops(),
+            self.adds,
+            self.muls,
+            self.divs,
+            self.funcs,
+            self.lets,
+        ]
+    }
 }
 
 impl fmt::Display for OpCount {

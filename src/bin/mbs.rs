@@ -112,17 +112,10 @@ fn expand_file(
                         {
                             continue;
                         }
-                        let c = r.ops;
+                        let (model, function) = (&r.model, &r.function);
+                        let [flops, adds, muls, divs, funcs, lets] = r.ops.columns();
                         println!(
-                            "// {:<28} {:<22} {:>8} {:>8} {:>8} {:>6} {:>6} {:>6}",
-                            r.model,
-                            r.function,
-                            c.flops(),
-                            c.adds,
-                            c.muls,
-                            c.divs,
-                            c.funcs,
-                            c.lets
+                            "// {model:<28} {function:<22} {flops:>8} {adds:>8} {muls:>8} {divs:>6} {funcs:>6} {lets:>6}"
                         );
                     }
                 }

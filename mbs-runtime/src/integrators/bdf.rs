@@ -186,13 +186,7 @@ impl<M: Model> Stepper<M> for Bdf {
     }
 
     fn attempt(&mut self, step: Step<'_, M>) -> Result<Attempt, Failure> {
-        let Step {
-            p,
-            cur,
-            h,
-            ctl,
-            next,
-        } = step;
+        let Step(p, cur, h, ctl, next) = step;
         let (n, m, k) = (self.n, 2 * self.n, self.order);
         // steps on a fixed grid differ from h in the last bits: not a change of step
         if (h - self.h).abs() > 1e-10 * self.h {

@@ -101,13 +101,7 @@ impl Dopri5 {
 
 impl<M: Model> Stepper<M> for Dopri5 {
     fn attempt(&mut self, step: Step<'_, M>) -> Result<Attempt, Failure> {
-        let Step {
-            p,
-            cur,
-            h,
-            ctl,
-            next,
-        } = step;
+        let Step(p, cur, h, ctl, next) = step;
         let n = self.n;
         self.kv[0].copy_from_slice(&cur.qd);
         self.ka[0].copy_from_slice(&cur.qdd);

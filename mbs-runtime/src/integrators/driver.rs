@@ -358,13 +358,8 @@ impl<M: Model + 'static> Simulation<M> {
                 return Err(self.fail(kind, h));
             }
             self.attempts += 1;
-            let result = self.stepper.attempt(Step {
-                p: &mut self.problem,
-                cur: &self.cur,
-                h,
-                ctl: &self.ctl,
-                next: &mut self.next,
-            });
+            let step = Step(&mut self.problem, &self.cur, h, &self.ctl, &mut self.next);
+            let result = self.stepper.attempt(step);
             match result {
                 Err(kind) => return Err(self.fail(kind, h)),
                 Ok(Attempt::Accepted { h_next }) => {

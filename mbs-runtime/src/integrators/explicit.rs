@@ -160,13 +160,7 @@ impl Probe {
 
 impl<M: Model> Stepper<M> for Explicit {
     fn attempt(&mut self, step: Step<'_, M>) -> Result<Attempt, Failure> {
-        let Step {
-            p,
-            cur,
-            h,
-            ctl,
-            next,
-        } = step;
+        let Step(p, cur, h, ctl, next) = step;
         if ctl.stability_check && self.steps % 16 == 0 {
             self.rho = self.estimate_rho(p, cur)?;
             // at the start, and before refusing a step, iterate until the estimate settles:

@@ -41,13 +41,7 @@ impl<M: Model> Stepper<M> for Midpoint {
     }
 
     fn attempt(&mut self, step: Step<'_, M>) -> Result<Attempt, Failure> {
-        let Step {
-            p,
-            cur,
-            h,
-            ctl,
-            next,
-        } = step;
+        let Step(p, cur, h, ctl, next) = step;
         for i in 0..self.n {
             self.qhat[i] = cur.q[i] + 0.5 * h * cur.qd[i];
             self.vhat[i] = cur.qd[i];

@@ -114,13 +114,7 @@ impl<M: Model> Stepper<M> for AlphaFamily {
     }
 
     fn attempt(&mut self, step: Step<'_, M>) -> Result<Attempt, Failure> {
-        let Step {
-            p,
-            cur,
-            h,
-            ctl,
-            next,
-        } = step;
+        let Step(p, cur, h, ctl, next) = step;
         let (am, af, b, g) = (self.alpha_m, self.alpha_f, self.beta, self.gamma);
         // a₁ = c·qdd₁ + a_c, with a_c from the current state
         let c = (1.0 - af) / (1.0 - am);

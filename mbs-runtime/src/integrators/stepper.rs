@@ -35,13 +35,14 @@ pub(crate) struct Control {
 
 /// One attempted step, as the driver hands it to a scheme: the model, the state the step
 /// starts from, its size, the controls, and the state to fill when it is accepted.
-pub(crate) struct Step<'a, M: Model> {
-    pub p: &'a mut Problem<M>,
-    pub cur: &'a State,
-    pub h: f64,
-    pub ctl: &'a Control,
-    pub next: &'a mut State,
-}
+/// A scheme takes it apart as `let Step(p, cur, h, ctl, next) = step;`.
+pub(crate) struct Step<'a, M: Model>(
+    pub &'a mut Problem<M>,
+    pub &'a State,
+    pub f64,
+    pub &'a Control,
+    pub &'a mut State,
+);
 
 /// A scheme, as the driver sees it.
 pub(crate) trait Stepper<M: Model> {

@@ -592,15 +592,10 @@ fn emit_scene(
         "/// - formulation of M and h: {form}\n///\n/// | function | flops | adds | muls | divs | funcs | lets |\n/// |---|---|---|---|---|---|---|"
     );
     for (name, c) in &ops {
+        let [flops, adds, muls, divs, funcs, lets] = c.columns();
         let _ = writeln!(
             doc,
-            "/// | {name} | {} | {} | {} | {} | {} | {} |",
-            c.flops(),
-            c.adds,
-            c.muls,
-            c.divs,
-            c.funcs,
-            c.lets
+            "/// | {name} | {flops} | {adds} | {muls} | {divs} | {funcs} | {lets} |"
         );
     }
     let pty = format!("{}Params", sys.name);

@@ -407,13 +407,7 @@ impl<M: Model> Stepper<M> for Radau {
     }
 
     fn attempt(&mut self, step: Step<'_, M>) -> Result<Attempt, Failure> {
-        let Step {
-            p,
-            cur,
-            h,
-            ctl,
-            next,
-        } = step;
+        let Step(p, cur, h, ctl, next) = step;
         let (s, n) = (self.k.s, self.n);
         let tol = Tol::new(ctl, s);
         for r in 0..n {

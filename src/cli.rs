@@ -35,7 +35,7 @@
 use crate::plot::{Chart, Series, line_chart};
 use crate::{
     ConstraintMethod, ConstraintOptions, CsvWriter, Failure, Inputs, Model, Options, Output,
-    Scheme, SimError, Simulation, Stats, StepControl, Trajectory,
+    Scheme, SimError, Simulation, Stats, StepControl, Trajectory, error::short,
 };
 /// `RunArgs::parse()` needs this trait in scope: programs can name it without depending on
 /// clap themselves (`use mbs::cli::Parser;`).
@@ -163,7 +163,7 @@ fn stopped_text(failure: Option<&SimError>, report: &RunReport) -> String {
         Some(e) => failure_text(e),
         None => format!(
             "interrupted (Ctrl-C) at t = {} s",
-            report.trajectory.t.last().copied().unwrap_or(f64::NAN)
+            short(report.trajectory.t.last().copied().unwrap_or(f64::NAN))
         ),
     }
 }
@@ -183,7 +183,7 @@ fn failure_text(e: &SimError) -> String {
             _ => return None,
         })
     };
-    let at = format!("(at t = {}, h = {:e})", e.t, e.h);
+    let at = format!("(at t = {}, h = {})", short(e.t), short(e.h));
     match &e.kind {
         Failure::InvalidOption {
             name: "step",
@@ -611,7 +611,8 @@ impl RunArgs {
             match &written {
                 Ok(files) if !files.is_empty() => {
                     eprintln!(
-                        "the run {why} at t = {t} s; the {} outputs computed until then are written:",
+                        "the run {why} at t = {} s; the {} outputs computed until then are written:",
+                        short(t),
                         report.outputs
                     );
                     for p in files {
@@ -762,7 +763,7 @@ impl RunReport {
             "CPU",
             name,
             self.scheme.name(),
-            format!("{t_end}"),
+            short(t_end),
             self.stats.steps,
             self.stats.evaluations(),
             energy,

@@ -37,6 +37,31 @@ pub enum ModelError {
     TangentsNotGenerated { model: &'static str },
 }
 
+/// `x` with at most 10 significant digits and no trailing zeros (`0.2394270743`, `2.5`,
+/// `1.5e-7`): times and steps in messages read like the numbers a user types, not like the
+/// 17 digits of a round trip.
+pub fn short(x: f64) -> String {
+    fn trim(s: &str) -> &str {
+        if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.')
+        } else {
+            s
+        }
+    }
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let a = x.abs();
+    if (1e-4..1e7).contains(&a) {
+        let decimals = (9 - a.log10().floor() as i32).max(0) as usize;
+        trim(&format!("{x:.decimals$}")).to_string()
+    } else {
+        let s = format!("{x:.9e}");
+        let (mantissa, exponent) = s.split_once('e').unwrap_or((&s, "0"));
+        format!("{}e{exponent}", trim(mantissa))
+    }
+}
+
 /// Checks an inertia tensor (xx, yy, zz, xy, xz, yz) about G; generated `validate()` calls it.
 pub fn check_inertia(body: &'static str, t: [f64; 6]) -> Result<(), ParamError> {
     match crate::inertia::inertia_problem(t) {
@@ -170,5 +195,26 @@ impl Failure {
                 coordinate: name(i),
             }),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::short;
+
+    #[test]
+    fn short_numbers_have_ten_significant_digits_at_most() {
+        assert_eq!(short(0.23942707429373464), "0.2394270743");
+        assert_eq!(short(2.5), "2.5");
+        assert_eq!(short(10.0), "10");
+        assert_eq!(short(-1.0), "-1");
+        assert_eq!(short(0.0), "0");
+        assert_eq!(
+            short(3.636924290476571e-2),
+            "0.03636924290".trim_end_matches('0')
+        );
+        assert_eq!(short(1.5e-7), "1.5e-7");
+        assert_eq!(short(1.234567890123e9), "1.23456789e9");
+        assert_eq!(short(f64::NAN), "NaN");
     }
 }

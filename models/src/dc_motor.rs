@@ -24,7 +24,7 @@ mbs::multibody! {
 }
 
 /// The motor: its current is the extra state, its torque acts on `theta`; the voltage is the
-/// model's input u[0].
+/// model's input `u[0]`.
 #[derive(Clone, Debug)]
 pub struct Motor {
     /// inductance (H), resistance (Ω), torque and back-emf constant (N·m/A = V·s/rad), gear
@@ -63,7 +63,7 @@ impl Efforts for Motor {
     }
 }
 
-/// A PI speed controller on the joint speed `qd[0]`, output u[0] = V, clipped to ±v_max.
+/// A PI speed controller on the joint speed `qd[0]`, output `u[0]` = V, clipped to ±v_max.
 #[derive(Clone, Debug)]
 pub struct PiSpeed {
     pub set_point: f64,

@@ -2,8 +2,8 @@
 //! with each bar free in the plane (x, y of its centre, θ its absolute angle) and the hinges
 //! as four constraints. Used by `examples/dpend_cartesian.rs` and the tests.
 //!
-//! θ is measured as dpend's q[0]: from the downward vertical, counter-clockwise about +z; so
-//! θ1 = q[0] and θ2 = q[0] + q[1] of [`dpend`](crate::dpend).
+//! θ is measured as dpend's `q[0]`: from the downward vertical, counter-clockwise about +z; so
+//! θ1 = `q[0]` and θ2 = `q[0] + q[1]` of [`dpend`](crate::dpend).
 
 mbs::multibody! {
     /// Double pendulum of two uniform bars (1 m, 1 kg) in 6 Cartesian coordinates,

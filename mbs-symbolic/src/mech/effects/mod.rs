@@ -1,7 +1,7 @@
 //! Effects of a scene → applied loads in world axes, their potential energy and the power of
 //! the non-conservative ones. Both formulations consume the same loads. Each kind of load
 //! is built in its own file, which adds its forces, torques, potential and power to a
-//! [`Build`].
+//! `Build`.
 //!
 //! Every elastic force is exactly minus the gradient of the potential counted here, and every
 //! other load's power is the power of the forces and torques pushed, so that

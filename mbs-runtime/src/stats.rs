@@ -39,7 +39,9 @@ pub struct Stats {
     /// solves with a factorisation
     pub solves: usize,
     /// Cholesky factorisations of M made only to watch for a singular configuration
-    /// (implicit schemes, at each iteration matrix that evaluates M: `Options::singularity_tol`)
+    /// (implicit schemes, at each iteration matrix that evaluates M, or at each accepted step
+    /// of the Newmark family and BDF when their iteration matrices are finite differences of
+    /// τ: `Options::singularity_tol`)
     pub condition_checks: usize,
     /// Newton iterations, all steps together
     pub newton_iterations: usize,

@@ -12,6 +12,7 @@ mod chain16;
 mod dpend_drift;
 mod fourbar_start;
 mod seed2dof_long_run;
+mod singular;
 mod springpend;
 mod structural;
 mod tumble;

@@ -238,6 +238,7 @@ impl<M: Model> Stepper<M> for Bdf {
             // fixed steps: raise the order by one per step, no error test
             self.next_order = (k + 1).min(self.max_order);
             self.reselected = self.next_order != k;
+            p.watch_accepted(cur.t + h, &next.q)?;
             return Ok(Attempt::Accepted { h_next: h });
         };
         for i in 0..n {
@@ -294,6 +295,7 @@ impl<M: Model> Stepper<M> for Bdf {
             self.reselected = true;
             h_next = h * (safety * facs[best]).min(MAX_FACTOR);
         }
+        p.watch_accepted(cur.t + h, &next.q)?;
         Ok(Attempt::Accepted { h_next })
     }
 

@@ -153,6 +153,7 @@ impl<M: Model> Stepper<M> for AlphaFamily {
         }
         next.lambda[..self.lam.len()].copy_from_slice(&self.lam);
         let Some(tol) = ctl.adaptive else {
+            p.watch_accepted(cur.t + h, &next.q)?;
             return Ok(Attempt::Accepted { h_next: h });
         };
         let k = h * h * (b - 1.0 / 6.0);
@@ -166,6 +167,7 @@ impl<M: Model> Stepper<M> for AlphaFamily {
         }
         let err = tol.error_norm(&self.err, &cur.q, &next.q);
         if err <= 1.0 {
+            p.watch_accepted(cur.t + h, &next.q)?;
             Ok(Attempt::Accepted {
                 h_next: next_step(h, err, 2, 2.0),
             })

@@ -5,6 +5,7 @@ use super::Problem;
 use crate::error::Failure;
 use crate::linalg::{Singular, cholesky, cholesky_solve};
 use crate::model::Model;
+use crate::options::IterationMatrix;
 
 impl<M: Model> Problem<M> {
     /// The failure for a singular matrix whose pivot column `s.column` names a coordinate,
@@ -83,6 +84,21 @@ impl<M: Model> Problem<M> {
     /// Whether singular configurations are watched (after the start, with a tolerance).
     pub(super) fn watching(&self) -> bool {
         self.singularity_tol > 0.0
+    }
+
+    /// Watches the accepted state (t, q) of a scheme that solves for accelerations by Newton
+    /// when its iteration matrices do not evaluate M (forward differences of τ on a model
+    /// without an index-1 form): one evaluation and one Cholesky factorisation of M per
+    /// accepted step. Other iteration matrices watch their own M (`iteration_block`), and
+    /// index-1 forms watch every evaluation of f.
+    pub fn watch_accepted(&mut self, t: f64, q: &[f64]) -> Result<(), Failure> {
+        if !self.watching() || self.iteration != IterationMatrix::FiniteDifferences || self.ode() {
+            return Ok(());
+        }
+        self.model.mass_matrix(t, q, &mut self.mchk);
+        self.stats.mass_matrix += 1;
+        Failure::non_finite("M", &self.mchk, |i| self.label(i % self.n))?;
+        self.watch_mchk(t, q)
     }
 
     /// M (in `mchk`) factorised only to watch its conditioning.

@@ -3,7 +3,7 @@
 
 use mbs_models::{dpend, seed2dof};
 
-use mbs::{Failure, Options, Scheme, simulate};
+use mbs::{Failure, Options, Output, Scheme, simulate};
 
 mbs::multibody! {
     /// A 1 kg point mass on a 1 m massless rod, started at 0.5 rad: E = −8.6 J.
@@ -130,4 +130,110 @@ fn rk4_on_dpend_past_its_limit_stops_before_any_non_finite_value() {
     };
     assert!(h_rho > limit);
     assert!(all_finite(&e.trajectory));
+}
+
+mbs::multibody! {
+    /// A slider on a stiff spring with a stiff damper (k = c = 1e4): λ ≈ −1e4 and −1. Once the
+    /// fast mode has decayed (a millisecond) the motion is slow, but an explicit scheme's step
+    /// stays bound to 1/|λ_fast|.
+    pub model StiffSlider {
+        dof x = 1.0;
+        body mass { mass = 1.0; }
+        TOG[mass] = Tdisp(x, 0, 0);
+        spring(ground, mass, k = 1e4, l0 = 0.0, axis = x);
+        damper(ground, mass, c = 1e4, axis = x);
+    }
+}
+
+fn quiet(opts: Options) -> Options {
+    Options {
+        output: Output::Last,
+        energy: false,
+        ..opts
+    }
+}
+
+#[test]
+fn dopri5_detects_stiffness_and_says_so() {
+    // to the end: the run completes, and its statistics say it was stiff
+    let (_, stats) = simulate(
+        StiffSlider::default(),
+        Scheme::Dopri5,
+        quiet(Options::adaptive(5.0, 1e-6)),
+    )
+    .unwrap();
+    println!("{stats}");
+    let t = stats.stiff_from.expect("detected as stiff");
+    assert!(stats.stiff_detections >= 1);
+    // the fast mode has decayed within 1 ms; the test needs 15 accepted steps past it
+    assert!(t < 0.05, "{t}");
+    // held at h·|λ| ≈ 3.3: about 5 s × 1e4 / 3.3 steps
+    assert!(stats.steps > 10_000, "{}", stats.steps);
+    assert!(stats.to_string().contains("stiff from t = "), "{stats}");
+
+    // with too few steps allowed: a typed failure that names the stiffness and the schemes
+    let opts = Options {
+        max_steps: 2000,
+        ..quiet(Options::adaptive(5.0, 1e-6))
+    };
+    let e = simulate(StiffSlider::default(), Scheme::Dopri5, opts).unwrap_err();
+    let text = e.to_string();
+    println!("{text}");
+    match e.kind {
+        Failure::LikelyStiff {
+            scheme,
+            t: from,
+            max_steps,
+        } => {
+            assert_eq!((scheme, max_steps), ("dopri5", 2000));
+            assert_eq!(from, t, "the same detection as the full run");
+        }
+        other => panic!("{other}"),
+    }
+    assert!(text.contains("radau5") && text.contains("bdf"), "{text}");
+
+    // the advised scheme takes few steps on it
+    let (_, radau) = simulate(
+        StiffSlider::default(),
+        Scheme::Radau5,
+        quiet(Options::adaptive(5.0, 1e-6)),
+    )
+    .unwrap();
+    println!(
+        "radau5: {} steps, dopri5: {} steps",
+        radau.steps, stats.steps
+    );
+    assert!(radau.steps * 20 < stats.steps);
+    assert_eq!(radau.stiff_detections, 0);
+}
+
+#[test]
+fn dopri5_finds_no_stiffness_on_smooth_problems() {
+    for tol in [1e-3, 1e-6, 1e-9] {
+        let (_, stats) = simulate(
+            dpend::DoublePendulum::default(),
+            Scheme::Dopri5,
+            quiet(Options::adaptive(10.0, tol)),
+        )
+        .unwrap();
+        assert_eq!((stats.stiff_detections, stats.stiff_from), (0, None));
+        assert!(!stats.to_string().contains("stiff"), "{stats}");
+        let (_, stats) = simulate(
+            seed2dof::Seed2dof::default(),
+            Scheme::Dopri5,
+            quiet(Options::adaptive(10.0, tol)),
+        )
+        .unwrap();
+        assert_eq!((stats.stiff_detections, stats.stiff_from), (0, None));
+    }
+    // too few steps on a smooth problem stays TooMuchWork
+    let opts = Options {
+        max_steps: 20,
+        ..quiet(Options::adaptive(10.0, 1e-9))
+    };
+    let e = simulate(dpend::DoublePendulum::default(), Scheme::Dopri5, opts).unwrap_err();
+    assert!(
+        matches!(e.kind, Failure::TooMuchWork { max_steps: 20 }),
+        "{e}"
+    );
 }

@@ -42,12 +42,10 @@ fn counts(s: &Stats) -> [usize; 9] {
 fn work_counters_of_reference_runs() {
     let cases: [(Scheme, [usize; 9]); 7] = [
         // 1000 steps, 1 evaluation each + the start + 2 every 16 steps for the stability check,
-        // + 2 per extra power iteration at the first step (3 until the estimate settles); Euler
-        // checks once more (step 993: the estimate at step 992, ρ ≈ 49, was within a quarter of
-        // its limit on oscillations, hω < 0.226)
+        // + 2 per extra power iteration at the first step (3 until the estimate settles)
         (
             Scheme::ExplicitEuler,
-            [1000, 0, 0, 1135, 0, 0, 1135, 1135, 0],
+            [1000, 0, 0, 1133, 0, 0, 1133, 1133, 0],
         ),
         (Scheme::Rk4, [1000, 0, 0, 4133, 0, 0, 4133, 4133, 0]),
         // 93 attempts × 6 evaluations (first same as last) + the start + the initial-step probe

@@ -16,8 +16,9 @@
 //! (π/x · ln(1 + x²) = ln 2); on a decaying mode it is the real interval hλ > −2.
 //!
 //! The state moves between two checks, and so does ρ (a pendulum started where gravity has no
-//! stiffness): the check runs at every step while h·ρ is above a quarter of the limit, or when
-//! a step changed the state by more than its own size.
+//! stiffness): the check runs every 4 steps while h·ρ is above half the limit (just past it,
+//! a mode grows slowly), and after a step that changed the state by more than its own size
+//! (far past it, a mode grows by orders of magnitude in a step).
 
 use super::problem::Problem;
 use super::{Attempt, State, Step, Stepper};
@@ -211,8 +212,13 @@ impl Probe {
 impl<M: Model> Stepper<M> for Explicit {
     fn attempt(&mut self, step: Step<'_, M>) -> Result<Attempt, Failure> {
         let Step(p, cur, h, ctl, next) = step;
-        let near_edge = h * self.rho > 0.25 * self.limit();
-        if ctl.stability_check && (self.steps % 16 == 0 || near_edge || self.lurched) {
+        // every 16 steps, every 4 within a factor 2 of the limit
+        let every = if h * self.rho > 0.5 * self.limit() {
+            4
+        } else {
+            16
+        };
+        if ctl.stability_check && (self.steps % every == 0 || self.lurched) {
             self.rho = self.estimate_rho(p, cur)?;
             // at the start, and before refusing a step, iterate until the estimate settles:
             // one iteration from the seed direction can be far below ρ, and the message

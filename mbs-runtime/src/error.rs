@@ -178,6 +178,16 @@ pub enum Failure {
         method: &'static str,
         supported: &'static str,
     },
+    #[error(
+        "more than {max_steps} steps on a stiff problem: from t = {} the step of {scheme} was held by its stability region (h·|λ| > 3.25 for 15 accepted steps in a row), not by accuracy; use radau5 or bdf",
+        short(*t)
+    )]
+    LikelyStiff {
+        scheme: &'static str,
+        /// the end of the first run of steps found stiff
+        t: f64,
+        max_steps: usize,
+    },
 }
 
 impl Failure {

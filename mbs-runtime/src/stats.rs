@@ -50,6 +50,11 @@ pub struct Stats {
     pub h_max: f64,
     /// for multistep schemes of variable order: steps taken at each order (index 0 = order 1)
     pub order_steps: Vec<usize>,
+    /// DOPRI5's stiffness detection: how often h·|λ| stayed past its stability region for 15
+    /// accepted steps in a row, and the time the first such run ended (the step was held by
+    /// stability, not accuracy: an implicit scheme would take far fewer steps)
+    pub stiff_detections: usize,
+    pub stiff_from: Option<f64>,
 }
 
 impl Stats {
@@ -124,6 +129,15 @@ impl fmt::Display for Stats {
                 .map(|(k, s)| format!("{}:{s}", k + 1))
                 .collect();
             write!(f, "\nsteps per order: {}", orders.join(" "))?;
+        }
+        if let Some(t) = self.stiff_from {
+            write!(
+                f,
+                "\nstiff from t = {} ({} detection{}): the step was held by stability, not accuracy; radau5 or bdf would take fewer",
+                crate::error::short(t),
+                self.stiff_detections,
+                if self.stiff_detections == 1 { "" } else { "s" }
+            )?;
         }
         Ok(())
     }

@@ -3,7 +3,17 @@
 //! chosen by Hairer's PI controller (β = 0.04, `step_control::PiController`), dense output
 //! by the order-4 continuous extension of Shampine (1986), as in Hairer's DOPRI5. Stability
 //! interval on the negative real axis ≈ 3.3; not for stiff problems.
+//!
+//! Stiffness detection (Hairer & Wanner, Solving ODEs II, IV.2, as in Hairer's DOPRI5): stages
+//! 6 and 7 are both at t + h, so h‖k₇ − k₆‖/‖y₇ − y₆‖ estimates h·|λ| of the dominant
+//! eigenvalue for free. When it exceeds 3.25 (the edge of the stability region) on 15 accepted
+//! steps in a row, the step is held by stability rather than accuracy: the run is recorded as
+//! stiff in `Stats` (`stiff_detections`, `stiff_from`), and running out of steps afterwards is
+//! reported as `Failure::LikelyStiff`. Six non-stiff steps in a row reset the count. Hairer's
+//! code tests every 1000th step and then each step while it suspects stiffness; the test costs
+//! no evaluation, so here it runs at every accepted step.
 
+use super::problem::Problem;
 use super::step_control::{Decision, PiController};
 use super::{Attempt, State, Step, Stepper};
 use crate::error::Failure;
@@ -71,6 +81,11 @@ pub(crate) struct Dopri5 {
     err: Vec<f64>,
     y0: Vec<f64>,
     y1: Vec<f64>,
+    /// stage 6's positions (its velocities are kv[5]), for the stiffness test
+    q6: Vec<f64>,
+    /// accepted steps in a row with h·λ > 3.25, and without since the last such step
+    stiff_run: usize,
+    nonstiff_run: usize,
     /// step control: Hairer's PI controller
     pi: PiController,
     /// dense output of the last accepted step: 5 coefficient vectors for q and for qd
@@ -92,6 +107,9 @@ impl Dopri5 {
             err: vec![0.0; 2 * n],
             y0: vec![0.0; 2 * n],
             y1: vec![0.0; 2 * n],
+            q6: z(),
+            stiff_run: 0,
+            nonstiff_run: 0,
             pi: PiController::new(4, 0.04),
             cont_q: s5(),
             cont_v: s5(),
@@ -116,6 +134,9 @@ impl<M: Model> Stepper<M> for Dopri5 {
                 self.v[i] = cur.qd[i] + h * dv;
             }
             self.kv[s].copy_from_slice(&self.v);
+            if s == 5 {
+                self.q6.copy_from_slice(&self.q);
+            }
             let r = p.accel(cur.t + C[s] * h, &self.q, &self.v, &mut self.ka[s]);
             if let Err(e) = r {
                 // a non-finite stage: too large a step when adaptive, fatal when fixed
@@ -156,6 +177,7 @@ impl<M: Model> Stepper<M> for Dopri5 {
         match self.pi.decide(h, err) {
             Decision::Accept { h_next } => {
                 self.dense(cur, next, h);
+                self.stiffness_test(p, cur.t, h);
                 Ok(Attempt::Accepted { h_next })
             }
             Decision::Reject { h_next } => Ok(Attempt::RejectedError { h_next }),
@@ -183,7 +205,41 @@ impl<M: Model> Stepper<M> for Dopri5 {
     }
 }
 
+/// h·|λ| beyond which a step is held by DOPRI5's stability region (its real interval ≈ 3.3)
+const STIFF_H_LAMBDA: f64 = 3.25;
+/// accepted steps in a row past it that make a run stiff, and that clear the suspicion
+const STIFF_STEPS: usize = 15;
+const NONSTIFF_STEPS: usize = 6;
+
 impl Dopri5 {
+    /// Hairer's test on the step just accepted from t: h·|λ| ≈ h‖k₇ − k₆‖/‖y₇ − y₆‖.
+    fn stiffness_test<M: Model>(&mut self, p: &mut Problem<M>, t: f64, h: f64) {
+        let (mut num, mut den) = (0.0, 0.0);
+        for i in 0..self.n {
+            let dv = self.kv[6][i] - self.kv[5][i];
+            let da = self.ka[6][i] - self.ka[5][i];
+            let dq = self.q[i] - self.q6[i];
+            num += dv * dv + da * da;
+            den += dq * dq + dv * dv;
+        }
+        if !(den > 0.0) {
+            return;
+        }
+        if h * (num / den).sqrt() > STIFF_H_LAMBDA {
+            self.nonstiff_run = 0;
+            self.stiff_run += 1;
+            if self.stiff_run == STIFF_STEPS {
+                p.stats.stiff_detections += 1;
+                p.stats.stiff_from.get_or_insert(t + h);
+            }
+        } else {
+            self.nonstiff_run += 1;
+            if self.nonstiff_run == NONSTIFF_STEPS {
+                self.stiff_run = 0;
+            }
+        }
+    }
+
     /// Coefficients of the continuous extension of the step just accepted.
     fn dense(&mut self, cur: &State, next: &State, h: f64) {
         for i in 0..self.n {

@@ -325,12 +325,17 @@ impl<M: Model + 'static> Simulation<M> {
         let t_stop = t_stop.min(self.next_sample());
         loop {
             if self.attempts >= self.options.max_steps {
-                return Err(self.fail(
-                    Failure::TooMuchWork {
-                        max_steps: self.options.max_steps,
+                let max_steps = self.options.max_steps;
+                // a scheme that found the problem stiff says so (DOPRI5's detection)
+                let kind = match self.problem.stats.stiff_from {
+                    Some(t) => Failure::LikelyStiff {
+                        scheme: self.scheme.name(),
+                        t,
+                        max_steps,
                     },
-                    self.h,
-                ));
+                    None => Failure::TooMuchWork { max_steps },
+                };
+                return Err(self.fail(kind, self.h));
             }
             let remaining = t_stop - self.cur.t;
             let mut h = self.h.min(self.options.h_max);

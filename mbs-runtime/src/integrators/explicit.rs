@@ -7,8 +7,18 @@
 //! overflow. To fail before that, every 16 steps a power iteration on J² (J = ∂f/∂y, two extra
 //! evaluations; iterated to 0.1 % at the first step and before a refusal) estimates the
 //! largest |λ| of the dynamics: J² has eigenvalues −ω² on an
-//! oscillating mode whatever the scaling of q and qd, so ‖J²δ‖/‖δ‖ → ρ². When h·ρ leaves the
-//! scheme's stability interval, the step fails with `UnstableStep`.
+//! oscillating mode whatever the scaling of q and qd, so ‖J²δ‖/‖δ‖ → ρ², and the sign of the
+//! Rayleigh quotient δ·J²δ tells an oscillating mode (−ω²) from a decaying one (+λ²). When
+//! h·ρ leaves the scheme's stability interval, the step fails with `UnstableStep`.
+//!
+//! Explicit Euler amplifies every undamped oscillation, by √(1 + (hω)²) a step: when the
+//! fastest mode oscillates, its limit is hω < 0.226, where the amplitude doubles in one period
+//! (π/x · ln(1 + x²) = ln 2); on a decaying mode it is the real interval hλ > −2.
+//!
+//! The state moves between two checks, and so does ρ (a pendulum started where gravity has no
+//! stiffness): the check runs every 4 steps while h·ρ is above half the limit (just past it,
+//! a mode grows slowly), and after a step that changed the state by more than its own size
+//! (far past it, a mode grows by orders of magnitude in a step).
 
 use super::problem::Problem;
 use super::{Attempt, State, Step, Stepper};
@@ -33,10 +43,20 @@ pub(crate) struct Explicit {
     dv: Vec<f64>,
     jq: Vec<f64>,
     jv: Vec<f64>,
+    /// δ before the last application of J², for the Rayleigh quotient
+    d0q: Vec<f64>,
+    d0v: Vec<f64>,
     probe: Probe,
     steps: usize,
     rho: f64,
+    /// the fastest mode oscillates (δ·J²δ < 0)
+    oscillating: bool,
+    /// the last step changed the state by more than its size: check before the next one
+    lurched: bool,
 }
+
+/// Explicit Euler's limit of hω on an oscillating mode: its amplitude doubles in one period.
+const EULER_OSCILLATING: f64 = 0.226;
 
 /// A start for the power iteration with components on every coordinate and both halves.
 fn seed_direction(dq: &mut [f64], dv: &mut [f64]) {
@@ -65,6 +85,8 @@ impl Explicit {
             dv,
             jq: z(),
             jv: z(),
+            d0q: z(),
+            d0v: z(),
             probe: Probe {
                 q: z(),
                 v: z(),
@@ -72,6 +94,8 @@ impl Explicit {
             },
             steps: 0,
             rho: 0.0,
+            oscillating: false,
+            lurched: false,
         }
     }
 
@@ -91,10 +115,11 @@ impl Explicit {
     }
 
     /// Radius of the stability interval of h·λ on the axes (RK4: min(2√2, 2.785) on the
-    /// imaginary and real axes; Euler: 2 on the real axis, and it is unstable for any undamped
-    /// oscillation, slowly).
+    /// imaginary and real axes; Euler: 2 on the real axis, and on an oscillating mode the h·ω
+    /// at which its amplitude doubles in one period, since it is unstable for any).
     fn limit(&self) -> f64 {
         match self.kind {
+            Kind::Euler if self.oscillating => EULER_OSCILLATING,
             Kind::Euler => 2.0,
             Kind::Rk4 => 2.785,
         }
@@ -105,6 +130,8 @@ impl Explicit {
         let n0 = norm2(&self.dq, &self.dv);
         self.probe
             .apply_j(p, s, &self.dq, &self.dv, &mut self.jq, &mut self.jv)?;
+        self.d0q.copy_from_slice(&self.dq);
+        self.d0v.copy_from_slice(&self.dv);
         self.probe
             .apply_j(p, s, &self.jq, &self.jv, &mut self.dq, &mut self.dv)?;
         let n2 = norm2(&self.dq, &self.dv);
@@ -112,11 +139,35 @@ impl Explicit {
             seed_direction(&mut self.dq, &mut self.dv);
             return Ok(self.rho);
         }
+        let rayleigh: f64 = self
+            .d0q
+            .iter()
+            .zip(&self.dq)
+            .map(|(a, b)| a * b)
+            .sum::<f64>()
+            + self
+                .d0v
+                .iter()
+                .zip(&self.dv)
+                .map(|(a, b)| a * b)
+                .sum::<f64>();
+        self.oscillating = rayleigh < 0.0;
         for x in self.dq.iter_mut().chain(self.dv.iter_mut()) {
             *x /= n2;
         }
         Ok((n2 / n0).sqrt())
     }
+}
+
+/// Whether a step changed (q, qd) by more than the larger of their size and 1: a step past
+/// the stability limit on a mode the last check did not see (ρ changes with the state).
+fn lurched(cur: &State, next: &State) -> bool {
+    let (mut change, mut size) = (0.0f64, 1.0f64);
+    for (a, b) in cur.q.iter().zip(&next.q).chain(cur.qd.iter().zip(&next.qd)) {
+        change = change.max((b - a).abs());
+        size = size.max(a.abs());
+    }
+    change > size
 }
 
 /// The point a Jacobian-vector product is probed at: q, qd and the accelerations there.
@@ -161,7 +212,13 @@ impl Probe {
 impl<M: Model> Stepper<M> for Explicit {
     fn attempt(&mut self, step: Step<'_, M>) -> Result<Attempt, Failure> {
         let Step(p, cur, h, ctl, next) = step;
-        if ctl.stability_check && self.steps % 16 == 0 {
+        // every 16 steps, every 4 within a factor 2 of the limit
+        let every = if h * self.rho > 0.5 * self.limit() {
+            4
+        } else {
+            16
+        };
+        if ctl.stability_check && (self.steps % every == 0 || self.lurched) {
             self.rho = self.estimate_rho(p, cur)?;
             // at the start, and before refusing a step, iterate until the estimate settles:
             // one iteration from the seed direction can be far below ρ, and the message
@@ -231,6 +288,7 @@ impl<M: Model> Stepper<M> for Explicit {
         p.check("q", &next.q)?;
         p.check("qd", &next.qd)?;
         p.accel(t + h, &next.q, &next.qd, &mut next.qdd)?;
+        self.lurched = lurched(cur, next);
         self.steps += 1;
         Ok(Attempt::Accepted { h_next: h })
     }

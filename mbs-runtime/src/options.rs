@@ -1,6 +1,6 @@
 //! Options in: plain structs with documented defaults, validated before any work.
 
-use crate::error::Failure;
+use crate::error::{Failure, short};
 use serde::{Deserialize, Serialize};
 
 /// Newmark's parameters β and γ (default: the trapezoidal rule β = ¼, γ = ½, unconditionally
@@ -551,7 +551,7 @@ impl Options {
                 if h < 64.0 * f64::EPSILON * t_far {
                     return Err(invalid(
                         "h",
-                        format!("{h} (with t_end = {})", self.t_end),
+                        format!("{} (with t_end = {})", short(h), short(self.t_end)),
                         "the fixed step is below the resolution of time there (64 ε·|t|): t + h would not move; take a larger h or a shorter run",
                     ));
                 }
@@ -559,7 +559,7 @@ impl Options {
                     if h_min > h {
                         return Err(invalid(
                             "h_min",
-                            format!("{h_min} (with the fixed step h = {h})"),
+                            format!("{} (with the fixed step h = {})", short(h_min), short(h)),
                             "h_min bounds adaptive steps and is above the fixed step: a fixed step is not judged by h_min; drop h_min (None) or take h ≥ h_min",
                         ));
                     }
@@ -594,7 +594,7 @@ impl Options {
                     if h0 < h_min {
                         return Err(invalid(
                             "h0",
-                            format!("{h0} (with h_min = {h_min})"),
+                            format!("{} (with h_min = {})", short(h0), short(h_min)),
                             "the first step is below h_min, so the run would stop at once: take h0 ≥ h_min or a smaller h_min",
                         ));
                     }
@@ -611,7 +611,7 @@ impl Options {
             if h > self.h_max && matches!(self.step, StepControl::Adaptive { .. }) {
                 return Err(invalid(
                     "h_min",
-                    format!("{h} (with h_max = {})", self.h_max),
+                    format!("{} (with h_max = {})", short(h), short(self.h_max)),
                     "h_min is above h_max, so no step is allowed: take h_min ≤ h_max",
                 ));
             }

@@ -93,7 +93,7 @@ pub enum Failure {
     )]
     TooMuchWork { max_steps: usize },
     #[error(
-        "Newton did not converge in {iterations} iterations (last correction {correction:e}) even at h_min"
+        "Newton did not converge in {iterations} iterations (last correction {correction:e}) at the smallest step allowed (h_min for adaptive steps; a fixed step is not reduced: take a smaller h)"
     )]
     NewtonDiverged { iterations: usize, correction: f64 },
     #[error("{matrix} is singular (rcond ≈ {rcond:.1e}) near coordinates {}", coordinates.join(", "))]

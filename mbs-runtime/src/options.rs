@@ -1,6 +1,6 @@
 //! Options in: plain structs with documented defaults, validated before any work.
 
-use crate::error::Failure;
+use crate::error::{Failure, short};
 use serde::{Deserialize, Serialize};
 
 /// Newmark's parameters β and γ (default: the trapezoidal rule β = ¼, γ = ½, unconditionally
@@ -392,9 +392,12 @@ pub struct Options {
     pub qd0: Option<Vec<f64>>,
     pub step: StepControl,
     pub output: Output,
-    /// largest step (s), default unbounded
+    /// largest step (s); the default (infinity) means the whole span |t_end − t0|, as in
+    /// Hairer's DOPRI5 and RADAU5 (see [`Options::h_max`])
     pub h_max: f64,
-    /// smallest step before `StepTooSmall` (s), default 1e-12·max(1, |t_end|)
+    /// smallest step of adaptive schemes before `StepTooSmall` (s), default
+    /// 1e-12·max(1, |t|) at the current time t: the resolution of time, not a fraction of
+    /// t_end (see [`Options::h_min_at`]); a fixed step is never judged by it
     pub h_min: Option<f64>,
     /// accepted plus rejected steps before `TooMuchWork` (default 1,000,000)
     pub max_steps: usize,
@@ -488,10 +491,28 @@ impl Options {
         }
     }
 
-    /// The smallest step allowed.
+    /// The smallest adaptive step allowed at the start.
     pub fn h_min(&self) -> f64 {
-        self.h_min
-            .unwrap_or(1e-12 * self.t_end.abs().max(self.t0.abs()).max(1.0))
+        self.h_min_at(self.t0)
+    }
+
+    /// The smallest adaptive step allowed at time `t`: the given `h_min`, or
+    /// 1e-12·max(1, |t|) — some 4,500 rounding units of t, below which t + h no longer
+    /// resolves the step. It follows t rather than t_end: a long run (t_end = 1e30) does not
+    /// start with a floor of 1e18 s that the first step would be pushed up to.
+    pub fn h_min_at(&self, t: f64) -> f64 {
+        self.h_min.unwrap_or(1e-12 * t.abs().max(1.0))
+    }
+
+    /// The largest step: the given `h_max`, or by default the span |t_end − t0| (Hairer's
+    /// DOPRI5 and RADAU5 take HMAX = XEND − X). Together with the first-step estimate
+    /// (Hairer, Nørsett & Wanner) and a floor `h_min_at` that follows t, this makes the
+    /// first step of a long run (t_end = 1e30) the one the dynamics ask for, not one pushed
+    /// up to a fraction of t_end.
+    pub fn h_max(&self) -> f64 {
+        self.h_max
+            .min((self.t_end - self.t0).abs())
+            .max(f64::MIN_POSITIVE)
     }
 
     /// Checks every option against the scheme and the model's sizes.
@@ -513,8 +534,12 @@ impl Options {
                 if v.len() != nq {
                     return Err(invalid(name, v.len(), "must have one value per coordinate"));
                 }
-                if let Some(x) = v.iter().find(|x| !x.is_finite()) {
-                    return Err(invalid(name, x, "must be finite"));
+                if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+                    return Err(invalid(
+                        name,
+                        format!("{} at coordinate {i}", v[i]),
+                        "every initial value must be finite",
+                    ));
                 }
             }
         }
@@ -522,6 +547,23 @@ impl Options {
             StepControl::Fixed { h } => {
                 if !(h > 0.0) || !h.is_finite() {
                     return Err(invalid("h", h, "must be > 0 and finite"));
+                }
+                let t_far = self.t0.abs().max(self.t_end.abs());
+                if h < 64.0 * f64::EPSILON * t_far {
+                    return Err(invalid(
+                        "h",
+                        format!("{} (with t_end = {})", short(h), short(self.t_end)),
+                        "the fixed step is below the resolution of time there (64 ε·|t|): t + h would not move; take a larger h or a shorter run",
+                    ));
+                }
+                if let Some(h_min) = self.h_min {
+                    if h_min > h {
+                        return Err(invalid(
+                            "h_min",
+                            format!("{} (with the fixed step h = {})", short(h_min), short(h)),
+                            "h_min bounds adaptive steps and is above the fixed step: a fixed step is not judged by h_min; drop h_min (None) or take h ≥ h_min",
+                        ));
+                    }
                 }
             }
             StepControl::Adaptive { rtol, atol, h0 } => {
@@ -549,6 +591,14 @@ impl Options {
                     if !(h0 > 0.0) || !h0.is_finite() {
                         return Err(invalid("h0", h0, "must be > 0 and finite"));
                     }
+                    let h_min = self.h_min_at(self.t0);
+                    if h0 < h_min {
+                        return Err(invalid(
+                            "h0",
+                            format!("{} (with h_min = {})", short(h0), short(h_min)),
+                            "the first step is below h_min, so the run would stop at once: take h0 ≥ h_min or a smaller h_min",
+                        ));
+                    }
                 }
             }
         }
@@ -558,6 +608,13 @@ impl Options {
         if let Some(h) = self.h_min {
             if !(h > 0.0) || !h.is_finite() {
                 return Err(invalid("h_min", h, "must be > 0 and finite"));
+            }
+            if h > self.h_max && matches!(self.step, StepControl::Adaptive { .. }) {
+                return Err(invalid(
+                    "h_min",
+                    format!("{} (with h_max = {})", short(h), short(self.h_max)),
+                    "h_min is above h_max, so no step is allowed: take h_min ≤ h_max",
+                ));
             }
         }
         if !(0.0..1.0).contains(&self.singularity_tol) {

@@ -141,7 +141,7 @@ impl<M: Model + 'static> Simulation<M> {
             prev: cur.clone(),
             scratch: cur.clone(),
             cur,
-            h: h.min(options.h_max),
+            h: h.min(options.h_max()),
             attempts: 0,
             last_cause: None,
             traj,
@@ -319,7 +319,9 @@ impl<M: Model + 'static> Simulation<M> {
     }
 
     fn step_until(&mut self, t_stop: f64) -> Result<(), SimError> {
-        let h_min = self.options.h_min();
+        // the floor of adaptive steps, at the time this step starts (a fixed step is never
+        // judged by it: its size is the user's, checked against the resolution of t up front)
+        let h_min = self.options.h_min_at(self.cur.t);
         let fixed = matches!(self.options.step, StepControl::Fixed { .. });
         // controllers are sampled exactly at their instants
         let t_stop = t_stop.min(self.next_sample());
@@ -338,7 +340,7 @@ impl<M: Model + 'static> Simulation<M> {
                 return Err(self.fail(kind, self.h));
             }
             let remaining = t_stop - self.cur.t;
-            let mut h = self.h.min(self.options.h_max);
+            let mut h = self.h.min(self.options.h_max());
             let t_next = if fixed {
                 // fixed steps stay on the grid t0 + k h, whatever the rounding of sums
                 let k = ((self.cur.t - self.options.t0) / h + 1e-9).floor();
@@ -354,7 +356,7 @@ impl<M: Model + 'static> Simulation<M> {
             } else if fixed {
                 h = t_next - self.cur.t;
             }
-            if h < h_min && !last {
+            if h < h_min && !last && !fixed {
                 // the cause of the rejections that shrank the step, when there is one
                 let kind = self
                     .last_cause

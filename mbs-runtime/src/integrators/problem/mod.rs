@@ -198,13 +198,14 @@ impl<M: Model> Problem<M> {
         self.labels[i].clone()
     }
 
-    /// The first non-finite entry of `v`, as a failure naming its coordinate.
+    /// The first non-finite entry of `v`, as a failure naming its coordinate and the vector
+    /// in words (`h` is the generalized force, not the step).
     pub fn check(&self, quantity: &'static str, v: &[f64]) -> Result<(), Failure> {
         // user code reports its own failure first (a NaN it caused is only its symptom)
         if let Some(f) = self.model.take_failure() {
             return Err(f);
         }
-        Failure::non_finite(quantity, v, |i| self.label(i % self.n))
+        Failure::non_finite(quantity_name(quantity), v, |i| self.label(i % self.n))
     }
 
     /// qdd from M qdd = h at (t, q, qd); for a constrained model, qdd and λ (in the
@@ -274,5 +275,24 @@ impl<M: Model> Problem<M> {
     pub fn energy(&mut self, t: f64, q: &[f64], qd: &[f64]) -> crate::model::Energy {
         self.stats.energy += 1;
         self.model.energy(t, q, qd)
+    }
+}
+
+/// The words a message uses for a vector the evaluations check: the symbol alone is
+/// ambiguous (`h` is the generalized force in M qdd = h, and the step in every message about
+/// steps).
+fn quantity_name(symbol: &'static str) -> &'static str {
+    match symbol {
+        "h" => "generalized force h",
+        "M" => "mass matrix M",
+        "q" => "position q",
+        "qd" => "velocity qd",
+        "qdd" => "acceleration qdd",
+        "q0" => "initial position q0",
+        "qd0" => "initial velocity qd0",
+        "τ" => "inverse-dynamics residual τ = M qdd − h",
+        "C_t" => "damping tangent C_t",
+        "K_t" => "stiffness tangent K_t",
+        other => other,
     }
 }

@@ -1,0 +1,213 @@
+//! Messages about steps: a fixed step is not judged by h_min, inconsistent step options are
+//! refused before any work, a long run starts with the step its dynamics ask for, and a
+//! non-finite generalized force is not mistaken for a step.
+
+use mbs_models::seed2dof;
+
+use mbs::{Failure, Options, Output, Scheme, StepControl, simulate};
+use seed2dof::Seed2dof;
+
+mbs::multibody! {
+    /// A pendulum pushed by a force that is not defined after t = 0.5 (sqrt of a negative).
+    pub model LateForce {
+        dof theta = 0.3;
+        body bob { mass = 1.0; inertia = (0.01, 0.01, 0.01); }
+        TOG[bob] = Trotz(theta) * Tdisp(0, -1, 0);
+        gravity(0, -9.81, 0);
+        generalized_force(theta, sqrt(0.5 - t));
+    }
+}
+
+mbs::multibody! {
+    /// The same pendulum with a force that is not defined at the start already.
+    pub model EarlyForce {
+        dof theta = 0.3;
+        body bob { mass = 1.0; inertia = (0.01, 0.01, 0.01); }
+        TOG[bob] = Trotz(theta) * Tdisp(0, -1, 0);
+        gravity(0, -9.81, 0);
+        generalized_force(theta, sqrt(t - 0.5));
+    }
+}
+
+fn quiet(o: Options) -> Options {
+    Options {
+        output: Output::Last,
+        energy: false,
+        ..o
+    }
+}
+
+/// 1e-4 s is below the old default h_min of this run (1e-12·t_end = 1e-3 s), which stopped
+/// it at t = 0 with "the step fell below h_min"; now it steps until its step budget is spent.
+#[test]
+fn a_fixed_step_below_the_default_h_min_runs() {
+    let o = Options {
+        max_steps: 2000,
+        ..quiet(Options::fixed(1e9, 1e-4))
+    };
+    let e = simulate(Seed2dof::default(), Scheme::Rk4, o).unwrap_err();
+    assert!(
+        matches!(e.kind, Failure::TooMuchWork { max_steps: 2000 }),
+        "{e}"
+    );
+    assert_eq!(e.stats.steps, 2000);
+    assert!((e.t - 0.2).abs() < 1e-9, "stopped at t = {}", e.t);
+}
+
+fn invalid(scheme: Scheme, o: Options) -> (&'static str, String) {
+    let e = simulate(Seed2dof::default(), scheme, o).unwrap_err();
+    assert_eq!(e.stats.steps, 0, "{e}");
+    assert_eq!(e.stats.dynamics, 0, "refused before any evaluation: {e}");
+    match e.kind {
+        Failure::InvalidOption { name, .. } => (name, e.kind.to_string()),
+        other => panic!("not an InvalidOption: {other}"),
+    }
+}
+
+#[test]
+fn inconsistent_step_options_are_refused_naming_both() {
+    // an h_min above the fixed step
+    let (name, msg) = invalid(
+        Scheme::Rk4,
+        Options {
+            h_min: Some(1e-2),
+            ..Options::fixed(1.0, 1e-3)
+        },
+    );
+    assert_eq!(name, "h_min");
+    for w in [
+        "h_min",
+        "fixed step h = 0.001",
+        "not judged by h_min",
+        "h ≥ h_min",
+    ] {
+        assert!(msg.contains(w), "{w:?} missing in: {msg}");
+    }
+    // a fixed step below the resolution of time at t_end
+    let (name, msg) = invalid(Scheme::Rk4, Options::fixed(1e9, 1e-9));
+    assert_eq!(name, "h");
+    for w in ["1e-9 (with t_end = 1e9)", "resolution of time", "larger h"] {
+        assert!(msg.contains(w), "{w:?} missing in: {msg}");
+    }
+    // a first step below h_min
+    let adaptive_h0 = |h0| StepControl::Adaptive {
+        rtol: 1e-6,
+        atol: 1e-8,
+        h0: Some(h0),
+    };
+    let (name, msg) = invalid(
+        Scheme::Dopri5,
+        Options {
+            step: adaptive_h0(1e-6),
+            h_min: Some(1e-4),
+            ..Options::default()
+        },
+    );
+    assert_eq!(name, "h0");
+    for w in ["h_min = 0.0001", "h0 ≥ h_min"] {
+        assert!(msg.contains(w), "{w:?} missing in: {msg}");
+    }
+    // an h_min above h_max
+    let (name, msg) = invalid(
+        Scheme::Dopri5,
+        Options {
+            h_min: Some(1e-2),
+            h_max: 1e-3,
+            ..Options::adaptive(1.0, 1e-6)
+        },
+    );
+    assert_eq!(name, "h_min");
+    for w in ["h_max = 0.001", "h_min ≤ h_max"] {
+        assert!(msg.contains(w), "{w:?} missing in: {msg}");
+    }
+    // consistent ones still run
+    let o = Options {
+        h_min: Some(1e-4),
+        ..Options::fixed(0.1, 1e-3)
+    };
+    simulate(Seed2dof::default(), Scheme::Rk4, quiet(o)).unwrap();
+}
+
+/// t_end = 1e30 used to push the first step up to the floor 1e-12·t_end = 1e18 s, and the
+/// run stopped at t = 0 with "h of coordinate q[0] is not finite (h = 1e18)". The floor now
+/// follows t and h_max defaults to the span: the first step is the one the dynamics ask for,
+/// and the run goes on until its step budget is spent.
+#[test]
+fn a_very_long_run_starts_with_a_sane_step() {
+    let o = Options::adaptive(1e30, 1e-6);
+    assert_eq!(o.h_max(), 1e30);
+    assert_eq!(o.h_min(), 1e-12);
+    assert_eq!(o.h_min_at(1e6), 1e-6);
+    for scheme in [Scheme::Dopri5, Scheme::from_name("radau5").unwrap()] {
+        let o = Options {
+            max_steps: 200,
+            output: Output::Steps,
+            ..Options::adaptive(1e30, 1e-6)
+        };
+        let e = simulate(Seed2dof::default(), scheme, o).unwrap_err();
+        assert!(
+            matches!(e.kind, Failure::TooMuchWork { max_steps: 200 }),
+            "{}: {e}",
+            scheme.name()
+        );
+        let first = e.trajectory.t[1] - e.trajectory.t[0];
+        assert!(
+            first > 0.0 && first < 0.1,
+            "{}: first step {first}",
+            scheme.name()
+        );
+        assert!(e.stats.h_max < 10.0, "{}: {}", scheme.name(), e.stats.h_max);
+    }
+}
+
+#[test]
+fn a_non_finite_force_is_called_a_generalized_force() {
+    let e = simulate(LateForce::default(), Scheme::Rk4, Options::fixed(1.0, 0.01)).unwrap_err();
+    match &e.kind {
+        Failure::NonFinite {
+            quantity,
+            coordinate,
+        } => {
+            assert_eq!(*quantity, "generalized force h");
+            assert!(coordinate.contains("theta"), "{coordinate}");
+        }
+        other => panic!("{other}"),
+    }
+    let msg = e.kind.to_string();
+    assert!(
+        msg.starts_with("generalized force h of coordinate"),
+        "{msg}"
+    );
+    // at the start already: refused at t0, before any step
+    let e = simulate(
+        EarlyForce::default(),
+        Scheme::Dopri5,
+        Options::adaptive(1.0, 1e-6),
+    )
+    .unwrap_err();
+    assert_eq!(e.t, 0.0);
+    assert_eq!(e.stats.steps, 0);
+    assert!(
+        matches!(
+            e.kind,
+            Failure::NonFinite {
+                quantity: "generalized force h",
+                ..
+            }
+        ),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_non_finite_initial_value_names_its_coordinate() {
+    let (name, msg) = invalid(
+        Scheme::Rk4,
+        Options {
+            qd0: Some(vec![0.0, f64::INFINITY]),
+            ..Options::fixed(1.0, 0.01)
+        },
+    );
+    assert_eq!(name, "qd0");
+    assert!(msg.contains("inf at coordinate 1"), "{msg}");
+}

@@ -7,18 +7,8 @@ use mbs::{
     Failure, GenAlphaParams, HhtParams, Model, NewmarkParams, Options, Output, Scheme, Simulation,
     simulate,
 };
+use mbs_models::undefined_force::LateForce;
 use seed2dof::Seed2dof;
-
-mbs::multibody! {
-    /// A pendulum pushed by a force that is not defined after t = 0.5 (sqrt of a negative).
-    pub model Broken {
-        dof theta = 0.3;
-        body bob { mass = 1.0; inertia = (0.01, 0.01, 0.01); }
-        TOG[bob] = Trotz(theta) * Tdisp(0, -1, 0);
-        gravity(0, -9.81, 0);
-        generalized_force(theta, sqrt(0.5 - t));
-    }
-}
 
 mbs::multibody! {
     /// A slider driven through a crank-like sine: its inertia vanishes at q = π/2.
@@ -140,7 +130,7 @@ fn a_model_that_returns_nan_stops_every_scheme_near_the_time_it_starts() {
             modes.push(Options::adaptive(2.0, 1e-6));
         }
         for opts in modes {
-            let e = simulate(Broken::default(), scheme, opts).unwrap_err();
+            let e = simulate(LateForce::default(), scheme, opts).unwrap_err();
             match &e.kind {
                 Failure::NonFinite { coordinate, .. } => {
                     assert_eq!(coordinate, "q[0] (theta)", "{}: {e}", scheme.name())

@@ -18,6 +18,7 @@
 //! | [`springpend`] | a point mass on a stiff spring (polar coordinates) |
 //! | [`tumble`] | a free body tumbling about its intermediate axis, on two sets of Euler angles |
 //! | [`structural`] | models whose mass matrix is singular by construction |
+//! | [`undefined_force`] | a pendulum whose generalized force is undefined after, or from, t = 0.5 |
 
 pub mod arm3d_6;
 pub mod chain16_stiff;
@@ -34,3 +35,4 @@ pub mod slidercrank;
 pub mod springpend;
 pub mod structural;
 pub mod tumble;
+pub mod undefined_force;

@@ -4,9 +4,9 @@
 
 use super::super::at::{At, Weights};
 use super::super::constrained::{Constrained, Mode};
-use super::{Problem, worst_pivot};
+use super::Problem;
 use crate::error::Failure;
-use crate::linalg::{Lu, cholesky};
+use crate::linalg::Lu;
 use crate::model::Model;
 use crate::options::IterationMatrix;
 
@@ -38,18 +38,11 @@ impl<M: Model> Problem<M> {
         self.model
             .dynamics(t, &self.qx, &self.vx, &self.u, &mut self.m, &mut self.h);
         self.stats.dynamics += 1;
-        self.check("h", &self.h)?;
-        self.check("M", &self.m)?;
-        self.chol.copy_from_slice(&self.m);
-        self.stats.factorizations += 1;
-        cholesky(&mut self.chol, self.n).map_err(|s| self.singular_mass(&self.chol, s))?;
-        if self.watching() {
-            let (ratio, j) = worst_pivot(&self.chol, self.n, &self.start_pivots);
-            let qx = std::mem::take(&mut self.qx);
-            let judged = self.judge(ratio, j, t, &qx);
-            self.qx = qx;
-            judged?;
-        }
+        // the completed coordinates are where M is judged (a Vec moved out and back: no copy)
+        let qx = std::mem::take(&mut self.qx);
+        let factorised = self.factorise_mass(t, &qx);
+        self.qx = qx;
+        factorised?;
         c.kkt(
             &self.model,
             &mut self.stats,

@@ -222,6 +222,21 @@ impl<M: Model> Problem<M> {
         }
     }
 
+    /// Checks the M and h just evaluated at (t, q), factorises M into `chol` and watches its
+    /// pivots: what every solve of M qdd = h starts with.
+    pub(super) fn factorise_mass(&mut self, t: f64, q: &[f64]) -> Result<(), Failure> {
+        self.check("h", &self.h)?;
+        self.check("M", &self.m)?;
+        self.chol.copy_from_slice(&self.m);
+        self.stats.factorizations += 1;
+        cholesky(&mut self.chol, self.n).map_err(|s| self.singular_mass(&self.chol, s))?;
+        if self.watching() {
+            let (ratio, j) = worst_pivot(&self.chol, self.n, &self.start_pivots);
+            self.judge(ratio, j, t, q)?;
+        }
+        Ok(())
+    }
+
     fn plain_accel(
         &mut self,
         t: f64,
@@ -233,15 +248,7 @@ impl<M: Model> Problem<M> {
         self.model
             .dynamics(t, q, qd, &self.u, &mut self.m, &mut self.h);
         self.stats.dynamics += 1;
-        self.check("h", &self.h)?;
-        self.check("M", &self.m)?;
-        self.chol.copy_from_slice(&self.m);
-        self.stats.factorizations += 1;
-        cholesky(&mut self.chol, self.n).map_err(|s| self.singular_mass(&self.chol, s))?;
-        if self.watching() {
-            let (ratio, j) = worst_pivot(&self.chol, self.n, &self.start_pivots);
-            self.judge(ratio, j, t, q)?;
-        }
+        self.factorise_mass(t, q)?;
         qdd.copy_from_slice(&self.h);
         cholesky_solve(&self.chol, self.n, qdd);
         self.stats.solves += 1;

@@ -239,16 +239,17 @@ fn shorten(h: f64) -> f64 {
     (h / scale).floor() * scale
 }
 
-/// `auto`, `index3`, `projection`, `partitioning` or `baumgarte:ALPHA,BETA`.
+/// `auto`, `index3`, `index2`, `projection`, `partitioning` or `baumgarte:ALPHA,BETA`.
 pub fn parse_constraint_method(s: &str) -> Result<ConstraintMethod, String> {
     let bad = || {
         format!(
-            "unknown constraint method `{s}`: use auto, index3, projection, partitioning or baumgarte:ALPHA,BETA"
+            "unknown constraint method `{s}`: use auto, index3, index2, projection, partitioning or baumgarte:ALPHA,BETA"
         )
     };
     Ok(match s {
         "auto" => ConstraintMethod::Auto,
         "index3" => ConstraintMethod::Index3,
+        "index2" => ConstraintMethod::Index2,
         "projection" => ConstraintMethod::Projection,
         "partitioning" => ConstraintMethod::Partitioning,
         _ => {

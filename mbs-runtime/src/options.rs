@@ -211,6 +211,12 @@ impl Scheme {
         )
     }
 
+    /// Whether the scheme solves constrained models in the stabilized index-2 form
+    /// ([`ConstraintMethod::Index2`]).
+    pub fn solves_index2(&self) -> bool {
+        false
+    }
+
     /// Whether the scheme can control its step by a local error estimate.
     pub fn is_adaptive(&self) -> bool {
         !matches!(
@@ -324,6 +330,12 @@ pub enum ConstraintMethod {
     /// stage with (A_i, Λ_i) as unknowns (radau3, radau5, as Hairer's RADAU5 solves index-3
     /// DAEs: positions of order 2s − 1, velocities s, λ s − 1)
     Index3,
+    /// the stabilized index-2 form of Gear, Gupta & Leimkuhler (1985): Φ(q) = 0 and
+    /// Φ̇ = B qd + Φ_t = 0 both enforced, the second by a multiplier μ that corrects the
+    /// positions (q̇ = qd + M⁻¹Bᵀμ in Radau, q₁ += Bᵀν in the Newmark family, the stabilized
+    /// index-2 generalized-α of Arnold, Brüls & Cardona); velocities satisfy their constraints
+    /// at every step, and the error test covers positions and velocities
+    Index2,
     /// the index-1 form (B qdd = γ, λ eliminated) with Baumgarte's stabilisation
     /// Φ̈ + 2αΦ̇ + β²Φ = 0 (α, β in 1/s; α = β = 0 is the plain index-1 form, which drifts);
     /// stops with `ConstraintDrift` when |Φ| exceeds `drift_tol`
@@ -344,6 +356,7 @@ impl ConstraintMethod {
         match self {
             ConstraintMethod::Auto => "auto",
             ConstraintMethod::Index3 => "index3",
+            ConstraintMethod::Index2 => "index2",
             ConstraintMethod::Baumgarte { .. } => "baumgarte",
             ConstraintMethod::Projection => "projection",
             ConstraintMethod::Partitioning => "partitioning",

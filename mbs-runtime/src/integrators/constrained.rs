@@ -33,7 +33,12 @@ use std::fmt;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum Mode {
     Index3,
-    Baumgarte { alpha: f64, beta: f64 },
+    /// stabilized index 2 (Gear–Gupta–Leimkuhler), solved by the scheme itself
+    Index2,
+    Baumgarte {
+        alpha: f64,
+        beta: f64,
+    },
     Projection,
     Partitioning,
 }
@@ -41,7 +46,7 @@ pub(crate) enum Mode {
 impl Mode {
     /// The scheme integrates the ODE qdd = f(t, q, qd) of the index-1 form (all but index 3).
     pub fn is_ode(&self) -> bool {
-        !matches!(self, Mode::Index3)
+        !matches!(self, Mode::Index3 | Mode::Index2)
     }
 }
 

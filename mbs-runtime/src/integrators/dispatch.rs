@@ -40,6 +40,14 @@ pub(super) fn constraint_mode(
             });
         }
         ConstraintMethod::Index3 => Mode::Index3,
+        ConstraintMethod::Index2 if !scheme.solves_index2() => {
+            return Err(Failure::ConstraintsUnsupported {
+                scheme: scheme.name(),
+                method: "stabilized index 2",
+                supported: INDEX2_SCHEMES,
+            });
+        }
+        ConstraintMethod::Index2 => Mode::Index2,
         ConstraintMethod::Baumgarte { alpha, beta } => Mode::Baumgarte { alpha, beta },
         ConstraintMethod::Partitioning => Mode::Partitioning,
     })
@@ -47,6 +55,9 @@ pub(super) fn constraint_mode(
 
 /// The schemes that solve the index-3 equations, for messages.
 const INDEX3_SCHEMES: &str = "index-3 constraints are solved by gen-alpha, hht, newmark, radau3 and radau5; every scheme takes them with Projection, Baumgarte or Partitioning";
+
+/// The schemes that solve the stabilized index-2 equations, for messages.
+const INDEX2_SCHEMES: &str = "the stabilized index-2 form is solved by no scheme yet; every scheme takes the constraints with Projection, Baumgarte or Partitioning";
 
 pub(super) fn stepper_for<M: Model>(scheme: &Scheme, n: usize) -> Box<dyn Stepper<M>> {
     match *scheme {

@@ -62,7 +62,7 @@ impl<M: Model> Problem<M> {
     fn closed_after_step(&mut self, c: &mut Constrained, next: &mut State) -> Result<(), Failure> {
         let t = next.t;
         match c.mode {
-            Mode::Index3 => c.check_drift(&self.model, &mut self.stats, t, &next.q),
+            Mode::Index3 | Mode::Index2 => c.check_drift(&self.model, &mut self.stats, t, &next.q),
             Mode::Baumgarte { .. } => {
                 let mut f = std::mem::take(&mut self.fa);
                 let r = self.closed_accel(c, t, &next.q, &next.qd, &mut f);

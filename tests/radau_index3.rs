@@ -273,3 +273,33 @@ fn index3_steps_allocate_nothing_after_warm_up() {
         }
     }
 }
+
+/// `Stats::error_test` says what rtol controls: at index 3 Radau weights velocities by h and
+/// λ by h², the Newmark family estimates positions only, fixed steps test nothing.
+#[test]
+fn stats_name_the_components_the_error_test_controls() {
+    use mbs::{ErrorTest, GenAlphaParams};
+    let adaptive = Options::adaptive(1.0, 1e-6);
+    let test = |scheme, o: &Options, method| run(scheme, o.clone(), method).1.error_test;
+    assert_eq!(
+        test(Scheme::Radau5, &adaptive, ConstraintMethod::Index3),
+        ErrorTest::PositionsScaledVelocities
+    );
+    assert_eq!(
+        test(Scheme::Radau5, &adaptive, ConstraintMethod::Projection),
+        ErrorTest::PositionsVelocities
+    );
+    assert_eq!(
+        test(Scheme::Dopri5, &adaptive, ConstraintMethod::Projection),
+        ErrorTest::PositionsVelocities
+    );
+    let gen_alpha = Scheme::GenAlpha(GenAlphaParams::from_rho_inf(0.8));
+    assert_eq!(
+        test(gen_alpha, &adaptive, ConstraintMethod::Index3),
+        ErrorTest::Positions
+    );
+    assert_eq!(
+        test(Scheme::Radau5, &fixed(100), ConstraintMethod::Index3),
+        ErrorTest::None
+    );
+}

@@ -44,5 +44,5 @@ pub use options::{
     BdfParams, ConstraintMethod, ConstraintOptions, GenAlphaParams, HhtParams, IterationMatrix,
     NewmarkParams, NewtonOptions, Options, Output, Scheme, StepControl,
 };
-pub use stats::Stats;
+pub use stats::{ErrorTest, Stats};
 pub use trajectory::{CsvWriter, Observer, Trajectory};

@@ -55,6 +55,38 @@ pub struct Stats {
     /// stability, not accuracy: an implicit scheme would take far fewer steps)
     pub stiff_detections: usize,
     pub stiff_from: Option<f64>,
+    /// which components the local error test controls (nothing at fixed steps)
+    pub error_test: ErrorTest,
+}
+
+/// The components an adaptive scheme's local error test measures, so that a user knows what
+/// `rtol` bought: at index 3 the velocities and multipliers are not controlled.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub enum ErrorTest {
+    /// fixed steps: no error test
+    #[default]
+    None,
+    /// positions and velocities (and extra states)
+    PositionsVelocities,
+    /// positions only: the Newmark family's estimate h²(β − ⅙)(a₁ − a₀), and at index 3 its
+    /// part along the constraints
+    Positions,
+    /// positions, with velocities weighted by h and multipliers by h² (Radau IIA at index 3,
+    /// as Hairer's RADAU5): velocities and multipliers follow the step size, not rtol
+    PositionsScaledVelocities,
+}
+
+impl fmt::Display for ErrorTest {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            ErrorTest::None => "none (fixed steps)",
+            ErrorTest::PositionsVelocities => "positions and velocities",
+            ErrorTest::Positions => "positions only",
+            ErrorTest::PositionsScaledVelocities => {
+                "positions; velocities weighted by h and multipliers by h²"
+            }
+        })
+    }
 }
 
 impl Stats {
@@ -120,6 +152,9 @@ impl fmt::Display for Stats {
                 "; {} Cholesky factorisations of M to watch its conditioning",
                 self.condition_checks
             )?;
+        }
+        if self.error_test != ErrorTest::None {
+            write!(f, "\nerror test on: {}", self.error_test)?;
         }
         if !self.order_steps.is_empty() {
             let orders: Vec<String> = self

@@ -113,6 +113,9 @@ impl<M: Model + 'static> Simulation<M> {
         if let Err(e) = stepper.start(&mut problem, &cur, &ctl) {
             return Err(early(e, problem.stats.clone()));
         }
+        if ctl.adaptive.is_some() {
+            problem.stats.error_test = stepper.error_test(&problem);
+        }
         let h = match options.step {
             StepControl::Fixed { h } => h,
             StepControl::Adaptive { h0: Some(h0), .. } => h0,

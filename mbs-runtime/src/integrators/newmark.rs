@@ -43,6 +43,7 @@ use super::{Attempt, Control, State, Step, Stepper};
 use crate::error::Failure;
 use crate::model::Model;
 use crate::options::{GenAlphaParams, HhtParams, NewmarkParams};
+use crate::stats::ErrorTest;
 
 pub(crate) struct AlphaFamily {
     alpha_m: f64,
@@ -102,6 +103,10 @@ impl AlphaFamily {
 }
 
 impl<M: Model> Stepper<M> for AlphaFamily {
+    fn error_test(&self, _p: &Problem<M>) -> ErrorTest {
+        ErrorTest::Positions
+    }
+
     fn start(&mut self, p: &mut Problem<M>, s: &State, _ctl: &Control) -> Result<(), Failure> {
         self.a.copy_from_slice(&s.qdd);
         if let Some(c) = p.loops.index3() {

@@ -7,6 +7,7 @@ use super::problem::Problem;
 use super::step_control::Tolerances;
 use crate::error::Failure;
 use crate::model::Model;
+use crate::stats::ErrorTest;
 
 /// What one attempted step gave.
 pub(crate) enum Attempt {
@@ -52,6 +53,10 @@ pub(crate) trait Stepper<M: Model> {
     }
     /// Attempts a step of size `step.h` from `step.cur`; on acceptance fills `step.next`.
     fn attempt(&mut self, step: Step<'_, M>) -> Result<Attempt, Failure>;
+    /// The components the local error test measures with adaptive steps (after `start`).
+    fn error_test(&self, _p: &Problem<M>) -> ErrorTest {
+        ErrorTest::PositionsVelocities
+    }
     /// Called once the driver has accepted the step from `prev` to `cur`.
     fn accepted(&mut self, _p: &mut Problem<M>, _prev: &State, _cur: &State) {}
     /// Dense output on [prev.t, cur.t]: by default the quintic Hermite interpolant of

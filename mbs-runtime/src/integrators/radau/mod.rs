@@ -182,6 +182,7 @@ use super::{Attempt, Control, State, Step, Stepper};
 use crate::error::Failure;
 use crate::linalg::{C64, Lu};
 use crate::model::Model;
+use crate::stats::ErrorTest;
 use tableau::Coefficients;
 
 /// θ below which M, C_t, K_t are kept for the next step (RADAU5's THET)
@@ -392,6 +393,14 @@ impl Radau {
 }
 
 impl<M: Model> Stepper<M> for Radau {
+    fn error_test(&self, p: &Problem<M>) -> ErrorTest {
+        if p.loops.index3().is_some() {
+            ErrorTest::PositionsScaledVelocities
+        } else {
+            ErrorTest::PositionsVelocities
+        }
+    }
+
     fn start(&mut self, p: &mut Problem<M>, _s: &State, _ctl: &Control) -> Result<(), Failure> {
         if let Some(c) = p.loops.index3() {
             self.enable_index3(c.nc, c.tol);

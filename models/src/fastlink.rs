@@ -1,6 +1,6 @@
 //! fastlink: a fast two-loop linkage of five light bodies, thrown by a stiff spring
 //! (`tests/reference/MODELS.md`), in the spirit of Andrews' squeezing mechanism: accelerations
-//! of bodies up to 6.6e4 m/s² and joint speeds up to 1,400 rad/s within its 30 ms. Reference:
+//! of bodies up to 6.6e4 m/s² and angular speeds up to 1,460 rad/s within its 30 ms. Reference:
 //! `tests/reference/fastlink.json` (computed outside mbs by `tests/reference/fastlink.py`).
 //!
 //! Planar, in the vertical x–y plane, gravity (0, −9.81, 0). Bodies, all uniform bars (centre
@@ -25,7 +25,7 @@
 //! motor torque of 0.05 N·m on the crank. Start: crank at a = 0, everything at rest, the loops
 //! closed on the branch with the coupler above the x axis ([`closed_loop`]: b = 0.8955,
 //! c = 1.7910, e = −0.7083, s = 0.0970). Released, the spring swings the crank to about
-//! 3.2 rad and back every 9 ms; run to t_end = 0.03 s.
+//! 3.3 rad and back every 9 ms; run to t_end = 0.03 s.
 
 mbs::multibody! {
     /// The fast linkage: crank `a`, coupler `b`, rocker `c`, rod `e` (absolute angles),

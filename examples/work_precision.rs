@@ -5,7 +5,8 @@
 //! cargo run --release --example work_precision -- --model dpend --out docs/figures
 //! ```
 //!
-//! `--model` is seed2dof, dpend, chain8, slidercrank, hexapod or all; `--out DIR` writes
+//! `--model` is seed2dof, dpend, chain8, slidercrank, hexapod, fourbar, pendulum3, fastlink or
+//! all; `--out DIR` writes
 //! `DIR/wp_MODEL.csv` and `DIR/wp_MODEL.svg`; `--repeats N` times each run N times and keeps
 //! the best (default 5; fewer for a run past 1 s). Each model in its natural setting:
 //!
@@ -21,7 +22,15 @@
 //! - hexapod, free-floating, no contact, to 1 s, tumbling: the declared pose with the
 //!   MODELS.md test-state velocities qd_i = 0.7 cos(0.9 i + 0.2) (from rest it would fall
 //!   with its legs still, exactly for every scheme of order ≥ 2); against a self-computed
-//!   reference (DOPRI5 at rtol 1e-13, checked by RK4 at h = 5e-5), every 0.05 s.
+//!   reference (DOPRI5 at rtol 1e-13, checked by RK4 at h = 5e-5), every 0.05 s;
+//! - the loops fourbar (to 2 s, self-computed: DOPRI5 with projection at rtol 1e-13, checked by
+//!   Radau5 with projection, every 0.05 s), pendulum3 (to t = 1 against
+//!   `tests/reference/pendulum3.json`) and fastlink (to 30 ms against
+//!   `tests/reference/fastlink.json`, SymPy and SciPy DOP853 at 1e-13, every 1 ms), each over
+//!   rtol 1e-4 … 1e-10 with every constraint method a scheme offers: DOPRI5 and BDF with
+//!   projection, Radau5 and generalized-α at index 3 and with projection, HHT at index 3, and
+//!   Radau5 and generalized-α in the stabilized index-2 form where the scheme accepts it (the
+//!   output says when it is refused and skipped).
 //!
 //! Every study prints its table (failures included), the cheapest run per scheme to 3, 5, 7
 //! and 9 significant digits, and how long it took. Points with no correct digit (error ≥ 1)
@@ -29,19 +38,25 @@
 
 use mbs_models::chain8;
 use mbs_models::dpend;
+use mbs_models::fastlink;
+use mbs_models::fourbar;
 use mbs_models::hexapod;
+use mbs_models::pendulum3;
 use mbs_models::seed2dof;
 use mbs_models::slidercrank;
 
 use clap::Parser;
 use mbs::work_precision::{Reference, Setting, Study, Sweep, WorkPrecision, decades, halvings};
-use mbs::{BdfParams, ConstraintMethod, GenAlphaParams, HhtParams, NewmarkParams, Scheme};
+use mbs::{
+    BdfParams, ConstraintMethod, ConstraintOptions, Failure, GenAlphaParams, HhtParams, Model,
+    NewmarkParams, Options, Scheme, Simulation,
+};
 use std::path::PathBuf;
 use std::time::Instant;
 
 #[derive(Parser, Debug)]
 struct Args {
-    /// seed2dof, dpend, chain8, slidercrank, hexapod or all
+    /// seed2dof, dpend, chain8, slidercrank, hexapod, fourbar, pendulum3, fastlink or all
     #[arg(long, default_value = "all")]
     model: String,
     /// write DIR/wp_MODEL.csv and DIR/wp_MODEL.svg
@@ -52,7 +67,16 @@ struct Args {
     repeats: usize,
 }
 
-const MODELS: [&str; 5] = ["seed2dof", "dpend", "chain8", "slidercrank", "hexapod"];
+const MODELS: [&str; 8] = [
+    "seed2dof",
+    "dpend",
+    "chain8",
+    "slidercrank",
+    "hexapod",
+    "fourbar",
+    "pendulum3",
+    "fastlink",
+];
 
 fn newmark() -> Scheme {
     Scheme::Newmark(NewmarkParams::default())
@@ -72,10 +96,10 @@ fn samples(t_end: f64, n: usize) -> Vec<f64> {
     (1..=n).map(|k| t_end * k as f64 / n as f64).collect()
 }
 
-/// States of `tests/reference/dpend.json` at `times` (q then qd).
-fn dpend_reference(times: &[f64]) -> Vec<Vec<f64>> {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/reference/dpend.json");
-    let text = std::fs::read_to_string(path).expect("tests/reference/dpend.json");
+/// States of `tests/reference/NAME.json` at `times` (q then qd).
+fn json_reference(name: &str, times: &[f64]) -> Vec<Vec<f64>> {
+    let path = format!("{}/tests/reference/{name}.json", env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
     let json: serde_json::Value = serde_json::from_str(&text).expect("json");
     let states = json["states"].as_array().expect("states");
     times
@@ -84,7 +108,7 @@ fn dpend_reference(times: &[f64]) -> Vec<Vec<f64>> {
             let s = states
                 .iter()
                 .find(|s| (s["t"].as_f64().expect("t") - t).abs() < 1e-12)
-                .unwrap_or_else(|| panic!("dpend.json has no state at t = {t}"));
+                .unwrap_or_else(|| panic!("{name}.json has no state at t = {t}"));
             ["q", "qd"]
                 .iter()
                 .flat_map(|k| s[*k].as_array().expect("array").iter())
@@ -92,6 +116,53 @@ fn dpend_reference(times: &[f64]) -> Vec<Vec<f64>> {
                 .collect()
         })
         .collect()
+}
+
+/// The state of `tests/reference/pendulum3.json` at t = 1: (x, y, ẋ, ẏ).
+fn pendulum3_reference() -> Vec<f64> {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/reference/pendulum3.json"
+    );
+    let text = std::fs::read_to_string(path).expect("tests/reference/pendulum3.json");
+    let json: serde_json::Value = serde_json::from_str(&text).expect("json");
+    ["x", "y", "xd", "yd"]
+        .iter()
+        .map(|k| json["state"][*k].as_f64().expect("number"))
+        .collect()
+}
+
+/// The sweeps of a closed-loop model over `rtols`: DOPRI5 and BDF with projection, Radau5
+/// and generalized-α at index 3 and with projection, HHT at index 3, and Radau5 and
+/// generalized-α at stabilized index 2 where the scheme accepts it (said when skipped).
+fn loop_sweeps<M: Model + Default + 'static>(rtols: &[f64]) -> Vec<Sweep> {
+    let proj = ConstraintMethod::Projection;
+    let idx3 = ConstraintMethod::Index3;
+    let mut v = vec![
+        Sweep::adaptive(Scheme::Dopri5, rtols).with_constraints(proj),
+        Sweep::adaptive(bdf(), rtols).with_constraints(proj),
+        Sweep::adaptive(Scheme::Radau5, rtols).with_constraints(idx3),
+        Sweep::adaptive(Scheme::Radau5, rtols).with_constraints(proj),
+        Sweep::adaptive(gen_alpha(), rtols).with_constraints(idx3),
+        Sweep::adaptive(gen_alpha(), rtols).with_constraints(proj),
+        Sweep::adaptive(hht(), rtols).with_constraints(idx3),
+    ];
+    for scheme in [Scheme::Radau5, gen_alpha()] {
+        let probe = Options {
+            constraints: ConstraintOptions {
+                method: ConstraintMethod::Index2,
+                ..ConstraintOptions::default()
+            },
+            ..Options::adaptive(1.0, 1e-6)
+        };
+        match Simulation::new(M::default(), scheme, probe) {
+            Err(e) if matches!(e.kind, Failure::ConstraintsUnsupported { .. }) => {
+                println!("skipped {} (index2): {}", scheme.name(), e.kind);
+            }
+            _ => v.push(Sweep::adaptive(scheme, rtols).with_constraints(ConstraintMethod::Index2)),
+        }
+    }
+    v
 }
 
 /// The sweeps of an unconstrained model: adaptive schemes over decades of rtol, fixed-step
@@ -155,7 +226,7 @@ fn study(name: &str, repeats: usize) -> WorkPrecision {
         }
         "dpend" => {
             let times = vec![0.5, 1.0, 2.0];
-            let states = dpend_reference(&times);
+            let states = json_reference("dpend", &times);
             let r = Reference::data(
                 "tests/reference/dpend.json (SymPy equations, SciPy DOP853 at rtol = atol = 1e-13; reproducible to 8e-12 at t = 2 s)",
                 times,
@@ -282,6 +353,55 @@ fn study(name: &str, repeats: usize) -> WorkPrecision {
                 ..Study::new("hexapod (free, tumbling)", r)
             });
             s.run(&model).expect("study")
+        }
+        "fourbar" => {
+            let model = fourbar::FourBar::default();
+            let options = mbs::Options {
+                constraints: ConstraintOptions {
+                    method: ConstraintMethod::Projection,
+                    ..ConstraintOptions::default()
+                },
+                ..mbs::Options::default()
+            };
+            let r = Reference::compute(
+                &model,
+                samples(2.0, 40),
+                (Scheme::Dopri5, Setting::Rtol(1e-13)),
+                Some((Scheme::Radau5, Setting::Rtol(1e-13))),
+                &options,
+            )
+            .expect("reference run");
+            let s = finish(Study {
+                sweeps: loop_sweeps::<fourbar::FourBar>(&decades(4, 10)),
+                ..Study::new("fourbar", r)
+            });
+            s.run(&model).expect("study")
+        }
+        "pendulum3" => {
+            let r = Reference::data(
+                "tests/reference/pendulum3.json (the test problem's published reference at t = 1)",
+                vec![1.0],
+                vec![pendulum3_reference()],
+            );
+            let s = finish(Study {
+                sweeps: loop_sweeps::<pendulum3::Pendulum3>(&decades(4, 10)),
+                ..Study::new("pendulum3", r)
+            });
+            s.run(&pendulum3::Pendulum3::default()).expect("study")
+        }
+        "fastlink" => {
+            let times = samples(0.03, 30);
+            let states = json_reference("fastlink", &times);
+            let r = Reference::data(
+                "tests/reference/fastlink.json (SymPy in absolute coordinates, SciPy DOP853 at rtol = atol = 1e-13; SciPy Radau agrees to 2e-10)",
+                times,
+                states,
+            );
+            let s = finish(Study {
+                sweeps: loop_sweeps::<fastlink::FastLink>(&decades(4, 10)),
+                ..Study::new("fastlink", r)
+            });
+            s.run(&fastlink::FastLink::default()).expect("study")
         }
         other => {
             eprintln!("unknown model `{other}`: use {} or all", MODELS.join(", "));

@@ -5,7 +5,8 @@
 //! `WorkPrecision::cheapest_per_label` picks it), rounded as printed; a range ("Newmark family
 //! 0.4–0.7 ms") is the cheapest and the dearest of its schemes; schemes named in a cell are in
 //! order of cost; and the figures of the text below the table (LU factorisations and steps,
-//! the refused RK4 step, the FAILED rows) are those of the CSV rows they describe. A figure
+//! the refused RK4 step, the FAILED rows, the digits of the fastlink paragraph) are those of
+//! the CSV rows they describe. A figure
 //! the test does not understand fails it, so a new one comes with its check.
 //!
 //! Timings depend on the machine: this checks that the README says what the committed CSV
@@ -126,6 +127,9 @@ fn labels(name: &str) -> &'static [&'static str] {
         "Newmark family" | "the Newmark family" => &["newmark", "hht", "gen-alpha"],
         "DOPRI5 + projection" => &["dopri5 (projection)"],
         "Radau5 index 3" => &["radau5 (index3)"],
+        "Radau5 + projection" => &["radau5 (projection)"],
+        "gen-α index 3" => &["gen-alpha (index3)"],
+        "HHT index 3" => &["hht (index3)"],
         "gen-α index 3 at fixed h" => &["gen-alpha (index3, fixed h)"],
         other => panic!("README names a scheme this test does not know: `{other}`"),
     }
@@ -273,7 +277,16 @@ fn the_work_precision_table_quotes_the_committed_csv_files() {
     }
     assert_eq!(
         models,
-        ["dpend", "seed2dof", "chain8", "slidercrank", "hexapod"]
+        [
+            "dpend",
+            "seed2dof",
+            "chain8",
+            "slidercrank",
+            "hexapod",
+            "fourbar",
+            "pendulum3",
+            "fastlink"
+        ]
     );
     println!("{figures} figures of the README's table match docs/figures/wp_*.csv");
 }
@@ -320,6 +333,57 @@ fn the_text_after_the_table_quotes_the_committed_csv_files() {
     assert_eq!(failed.len(), 3, "{failed:?}");
     for r in failed {
         assert!(r.label == "newmark (index3)" && r.setting == "h" && r.value >= 1e-3);
+    }
+
+    // fastlink: "DOPRI5 gains about a digit per decade of rtol (1.43 digits at rtol 1e-4, 8.00
+    // at 1e-10); Radau5 at index 3 gives 2.85, 3.05 and 3.27 digits at rtol 1e-5, 1e-6 and
+    // 1e-7, … no order-2 run reaches 6 digits"
+    let runs = read_runs("fastlink");
+    let digits_at = |label: &str, rtol: f64| {
+        runs.iter()
+            .find(|r| r.label == label && r.setting == "rtol" && r.value == rtol && r.ok)
+            .unwrap_or_else(|| panic!("fastlink's {label} run at rtol {rtol:e}"))
+            .mescd
+    };
+    let quoted = [
+        (
+            "(1.43 digits at rtol 1e-4",
+            "dopri5 (projection)",
+            1e-4,
+            "1.43",
+        ),
+        (" 8.00 at 1e-10)", "dopri5 (projection)", 1e-10, "8.00"),
+    ];
+    for (phrase, label, rtol, printed) in quoted {
+        assert!(text.contains(phrase), "the fastlink paragraph: `{phrase}`");
+        let d = digits_at(label, rtol);
+        assert!(rounds_to(d, printed), "{label} at rtol {rtol:e}: {d:.4}");
+    }
+    assert!(text.contains(
+        "Radau5 at index 3 gives 2.85, 3.05 and 3.27 digits at rtol 1e-5, 1e-6 and 1e-7"
+    ));
+    for (rtol, printed) in [(1e-5, "2.85"), (1e-6, "3.05"), (1e-7, "3.27")] {
+        let d = digits_at("radau5 (index3)", rtol);
+        assert!(
+            rounds_to(d, printed),
+            "radau5 (index3) at rtol {rtol:e}: {d:.4}"
+        );
+    }
+    assert!(text.contains("no order-2 run reaches 6 digits"));
+    for r in runs.iter().filter(|r| r.ok) {
+        if ["gen-alpha", "hht", "newmark"]
+            .iter()
+            .any(|s| r.label.starts_with(s))
+        {
+            assert!(
+                r.mescd < 6.0,
+                "{} at {} {}: {:.2}",
+                r.label,
+                r.setting,
+                r.value,
+                r.mescd
+            );
+        }
     }
 }
 

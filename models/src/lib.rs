@@ -13,6 +13,7 @@
 //! | [`hexapod`] | 24-dof walking robot, free and standing on its feet |
 //! | [`pendulum3`] | Cash's index-3 pendulum in Cartesian coordinates |
 //! | [`fourbar`] | a crank-rocker four-bar loop |
+//! | [`fastlink`] | a fast two-loop linkage of five light bodies thrown by a stiff spring |
 //! | [`slidercrank`] | a slider-crank, with its loop as constraints and in closed form |
 //! | [`dc_motor`] | an arm driven by a DC motor under a sampled PI controller |
 //! | [`springpend`] | a point mass on a stiff spring (polar coordinates) |
@@ -27,6 +28,7 @@ pub mod chain8;
 pub mod dc_motor;
 pub mod dpend;
 pub mod dpend_cartesian;
+pub mod fastlink;
 pub mod fourbar;
 pub mod hexapod;
 pub mod pendulum3;

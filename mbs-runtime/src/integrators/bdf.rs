@@ -42,8 +42,9 @@
 //! - Stability limits on undamped oscillations (below).
 //! - Fixed steps: constant h and no error test, the order rising by one each step up to
 //!   `max_order` (step s uses order min(s, max_order): every point of its formula has been
-//!   computed) and as far as h is stable on the fastest oscillation (below). The order-1 first step limits fixed-step accuracy to O(h²) from the start;
-//!   variable order is meant to be used adaptively.
+//!   computed) and as far as h is stable on the fastest oscillation (below). The order-1
+//!   first step limits fixed-step accuracy to O(h²) from the start; variable order is meant
+//!   to be used adaptively.
 //! - Dense output: the driver's quintic Hermite interpolation of (q, qd, qdd) at the step ends.
 //!
 //! # Undamped stiff oscillations
@@ -87,7 +88,11 @@
 //! --nocapture`): 105 / 472 / 2,437 steps at rtol 1e-4 / 1e-6 / 1e-8, orders 3–5 never taken,
 //! the error of BDF capped at order 2 (4.5e-2, 2.2e-3, 8.5e-5; Radau5: 16 / 32 / 78 steps).
 //! At rtol 1e-4 the unlimited BDF5 did better (45 steps, 3.6e-3): its steps put every stiff
-//! mode beyond BDF5's unstable band (h·ω_min,stiff > 9.38), which ω_max alone cannot tell.
+//! mode beyond BDF5's unstable band (h·ω_min,stiff > 9.38), which ω_max alone cannot tell;
+//! likewise springpend's single radial mode from the slow-manifold start at k = 1e8 (286 steps,
+//! was 45). Where the oscillation must be followed, the high order stays: springpend at
+//! k = 1e8 from r = 1 + 9.81/k runs 92 % of its 20,962 steps at order 5 with hω ≤ 0.7 (it
+//! took 23,901 when rejected past the limit).
 //!
 //! Every buffer is allocated in [`Bdf::new`]; steps allocate nothing.
 

@@ -13,12 +13,12 @@
 //! runs give q and qd within a few rtol on the pendulum (the slider-crank within 10 rtol of
 //! its scale), λ within √rtol, and |Φ| below 1e-13, |Φ̇| below 1e-11 at every step.
 
-use mbs::work_precision::{Reference, Setting};
+use mbs::work_precision::{Reference, Setting, mixed_error};
 use mbs::{
     ConstraintMethod, ConstraintOptions, Integrator, Model, Options, Output, Scheme, Simulation,
-    Stats, Trajectory, simulate,
+    Stats, StepControl, Trajectory, simulate,
 };
-use mbs_models::{pendulum3, slidercrank};
+use mbs_models::{dpend, fourbar, pendulum3, slidercrank};
 use pendulum3::Pendulum3;
 #[path = "common/alloc.rs"]
 mod alloc;
@@ -333,4 +333,177 @@ fn work_counters_of_an_index2_run() {
     // (5.6 per step, with the 3 rejected attempts)
     assert_eq!(got, [18, 0, 3, 18, 393, 1003, 46, 224, 101]);
     assert_eq!(s.error_test, mbs::ErrorTest::PositionsVelocities);
+}
+
+/// The mixed error over (q, qd) (Test Set for IVP Solvers, floor 0.01, the largest over the
+/// sampled times) of a run at rtol (atol = rtol/100), as log10(error/rtol).
+fn excess<M: Model + Clone + 'static>(
+    model: &M,
+    scheme: Scheme,
+    method: Option<ConstraintMethod>,
+    rtol: f64,
+    times: &[f64],
+    refs: &[Vec<f64>],
+) -> f64 {
+    let mut o = Options {
+        t_end: *times.last().expect("times"),
+        step: StepControl::Adaptive {
+            rtol,
+            atol: rtol * 1e-2,
+            h0: None,
+        },
+        output: Output::Times(times.to_vec()),
+        energy: false,
+        ..Options::default()
+    };
+    if let Some(m) = method {
+        o.constraints.method = m;
+    }
+    let (tr, _) = run(model.clone(), scheme, o);
+    let e = (0..tr.len())
+        .map(|i| {
+            let y: Vec<f64> = tr.q(i).iter().chain(tr.qd(i)).copied().collect();
+            mixed_error(&y, &refs[i], 1e-2)
+        })
+        .fold(0.0, f64::max);
+    (e / rtol).log10()
+}
+
+fn samples(t_end: f64, n: usize) -> Vec<f64> {
+    (1..=n).map(|k| t_end * k as f64 / n as f64).collect()
+}
+
+/// What rtol means for Radau today: for rtol = 1e-4 … 1e-10 the mixed error over (q, qd)
+/// of radau3 and radau5 by projection, at index 2 and at index 3 on pendulum3, the
+/// slider-crank (a) and the four-bar, and of the open-loop double pendulum, printed as
+/// log10(error/rtol). With RADAU5's tolerance transformation (`Tol::new` in
+/// `mbs-runtime/src/integrators/radau/mod.rs`) the target of 1 digit is not met (the module
+/// doc, "What rtol means"): what is asserted is the present behaviour, within 4.5 digits of
+/// rtol by projection and at index 2, and at most 0.5 digits lost when rtol tightens by a
+/// decade (the four-bar, radau5 at index 2, from 1e-5 to 1e-6: −0.54 → 0.94); index 3 is
+/// printed only.
+#[test]
+fn the_mixed_error_against_rtol() {
+    let rtols: Vec<f64> = (4..=10).map(|k| 10f64.powi(-k)).collect();
+    let mut worst = f64::NEG_INFINITY;
+    let mut study = |name: &str,
+                     table: &mut Vec<(String, Vec<f64>, bool)>,
+                     f: &dyn Fn(Scheme, Option<ConstraintMethod>, f64) -> f64,
+                     methods: &[Option<ConstraintMethod>]| {
+        for scheme in [Scheme::Radau3, Scheme::Radau5] {
+            for &m in methods {
+                let row: Vec<f64> = rtols.iter().map(|&r| f(scheme, m, r)).collect();
+                let label = format!(
+                    "{name:<12} {:<7} {:<10}",
+                    scheme.name(),
+                    m.map_or("-", |m| m.name())
+                );
+                let asserted = m != Some(ConstraintMethod::Index3);
+                if asserted {
+                    worst = row.iter().copied().fold(worst, f64::max);
+                }
+                table.push((label, row, asserted));
+            }
+        }
+    };
+    let closed = [
+        Some(ConstraintMethod::Projection),
+        Some(INDEX2),
+        Some(ConstraintMethod::Index3),
+    ];
+    let mut projection = Options::default();
+    projection.constraints.method = ConstraintMethod::Projection;
+    let mut table = Vec::new();
+    // the pendulum: reference by DOPRI5 at rtol 1e-13, checked by Radau5 at 1e-12
+    let times = samples(1.0, 10);
+    let pend = Pendulum3::default();
+    let r = Reference::compute(
+        &pend,
+        times.clone(),
+        (Scheme::Dopri5, Setting::Rtol(1e-13)),
+        Some((Scheme::Radau5, Setting::Rtol(1e-12))),
+        &projection,
+    )
+    .expect("pendulum3 reference");
+    let check = r.estimated_error(1e-2).expect("check").1;
+    println!("reference against its check: {check:.1e}");
+    assert!(check < 1e-9);
+    let f = |s, m, rtol| excess(&pend, s, m, rtol, &times, &r.states);
+    study("pendulum3", &mut table, &f, &closed);
+    // the slider-crank: form (b) mapped to form (a)
+    let times = samples(2.0, 10);
+    let r = Reference::compute(
+        &slidercrank::SliderCrankClosed::default(),
+        times.clone(),
+        (Scheme::Dopri5, Setting::Rtol(1e-13)),
+        None,
+        &Options::default(),
+    )
+    .expect("slider-crank reference")
+    .map("form (b) mapped to form (a)", |_, y| {
+        let (r, l) = (0.1, 0.3);
+        let (th, thd) = (y[0], y[1]);
+        let (psi, s) = slidercrank::closed_loop(th);
+        let psid = -r * th.cos() * thd / (l * psi.cos());
+        let sd = -r * th.sin() * thd - l * psi.sin() * psid;
+        vec![th, psi, s, thd, psid, sd]
+    });
+    let sc = slidercrank::SliderCrank::default();
+    let f = |s, m, rtol| excess(&sc, s, m, rtol, &times, &r.states);
+    study("slidercrank", &mut table, &f, &closed);
+    // the four-bar: DOPRI5 by projection at rtol 1e-13, checked by Radau5 at 1e-12
+    let fb = fourbar::FourBar::default();
+    let r = Reference::compute(
+        &fb,
+        times.clone(),
+        (Scheme::Dopri5, Setting::Rtol(1e-13)),
+        Some((Scheme::Radau5, Setting::Rtol(1e-12))),
+        &projection,
+    )
+    .expect("four-bar reference");
+    let check = r.estimated_error(1e-2).expect("check").1;
+    println!("reference against its check: {check:.1e}");
+    assert!(check < 1e-9);
+    let f = |s, m, rtol| excess(&fb, s, m, rtol, &times, &r.states);
+    study("fourbar", &mut table, &f, &closed);
+    // the double pendulum (no loop): tests/reference/dpend.json at 0.5, 1 and 2 s
+    let path = format!("{}/tests/reference/dpend.json", env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let json: serde_json::Value = serde_json::from_str(&text).expect("json");
+    let states = json["states"].as_array().expect("states");
+    let times = [0.5, 1.0, 2.0];
+    let refs: Vec<Vec<f64>> = times
+        .iter()
+        .map(|&t| {
+            let s = states
+                .iter()
+                .find(|s| s["t"].as_f64() == Some(t))
+                .unwrap_or_else(|| panic!("dpend.json: no state at {t}"));
+            ["q", "qd"]
+                .iter()
+                .flat_map(|k| s[*k].as_array().expect("array").iter())
+                .map(|x| x.as_f64().expect("number"))
+                .collect()
+        })
+        .collect();
+    let dp = dpend::DoublePendulum::default();
+    let f = |s, m, rtol| excess(&dp, s, m, rtol, &times, &refs);
+    study("dpend", &mut table, &f, &[None]);
+    println!("log10(mixed error / rtol), rtol = 1e-4 … 1e-10");
+    for (label, row, _) in &table {
+        let cells: Vec<String> = row.iter().map(|x| format!("{x:>6.2}")).collect();
+        println!("{label} {}", cells.join(""));
+    }
+    println!("worst asserted: {worst:.2}");
+    for (label, row, asserted) in &table {
+        if !asserted {
+            continue;
+        }
+        assert!(row.iter().all(|&x| x <= 4.5), "{label}: {row:?}");
+        // a decade tighter: at most 0.5 correct digits lost
+        assert!(
+            row.windows(2).all(|w| w[1] - w[0] <= 1.5),
+            "{label}: {row:?}"
+        );
+    }
 }

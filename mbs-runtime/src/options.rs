@@ -214,7 +214,7 @@ impl Scheme {
     /// Whether the scheme solves constrained models in the stabilized index-2 form
     /// ([`ConstraintMethod::Index2`]).
     pub fn solves_index2(&self) -> bool {
-        false
+        matches!(self, Scheme::Radau3 | Scheme::Radau5)
     }
 
     /// Whether the scheme can control its step by a local error estimate.
@@ -321,20 +321,25 @@ pub enum ConstraintMethod {
     /// diverge there; `Projection` for every other scheme,
     /// Radau included: at index 3 Radau's λ is only of order s − 1 and its error control
     /// does not aim at it, while projection gives λ of the index-1 form at the accuracy of q
-    /// and qd — the default
+    /// and qd (in the stabilized index-2 form λ is of order s, and the run takes more steps
+    /// and more work per step for errors in q and qd about as small) — the default
     #[default]
     Auto,
     /// the index-3 DAE solved directly: Φ(q₁) = 0 and the dynamics with λ₁ as unknowns
     /// (generalized-α, HHT, Newmark with the scaled iteration matrix of Bottasso, Dopico &
     /// Trainelli 2008; refused for the undamped members with adaptive steps), or at every
     /// stage with (A_i, Λ_i) as unknowns (radau3, radau5, as Hairer's RADAU5 solves index-3
-    /// DAEs: positions of order 2s − 1, velocities s, λ s − 1)
+    /// DAEs: positions of order 2s − 1, velocities s, λ s − 1; the error test weights velocity
+    /// errors by h and λ errors by h², `ErrorTest::PositionsScaledVelocities`, so rtol bounds
+    /// the positions only)
     Index3,
     /// the stabilized index-2 form of Gear, Gupta & Leimkuhler (1985): Φ(q) = 0 and
     /// Φ̇ = B qd + Φ_t = 0 both enforced, the second by a multiplier μ that corrects the
-    /// positions (q̇ = qd + M⁻¹Bᵀμ in Radau, q₁ += Bᵀν in the Newmark family, the stabilized
-    /// index-2 generalized-α of Arnold, Brüls & Cardona); velocities satisfy their constraints
-    /// at every step, and the error test covers positions and velocities
+    /// positions (q̇ = qd + B₀ᵀμ in Radau, B₀ = B at the start of the step, μ = 0 on the
+    /// exact solution; q₁ += Bᵀν in the Newmark family, the stabilized index-2
+    /// generalized-α of Arnold, Brüls & Cardona); velocities satisfy their constraints at
+    /// every step, and the error test covers positions and velocities (radau3, radau5:
+    /// q and qd of order 2s − 1, λ of order s)
     Index2,
     /// the index-1 form (B qdd = γ, λ eliminated) with Baumgarte's stabilisation
     /// Φ̈ + 2αΦ̇ + β²Φ = 0 (α, β in 1/s; α = β = 0 is the plain index-1 form, which drifts);

@@ -57,7 +57,7 @@ pub(super) fn constraint_mode(
 const INDEX3_SCHEMES: &str = "index-3 constraints are solved by gen-alpha, hht, newmark, radau3 and radau5; every scheme takes them with Projection, Baumgarte or Partitioning";
 
 /// The schemes that solve the stabilized index-2 equations, for messages.
-const INDEX2_SCHEMES: &str = "the stabilized index-2 form is solved by no scheme yet; every scheme takes the constraints with Projection, Baumgarte or Partitioning";
+const INDEX2_SCHEMES: &str = "the stabilized index-2 form is solved by radau3 and radau5; every scheme takes the constraints with Projection, Baumgarte or Partitioning";
 
 pub(super) fn stepper_for<M: Model>(scheme: &Scheme, n: usize) -> Box<dyn Stepper<M>> {
     match *scheme {

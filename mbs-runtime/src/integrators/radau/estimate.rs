@@ -28,7 +28,7 @@ impl Radau {
 
     /// The embedded formula's difference from the step's solution, before filtering, into
     /// (r_q, r_v): r_q = h² Σ d̂_q,j a_j, r_v = h (γ₀ qdd₀ + Σ d̂_b,j a_j).
-    fn embedded_difference(&mut self, cur: &State, h: f64) {
+    pub(super) fn embedded_difference(&mut self, cur: &State, h: f64) {
         let (s, n, g0) = (self.k.s, self.n, self.k.gamma0);
         for r in 0..n {
             let (mut x, mut y) = (0.0, 0.0);

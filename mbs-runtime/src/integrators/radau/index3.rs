@@ -1,5 +1,6 @@
-//! Radau at index 3: the stage multipliers as unknowns, B and ∂(Bᵀλ)/∂q frozen with the
-//! iteration matrices, and the bordered blocks.
+//! Radau at index 3 (and what the stabilized index-2 form shares with it): the stage
+//! multipliers as unknowns, B and ∂(Bᵀλ)/∂q frozen with the iteration matrices, and the
+//! bordered blocks.
 
 use super::super::State;
 use super::super::problem::Problem;
@@ -10,29 +11,33 @@ use crate::model::Model;
 use crate::options::IterationMatrix;
 
 impl Radau {
-    /// Solves for (A_i, Λ_i) at index 3 from now on: `nc` constraints, |Φ_i| ≤ `tol_phi` at
+    /// Solves for (A_i, Λ_i) at index 3, or for (A_i, Λ_i, M_i) in the stabilized index-2 form
+    /// (`index2`), from now on: `nc` constraints, |Φ_i| (and at index 2 |Φ̇_i|) ≤ `tol_phi` at
     /// convergence. The only allocation: the augmented matrices and their buffers.
-    pub(super) fn enable_index3(&mut self, nc: usize, tol_phi: f64) {
+    pub(super) fn enable_constraints(&mut self, nc: usize, tol_phi: f64, index2: bool) {
         let (n, s) = (self.n, self.k.s);
         self.tol_phi = tol_phi;
-        if self.nc == nc {
+        if self.nc == nc && self.index2 == index2 {
             // a restart (after a controller's sample): the buffers are there
             self.h_c = f64::NAN;
             self.h_r = f64::NAN;
             return;
         }
         let z = |k: usize| vec![0.0; k];
+        // the blocks' size: n + nc at index 3, n + 2nc at index 2 (μ too)
+        let big = n + if index2 { 2 * nc } else { nc };
         self.nc = nc;
+        self.index2 = index2;
         self.tol_phi = tol_phi;
         self.ainv = inverse_row_norm(&self.k.a, s);
         self.a2inv = inverse_row_norm(&self.k.a2, s);
-        self.lu_r = Lu::new(n + nc);
-        self.lu_c = Lu::new(n + nc);
+        self.lu_r = Lu::new(big);
+        self.lu_c = Lu::new(big);
         self.h_c = f64::NAN;
         self.h_r = f64::NAN;
-        self.rho_r = z(n + nc);
-        self.rho_c = vec![C64::default(); n + nc];
-        self.tmp = z(n + nc);
+        self.rho_r = z(big);
+        self.rho_c = vec![C64::default(); big];
+        self.tmp = z(big);
         self.bm = z(nc * n);
         self.kc = z(n * n);
         self.lam = z(s * nc);
@@ -46,6 +51,16 @@ impl Radau {
         self.bv = z(n);
         self.phix = z(nc);
         self.lx = z(nc);
+        if index2 {
+            self.mu = z(s * nc);
+            self.dmu = z(s * nc);
+            self.bmu = z(s * n);
+            self.psis = z(s * nc);
+            self.phit = z(nc);
+            self.kbt = z(n * nc);
+            self.bbt = z(nc * nc);
+            self.psix = z(nc);
+        }
     }
 
     /// Index 3: ∂(Bᵀλ)/∂q and B at the start of the step (with λ₀), frozen with M, C_t, K_t;
@@ -69,10 +84,16 @@ impl Radau {
             c.eval_b(&p.model, &mut p.stats, cur.t, &cur.q);
             self.bm.copy_from_slice(&c.b);
         }
-        Failure::non_finite("B = ∂Φ/∂q", &self.bm, |i| p.label((i / nc).min(n - 1)))
+        Failure::non_finite("B = ∂Φ/∂q", &self.bm, |i| p.label((i / nc).min(n - 1)))?;
+        if self.index2 {
+            self.index2_matrices();
+        }
+        Ok(())
     }
 
-    /// Index 3, stage i: r_i −= B(Q_i)ᵀΛ_i, Φ(Q_i, t) into `phis`, the largest |Φ_i| kept.
+    /// Index 3 and 2, stage i: r_i −= B(Q_i)ᵀΛ_i, Φ(Q_i, t) into `phis`, the largest |Φ_i|
+    /// kept; at index 2 also Φ̇_i = B(Q_i)V_i + Φ_t(Q_i, t) into `psis` (its largest |Φ̇_i| in
+    /// `psi_max`).
     pub(super) fn constraint_residual<M: Model>(
         &mut self,
         p: &mut Problem<M>,
@@ -90,6 +111,16 @@ impl Radau {
             }
             self.phis[i * nc..(i + 1) * nc].copy_from_slice(&c.phi);
             self.phi_max = self.phi_max.max(c.worst().0);
+            if self.index2 {
+                p.model.constraint_rate(t, &self.qs[lo..hi], &mut self.phit);
+                p.stats.constraints += 1;
+                let v = &self.vs[lo..hi];
+                for k in 0..nc {
+                    let x = self.phit[k] + (0..n).map(|j| c.b[k + nc * j] * v[j]).sum::<f64>();
+                    self.psis[i * nc + k] = x;
+                    self.psi_max = self.psi_max.max(x.abs());
+                }
+            }
         }
         p.check("τ − Bᵀλ", &self.res[lo..hi])
     }

@@ -3,9 +3,12 @@
 
 use super::super::State;
 use super::super::problem::Problem;
+use super::index2::border2;
 use super::index3::border;
 use super::tableau::re;
-use super::{MATRIX_C, MATRIX_C3, MATRIX_R, MATRIX_R3, NewtonFail, Radau, THET, Tol};
+use super::{
+    MATRIX_C, MATRIX_C2, MATRIX_C3, MATRIX_R, MATRIX_R2, MATRIX_R3, NewtonFail, Radau, THET, Tol,
+};
 use crate::error::Failure;
 use crate::linalg::{C64, Singular};
 use crate::model::Model;
@@ -21,7 +24,7 @@ impl Radau {
     ) -> Result<(), Failure> {
         let close = |x: f64, y: f64| (x - y).abs() <= 1e-10 * x.abs().max(y.abs());
         let (n, nc) = (self.n, self.nc);
-        let big = n + nc;
+        let big = n + if self.index2 { 2 * nc } else { nc };
         if !close(self.h_c, h) {
             self.h_c = f64::NAN;
             let lam = self.k.lambda[self.k.complex];
@@ -37,10 +40,14 @@ impl Radau {
                     );
                 }
             }
-            border(a, &self.bm, n, nc);
+            if self.index2 {
+                border2(a, &self.bm, &self.kbt, &self.bbt, g2, n, nc);
+            } else {
+                border(a, &self.bm, n, nc);
+            }
             p.stats.factorizations += 1;
             if let Err(e) = self.lu_c.factor() {
-                return Err(self.singular(p, e, MATRIX_C, MATRIX_C3));
+                return Err(self.singular(p, e, [MATRIX_C, MATRIX_C3, MATRIX_C2]));
             }
             self.h_c = h;
         }
@@ -54,26 +61,34 @@ impl Radau {
                     a[i + big * j] = self.m[x] + g * self.cm[x] + g * g * self.km[x];
                 }
             }
-            border(a, &self.bm, n, nc);
+            if self.index2 {
+                border2(a, &self.bm, &self.kbt, &self.bbt, g * g, n, nc);
+            } else {
+                border(a, &self.bm, n, nc);
+            }
             p.stats.factorizations += 1;
             if let Err(e) = self.lu_r.factor() {
-                return Err(self.singular(p, e, MATRIX_R, MATRIX_R3));
+                return Err(self.singular(p, e, [MATRIX_R, MATRIX_R3, MATRIX_R2]));
             }
             self.h_r = h;
         }
         Ok(())
     }
 
-    /// The failure for a singular iteration matrix: its pivot column names a coordinate, or
-    /// (index 3) the multiplier of a constraint.
+    /// The failure for a singular iteration matrix (named plain, index 3, index 2): its pivot
+    /// column names a coordinate, or (index 3, 2) a multiplier of a constraint.
     pub(super) fn singular<M: Model>(
         &self,
         p: &Problem<M>,
         e: Singular,
-        plain: &'static str,
-        index3: &'static str,
+        names: [&'static str; 3],
     ) -> Failure {
-        p.singular(if self.nc == 0 { plain } else { index3 }, e)
+        let k = match (self.nc, self.index2) {
+            (0, _) => 0,
+            (_, false) => 1,
+            (_, true) => 2,
+        };
+        p.singular(names[k], e)
     }
 
     /// Starting stage accelerations (and multipliers): the previous step's collocation
@@ -105,11 +120,17 @@ impl Radau {
                 self.lam[i * nc..(i + 1) * nc].copy_from_slice(&cur.lambda[..nc]);
             }
         }
+        // index 2: μ is zero on the exact solution
+        self.mu.fill(0.0);
     }
 
-    /// Stage positions and velocities of the current stage accelerations.
+    /// Stage positions and velocities of the current stage accelerations (and, at index 2,
+    /// multipliers μ: Q_i += h Σ_j a_ij B₀ᵀM_j).
     pub(super) fn stages(&mut self, cur: &State, h: f64) {
         let (s, n) = (self.k.s, self.n);
+        if self.index2 {
+            self.position_corrections();
+        }
         let (a, a2, c) = (&self.k.a, &self.k.a2, &self.k.c);
         for i in 0..s {
             for r in 0..n {
@@ -120,24 +141,31 @@ impl Radau {
                 }
                 self.vs[i * n + r] = cur.qd[r] + h * v;
                 self.qs[i * n + r] = cur.q[r] + h * c[i] * cur.qd[r] + h * h * q;
+                if self.index2 {
+                    let m: f64 = (0..s).map(|j| a[i][j] * self.bmu[j * n + r]).sum();
+                    self.qs[i * n + r] += h * m;
+                }
             }
         }
     }
 
     /// Newton's correction δ = −(I ⊗ M + hA ⊗ C + h²A² ⊗ K)⁻¹ r through the eigen-blocks; at
     /// index 3 also the λ corrections, the constraint rows of block μ being
-    /// B W_μ = −[(T⁻¹ ⊗ I) Φ]_μ / (h²μ²).
+    /// B W_μ = −[(T⁻¹ ⊗ I) Φ]_μ / (h²μ²); at index 2 also the μ corrections, whose unknowns in
+    /// block μ are Z_μ/(hμ), with the rows B W_μ + BBᵀ Z_μ/(hμ) = −[(T⁻¹ ⊗ I) Φ]_μ / (h²μ²)
+    /// and B W_μ = −[(T⁻¹ ⊗ I) Φ̇]_μ / (hμ).
     pub(super) fn correction<M: Model>(&mut self, p: &mut Problem<M>, h: f64) {
         let (s, n, nc) = (self.k.s, self.n, self.nc);
         let (t, ti, kc) = (&self.k.t, &self.k.ti, self.k.complex);
+        let index2 = self.index2;
         if let Some(kr) = self.k.real {
             for r in 0..n {
                 self.rho_r[r] = -(0..s)
                     .map(|j| ti[kr][j].re * self.res[j * n + r])
                     .sum::<f64>();
             }
+            let g = self.k.lambda[kr].re * h;
             if nc > 0 {
-                let g = self.k.lambda[kr].re * h;
                 let scale = 1.0 / (g * g);
                 for r in 0..nc {
                     self.rho_r[n + r] = -scale
@@ -146,8 +174,21 @@ impl Radau {
                             .sum::<f64>();
                 }
             }
+            if index2 {
+                for r in 0..nc {
+                    self.rho_r[n + nc + r] = -(0..s)
+                        .map(|j| ti[kr][j].re * self.psis[j * nc + r])
+                        .sum::<f64>()
+                        / g;
+                }
+            }
             self.lu_r.solve(&mut self.rho_r);
             p.stats.solves += 1;
+            if index2 {
+                for r in 0..nc {
+                    self.rho_r[n + nc + r] *= g;
+                }
+            }
         }
         for r in 0..n {
             let mut z = C64::default();
@@ -156,9 +197,9 @@ impl Radau {
             }
             self.rho_c[r] = z;
         }
+        let g1 = self.k.lambda[kc] * re(h);
         if nc > 0 {
-            let lam = self.k.lambda[kc];
-            let g2 = lam * lam * re(h * h);
+            let g2 = g1 * g1;
             for r in 0..nc {
                 let mut z = C64::default();
                 for j in 0..s {
@@ -167,22 +208,40 @@ impl Radau {
                 self.rho_c[n + r] = z / g2;
             }
         }
+        if index2 {
+            for r in 0..nc {
+                let mut z = C64::default();
+                for j in 0..s {
+                    z = z - ti[kc][j] * re(self.psis[j * nc + r]);
+                }
+                self.rho_c[n + nc + r] = z / g1;
+            }
+        }
         self.lu_c.solve(&mut self.rho_c);
         p.stats.solves += 1;
+        if index2 {
+            for r in 0..nc {
+                self.rho_c[n + nc + r] = self.rho_c[n + nc + r] * g1;
+            }
+        }
+        let back = |rho_c: &[C64], rho_r: &[f64], i: usize, r: usize| {
+            let mut d = 2.0 * (t[i][kc] * rho_c[r]).re;
+            if let Some(kr) = self.k.real {
+                d += t[i][kr].re * rho_r[r];
+            }
+            d
+        };
         for i in 0..s {
             for r in 0..n {
-                let mut d = 2.0 * (t[i][kc] * self.rho_c[r]).re;
-                if let Some(kr) = self.k.real {
-                    d += t[i][kr].re * self.rho_r[r];
-                }
-                self.delta[i * n + r] = d;
+                self.delta[i * n + r] = back(&self.rho_c, &self.rho_r, i, r);
             }
             for r in 0..nc {
-                let mut d = 2.0 * (t[i][kc] * self.rho_c[n + r]).re;
-                if let Some(kr) = self.k.real {
-                    d += t[i][kr].re * self.rho_r[n + r];
+                self.dlam[i * nc + r] = back(&self.rho_c, &self.rho_r, i, n + r);
+            }
+            if index2 {
+                for r in 0..nc {
+                    self.dmu[i * nc + r] = back(&self.rho_c, &self.rho_r, i, n + nc + r);
                 }
-                self.dlam[i * nc + r] = d;
             }
         }
     }
@@ -207,6 +266,9 @@ impl Radau {
                 let el = self.dlam[i * nc + r] / self.scl[r];
                 sum += el * el;
             }
+        }
+        if self.index2 {
+            sum += self.mu_correction_sum(h);
         }
         (sum / (2 * s * n + s * nc).max(1) as f64).sqrt()
     }
@@ -238,6 +300,7 @@ impl Radau {
             }
             self.stages(cur, h);
             self.phi_max = 0.0;
+            self.psi_max = 0.0;
             for i in 0..s {
                 let (lo, hi) = (i * n, (i + 1) * n);
                 let ti = cur.t + self.k.c[i] * h;
@@ -303,11 +366,22 @@ impl Radau {
             for (x, d) in self.lam.iter_mut().zip(&self.dlam) {
                 *x += d;
             }
-            // index 3: the largest |Φ_i| after this update, predicted from its value before
-            let phi_ok = self.nc == 0 || self.phi_max * self.faccon.min(1.0) <= self.tol_phi;
+            for (x, d) in self.mu.iter_mut().zip(&self.dmu) {
+                *x += d;
+            }
+            // index 3 and 2: the largest |Φ_i| after this update, predicted from its value
+            // before; at index 2 |Φ̇_i| before it (the prediction falls short there: 4e-11
+            // after an update predicted below 1e-11 on the pendulum at rtol 1e-4)
+            let phi_ok = self.nc == 0
+                || (self.phi_max * self.faccon.min(1.0) <= self.tol_phi
+                    && self.psi_max <= self.tol_phi);
             if self.faccon * dyno <= tol.kappa && phi_ok {
                 self.stages(cur, h);
-                return Ok(newt);
+                // index 2: the new state's |Φ̇| too (the simplified Newton leaves out
+                // ∂(B qd)/∂q, so an update may leave Φ̇ above what it was before it)
+                if !self.index2 || self.final_rate(p, cur.t + h) <= self.tol_phi {
+                    return Ok(newt);
+                }
             }
         }
     }

@@ -1,0 +1,222 @@
+//! Radau in the stabilized index-2 form (Gear, Gupta & Leimkuhler 1985): the stage
+//! multipliers M_i of the velocity constraints as unknowns besides (A_i, Λ_i), the blocks
+//! bordered by both constraint rows, and the error estimate for an index-2 DAE.
+
+use super::super::State;
+use super::super::problem::Problem;
+use super::{Radau, Tol};
+use crate::linalg::Field;
+use crate::model::Model;
+
+impl Radau {
+    /// Index 2: K̃Bᵀ (n × nc) and BBᵀ (nc × nc) of the frozen K̃ = K_t − ∂(Bᵀλ)/∂q and B, the
+    /// blocks of μ in the iteration matrix.
+    pub(super) fn index2_matrices(&mut self) {
+        let (n, nc) = (self.n, self.nc);
+        for k in 0..nc {
+            for i in 0..n {
+                self.kbt[i + n * k] = (0..n)
+                    .map(|j| self.km[i + n * j] * self.bm[k + nc * j])
+                    .sum();
+            }
+            for l in 0..nc {
+                self.bbt[k + nc * l] = (0..n)
+                    .map(|j| self.bm[k + nc * j] * self.bm[l + nc * j])
+                    .sum();
+            }
+        }
+    }
+
+    /// Index 2: the stage position corrections B₀ᵀM_j of the current stage multipliers μ
+    /// into `bmu` (stage j at j·n..).
+    pub(super) fn position_corrections(&mut self) {
+        let (s, n, nc) = (self.k.s, self.n, self.nc);
+        for j in 0..s {
+            for r in 0..n {
+                self.bmu[j * n + r] = (0..nc)
+                    .map(|k| self.bm[k + nc * r] * self.mu[j * nc + k])
+                    .sum();
+            }
+        }
+    }
+
+    /// Index 2: the largest |Φ̇| = |B(Q_s)V_s + Φ_t| of the last stage (the new state), at t.
+    pub(super) fn final_rate<M: Model>(&mut self, p: &mut Problem<M>, t: f64) -> f64 {
+        let (s, n, nc) = (self.k.s, self.n, self.nc);
+        let (lo, hi) = ((s - 1) * n, s * n);
+        let Some(c) = p.loops.closed_mut() else {
+            return 0.0;
+        };
+        c.eval_b(&p.model, &mut p.stats, t, &self.qs[lo..hi]);
+        p.model.constraint_rate(t, &self.qs[lo..hi], &mut self.phit);
+        p.stats.constraints += 1;
+        let v = &self.vs[lo..hi];
+        (0..nc)
+            .map(|k| (self.phit[k] + (0..n).map(|j| c.b[k + nc * j] * v[j]).sum::<f64>()).abs())
+            .fold(0.0, f64::max)
+    }
+
+    /// Index 2: the weighted RMS of the stage position corrections h Σ_j a_ij B₀ᵀδM_j
+    /// (sum of squares, added to Newton's norm).
+    pub(super) fn mu_correction_sum(&self, h: f64) -> f64 {
+        let (s, n, nc) = (self.k.s, self.n, self.nc);
+        let mut sum = 0.0;
+        for i in 0..s {
+            for r in 0..n {
+                let mut x = 0.0;
+                for j in 0..s {
+                    let btd: f64 = (0..nc)
+                        .map(|k| self.bm[k + nc * r] * self.dmu[j * nc + k])
+                        .sum();
+                    x += self.k.a[i][j] * btd;
+                }
+                let e = h * x / self.scq[r];
+                sum += e * e;
+            }
+        }
+        sum
+    }
+
+    /// Index 2: the filter (E − gJ)⁻¹ on y = (q, v, λ, μ), E = diag(I, M, 0, 0),
+    /// f = (v + B₀ᵀμ, h + Bᵀλ, Φ, Bv + Φ_t), in second-order form with the real block:
+    ///
+    /// [M + gC + g²K̃, −Bᵀ, g²K̃Bᵀ; B, 0, BBᵀ; B, 0, 0] (e_v, g e_λ, e_μ)
+    ///   = (b_v − gK̃ r_q, −(Φ + B r_q)/g, −Φ̇/g),   e_q = r_q + g (e_v + Bᵀe_μ);
+    ///
+    /// into `err` as (e_q, e_v, h e_λ); `phix` and `psix` hold Φ and Φ̇ (zero for the first
+    /// estimate).
+    fn filter2<M: Model>(&mut self, p: &mut Problem<M>, g: f64, h: f64) {
+        let (n, nc) = (self.n, self.nc);
+        for i in 0..n {
+            let mut x = self.bv[i];
+            for j in 0..n {
+                x -= g * self.km[i + n * j] * self.rq[j];
+            }
+            self.tmp[i] = x;
+        }
+        for k in 0..nc {
+            let brq: f64 = (0..n).map(|j| self.bm[k + nc * j] * self.rq[j]).sum();
+            self.tmp[n + k] = -(self.phix[k] + brq) / g;
+            self.tmp[n + nc + k] = -self.psix[k] / g;
+        }
+        self.lu_r.solve(&mut self.tmp);
+        p.stats.solves += 1;
+        for i in 0..n {
+            let btm: f64 = (0..nc)
+                .map(|k| self.bm[k + nc * i] * self.tmp[n + nc + k])
+                .sum();
+            self.err[i] = self.rq[i] + g * (self.tmp[i] + btm);
+            self.err[n + i] = self.tmp[i];
+        }
+        for k in 0..nc {
+            self.err[2 * n + k] = h * self.tmp[n + k] / g;
+        }
+    }
+
+    /// Index 2: RADAU5's estimate for the index-2 DAE E y' = f(y); q and qd are differential
+    /// components (unscaled), λ an index-2 one (weighted by h, RADAU5's scaling), μ (zero on
+    /// the exact solution) left out.
+    pub(super) fn estimate2<M: Model>(
+        &mut self,
+        p: &mut Problem<M>,
+        cur: &State,
+        next: &State,
+        h: f64,
+        tol: &Tol,
+    ) -> f64 {
+        let (s, n, nc) = (self.k.s, self.n, self.nc);
+        let g = self.k.gamma0 * self.h_r;
+        self.embedded_difference(cur, h);
+        // the positions' derivative has B₀ᵀμ too: Σ_i e_i (hA B₀ᵀM)_i = h Σ_j (b̂ − b)_j B₀ᵀM_j
+        for r in 0..n {
+            self.rq[r] += h
+                * (0..s)
+                    .map(|j| self.k.db[j] * self.bmu[j * n + r])
+                    .sum::<f64>();
+        }
+        for i in 0..n {
+            self.bv[i] = (0..n).map(|j| self.m[i + n * j] * self.rv[j]).sum();
+        }
+        // γ₀h Φ(q₀) and γ₀h Φ̇(q₀, v₀): below the constraint tolerance, taken as 0
+        self.phix.fill(0.0);
+        self.psix.fill(0.0);
+        self.filter2(p, g, h);
+        self.y0[..n].copy_from_slice(&cur.q);
+        self.y0[n..2 * n].copy_from_slice(&cur.qd);
+        self.y0[2 * n..].copy_from_slice(&cur.lambda[..nc]);
+        self.y1[..n].copy_from_slice(&next.q);
+        self.y1[n..2 * n].copy_from_slice(&next.qd);
+        self.y1[2 * n..].copy_from_slice(&next.lambda[..nc]);
+        let mut err = tol.weights.error_norm(&self.err, &self.y0, &self.y1);
+        if err >= 1.0 && (self.first || self.reject) {
+            // RADAU5: f(y₀ + err) in place of f(y₀); its position row less f_q(y₀) is
+            // e_v + B₀ᵀe_μ (e_μ still in `tmp`)
+            for r in 0..n {
+                let btm: f64 = (0..nc)
+                    .map(|k| self.bm[k + nc * r] * self.tmp[n + nc + k])
+                    .sum();
+                self.rq[r] += g * (self.err[n + r] + btm);
+            }
+            let hr = 1.0 / h;
+            for r in 0..n {
+                self.qx[r] = cur.q[r] + self.err[r];
+                self.vx[r] = cur.qd[r] + self.err[n + r];
+            }
+            for k in 0..nc {
+                self.lx[k] = cur.lambda[k] + self.err[2 * n + k] * hr;
+            }
+            if self.residual_at(p, cur) {
+                if let Some(c) = p.loops.closed_mut() {
+                    // Φ̇ at (q₀ + e_q, v₀ + e_v), with B(q₀ + e_q) from `residual_at`
+                    p.model.constraint_rate(cur.t, &self.qx, &mut self.psix);
+                    p.stats.constraints += 1;
+                    for k in 0..nc {
+                        self.psix[k] += (0..n).map(|j| c.b[k + nc * j] * self.vx[j]).sum::<f64>();
+                    }
+                }
+                for r in 0..n {
+                    self.bv[r] -= g * self.ax[r];
+                }
+                if self.psix.iter().all(|x| x.is_finite()) {
+                    self.filter2(p, g, h);
+                    err = tol.weights.error_norm(&self.err, &self.y0, &self.y1);
+                }
+            }
+        }
+        err.max(1e-10)
+    }
+}
+
+/// Borders the n × n block of the (n + 2nc) × (n + 2nc) column-major matrix `a` for the
+/// stabilized index-2 form: columns of Λ (−Bᵀ), of μ (g2·K̃Bᵀ over BBᵀ), rows of Φ (B, 0,
+/// BBᵀ) and of Φ̇ (B, 0, 0); `g2` = h²μ² of the block.
+pub(super) fn border2<T: Field>(
+    a: &mut [T],
+    b: &[f64],
+    kbt: &[f64],
+    bbt: &[f64],
+    g2: T,
+    n: usize,
+    nc: usize,
+) {
+    let big = n + 2 * nc;
+    for j in n..big {
+        for i in 0..big {
+            a[i + big * j] = T::default();
+        }
+    }
+    for j in 0..n {
+        for k in 0..nc {
+            let bkj = T::from_f64(b[k + nc * j]);
+            a[j + big * (n + k)] = -bkj;
+            a[(n + k) + big * j] = bkj;
+            a[(n + nc + k) + big * j] = bkj;
+            a[j + big * (n + nc + k)] = g2 * T::from_f64(kbt[j + n * k]);
+        }
+    }
+    for k in 0..nc {
+        for l in 0..nc {
+            a[(n + k) + big * (n + nc + l)] = T::from_f64(bbt[k + nc * l]);
+        }
+    }
+}

@@ -214,7 +214,10 @@ impl Scheme {
     /// Whether the scheme solves constrained models in the stabilized index-2 form
     /// ([`ConstraintMethod::Index2`]).
     pub fn solves_index2(&self) -> bool {
-        false
+        matches!(
+            self,
+            Scheme::Newmark(_) | Scheme::Hht(_) | Scheme::GenAlpha(_)
+        )
     }
 
     /// Whether the scheme can control its step by a local error estimate.

@@ -88,7 +88,7 @@
 //! rtol. The velocities, whose Φ̇ is only O(h²), are not controlled (table above): use index
 //! 2 for them.
 //!
-//! ## Constraints at index 2
+//! ## Constraints at index 2 (the default of the damped members)
 //! With `Index2`, the stabilized index-2 generalized-α of Arnold, Brüls & Cardona (2015,
 //! after Gear, Gupta & Leimkuhler): a second multiplier ν corrects the positions,
 //!

@@ -68,9 +68,11 @@ pub enum ErrorTest {
     None,
     /// positions and velocities (and extra states)
     PositionsVelocities,
-    /// positions only: the Newmark family's estimate h²(β − ⅙)(a₁ − a₀), and at index 3 its
-    /// part along the constraints
+    /// positions only, per step: the Newmark family's estimate h²(β − ⅙)(a₁ − a₀) except at
+    /// index 2 (at index 3 its part along the constraints); velocities and multipliers are
+    /// not controlled
     Positions,
+
     /// positions, with velocities weighted by h and multipliers by h² (Radau IIA at index 3,
     /// as Hairer's RADAU5): velocities and multipliers follow the step size, not rtol
     PositionsScaledVelocities,
@@ -82,6 +84,7 @@ impl fmt::Display for ErrorTest {
             ErrorTest::None => "none (fixed steps)",
             ErrorTest::PositionsVelocities => "positions and velocities",
             ErrorTest::Positions => "positions only",
+
             ErrorTest::PositionsScaledVelocities => {
                 "positions; velocities weighted by h and multipliers by h²"
             }

@@ -24,6 +24,24 @@
 //! requires the predicted |Φ_i| after the update to be below the constraint tolerance. The matrix is made afresh at every
 //! step (kept only within it): on the index-3 pendulum, matrices kept across steps needed
 //! 2–3 times the iterations of fresh ones and left λ less converged.
+//!
+//! ## Index 2
+//! With the stabilized index-2 form (`AccelNewton::enable_index2`), the positions also move
+//! along B(q₀)ᵀ by a second multiplier ν (scaled: q = q̂ + β'(a + B₀ᵀν)), and the unknowns
+//! (a, λ, ν) solve τ − Bᵀλ = 0, Φ/β' = 0, (B v + Φ_t)/γ' = 0 with
+//!
+//! ```text
+//! [ M + γ'C_t + β'(K_t − ∂(Bᵀλ)/∂q)   −Bᵀ   0    ]
+//! [ B                                   0    B B₀ᵀ ]
+//! [ B                                   0    0    ]
+//! ```
+//!
+//! plus, in the Φ̇ rows, β'/γ'·Z (along a) and β'/γ'·Z B₀ᵀ (along ν), Z = ∂(B v + Φ_t)/∂q by
+//! forward differences (n evaluations of B and Φ_t per matrix; without it Newton took 3.2
+//! iterations per step on the four-bar at h = 1 ms, with it 2.0, index 3 1.8); the O(h²)
+//! coupling β'K_t B₀ᵀ is left out. Φ̇ = 0 fixes a across the constraints, so the rounding
+//! floors are ε|q| for q, ε|v| for v and ε|v|/γ' for λ; convergence requires |Φ_i| and
+//! |Φ̇_i|/max(1, |v|) below the constraint tolerance.
 
 use super::at::{Affine, At, Weights};
 use super::problem::Problem;
@@ -75,6 +93,17 @@ pub(crate) struct AccelNewton {
     tol_phi: f64,
     l0: Vec<f64>,
     phi_max: f64,
+    /// stabilized index 2: the second multiplier ν (scaled: q = q̂ + β'(a + B₀ᵀν)), its
+    /// guess, B₀ = B(q₀) of the step's start, and Φ_t
+    index2: bool,
+    nu: Vec<f64>,
+    b0: Vec<f64>,
+    phi_t: Vec<f64>,
+    /// index 2: B at the matrix's q, Z = ∂(B v + Φ_t)/∂q there (nc × n), and work vectors
+    bq: Vec<f64>,
+    z: Vec<f64>,
+    qp: Vec<f64>,
+    rate0: Vec<f64>,
     mm: Vec<f64>,
     kc: Vec<f64>,
     valid: bool,
@@ -98,6 +127,14 @@ impl AccelNewton {
             tol_phi: f64::INFINITY,
             l0: Vec::new(),
             phi_max: 0.0,
+            index2: false,
+            nu: Vec::new(),
+            b0: Vec::new(),
+            phi_t: Vec::new(),
+            bq: Vec::new(),
+            z: Vec::new(),
+            qp: Vec::new(),
+            rate0: Vec::new(),
             mm: Vec::new(),
             kc: Vec::new(),
             valid: false,
@@ -114,20 +151,47 @@ impl AccelNewton {
     /// Solves for (a, λ) at index 3 from now on: `nc` constraints, the constraint rows
     /// scaled by 1/β' when `scaled`, |Φ_i| ≤ `tol_phi` at convergence.
     pub fn enable_index3(&mut self, nc: usize, scaled: bool, tol_phi: f64) {
+        self.enable(nc, false, scaled, tol_phi);
+    }
+
+    /// Solves the stabilized index-2 step for (a, λ, ν) from now on (see the module notes):
+    /// as [`AccelNewton::enable_index3`], with Φ̇ = 0 too. Each step's B₀ is set by
+    /// [`AccelNewton::index2_start`].
+    pub fn enable_index2(&mut self, nc: usize, scaled: bool, tol_phi: f64) {
+        self.enable(nc, true, scaled, tol_phi);
+    }
+
+    fn enable(&mut self, nc: usize, index2: bool, scaled: bool, tol_phi: f64) {
         let (n, z) = (self.n, |k: usize| vec![0.0; k]);
         self.scaled = scaled;
         self.tol_phi = tol_phi;
         self.valid = false;
-        if self.nc == nc {
+        if self.nc == nc && self.index2 == index2 {
             // a restart: the buffers are there
             return;
         }
         self.nc = nc;
-        self.lu = Lu::new(n + nc);
-        self.r = z(n + nc);
+        self.index2 = index2;
+        let rows = if index2 { n + 2 * nc } else { n + nc };
+        self.lu = Lu::new(rows);
+        self.r = z(rows);
         self.l0 = z(nc);
         (self.mm, self.kc) = (z(n * n), z(n * n));
+        if index2 {
+            (self.nu, self.b0, self.phi_t) = (z(nc), z(nc * n), z(nc));
+            (self.bq, self.z, self.qp, self.rate0) = (z(nc * n), z(nc * n), z(n), z(nc));
+        }
         self.valid = false;
+    }
+
+    /// Stabilized index 2: B₀ = B(q₀) at the start (t₀, q₀) of the step to solve, along
+    /// which the second multiplier moves the positions; ν starts from zero.
+    pub fn index2_start<M: Model>(&mut self, p: &mut Problem<M>, t0: f64, q0: &[f64]) {
+        if let Some(c) = p.loops.closed_mut() {
+            c.eval_b(&p.model, &mut p.stats, t0, q0);
+            self.b0.copy_from_slice(&c.b);
+        }
+        self.nu.fill(0.0);
     }
 
     /// Solves τ(t, q̂ + β'a, v̂ + γ'a, a) = 0; `a` holds the guess and receives the solution.
@@ -172,6 +236,7 @@ impl AccelNewton {
                 // the reused matrix failed: start again from the guess with a fresh one
                 a.copy_from_slice(&self.a0);
                 lambda.copy_from_slice(&self.l0);
+                self.nu.fill(0.0);
             }
             if fresh {
                 self.affine(step, a);
@@ -202,7 +267,7 @@ impl AccelNewton {
                 let n = self.n;
                 let mut res = p.residual(t, &self.q, &self.v, a, &mut self.r[..n]);
                 if nc > 0 && res.is_ok() {
-                    res = self.index3_residual(p, t, lambda, beta);
+                    res = self.index3_residual(p, t, lambda, w);
                 }
                 if let Err(e) = res {
                     self.valid = false;
@@ -218,7 +283,14 @@ impl AccelNewton {
                 total += 1;
                 // index 3: no variable resolves below the rounding of Φ: q to ~ε|q|, λ to
                 // ~ε|q|/β' (Φ/β' is solved for), v = v̂ + γ'a to ~ε|q|γ'/β'
-                let (fq, fv, fl) = if nc > 0 {
+                let (fq, fv, fl) = if self.index2 {
+                    // index 2: Φ̇ = 0 fixes a across the constraints to ~ε|v|/γ' (Φ, through
+                    // ν, moves q alone): v to ~ε|v|, λ to ~ε|v|/γ'
+                    let qmax = self.q.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+                    let vmax = self.v.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+                    let fv = 10.0 * f64::EPSILON * vmax;
+                    (10.0 * f64::EPSILON * qmax, fv, fv / gamma)
+                } else if nc > 0 {
                     let qmax = self.q.iter().fold(1.0f64, |m, x| m.max(x.abs()));
                     let fq = 10.0 * f64::EPSILON * qmax;
                     (fq, fq * gamma / beta, fq / beta)
@@ -226,10 +298,23 @@ impl AccelNewton {
                     (0.0, 0.0, 0.0)
                 };
                 let mut s = 0.0;
+                if self.index2 {
+                    for k in 0..nc {
+                        self.nu[k] -= self.r[n + nc + k];
+                    }
+                }
                 for i in 0..n {
                     let d = -self.r[i];
                     a[i] += d;
-                    let eq = beta * d / (tol.atol + tol.rtol * self.q[i].abs() + fq);
+                    // index 2: q moves by β'(δa + B₀ᵀδν)
+                    let dq = if self.index2 {
+                        d - (0..nc)
+                            .map(|k| self.b0[k + nc * i] * self.r[n + nc + k])
+                            .sum::<f64>()
+                    } else {
+                        d
+                    };
+                    let eq = beta * dq / (tol.atol + tol.rtol * self.q[i].abs() + fq);
                     let ev = gamma * d / (tol.atol + tol.rtol * self.v[i].abs() + fv);
                     s += eq * eq + ev * ev;
                 }
@@ -270,6 +355,7 @@ impl AccelNewton {
         self.refresh = true;
         a.copy_from_slice(&self.a0);
         lambda.copy_from_slice(&self.l0);
+        self.nu.fill(0.0);
         Err(NewtonFail {
             iterations: total,
             correction: last,
@@ -277,14 +363,16 @@ impl AccelNewton {
         })
     }
 
-    /// r[..n] −= Bᵀλ at the current q; r[n..] = Φ(q)/β' (scaled) or Φ(q).
+    /// r[..n] −= Bᵀλ at the current q; r[n..n + nc] = Φ(q)/β' (scaled) or Φ(q); index 2:
+    /// r[n + nc..] = (B(q)v + Φ_t)/γ' (scaled) or B(q)v + Φ_t.
     fn index3_residual<M: Model>(
         &mut self,
         p: &mut Problem<M>,
         t: f64,
         lambda: &[f64],
-        beta: f64,
+        w: Weights,
     ) -> Result<(), Failure> {
+        let Weights { beta, gamma } = w;
         let (n, nc) = (self.n, self.nc);
         // open loops have no multipliers and no constraint rows
         if let Some(c) = p.loops.closed_mut() {
@@ -298,6 +386,19 @@ impl AccelNewton {
                 self.r[n + k] = s * c.phi[k];
             }
             self.phi_max = c.worst().0;
+            if self.index2 {
+                p.model.constraint_rate(t, &self.q, &mut self.phi_t);
+                p.stats.constraints += 1;
+                let s = if self.scaled { 1.0 / gamma } else { 1.0 };
+                // |Φ̇| counts against the constraint tolerance per unit of velocity scale
+                let vmax = self.v.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+                for k in 0..nc {
+                    let rate =
+                        self.phi_t[k] + (0..n).map(|j| c.b[k + nc * j] * self.v[j]).sum::<f64>();
+                    self.r[n + nc + k] = s * rate;
+                    self.phi_max = self.phi_max.max(rate.abs() / vmax);
+                }
+            }
         }
         p.check("τ − Bᵀλ", &self.r[..n])
     }
@@ -312,7 +413,7 @@ impl AccelNewton {
         w: Weights,
     ) -> Result<(), Failure> {
         let (n, nc) = (self.n, self.nc);
-        let big = n + nc;
+        let big = if self.index2 { n + 2 * nc } else { n + nc };
         let beta = w.beta;
         p.iteration_block(At::new(t, &self.q, &self.v), a, w, &mut self.mm)?;
         if p.iteration != IterationMatrix::MassOnly {
@@ -329,6 +430,18 @@ impl AccelNewton {
             }
             None => &[],
         };
+        let with_z = self.index2 && p.iteration != IterationMatrix::MassOnly;
+        if self.index2 {
+            self.bq.copy_from_slice(b);
+        }
+        if with_z {
+            self.rate_jacobian(p, t);
+        }
+        let b: &[f64] = match (self.index2, p.loops.closed()) {
+            (true, _) => &self.bq,
+            (false, Some(c)) => &c.b,
+            (false, None) => &[],
+        };
         let s = if self.scaled { 1.0 } else { beta };
         let m = self.lu.matrix_mut();
         m.fill(0.0);
@@ -343,7 +456,63 @@ impl AccelNewton {
                 m[(n + k) + big * j] = s * bkj;
             }
         }
+        if self.index2 {
+            // Φ̇ rows: B + β'/γ'·Z along a, β'/γ'·Z B₀ᵀ along ν; Φ rows: B B₀ᵀ along ν
+            let s2 = if self.scaled { 1.0 } else { w.gamma };
+            let r = if with_z { beta / w.gamma } else { 0.0 };
+            for j in 0..n {
+                for k in 0..nc {
+                    m[(n + nc + k) + big * j] = s2 * (b[k + nc * j] + r * self.z[k + nc * j]);
+                }
+            }
+            for k in 0..nc {
+                for l in 0..nc {
+                    m[(n + nc + k) + big * (n + nc + l)] = s2
+                        * r
+                        * (0..n)
+                            .map(|j| self.z[k + nc * j] * self.b0[l + nc * j])
+                            .sum::<f64>();
+                }
+            }
+            for k in 0..nc {
+                for l in 0..nc {
+                    m[(n + k) + big * (n + nc + l)] = s
+                        * (0..n)
+                            .map(|j| b[k + nc * j] * self.b0[l + nc * j])
+                            .sum::<f64>();
+                }
+            }
+        }
         Failure::non_finite("iteration matrix", m, |i| p.label((i % big).min(n - 1)))
+    }
+
+    /// Index 2: Z = ∂(B v + Φ_t)/∂q at the current (q, v) by forward differences, with B(q)
+    /// in `self.bq`; leaves B(q) in the constraints' buffer.
+    fn rate_jacobian<M: Model>(&mut self, p: &mut Problem<M>, t: f64) {
+        let (n, nc) = (self.n, self.nc);
+        let Some(c) = p.loops.closed_mut() else {
+            return;
+        };
+        p.model.constraint_rate(t, &self.q, &mut self.phi_t);
+        p.stats.constraints += 1;
+        for k in 0..nc {
+            self.rate0[k] =
+                self.phi_t[k] + (0..n).map(|j| self.bq[k + nc * j] * self.v[j]).sum::<f64>();
+        }
+        self.qp.copy_from_slice(&self.q);
+        for j in 0..n {
+            let d = f64::EPSILON.sqrt() * self.q[j].abs().max(1.0);
+            self.qp[j] = self.q[j] + d;
+            c.eval_b(&p.model, &mut p.stats, t, &self.qp);
+            p.model.constraint_rate(t, &self.qp, &mut self.phi_t);
+            p.stats.constraints += 1;
+            for k in 0..nc {
+                let rate = self.phi_t[k] + (0..n).map(|i| c.b[k + nc * i] * self.v[i]).sum::<f64>();
+                self.z[k + nc * j] = (rate - self.rate0[k]) / d;
+            }
+            self.qp[j] = self.q[j];
+        }
+        c.b.copy_from_slice(&self.bq);
     }
 
     /// The index-3 iteration matrix (N × N, N = n + nc, column-major) at (t, q̂ + β'a,
@@ -370,8 +539,15 @@ impl AccelNewton {
             w: Weights { beta, gamma },
             ..
         } = step;
+        let nc = self.nc;
         for i in 0..self.n {
-            self.q[i] = qhat[i] + beta * a[i];
+            // index 2: the second multiplier moves q along B₀ᵀ
+            let nu = if self.index2 {
+                (0..nc).map(|k| self.b0[k + nc * i] * self.nu[k]).sum()
+            } else {
+                0.0
+            };
+            self.q[i] = qhat[i] + beta * (a[i] + nu);
             self.v[i] = vhat[i] + gamma * a[i];
         }
     }

@@ -8,7 +8,7 @@
 //! `cargo test --release --test tolerance_proportionality -- --nocapture` prints the digits of
 //! every run (−log10 of the mixed error) against those of rtol.
 
-use mbs::work_precision::{Reference, Setting, Study, Sweep, WorkPrecision, decades};
+use mbs::work_precision::{Reference, Setting, Study, Sweep, WorkPrecision, decades, mixed_error};
 use mbs::{ConstraintMethod, GenAlphaParams, HhtParams, Model, Options, Scheme};
 use mbs_models::{dpend, dpend_cartesian, fastlink, fourbar, pendulum3, slidercrank};
 
@@ -146,6 +146,36 @@ fn study(title: &str, reference: Reference, constrained: bool) -> Study {
     }
 }
 
+/// Runs the study, prints its proportionality table and, at rtol 1e-8, the digits over q
+/// alone and qd alone of every offered sweep (where the error sits); returns what breaks
+/// proportionality.
+fn measure<M: Model + Clone + 'static>(s: Study, model: &M) -> Vec<String> {
+    let wp = s.run(model).expect("study");
+    let bad = judge(&wp);
+    let n = M::NQ;
+    println!(
+        "digits over q alone and qd alone at rtol 1e-8 (largest mixed error over the samples):"
+    );
+    for sweep in &s.sweeps {
+        let o = s.options_for(sweep, Setting::Rtol(1e-8));
+        let Ok((tr, _)) = mbs::simulate(model.clone(), sweep.scheme, o) else {
+            continue;
+        };
+        let (mut eq, mut ev) = (0.0f64, 0.0f64);
+        for (i, r) in s.reference.states.iter().enumerate() {
+            eq = eq.max(mixed_error(tr.q(i), &r[..n], s.floor));
+            ev = ev.max(mixed_error(tr.qd(i), &r[n..], s.floor));
+        }
+        println!(
+            "  {:<28} q {:5.2}  qd {:5.2}",
+            sweep.label,
+            -eq.log10(),
+            -ev.log10()
+        );
+    }
+    bad
+}
+
 fn assert_proportional(bad: Vec<String>) {
     assert!(
         bad.is_empty(),
@@ -161,11 +191,7 @@ fn slider_crank_both_forms() {
     let closed = slidercrank::SliderCrankClosed::default();
     let times = samples(2.0, 20);
     let rb = computed(&closed, times.clone());
-    let mut bad = judge(
-        &study("slider-crank (b)", rb, false)
-            .run(&closed)
-            .expect("study"),
-    );
+    let mut bad = measure(study("slider-crank (b)", rb, false), &closed);
     let ra = computed(&closed, times).map("form (b) mapped to form (a)", |_, y| {
         let (r, l) = (0.1, 0.3);
         let (th, thd) = (y[0], y[1]);
@@ -175,11 +201,7 @@ fn slider_crank_both_forms() {
         vec![th, psi, s, thd, psid, sd]
     });
     let model = slidercrank::SliderCrank::default();
-    bad.extend(judge(
-        &study("slider-crank (a)", ra, true)
-            .run(&model)
-            .expect("study"),
-    ));
+    bad.extend(measure(study("slider-crank (a)", ra, true), &model));
     assert_proportional(bad);
 }
 
@@ -187,18 +209,14 @@ fn slider_crank_both_forms() {
 fn four_bar() {
     let model = fourbar::FourBar::default();
     let r = computed(&model, samples(2.0, 20));
-    assert_proportional(judge(
-        &study("four-bar", r, true).run(&model).expect("study"),
-    ));
+    assert_proportional(measure(study("four-bar", r, true), &model));
 }
 
 #[test]
 fn cash_pendulum() {
     let model = pendulum3::Pendulum3::default();
     let r = computed(&model, samples(1.0, 10));
-    assert_proportional(judge(
-        &study("pendulum3", r, true).run(&model).expect("study"),
-    ));
+    assert_proportional(measure(study("pendulum3", r, true), &model));
 }
 
 /// The Cartesian double pendulum against dpend (two relative angles, no constraint) at rtol
@@ -221,11 +239,7 @@ fn cartesian_double_pendulum() {
         },
     );
     let model = dpend_cartesian::DoublePendulumCartesian::default();
-    assert_proportional(judge(
-        &study("dpend (Cartesian)", r, true)
-            .run(&model)
-            .expect("study"),
-    ));
+    assert_proportional(measure(study("dpend (Cartesian)", r, true), &model));
 }
 
 /// fastlink to 30 ms against `tests/reference/fastlink.json` (SymPy in absolute coordinates,
@@ -242,7 +256,5 @@ fn fast_linkage() {
         .collect();
     let r = Reference::data("tests/reference/fastlink.json", times, states);
     let model = fastlink::FastLink::default();
-    assert_proportional(judge(
-        &study("fastlink", r, true).run(&model).expect("study"),
-    ));
+    assert_proportional(measure(study("fastlink", r, true), &model));
 }

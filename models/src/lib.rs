@@ -10,6 +10,7 @@
 //! | [`arm3d_6`] | spatial arm of six revolute joints |
 //! | [`chain8`], [`chain24`] | planar chains of 8 and 24 uniform bars |
 //! | [`chain16_stiff`] | a chain of 16 bars with torsional springs of 1e6 N·m/rad in its joints |
+//! | [`chain30_stiff`] | a swinging chain of 30 light bars with undamped stiff torsional springs |
 //! | [`hexapod`] | 24-dof walking robot, free and standing on its feet |
 //! | [`pendulum3`] | Cash's index-3 pendulum in Cartesian coordinates |
 //! | [`fourbar`] | a crank-rocker four-bar loop |
@@ -24,6 +25,7 @@
 pub mod arm3d_6;
 pub mod chain16_stiff;
 pub mod chain24;
+pub mod chain30_stiff;
 pub mod chain8;
 pub mod dc_motor;
 pub mod dpend;

@@ -39,11 +39,60 @@
 //!   those k + 1 steps is met by a rejection rather than by shrinking h ahead (≈ 10 % of the
 //!   attempts on the double pendulum). Newton failure: h/4, with the failure's cause.
 //! - Start at order 1 from D = (y₀, h·f(y₀)) with the driver's first step.
+//! - Stability limits on undamped oscillations (below).
 //! - Fixed steps: constant h and no error test, the order rising by one each step up to
 //!   `max_order` (step s uses order min(s, max_order): every point of its formula has been
-//!   computed). The order-1 first step limits fixed-step accuracy to O(h²) from the start;
-//!   variable order is meant to be used adaptively.
+//!   computed) and as far as h is stable on the fastest oscillation (below). The order-1
+//!   first step limits fixed-step accuracy to O(h²) from the start; variable order is meant
+//!   to be used adaptively.
 //! - Dense output: the driver's quintic Hermite interpolation of (q, qd, qdd) at the step ends.
+//!
+//! # Undamped stiff oscillations
+//!
+//! BDF3–5 are unstable on part of the imaginary axis: an undamped mode of frequency ω grows
+//! when hω lies in (0, 1.93) for BDF3 (by up to 4.6 % a step), (0, 4.69) for BDF4 (19 %) and
+//! (0.714, 9.38) for BDF5 (38 %). On a stiff undamped chain (`chain30_stiff`: modes from 4 to
+//! 1.6e5 rad/s) the order selection, which sees only accuracy, took orders 4–5 and the error
+//! test then held h where the parasitic growth balanced the tolerance: 586,920 and 635,988
+//! steps at rtol 1e-6 and 1e-8 (hω_max ≈ 0.5), where BDF capped at order 2 takes 472 and 2,435
+//! for the same error. SUNDIALS CVODE behaves alike on such chains, and its stability-limit
+//! detection (STALD: the dominant characteristic root estimated from the scaled derivatives
+//! of the last steps, the order lowered by one when the root leaves the unit circle) made it
+//! worse there: many undamped modes at once leave no single dominant root, and BDF4 and BDF3,
+//! one order down at a time, are unstable on them too. Hairer & Wanner (Solving ODEs II, V.2)
+//! give the A(α) regions behind this; lightly damped oscillations want orders ≤ 2.
+//!
+//! Here the scheme looks at the spectrum instead. Whenever Newton builds a fresh iteration
+//! matrix from the model's tangents, M, C_t and K_t are there at no evaluation: a power
+//! iteration on M⁻¹K_t (12 iterations from the previous direction, a Cholesky of M and 24
+//! n² products) gives ω_max of the fastest undamped mode, xᵀK_t x > 0 tells an oscillation
+//! from a static instability, and ζ = xᵀC_t x / (2ω xᵀM x) its damping ratio. Order k > 2 is
+//! then allowed steps with h·ω_max ≤ 0.3, 0.4, 0.7 (k = 3, 4, 5: growth below 0.2 % a step,
+//! BDF5 stable) unless ζ > cos α_k (the mode lies in the order's A(α) sector, α = 86°, 73°,
+//! 52°). Since a chain's modes fill [ω_min, ω_max], a mode lies in the unstable band as soon
+//! as h·ω_max exceeds the limit, even when ω_max itself is beyond it (BDF5 at hω_max > 9.38).
+//! - Order selection: each candidate's step factor is the smaller of its accuracy factor and
+//!   its stability factor limit/(h·ω_max); the order rises only where its step is stable.
+//! - When stability holds the chosen order k > 3 below what accuracy allows, order 2 (error
+//!   from ∇³y_{n+1}) is taken if its step is 10 times longer on 3 selections in a row; near
+//!   the limit (BDF5 resolving an oscillation at hω ≈ 0.7, springpend at k = 1e8) the
+//!   estimates of order 2 swing with the phase, and a drop there would trade a resolved,
+//!   stable oscillation for BDF2's damping of it.
+//! - Between selections, a fresh estimate that puts h beyond order k's limit shrinks h to the
+//!   limit when that costs less than a factor 10, and otherwise drops to the highest stable
+//!   order at once.
+//! - Finite-difference and mass-only iteration matrices (models without tangents) give no M,
+//!   K_t apart: no estimate, no limit (dpend, chain8 and seed2dof run as before).
+//!
+//! On `chain30_stiff` over 2 s (`cargo test --release --test bdf_stiff_oscillation --
+//! --nocapture`): 105 / 472 / 2,437 steps at rtol 1e-4 / 1e-6 / 1e-8, orders 3–5 never taken,
+//! the error of BDF capped at order 2 (4.5e-2, 2.2e-3, 8.5e-5; Radau5: 16 / 32 / 78 steps).
+//! At rtol 1e-4 the unlimited BDF5 did better (45 steps, 3.6e-3): its steps put every stiff
+//! mode beyond BDF5's unstable band (h·ω_min,stiff > 9.38), which ω_max alone cannot tell;
+//! likewise springpend's single radial mode from the slow-manifold start at k = 1e8 (286 steps,
+//! was 45). Where the oscillation must be followed, the high order stays: springpend at
+//! k = 1e8 from r = 1 + 9.81/k runs 92 % of its 20,962 steps at order 5 with hω ≤ 0.7 (it
+//! took 23,901 when rejected past the limit).
 //!
 //! Every buffer is allocated in [`Bdf::new`]; steps allocate nothing.
 
@@ -53,6 +102,7 @@ use super::problem::Problem;
 use super::step_control::{elementary_factor, optimal_factor};
 use super::{Attempt, Control, State, Step, Stepper};
 use crate::error::Failure;
+use crate::linalg::{cholesky, cholesky_solve};
 use crate::model::Model;
 
 const MAX_ORDER: usize = 5;
@@ -61,6 +111,124 @@ const GAMMA: [f64; MAX_ORDER + 1] = [0.0, 1.0, 1.5, 11.0 / 6.0, 25.0 / 12.0, 137
 /// step factor limits: shrinking by at most 5 on a rejection, growing by at most 10
 const MIN_FACTOR: f64 = 0.2;
 const MAX_FACTOR: f64 = 10.0;
+
+/// h·ω of an undamped oscillation up to which order k is used (orders 1 and 2 are A-stable):
+/// BDF3 and BDF4 amplify it by 1 + 1.3e-4 and 1 + 7e-5 a step there (their growth on the
+/// imaginary axis goes as (hω)^(k+1) up to 1.93 and 4.69, peaking at 4.6 % and 19 % a step);
+/// BDF5 is stable up to hω = 0.714 (then unstable up to 9.38, by up to 38 % a step), 0.6 leaves
+/// room for an estimate of ω from below.
+const OSCILLATION_LIMIT: [f64; MAX_ORDER + 1] =
+    [f64::INFINITY, f64::INFINITY, f64::INFINITY, 0.3, 0.4, 0.7];
+/// cos α_k of the A(α_k)-stable orders (α = 86.03°, 73.35°, 51.84°): a mode of damping ratio
+/// ζ > cos α_k lies in the sector order k is stable in, whatever h.
+const COS_ALPHA: [f64; MAX_ORDER + 1] = [0.0, 0.0, 0.0, 0.0692, 0.2865, 0.6182];
+/// a stability-limited order k > 2 drops to order 2 at a selection when order 2's error allows a
+/// step this many times longer: near the limit (an oscillation resolved at hω ≈ 0.7 by BDF5)
+/// the estimates of order 2 swing with the oscillation's phase, and a drop there would trade
+/// a stable resolved oscillation for BDF2's damping of it
+const DROP_GAIN: f64 = 10.0;
+/// … on this many selections in a row
+const DROP_VOTES: usize = 3;
+/// power iterations per fresh iteration matrix, each continuing from the last direction
+const POWER_ITERATIONS: usize = 12;
+
+/// The fastest undamped mode, from M and K_t of the last iteration matrix: a power iteration on
+/// M⁻¹K_t (warm-started from the previous direction) gives ω² of the fastest mode, the Rayleigh
+/// quotients xᵀK_t x and xᵀC_t x its sign (an oscillation, or a static instability) and its
+/// damping ratio ζ = xᵀC_t x / (2ω xᵀM x).
+struct Spectrum {
+    n: usize,
+    /// Cholesky factor of M
+    chol: Vec<f64>,
+    x: Vec<f64>,
+    y: Vec<f64>,
+    /// an estimate is there and the fastest mode oscillates
+    oscillating: bool,
+    omega: f64,
+    zeta: f64,
+}
+
+impl Spectrum {
+    fn new(n: usize) -> Spectrum {
+        Spectrum {
+            n,
+            chol: vec![0.0; n * n],
+            x: vec![0.0; n],
+            y: vec![0.0; n],
+            oscillating: false,
+            omega: 0.0,
+            zeta: 0.0,
+        }
+    }
+
+    fn forget(&mut self) {
+        self.oscillating = false;
+        self.x.fill(0.0);
+    }
+
+    /// y = A x (A n × n, column-major)
+    fn product(n: usize, a: &[f64], x: &[f64], y: &mut [f64]) {
+        y.fill(0.0);
+        for (j, xj) in x.iter().enumerate() {
+            for (yi, aij) in y.iter_mut().zip(&a[j * n..(j + 1) * n]) {
+                *yi += aij * xj;
+            }
+        }
+    }
+
+    fn dot(a: &[f64], b: &[f64]) -> f64 {
+        a.iter().zip(b).map(|(x, y)| x * y).sum()
+    }
+
+    fn estimate(&mut self, m: &[f64], c: &[f64], k: &[f64]) {
+        let n = self.n;
+        self.oscillating = false;
+        self.chol.copy_from_slice(m);
+        if cholesky(&mut self.chol, n).is_err() {
+            return;
+        }
+        if self.x.iter().all(|x| *x == 0.0) {
+            for (i, x) in self.x.iter_mut().enumerate() {
+                *x = 1.0 + 0.37 * i as f64 * if i % 2 == 0 { 1.0 } else { -1.0 };
+            }
+        }
+        let norm = Self::dot(&self.x, &self.x).sqrt();
+        self.x.iter_mut().for_each(|x| *x /= norm);
+        let mut lambda = 0.0;
+        for _ in 0..POWER_ITERATIONS {
+            Self::product(n, k, &self.x, &mut self.y);
+            cholesky_solve(&self.chol, n, &mut self.y);
+            lambda = Self::dot(&self.y, &self.y).sqrt();
+            if !(lambda > 0.0 && lambda.is_finite()) {
+                // no stiffness (or not a number): nothing to limit
+                self.x.fill(0.0);
+                return;
+            }
+            for (x, y) in self.x.iter_mut().zip(&self.y) {
+                *x = y / lambda;
+            }
+        }
+        Self::product(n, k, &self.x, &mut self.y);
+        let xkx = Self::dot(&self.x, &self.y);
+        Self::product(n, m, &self.x, &mut self.y);
+        let xmx = Self::dot(&self.x, &self.y);
+        Self::product(n, c, &self.x, &mut self.y);
+        let xcx = Self::dot(&self.x, &self.y);
+        self.omega = lambda.sqrt();
+        self.zeta = xcx / (2.0 * self.omega * xmx);
+        self.oscillating = xkx > 0.0 && xmx > 0.0 && self.zeta.is_finite();
+    }
+
+    /// The largest factor on h that order k may take from h for stability: unlimited but on an
+    /// oscillation order k's sector leaves out.
+    fn factor(&self, k: usize, h: f64) -> f64 {
+        if k <= 2 || !self.oscillating || self.zeta > COS_ALPHA[k] {
+            f64::INFINITY
+        } else {
+            OSCILLATION_LIMIT[k] / (self.omega * h)
+        }
+    }
+}
 
 /// The error constant of order k: local error ≈ ∇^{k+1}y_{n+1}/(k+1).
 fn error_const(k: usize) -> f64 {
@@ -109,6 +277,9 @@ pub(crate) struct Bdf {
     next_order: usize,
     reselected: bool,
     newton: AccelNewton,
+    spectrum: Spectrum,
+    /// selections in a row at which order 2 would have taken DROP_GAIN times the step
+    drop_votes: usize,
 }
 
 impl Bdf {
@@ -134,6 +305,8 @@ impl Bdf {
             next_order: 1,
             reselected: false,
             newton: AccelNewton::new(n),
+            spectrum: Spectrum::new(n),
+            drop_votes: 0,
         }
     }
 
@@ -182,6 +355,8 @@ impl<M: Model> Stepper<M> for Bdf {
         self.order = 1;
         self.next_order = 1;
         self.n_equal = 0;
+        self.spectrum.forget();
+        self.drop_votes = 0;
         Ok(())
     }
 
@@ -220,7 +395,13 @@ impl<M: Model> Stepper<M> for Bdf {
                 gamma: c,
             },
         };
+        let made = p.stats.tangents;
         let r = self.newton.solve(p, step, &mut self.a, &ctl.newton);
+        if p.stats.tangents != made
+            && let Some((m, c, k)) = p.last_tangents()
+        {
+            self.spectrum.estimate(m, c, k);
+        }
         let iterations = match r {
             Ok(it) => it,
             Err(f) => {
@@ -235,8 +416,13 @@ impl<M: Model> Stepper<M> for Bdf {
             self.corr[n + i] = next.qd[i] - self.ypred[n + i];
         }
         let Some(tol) = ctl.adaptive else {
-            // fixed steps: raise the order by one per step, no error test
-            self.next_order = (k + 1).min(self.max_order);
+            // fixed steps: raise the order by one per step, no error test, as far as h is
+            // stable on the fastest oscillation
+            let mut order = (k + 1).min(self.max_order);
+            while order > 2 && self.spectrum.factor(order, h) < 1.0 {
+                order -= 1;
+            }
+            self.next_order = order;
             self.reselected = self.next_order != k;
             p.watch_accepted(cur.t + h, &next.q)?;
             return Ok(Attempt::Accepted { h_next: h });
@@ -279,21 +465,60 @@ impl<M: Model> Stepper<M> for Bdf {
             } else {
                 f64::INFINITY
             };
-            // step factors err^(−1/(order+1)); the first of the largest wins
-            let facs = [
-                optimal_factor(err_m, k - 1),
-                optimal_factor(err, k),
-                optimal_factor(err_p, k + 1),
-            ];
-            let mut best = 0;
-            for (i, f) in facs.iter().enumerate() {
-                if *f > facs[best] {
-                    best = i;
+            // step factors err^(−1/(order+1)), each within what stability allows the order;
+            // the first of the largest wins
+            let mut best = (k, 0.0);
+            let mut consider = |order: usize, err: f64| {
+                let f = optimal_factor(err, order).min(self.spectrum.factor(order, h) / safety);
+                if f > best.1 {
+                    best = (order, f);
                 }
+            };
+            consider(k - 1, err_m);
+            consider(k, err);
+            if k < self.max_order {
+                consider(k + 1, err_p);
             }
-            self.next_order = k + best - 1;
+            // stability holds every order above 2 below what accuracy allows: consider the
+            // A-stable order 2 too, its error from ∇³y_{n+1} = Σ_{j=3..k} ∇ʲyₙ + ∇^{k+1}y_{n+1}
+            let f = best.1;
+            if k > 3 && f < optimal_factor(err, k).max(optimal_factor(err_m, k - 1)) {
+                for i in 0..m {
+                    let mut s = self.corr[i];
+                    for j in 3..=k {
+                        s += self.d[j * m + i];
+                    }
+                    self.err[i] = error_const(2) * s;
+                }
+                let err_2 = tol.error_norm(&self.err, &self.y0, &self.y1);
+                if optimal_factor(err_2, 2) > DROP_GAIN * f {
+                    self.drop_votes += 1;
+                    if self.drop_votes >= DROP_VOTES {
+                        best = (2, optimal_factor(err_2, 2));
+                    }
+                } else {
+                    self.drop_votes = 0;
+                }
+            } else {
+                self.drop_votes = 0;
+            }
+            self.next_order = best.0;
             self.reselected = true;
-            h_next = h * (safety * facs[best]).min(MAX_FACTOR);
+            h_next = h * (safety * best.1).min(MAX_FACTOR);
+        } else if k > 2 && self.spectrum.factor(k, h) < 1.0 {
+            // a fresh estimate finds h beyond order k's limit: shrink h to it when that costs
+            // less than DROP_GAIN, else drop at once to the highest order stable at h
+            let stable = self.spectrum.factor(k, h);
+            if stable * DROP_GAIN >= 1.0 {
+                h_next = h * stable;
+            } else {
+                let mut order = k - 1;
+                while order > 2 && self.spectrum.factor(order, h) < 1.0 {
+                    order -= 1;
+                }
+                self.next_order = order;
+                self.reselected = true;
+            }
         }
         p.watch_accepted(cur.t + h, &next.q)?;
         Ok(Attempt::Accepted { h_next })

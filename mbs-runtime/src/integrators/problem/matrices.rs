@@ -106,6 +106,17 @@ impl<M: Model> Problem<M> {
         Ok(())
     }
 
+    /// M, C_t and K_t (n × n, column-major) the last iteration matrix was made of, when it was
+    /// made of them (exact tangents, tree models): what a scheme may read, at no evaluation,
+    /// right after a fresh matrix to learn about the stiffness (BDF's spectrum estimate).
+    pub fn last_tangents(&self) -> Option<(&[f64], &[f64], &[f64])> {
+        let exact = matches!(
+            self.iteration,
+            IterationMatrix::Exact | IterationMatrix::Auto
+        );
+        (exact && !self.ode()).then_some((&self.m[..], &self.c[..], &self.k[..]))
+    }
+
     /// The pieces of the iteration matrix, unfactorised, for schemes that combine them with
     /// several (or complex) coefficients: M, C_t = ∂τ/∂qd and K_t = ∂τ/∂q at
     /// (t, q, qd, qdd), n × n column-major each, as `self.iteration` says: exact (M and the

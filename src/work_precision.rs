@@ -990,3 +990,118 @@ impl fmt::Display for WorkPrecision {
         Ok(())
     }
 }
+
+/// How one adaptive sweep's error follows its tolerance: the digits −log10 e_max of every run
+/// against those of its rtol (tolerance proportionality). A sweep whose runs gain one digit
+/// per decade of rtol, close to rtol itself, is one whose rtol means what it says.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Proportionality {
+    pub label: String,
+    /// the sweep's tolerances, in its order
+    pub rtols: Vec<f64>,
+    /// −log10 e_max of each run; `None` where the run failed
+    pub digits: Vec<Option<f64>>,
+}
+
+impl Proportionality {
+    /// digits − (−log10 rtol) of each successful run: negative where the run is less accurate
+    /// than rtol.
+    pub fn offsets(&self) -> impl Iterator<Item = (f64, f64)> + '_ {
+        self.rtols
+            .iter()
+            .zip(&self.digits)
+            .filter_map(|(r, d)| d.map(|d| (*r, d + r.log10())))
+    }
+
+    /// The largest number of digits lost from one rtol to the next, tighter, one (0 when every
+    /// tightening gained); failed runs are skipped.
+    pub fn largest_loss(&self) -> f64 {
+        let ok: Vec<f64> = self.digits.iter().flatten().copied().collect();
+        ok.windows(2).map(|w| w[0] - w[1]).fold(0.0, f64::max)
+    }
+
+    /// Least-squares slope of the digits against −log10 rtol (1 for a proportional sweep).
+    pub fn slope(&self) -> f64 {
+        let pts: Vec<(f64, f64)> = self
+            .rtols
+            .iter()
+            .zip(&self.digits)
+            .filter_map(|(r, d)| d.map(|d| (-r.log10(), d)))
+            .collect();
+        let n = pts.len() as f64;
+        let (mx, my) = pts
+            .iter()
+            .fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n, b + y / n));
+        let sxy: f64 = pts.iter().map(|(x, y)| (x - mx) * (y - my)).sum();
+        let sxx: f64 = pts.iter().map(|(x, _)| (x - mx) * (x - mx)).sum();
+        sxy / sxx
+    }
+}
+
+impl WorkPrecision {
+    /// The tolerance proportionality of every adaptive sweep, in the study's order (sweeps of
+    /// fixed steps have no rtol to follow and are left out).
+    pub fn proportionality(&self) -> Vec<Proportionality> {
+        let mut out: Vec<Proportionality> = Vec::new();
+        for r in &self.rows {
+            let Setting::Rtol(rtol) = r.setting else {
+                continue;
+            };
+            let digits = r.outcome.as_ref().ok().map(|a| -a.error_max.log10());
+            match out.iter_mut().find(|p| p.label == r.label) {
+                Some(p) => {
+                    p.rtols.push(rtol);
+                    p.digits.push(digits);
+                }
+                None => out.push(Proportionality {
+                    label: r.label.clone(),
+                    rtols: vec![rtol],
+                    digits: vec![digits],
+                }),
+            }
+        }
+        out
+    }
+
+    /// The proportionality table: for each adaptive sweep, −log10 e_max at each rtol, the
+    /// slope, the mean offset from rtol's digits and the largest loss when rtol tightens.
+    pub fn proportionality_table(&self) -> String {
+        let props = self.proportionality();
+        let w = props
+            .iter()
+            .map(|p| p.label.chars().count())
+            .fold(6, usize::max);
+        let mut s = format!(
+            "tolerance proportionality: {} (digits = −log10 e_max)\n{:<w$}",
+            self.title, "scheme"
+        );
+        let rtols = props.first().map(|p| p.rtols.clone()).unwrap_or_default();
+        for r in &rtols {
+            let _ = write!(s, " {:>6}", short(*r));
+        }
+        let _ = writeln!(s, " {:>6} {:>7} {:>6}", "slope", "offset", "loss");
+        for p in &props {
+            let _ = write!(s, "{:<w$}", p.label);
+            for d in &p.digits {
+                match d {
+                    Some(d) => {
+                        let _ = write!(s, " {d:>6.2}");
+                    }
+                    None => {
+                        let _ = write!(s, " {:>6}", "fail");
+                    }
+                }
+            }
+            let offsets: Vec<f64> = p.offsets().map(|(_, o)| o).collect();
+            let mean = offsets.iter().sum::<f64>() / offsets.len().max(1) as f64;
+            let _ = writeln!(
+                s,
+                " {:>6.2} {:>7.2} {:>6.2}",
+                p.slope(),
+                mean,
+                p.largest_loss()
+            );
+        }
+        s
+    }
+}

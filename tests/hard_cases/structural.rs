@@ -139,7 +139,7 @@ fn structurally_singular_models_are_refused_naming_their_coordinates() {
         &[
             [87, 23, 0, 667, 3, 0, 0, 670, 674, 0, 0], // sine slider dopri5
             [1117, 0, 12, 2, 122, 4550, 86, 112, 4648, 4550, 86], // sine slider gen-alpha
-            [408, 42, 11, 2, 93, 833, 60, 84, 923, 833, 60], // sine slider bdf
+            [1010, 17, 11, 2, 131, 1044, 98, 122, 1134, 1044, 98], // sine slider bdf
             [173, 0, 0, 2, 176, 1548, 173, 351, 1215, 516, 173], // sine slider radau5
             [994, 0, 0, 4108, 3, 0, 0, 4111, 4115, 0, 0], // sine slider rk4, singularity_tol 1e-2
         ],

@@ -35,15 +35,16 @@ fn distance(q: &[f64], qd: &[f64], rq: &[f64], rqd: &[f64]) -> f64 {
 ///
 /// Measured (slopes of the fits below): k = 1: 0.97, 2: 2.00, 3: 3.00, 4: 4.01, 5: 5.05.
 /// BDF1 and BDF2 need small steps on the 10 Hz mode (their damping is of order hω per step),
-/// hence the looser tolerances and the many steps of k = 1 (up to 230,000, still fast).
+/// hence the looser tolerances and the many steps of k = 1 (up to 230,000, still fast). The
+/// tolerances are the user's; the error test runs at rtol' = 0.1·rtol^1.25 (1e-5 … 1e-9 here).
 #[test]
 fn observed_orders_on_seed2dof() {
     let cases: [(usize, &[f64]); 5] = [
-        (1, &[1e-5, 1e-6, 1e-7]),
-        (2, &[1e-6, 1e-7, 1e-8, 1e-9]),
-        (3, &[1e-6, 1e-7, 1e-8, 1e-9]),
-        (4, &[1e-6, 1e-7, 1e-8, 1e-9]),
-        (5, &[1e-6, 1e-7, 1e-8, 1e-9]),
+        (1, &[6e-4, 1e-4, 1.6e-5]),
+        (2, &[1e-4, 1e-5, 1e-6, 1e-7]),
+        (3, &[1e-4, 1e-5, 1e-6, 1e-7]),
+        (4, &[1e-4, 1e-5, 1e-6, 1e-7]),
+        (5, &[1e-4, 1e-5, 1e-6, 1e-7]),
     ];
     for (k, rtols) in cases {
         let mut steps = Vec::new();
@@ -201,7 +202,7 @@ fn work_counters_snapshot() {
     // evaluations, steps per order)
     assert_eq!(
         got,
-        (308, 32, 0, 575, 61, 1062, vec![2, 17, 4, 5, 280]),
+        (637, 68, 0, 756, 113, 1728, vec![2, 19, 4, 54, 558]),
         "{st}"
     );
 }

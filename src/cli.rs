@@ -7,7 +7,7 @@
 //! --rtol R --atol A
 //! --max-steps N   attempted steps before the run gives up (default 1000000)
 //! --dt DT         output every DT seconds (default: every step)
-//! --constraints M auto, index3, projection, partitioning, baumgarte:ALPHA,BETA
+//! --constraints M auto, index3, index2, projection, partitioning, baumgarte:ALPHA,BETA
 //!                 (constrained models; default auto)
 //! --scene NAME    the scene to run (programs whose model has several)
 //! --out DIR       write DIR/trajectory.csv (every output, written as the run goes),
@@ -84,7 +84,7 @@ pub struct RunArgs {
     /// stats.json (also, up to where it stopped, for a run that fails or is stopped by Ctrl-C)
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// constraint method of constrained models: auto, index3, projection, partitioning or
+    /// constraint method of constrained models: auto, index3, index2, projection, partitioning or
     /// baumgarte:ALPHA,BETA (1/s)
     #[arg(long, default_value = "auto", value_parser = parse_constraint_method)]
     pub constraints: ConstraintMethod,
@@ -224,7 +224,7 @@ fn failure_text(e: &SimError) -> String {
             "constraint `{constraint}` drifted to |Φ| = {value:.2e}, beyond {tolerance:.1e} {at}: use --constraints projection, index3 or partitioning, or larger baumgarte:ALPHA,BETA"
         ),
         Failure::ConstraintsUnsupported { scheme, method, .. } => format!(
-            "{scheme} cannot integrate constraints by {method}: use --constraints projection (any scheme), or index 3 with --scheme gen-alpha, hht or radau5"
+            "{scheme} cannot integrate constraints by {method}: use --constraints projection (any scheme), or index 3 or index 2 with --scheme gen-alpha, hht, newmark, radau3 or radau5"
         ),
         _ => e.to_string(),
     }

@@ -6,10 +6,13 @@
 
 #[path = "common/alloc.rs"]
 mod alloc;
+mod common;
+
+use common::constraint_residuals;
 
 use mbs::{
-    ConstraintMethod, ErrorTest, GenAlphaParams, HhtParams, Integrator, Model, NewmarkParams,
-    Options, Output, Scheme, Simulation, Stats, Trajectory, simulate,
+    ConstraintMethod, ErrorTest, GenAlphaParams, HhtParams, Integrator, NewmarkParams, Options,
+    Output, Scheme, Simulation, Stats, simulate,
 };
 use mbs_models::{pendulum3, slidercrank};
 use pendulum3::Pendulum3;
@@ -83,25 +86,6 @@ fn index2_is_second_order_in_q_qd_and_lambda() {
             assert!(min(&ol) >= 1.7, "{name}: λ orders {ol:?}");
         }
     }
-}
-
-/// Largest |Φ_i| and |Φ̇_i| = |B qd + Φ_t| over the outputs of a trajectory.
-fn constraint_residuals<M: Model>(m: &M, t: &Trajectory) -> (f64, f64) {
-    let (n, nc) = (M::NQ, M::NC);
-    let (mut phi, mut b, mut phi_t) = (vec![0.0; nc], vec![0.0; nc * n], vec![0.0; nc]);
-    let (mut worst, mut worst_rate) = (0.0f64, 0.0f64);
-    for k in 0..t.len() {
-        let (tk, q, qd) = (t.t[k], t.q(k), t.qd(k));
-        m.constraints(tk, q, &mut phi);
-        m.constraint_jacobian(tk, q, &mut b);
-        m.constraint_rate(tk, q, &mut phi_t);
-        for i in 0..nc {
-            let rate = phi_t[i] + (0..n).map(|j| b[i + nc * j] * qd[j]).sum::<f64>();
-            worst = worst.max(phi[i].abs());
-            worst_rate = worst_rate.max(rate.abs());
-        }
-    }
-    (worst, worst_rate)
 }
 
 #[test]

@@ -22,6 +22,7 @@ use mbs_models::{dpend, fourbar, pendulum3, slidercrank};
 use pendulum3::Pendulum3;
 #[path = "common/alloc.rs"]
 mod alloc;
+mod common;
 
 const INDEX2: ConstraintMethod = ConstraintMethod::Index2;
 
@@ -249,20 +250,7 @@ fn constraints_and_their_rates_hold_at_every_step() {
                     ..with_method(Options::adaptive(t_end, rtol), INDEX2)
                 };
                 let (tr, _) = run(model.clone(), scheme, o);
-                let (n, nc) = (M::NQ, M::NC);
-                let (mut phi, mut b, mut phit) = (vec![0.0; nc], vec![0.0; nc * n], vec![0.0; nc]);
-                let (mut worst, mut worst_rate) = (0.0f64, 0.0f64);
-                for i in 0..tr.len() {
-                    let (t, q, qd) = (tr.t[i], tr.q(i), tr.qd(i));
-                    model.constraints(t, q, &mut phi);
-                    model.constraint_jacobian(t, q, &mut b);
-                    model.constraint_rate(t, q, &mut phit);
-                    for k in 0..nc {
-                        let rate = phit[k] + (0..n).map(|j| b[k + nc * j] * qd[j]).sum::<f64>();
-                        worst = worst.max(phi[k].abs());
-                        worst_rate = worst_rate.max(rate.abs());
-                    }
-                }
+                let (worst, worst_rate) = common::constraint_residuals(&model, &tr);
                 println!(
                     "{} {} rtol {rtol:e}: max |Φ| {worst:.1e}, max |Φ̇| {worst_rate:.1e} over {} steps",
                     model.info().name,

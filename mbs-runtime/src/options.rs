@@ -214,14 +214,8 @@ impl Scheme {
     /// Whether the scheme solves constrained models in the stabilized index-2 form
     /// ([`ConstraintMethod::Index2`]).
     pub fn solves_index2(&self) -> bool {
-        matches!(
-            self,
-            Scheme::Newmark(_)
-                | Scheme::Hht(_)
-                | Scheme::GenAlpha(_)
-                | Scheme::Radau3
-                | Scheme::Radau5
-        )
+        // the same schemes as index 3: the scheme itself solves for the multipliers
+        self.solves_index3()
     }
 
     /// Whether the scheme can control its step by a local error estimate.

@@ -1,7 +1,7 @@
 //! Helpers shared by the integration tests: exact solutions and reference data.
 #![allow(dead_code)]
 
-use mbs::Trajectory;
+use mbs::{Model, Trajectory};
 
 /// The seed2dof system: M = I, K = [[k1 + k2, −k2], [−k2, k2]], q0 = (0, 1), qd0 = 0.
 pub const K1: f64 = 79.15;
@@ -89,4 +89,23 @@ pub fn final_error(tr: &Trajectory, q: &[f64], qd: &[f64]) -> f64 {
         .chain(tr.qd(i).iter().zip(qd))
         .map(|(a, b)| (a - b).abs())
         .fold(0.0, f64::max)
+}
+
+/// Largest |Φ_i| and |Φ̇_i| = |B qd + Φ_t| over the outputs of a trajectory.
+pub fn constraint_residuals<M: Model>(m: &M, t: &Trajectory) -> (f64, f64) {
+    let (n, nc) = (M::NQ, M::NC);
+    let (mut phi, mut b, mut phi_t) = (vec![0.0; nc], vec![0.0; nc * n], vec![0.0; nc]);
+    let (mut worst, mut worst_rate) = (0.0f64, 0.0f64);
+    for k in 0..t.len() {
+        let (tk, q, qd) = (t.t[k], t.q(k), t.qd(k));
+        m.constraints(tk, q, &mut phi);
+        m.constraint_jacobian(tk, q, &mut b);
+        m.constraint_rate(tk, q, &mut phi_t);
+        for i in 0..nc {
+            let rate = phi_t[i] + (0..n).map(|j| b[i + nc * j] * qd[j]).sum::<f64>();
+            worst = worst.max(phi[i].abs());
+            worst_rate = worst_rate.max(rate.abs());
+        }
+    }
+    (worst, worst_rate)
 }

@@ -7,24 +7,29 @@
 //!
 //! Asserted for the methods whose error test covers positions and velocities and whose
 //! tolerance is mapped so that the error follows rtol (DOPRI5 and BDF with projection or
-//! partitioning, Radau5 with projection, partitioning or index 2, the Newmark family at
-//! index 2, its default, from rtol 1e-4 to 1e-7 — below that its local tolerance reaches the
+//! partitioning, Radau5 with projection or partitioning, the Newmark family at index 2
+//! from rtol 1e-4 to 1e-7 — below that its local tolerance reaches the
 //! rounding floor; DOPRI5 from 1e-5), over their range:
 //!
 //! - every run reaches t_end;
 //! - no run loses more than 0.2 digits when rtol tightens by a decade;
-//! - within 1.5 digits of the median of the asserted sweeps at the same rtol, on every model:
-//!   what rtol means does not depend on the scheme or the method by more than that.
+//! - no more than 1.5 digits below the median of the asserted sweeps at the same rtol, on
+//!   every model: a user who trusts rtol is not misled by the choice of scheme or method by
+//!   more than that. (Above it is not an error: BDF with partitioning gets 6.1 digits on
+//!   fastlink at rtol 1e-7, where the median is 4.3.)
 //!
 //! Not asserted, because not true: within 1.5 digits of rtol itself. On the Cartesian double
 //! pendulum, Cash's pendulum and slider-crank (b) the asserted sweeps are 0.3–1.8 digits short
 //! (DOPRI5 at rtol 1e-4 the worst), on the four-bar, slider-crank (a) and fastlink 1.5–3
 //! digits: these motions amplify local errors, which no local error test sees.
 //!
-//! Printed, not asserted: index 3 (Radau weights velocity errors by h, the Newmark family
-//! tests positions only: 2–5 digits short, ⅔ of a digit per decade), the Newmark family with
-//! projection or partitioning (positions only), and Radau3, which keeps RADAU5's tolerance
-//! transformation (2–4 digits short: `mbs-runtime/src/integrators/radau/mod.rs`).
+//! Printed, not asserted: index 3, the Newmark family's default (Radau weights velocity
+//! errors by h, the Newmark family tests positions only: 2–5 digits short, ⅔ of a digit per
+//! decade), the Newmark family with projection or partitioning (positions only), Radau3, which
+//! keeps RADAU5's tolerance transformation (2–4 digits short:
+//! `mbs-runtime/src/integrators/radau/mod.rs`), and Radau5 at index 2 (over-accurate at loose
+//! rtol, half a digit per decade: 5.4 digits at rtol 1e-4 and 8.0 at 1e-10 on the Cartesian
+//! double pendulum, and it loses 0.5 digits from rtol 1e-5 to 1e-6 on the four-bar).
 //!
 //! `cargo test --release --test tolerance_proportionality -- --nocapture` prints the tables
 //! and the digits of q and qd apart at rtol 1e-8.
@@ -35,7 +40,7 @@ use mbs_models::{dpend, dpend_cartesian, fastlink, fourbar, pendulum3, slidercra
 
 mod common;
 
-/// Digits of rtol (or of DOPRI5's error) the mixed error may differ by.
+/// Digits a sweep may fall below the median of the others at the same rtol.
 const WITHIN: f64 = 1.5;
 /// Digits a run may lose when rtol tightens by a decade.
 const LOSS: f64 = 0.2;
@@ -47,7 +52,7 @@ fn claimed(label: &str) -> Option<(f64, f64)> {
     let (scheme, method) = label.split_once(' ').unwrap_or((label, ""));
     match (scheme, method) {
         (_, "index3") | ("radau3", _) | ("radau5", "index2") => None,
-        ("gen-alpha" | "hht", "auto" | "index2") => Some((1e-4, 1e-7)),
+        ("gen-alpha" | "hht", "index2") => Some((1e-4, 1e-7)),
         ("gen-alpha" | "hht", _) => None,
         ("dopri5", _) => Some((1e-5, 1e-10)),
         _ => Some((1e-4, 1e-10)),
@@ -180,7 +185,7 @@ fn judge(wp: &WorkPrecision, constrained: bool) -> Vec<String> {
                 continue;
             };
             if let Some(m) = median(k)
-                && (d - m).abs() > WITHIN
+                && d < m - WITHIN
             {
                 bad.push(format!("{}: {d:.2} digits, the median {m:.2}", at(r)));
             }

@@ -316,10 +316,11 @@ impl Default for NewtonOptions {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, Default)]
 #[non_exhaustive]
 pub enum ConstraintMethod {
-    /// `Index2` for the Newmark family (generalized-α, HHT, Newmark), whose error test then
-    /// covers positions and velocities, except for its undamped members (ρ∞ = 1: Newmark's
-    /// trapezoidal rule, generalized-α at ρ∞ = 1, HHT at α = 0), whose λ oscillates at index
-    /// 3 and 2 and which may diverge there; `Projection` for every other scheme,
+    /// `Index3` for the Newmark family (generalized-α, HHT, Newmark; `Index2` follows rtol in
+    /// (q, qd) but costs more for the same digits: 3–14× on fastlink), except for its
+    /// undamped members (ρ∞ = 1: Newmark's trapezoidal rule, generalized-α at ρ∞ = 1, HHT at
+    /// α = 0), whose λ oscillates at index 3 and 2 and which may diverge there; `Projection`
+    /// for every other scheme,
     /// Radau included: at index 3 Radau's λ is only of order s − 1 and its error control
     /// does not aim at it, while projection gives λ of the index-1 form at the accuracy of q
     /// and qd (in the stabilized index-2 form λ is of order s, and the run takes more steps

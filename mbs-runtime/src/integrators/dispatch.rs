@@ -18,15 +18,14 @@ pub(super) fn constraint_mode(
     let no_damping = scheme.spectral_radius_at_infinity() == Some(1.0);
     let undamped = adaptive && no_damping;
     Ok(match method {
-        // the damped members of the Newmark family solve the stabilized index-2 form by
-        // default, Radau only on request: for the same steps index 2 gets as many digits in
-        // (q, qd) as index 3 (slider-crank 3.1 in 6,000 steps, four-bar 4.0–4.2 in 14,800,
-        // pendulum3 5.2 in 670 where index 3 needs 1,000), and at the rtol asked for, where
-        // index 3 needs rtol 1e-9 … 1e-10 (`examples/newmark_tolerance.rs`). The undamped
-        // members (trapezoidal Newmark, ρ∞ = 1) diverge at index 3 on fast loops even at fixed
-        // steps (slider-crank at h ≥ 1 ms: `examples/work_precision.rs`) and take Projection
+        // the damped members of the Newmark family at index 3, Radau only on request. Index 2
+        // follows rtol but costs more for the same digits in (q, qd) (`examples/
+        // work_precision.rs`: fastlink, 3 digits, gen-α 60 ms at index 2 against 18 ms at
+        // index 3, 5 digits 574 ms against 40 ms; four-bar, 3 digits, 6.6 ms against 4.7 ms).
+        // The undamped members (trapezoidal Newmark, ρ∞ = 1) diverge at index 3 on fast loops
+        // even at fixed steps (slider-crank at h ≥ 1 ms) and take Projection
         ConstraintMethod::Auto if scheme.spectral_radius_at_infinity().is_some() && !no_damping => {
-            Mode::Index2
+            Mode::Index3
         }
         ConstraintMethod::Auto | ConstraintMethod::Projection => Mode::Projection,
         ConstraintMethod::Index3 if !scheme.solves_index3() => {

@@ -78,7 +78,7 @@
 //! rtol. The velocities, whose Φ̇ is only O(h²), are not controlled (table above): use index
 //! 2 for them.
 //!
-//! ## Constraints at index 2 (the default of the damped members)
+//! ## Constraints at index 2 (on request)
 //! With `Index2`, the stabilized index-2 generalized-α of Arnold, Brüls & Cardona (2015,
 //! after Gear, Gupta & Leimkuhler): a second multiplier ν corrects the positions,
 //!
@@ -94,7 +94,10 @@
 //! with order 2 at fixed steps for ρ∞ < 1 (`tests/newmark_index2.rs`: pendulum3, orders 2.00
 //! at h = 8 … 1 ms), and the error test covers q and qd (`ErrorTest::PositionsVelocities`).
 //! Newton takes about as many iterations as at index 3 (four-bar at h = 1 ms: 2.0 against
-//! 1.8 per step), its matrix n more evaluations of B and Φ_t. The undamped members (ρ∞ = 1) are refused with adaptive steps, as at index 3: on
+//! 1.8 per step), its matrix n more evaluations of B and Φ_t. It is not the default: for the
+//! same digits in (q, qd) index 3 is cheaper (`examples/work_precision.rs`, fastlink: gen-α
+//! at 3 digits 60 ms at index 2 and 18 ms at index 3, at 5 digits 574 ms and 40 ms). The
+//! undamped members (ρ∞ = 1) are refused with adaptive steps, as at index 3: on
 //! the fast loops (slider-crank, four-bar) their accelerations oscillate from step to step
 //! and the adaptive runs took 15–25 times the steps of gen-α.
 

@@ -78,10 +78,9 @@ impl Radau {
         err.max(1e-10)
     }
 
-    /// Index 3: the filter (E − gJ)⁻¹ on y = (q, v, λ), E = diag(I, M, 0), in second-order
-    /// form with the real block: [M + gC + g²K̃, −Bᵀ; B, 0] (e_v, g e_λ) =
-    /// (b_v − gK̃ r_q, −(Φ + B r_q)/g), e_q = r_q + g e_v; into `err` as (e_q, h e_v, h² e_λ).
-    pub(super) fn filter3<M: Model>(&mut self, p: &mut Problem<M>, g: f64, h: f64) {
+    /// The right-hand side the index-3 and index-2 filters share, into `tmp`:
+    /// b_v − gK̃ r_q (n rows), then −(Φ + B r_q)/g (nc rows).
+    pub(super) fn filter_rhs(&mut self, g: f64) {
         let (n, nc) = (self.n, self.nc);
         for i in 0..n {
             let mut x = self.bv[i];
@@ -94,6 +93,14 @@ impl Radau {
             let brq: f64 = (0..n).map(|j| self.bm[k + nc * j] * self.rq[j]).sum();
             self.tmp[n + k] = -(self.phix[k] + brq) / g;
         }
+    }
+
+    /// Index 3: the filter (E − gJ)⁻¹ on y = (q, v, λ), E = diag(I, M, 0), in second-order
+    /// form with the real block: [M + gC + g²K̃, −Bᵀ; B, 0] (e_v, g e_λ) =
+    /// (b_v − gK̃ r_q, −(Φ + B r_q)/g), e_q = r_q + g e_v; into `err` as (e_q, h e_v, h² e_λ).
+    pub(super) fn filter3<M: Model>(&mut self, p: &mut Problem<M>, g: f64, h: f64) {
+        let (n, nc) = (self.n, self.nc);
+        self.filter_rhs(g);
         self.lu_r.solve(&mut self.tmp);
         p.stats.solves += 1;
         for i in 0..n {

@@ -87,16 +87,8 @@ impl Radau {
     /// estimate).
     fn filter2<M: Model>(&mut self, p: &mut Problem<M>, g: f64, h: f64) {
         let (n, nc) = (self.n, self.nc);
-        for i in 0..n {
-            let mut x = self.bv[i];
-            for j in 0..n {
-                x -= g * self.km[i + n * j] * self.rq[j];
-            }
-            self.tmp[i] = x;
-        }
+        self.filter_rhs(g);
         for k in 0..nc {
-            let brq: f64 = (0..n).map(|j| self.bm[k + nc * j] * self.rq[j]).sum();
-            self.tmp[n + k] = -(self.phix[k] + brq) / g;
             self.tmp[n + nc + k] = -self.psix[k] / g;
         }
         self.lu_r.solve(&mut self.tmp);

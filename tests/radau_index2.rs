@@ -15,8 +15,8 @@
 
 use mbs::work_precision::{Reference, Setting, mixed_error};
 use mbs::{
-    ConstraintMethod, ConstraintOptions, Integrator, Model, Options, Output, Scheme, Simulation,
-    Stats, StepControl, Trajectory, simulate,
+    ConstraintMethod, ConstraintOptions, Model, Options, Output, Scheme, Simulation, Stats,
+    StepControl, Trajectory, simulate,
 };
 use mbs_models::{dpend, fourbar, pendulum3, slidercrank};
 use pendulum3::Pendulum3;
@@ -277,22 +277,9 @@ fn index2_steps_allocate_nothing_after_warm_up() {
                 output: Output::Every { dt: 0.01 },
                 ..with_method(base, INDEX2)
             };
-            let mut sim = Simulation::new(Pendulum3::default(), scheme, o)
+            let sim = Simulation::new(Pendulum3::default(), scheme, o)
                 .unwrap_or_else(|e| panic!("{}: {e}", scheme.name()));
-            for _ in 0..20 {
-                sim.step().unwrap();
-            }
-            let before = alloc::allocations();
-            for _ in 0..200 {
-                sim.step().unwrap();
-            }
-            let allocated = alloc::allocations() - before;
-            assert_eq!(
-                allocated,
-                0,
-                "{} allocated {allocated} times",
-                scheme.name()
-            );
+            alloc::assert_no_allocation(sim, scheme.name());
         }
     }
 }

@@ -37,3 +37,20 @@ static GLOBAL: Counting = Counting;
 pub fn allocations() -> usize {
     ALLOCATIONS.with(|c| c.get())
 }
+
+/// 20 steps of warm-up, then 200 steps that must not allocate.
+pub fn assert_no_allocation<M: mbs::Model + 'static>(mut sim: mbs::Simulation<M>, what: &str) {
+    use mbs::Integrator;
+    for _ in 0..20 {
+        sim.step().unwrap();
+    }
+    let before = allocations();
+    for _ in 0..200 {
+        sim.step().unwrap();
+    }
+    let allocated = allocations() - before;
+    assert_eq!(
+        allocated, 0,
+        "{what} allocated {allocated} times in 200 steps"
+    );
+}

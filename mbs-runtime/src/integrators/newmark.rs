@@ -46,11 +46,11 @@
 //! largest mixed error over (q, qd) (Test Set for IVP Solvers, floor 0.01) as digits, at rtol
 //! 1e-4 … 1e-7, gen-α (ρ∞ 0.8) at index 2: pendulum3 4.07 5.07 6.07 7.07, the Cartesian
 //! double pendulum 3.44 4.43 5.31 6.49, four-bar 2.47 3.63 4.69 5.71, slider-crank (a) 1.98
-//! 2.96 3.95 4.95, fastlink 1.86 3.08 4.17 5.21: one digit per decade, 0–3 digits short of rtol
-//! as the model amplifies errors (index 3 and projection: 2–5 digits short, ⅔ of a digit per
-//! decade). Below rtol 1e-7 the local tolerance reaches its floor and the digits stall (7.5 on
+//! 2.96 3.95 4.95, fastlink 1.86 3.08 4.17 5.21: one digit per decade, up to 2.2 digits short
+//! of rtol as the model amplifies errors (index 3 and projection: 2.9–5.5 digits short on
+//! average, ⅔ of a digit per decade). Below rtol 1e-7 the local tolerance reaches its floor and the digits stall (7.5 on
 //! pendulum3, 6.1 on the four-bar, 5.4 on the slider-crank); fastlink stops with
-//! `StepTooSmall` from rtol 1e-8 (gen-α) and 1e-9 (HHT). An error per unit step (rtol·h/1 s)
+//! `StepTooSmall` from rtol 1e-8 (gen-α) and at 1e-9 (HHT). An error per unit step (rtol·h/1 s)
 //! was tried first: it failed on fastlink (30 ms) at every rtol, its steps falling to 1e-12 s.
 //! The transformation is not applied to the other methods: with the velocity estimate on
 //! stiff models (the spring pendulum at k = 1e6, the stiff chain of `tests/hard_cases/`) the

@@ -78,12 +78,7 @@ fn slidercrank_reference() -> Reference {
     )
     .expect("reference run")
     .map("form (b) mapped to form (a)", |_, y| {
-        let (r, l) = (0.1, 0.3);
-        let (th, thd) = (y[0], y[1]);
-        let (psi, s) = slidercrank::closed_loop(th);
-        let psid = -r * th.cos() * thd / (l * psi.cos());
-        let sd = -r * th.sin() * thd - l * psi.sin() * psid;
-        vec![th, psi, s, thd, psid, sd]
+        slidercrank::form_a_state(y[0], y[1]).to_vec()
     })
 }
 

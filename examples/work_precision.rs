@@ -286,14 +286,7 @@ fn study(name: &str, repeats: usize) -> WorkPrecision {
             .expect("reference run")
             .map(
                 "form (b) (θ alone, loop in closed form) mapped to form (a)'s (θ, ψ, s) and rates",
-                |_, y| {
-                    let (r, l) = (0.1, 0.3);
-                    let (th, thd) = (y[0], y[1]);
-                    let (psi, s) = slidercrank::closed_loop(th);
-                    let psid = -r * th.cos() * thd / (l * psi.cos());
-                    let sd = -r * th.sin() * thd - l * psi.sin() * psid;
-                    vec![th, psi, s, thd, psid, sd]
-                },
+                |_, y| slidercrank::form_a_state(y[0], y[1]).to_vec(),
             );
             let proj = ConstraintMethod::Projection;
             let idx3 = ConstraintMethod::Index3;

@@ -203,12 +203,8 @@ fn adaptive_runs_reach_the_slider_crank_reference() {
     )
     .expect("form (b)");
     let y = &r.states[0];
-    let (rr, l) = (0.1, 0.3);
-    let (th, thd) = (y[0], y[1]);
-    let (psi, s) = slidercrank::closed_loop(th);
-    let psid = -rr * th.cos() * thd / (l * psi.cos());
-    let sd = -rr * th.sin() * thd - l * psi.sin() * psid;
-    let (rq, rv) = ([th, psi, s], [thd, psid, sd]);
+    let a = slidercrank::form_a_state(y[0], y[1]);
+    let (rq, rv) = ([a[0], a[1], a[2]], [a[3], a[4], a[5]]);
     let o = with_method(Options::adaptive(2.0, 1e-11), ConstraintMethod::Projection);
     let (tr, _) = run(slidercrank::SliderCrank::default(), Scheme::Radau5, o);
     let (_, _, rl) = last(&tr);
@@ -416,12 +412,7 @@ fn the_mixed_error_against_rtol() {
     )
     .expect("slider-crank reference")
     .map("form (b) mapped to form (a)", |_, y| {
-        let (r, l) = (0.1, 0.3);
-        let (th, thd) = (y[0], y[1]);
-        let (psi, s) = slidercrank::closed_loop(th);
-        let psid = -r * th.cos() * thd / (l * psi.cos());
-        let sd = -r * th.sin() * thd - l * psi.sin() * psid;
-        vec![th, psi, s, thd, psid, sd]
+        slidercrank::form_a_state(y[0], y[1]).to_vec()
     });
     let sc = slidercrank::SliderCrank::default();
     let f = |s, m, rtol| excess(&sc, s, m, rtol, &times, &r.states);

@@ -258,12 +258,7 @@ fn slider_crank_both_forms() {
     let rb = computed(&closed, times.clone());
     let mut bad = measure(study("slider-crank (b)", rb, false), &closed);
     let ra = computed(&closed, times).map("form (b) mapped to form (a)", |_, y| {
-        let (r, l) = (0.1, 0.3);
-        let (th, thd) = (y[0], y[1]);
-        let (psi, s) = slidercrank::closed_loop(th);
-        let psid = -r * th.cos() * thd / (l * psi.cos());
-        let sd = -r * th.sin() * thd - l * psi.sin() * psid;
-        vec![th, psi, s, thd, psid, sd]
+        slidercrank::form_a_state(y[0], y[1]).to_vec()
     });
     let model = slidercrank::SliderCrank::default();
     bad.extend(measure(study("slider-crank (a)", ra, true), &model));

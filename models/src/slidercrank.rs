@@ -64,3 +64,13 @@ pub fn closed_loop(theta: f64) -> (f64, f64) {
     let psi = -(r * theta.sin() / l).asin();
     (psi, r * theta.cos() + l * psi.cos())
 }
+
+/// Form (a)'s state (θ, ψ, s, θ̇, ψ̇, ṡ) from form (b)'s (θ, θ̇), by [`closed_loop`] and its
+/// derivative: how a reference computed on form (b) is compared with form (a).
+pub fn form_a_state(theta: f64, theta_d: f64) -> [f64; 6] {
+    let (r, l) = (0.1, 0.3);
+    let (psi, s) = closed_loop(theta);
+    let psi_d = -r * theta.cos() * theta_d / (l * psi.cos());
+    let s_d = -r * theta.sin() * theta_d - l * psi.sin() * psi_d;
+    [theta, psi, s, theta_d, psi_d, s_d]
+}

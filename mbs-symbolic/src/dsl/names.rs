@@ -1,16 +1,25 @@
 //! "Did you mean" suggestions for unknown names.
 
-/// Edit distance between two names (Levenshtein).
+/// Edit distance between two names: the optimal-string-alignment distance, in which an
+/// insertion, a deletion, a substitution or a swap of two adjacent letters counts as one edit
+/// (`bsae` is one edit from `base`).
 pub fn distance(a: &str, b: &str) -> usize {
+    let a: Vec<char> = a.chars().collect();
     let b: Vec<char> = b.chars().collect();
+    // rows i − 2, i − 1 and i of the table d[i][j] = distance(a[..i], b[..j])
+    let mut before: Vec<usize> = Vec::new();
     let mut prev: Vec<usize> = (0..=b.len()).collect();
-    for (i, ca) in a.chars().enumerate() {
+    for (i, &ca) in a.iter().enumerate() {
         let mut cur = vec![i + 1; b.len() + 1];
         for (j, &cb) in b.iter().enumerate() {
             let sub = prev[j] + usize::from(ca != cb);
-            cur[j + 1] = sub.min(prev[j + 1] + 1).min(cur[j] + 1);
+            let mut d = sub.min(prev[j + 1] + 1).min(cur[j] + 1);
+            if i > 0 && j > 0 && ca == b[j - 1] && a[i - 1] == cb {
+                d = d.min(before[j - 1] + 1);
+            }
+            cur[j + 1] = d;
         }
-        prev = cur;
+        before = std::mem::replace(&mut prev, cur);
     }
     prev[b.len()]
 }
@@ -55,6 +64,16 @@ mod tests {
     #[test]
     fn suggests_close_names_only() {
         assert_eq!(distance("uper_arm", "upper_arm"), 1);
+        // a swap of two adjacent letters is one edit (Levenshtein counts two)
+        assert_eq!(distance("bsae", "base"), 1);
+        assert_eq!(distance("ab", "ba"), 1);
+        assert_eq!(distance("abc", "ca"), 3);
+        assert_eq!(distance("", "abc"), 3);
+        assert_eq!(distance("kitten", "sitting"), 3);
+        assert_eq!(
+            did_you_mean("bsae", ["base", "arm"].into_iter(), "x"),
+            "; did you mean `base`?"
+        );
         assert_eq!(
             did_you_mean("uper_arm", ["upper_arm", "leg"].into_iter(), "x"),
             "; did you mean `upper_arm`?"

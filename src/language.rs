@@ -38,7 +38,9 @@
 //! | `input torque;` | the next input `u[k]`; `torque` or `u[k]` in effects |
 //! | `body arm { mass = m; inertia = (Ixx, Iyy, Izz); }` | a body; its frame (TOG) is at its centre of gravity G |
 //! | `inertia = (Ixx, Iyy, Izz, Ixy, Ixz, Iyz);` | full tensor about G in body axes; the entries are the tensor's (`Ixy = −∫xy dm`) |
-//! | `body point_mass { mass = 2.0; }` | a point mass (zero inertia) |
+//! | `body bar { mass = m; inertia_z = I; }` | a body that turns about its z axis only (planar models): its moment about z. It is stored as the tensor of a thin plate across z, `(I/2, I/2, I)`, a possible tensor whose other moments play no part while the body turns about z only; `inertia_x`, `inertia_y` likewise |
+//! | `body point_mass { mass = 2.0; }` | a point mass (zero inertia) with its own pose |
+//! | `mass tip on bar at (0, -l/2, 0) = 0.5;` | a point mass fixed on a body, at a point in its axes: a body `tip` of that mass and no inertia, its frame at the point (the same as `body tip { mass = 0.5; }` with `TOG[tip] = TOG[bar] * Tdisp(0, -l/2, 0);`); effects and shapes may name it, a pose may not start from it |
 //! | `frame sensor;` | a massless frame (a secondary frame) |
 //! | `point tip on arm at (0, -l/2, 0);` | a point fixed on a body, frame or `ground`, in its axes |
 //! | `TOG[arm] = …;` | the body's pose: a product of transforms (below) |
@@ -118,13 +120,15 @@
 //! | `contact(p, k = …, c = …, mu = …);` | penalty contact of a point or body origin with the ground plane z = 0 (below) |
 //! | `contact(p, k = …, plane = y, offset = h0);` | with the fixed plane n·x = h0: `plane` is its unit normal pointing out of the ground, `x`, `y`, `z` (default), `-z`, … or `(nx, ny, nz)`; `offset` default 0 |
 //! | `contact(body, sphere = r, k = …, …);` | a sphere of radius r centred at the body's origin (or at a point) |
+//! | `rotational_spring(A, B, axis = z, k = …, angle0 = θ0);` | a linear rotational spring between two bodies or frames (either may be `ground`) about an axis (`x`, `y`, `z` or a unit `(nx, ny, nz)`, in A's axes): the torque −k (θ − θ0) about the axis on B and the opposite on A, θ the angle of B relative to A about it (below); potential ½ k (θ − θ0)²; `angle0` default 0; `c = …` adds a damper |
+//! | `rotational_damper(A, B, axis = z, c = …);` | the torque −c θ̇ about the axis on B, the opposite on A |
 //! | `bushing(A, B, k = (kx, ky, kz), kr = (…), c = (…), cr = (…));` | six-axis linear spring–damper between the origins and axes of two bodies or frames (either may be `ground`), coefficients along A's axes; one value sets all three axes; each of `k kr c cr` defaults to 0 (at least one) |
 //!
 //! Force and torque values may depend on `q`, `qd`, `t`, parameters and inputs `u[k]`; the
 //! coefficients of springs, dampers, contacts and bushings are constants or parameters.
 //! Gravity and springs are conservative (potential energy); the others count in `power()`;
-//! contacts and bushings have both: their elastic parts are in the potential, their
-//! damping and friction (whose power is never positive) in `power()`.
+//! contacts, bushings and rotational springs have both: their elastic parts are in the
+//! potential, their damping and friction (whose power is never positive) in `power()`.
 //!
 //! **Contacts** are penalty forces generated with the rest of the equations (so M, h, τ, exact
 //! tangents, energy and power include them). With the penetration δ = h0 + r − n·x of the
@@ -174,6 +178,49 @@
 //! // 1 mm deep, the contact pushes up with k δ = 100 N (less the weight, plus the spring)
 //! model.dynamics(0.0, &[0.0, 0.0, 0.099, 0.0], &[0.0; 4], &[], &mut m, &mut h);
 //! assert!(h[2] > 90.0 && h[2] < 100.0);
+//! ```
+//!
+//! **Rotational springs** act about one axis n (in A's axes) with the angle θ of B relative
+//! to A about it. When every rotation between A and B in the tree (from each up to the pose
+//! they share) is a `Trot…` about ±n — a joint, as in `TOG[B] = TOG[A] * Tdisp(…) *
+//! Trotz(q[1]) * …` — θ is the sum of those rotations' angles, here `q[1]`: no trigonometry,
+//! and the spring costs what `generalized_force(q[1], -k * (q[1] - θ0) - c * qd[1])` costs
+//! (a chain of 8 bars with one at each joint: 236 flops for h either way). Otherwise θ is
+//! read from the relative rotation R = R_Aᵀ R_B as atan2(n·vee(R − Rᵀ), tr R − nᵀ R n), the
+//! angle of R when it is a rotation about n (and its twist about n when it is not), in
+//! (−π, π]. Either way the load is the generalised force −(k (θ − θ0) + c θ̇) ∂θ/∂q, the
+//! exact gradient of the potential ½ k (θ − θ0)² plus the damping, which is the torque pair
+//! about n when B turns about n relative to A; the damper's power is −c θ̇².
+//!
+//! It differs from `torque(B, axis = z, value, relative_to = A)`, whose value is any
+//! expression (`-k * q[1]`) with no potential: `energy()` misses its elastic energy and
+//! `power()` counts its work; and from the bushing's `kr`, a stiffness on all three axes
+//! whose angle is ½ vee(R − Rᵀ) (the sine of the angle for a single rotation), for small
+//! relative rotations, with the translations held too.
+//!
+//! ```
+//! mbs::multibody! {
+//!     /// A double pendulum with a torsion spring at each joint and a damper at the elbow.
+//!     model Sprung {
+//!         param k = 5.0; param l = 1.0;
+//!         dof q[0] = 0.5; dof q[1] = 0.0;
+//!         body bar1 { mass = 1.0; inertia_z = l * l / 12; }
+//!         body bar2 { mass = 1.0; inertia_z = l * l / 12; }
+//!         mass tip on bar2 at (0, -l/2, 0) = 0.2;
+//!         TOG[bar1] = Trotz(q[0]) * Tdisp(0, -l/2, 0);
+//!         TOG[bar2] = TOG[bar1] * Tdisp(0, -l/2, 0) * Trotz(q[1]) * Tdisp(0, -l/2, 0);
+//!         rotational_spring(ground, bar1, axis = z, k = k, angle0 = 0.1);
+//!         rotational_spring(bar1, bar2, axis = z, k = k, c = 0.2);
+//!     }
+//! }
+//! use mbs::Model;
+//! let model = Sprung::default();
+//! let (mut m, mut h) = ([0.0; 4], [0.0; 2]);
+//! model.dynamics(0.0, &[0.5, 0.3], &[0.0, 1.0], &[], &mut m, &mut h);
+//! // on q[1], the elbow's spring and damper: −k q1 − c q̇1 (no centrifugal term there)
+//! assert!((h[1] - (-5.0 * 0.3 - 0.2 * 1.0)).abs() < 1e-12);
+//! let e = model.energy(0.0, &[0.5, 0.3], &[0.0, 0.0]);
+//! assert!((e.potential - 0.5 * 5.0 * (0.4f64.powi(2) + 0.3f64.powi(2))).abs() < 1e-12);
 //! ```
 //!
 //! ## Constraints
@@ -280,6 +327,15 @@
 //! error: coordinate `q[2]` moves no body with mass, so the mass matrix would be singular: …
 //! error: the mass of body `arm` must be positive, it is -1: …
 //! ```
+//!
+//! Some of them:
+//!
+//! | mistake | message |
+//! |---|---|
+//! | `param u = 1.0;` (or a body, coordinate, … named `t q qd qdd u PI E TAU ground TOG`) | "`u` is reserved for the inputs u[k]: give this parameter another name", once: its uses are not reported again |
+//! | `TOG[a] = TOG[b] * …; TOG[b] = TOG[a] * …;` | "the poses form a cycle, `a → b → a`: each starts from the next, so none is ever placed; …" |
+//! | `Tdisp(0, -sqrt(-1.0), 0)`, `ln(0)`, `asin(2)`, `exp(1000)` | "`sqrt(-1.0)` is NaN (not a number): an argument is outside the domain of the function or operation, …; correct the constant", on those tokens: constants fold when the model is compiled (`1/0`: "division by zero") |
+//! | `TOG[bsae]` | "unknown body `bsae`; did you mean `base`?": a swap of two adjacent letters counts as one edit, like a letter added, removed or replaced |
 //!
 //! All the mistakes of a model are reported at once. The macro still emits placeholder types
 //! (the parameter struct with its fields, the model types with `new` and the

@@ -162,3 +162,156 @@ fn elements_in_rust_give_the_dsl_motion() {
     );
     assert!(d < 1e-10);
 }
+
+mbs::multibody! {
+    /// A yoke turning about x carries a base turning about z, which carries a bar turning
+    /// about z, with gravity: rotational springs at the three joints (scene `Rot`), or the
+    /// same springs written as generalised forces (scene `Gen`); scene `Twist` adds a spring
+    /// between the ground and the bar about z, whose angle is not a coordinate.
+    model Hinged {
+        param k = 4.0; param c = 0.3; param a0 = 0.2;
+        dof r = 0.3, qd = -1.0; dof a = 0.4, qd = 1.0; dof b = -0.3, qd = 2.0;
+        frame yoke;
+        body base { mass = 2.0; inertia = (0.02, 0.03, 0.04); }
+        body bar { mass = 1.0; inertia = (0.01, 0.002, 0.01); }
+        TOG[yoke] = Trotx(r);
+        TOG[base] = TOG[yoke] * Trotz(a) * Tdisp(0, -0.5, 0);
+        TOG[bar] = TOG[base] * Tdisp(0, -0.5, 0) * Trotz(b) * Tdisp(0, -0.5, 0);
+        gravity(0, -9.81, 0);
+        effect rot {
+            rotational_spring(ground, yoke, axis = x, k = 2 * k, angle0 = -a0);
+            rotational_spring(yoke, base, axis = z, k = k, angle0 = a0);
+            rotational_spring(base, bar, axis = (0, 0, 1), k = k, c = c, angle0 = a0);
+        }
+        effect gen {
+            generalized_force(r, -2 * k * (r + a0));
+            generalized_force(a, -k * (a - a0));
+            generalized_force(b, -k * (b - a0) - c * qd[b]);
+        }
+        effect twist { rotational_spring(ground, bar, axis = z, k = k, c = c); }
+        scene Rot = [rot]; scene Gen = [gen]; scene Twist = [rot, twist];
+    }
+}
+
+fn hinged_state(s: f64) -> ([f64; 3], [f64; 3]) {
+    let q = [0.3 + s, 0.4 - 2.0 * s, -0.3 + 3.0 * s];
+    let qd = [-1.0 + s, 1.0 + 0.5 * s, 2.0 - s];
+    (q, qd)
+}
+
+#[test]
+fn rotational_springs_at_joints_are_the_generalised_forces_of_their_coordinates() {
+    let (rot, gen_) = (HingedRot::default(), HingedGen::default());
+    let (mut m1, mut h1, mut m2, mut h2) = ([0.0; 9], [0.0; 3], [0.0; 9], [0.0; 3]);
+    let (k, c, a0) = (4.0, 0.3, 0.2);
+    for i in 0..10 {
+        let (q, qd) = hinged_state(0.4 * i as f64 - 2.0);
+        rot.dynamics(0.0, &q, &qd, &[], &mut m1, &mut h1);
+        gen_.dynamics(0.0, &q, &qd, &[], &mut m2, &mut h2);
+        for j in 0..3 {
+            assert!(
+                (h1[j] - h2[j]).abs() < 1e-12 * (1.0 + h2[j].abs()),
+                "h[{j}] at {q:?}"
+            );
+        }
+        // the springs' potential, and the power of the damper alone
+        let springs = 0.5 * 2.0 * k * (q[0] + a0).powi(2)
+            + 0.5 * k * (q[1] - a0).powi(2)
+            + 0.5 * k * (q[2] - a0).powi(2);
+        let (e1, e2) = (rot.energy(0.0, &q, &qd), gen_.energy(0.0, &q, &qd));
+        assert!((e1.kinetic - e2.kinetic).abs() < 1e-12);
+        assert!((e1.potential - e2.potential - springs).abs() < 1e-12);
+        let p = rot.power(0.0, &q, &qd, &[]);
+        assert!((p + c * qd[2] * qd[2]).abs() < 1e-12, "{p}");
+    }
+}
+
+/// Along a run, T + V changes by the work of the dampers, ∫ power dt: with the spring between
+/// the ground and the bar (its angle from the rotations, atan2) and without.
+#[test]
+fn rotational_springs_keep_the_energy_balance() {
+    fn balance<M: Model + 'static>(make: impl Fn() -> M) -> (f64, f64) {
+        let opts = Options {
+            output: Output::Every { dt: 1e-4 },
+            energy: true,
+            ..Options::adaptive(2.0, 1e-11)
+        };
+        let (tr, _) = simulate(make(), Scheme::Dopri5, opts).unwrap();
+        let model = make();
+        let power: Vec<f64> = (0..tr.len())
+            .map(|i| model.power(tr.t[i], tr.q(i), tr.qd(i), &[]))
+            .collect();
+        let (mut work, mut worst) = (0.0, 0.0f64);
+        for i in 1..tr.len() {
+            work += 0.5 * (power[i] + power[i - 1]) * (tr.t[i] - tr.t[i - 1]);
+            let de = tr.energy[i].total() - tr.energy[0].total();
+            worst = worst.max((de - work).abs());
+        }
+        (worst, work)
+    }
+    for (name, (worst, work)) in [
+        ("joints", balance(HingedRot::default)),
+        ("joints and twist", balance(HingedTwist::default)),
+    ] {
+        println!(
+            "{name}: |ΔE − ∫power| ≤ {worst:.1e} over 2 s, the dampers dissipated {:.3} J",
+            -work
+        );
+        assert!(work < -0.1, "{name}: the damper works");
+        // the trapezoidal rule on the outputs makes an error of about 1e-7 J
+        assert!(worst < 1e-6, "{name}: {worst:e}");
+    }
+}
+
+mbs::multibody! {
+    /// A bar turning about z with a lumped mass at its tip, in the shorthands (`inertia_z`,
+    /// `mass … on … at …`) and in the long forms.
+    model Short {
+        param l = 0.8; param m = 1.5;
+        dof th = 0.3, qd = 1.0; dof s = 0.2, qd = -0.5;
+        body cart { mass = 2.0; }
+        body bar { mass = m; inertia_z = m * l * l / 12; }
+        TOG[cart] = Tdisp(s, 0, 0);
+        TOG[bar] = TOG[cart] * Trotz(th) * Tdisp(0, -l / 2, 0);
+        mass tip on bar at (0, -l / 2, 0) = 0.5;
+        gravity(0, -9.81, 0);
+        rotational_damper(cart, bar, axis = z, c = 0.1);
+    }
+    model Long {
+        param l = 0.8; param m = 1.5;
+        dof th = 0.3, qd = 1.0; dof s = 0.2, qd = -0.5;
+        body cart { mass = 2.0; }
+        body bar { mass = m; inertia = (m * l * l / 12, 0, m * l * l / 12); }
+        body tip { mass = 0.5; }
+        TOG[cart] = Tdisp(s, 0, 0);
+        TOG[bar] = TOG[cart] * Trotz(th) * Tdisp(0, -l / 2, 0);
+        TOG[tip] = TOG[bar] * Tdisp(0, -l / 2, 0);
+        gravity(0, -9.81, 0);
+        torque(bar, axis = z, -0.1 * qd[th], relative_to = cart);
+    }
+}
+
+#[test]
+fn planar_inertia_and_point_mass_shorthands_give_the_long_forms() {
+    let (short, long) = (Short::default(), Long::default());
+    let (mut m1, mut h1, mut m2, mut h2) = ([0.0; 4], [0.0; 2], [0.0; 4], [0.0; 2]);
+    for i in 0..10 {
+        let x = i as f64 - 4.5;
+        let (q, qd) = ([0.7 * x, 0.1 * x], [1.0 - 0.3 * x, 0.2 * x]);
+        short.dynamics(0.0, &q, &qd, &[], &mut m1, &mut h1);
+        long.dynamics(0.0, &q, &qd, &[], &mut m2, &mut h2);
+        for j in 0..4 {
+            assert!((m1[j] - m2[j]).abs() < 1e-12, "M at {q:?}");
+        }
+        for j in 0..2 {
+            assert!(
+                (h1[j] - h2[j]).abs() < 1e-12 * (1.0 + h2[j].abs()),
+                "h at {q:?}"
+            );
+        }
+        let (e1, e2) = (short.energy(0.0, &q, &qd), long.energy(0.0, &q, &qd));
+        assert!((e1.total() - e2.total()).abs() < 1e-12);
+    }
+    // the tip is a body of the model, named like the others
+    assert!(short.info().frame_index("tip").is_some());
+}

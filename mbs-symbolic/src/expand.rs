@@ -204,7 +204,7 @@ fn stub(def: &ModelDef) -> String {
             }
             Item::Dof { .. } => nq += 1,
             Item::Input { .. } => nu += 1,
-            Item::Body { .. } | Item::Frame { .. } => nframes += 1,
+            Item::Body { .. } | Item::Frame { .. } | Item::Mass { .. } => nframes += 1,
             Item::Point { .. } => npoints += 1,
             Item::Scene { name: s, .. } => {
                 let ty = format!("{name}{s}");

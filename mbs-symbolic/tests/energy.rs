@@ -1,6 +1,6 @@
 //! Energy balance on random scleronomic trees with gravity, springs (with preloads), dampers,
 //! forces, torques and generalised forces, and then also with penalty contacts (points and
-//! spheres, with friction) and bushings: along the motion qdd = M⁻¹ h, the exact time
+//! spheres, with friction), bushings and rotational springs: along the motion qdd = M⁻¹ h, the exact time
 //! derivative of the generated T + V equals the generated power of the non-conservative
 //! effects. The energy balance cannot see a load that is wrong but consistently so in h and
 //! in the power (a reaction torque's sign, a force's axes), so h with every load is also
@@ -222,6 +222,46 @@ fn oracle_h(
                     );
                     torque(&mut ext, *a, scale(-1.0, mw));
                 }
+                Load::RotationalSpring {
+                    a,
+                    b,
+                    axis,
+                    k,
+                    c,
+                    angle0,
+                } => {
+                    // θ = atan2(s, co) from R = R_Aᵀ R_B; θ̇ = g·Ω with Ω = R_Aᵀ (ω_B − ω_A)
+                    // and g = (co (tr R n − Rᵀ n) + s (v + R n × n)) / (s² + co²), so that
+                    // the torque −T R_A g on B and T R_A g on A do the work −T θ̇
+                    let rot = |f: Option<usize>| match f {
+                        None => (eye3(), [0.0; 3]),
+                        Some(f) => {
+                            let (rot, _) = poses[frame_link[f].0];
+                            let v = vels[frame_link[f].0];
+                            (rot, mv(&rot, [v[0], v[1], v[2]]))
+                        }
+                    };
+                    let ((ra, wa), (rb, wb)) = (rot(*a), rot(*b));
+                    let n = ev3(axis);
+                    let p = ev(&[*k, *c, *angle0]);
+                    let r = mm(&tr(&ra), &rb);
+                    let v = [r[2][1] - r[1][2], r[0][2] - r[2][0], r[1][0] - r[0][1]];
+                    let rn = mv(&r, n);
+                    let tr_r = r[0][0] + r[1][1] + r[2][2];
+                    let (s, co) = (dot(n, v), tr_r - dot(n, rn));
+                    let g = scale(
+                        1.0 / (s * s + co * co),
+                        add(
+                            scale(co, sub(scale(tr_r, n), mv(&tr(&r), n))),
+                            scale(s, add(v, cross(rn, n))),
+                        ),
+                    );
+                    let om = mv(&tr(&ra), sub(wb, wa));
+                    let tq = p[0] * (s.atan2(co) - p[2]) + p[1] * dot(g, om);
+                    let mw = scale(-tq, mv(&ra, g));
+                    torque(&mut ext, *b, mw);
+                    torque(&mut ext, *a, scale(-1.0, mw));
+                }
             }
         }
     }
@@ -250,7 +290,7 @@ fn balance(
     seed0: u64,
     elements: bool,
     tally: &mut [usize; 7],
-    el_tally: &mut [usize; 4],
+    el_tally: &mut [usize; 6],
 ) -> Balance {
     let mut out = Balance {
         max_power: f64::NEG_INFINITY,
@@ -360,7 +400,7 @@ fn balance(
 #[test]
 fn energy_balance_with_loads() {
     let mut tally = [0usize; 7];
-    let b = balance(3000, false, &mut tally, &mut [0; 4]);
+    let b = balance(3000, false, &mut tally, &mut [0; 6]);
     println!(
         "{TREES} trees x {STATES} states x 2 scenes; loads: {} springs, {} dampers, {} world \
          forces, {} body-frame forces, {} torques, {} torques with reaction, {} generalised forces",
@@ -374,19 +414,22 @@ fn energy_balance_with_loads() {
     assert!(tally.iter().all(|&c| c >= 5), "{tally:?}");
 }
 
-/// The same with contacts (points and spheres, damping, friction) and bushings: an undamped
-/// bushing and an undamped, frictionless contact join the conservative scene (the bushing's
-/// elastic torque must be exactly the gradient of ½ θᵀ K_r θ for the balance to hold),
-/// damped contacts with friction and a damped bushing the full one.
+/// The same with contacts (points and spheres, damping, friction), bushings and rotational
+/// springs: an undamped bushing, an undamped, frictionless contact and an undamped rotational
+/// spring join the conservative scene (the bushing's elastic torque must be exactly the
+/// gradient of ½ θᵀ K_r θ, the rotational spring's that of ½ k (θ − θ0)², for the balance to
+/// hold), damped contacts with friction, a damped bushing and a damped rotational spring the
+/// full one.
 #[test]
 fn energy_balance_with_contacts_and_bushings() {
-    let mut el = [0usize; 4];
+    let mut el = [0usize; 6];
     let b = balance(5000, true, &mut [0; 7], &mut el);
     println!(
         "{TREES} trees x {STATES} states x 3 scenes; {} point contacts, {} sphere contacts, \
-         {} bushings to the ground, {} between frames; contact states: {} separated, {} \
-         pressing, {} penetrating with F_n clipped to 0",
-        el[0], el[1], el[2], el[3], b.regimes[0], b.regimes[1], b.regimes[2]
+         {} bushings to the ground, {} between frames, {} rotational springs about a joint's \
+         axis, {} about a random axis; contact states: {} separated, {} pressing, {} \
+         penetrating with F_n clipped to 0",
+        el[0], el[1], el[2], el[3], el[4], el[5], b.regimes[0], b.regimes[1], b.regimes[2]
     );
     b.vp_rec.check(
         "M, h with force elements: virtual power vs recursive",

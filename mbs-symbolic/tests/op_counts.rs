@@ -95,3 +95,89 @@ fn both_formulations_are_built_and_the_cheaper_is_chosen() {
         assert_eq!(ops(a, &e.chosen().roots()).flops(), vp.min(rec));
     }
 }
+
+/// An n-bar chain (relative angles) with a damped rotational spring at every joint, written
+/// with `rotational_spring` (scene `Rot`) and with the equivalent generalised forces (scene
+/// `Gen`), both with gravity.
+fn sprung_chain(n: usize, absolute: bool) -> SymbolicModel {
+    let mut src =
+        String::from("model SprungChain { param l = 0.5; param k = 3.0; param c = 0.2;\n");
+    let (mut rot, mut gen_) = (String::new(), String::new());
+    let mut prefix = String::new();
+    for i in 0..n {
+        src += &format!(
+            "dof q[{i}] = 0.1; body bar{i} {{ mass = 1.0; inertia = (0.02, 0.0, 0.02); }}\n"
+        );
+        let joint = format!("Trotz(q[{i}]) * Tdisp(0, -l/2, 0)");
+        let pose = if i == 0 {
+            joint.clone()
+        } else if absolute {
+            // CAGeM's absolute style: every pose from the ground
+            format!("{prefix} * Tdisp(0, -l/2, 0) * {joint}")
+        } else {
+            format!("TOG[bar{}] * Tdisp(0, -l/2, 0) * {joint}", i - 1)
+        };
+        src += &format!("TOG[bar{i}] = {pose};\n");
+        prefix = if i == 0 {
+            joint
+        } else {
+            format!("{prefix} * Tdisp(0, -l/2, 0) * {joint}")
+        };
+        let parent = if i == 0 {
+            "ground".to_string()
+        } else {
+            format!("bar{}", i - 1)
+        };
+        rot += &format!(
+            "rotational_spring({parent}, bar{i}, axis = z, k = k, c = c, angle0 = 0.1);\n"
+        );
+        gen_ += &format!("generalized_force(q[{i}], -k * (q[{i}] - 0.1) - c * qd[{i}]);\n");
+    }
+    src += &format!(
+        "effect rot {{ {rot} }} effect gen {{ {gen_} }} effect gravity {{ gravity(0, -9.81, 0); }}\n\
+         scene Rot = [gravity, rot]; scene Gen = [gravity, gen]; }}"
+    );
+    let sys = mbs_symbolic::systems_from_str(&src).unwrap().remove(0);
+    SymbolicModel::build(sys)
+}
+
+fn has_atan2(a: &mbs_symbolic::expr::Arena, roots: &[mbs_symbolic::expr::ExprId]) -> bool {
+    a.reachable(roots)
+        .into_iter()
+        .any(|e| matches!(a.node(e), mbs_symbolic::expr::Node::Atan2(..)))
+}
+
+/// In a chain the angle of a rotational spring between a bar and its parent is the joint's
+/// coordinate: its code is that of the generalised force −k (q − θ0) − c q̇, with no atan2,
+/// whether the poses are relative (`TOG[parent] * …`) or absolute (shared prefixes).
+#[test]
+fn rotational_springs_in_a_chain_cost_what_generalised_forces_cost() {
+    for absolute in [false, true] {
+        let model = sprung_chain(8, absolute);
+        let a = &model.sys.arena;
+        let count = |scene: usize| {
+            let eq = &model.scenes[scene];
+            let mut r = eq.chosen().roots();
+            r.push(eq.potential);
+            r.push(eq.power);
+            (ops(a, &eq.chosen().h), ops(a, &r), has_atan2(a, &r))
+        };
+        let (rot, gen_) = (count(0), count(1));
+        println!(
+            "chain of 8 bars with rotational springs ({}): h {} flops, M + h + V + power {} flops; \
+             with generalised forces: h {} flops, M + h + power {} flops",
+            if absolute {
+                "absolute poses"
+            } else {
+                "relative poses"
+            },
+            rot.0.flops(),
+            rot.1.flops(),
+            gen_.0.flops(),
+            gen_.1.flops()
+        );
+        assert!(!rot.2, "no atan2 in a chain's rotational springs");
+        assert_eq!(rot.0.flops(), gen_.0.flops(), "h");
+        assert_eq!(rot.0.funcs, gen_.0.funcs, "functions in h");
+    }
+}

@@ -217,7 +217,7 @@ fn emit_params(
             ));
         }
     }
-    let (mut spring, mut contact, mut bushing) = (0, 0, 0);
+    let (mut spring, mut contact, mut bushing, mut rotational) = (0, 0, 0, 0);
     for e in &sys.effects {
         for l in &e.loads {
             // coefficients that parameters may make unphysical: (element, name, value, strict)
@@ -257,6 +257,13 @@ fn emit_params(
                             coefficients.push((el.clone(), name, *e, false));
                         }
                     }
+                }
+                Load::RotationalSpring { k: kk, c, .. } => {
+                    // rotational springs and dampers, numbered together
+                    let el = format!("rotational spring {rotational}");
+                    rotational += 1;
+                    coefficients.push((el.clone(), "k", *kk, false));
+                    coefficients.push((el, "c", *c, false));
                 }
                 _ => {}
             }

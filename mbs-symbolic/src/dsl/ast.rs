@@ -72,6 +72,13 @@ pub enum Item {
         body: BodyRef,
         at: Expr,
     },
+    /// `mass tip on bar at (x, y, z) = 0.5;`: a point mass fixed on a body
+    Mass {
+        name: Ident,
+        body: BodyRef,
+        at: Expr,
+        value: Expr,
+    },
     /// `TOG[bar] = chain;`
     Tog {
         target: BodyRef,

@@ -184,7 +184,7 @@ fn parse_item(input: ParseStream) -> syn::Result<Item> {
         });
     }
     let kw: Ident = input.fork().parse().map_err(|e| {
-        syn::Error::new(e.span(), "expected a statement: param, let, dof, input, body, frame, point, TOG[…], fn, extern fn, effect, scene, option or an effect such as gravity(…)")
+        syn::Error::new(e.span(), "expected a statement: param, let, dof, input, body, frame, point, mass, TOG[…], fn, extern fn, effect, scene, option or an effect such as gravity(…)")
     })?;
     let k = kw.to_string();
     match k.as_str() {
@@ -313,6 +313,50 @@ fn parse_item(input: ParseStream) -> syn::Result<Item> {
                 name,
                 body,
                 at: pos,
+            })
+        }
+        "mass" => {
+            input.parse::<Ident>()?;
+            let usage = "write `mass name on body at (x, y, z) = m;`";
+            let name: Ident = input.parse()?;
+            let on: Ident = input.parse()?;
+            if on != "on" {
+                return Err(syn::Error::new(
+                    on.span(),
+                    format!("expected `on`: {usage}"),
+                ));
+            }
+            let body = body_ref(input)?;
+            let at: Ident = input.parse()?;
+            if at != "at" {
+                return Err(syn::Error::new(
+                    at.span(),
+                    format!("expected `at`: {usage}"),
+                ));
+            }
+            if !input.peek(syn::token::Paren) {
+                return Err(syn::Error::new(
+                    input.span(),
+                    format!("expected the position `(x, y, z)` in the body's axes: {usage}"),
+                ));
+            }
+            let content;
+            let paren_token = parenthesized!(content in input);
+            let pos = Expr::Tuple(syn::ExprTuple {
+                attrs: Vec::new(),
+                paren_token,
+                elems: content.parse_terminated(Expr::parse, Token![,])?,
+            });
+            input
+                .parse::<Token![=]>()
+                .map_err(|e| syn::Error::new(e.span(), format!("expected `= m`: {usage}")))?;
+            let value: Expr = input.parse()?;
+            semi(input, "`mass`")?;
+            Ok(Item::Mass {
+                name,
+                body,
+                at: pos,
+                value,
             })
         }
         "TOG" => {

@@ -192,6 +192,19 @@ pub enum Load {
         c: [ExprId; 3],
         cr: [ExprId; 3],
     },
+    /// linear rotational spring–damper about the unit `axis` (in `a`'s axes) between frames
+    /// `a` and `b` (`None`: the ground): with θ the angle of `b` relative to `a` about the
+    /// axis, the torque −k (θ − θ0) − c θ̇ about the axis on `b` and the opposite on `a`
+    /// (the generalised forces −(k (θ − θ0) + c θ̇) ∂θ/∂q); see
+    /// `mech::effects::rotational_spring` for θ. Potential ½ k (θ − θ0)²; power −c θ̇²
+    RotationalSpring {
+        a: Option<usize>,
+        b: Option<usize>,
+        axis: [ExprId; 3],
+        k: ExprId,
+        c: ExprId,
+        angle0: ExprId,
+    },
 }
 
 impl Load {

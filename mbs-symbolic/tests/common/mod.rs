@@ -977,15 +977,17 @@ pub fn add_loads(
     )
 }
 
-/// Adds random force elements: an effect `elastic` (a bushing without damping and a contact
-/// without damping or friction, conservative) and an effect `contacts` (1 to 3 penalty
-/// contacts of points or spheres with friction, and a damped bushing). The planes are placed so that most contacts penetrate at the random
-/// states. Returns the two effects; `tally` counts point contacts, sphere contacts, bushings
-/// to the ground and bushings between two frames.
+/// Adds random force elements: an effect `elastic` (a bushing without damping, a contact
+/// without damping or friction and an undamped rotational spring, conservative) and an effect
+/// `contacts` (1 to 3 penalty contacts of points or spheres with friction, a damped bushing
+/// and a damped rotational spring). The planes are placed so that most contacts penetrate at
+/// the random states. Returns the two effects; `tally` counts point contacts, sphere
+/// contacts, bushings to the ground, bushings between two frames, rotational springs about
+/// a joint's axis and rotational springs about a random axis.
 pub fn add_force_elements(
     rng: &mut Rng,
     sys: &mut System,
-    tally: &mut [usize; 4],
+    tally: &mut [usize; 6],
 ) -> (usize, usize) {
     let nf = sys.frames.len();
     let mut bushing = |rng: &mut Rng, sys: &mut System, damped: bool| {
@@ -1048,6 +1050,60 @@ pub fn add_force_elements(
             mu,
             eps,
         });
+    }
+    // a rotational spring (elastic) and a damped one (lossy): about the axis of the one
+    // rotation between a frame and its parent (θ is then that angle), or about a random axis
+    // between two random frames (θ from their rotations)
+    for damped in [false, true] {
+        let one_rotation = |f: &usize| {
+            let rots = sys.frames[*f]
+                .factors
+                .iter()
+                .filter_map(|x| match x {
+                    Factor::Rot { axis, .. } => Some(*axis),
+                    Factor::Disp(_) => None,
+                })
+                .collect::<Vec<_>>();
+            (rots.len() == 1).then(|| rots[0])
+        };
+        let joints: Vec<(usize, [ExprId; 3])> = (0..nf)
+            .filter_map(|f| one_rotation(&f).map(|n| (f, n)))
+            .collect();
+        let (a, b, axis) = if !joints.is_empty() && rng.chance(0.5) {
+            tally[4] += 1;
+            let (f, n) = joints[rng.below(joints.len())];
+            (sys.frames[f].parent, Some(f), n)
+        } else {
+            tally[5] += 1;
+            let a = (!rng.chance(0.25)).then(|| rng.below(nf));
+            let b = loop {
+                let b = (!rng.chance(0.25)).then(|| rng.below(nf));
+                if b != a {
+                    break b;
+                }
+            };
+            (a, b, random_unit(rng, sys))
+        };
+        let k = sys.num(rng.range(1.0, 20.0));
+        let angle0 = sys.num(rng.range(-0.5, 0.5));
+        let c = if damped {
+            sys.num(rng.range(0.05, 1.0))
+        } else {
+            sys.arena.zero()
+        };
+        let load = Load::RotationalSpring {
+            a,
+            b,
+            axis,
+            k,
+            c,
+            angle0,
+        };
+        if damped {
+            lossy.push(load);
+        } else {
+            elastic.push(load);
+        }
     }
     (
         sys.effect(Some("elastic"), elastic),

@@ -43,6 +43,10 @@ impl Checker {
                     mass = Some(m);
                 }
                 "inertia" => {
+                    if tensor.is_some() {
+                        self.error(key.span(), format!("body `{name}` has its inertia twice: give either `inertia = (…);` or one moment `inertia_z = …;`"));
+                        continue;
+                    }
                     let a = Allow { what: "an inertia", ..PARAMS_ONLY };
                     let elems: Vec<&Expr> = match value {
                         Expr::Tuple(t) => t.elems.iter().collect(),
@@ -71,7 +75,25 @@ impl Checker {
                     }
                     tensor = Some(t);
                 }
-                other => self.error(key.span(), format!("unknown property `{other}` of body `{name}`: a body has `mass = …;` and `inertia = (Ixx, Iyy, Izz[, Ixy, Ixz, Iyz]);`")),
+                axis @ ("inertia_x" | "inertia_y" | "inertia_z") => {
+                    // the moment about one axis, for a body that turns only about it: the
+                    // tensor of a thin plate across that axis (the two other moments half of
+                    // it), so that it is a possible tensor
+                    if tensor.is_some() {
+                        self.error(key.span(), format!("body `{name}` has its inertia twice: give either `inertia = (…);` or one moment `{axis} = …;`"));
+                        continue;
+                    }
+                    let i = self.lower(value, Allow { what: "an inertia", ..PARAMS_ONLY });
+                    self.not_negative(i, value, &format!("the moment of inertia `{axis}` of body `{name}`"));
+                    let a = &mut self.sys.arena;
+                    let (half, z) = (a.scale(0.5, i), a.zero());
+                    tensor = Some(match axis {
+                        "inertia_x" => [i, half, half, z, z, z],
+                        "inertia_y" => [half, i, half, z, z, z],
+                        _ => [half, half, i, z, z, z],
+                    });
+                }
+                other => self.error(key.span(), format!("unknown property `{other}` of body `{name}`: a body has `mass = …;` and `inertia = (Ixx, Iyy, Izz[, Ixy, Ixz, Iyz]);` or, turning about one axis only, `inertia_z = Izz;` (`inertia_x`, `inertia_y`)")),
             }
         }
         match (mass, tensor) {
@@ -83,6 +105,59 @@ impl Checker {
             }
             (None, _) => self.error(name.span(), format!("body `{name}` has no mass: add `mass = …;` (or declare a massless `frame {name};`)")),
         }
+    }
+
+    /// `mass NAME on BODY at (x, y, z) = m;`: a frame at that point of the body, with the
+    /// mass m and no inertia of its own.
+    pub(super) fn lower_mass(&mut self, name: &Ident, body: &BodyRef, at: &Expr, value: &Expr) {
+        let Some(&fi) = self.frame_names.get(&name.to_string()) else {
+            return;
+        };
+        let on = self.body_ref(body);
+        let pos = self.triple(
+            at,
+            Allow {
+                what: "the position of a point mass",
+                ..PARAMS_ONLY
+            },
+            "the position of a point mass",
+        );
+        let m = self.lower(
+            value,
+            Allow {
+                what: "a mass",
+                ..PARAMS_ONLY
+            },
+        );
+        if let Some(mv) = self.eval_default(m) {
+            if mv <= 0.0 || !mv.is_finite() {
+                let how = self.with_defaults(m);
+                self.error_at(value, format!("the point mass `{name}` must be positive, it is {mv}{how}: give it a positive mass"));
+            }
+        }
+        let (Some(on), Some(pos)) = (on, pos) else {
+            return;
+        };
+        let Some(parent) = on else {
+            self.error(body.span(), format!("a mass on the ground never moves, so it changes nothing: put `{name}` on a body"));
+            return;
+        };
+        if self.lumped.contains(&parent) {
+            let p = &self.sys.frames[parent].name;
+            self.error(
+                body.span(),
+                format!("`{p}` is a point mass: put `{name}` on the body `{p}` is on"),
+            );
+            return;
+        }
+        let z = self.sys.arena.zero();
+        let frame = &mut self.sys.frames[fi];
+        frame.parent = Some(parent);
+        frame.factors = vec![Factor::Disp(pos)];
+        frame.inertia = Some(Inertia {
+            mass: m,
+            tensor: [z; 6],
+        });
     }
 
     /// The value of a parameter expression with the default parameters; `None` when it
@@ -127,6 +202,7 @@ impl Checker {
                     );
                     None
                 }
+                None if self.taken_reserved.contains(&id.to_string()) => None,
                 None => {
                     let names: Vec<String> = self.frame_names.keys().cloned().collect();
                     self.error(
@@ -262,8 +338,15 @@ impl Checker {
                         }
                     };
                     match self.body_ref(&r) {
+                        Some(Some(p)) if self.lumped.contains(&p) => self.error(r.span(), format!("`{}` is a point mass, not a pose to start from: start from the body it is on, or make it a body with its own pose, `body {} {{ mass = …; }}`", self.sys.frames[p].name, self.sys.frames[p].name)),
                         Some(Some(p)) if p == fi => self.error(r.span(), format!("TOG[{}] cannot refer to itself: start from its parent's pose, `TOG[parent] * …`, or from the ground", self.sys.frames[fi].name)),
-                        Some(Some(p)) if !self.tog_defined[p] => self.error(r.span(), format!("TOG[{}] is used before it is defined: move `TOG[{}] = …;` above this line (a pose may refer only to poses defined earlier)", self.sys.frames[p].name, self.sys.frames[p].name)),
+                        Some(Some(p)) if !self.tog_defined[p] => {
+                            let msg = match self.pose_cycle(fi, p) {
+                                Some(cycle) => format!("the poses form a cycle, {cycle}: each starts from the next, so none is ever placed; start one of them from the ground or from another body's pose"),
+                                None => format!("TOG[{}] is used before it is defined: move `TOG[{}] = …;` above this line (a pose may refer only to poses defined earlier)", self.sys.frames[p].name, self.sys.frames[p].name),
+                            };
+                            self.error(r.span(), msg);
+                        }
                         Some(p) => parent = p,
                         None => {}
                     }
@@ -278,6 +361,62 @@ impl Checker {
         frame.parent = parent;
         frame.factors = factors;
         self.tog_defined[fi] = true;
+    }
+
+    /// Notes the frame each TOG statement starts from (no errors: `lower_tog` reports them).
+    pub(super) fn note_tog_starts(&mut self, def: &ModelDef) {
+        let frame = |c: &Self, r: &BodyRef| match r {
+            BodyRef::Name(id) => c.frame_names.get(&id.to_string()).copied(),
+            BodyRef::Index(i, _) => (*i < c.sys.frames.len()).then_some(*i),
+        };
+        for item in &def.items {
+            let Item::Tog { target, chain, .. } = item else {
+                continue;
+            };
+            let mut first = chain;
+            loop {
+                match first {
+                    Expr::Binary(b) if matches!(b.op, syn::BinOp::Mul(_)) => first = &b.left,
+                    Expr::Paren(p) => first = &p.expr,
+                    Expr::Group(g) => first = &g.expr,
+                    _ => break,
+                }
+            }
+            let Expr::Index(ix) = first else { continue };
+            if !matches!(&*ix.expr, Expr::Path(p) if p.path.is_ident("TOG")) {
+                continue;
+            }
+            let start = match &*ix.index {
+                Expr::Path(p) => p.path.get_ident().map(|id| BodyRef::Name(id.clone())),
+                Expr::Lit(syn::ExprLit {
+                    lit: syn::Lit::Int(l),
+                    ..
+                }) => l.base10_parse().ok().map(|v| BodyRef::Index(v, l.span())),
+                _ => None,
+            };
+            if let (Some(t), Some(s)) = (frame(self, target), start.and_then(|s| frame(self, &s))) {
+                self.tog_start.entry(t).or_insert(s);
+            }
+        }
+    }
+
+    /// `TOG[from]` starts from `TOG[to]`, not yet defined: "`a → b → a`" when `to`'s pose
+    /// leads back to `from`.
+    fn pose_cycle(&self, from: usize, to: usize) -> Option<String> {
+        let mut path = vec![from, to];
+        let mut cur = to;
+        while path.len() <= self.sys.frames.len() + 1 {
+            cur = *self.tog_start.get(&cur)?;
+            path.push(cur);
+            if cur == from {
+                let names: Vec<&str> = path
+                    .iter()
+                    .map(|&f| self.sys.frames[f].name.as_str())
+                    .collect();
+                return Some(format!("`{}`", names.join(" → ")));
+            }
+        }
+        None
     }
 
     /// Splits `a * b * c` into its factors; anything but products is an error.

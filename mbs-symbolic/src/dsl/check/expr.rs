@@ -90,6 +90,7 @@ impl Checker {
                 match (self.scalars.get(&id.to_string()), v) {
                     (Some(Scalar::Input(i)), "u") => Some(*i),
                     (Some(Scalar::Dof(i)), "q" | "qd" | "qdd") => Some(*i),
+                    (None, _) if self.taken_reserved.contains(&id.to_string()) => None,
                     (other, _) => {
                         let is = self.describe(id, other);
                         self.error(
@@ -157,8 +158,28 @@ impl Checker {
         self.sys.arena.zero()
     }
 
-    /// Lowers a scalar expression.
+    /// Lowers a scalar expression. An operation or function of constants that folds to a
+    /// non-finite number (`sqrt(-1.0)`, `ln(0)`) is reported on its tokens.
     pub(super) fn lower(&mut self, e: &Expr, a: Allow) -> ExprId {
+        let r = self.lower_inner(e, a);
+        if !matches!(e, Expr::Binary(_) | Expr::Call(_) | Expr::MethodCall(_)) {
+            return r;
+        }
+        match self.sys.arena.as_num(r) {
+            Some(v) if !v.is_finite() => {
+                let what = if v.is_nan() {
+                    "is NaN (not a number): an argument is outside the domain of the function or operation, and every equation using it would be NaN".to_string()
+                } else {
+                    format!("is {v}: every equation using it would be infinite or NaN")
+                };
+                self.error_at(e, format!("`{}` {what}; correct the constant", text(e)));
+                self.sys.arena.zero()
+            }
+            _ => r,
+        }
+    }
+
+    fn lower_inner(&mut self, e: &Expr, a: Allow) -> ExprId {
         match e {
             Expr::Lit(l) => match &l.lit {
                 syn::Lit::Int(i) => match i.base10_parse::<f64>() {
@@ -402,6 +423,10 @@ impl Checker {
                         format!("its pose TOG[{s}] may start a transform product")
                     };
                     self.error(id.span(), format!("`{s}` is a {kind}, not a number: {fix}"));
+                    return self.sys.arena.zero();
+                }
+                if self.taken_reserved.contains(&s) {
+                    // its declaration was reported as taking a reserved name
                     return self.sys.arena.zero();
                 }
                 let names: Vec<String> = self

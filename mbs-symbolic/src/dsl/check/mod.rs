@@ -163,6 +163,14 @@ struct Checker {
     ground_declared: bool,
     /// inline-function call depth, against runaway recursion
     depth: usize,
+    /// reserved names a declaration tried to take (reported there; their uses would only
+    /// repeat it as "unknown name")
+    taken_reserved: rustc_hash::FxHashSet<String>,
+    /// the frame each TOG statement's product starts from (`TOG[b] = TOG[a] * …`: b → a),
+    /// to name a cycle of poses
+    tog_start: FxHashMap<usize, usize>,
+    /// frames declared by `mass NAME on BODY at (…) = m;`
+    lumped: rustc_hash::FxHashSet<usize>,
 }
 
 /// A checked model and the spans that generation-time errors point at.
@@ -194,6 +202,9 @@ pub fn check(def: &ModelDef) -> Result<Checked, syn::Error> {
         tog_target_error: false,
         ground_declared: false,
         depth: 0,
+        taken_reserved: Default::default(),
+        tog_start: FxHashMap::default(),
+        lumped: Default::default(),
     };
     c.sys.docs = def.docs.clone();
     c.declare(def);
@@ -254,6 +265,7 @@ impl Checker {
     fn reserved(&mut self, name: &Ident, what: &str) -> bool {
         let s = name.to_string();
         if RESERVED.contains(&s.as_str()) {
+            self.taken_reserved.insert(s.clone());
             self.error(
                 name.span(),
                 format!(
@@ -326,11 +338,15 @@ impl Checker {
                             format!("q[{i}]")
                         }
                         DofName::Named(id) => {
-                            if self.reserved(id, "coordinate") || self.duplicate_scalar(id) {
+                            if self.reserved(id, "coordinate") {
+                                // still the coordinate q[i]: the next ones keep their numbers
+                                format!("q[{i}]")
+                            } else if self.duplicate_scalar(id) {
                                 continue;
+                            } else {
+                                self.scalars.insert(id.to_string(), Scalar::Dof(i));
+                                id.to_string()
                             }
-                            self.scalars.insert(id.to_string(), Scalar::Dof(i));
-                            id.to_string()
                         }
                     };
                     let z = self.sys.arena.zero();
@@ -365,6 +381,24 @@ impl Checker {
                         .insert(name.to_string(), self.sys.frames.len());
                     self.frame_spans.push(name.span());
                     self.tog_defined.push(false);
+                    self.sys.frames.push(FrameDef {
+                        name: name.to_string(),
+                        parent: None,
+                        factors: Vec::new(),
+                        inertia: None,
+                    });
+                }
+                Item::Mass { name, .. } => {
+                    if self.reserved(name, "point mass") || self.duplicate_frame_or_point(name) {
+                        continue;
+                    }
+                    self.kinds.insert(name.to_string(), "point mass");
+                    self.lumped.insert(self.sys.frames.len());
+                    self.frame_names
+                        .insert(name.to_string(), self.sys.frames.len());
+                    self.frame_spans.push(name.span());
+                    // its pose is the statement's
+                    self.tog_defined.push(true);
                     self.sys.frames.push(FrameDef {
                         name: name.to_string(),
                         parent: None,
@@ -484,6 +518,7 @@ impl Checker {
 
     /// Pass 2: lower every statement in order.
     fn lower_items(&mut self, def: &ModelDef) {
+        self.note_tog_starts(def);
         // points first: effects may name points declared after them
         for item in &def.items {
             if let Item::Point { name, body, at } = item {
@@ -511,6 +546,10 @@ impl Checker {
             match item {
                 Item::Dof { q0, qd0, name, .. } => {
                     if let DofName::Named(id) = name {
+                        if self.taken_reserved.contains(&id.to_string()) {
+                            dof_i += 1;
+                            continue;
+                        }
                         if !matches!(self.scalars.get(&id.to_string()), Some(Scalar::Dof(i)) if *i == dof_i)
                         {
                             continue;
@@ -529,6 +568,12 @@ impl Checker {
                     dof_i += 1;
                 }
                 Item::Body { name, props } => self.lower_body(name, props),
+                Item::Mass {
+                    name,
+                    body,
+                    at,
+                    value,
+                } => self.lower_mass(name, body, at, value),
                 Item::Tog {
                     target,
                     chain,

@@ -13,6 +13,7 @@ mod damper;
 mod force;
 mod generalized_force;
 mod gravity;
+mod rotational_spring;
 mod spring;
 mod torque;
 
@@ -33,7 +34,7 @@ pub struct Loads {
     pub torques: Vec<(usize, V3)>,
     /// (coordinate, generalised force)
     pub generalized: Vec<(usize, ExprId)>,
-    /// potential energy of springs, contacts and bushings (gravity's is computed from the
+    /// potential energy of springs, rotational springs, contacts and bushings (gravity's is computed from the
     /// bodies)
     pub elastic_potential: Option<ExprId>,
     /// power of the non-conservative loads
@@ -153,6 +154,7 @@ impl Loads {
                 Load::GenForce { .. } => generalized_force::build(&mut b, load),
                 Load::Contact { .. } => contact::build(&mut b, load),
                 Load::Bushing { .. } => bushing::build(&mut b, load),
+                Load::RotationalSpring { .. } => rotational_spring::build(&mut b, load),
             }
         }
         let mut out = b.out;

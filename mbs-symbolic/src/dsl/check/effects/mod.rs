@@ -1,12 +1,13 @@
 //! Effects: attachment points, the arguments every effect shares, and the table of effect
 //! kinds; each kind is lowered in its own file (gravity, springs and dampers, forces,
-//! torques, generalised forces, contacts, bushings).
+//! torques, generalised forces, contacts, bushings, rotational springs and dampers).
 
 mod bushing;
 mod contact;
 mod force;
 mod generalized_force;
 mod gravity;
+mod rotational_spring;
 mod spring;
 mod torque;
 
@@ -20,7 +21,7 @@ struct Kind {
 }
 
 /// Every kind of effect, in the order error messages list them.
-const KINDS: [Kind; 8] = [
+const KINDS: [Kind; 10] = [
     gravity::KIND,
     spring::KIND,
     spring::DAMPER,
@@ -29,6 +30,8 @@ const KINDS: [Kind; 8] = [
     generalized_force::KIND,
     contact::KIND,
     bushing::KIND,
+    rotational_spring::KIND,
+    rotational_spring::DAMPER,
 ];
 
 /// The value of the named argument `key` of `s`.
@@ -78,6 +81,9 @@ impl Checker {
                         frame: Some(fi),
                         pos: [z; 3],
                     });
+                }
+                if self.taken_reserved.contains(&s) {
+                    return None;
                 }
                 let names: Vec<String> = self
                     .points

@@ -345,4 +345,16 @@
 //! ## Reading the generated code
 //!
 //! `mbs expand FILE.rs [--model NAME] [--scene S]` prints exactly what the macro emits,
-//! pretty-printed, with a table of operations per generated function.
+//! pretty-printed, with a table of operations per generated function. It reads the blocks of
+//! `FILE.rs` and of the files it includes, found as rustc finds them (`mod name;`: `name.rs`
+//! or `name/mod.rs`, in a folder named after a file that is not a crate root or `mod.rs`;
+//! `#[path = "…"] mod name;` relative to the file's folder), and of the modules of workspace
+//! crates it names in `use` (`use mbs_models::hexapod;` reads that crate's `src/hexapod.rs`,
+//! so `mbs expand examples/hexapod.rs` shows the hexapod). Every error is printed as
+//! `file:line:col: message` after every model has been tried, and the exit status is then
+//! non-zero; an unknown `--scene` is an error that lists the scenes:
+//!
+//! ```text
+//! error: examples/legs.rs:7:24: model `Bad`: unknown body `bra`; did you mean `bar`?
+//! error: no scene `Drivn` in model `Leg`: its scenes are `Passive` and `Driven`
+//! ```

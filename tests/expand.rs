@@ -118,3 +118,149 @@ fn user_functions_and_inputs_reach_the_generated_code() {
     model.initial_state(&mut q0, &mut qd0);
     assert_eq!((q0, qd0), ([0.3, -0.2], [0.0, 0.5]));
 }
+
+/// Writes `files` (path relative to a fresh folder, text) and returns the folder.
+fn fixture(name: &str, files: &[(&str, &str)]) -> std::path::PathBuf {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    for (path, text) in files {
+        let p = dir.join(path);
+        std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+        std::fs::write(p, text).unwrap();
+    }
+    dir
+}
+
+fn run(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_mbs"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.success(),
+        String::from_utf8(out.stdout).unwrap(),
+        String::from_utf8(out.stderr).unwrap(),
+    )
+}
+
+const GOOD: &str = "dof q[0] = 0.1; body bar { mass = 1.0; inertia_z = 0.1; } TOG[bar] = Trotz(q[0]) * Tdisp(0, -0.5, 0);";
+
+/// `mod name;` (name.rs next to a crate root, in a folder of its name below a plain file),
+/// `name/mod.rs` and `#[path]` (whose file finds its modules next to it) are followed; every model is expanded, an error in one is
+/// reported with file:line:col and the others still come; the exit status says there was one.
+#[test]
+fn expand_follows_modules_and_reports_every_error_with_its_place() {
+    let dir = fixture(
+        "expand_modules",
+        &[
+            (
+                "main.rs",
+                "mod legs;\nmod arms;\n#[path = \"extra/base.rs\"]\nmod base;\nfn main() {}\n",
+            ),
+            (
+                "legs.rs",
+                &format!(
+                    "mod foot;\nmbs::multibody! {{\n    model Leg {{ {GOOD} }}\n    model Bad {{\n        dof q[0] = 0.1;\n        body bar {{ mass = 1.0; }}\n        TOG[bar] = TOG[bra] * Trotz(q[0]);\n    }}\n}}\n"
+                ),
+            ),
+            (
+                "legs/foot.rs",
+                &format!("mbs::multibody! {{ model Foot {{ {GOOD} }} }}\n"),
+            ),
+            (
+                "arms/mod.rs",
+                &format!(
+                    "mbs::multibody! {{ model Arm {{ {GOOD} scene Up = []; scene Down = []; }} }}\n"
+                ),
+            ),
+            (
+                "extra/base.rs",
+                &format!("mod wheel;\nmbs::multibody! {{ model Base {{ {GOOD} }} }}\n"),
+            ),
+            (
+                "extra/wheel.rs",
+                &format!("mbs::multibody! {{ model Wheel {{ {GOOD} }} }}\n"),
+            ),
+        ],
+    );
+    let main = dir.join("main.rs");
+    let (ok, stdout, stderr) = run(&["expand", main.to_str().unwrap(), "--counts-only"]);
+    assert!(!ok, "errors make the exit status non-zero");
+    for m in [
+        "model Leg:",
+        "model Foot:",
+        "model Arm:",
+        "model Base:",
+        "model Wheel:",
+    ] {
+        assert!(stdout.contains(m), "missing {m} in\n{stdout}");
+    }
+    let legs = dir.join("legs.rs");
+    assert!(
+        stderr.contains(&format!(
+            "error: {}:7:24: model `Bad`: unknown body `bra`; did you mean `bar`?",
+            legs.display()
+        )),
+        "{stderr}"
+    );
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+
+    // a module whose file is missing is reported where it is declared
+    let dir = fixture(
+        "expand_missing",
+        &[(
+            "main.rs",
+            &format!("mbs::multibody! {{ model Alone {{ {GOOD} }} }}\nmod gone;\n"),
+        )],
+    );
+    let (ok, stdout, stderr) = run(&["expand", dir.join("main.rs").to_str().unwrap()]);
+    assert!(!ok && stdout.contains("struct Alone {"));
+    assert!(
+        stderr.starts_with(&format!(
+            "error: {}:2:5: file not found for module `gone`",
+            dir.join("main.rs").display()
+        )),
+        "{stderr}"
+    );
+
+    // --scene: a scene of one of the models is shown alone; an unknown one is an error that
+    // lists the scenes
+    let (ok, stdout, _) = run(&[
+        "expand",
+        main.to_str().unwrap(),
+        "--model",
+        "Arm",
+        "--scene",
+        "Up",
+    ]);
+    assert!(ok && stdout.contains("struct ArmUp {") && !stdout.contains("struct ArmDown {"));
+    let (ok, stdout, stderr) = run(&[
+        "expand",
+        main.to_str().unwrap(),
+        "--model",
+        "Arm",
+        "--scene",
+        "Sideways",
+    ]);
+    assert!(!ok && stdout.is_empty());
+    assert_eq!(
+        stderr.trim(),
+        "error: no scene `Sideways` in model `Arm`: its scenes are `Up` and `Down`"
+    );
+    let (ok, _, stderr) = run(&["expand", &this_file(), "--scene", "Drivn"]);
+    assert!(!ok);
+    assert_eq!(
+        stderr.trim(),
+        "error: no scene `Drivn` in model `Leg`: its scenes are `Passive` and `Driven`"
+    );
+}
+
+/// The examples keep their models in `mbs-models`: `mbs expand examples/hexapod.rs` finds the
+/// model through `use mbs_models::hexapod`.
+#[test]
+fn expand_finds_the_models_an_example_uses() {
+    let example = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/hexapod.rs");
+    let (ok, stdout, stderr) = run(&["expand", example, "--counts-only"]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("// model Hexapod:") && stdout.contains("HexapodStanding"));
+}

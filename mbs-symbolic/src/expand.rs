@@ -10,6 +10,9 @@ use crate::dsl::parse::Models;
 use proc_macro2::{Group, TokenStream, TokenTree};
 use quote::ToTokens;
 
+mod sources;
+pub use sources::{Source, SourceError, sources};
+
 /// The tokens of every `multibody! { … }` invocation in a Rust file (for `mbs expand` and
 /// tools that expand a file the way the macro does).
 pub fn multibody_blocks(file: &syn::File) -> Vec<TokenStream> {

@@ -1,12 +1,15 @@
 //! `mbs`: command-line tools of the mbs toolkit.
 //!
 //! `mbs expand FILE.rs [--model NAME] [--scene S]` prints the code that `multibody!` generates
-//! for the blocks of a file, exactly as the macro emits it, pretty-printed, then a table of
-//! operation counts per generated function and the generation time.
+//! for the blocks of a file and of the files it includes (`mod name;`, `#[path = "…"] mod
+//! name;`, and the modules of workspace crates it names in `use`), exactly as the macro emits
+//! it, pretty-printed, then a table of operation counts per generated function and the
+//! generation time. Errors are reported with file:line:col, after every model is tried.
 
 use clap::{Parser, Subcommand};
-use mbs_symbolic::expand::{Expansion, expand_models, multibody_blocks};
-use std::path::PathBuf;
+use mbs_symbolic::codegen::Generated;
+use mbs_symbolic::expand::{Expansion, expand_models, sources};
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Parser)]
@@ -42,91 +45,209 @@ fn main() -> ExitCode {
             model,
             scene,
             counts_only,
-        } => match expand_file(&file, model.as_deref(), scene.as_deref(), counts_only) {
-            Ok(()) => ExitCode::SUCCESS,
-            Err(e) => {
+        } => {
+            let errors = expand_file(&file, model.as_deref(), scene.as_deref(), counts_only);
+            for e in &errors {
                 eprintln!("error: {e}");
+            }
+            if errors.is_empty() {
+                ExitCode::SUCCESS
+            } else {
                 ExitCode::FAILURE
             }
-        },
+        }
     }
 }
 
+/// `file:line:col: message` of an error in `file` (line and column of the span's start).
+fn located(file: &Path, span: Option<proc_macro2::Span>, message: &str) -> String {
+    match span {
+        Some(s) => {
+            let p = s.start();
+            format!("{}:{}:{}: {message}", file.display(), p.line, p.column + 1)
+        }
+        None => format!("{}: {message}", file.display()),
+    }
+}
+
+/// Prints the expansion of every model of `file` and of the files it includes (or of
+/// `model` only, of its scene `scene` only); returns every error, each with file:line:col,
+/// after going through every model.
 fn expand_file(
-    file: &PathBuf,
+    file: &Path,
     model: Option<&str>,
     scene: Option<&str>,
     counts_only: bool,
-) -> Result<(), String> {
-    let src = std::fs::read_to_string(file)
-        .map_err(|e| format!("cannot read {}: {e}", file.display()))?;
-    let ast = syn::parse_file(&src)
-        .map_err(|e| format!("{} does not parse as Rust: {e}", file.display()))?;
-    let blocks = multibody_blocks(&ast);
-    if blocks.is_empty() {
-        return Err(format!("no multibody! block in {}", file.display()));
+) -> Vec<String> {
+    let (sources, read_errors) = sources(file);
+    let mut errors: Vec<String> = read_errors
+        .iter()
+        .map(|e| located(&e.file, e.span, &e.message))
+        .collect();
+    if sources.iter().all(|s| s.blocks.is_empty()) {
+        if errors.is_empty() {
+            let read: Vec<String> = sources
+                .iter()
+                .map(|s| s.path.display().to_string())
+                .collect();
+            errors.push(format!(
+                "no multibody! block in {} (read: {})",
+                file.display(),
+                read.join(", ")
+            ));
+        }
+        return errors;
     }
-    let mut found = false;
-    for tokens in blocks {
-        let expansions = expand_models(tokens).map_err(|e| e.to_string())?;
-        for e in expansions {
-            match e {
-                Expansion::Err { name, error, .. } => {
-                    if model.is_none_or(|m| m == name) {
-                        return Err(format!("model `{name}` has errors: {error}"));
-                    }
+    // models found, and the scenes of those `--model` selects
+    let (mut found, mut scenes): (bool, Vec<(String, Vec<String>)>) = (false, Vec::new());
+    for source in &sources {
+        for tokens in &source.blocks {
+            let expansions = match expand_models(tokens.clone()) {
+                Ok(e) => e,
+                Err(e) => {
+                    errors.extend(
+                        e.into_iter()
+                            .map(|e| located(&source.path, Some(e.span()), &e.to_string())),
+                    );
+                    continue;
                 }
-                Expansion::Ok { name, generated } => {
-                    if model.is_some_and(|m| m != name) {
-                        continue;
+            };
+            for e in expansions {
+                match e {
+                    Expansion::Err { name, error, .. } => {
+                        if model.is_none_or(|m| m == name) {
+                            found = true;
+                            errors.extend(error.into_iter().map(|e| {
+                                located(
+                                    &source.path,
+                                    Some(e.span()),
+                                    &format!("model `{name}`: {e}"),
+                                )
+                            }));
+                        }
                     }
-                    found = true;
-                    let file: syn::File = syn::parse_str(&generated.code).map_err(|e| {
-                        format!("internal error: generated code does not parse: {e}")
-                    })?;
-                    let items: Vec<syn::Item> = file
-                        .items
-                        .into_iter()
-                        .filter(|it| scene.is_none_or(|s| item_belongs(it, &name, s)))
-                        .collect();
-                    if !counts_only {
-                        let shown = syn::File {
-                            shebang: None,
-                            attrs: Vec::new(),
-                            items,
-                        };
-                        println!("{}", prettyplease::unparse(&shown));
-                    }
-                    println!(
-                        "// model {name}: generation {:.1} ms (symbolic {:.1} ms, emission {:.1} ms)",
-                        (generated.build_time + generated.emit_time).as_secs_f64() * 1e3,
-                        generated.build_time.as_secs_f64() * 1e3,
-                        generated.emit_time.as_secs_f64() * 1e3
-                    );
-                    println!(
-                        "// {:<28} {:<22} {:>8} {:>8} {:>8} {:>6} {:>6} {:>6}",
-                        "type", "function", "flops", "adds", "muls", "divs", "funcs", "lets"
-                    );
-                    for r in &generated.reports {
-                        if scene.is_some_and(|s| r.model != format!("{name}{s}") && r.model != name)
-                        {
+                    Expansion::Ok { name, generated } => {
+                        if model.is_some_and(|m| m != name) {
                             continue;
                         }
-                        let (model, function) = (&r.model, &r.function);
-                        let [flops, adds, muls, divs, funcs, lets] = r.ops.columns();
-                        println!(
-                            "// {model:<28} {function:<22} {flops:>8} {adds:>8} {muls:>8} {divs:>6} {funcs:>6} {lets:>6}"
-                        );
+                        found = true;
+                        let own = model_scenes(&name, &generated);
+                        let shown = scene.is_none_or(|s| own.iter().any(|o| o == s));
+                        scenes.push((name.clone(), own));
+                        if !shown {
+                            continue;
+                        }
+                        if let Err(e) = print_model(&name, &generated, scene, counts_only) {
+                            errors.push(located(&source.path, None, &e));
+                        }
                     }
                 }
             }
         }
     }
     if !found {
-        return Err(match model {
-            Some(m) => format!("no model named `{m}` in {}", file.display()),
+        errors.push(match model {
+            Some(m) => format!(
+                "no model named `{m}` in {} or the files it includes",
+                file.display()
+            ),
             None => format!("no model generated from {}", file.display()),
         });
+    } else if let Some(s) = scene {
+        if !scenes.iter().any(|(_, own)| own.iter().any(|o| o == s)) {
+            errors.push(unknown_scene(s, &scenes));
+        }
+    }
+    errors
+}
+
+/// "no scene `S` …" with the scenes there are.
+fn unknown_scene(s: &str, scenes: &[(String, Vec<String>)]) -> String {
+    let list = |v: &[String]| {
+        let v: Vec<String> = v.iter().map(|x| format!("`{x}`")).collect();
+        match v.split_last() {
+            None => "none".to_string(),
+            Some((last, [])) => last.clone(),
+            Some((last, init)) => format!("{} and {last}", init.join(", ")),
+        }
+    };
+    match scenes {
+        [(m, own)] if own.is_empty() => {
+            format!(
+                "no scene `{s}`: model `{m}` has no scenes (its one type is `{m}`); leave out --scene"
+            )
+        }
+        [(m, own)] => format!(
+            "no scene `{s}` in model `{m}`: its scenes are {}",
+            list(own)
+        ),
+        _ => {
+            let all: Vec<String> = scenes
+                .iter()
+                .map(|(m, own)| format!("model `{m}`: {}", list(own)))
+                .collect();
+            format!(
+                "no scene `{s}` in any model; the scenes are, {}",
+                all.join("; ")
+            )
+        }
+    }
+}
+
+/// The scenes of a model: the suffixes of its types (none when its one type is the model).
+fn model_scenes(name: &str, generated: &Generated) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    for r in &generated.reports {
+        if let Some(s) = r.model.strip_prefix(name).filter(|s| !s.is_empty()) {
+            if !out.iter().any(|o| o == s) {
+                out.push(s.to_string());
+            }
+        }
+    }
+    out
+}
+
+/// Prints a model's code (its scene's, with `scene`) and its op-count table.
+fn print_model(
+    name: &str,
+    generated: &Generated,
+    scene: Option<&str>,
+    counts_only: bool,
+) -> Result<(), String> {
+    let file: syn::File = syn::parse_str(&generated.code)
+        .map_err(|e| format!("internal error: generated code does not parse: {e}"))?;
+    let items: Vec<syn::Item> = file
+        .items
+        .into_iter()
+        .filter(|it| scene.is_none_or(|s| item_belongs(it, name, s)))
+        .collect();
+    if !counts_only {
+        let shown = syn::File {
+            shebang: None,
+            attrs: Vec::new(),
+            items,
+        };
+        println!("{}", prettyplease::unparse(&shown));
+    }
+    println!(
+        "// model {name}: generation {:.1} ms (symbolic {:.1} ms, emission {:.1} ms)",
+        (generated.build_time + generated.emit_time).as_secs_f64() * 1e3,
+        generated.build_time.as_secs_f64() * 1e3,
+        generated.emit_time.as_secs_f64() * 1e3
+    );
+    println!(
+        "// {:<28} {:<22} {:>8} {:>8} {:>8} {:>6} {:>6} {:>6}",
+        "type", "function", "flops", "adds", "muls", "divs", "funcs", "lets"
+    );
+    for r in &generated.reports {
+        if scene.is_some_and(|s| r.model != format!("{name}{s}") && r.model != name) {
+            continue;
+        }
+        let (model, function) = (&r.model, &r.function);
+        let [flops, adds, muls, divs, funcs, lets] = r.ops.columns();
+        println!(
+            "// {model:<28} {function:<22} {flops:>8} {adds:>8} {muls:>8} {divs:>6} {funcs:>6} {lets:>6}"
+        );
     }
     Ok(())
 }

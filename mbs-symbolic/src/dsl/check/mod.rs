@@ -121,7 +121,7 @@ const ANY: Allow = Allow {
 #[derive(Clone)]
 enum Scalar {
     Param(usize),
-    Let(Expr),
+    Let(Box<Expr>),
     Dof(usize),
     Input(usize),
     /// inline-function argument, bound to an expression
@@ -130,7 +130,7 @@ enum Scalar {
 
 #[derive(Clone)]
 enum FnSym {
-    Inline { args: Vec<Ident>, body: Expr },
+    Inline { args: Vec<Ident>, body: Box<Expr> },
     Extern { id: u16 },
 }
 
@@ -320,7 +320,7 @@ impl Checker {
                     let ok = !self.reserved(name, "`let`") && !self.duplicate_scalar(name);
                     if ok {
                         self.scalars
-                            .insert(name.to_string(), Scalar::Let(value.clone()));
+                            .insert(name.to_string(), Scalar::Let(Box::new(value.clone())));
                     }
                 }
                 Item::Dof {
@@ -439,7 +439,7 @@ impl Checker {
                         name.to_string(),
                         FnSym::Inline {
                             args: args.clone(),
-                            body: body.clone(),
+                            body: Box::new(body.clone()),
                         },
                     );
                 }

@@ -315,3 +315,23 @@ fn planar_inertia_and_point_mass_shorthands_give_the_long_forms() {
     // the tip is a body of the model, named like the others
     assert!(short.info().frame_index("tip").is_some());
 }
+
+/// A rotational spring's stiffness and damping made negative by parameters are refused at run
+/// time (the defaults are checked at compile time).
+#[test]
+fn negative_rotational_coefficients_from_parameters_are_typed_errors() {
+    use mbs::{ParamError, Parameters};
+    let mut model = HingedRot::default();
+    for (name, element, coefficient) in [
+        ("k", "rotational spring 0", "k"),
+        ("c", "rotational spring 2", "c"),
+    ] {
+        let mut p = model.params().clone();
+        p.set(name, -1.0).unwrap();
+        let e = model.set_params(p).unwrap_err();
+        assert!(
+            matches!(e, ParamError::InvalidCoefficient { element: el, name: n, .. } if el == element && n == coefficient),
+            "{e:?}"
+        );
+    }
+}

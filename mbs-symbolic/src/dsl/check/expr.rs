@@ -162,7 +162,10 @@ impl Checker {
     /// non-finite number (`sqrt(-1.0)`, `ln(0)`) is reported on its tokens.
     pub(super) fn lower(&mut self, e: &Expr, a: Allow) -> ExprId {
         let r = self.lower_inner(e, a);
-        if !matches!(e, Expr::Binary(_) | Expr::Call(_) | Expr::MethodCall(_)) {
+        if !matches!(
+            e,
+            Expr::Binary(_) | Expr::Call(_) | Expr::MethodCall(_) | Expr::Lit(_)
+        ) {
             return r;
         }
         match self.sys.arena.as_num(r) {

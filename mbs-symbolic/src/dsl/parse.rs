@@ -319,21 +319,19 @@ fn parse_item(input: ParseStream) -> syn::Result<Item> {
             input.parse::<Ident>()?;
             let usage = "write `mass name on body at (x, y, z) = m;`";
             let name: Ident = input.parse()?;
-            let on: Ident = input.parse()?;
-            if on != "on" {
-                return Err(syn::Error::new(
-                    on.span(),
-                    format!("expected `on`: {usage}"),
-                ));
-            }
+            // the keyword `w` next, or an error naming it
+            let word = |w: &str| -> syn::Result<()> {
+                match input.fork().parse::<Ident>() {
+                    Ok(i) if i == w => input.parse::<Ident>().map(|_| ()),
+                    _ => Err(syn::Error::new(
+                        input.span(),
+                        format!("expected `{w}`: {usage}"),
+                    )),
+                }
+            };
+            word("on")?;
             let body = body_ref(input)?;
-            let at: Ident = input.parse()?;
-            if at != "at" {
-                return Err(syn::Error::new(
-                    at.span(),
-                    format!("expected `at`: {usage}"),
-                ));
-            }
+            word("at")?;
             if !input.peek(syn::token::Paren) {
                 return Err(syn::Error::new(
                     input.span(),

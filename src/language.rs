@@ -292,7 +292,9 @@
 //! parts and contain loops.
 //!
 //! Names: loop variables and part arguments are local (they replace every identifier of that
-//! name in their body, except argument names before `=` such as `k = …` in `contact(…)`);
+//! name in their body, except argument names before `=` such as `k = …` in `contact(…)`; a
+//! part's statements see its arguments, not the loop variables around the instance, so pass
+//! them: `for i in 0..6 { Leg(i, …); }`);
 //! every name a part declares is a name of the model, so an instance keeps its names apart
 //! by indexing them with an argument (`body thigh[k]`). `thigh[3]` is how an indexed name
 //! reads everywhere: in messages, `mbs expand`, [`ModelInfo`](crate::ModelInfo)'s coordinate,

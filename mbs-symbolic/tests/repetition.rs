@@ -305,3 +305,63 @@ fn nested_parts_name_arguments_and_integer_arithmetic() {
         "{e:?}"
     );
 }
+
+#[test]
+fn mistakes_in_the_statements_themselves() {
+    let first = |src: &str| errors(src).remove(0);
+    let body = "dof x; body b { mass = 1.0; } TOG[b] = Tdisp(x, 0, 0);";
+    assert_eq!(
+        first(&format!("model L {{ {body} part leg(k) {{ }} }}")),
+        "a part's name starts with an uppercase letter, which tells its instances from effects: `part Leg…`"
+    );
+    assert_eq!(
+        first(&format!(
+            "model L {{ {body} part P(k) {{ }} part P(j) {{ }} }}"
+        )),
+        "duplicate part `P`: rename one of the two"
+    );
+    assert_eq!(
+        first(&format!("model L {{ {body} part P(k, k) {{ }} }}")),
+        "part `P` has two arguments named `k`: rename one of them"
+    );
+    assert_eq!(
+        first(&format!("model L {{ {body} part P(q) {{ }} }}")),
+        "`q` is reserved: give argument 1 of part `P` another name"
+    );
+    assert_eq!(
+        first(&format!("model L {{ {body} for q in 0..2 {{ }} }}")),
+        "`q` is reserved: give the loop variable another name"
+    );
+    assert_eq!(
+        first(&format!("model L {{ {body} for i of 0..2 {{ }} }}")),
+        "expected `in` after `for i`: write `for i in 0..n { statements }`"
+    );
+    assert_eq!(
+        first(&format!("model L {{ {body} for i in 0.. {{ }} }}")),
+        "a loop range needs both ends: write `for i in 0..n { statements }`"
+    );
+    assert_eq!(
+        first(&format!("model L {{ {body} for i in 0..1000000 {{ }} }}")),
+        "`for i in 0..1000000` repeats 1000000 times: at most 100000 instances per loop"
+    );
+    assert_eq!(
+        first(&format!(
+            "model L {{ {body} for i in 0..2 {{ frame f[i / 0]; }} }}"
+        )),
+        "the index of `f[…]` must be a constant integer: division by zero; in `for i in 0..2`, i = 0"
+    );
+    assert_eq!(
+        first(&format!("model L {{ {body} frame f[1.5]; }}")),
+        "the index of `f[…]` must be a constant integer: `1.5` is not an integer"
+    );
+    assert_eq!(
+        first(&format!(
+            "model L {{ {body} for i in 0..2 {{ scene S[i] = []; }} }}"
+        )),
+        "a scene's name names a type, so `S[0]` cannot be indexed: give it a plain name; in `for i in 0..2`, i = 0"
+    );
+    // `0..=n` includes n
+    let code = generate("model L { for i in 0..=2 { dof x[i]; body b[i] { mass = 1.0; } TOG[b[i]] = Tdisp(x[i], i, 0); } }")
+        .expect("closed range");
+    assert!(code.contains("\"x[2]\""));
+}

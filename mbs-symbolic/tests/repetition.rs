@@ -365,3 +365,12 @@ fn mistakes_in_the_statements_themselves() {
         .expect("closed range");
     assert!(code.contains("\"x[2]\""));
 }
+
+#[test]
+fn a_loop_that_does_not_expand_is_an_error_of_systems_from_str() {
+    let e = mbs_symbolic::systems_from_str(
+        "model L { param n = 2.0; dof x; body b { mass = 1.0; } TOG[b] = Tdisp(x, 0, 0); for i in 0..n { frame f[i]; } }",
+    )
+    .expect_err("an error");
+    assert!(e.contains("a loop range must be constant integers"), "{e}");
+}

@@ -152,9 +152,20 @@ fn indexed_parameters_are_rust_fields() {
     let clash = errors(
         "model P { param k_1 = 2.0; param k[1] = 1.0; dof x; body b { mass = 1.0; inertia = (1, 1, 1); } TOG[b] = Tdisp(x, 0, 0); }",
     );
-    assert!(
-        clash[0].starts_with("parameter `k[1]` is the field `k_1`"),
-        "{clash:?}"
+    assert_eq!(
+        clash,
+        [
+            "parameters `k_1` and `k[1]` are both the field `k_1` of the parameter struct (an indexed parameter `k[3]` is the field `k_3`): rename one of them"
+        ]
+    );
+    let clash = errors(
+        "model P { param k[1] = 1.0; param k_1 = 2.0; dof x; body b { mass = 1.0; inertia = (1, 1, 1); } TOG[b] = Tdisp(x, 0, 0); }",
+    );
+    assert_eq!(
+        clash,
+        [
+            "parameters `k[1]` and `k_1` are both the field `k_1` of the parameter struct (an indexed parameter `k[3]` is the field `k_3`): rename one of them"
+        ]
     );
 }
 

@@ -333,8 +333,11 @@ impl Checker {
                     };
                     // an indexed parameter `k[3]` is the field `k_3`
                     let field = repeat::rust_ident(&name.to_string());
-                    if *name != field && self.sys.params.iter().any(|p| p.name == field) {
-                        self.error(name.span(), format!("parameter `{name}` is the field `{field}` of the parameter struct, as is the parameter `{field}`: rename one of them"));
+                    if let Some(other) = self.scalars.iter().find_map(|(n, s)| match s {
+                        Scalar::Param(i) if self.sys.params[*i].name == field => Some(n.clone()),
+                        _ => None,
+                    }) {
+                        self.error(name.span(), format!("parameters `{other}` and `{name}` are both the field `{field}` of the parameter struct (an indexed parameter `k[3]` is the field `k_3`): rename one of them"));
                         continue;
                     }
                     self.bad_params.push(bad);

@@ -56,6 +56,7 @@
 //! | `option tangents;` | also generate exact K_t = ∂τ/∂q and C_t = ∂τ/∂qd |
 //! | `option formulation = recursive;` | force `recursive` or `virtual_power` (default: the cheaper by op count) |
 //! | `shape arm: box(0.3, 0.05, 0.05);` | what to draw with a body, a frame or the `ground` (below); no effect on the dynamics |
+//! | `for i in 0..n { … }`, `part Leg(k, x) { … }`, `Leg(0, 0.4);` | statements repeated with an index, templates instantiated with arguments; indexed names `bar[i]` ([below](#repetition-and-parts)) |
 //!
 //! Without scenes the model type is named after the model and has every effect. With scenes,
 //! each scene is a type `{Model}{Scene}`; an effect a scene does not name has no code in it.
@@ -317,6 +318,85 @@
 //! feature `anim`) or `mbs::gltf::write_gltf(Path::new("crane.gltf"), model.info(),
 //! &trajectory)` (a glTF file, feature `gltf`); both take a `&std::path::Path`.
 //!
+//! ## Repetition and parts
+//!
+//! | statement | meaning |
+//! |---|---|
+//! | `for i in 0..n { … }` | the statements once for each integer `i` from 0 to n − 1 (`0..=n` includes n); at model level and inside `effect` blocks; nestable |
+//! | `body bar[i] { … }`, `dof b[i]`, `point tip[i] on bar[i] at …`, `param k[i] = …` | indexed names: the index is a constant integer expression (`i`, `i - 1`, `2 * i + 1`, `i / 2`, `i % 2`: integer arithmetic) |
+//! | `TOG[bar[i]] = TOG[bar[i-1]] * …;`, `q[b[i]]`, `qd[b[i]]` | indexed names wherever names go |
+//! | `Tdisp(i * l, 0, 0)` | elsewhere the loop variable is a number |
+//! | `part Leg(k, hx, hy) { … }` | a template of statements, declared at model level (above or below its instances); its name starts with an uppercase letter |
+//! | `Leg(0, 0.4, 0.3);` | an instance: the part's statements with each argument replaced by the tokens given for it |
+//!
+//! Loops and parts are unrolled before the model is checked, by substituting tokens: the
+//! statements they produce are exactly those one would write out, so the generated code is
+//! the same. The range of a loop is made of integers, loop variables and integer part
+//! arguments (not parameters, which change at run time). A part's arguments may be integers
+//! (indices), scalar expressions (`0.4`, `-l / 2`), transform products (a mounting
+//! transform, `TOG[base] * Trotz(PI)`, as the start of a product) and names (`Leg(0, base)`);
+//! an argument of several tokens is substituted in parentheses. Parts may instantiate other
+//! parts and contain loops.
+//!
+//! Names: loop variables and part arguments are local (they replace every identifier of that
+//! name in their body, except argument names before `=` such as `k = …` in `contact(…)`; a
+//! part's statements see its arguments, not the loop variables around the instance, so pass
+//! them: `for i in 0..6 { Leg(i, …); }`);
+//! every name a part declares is a name of the model, so an instance keeps its names apart
+//! by indexing them with an argument (`body thigh[k]`). `thigh[3]` is how an indexed name
+//! reads everywhere: in messages, `mbs expand`, [`ModelInfo`](crate::ModelInfo)'s coordinate,
+//! body and point names, the CSV columns and the animations' node names. Where a name must
+//! be a Rust identifier, the brackets become underscores: `param k[3]` is the field `k_3` of
+//! the parameter struct (and is set by that name); a scene, whose name is a type, cannot be
+//! indexed. An index is never negative (`bar[i - 1]` at i = 0 is an error at the template,
+//! naming the instance); an index that no statement declares (`bar[40]` in a chain of 40)
+//! is an unknown name, with the indices that exist.
+//!
+//! An error inside a loop or a part points at the template's tokens and says which instance
+//! (``…; in `for i in 1..5`, i = 4``, `…; in part Leg, instance 3 (k = 2, hx = 0, hy = 0.3)`;
+//! nested ones are listed outermost first); an error that several instances repeat word for
+//! word is reported once, at the first. Mistakes of the statements themselves: a range that
+//! is not made of constant integers, an index that is not a constant integer or is negative,
+//! a wrong number of arguments to a part, an unknown part (with the closest name), a part
+//! declared inside a loop, an effect or another part.
+//!
+//! ```
+//! mbs::multibody! {
+//!     /// A chain of 10 bars, a torsional spring in every joint, and two legs on a frame.
+//!     model Repeated {
+//!         param l = 0.5; param m = 1.0; param k = 50.0;
+//!         for i in 0..10 {
+//!             dof q[i] = 0.1;
+//!             body bar[i] { mass = m; inertia = (m*l*l/12, 0, m*l*l/12); }
+//!         }
+//!         TOG[bar[0]] = Trotz(q[0]) * Tdisp(0, -l/2, 0);
+//!         for i in 1..10 {
+//!             TOG[bar[i]] = TOG[bar[i-1]] * Tdisp(0, -l/2, 0) * Trotz(q[i]) * Tdisp(0, -l/2, 0);
+//!             torque(bar[i], relative_to = bar[i-1], axis = z, -k * q[i]);
+//!         }
+//!         point tip on bar[9] at (0, -l/2, 0);
+//!
+//!         part Leg(j, mount, side) {
+//!             dof hip[j] = 0.2 * side;
+//!             body thigh[j] { mass = 1.0; inertia = (0.01, 0.01, 0.002); }
+//!             TOG[thigh[j]] = mount * Tdisp(0, 0.1 * side, 0) * Trotx(hip[j]) * Tdisp(0, 0, -0.2);
+//!             point foot[j] on thigh[j] at (0, 0, -0.2);
+//!         }
+//!         frame hips;
+//!         TOG[hips] = Tdisp(3, 0, 1);
+//!         Leg(0, TOG[hips], 1);
+//!         Leg(1, TOG[hips], -1);
+//!         effect stance { for j in 0..2 { contact(foot[j], k = 1e4, c = 100); } }
+//!         gravity(0, -9.81, 0);
+//!     }
+//! }
+//! use mbs::Model;
+//! let info = Repeated::default().info();
+//! assert_eq!(info.frames[9], "bar[9]");
+//! assert_eq!(&info.dofs[10..], ["hip[0]", "hip[1]"]);
+//! assert_eq!(info.points, ["tip", "foot[0]", "foot[1]"]);
+//! ```
+//!
 //! ## Errors
 //!
 //! Every mistake is a compile error on the offending tokens, naming the construct and the
@@ -326,6 +406,7 @@
 //! error: unknown body `uper_arm`; did you mean `upper_arm`?
 //! error: coordinate `q[2]` moves no body with mass, so the mass matrix would be singular: …
 //! error: the mass of body `arm` must be positive, it is -1: …
+//! error: unknown body `bar[4]`; `bar[…]` is declared with the indices 0 to 3; in `for i in 1..5`, i = 4
 //! ```
 //!
 //! Some of them:

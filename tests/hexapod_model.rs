@@ -45,9 +45,9 @@ fn hexapod_sizes_and_names() {
     assert_eq!(Hexapod::NPOINTS, 6);
     assert_eq!(
         &info.dofs[..9],
-        ["x", "y", "z", "psi", "theta", "phi", "a0", "b0", "c0"]
+        ["x", "y", "z", "psi", "theta", "phi", "a[0]", "b[0]", "c[0]"]
     );
-    assert_eq!(info.dofs[23], "c5");
+    assert_eq!(info.dofs[23], "c[5]");
 }
 
 #[test]

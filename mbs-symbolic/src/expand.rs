@@ -200,7 +200,7 @@ fn stub(def: &ModelDef) -> String {
     for item in &def.items {
         match item {
             Item::Param { name: p, .. } => {
-                let p = p.to_string();
+                let p = crate::dsl::repeat::rust_ident(&p.to_string());
                 if !params.contains(&p) && !matches!(p.as_str(), "t" | "q" | "qd" | "qdd" | "u") {
                     params.push(p);
                 }

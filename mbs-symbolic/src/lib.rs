@@ -18,6 +18,10 @@ pub fn systems_from_str(src: &str) -> Result<Vec<System>, String> {
     let models: dsl::parse::Models = syn::parse_str(src).map_err(|e| e.to_string())?;
     let mut out = Vec::new();
     for m in &models.0 {
+        // statements that did not parse or expand: the rest would check without them
+        if let Some(e) = m.errors.first() {
+            return Err(e.clone().into_compile_error().to_string());
+        }
         let c = dsl::check::check(m).map_err(|e| e.into_compile_error().to_string())?;
         out.push(c.system);
     }

@@ -4,9 +4,11 @@
 //!
 //! Legs are numbered k = 2i + j with the hip at (hx_i, hy_j, 0) in the base frame,
 //! hx = (0.4, 0, −0.4), hy = (0.3, −0.3): 0 front left, 1 front right, 2 middle left, … 5 rear
-//! right. Every leg has the dofs a_k (hip yaw), b_k (thigh pitch), c_k (knee pitch) and eight
-//! bodies; the pantograph link and coupler follow their products literally (no closed loop),
-//! the motor rotors turn 100 times as fast as their joints.
+//! right. Every leg is an instance of `part Leg(k, hx, hy)`: the dofs `a[k]` (hip yaw), `b[k]`
+//! (thigh pitch), `c[k]` (knee pitch), eight bodies (`support[k]`, `thigh[k]`, `shank[k]`,
+//! `panto[k]`, `coupler[k]`, `rotor_a[k]`, `rotor_b[k]`, `rotor_c[k]`) and the point `foot[k]`;
+//! the pantograph link and coupler follow their products literally (no closed loop), the motor
+//! rotors turn 100 times as fast as their joints.
 //!
 //! Two scenes: `Free` (gravity only; also named `Hexapod`, the type of the contact-free
 //! figures) and `Standing` (`HexapodStanding`: the feet's ground contact and a PD controller
@@ -83,158 +85,52 @@ mbs::multibody! {
         body base { mass = m_base; inertia = (base_ixx, base_iyy, base_izz); }
         TOG[base] = Tdisp(x, y, z) * Trotz(psi) * Troty(theta) * Trotx(phi);
 
-        // Leg 0, front left: hip at (0.4, 0.3, 0).
-        dof a0 = 0.0; dof b0 = 0.3; dof c0 = -0.3;
-        body support0 { mass = m_support; inertia = (i_support, i_support, i_support); }
-        body thigh0 { mass = m_thigh; inertia = (0, i_thigh, i_thigh); }
-        body shank0 { mass = m_shank; inertia = (i_shank, i_shank, 0); }
-        body panto0 { mass = m_panto; inertia = (0, i_panto, i_panto); }
-        body coupler0 { mass = m_coupler; inertia = (i_coupler, i_coupler, 0); }
-        body rotor_a0 { mass = m_rotor; inertia = (1e-5, 1e-5, 2e-5); }
-        body rotor_b0 { mass = m_rotor; inertia = (1e-5, 2e-5, 1e-5); }
-        body rotor_c0 { mass = m_rotor; inertia = (1e-5, 2e-5, 1e-5); }
-        TOG[support0] = TOG[base] * Tdisp(0.4, 0.3, 0) * Trotz(a0) * Tdisp(0.05, 0, 0);
-        TOG[thigh0] = TOG[support0] * Tdisp(0.05, 0, 0) * Troty(b0) * Tdisp(0.15, 0, 0);
-        TOG[shank0] = TOG[thigh0] * Tdisp(0.15, 0, 0) * Troty(c0) * Tdisp(0, 0, -0.2);
-        TOG[panto0] = TOG[support0] * Tdisp(0.05, 0, -0.05) * Troty(b0) * Tdisp(0.15, 0, 0);
-        TOG[coupler0] = TOG[thigh0] * Tdisp(0.15, 0, 0) * Troty(c0) * Tdisp(0, 0, -0.05);
-        TOG[rotor_a0] = TOG[base] * Tdisp(0.4, 0.3, 0.05) * Trotz(100 * a0);
-        TOG[rotor_b0] = TOG[support0] * Tdisp(0, 0.05, 0) * Troty(100 * b0);
-        TOG[rotor_c0] = TOG[thigh0] * Tdisp(0, 0.05, 0) * Troty(100 * c0);
-        point foot0 on shank0 at (0, 0, -0.2);
-
-        // Leg 1, front right: hip at (0.4, -0.3, 0).
-        dof a1 = 0.0; dof b1 = 0.3; dof c1 = -0.3;
-        body support1 { mass = m_support; inertia = (i_support, i_support, i_support); }
-        body thigh1 { mass = m_thigh; inertia = (0, i_thigh, i_thigh); }
-        body shank1 { mass = m_shank; inertia = (i_shank, i_shank, 0); }
-        body panto1 { mass = m_panto; inertia = (0, i_panto, i_panto); }
-        body coupler1 { mass = m_coupler; inertia = (i_coupler, i_coupler, 0); }
-        body rotor_a1 { mass = m_rotor; inertia = (1e-5, 1e-5, 2e-5); }
-        body rotor_b1 { mass = m_rotor; inertia = (1e-5, 2e-5, 1e-5); }
-        body rotor_c1 { mass = m_rotor; inertia = (1e-5, 2e-5, 1e-5); }
-        TOG[support1] = TOG[base] * Tdisp(0.4, -0.3, 0) * Trotz(a1) * Tdisp(0.05, 0, 0);
-        TOG[thigh1] = TOG[support1] * Tdisp(0.05, 0, 0) * Troty(b1) * Tdisp(0.15, 0, 0);
-        TOG[shank1] = TOG[thigh1] * Tdisp(0.15, 0, 0) * Troty(c1) * Tdisp(0, 0, -0.2);
-        TOG[panto1] = TOG[support1] * Tdisp(0.05, 0, -0.05) * Troty(b1) * Tdisp(0.15, 0, 0);
-        TOG[coupler1] = TOG[thigh1] * Tdisp(0.15, 0, 0) * Troty(c1) * Tdisp(0, 0, -0.05);
-        TOG[rotor_a1] = TOG[base] * Tdisp(0.4, -0.3, 0.05) * Trotz(100 * a1);
-        TOG[rotor_b1] = TOG[support1] * Tdisp(0, 0.05, 0) * Troty(100 * b1);
-        TOG[rotor_c1] = TOG[thigh1] * Tdisp(0, 0.05, 0) * Troty(100 * c1);
-        point foot1 on shank1 at (0, 0, -0.2);
-
-        // Leg 2, middle left: hip at (0, 0.3, 0).
-        dof a2 = 0.0; dof b2 = 0.3; dof c2 = -0.3;
-        body support2 { mass = m_support; inertia = (i_support, i_support, i_support); }
-        body thigh2 { mass = m_thigh; inertia = (0, i_thigh, i_thigh); }
-        body shank2 { mass = m_shank; inertia = (i_shank, i_shank, 0); }
-        body panto2 { mass = m_panto; inertia = (0, i_panto, i_panto); }
-        body coupler2 { mass = m_coupler; inertia = (i_coupler, i_coupler, 0); }
-        body rotor_a2 { mass = m_rotor; inertia = (1e-5, 1e-5, 2e-5); }
-        body rotor_b2 { mass = m_rotor; inertia = (1e-5, 2e-5, 1e-5); }
-        body rotor_c2 { mass = m_rotor; inertia = (1e-5, 2e-5, 1e-5); }
-        TOG[support2] = TOG[base] * Tdisp(0, 0.3, 0) * Trotz(a2) * Tdisp(0.05, 0, 0);
-        TOG[thigh2] = TOG[support2] * Tdisp(0.05, 0, 0) * Troty(b2) * Tdisp(0.15, 0, 0);
-        TOG[shank2] = TOG[thigh2] * Tdisp(0.15, 0, 0) * Troty(c2) * Tdisp(0, 0, -0.2);
-        TOG[panto2] = TOG[support2] * Tdisp(0.05, 0, -0.05) * Troty(b2) * Tdisp(0.15, 0, 0);
-        TOG[coupler2] = TOG[thigh2] * Tdisp(0.15, 0, 0) * Troty(c2) * Tdisp(0, 0, -0.05);
-        TOG[rotor_a2] = TOG[base] * Tdisp(0, 0.3, 0.05) * Trotz(100 * a2);
-        TOG[rotor_b2] = TOG[support2] * Tdisp(0, 0.05, 0) * Troty(100 * b2);
-        TOG[rotor_c2] = TOG[thigh2] * Tdisp(0, 0.05, 0) * Troty(100 * c2);
-        point foot2 on shank2 at (0, 0, -0.2);
-
-        // Leg 3, middle right: hip at (0, -0.3, 0).
-        dof a3 = 0.0; dof b3 = 0.3; dof c3 = -0.3;
-        body support3 { mass = m_support; inertia = (i_support, i_support, i_support); }
-        body thigh3 { mass = m_thigh; inertia = (0, i_thigh, i_thigh); }
-        body shank3 { mass = m_shank; inertia = (i_shank, i_shank, 0); }
-        body panto3 { mass = m_panto; inertia = (0, i_panto, i_panto); }
-        body coupler3 { mass = m_coupler; inertia = (i_coupler, i_coupler, 0); }
-        body rotor_a3 { mass = m_rotor; inertia = (1e-5, 1e-5, 2e-5); }
-        body rotor_b3 { mass = m_rotor; inertia = (1e-5, 2e-5, 1e-5); }
-        body rotor_c3 { mass = m_rotor; inertia = (1e-5, 2e-5, 1e-5); }
-        TOG[support3] = TOG[base] * Tdisp(0, -0.3, 0) * Trotz(a3) * Tdisp(0.05, 0, 0);
-        TOG[thigh3] = TOG[support3] * Tdisp(0.05, 0, 0) * Troty(b3) * Tdisp(0.15, 0, 0);
-        TOG[shank3] = TOG[thigh3] * Tdisp(0.15, 0, 0) * Troty(c3) * Tdisp(0, 0, -0.2);
-        TOG[panto3] = TOG[support3] * Tdisp(0.05, 0, -0.05) * Troty(b3) * Tdisp(0.15, 0, 0);
-        TOG[coupler3] = TOG[thigh3] * Tdisp(0.15, 0, 0) * Troty(c3) * Tdisp(0, 0, -0.05);
-        TOG[rotor_a3] = TOG[base] * Tdisp(0, -0.3, 0.05) * Trotz(100 * a3);
-        TOG[rotor_b3] = TOG[support3] * Tdisp(0, 0.05, 0) * Troty(100 * b3);
-        TOG[rotor_c3] = TOG[thigh3] * Tdisp(0, 0.05, 0) * Troty(100 * c3);
-        point foot3 on shank3 at (0, 0, -0.2);
-
-        // Leg 4, rear left: hip at (-0.4, 0.3, 0).
-        dof a4 = 0.0; dof b4 = 0.3; dof c4 = -0.3;
-        body support4 { mass = m_support; inertia = (i_support, i_support, i_support); }
-        body thigh4 { mass = m_thigh; inertia = (0, i_thigh, i_thigh); }
-        body shank4 { mass = m_shank; inertia = (i_shank, i_shank, 0); }
-        body panto4 { mass = m_panto; inertia = (0, i_panto, i_panto); }
-        body coupler4 { mass = m_coupler; inertia = (i_coupler, i_coupler, 0); }
-        body rotor_a4 { mass = m_rotor; inertia = (1e-5, 1e-5, 2e-5); }
-        body rotor_b4 { mass = m_rotor; inertia = (1e-5, 2e-5, 1e-5); }
-        body rotor_c4 { mass = m_rotor; inertia = (1e-5, 2e-5, 1e-5); }
-        TOG[support4] = TOG[base] * Tdisp(-0.4, 0.3, 0) * Trotz(a4) * Tdisp(0.05, 0, 0);
-        TOG[thigh4] = TOG[support4] * Tdisp(0.05, 0, 0) * Troty(b4) * Tdisp(0.15, 0, 0);
-        TOG[shank4] = TOG[thigh4] * Tdisp(0.15, 0, 0) * Troty(c4) * Tdisp(0, 0, -0.2);
-        TOG[panto4] = TOG[support4] * Tdisp(0.05, 0, -0.05) * Troty(b4) * Tdisp(0.15, 0, 0);
-        TOG[coupler4] = TOG[thigh4] * Tdisp(0.15, 0, 0) * Troty(c4) * Tdisp(0, 0, -0.05);
-        TOG[rotor_a4] = TOG[base] * Tdisp(-0.4, 0.3, 0.05) * Trotz(100 * a4);
-        TOG[rotor_b4] = TOG[support4] * Tdisp(0, 0.05, 0) * Troty(100 * b4);
-        TOG[rotor_c4] = TOG[thigh4] * Tdisp(0, 0.05, 0) * Troty(100 * c4);
-        point foot4 on shank4 at (0, 0, -0.2);
-
-        // Leg 5, rear right: hip at (-0.4, -0.3, 0).
-        dof a5 = 0.0; dof b5 = 0.3; dof c5 = -0.3;
-        body support5 { mass = m_support; inertia = (i_support, i_support, i_support); }
-        body thigh5 { mass = m_thigh; inertia = (0, i_thigh, i_thigh); }
-        body shank5 { mass = m_shank; inertia = (i_shank, i_shank, 0); }
-        body panto5 { mass = m_panto; inertia = (0, i_panto, i_panto); }
-        body coupler5 { mass = m_coupler; inertia = (i_coupler, i_coupler, 0); }
-        body rotor_a5 { mass = m_rotor; inertia = (1e-5, 1e-5, 2e-5); }
-        body rotor_b5 { mass = m_rotor; inertia = (1e-5, 2e-5, 1e-5); }
-        body rotor_c5 { mass = m_rotor; inertia = (1e-5, 2e-5, 1e-5); }
-        TOG[support5] = TOG[base] * Tdisp(-0.4, -0.3, 0) * Trotz(a5) * Tdisp(0.05, 0, 0);
-        TOG[thigh5] = TOG[support5] * Tdisp(0.05, 0, 0) * Troty(b5) * Tdisp(0.15, 0, 0);
-        TOG[shank5] = TOG[thigh5] * Tdisp(0.15, 0, 0) * Troty(c5) * Tdisp(0, 0, -0.2);
-        TOG[panto5] = TOG[support5] * Tdisp(0.05, 0, -0.05) * Troty(b5) * Tdisp(0.15, 0, 0);
-        TOG[coupler5] = TOG[thigh5] * Tdisp(0.15, 0, 0) * Troty(c5) * Tdisp(0, 0, -0.05);
-        TOG[rotor_a5] = TOG[base] * Tdisp(-0.4, -0.3, 0.05) * Trotz(100 * a5);
-        TOG[rotor_b5] = TOG[support5] * Tdisp(0, 0.05, 0) * Troty(100 * b5);
-        TOG[rotor_c5] = TOG[thigh5] * Tdisp(0, 0.05, 0) * Troty(100 * c5);
-        point foot5 on shank5 at (0, 0, -0.2);
+        // One leg, hip at (hx, hy, 0) in the base frame: hip yaw a[k], thigh pitch b[k], knee
+        // pitch c[k]; the pantograph link and coupler follow the thigh and knee angles, the
+        // rotors turn 100 times as fast as their joints.
+        part Leg(k, hx, hy) {
+            dof a[k] = 0.0; dof b[k] = 0.3; dof c[k] = -0.3;
+            body support[k] { mass = m_support; inertia = (i_support, i_support, i_support); }
+            body thigh[k] { mass = m_thigh; inertia = (0, i_thigh, i_thigh); }
+            body shank[k] { mass = m_shank; inertia = (i_shank, i_shank, 0); }
+            body panto[k] { mass = m_panto; inertia = (0, i_panto, i_panto); }
+            body coupler[k] { mass = m_coupler; inertia = (i_coupler, i_coupler, 0); }
+            body rotor_a[k] { mass = m_rotor; inertia = (1e-5, 1e-5, 2e-5); }
+            body rotor_b[k] { mass = m_rotor; inertia = (1e-5, 2e-5, 1e-5); }
+            body rotor_c[k] { mass = m_rotor; inertia = (1e-5, 2e-5, 1e-5); }
+            TOG[support[k]] = TOG[base] * Tdisp(hx, hy, 0) * Trotz(a[k]) * Tdisp(0.05, 0, 0);
+            TOG[thigh[k]] = TOG[support[k]] * Tdisp(0.05, 0, 0) * Troty(b[k]) * Tdisp(0.15, 0, 0);
+            TOG[shank[k]] = TOG[thigh[k]] * Tdisp(0.15, 0, 0) * Troty(c[k]) * Tdisp(0, 0, -0.2);
+            TOG[panto[k]] = TOG[support[k]] * Tdisp(0.05, 0, -0.05) * Troty(b[k]) * Tdisp(0.15, 0, 0);
+            TOG[coupler[k]] = TOG[thigh[k]] * Tdisp(0.15, 0, 0) * Troty(c[k]) * Tdisp(0, 0, -0.05);
+            TOG[rotor_a[k]] = TOG[base] * Tdisp(hx, hy, 0.05) * Trotz(100 * a[k]);
+            TOG[rotor_b[k]] = TOG[support[k]] * Tdisp(0, 0.05, 0) * Troty(100 * b[k]);
+            TOG[rotor_c[k]] = TOG[thigh[k]] * Tdisp(0, 0.05, 0) * Troty(100 * c[k]);
+            point foot[k] on shank[k] at (0, 0, -0.2);
+        }
+        Leg(0, 0.4, 0.3);   // front left
+        Leg(1, 0.4, -0.3);  // front right
+        Leg(2, 0, 0.3);     // middle left
+        Leg(3, 0, -0.3);    // middle right
+        Leg(4, -0.4, 0.3);  // rear left
+        Leg(5, -0.4, -0.3); // rear right
 
         gravity(0, 0, -g);
 
         // Ground contact of the six feet with the plane z = 0 (MODELS.md).
         effect contact {
-            contact(foot0, k = k_contact, c = c_contact, mu = mu, eps = eps);
-            contact(foot1, k = k_contact, c = c_contact, mu = mu, eps = eps);
-            contact(foot2, k = k_contact, c = c_contact, mu = mu, eps = eps);
-            contact(foot3, k = k_contact, c = c_contact, mu = mu, eps = eps);
-            contact(foot4, k = k_contact, c = c_contact, mu = mu, eps = eps);
-            contact(foot5, k = k_contact, c = c_contact, mu = mu, eps = eps);
+            for i in 0..6 {
+                contact(foot[i], k = k_contact, c = c_contact, mu = mu, eps = eps);
+            }
         }
 
         // A PD controller on each of the 18 leg joints, holding the start angles.
         effect pd {
-            generalized_force(a0, -kp_a * (a0 - a_ref) - kd_a * qd[a0]);
-            generalized_force(b0, -kp_b * (b0 - b_ref) - kd_b * qd[b0]);
-            generalized_force(c0, -kp_c * (c0 - c_ref) - kd_c * qd[c0]);
-            generalized_force(a1, -kp_a * (a1 - a_ref) - kd_a * qd[a1]);
-            generalized_force(b1, -kp_b * (b1 - b_ref) - kd_b * qd[b1]);
-            generalized_force(c1, -kp_c * (c1 - c_ref) - kd_c * qd[c1]);
-            generalized_force(a2, -kp_a * (a2 - a_ref) - kd_a * qd[a2]);
-            generalized_force(b2, -kp_b * (b2 - b_ref) - kd_b * qd[b2]);
-            generalized_force(c2, -kp_c * (c2 - c_ref) - kd_c * qd[c2]);
-            generalized_force(a3, -kp_a * (a3 - a_ref) - kd_a * qd[a3]);
-            generalized_force(b3, -kp_b * (b3 - b_ref) - kd_b * qd[b3]);
-            generalized_force(c3, -kp_c * (c3 - c_ref) - kd_c * qd[c3]);
-            generalized_force(a4, -kp_a * (a4 - a_ref) - kd_a * qd[a4]);
-            generalized_force(b4, -kp_b * (b4 - b_ref) - kd_b * qd[b4]);
-            generalized_force(c4, -kp_c * (c4 - c_ref) - kd_c * qd[c4]);
-            generalized_force(a5, -kp_a * (a5 - a_ref) - kd_a * qd[a5]);
-            generalized_force(b5, -kp_b * (b5 - b_ref) - kd_b * qd[b5]);
-            generalized_force(c5, -kp_c * (c5 - c_ref) - kd_c * qd[c5]);
+            for i in 0..6 {
+                generalized_force(a[i], -kp_a * (a[i] - a_ref) - kd_a * qd[a[i]]);
+                generalized_force(b[i], -kp_b * (b[i] - b_ref) - kd_b * qd[b[i]]);
+                generalized_force(c[i], -kp_c * (c[i] - c_ref) - kd_c * qd[c[i]]);
+            }
         }
 
         scene Free = [];

@@ -4,6 +4,8 @@
 use proc_macro2::Span;
 use syn::{Expr, Ident};
 
+pub use super::repeat::Origin;
+
 /// One `model` of a `multibody!` block.
 #[derive(Clone)]
 pub struct ModelDef {
@@ -13,6 +15,8 @@ pub struct ModelDef {
     pub vis: syn::Visibility,
     pub name: Ident,
     pub items: Vec<Item>,
+    /// which loop iteration or part instance each item comes from (parallel to `items`)
+    pub origins: Vec<Origin>,
     /// statements that did not parse (the parser skips them and goes on, so that the model
     /// still gets placeholder types)
     pub errors: Vec<syn::Error>,
@@ -96,7 +100,12 @@ pub enum Item {
     /// an effect statement outside any `effect` block: always on
     Effect(EffectStmt),
     /// `effect name { statements }`
-    EffectBlock { name: Ident, stmts: Vec<EffectStmt> },
+    EffectBlock {
+        name: Ident,
+        stmts: Vec<EffectStmt>,
+        /// which loop iteration or part instance each statement comes from
+        origins: Vec<Origin>,
+    },
     /// `scene Name = [effect, …];`
     Scene { name: Ident, effects: Vec<Ident> },
     /// `constraint NAME = Φ;` or `constraint NAME: coincide(…);`

@@ -1,10 +1,12 @@
-//! The `multibody!` language: `parse` (tokens → syntax tree with spans), then `check`
+//! The `multibody!` language: `repeat` (loops and parts unrolled, indexed names folded),
+//! `parse` (tokens → syntax tree with spans), then `check`
 //! (names, shapes, constants → a [`System`](crate::mech::System)), collecting every error.
 
 pub mod ast;
 pub mod check;
 pub mod names;
 pub mod parse;
+pub mod repeat;
 
 /// The admissibility check of inertia tensors, shared with the runtime's `validate()`.
 #[path = "../../../mbs-runtime/src/inertia.rs"]

@@ -31,6 +31,11 @@ pub fn did_you_mean<'a>(
     candidates: impl Iterator<Item = &'a str>,
     otherwise: &str,
 ) -> String {
+    let candidates: Vec<&str> = candidates.collect();
+    if let Some(hint) = super::repeat::index_hint(name, &candidates) {
+        return hint;
+    }
+    let candidates = candidates.into_iter();
     let prefix = |c: &str| {
         name.chars()
             .zip(c.chars())

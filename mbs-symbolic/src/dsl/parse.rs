@@ -2,9 +2,9 @@
 //! `syn::Expr` and get their meaning in `check`.
 
 use super::ast::{BodyRef, ConstraintBody, DofName, EffectStmt, Item, ModelDef};
+use super::repeat;
 use proc_macro2::TokenTree;
 use syn::ext::IdentExt;
-use syn::parse::discouraged::Speculative;
 use syn::parse::{Parse, ParseStream};
 use syn::punctuated::Punctuated;
 use syn::{Expr, Ident, Token, braced, bracketed, parenthesized};
@@ -66,20 +66,53 @@ impl Parse for ModelDef {
         }
         let name: Ident = input.parse()?;
         let content;
-        braced!(content in input);
-        let mut items = Vec::new();
+        let brace = braced!(content in input);
+        let tokens: proc_macro2::TokenStream = content.parse()?;
         let mut errors = Vec::new();
-        while !content.is_empty() {
-            let fork = content.fork();
-            match parse_item(&fork) {
+        let stmts = repeat::expand(tokens, brace.span.close(), &mut errors);
+        let mut items = Vec::new();
+        let mut origins = Vec::new();
+        for s in stmts {
+            let parsed = match s.inner {
+                None => parse_in(s.tokens, s.end, parse_item),
+                Some(inner) => parse_in(s.tokens, s.end, |input| {
+                    input.parse::<Ident>()?;
+                    input.parse::<Ident>()
+                })
+                .map(|name| {
+                    let mut stmts = Vec::new();
+                    let mut origins = Vec::new();
+                    for e in inner {
+                        match parse_in(e.tokens, e.end, parse_effect) {
+                            Ok(stmt) => {
+                                stmts.push(stmt);
+                                origins.push(e.origin);
+                            }
+                            Err(err) => errors.push(relabel(err, &e.origin)),
+                        }
+                    }
+                    Item::EffectBlock {
+                        name,
+                        stmts,
+                        origins,
+                    }
+                }),
+            };
+            match parsed {
+                Ok(Item::Scene { name, .. }) if name.to_string().contains(repeat::SEP) => {
+                    errors.push(relabel(
+                        syn::Error::new(
+                            name.span(),
+                            format!("a scene's name names a type, so `{name}` cannot be indexed: give it a plain name"),
+                        ),
+                        &s.origin,
+                    ));
+                }
                 Ok(item) => {
-                    content.advance_to(&fork);
                     items.push(item);
+                    origins.push(s.origin);
                 }
-                Err(e) => {
-                    errors.push(e);
-                    skip_statement(&content)?;
-                }
+                Err(e) => errors.push(relabel(e, &s.origin)),
             }
         }
         Ok(ModelDef {
@@ -87,29 +120,51 @@ impl Parse for ModelDef {
             vis,
             name,
             items,
-            errors,
+            origins,
+            errors: repeat::dedupe(errors),
         })
     }
 }
 
-/// Skips a statement that did not parse: up to and including its `;`, or up to its `{ … }`
-/// block (`body`, `effect`) and an optional `;` after it.
-fn skip_statement(input: ParseStream) -> syn::Result<()> {
-    while !input.is_empty() {
-        if input.peek(Token![;]) {
-            input.parse::<Token![;]>()?;
-            return Ok(());
-        }
-        if let TokenTree::Group(g) = input.parse::<TokenTree>()? {
-            if g.delimiter() == proc_macro2::Delimiter::Brace {
-                if input.peek(Token![;]) {
-                    input.parse::<Token![;]>()?;
-                }
-                return Ok(());
+/// Parses one statement's tokens with `f`, as if they stood alone in braces whose end is
+/// `end` (the next statement), so that "expected `;`, found …" points where it did before.
+fn parse_in<T>(
+    tokens: proc_macro2::TokenStream,
+    end: proc_macro2::Span,
+    f: impl FnOnce(ParseStream) -> syn::Result<T>,
+) -> syn::Result<T> {
+    let mut g = proc_macro2::Group::new(proc_macro2::Delimiter::Brace, tokens);
+    g.set_span(end);
+    let wrapped: proc_macro2::TokenStream = TokenTree::Group(g).into();
+    syn::parse::Parser::parse2(
+        |input: ParseStream| {
+            let content;
+            braced!(content in input);
+            let v = f(&content)?;
+            if !content.is_empty() {
+                return Err(content
+                    .error("unexpected tokens after the statement: end each statement with `;`"));
             }
+            Ok(v)
+        },
+        wrapped,
+    )
+}
+
+/// An error with its statement's origin appended and indexed names shown as written.
+fn relabel(e: syn::Error, origin: &repeat::Origin) -> syn::Error {
+    if origin.is_none() && !e.to_string().contains(repeat::SEP) {
+        return e;
+    }
+    let mut out: Option<syn::Error> = None;
+    for one in e {
+        let new = syn::Error::new(one.span(), repeat::with_origin(&one.to_string(), origin));
+        match &mut out {
+            None => out = Some(new),
+            Some(o) => o.combine(new),
         }
     }
-    Ok(())
+    out.expect("an error has at least one message")
 }
 
 fn body_ref(input: ParseStream) -> syn::Result<BodyRef> {
@@ -390,7 +445,12 @@ fn parse_item(input: ParseStream) -> syn::Result<Item> {
             while !content.is_empty() {
                 stmts.push(parse_effect(&content)?);
             }
-            Ok(Item::EffectBlock { name, stmts })
+            let origins = vec![None; stmts.len()];
+            Ok(Item::EffectBlock {
+                name,
+                stmts,
+                origins,
+            })
         }
         "scene" => {
             input.parse::<Ident>()?;

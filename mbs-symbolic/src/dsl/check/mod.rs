@@ -4,6 +4,7 @@
 
 use super::ast::{BodyRef, DofName, EffectStmt, Item, ModelDef};
 use super::names::did_you_mean;
+use super::repeat::{self, Origin};
 use crate::expr::{ExprId, Func, SliceEnv, UserFn, Var};
 use crate::mech::system::*;
 use proc_macro2::{Span, TokenStream};
@@ -34,7 +35,7 @@ fn reserved_meaning(s: &str) -> &'static str {
 }
 
 /// Source text of tokens, spaced as people write it: `q[0]`, `sin(x)`, `a + b`.
-fn text(t: &impl ToTokens) -> String {
+pub(crate) fn text(t: &impl ToTokens) -> String {
     let raw = t.to_token_stream().to_string();
     let mut out = String::with_capacity(raw.len());
     let chars: Vec<char> = raw.chars().collect();
@@ -171,6 +172,11 @@ struct Checker {
     tog_start: FxHashMap<usize, usize>,
     /// frames declared by `mass NAME on BODY at (…) = m;`
     lumped: rustc_hash::FxHashSet<usize>,
+    /// the loop iteration or part instance of the statement being checked, appended to its
+    /// errors; and those of each frame's and coordinate's declaration
+    origin: Origin,
+    frame_origins: Vec<Origin>,
+    dof_origins: Vec<Origin>,
 }
 
 /// A checked model and the spans that generation-time errors point at.
@@ -205,12 +211,16 @@ pub fn check(def: &ModelDef) -> Result<Checked, syn::Error> {
         taken_reserved: Default::default(),
         tog_start: FxHashMap::default(),
         lumped: Default::default(),
+        origin: None,
+        frame_origins: Vec::new(),
+        dof_origins: Vec::new(),
     };
     c.sys.docs = def.docs.clone();
     c.declare(def);
     c.lower_items(def);
     c.final_checks();
-    let mut errs = c.errors.into_iter();
+    c.show_names();
+    let mut errs = repeat::dedupe(c.errors).into_iter();
     match errs.next() {
         None => Ok(Checked {
             system: c.sys,
@@ -226,12 +236,37 @@ pub fn check(def: &ModelDef) -> Result<Checked, syn::Error> {
 }
 
 fn err(span: Span, msg: impl std::fmt::Display) -> syn::Error {
-    syn::Error::new(span, msg.to_string())
+    syn::Error::new(span, repeat::display(&msg.to_string()))
 }
 
 impl Checker {
     fn error(&mut self, span: Span, msg: impl std::fmt::Display) {
+        let msg = repeat::with_origin(&msg.to_string(), &self.origin);
         self.errors.push(err(span, msg));
+    }
+
+    /// Indexed names as written (`bar[3]`) in what the model reports, once every name has
+    /// been resolved; parameters keep their Rust field names (`k_3`).
+    fn show_names(&mut self) {
+        let s = &mut self.sys;
+        for f in &mut s.frames {
+            f.name = repeat::display(&f.name);
+        }
+        for d in &mut s.dofs {
+            d.name = repeat::display(&d.name);
+        }
+        for p in &mut s.points {
+            p.name = repeat::display(&p.name);
+        }
+        for c in &mut s.constraints {
+            c.name = repeat::display(&c.name);
+        }
+        for e in &mut s.effects {
+            e.name = e.name.as_deref().map(repeat::display);
+        }
+        for i in &mut s.inputs {
+            *i = repeat::display(i);
+        }
     }
 
     /// An error underlining all of `tokens` (an expression, a call, …).
@@ -257,8 +292,8 @@ impl Checker {
     }
 
     fn error_at(&mut self, tokens: &impl ToTokens, msg: impl std::fmt::Display) {
-        self.errors
-            .push(syn::Error::new_spanned(tokens, msg.to_string()));
+        let msg = repeat::with_origin(&msg.to_string(), &self.origin);
+        self.errors.push(syn::Error::new_spanned(tokens, msg));
     }
 
     /// `what`: the construct being named ("parameter", "body", …)
@@ -280,7 +315,8 @@ impl Checker {
 
     /// Pass 1: every declared name, so statements may refer to names declared later.
     fn declare(&mut self, def: &ModelDef) {
-        for item in &def.items {
+        for (item, origin) in def.items.iter().zip(&def.origins) {
+            self.origin = origin.clone();
             match item {
                 Item::Param { name, value } => {
                     if self.reserved(name, "parameter") || self.duplicate_scalar(name) {
@@ -307,11 +343,20 @@ impl Checker {
                         bad = true;
                         0.0
                     };
+                    // an indexed parameter `k[3]` is the field `k_3`
+                    let field = repeat::rust_ident(&name.to_string());
+                    if let Some(other) = self.scalars.iter().find_map(|(n, s)| match s {
+                        Scalar::Param(i) if self.sys.params[*i].name == field => Some(n.clone()),
+                        _ => None,
+                    }) {
+                        self.error(name.span(), format!("parameters `{other}` and `{name}` are both the field `{field}` of the parameter struct (an indexed parameter `k[3]` is the field `k_3`): rename one of them"));
+                        continue;
+                    }
                     self.bad_params.push(bad);
                     self.scalars
                         .insert(name.to_string(), Scalar::Param(self.sys.params.len()));
                     self.sys.params.push(ParamDef {
-                        name: name.to_string(),
+                        name: field,
                         default,
                     });
                     self.defaults.push(default);
@@ -357,6 +402,7 @@ impl Checker {
                         independent: *independent,
                     });
                     self.dof_spans.push(*span);
+                    self.dof_origins.push(origin.clone());
                 }
                 Item::Input { name } => {
                     let ok = !self.reserved(name, "input") && !self.duplicate_scalar(name);
@@ -380,6 +426,7 @@ impl Checker {
                     self.frame_names
                         .insert(name.to_string(), self.sys.frames.len());
                     self.frame_spans.push(name.span());
+                    self.frame_origins.push(origin.clone());
                     self.tog_defined.push(false);
                     self.sys.frames.push(FrameDef {
                         name: name.to_string(),
@@ -520,7 +567,8 @@ impl Checker {
     fn lower_items(&mut self, def: &ModelDef) {
         self.note_tog_starts(def);
         // points first: effects may name points declared after them
-        for item in &def.items {
+        for (item, origin) in def.items.iter().zip(&def.origins) {
+            self.origin = origin.clone();
             if let Item::Point { name, body, at } = item {
                 let Some(&pi) = self.points.get(&name.to_string()) else {
                     continue;
@@ -542,7 +590,8 @@ impl Checker {
         }
         let mut dof_i = 0;
         let mut scene_names: FxHashMap<String, ()> = FxHashMap::default();
-        for item in &def.items {
+        for (item, origin) in def.items.iter().zip(&def.origins) {
+            self.origin = origin.clone();
             match item {
                 Item::Dof { q0, qd0, name, .. } => {
                     if let DofName::Named(id) = name {
@@ -586,11 +635,16 @@ impl Checker {
                         None => self.sys.effects.push(EffectDef { name: None, loads }),
                     }
                 }
-                Item::EffectBlock { name, stmts } => {
+                Item::EffectBlock {
+                    name,
+                    stmts,
+                    origins,
+                } => {
                     let Some(&ei) = self.effects.get(&name.to_string()) else {
                         continue;
                     };
-                    for s in stmts {
+                    for (s, o) in stmts.iter().zip(origins) {
+                        self.origin = o.clone().or_else(|| origin.clone());
                         let loads = self.lower_effect(s);
                         self.sys.effects[ei].loads.extend(loads);
                     }
@@ -642,16 +696,16 @@ impl Checker {
     }
 
     fn final_checks(&mut self) {
-        for (i, f) in self.sys.frames.iter().enumerate() {
+        for i in 0..self.sys.frames.len() {
+            let f = &self.sys.frames[i];
             if !self.tog_defined[i] && !self.tog_target_error {
                 let kind = if f.inertia.is_some() { "body" } else { "frame" };
-                self.errors.push(err(
-                    self.frame_spans[i],
-                    format!(
-                        "{kind} `{}` has no pose: add `TOG[{}] = …;`",
-                        f.name, f.name
-                    ),
-                ));
+                let msg = format!(
+                    "{kind} `{}` has no pose: add `TOG[{}] = …;`",
+                    f.name, f.name
+                );
+                self.origin = self.frame_origins[i].clone();
+                self.error(self.frame_spans[i], msg);
             }
         }
         if !self.errors.is_empty() {
@@ -687,7 +741,8 @@ impl Checker {
             })
             .collect();
         for k in unmoved {
-            self.errors.push(err(self.dof_spans[k], format!("coordinate `{}` moves no body with mass, so the mass matrix would be singular: use it in the TOG of a body with mass (or of a frame that carries one), or remove it", self.sys.dofs[k].name)));
+            self.origin = self.dof_origins[k].clone();
+            self.error(self.dof_spans[k], format!("coordinate `{}` moves no body with mass, so the mass matrix would be singular: use it in the TOG of a body with mass (or of a frame that carries one), or remove it", self.sys.dofs[k].name));
         }
     }
 }

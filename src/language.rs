@@ -78,6 +78,13 @@
 //! Arguments are expressions of `q`, `t` (rheonomic, imposed motion) and parameters, never of
 //! velocities or inputs.
 //!
+//! A translation along the axis of the rotation just before it commutes with that rotation,
+//! and the generator moves it in front: `TOG[rotor] = TOG[arm] * Trotz(50 * q[0]) * Tdisp(0, 0,
+//! 0.05)` is generated as `TOG[arm] * Tdisp(0, 0, 0.05) * Trotz(50 * q[0])`. A body whose
+//! product ends with a rotation about x, y or z and whose inertia is symmetric about that
+//! axis (a rotor, a wheel: `inertia = (i, i, i_spin)`, no products) costs no trigonometry of
+//! its spin angle, whichever way the product is written.
+//!
 //! ```
 //! mbs::multibody! {
 //!     /// A cart carrying a pendulum, the track moved by an imposed motion.

@@ -202,7 +202,7 @@ fn work_counters_snapshot() {
     // evaluations, steps per order)
     assert_eq!(
         got,
-        (637, 68, 0, 756, 113, 1728, vec![2, 19, 4, 54, 558]),
+        (638, 66, 0, 762, 107, 1717, vec![2, 19, 4, 46, 567]),
         "{st}"
     );
 }

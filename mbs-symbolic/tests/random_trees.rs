@@ -8,6 +8,7 @@ mod common;
 use common::*;
 use mbs_symbolic::SymbolicModel;
 use mbs_symbolic::expr::ExprId;
+use mbs_symbolic::mech::tree::canonical;
 
 const TREES: u64 = 100;
 const STATES: usize = 3;
@@ -169,34 +170,150 @@ fn square(v: &[f64], n: usize) -> Vec<Vec<f64>> {
     v.chunks(n).map(|r| r.to_vec()).collect()
 }
 
+/// The worst errors of the generated equations against the oracle over many trees.
+#[derive(Default)]
+struct Checks {
+    m_vp: Worst,
+    m_rec: Worst,
+    h_vp: Worst,
+    h_rec: Worst,
+    vp_rec: Worst,
+    tau_rec: Worst,
+    tau_vp: Worst,
+    sym: Worst,
+    pos: Worst,
+    static_h: Worst,
+    energy: Worst,
+    /// errors are relative to the largest entry of the reference, or to this when larger
+    /// (0: no floor)
+    floor: f64,
+}
+
+impl Checks {
+    /// Builds the system of `desc` (drawing how it is written from `rng`) and compares it
+    /// with the oracle at `STATES` random states.
+    fn tree(&mut self, seed: u64, desc: &Desc, rng: &mut Rng) {
+        let n = desc.ndof;
+        let floor = self.floor;
+        let rel = |x: &[f64], r: &[f64]| {
+            if floor > 0.0 {
+                rel_err_floor(x, r, floor)
+            } else {
+                rel_err(x, r)
+            }
+        };
+        let oracle = Oracle::new(desc);
+        let built = to_system(desc, rng);
+        let bodies = built.body.clone();
+        let model = SymbolicModel::build(built.sys);
+        let eq = &model.scenes[0];
+        let mut roots = Vec::new();
+        roots.extend(flat(&eq.vp.m));
+        roots.extend(&eq.vp.h);
+        roots.extend(flat(&eq.rec.m));
+        roots.extend(&eq.rec.h);
+        roots.extend(&eq.tau_rec);
+        roots.extend(&eq.tau_vp);
+        roots.extend(&eq.static_h);
+        roots.extend([eq.kinetic, eq.potential]);
+        for &b in &bodies {
+            roots.extend(model.world.nodes[model.tree.frame_node[b]].p);
+        }
+        for s in 0..STATES {
+            let (t, q, qd, qdd) = random_state(rng, n);
+            let v = eval(&model, &roots, t, &q, &qd, &qdd);
+            let mut it = 0;
+            let mut take = |k: usize| {
+                let s = v[it..it + k].to_vec();
+                it += k;
+                s
+            };
+            let (m_vp, h_vp) = (take(n * n), take(n));
+            let (m_rec, h_rec) = (take(n * n), take(n));
+            let (tau_rec, tau_vp) = (take(n), take(n));
+            let static_h = take(n);
+            let energy = take(2);
+            let pos = take(3 * bodies.len());
+            let at = || format!("seed {seed}, state {s}, {n} dof");
+            let m_ref = oracle.crba(&q, t);
+            let m_flat: Vec<f64> = m_ref.iter().flatten().copied().collect();
+            let h_ref = oracle.bias(&q, &qd, t);
+            let tau_ref = oracle.rnea(&q, &qd, &qdd, t, true);
+            self.m_vp.see(rel(&m_vp, &m_flat), at);
+            self.m_rec.see(rel(&m_rec, &m_flat), at);
+            self.h_vp.see(rel(&h_vp, &h_ref), at);
+            self.h_rec.see(rel(&h_rec, &h_ref), at);
+            self.vp_rec
+                .see(rel(&m_vp, &m_rec).max(rel(&h_vp, &h_rec)), at);
+            // τ at random qdd equals M qdd − h (of the oracle and of the same formulation)
+            for (tau, m, h, w) in [
+                (&tau_rec, &m_rec, &h_rec, &mut self.tau_rec),
+                (&tau_vp, &m_vp, &h_vp, &mut self.tau_vp),
+            ] {
+                let mq = mat_vec(&square(m, n), &qdd);
+                let own: Vec<f64> = mq.iter().zip(h).map(|(a, b)| a - b).collect();
+                w.see(rel(tau, &tau_ref).max(rel(tau, &own)), at);
+            }
+            // symmetric positive definite
+            for m in [&m_vp, &m_rec] {
+                let mm = square(m, n);
+                let scale = m.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+                let asym = (0..n)
+                    .flat_map(|i| (0..n).map(move |j| (i, j)))
+                    .fold(0.0f64, |a, (i, j)| a.max((mm[i][j] - mm[j][i]).abs()));
+                self.sym.see(asym / scale, at);
+                assert!(
+                    cholesky(&mm).is_some(),
+                    "M not positive definite at {}",
+                    at()
+                );
+            }
+            let g_ref: Vec<f64> = oracle.com_positions(&q, t).concat();
+            self.pos.see(rel(&pos, &g_ref), at);
+            let zero = vec![0.0; n];
+            self.static_h
+                .see(rel(&static_h, &oracle.bias(&q, &zero, t)), at);
+            let e_ref = [oracle.kinetic(&q, &qd, t), oracle.potential(&q, t)];
+            self.energy.see(rel(&energy, &e_ref), at);
+        }
+    }
+
+    /// Prints and asserts the bounds.
+    fn check(&self) {
+        // relative to the largest entry; the README quotes these bounds (worst measured:
+        // 2.5e-15 for M and positions, 1.8e-14 for h, τ and energies)
+        self.pos.check("centre-of-mass positions vs oracle", 1e-14);
+        self.m_vp.check("M virtual power vs oracle", 1e-14);
+        self.m_rec.check("M recursive vs oracle", 1e-14);
+        self.h_vp.check("h virtual power vs oracle", 1e-13);
+        self.h_rec.check("h recursive vs oracle", 1e-13);
+        self.vp_rec.check("M, h virtual power vs recursive", 1e-13);
+        self.tau_rec.check("tau_rec vs oracle and M qdd - h", 1e-13);
+        self.tau_vp.check("tau_vp vs oracle and M qdd - h", 1e-13);
+        self.sym.check("M symmetry", 1e-14);
+        self.static_h.check("static h (qd = 0) vs oracle", 1e-13);
+        self.energy
+            .check("kinetic and potential energy vs oracle", 1e-13);
+    }
+}
+
+const OPTS: GenOpts = GenOpts {
+    min_dof: 1,
+    max_dof: 12,
+    rheonomic: true,
+    gravity: true,
+};
+
 #[test]
 fn random_trees_match_oracle() {
-    let mut w_m_vp = Worst::default();
-    let mut w_m_rec = Worst::default();
-    let mut w_h_vp = Worst::default();
-    let mut w_h_rec = Worst::default();
-    let mut w_vp_rec = Worst::default();
-    let mut w_tau_rec = Worst::default();
-    let mut w_tau_vp = Worst::default();
-    let mut w_sym = Worst::default();
-    let mut w_pos = Worst::default();
-    let mut w_static = Worst::default();
-    let mut w_energy = Worst::default();
+    let mut checks = Checks::default();
     let (mut branching, mut prismatic, mut revolute, mut rheonomic, mut driven, mut coupled) =
         (0, 0, 0, 0, 0, 0);
     let mut max_dof = 0;
     let mut dof_hist = [0usize; 13];
     for seed in 0..TREES {
         let mut rng = Rng::new(seed);
-        let desc = random_desc(
-            &mut rng,
-            GenOpts {
-                min_dof: 1,
-                max_dof: 12,
-                rheonomic: true,
-                gravity: true,
-            },
-        );
+        let desc = random_desc(&mut rng, OPTS);
         let n = desc.ndof;
         max_dof = max_dof.max(n);
         dof_hist[n] += 1;
@@ -216,101 +333,61 @@ fn random_trees_match_oracle() {
             }
         }
         coupled += used.iter().any(|&u| u > 1) as usize;
-        let oracle = Oracle::new(&desc);
-        let built = to_system(&desc, &mut rng);
-        let bodies = built.body.clone();
-        let model = SymbolicModel::build(built.sys);
-        let eq = &model.scenes[0];
-        let mut roots = Vec::new();
-        roots.extend(flat(&eq.vp.m));
-        roots.extend(&eq.vp.h);
-        roots.extend(flat(&eq.rec.m));
-        roots.extend(&eq.rec.h);
-        roots.extend(&eq.tau_rec);
-        roots.extend(&eq.tau_vp);
-        roots.extend(&eq.static_h);
-        roots.extend([eq.kinetic, eq.potential]);
-        for &b in &bodies {
-            roots.extend(model.world.nodes[model.tree.frame_node[b]].p);
-        }
-        for s in 0..STATES {
-            let (t, q, qd, qdd) = random_state(&mut rng, n);
-            let v = eval(&model, &roots, t, &q, &qd, &qdd);
-            let mut it = 0;
-            let mut take = |k: usize| {
-                let s = v[it..it + k].to_vec();
-                it += k;
-                s
-            };
-            let (m_vp, h_vp) = (take(n * n), take(n));
-            let (m_rec, h_rec) = (take(n * n), take(n));
-            let (tau_rec, tau_vp) = (take(n), take(n));
-            let static_h = take(n);
-            let energy = take(2);
-            let pos = take(3 * bodies.len());
-            let at = || format!("seed {seed}, state {s}, {n} dof");
-            let m_ref = oracle.crba(&q, t);
-            let m_flat: Vec<f64> = m_ref.iter().flatten().copied().collect();
-            let h_ref = oracle.bias(&q, &qd, t);
-            let tau_ref = oracle.rnea(&q, &qd, &qdd, t, true);
-            w_m_vp.see(rel_err(&m_vp, &m_flat), at);
-            w_m_rec.see(rel_err(&m_rec, &m_flat), at);
-            w_h_vp.see(rel_err(&h_vp, &h_ref), at);
-            w_h_rec.see(rel_err(&h_rec, &h_ref), at);
-            w_vp_rec.see(rel_err(&m_vp, &m_rec).max(rel_err(&h_vp, &h_rec)), at);
-            // τ at random qdd equals M qdd − h (of the oracle and of the same formulation)
-            for (tau, m, h, w) in [
-                (&tau_rec, &m_rec, &h_rec, &mut w_tau_rec),
-                (&tau_vp, &m_vp, &h_vp, &mut w_tau_vp),
-            ] {
-                let mq = mat_vec(&square(m, n), &qdd);
-                let own: Vec<f64> = mq.iter().zip(h).map(|(a, b)| a - b).collect();
-                w.see(rel_err(tau, &tau_ref).max(rel_err(tau, &own)), at);
-            }
-            // symmetric positive definite
-            for m in [&m_vp, &m_rec] {
-                let mm = square(m, n);
-                let scale = m.iter().fold(0.0f64, |a, b| a.max(b.abs()));
-                let asym = (0..n)
-                    .flat_map(|i| (0..n).map(move |j| (i, j)))
-                    .fold(0.0f64, |a, (i, j)| a.max((mm[i][j] - mm[j][i]).abs()));
-                w_sym.see(asym / scale, at);
-                assert!(
-                    cholesky(&mm).is_some(),
-                    "M not positive definite at {}",
-                    at()
-                );
-            }
-            let g_ref: Vec<f64> = oracle.com_positions(&q, t).concat();
-            w_pos.see(rel_err(&pos, &g_ref), at);
-            let zero = vec![0.0; n];
-            w_static.see(rel_err(&static_h, &oracle.bias(&q, &zero, t)), at);
-            let e_ref = [oracle.kinetic(&q, &qd, t), oracle.potential(&q, t)];
-            w_energy.see(rel_err(&energy, &e_ref), at);
-        }
+        checks.tree(seed, &desc, &mut rng);
     }
     println!(
         "{TREES} trees x {STATES} states; dof histogram {dof_hist:?}; {branching} branching; \
          {revolute} revolute, {prismatic} prismatic joints; {rheonomic} rheonomic, {driven} \
          purely time-driven; {coupled} trees with a coordinate driving two joints"
     );
-    // relative to the largest entry; the README quotes these bounds (worst measured: 2.5e-15
-    // for M and positions, 1.8e-14 for h, τ and energies)
-    w_pos.check("centre-of-mass positions vs oracle", 1e-14);
-    w_m_vp.check("M virtual power vs oracle", 1e-14);
-    w_m_rec.check("M recursive vs oracle", 1e-14);
-    w_h_vp.check("h virtual power vs oracle", 1e-13);
-    w_h_rec.check("h recursive vs oracle", 1e-13);
-    w_vp_rec.check("M, h virtual power vs recursive", 1e-13);
-    w_tau_rec.check("tau_rec vs oracle and M qdd - h", 1e-13);
-    w_tau_vp.check("tau_vp vs oracle and M qdd - h", 1e-13);
-    w_sym.check("M symmetry", 1e-14);
-    w_static.check("static h (qd = 0) vs oracle", 1e-13);
-    w_energy.check("kinetic and potential energy vs oracle", 1e-13);
+    checks.check();
     assert_eq!(max_dof, 12);
     assert!(
         branching >= TREES as usize / 2,
         "{branching} branching trees"
     );
     assert!(prismatic > 20 && revolute > 20 && rheonomic > 20 && driven > 10 && coupled > 3);
+}
+
+/// Translations along a revolute joint's axis — the centre of mass on the axis, a child's
+/// offset along its parent's axis — are the products the tree reorders (the translation moves
+/// in front of the rotation, `mech::tree::canonical`), siblings then part at the rotation
+/// they shared; the equations must still match the oracle.
+#[test]
+fn translations_along_joint_axes_match_oracle() {
+    // h vanishes in some of these trees (a single joint with its centre of mass on its axis):
+    // errors relative to the largest entry or to 1 (entries are of order 1 to 10)
+    let mut checks = Checks {
+        floor: 1.0,
+        ..Checks::default()
+    };
+    let mut reordered = 0;
+    for seed in 0..40 {
+        let mut rng = Rng::new(seed);
+        let mut desc = random_desc(&mut rng, OPTS);
+        let mut along = Rng::new(1000 + seed);
+        let joints: Vec<(Kind, [f64; 3])> = desc.links.iter().map(|l| (l.kind, l.axis)).collect();
+        for l in desc.links.iter_mut() {
+            if l.kind == Kind::Revolute && along.chance(0.6) {
+                l.com = scale(along.range(-0.4, 0.4), l.axis);
+            }
+            if let Some((Kind::Revolute, axis)) = l.parent.map(|p| joints[p]) {
+                if along.chance(0.6) {
+                    l.offset = scale(along.range(-0.5, 0.5), axis);
+                }
+            }
+        }
+        // the same draws as `checks.tree` makes below
+        let mut same = Rng::new(seed);
+        random_desc(&mut same, OPTS);
+        let mut sys = to_system(&desc, &mut same).sys;
+        for f in 0..sys.frames.len() {
+            let factors = sys.frames[f].factors.clone();
+            reordered += (canonical(&factors, &mut sys.arena) != factors) as usize;
+        }
+        checks.tree(seed, &desc, &mut rng);
+    }
+    checks.check();
+    println!("{reordered} products reordered");
+    assert!(reordered > 40, "{reordered} products reordered");
 }

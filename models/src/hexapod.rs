@@ -139,5 +139,5 @@ mbs::multibody! {
 }
 
 /// The hexapod without contact or controllers (gravity only): the type of the contact-free
-/// figures (M+h 5,868 flops).
+/// figures (M+h 5,760 flops).
 pub type Hexapod = HexapodFree;

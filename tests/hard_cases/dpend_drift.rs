@@ -1,9 +1,9 @@
 //! dpend (MODELS.md, chaotic, E(0) = 0) over 1000 s, energy at outputs every 0.5 s: the
 //! implicit midpoint rule at a fixed h = 1e-2 s has no secular drift (a line fitted to
-//! E(t) moves less over the run than E oscillates about it, and the largest |E − E0| over
-//! 1000 s is less than twice that of the first 100 s), DOPRI5 at rtol 1e-6 drifts (a steady
-//! climb, 90 times its oscillation, ten times larger at 1000 s than at 100 s; trend, sign
-//! and size printed).
+//! E(t) moves over the run less than ten times the rms oscillation of E about it, and the
+//! largest |E − E0| over 1000 s is less than twice that of the first 100 s), DOPRI5 at rtol
+//! 1e-6 drifts (a steady climb, 90 times its oscillation, ten times larger at 1000 s than at
+//! 100 s; trend, sign and size printed).
 
 use crate::support::{Work, all_finite, check_work, fit_line, work};
 use mbs::{Options, Output, Scheme, Trajectory, simulate};
@@ -56,9 +56,12 @@ fn dpend_over_1000_s_midpoint_has_no_energy_drift_and_dopri5_drifts() {
     );
     let early = deviation(&tr, 100.0);
     println!("    largest |E − E0|: {early:.2e} J over the first 100 s, {dev:.2e} J over 1000 s");
-    // no secular drift: the trend over the whole run is within the oscillation, and the
-    // deviation does not grow with the length of the run
-    assert!((slope * T_END).abs() < spread, "midpoint drifts");
+    // no secular drift: the deviation does not grow with the length of the run, and the
+    // fitted line stays within a few oscillations. The trajectory is chaotic, so the line
+    // wanders with the last bits of the start: from the declared start and eleven others
+    // 1e-13 to 1.1e-12 rad away, its move over 1000 s was 0.2 to 6.1 times the rms
+    // oscillation, of either sign (above 1 for 9 of the 12); DOPRI5's climb is 90 times
+    assert!((slope * T_END).abs() < 10.0 * spread, "midpoint drifts");
     assert!(
         dev < 0.3 && dev < 2.0 * early,
         "bounded: {early} then {dev}"
@@ -95,9 +98,9 @@ fn dpend_over_1000_s_midpoint_has_no_energy_drift_and_dopri5_drifts() {
         &snapshots,
         &[
             [
-                100000, 0, 0, 100001, 0, 828695, 0, 136925, 817924, 717923, 0,
+                100000, 0, 0, 100001, 0, 828903, 0, 136925, 818132, 718131, 0,
             ], // midpoint h 1e-2
-            [38384, 8068, 0, 278714, 0, 0, 0, 278714, 278714, 0, 0], // dopri5 rtol 1e-6
+            [38084, 8107, 0, 277148, 0, 0, 0, 277148, 277148, 0, 0], // dopri5 rtol 1e-6
         ],
     );
 }

@@ -5,7 +5,10 @@
 //! - products carry at most one positive numeric factor, in front (`Mul(Num c, x)`, c > 0);
 //! - signs float outwards (`Neg` above `Mul`/`Div`/odd functions) and are absorbed by
 //!   `Add`/`Sub`: `a + (-b)` is `a - b`, `-(a - b)` is `b - a`;
-//! - like terms merge: `c1·x + c2·x` is `(c1 + c2)·x`, `x - x` is 0;
+//! - like terms merge: `c1·x + c2·x` is `(c1 + c2)·x`, `x - x` is 0; also one level down,
+//!   between an operand and the terms of the other when it is a sum or difference, or the
+//!   terms of both: `x + (c - x)` is `c`, `2x + (y + 3x)` is `5x + y` (not `x + (x + y)`,
+//!   which `2x + y` would make dearer when `x + y` is needed elsewhere);
 //! - `pos` and `step` absorb each other and positive factors: `pos(pos x)` is `pos x`,
 //!   `step(pos x)` is `step x`, `pos(c·x)` is `c·pos x` and `step(c·x)` is `step x` (c > 0).
 //!
@@ -32,25 +35,102 @@ impl Arena {
         }
     }
 
-    fn ordered(&self, a: ExprId, b: ExprId) -> (ExprId, ExprId) {
-        let an = self.as_num(a).is_some();
-        let bn = self.as_num(b).is_some();
+    /// The operands of `c·e` as signed terms when `e` is a sum or difference and c = ±1
+    /// (`c·(x + y)` with another c stays whole: distributing it would cost products).
+    fn parts(&self, (c, e): (f64, ExprId)) -> Option<[(f64, ExprId); 2]> {
+        if c != 1.0 && c != -1.0 {
+            return None;
+        }
+        let (x, y, sy) = match self.node(e) {
+            Node::Add(x, y) => (x, y, c),
+            Node::Sub(x, y) => (x, y, -c),
+            _ => return None,
+        };
+        let ((cx, tx), (cy, ty)) = (self.split_coef(x), self.split_coef(y));
+        Some([(c * cx, tx), (sy * cy, ty)])
+    }
+
+    /// Like terms one level down in `a + b`, given split as coefficient × term: when `a` or
+    /// one of its terms (the operands of a sum or difference) and `b` or one of its terms are
+    /// the same expression, their coefficients merge and the rest is rebuilt: `x + (c − x)`
+    /// is `c`, `2x + (y + 3x)` is `5x + y`, `(x + y) − (z + (x + y))` is `−z`. At most eight
+    /// pairs are compared and no node is visited twice, so the rule costs O(1) per node.
+    fn merge_terms(&mut self, wa: (f64, ExprId), wb: (f64, ExprId)) -> Option<ExprId> {
+        let pa = self.parts(wa);
+        let pb = self.parts(wb);
+        if pa.is_none() && pb.is_none() {
+            return None;
+        }
+        // (coefficient of a's match, b's match, the term, what is left of a and of b)
+        let mut found = None;
+        if let Some(pb) = pb {
+            for j in 0..2 {
+                if wa.1 == pb[j].1 && self.worth_merging(wa.0, pb[j].0) {
+                    found = Some((wa.0, pb[j].0, wa.1, None, Some(pb[1 - j])));
+                    break;
+                }
+            }
+        }
+        if let (None, Some(pa)) = (found, pa) {
+            for i in 0..2 {
+                let rest_a = Some(pa[1 - i]);
+                if pa[i].1 == wb.1 && self.worth_merging(pa[i].0, wb.0) {
+                    found = Some((pa[i].0, wb.0, wb.1, rest_a, None));
+                    break;
+                }
+                if let Some(pb) = pb {
+                    if let Some(j) =
+                        (0..2).find(|&j| pa[i].1 == pb[j].1 && self.worth_merging(pa[i].0, pb[j].0))
+                    {
+                        found = Some((pa[i].0, pb[j].0, pa[i].1, rest_a, Some(pb[1 - j])));
+                        break;
+                    }
+                }
+            }
+        }
+        let (ca, cb, t, ra, rb) = found?;
+        let mut acc = self.scale(ca + cb, t);
+        for (ck, tk) in ra.into_iter().chain(rb) {
+            let x = self.scale(ck.abs(), tk);
+            acc = if ck < 0.0 {
+                self.sub(acc, x)
+            } else {
+                self.add(acc, x)
+            };
+        }
+        Some(acc)
+    }
+
+    /// Whether merging `ca·t` and `cb·t` found at different levels is worth it: when they
+    /// cancel, or when both carry a coefficient (`c·t` is then one product, as each was).
+    /// `t + (t + y)` stays: `2t + y` would cost a product more whenever `t + y` is shared.
+    fn worth_merging(&self, ca: f64, cb: f64) -> bool {
+        ca + cb == 0.0 || (ca.abs() != 1.0 && cb.abs() != 1.0)
+    }
+
+    /// The operands of a commutative node in canonical order, given their values when they
+    /// are numbers (looked up once per constructor); the first one's value comes along.
+    fn ordered(
+        a: ExprId,
+        b: ExprId,
+        na: Option<f64>,
+        nb: Option<f64>,
+    ) -> (ExprId, ExprId, Option<f64>) {
+        let (an, bn) = (na.is_some(), nb.is_some());
         if bn && !an || (an == bn && b < a) {
-            (b, a)
+            (b, a, nb)
         } else {
-            (a, b)
+            (a, b, na)
         }
     }
 
     pub fn add(&mut self, a: ExprId, b: ExprId) -> ExprId {
-        if let (Some(x), Some(y)) = (self.as_num(a), self.as_num(b)) {
-            return self.num(x + y);
-        }
-        if self.is_num(a, 0.0) {
-            return b;
-        }
-        if self.is_num(b, 0.0) {
-            return a;
+        let (na, nb) = (self.as_num(a), self.as_num(b));
+        match (na, nb) {
+            (Some(x), Some(y)) => return self.num(x + y),
+            (Some(0.0), None) => return b,
+            (None, Some(0.0)) => return a,
+            _ => {}
         }
         let (ca, ta) = self.split_coef(a);
         let (cb, tb) = self.split_coef(b);
@@ -66,9 +146,12 @@ impl Arena {
             (Node::Neg(x), _) => return self.sub(b, x),
             _ => {}
         }
-        let (a, b) = self.ordered(a, b);
+        if let Some(r) = self.merge_terms((ca, ta), (cb, tb)) {
+            return r;
+        }
+        let (a, b, na) = Self::ordered(a, b, na, nb);
         // fold a number into a sum that already starts with one
-        if let Some(c) = self.as_num(a) {
+        if let Some(c) = na {
             match self.node(b) {
                 Node::Add(x, y) if self.as_num(x).is_some() => {
                     let s = self.num(c + self.as_num(x).unwrap());
@@ -85,14 +168,12 @@ impl Arena {
     }
 
     pub fn sub(&mut self, a: ExprId, b: ExprId) -> ExprId {
-        if let (Some(x), Some(y)) = (self.as_num(a), self.as_num(b)) {
-            return self.num(x - y);
-        }
-        if self.is_num(b, 0.0) {
-            return a;
-        }
-        if self.is_num(a, 0.0) {
-            return self.neg(b);
+        let (na, nb) = (self.as_num(a), self.as_num(b));
+        match (na, nb) {
+            (Some(x), Some(y)) => return self.num(x - y),
+            (_, Some(0.0)) => return a,
+            (Some(0.0), _) => return self.neg(b),
+            _ => {}
         }
         if a == b {
             return self.zero();
@@ -109,9 +190,12 @@ impl Arena {
             let s = self.add(x, b);
             return self.neg(s);
         }
-        if let Some(c) = self.as_num(b) {
+        if let Some(c) = nb {
             let m = self.num(-c);
             return self.add(m, a);
+        }
+        if let Some(r) = self.merge_terms((ca, ta), (-cb, tb)) {
+            return r;
         }
         self.intern(Node::Sub(a, b))
     }
@@ -126,11 +210,12 @@ impl Arena {
     }
 
     pub fn mul(&mut self, a: ExprId, b: ExprId) -> ExprId {
-        if let (Some(x), Some(y)) = (self.as_num(a), self.as_num(b)) {
+        let (na, nb) = (self.as_num(a), self.as_num(b));
+        if let (Some(x), Some(y)) = (na, nb) {
             return self.num(x * y);
         }
-        let (a, b) = self.ordered(a, b);
-        if let Some(c) = self.as_num(a) {
+        let (a, b, na) = Self::ordered(a, b, na, nb);
+        if let Some(c) = na {
             if c == 0.0 {
                 return self.zero();
             }
@@ -400,6 +485,126 @@ mod tests {
         // commutative canonical order
         assert_eq!(a.mul(y, x), a.mul(x, y));
         assert_eq!(a.add(y, x), a.add(x, y));
+    }
+
+    #[test]
+    fn terms_cancel_and_merge_one_level_down() {
+        let mut a = Arena::new();
+        let x = a.var(Var::Q(0));
+        let y = a.var(Var::Q(1));
+        let z = a.var(Var::Q(2));
+        let c = a.var(Var::Param(0));
+        let five = a.num(5.0);
+        // x + (c − x) = c, whichever side the sum is on, and with numbers
+        let cx = a.sub(c, x);
+        assert_eq!(a.add(x, cx), c);
+        assert_eq!(a.add(cx, x), c);
+        let fx = a.sub(five, x);
+        assert_eq!(a.add(x, fx), five);
+        // (c + x) − x = c and x − (x − y) = y, also under a sign
+        let xc = a.add(c, x);
+        assert_eq!(a.sub(xc, x), c);
+        let xy = a.sub(x, y);
+        assert_eq!(a.sub(x, xy), y);
+        let nx = a.neg(x);
+        let nxy = a.add(nx, y);
+        assert_eq!(a.add(x, nxy), y);
+        // −(x + y) + x = −y
+        let s = a.add(x, y);
+        let ns = a.neg(s);
+        let r = a.add(ns, x);
+        assert_eq!(a.node(r), Node::Neg(y));
+        // a whole sum against a term of the other: (x + y) − (z + (x + y)) = −z
+        let zs = a.add(z, s);
+        let r = a.sub(s, zs);
+        assert_eq!(a.node(r), Node::Neg(z));
+        // terms of both sums: (x + y) + (z − y) = x + z
+        let zy = a.sub(z, y);
+        assert_eq!(a.add(s, zy), a.add(x, z));
+        // coefficients on both sides merge: 2x + (y + 3x) = 5x + y
+        let x2 = a.scale(2.0, x);
+        let x3 = a.scale(3.0, x);
+        let y3x = a.add(y, x3);
+        let r = a.add(x2, y3x);
+        let x5 = a.scale(5.0, x);
+        assert_eq!(r, a.add(x5, y));
+        // 0.5x − (0.5x − y) = y
+        let h = a.scale(0.5, x);
+        let hy = a.sub(h, y);
+        assert_eq!(a.sub(h, hy), y);
+    }
+
+    #[test]
+    fn terms_that_would_cost_a_product_stay() {
+        let mut a = Arena::new();
+        let x = a.var(Var::Q(0));
+        let y = a.var(Var::Q(1));
+        // x + (x + y) stays: 2x + y costs a product more when x + y is needed anyway
+        let s = a.add(x, y);
+        let r = a.add(x, s);
+        assert_eq!(a.node(r), Node::Add(x, s));
+        // x + (3x + y) stays for the same reason
+        let x3 = a.scale(3.0, x);
+        let s3 = a.add(x3, y);
+        let r = a.add(x, s3);
+        assert_eq!(a.node(r), Node::Add(x, s3));
+        // a scaled sum is not distributed: x + 2(y − x) stays
+        let d = a.sub(y, x);
+        let d2 = a.scale(2.0, d);
+        let r = a.add(x, d2);
+        assert_eq!(a.node(r), Node::Add(x, d2));
+    }
+
+    #[test]
+    fn merged_terms_keep_their_values() {
+        use super::super::SliceEnv;
+        // random sums and differences of a few terms, built with the rules and evaluated
+        // against the same arithmetic on numbers
+        let mut a = Arena::new();
+        let q = [0.7, -1.3, 2.1];
+        let leaves: Vec<_> = (0..3).map(|k| a.var(Var::Q(k))).collect();
+        let mut seed = 12345u64;
+        let mut next = |n: usize| {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((seed >> 33) % n as u64) as usize
+        };
+        // (expression, value, sum of the magnitudes of its terms: the rounding scale)
+        let mut pool: Vec<(super::ExprId, f64, f64)> = leaves
+            .iter()
+            .zip(q)
+            .map(|(&e, v): (_, f64)| (e, v, v.abs()))
+            .collect();
+        let coefs = [1.0, -1.0, 0.5, 2.0, -3.0];
+        let mut merged = 0;
+        for _ in 0..400 {
+            let (e1, v1, m1) = pool[next(pool.len())];
+            let (e2, v2, m2) = pool[next(pool.len())];
+            let c = coefs[next(coefs.len())];
+            let e2 = a.scale(c, e2);
+            let (v2, m) = (c * v2, m1 + c.abs() * m2);
+            let (e, v) = if next(2) == 0 {
+                (a.add(e1, e2), v1 + v2)
+            } else {
+                (a.sub(e1, e2), v1 - v2)
+            };
+            // results with fewer nodes than their operands: terms merged
+            merged += (a.reachable(&[e]).len() < a.reachable(&[e1, e2]).len()) as usize;
+            pool.push((e, v, m));
+        }
+        // 43 here; the rules without the merge one level down shrink 27
+        println!("{merged} of 400 results merged terms");
+        assert!(merged >= 35, "{merged} merged");
+        let env = SliceEnv {
+            q: &q,
+            ..SliceEnv::default()
+        };
+        let roots: Vec<_> = pool.iter().map(|p| p.0).collect();
+        let got = a.eval(&roots, &env);
+        for (&(_, want, scale), got) in pool.iter().zip(got) {
+            assert!((want - got).abs() <= 1e-13 * scale, "{got} vs {want}");
+        }
     }
 
     #[test]

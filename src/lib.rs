@@ -66,6 +66,8 @@ pub mod language;
 pub mod plot;
 #[cfg(feature = "spectral")]
 pub mod spectral;
+#[cfg(feature = "urdf")]
+pub mod urdf;
 #[cfg(feature = "work_precision")]
 pub mod work_precision;
 

@@ -3,6 +3,9 @@
 //! `mbs expand FILE.rs [--model NAME] [--scene S]` prints the code that `multibody!` generates
 //! for the blocks of a file, exactly as the macro emits it, pretty-printed, then a table of
 //! operation counts per generated function and the generation time.
+//!
+//! `mbs import urdf FILE.urdf > model.rs` writes a robot's URDF description as a `multibody!`
+//! block to edit (feature `urdf`; see `mbs::urdf`).
 
 use clap::{Parser, Subcommand};
 use mbs_symbolic::expand::{Expansion, expand_models, multibody_blocks};
@@ -32,6 +35,22 @@ enum Command {
         #[arg(long)]
         counts_only: bool,
     },
+    /// Write a robot description as a `multibody!` block (on standard output)
+    #[cfg(feature = "urdf")]
+    Import {
+        #[command(subcommand)]
+        format: ImportFormat,
+    },
+}
+
+#[cfg(feature = "urdf")]
+#[derive(Subcommand)]
+enum ImportFormat {
+    /// a URDF file: links, joints, inertias, visuals
+    Urdf {
+        /// the URDF file
+        file: PathBuf,
+    },
 }
 
 fn main() -> ExitCode {
@@ -46,6 +65,20 @@ fn main() -> ExitCode {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => {
                 eprintln!("error: {e}");
+                ExitCode::FAILURE
+            }
+        },
+        #[cfg(feature = "urdf")]
+        Command::Import {
+            format: ImportFormat::Urdf { file },
+        } => match mbs::urdf::import_file(&file) {
+            Ok(imported) => {
+                let source = file.file_name().unwrap_or(file.as_os_str());
+                print!("{}", imported.block(&source.to_string_lossy()));
+                ExitCode::SUCCESS
+            }
+            Err(e) => {
+                eprintln!("error: {}: {e}", file.display());
                 ExitCode::FAILURE
             }
         },

@@ -44,6 +44,7 @@
 //! | `work_precision` | `mbs::work_precision`, work–precision studies | `plot`, cpu-time |
 //! | `cli` | `mbs::cli`, the per-system programs' command line | `plot`, `anim`, `gltf`, clap, indicatif, cpu-time |
 //! | `expand` | the `mbs` program (`mbs expand`) | mbs-symbolic, syn, prettyplease, clap |
+//! | `urdf` | `mbs::urdf`, URDF robots as `multibody!` source (`mbs import urdf` with `expand`) | roxmltree |
 //!
 //! With `default-features = false` you get [`multibody!`], the runtime ([`Model`], the schemes,
 //! [`simulate`], [`analysis`], CSV and JSON output) and this documentation, nothing else:

@@ -1327,7 +1327,8 @@ impl<'a> Writer<'a> {
             "        // joint `{}` mimics `{}`: its motion is {e}",
             joint.name, m.leader
         );
-        self.motion[j] = vec![format!("({e})")];
+        let bare = m.multiplier == 1.0 && m.offset == 0.0;
+        self.motion[j] = vec![if bare { e } else { format!("({e})") }];
     }
 
     fn declare_entity(&mut self, e: usize) {

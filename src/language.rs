@@ -354,8 +354,9 @@
 //! two links or joints of one name, a joint naming an unknown link, a link with two parent
 //! joints, a cycle, none or several root links, a negative mass, an inertia that is not
 //! positive definite, a joint type other than the six above, an axis of zero length, a mimic
-//! of an unknown, fixed or mimicking joint, a joint that moves no mass (M would be singular).
-//! `examples/urdf.rs` imports a robot, prints its op counts, then builds and simulates it.
+//! of an unknown, fixed or mimicking joint, a joint that moves no mass (M would be singular),
+//! a robot without a moving joint. `examples/urdf.rs` imports a robot, prints its op counts,
+//! then builds and simulates it.
 //!
 //! ## Errors
 //!

@@ -133,6 +133,12 @@ pub enum UrdfError {
         leader: String,
         problem: String,
     },
+    /// No joint moves: there is nothing to simulate.
+    #[error(
+        "the robot has no joint that moves (every joint is fixed, or there is none): give it a \
+         revolute, continuous, prismatic, floating or planar joint"
+    )]
+    NoMotion,
     /// A joint that moves no mass: the mass matrix would be singular.
     #[error(
         "joint `{joint}` moves no link with mass (link `{link}` and the links after it have no \
@@ -799,6 +805,13 @@ impl Tree {
             link_index,
             joint_index,
         };
+        if robot
+            .joints
+            .iter()
+            .all(|j| j.kind == JointKind::Fixed || j.mimic.is_some())
+        {
+            return Err(UrdfError::NoMotion);
+        }
         // every joint with a coordinate moves some mass
         for j in &robot.joints {
             if j.kind == JointKind::Fixed || j.mimic.is_some() {
@@ -1576,6 +1589,20 @@ impl<'a> Writer<'a> {
             let along = |k: usize| -> Option<usize> {
                 (0..3).find(|&i| (r[i][k].abs() - 1.0).abs() < 1e-9)
             };
+            let sizes: &[f64] = match &v.geometry {
+                Geometry::Sphere(r) => std::slice::from_ref(r),
+                Geometry::Box(size) => size,
+                Geometry::Cylinder { radius, length } => &[*radius, *length],
+                Geometry::Mesh(_) => &[],
+            };
+            if sizes.iter().any(|&x| x <= 0.0) {
+                let _ = writeln!(
+                    self.shapes,
+                    "        // link `{}`: a visual with a size that is not positive is not drawn",
+                    link.name
+                );
+                continue;
+            }
             let statement = match &v.geometry {
                 Geometry::Sphere(radius) => Some(format!("sphere({}{tail})", num(*radius))),
                 Geometry::Box(size) => {

@@ -242,6 +242,14 @@ fn shapes_come_from_the_visuals() {
     assert!(text.contains("shape ground: cylinder(0.08, 0.1, axis = z, at = (0.0, 0.0, 0.05));"));
     // the upper arm's cylinder is turned from z onto x by its visual's pitch of π/2
     assert!(text.contains("shape upper_arm: cylinder(0.03, 0.5, axis = x, color = \"#3366cc\");"));
+    // a visual of zero size is a comment, not a shape the macro would refuse
+    let flat = r#"<robot name="flat"><link name="a"/><link name="b">
+        <inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1"/></inertial>
+        <visual><geometry><box size="0.1 0 0.1"/></geometry></visual></link>
+        <joint name="j" type="revolute"><parent link="a"/><child link="b"/></joint></robot>"#;
+    let text = import(flat).unwrap().model;
+    assert!(!text.contains("shape b:"));
+    assert!(text.contains("// link `b`: a visual with a size that is not positive is not drawn"));
     let info = imported::arm2::Arm2::default().info();
     assert_eq!(info.shapes.iter().filter(|s| s.declared).count(), 3);
 }
@@ -274,6 +282,8 @@ fn bad_descriptions_are_typed_errors_naming_the_culprit() {
     assert!(
         matches!(&e, UrdfError::UnknownLink { joint, role: "parent", link, .. } if joint == "j" && link == "c")
     );
+    let e = error(&robot(&format!("{LINKS}{}", joint("j", "fixed", "a", "b"))));
+    assert_eq!(e, UrdfError::NoMotion);
     let e = error(&robot(&format!(
         "{LINKS}{}",
         joint("j", "revolute", "aa", "b")

@@ -279,7 +279,7 @@
 //! | URDF | `multibody!` |
 //! |---|---|
 //! | the root link | the `ground` (its mass does not move: a comment says so) |
-//! | `<link>` with `<inertial>` | `body`; TOG at the centre of mass (`<inertial><origin xyz>`), axes parallel to the link frame; `param`s `{link}_m`, `{link}_cx`…, `{link}_ixx`… (an `<inertial><origin rpy>` is rotated into those axes) |
+//! | `<link>` with `<inertial>` | `body`; TOG at the centre of mass (`<inertial><origin xyz>`), axes parallel to the link frame; `param`s `{link}_m`, `{link}_cx`…, `{link}_ixx`… (an `<inertial><origin rpy>` is rotated into those axes); when other links hang from the link, a `frame {link}_frame` at the joint carries them |
 //! | `<link>` without mass | `frame` at the link frame |
 //! | `<joint><origin xyz rpy>` | `Tdisp({joint}_dx, {joint}_dy, {joint}_dz) * Trotz(yaw) * Troty(pitch) * Trotx(roll)` (URDF's R = Rz·Ry·Rx) |
 //! | `revolute`, `continuous` | `dof {joint}` (limits, effort and velocity in a comment; starts at 0, or the nearer limit), then `Trotx/y/z({joint})` about a coordinate axis (`Trotz(-{joint})` for −z), `Trotn(nx, ny, nz, {joint})` about another |

@@ -5,7 +5,9 @@
 //!
 //! - a link frame is at its parent joint; a body's frame (TOG) is at its centre of mass, so a
 //!   body is its link frame moved by `<inertial><origin xyz>`, axes parallel to the link
-//!   frame; an `<inertial><origin rpy>` rotates the inertia tensor into those axes;
+//!   frame; an `<inertial><origin rpy>` rotates the inertia tensor into those axes; when
+//!   other links hang from a link with its centre of mass off the joint, its link frame is a
+//!   `frame {link}_frame` the body and the children share (cheaper than going back from G);
 //! - a joint is `Tdisp(xyz) * Trotz(yaw) * Troty(pitch) * Trotx(roll)` (URDF's fixed-axis
 //!   roll–pitch–yaw, R = Rz·Ry·Rx) then its motion: `Trotx/y/z(q)` about a coordinate axis,
 //!   `Trotn(nx, ny, nz, q)` about another, `Tdisp` along the axis for a prismatic joint;
@@ -1536,27 +1538,28 @@ impl<'a> Writer<'a> {
         match self.holder[l] {
             Holder::Entity(e) if self.entities[e].link == l => {
                 let en = &self.entities[e];
+                let name = en.name.clone();
                 let moved = en.mass > 0.0 && en.com != [0.0; 3];
-                if moved {
-                    factors.push(format!("Tdisp({})", en.com_param.join(", ")));
+                let com = format!("Tdisp({})", en.com_param.join(", "));
+                if moved && !self.tree.children[l].is_empty() {
+                    // links hang from the link frame: a frame of its own, shared by the body
+                    // and the children (cheaper than going back from G)
+                    let link = self.names.fresh(&format!("{name}_frame"));
+                    let text = product(base.as_deref(), &factors);
+                    let _ = writeln!(self.items, "        frame {link};");
+                    let _ = writeln!(self.items, "        TOG[{link}] = {text};");
+                    let _ = writeln!(self.items, "        TOG[{name}] = TOG[{link}] * {com};");
+                    self.chain
+                        .insert(l, (Some(format!("TOG[{link}]")), Vec::new()));
+                } else {
+                    if moved {
+                        factors.push(com);
+                    }
+                    let text = product(base.as_deref(), &factors);
+                    let _ = writeln!(self.items, "        TOG[{name}] = {text};");
+                    self.chain
+                        .insert(l, (Some(format!("TOG[{name}]")), Vec::new()));
                 }
-                let text = product(base.as_deref(), &factors);
-                let _ = writeln!(self.items, "        TOG[{}] = {text};", en.name);
-                // the link frame, back from G
-                let back = moved.then(|| {
-                    let minus = en
-                        .com_param
-                        .iter()
-                        .map(|n| if n == "0" { n.clone() } else { format!("-{n}") });
-                    format!("Tdisp({})", minus.collect::<Vec<_>>().join(", "))
-                });
-                self.chain.insert(
-                    l,
-                    (
-                        Some(format!("TOG[{}]", en.name)),
-                        back.into_iter().collect(),
-                    ),
-                );
             }
             _ => {
                 self.chain.insert(l, (base, factors));

@@ -28,8 +28,10 @@ mbs::multibody! {
         dof elbow = 0.0; // revolute, limits [-2.5, 2.5] rad, effort 30.0 N·m, velocity 3.0 rad/s
         body upper_arm { mass = upper_arm_m; inertia = (upper_arm_ixx, upper_arm_iyy, upper_arm_izz); }
         body forearm { mass = forearm_m; inertia = (forearm_ixx, forearm_iyy, forearm_izz); }
-        TOG[upper_arm] = Tdisp(0, 0, shoulder_dz) * Trotz(shoulder) * Tdisp(upper_arm_cx, 0, 0);
-        TOG[forearm] = TOG[upper_arm] * Tdisp(-upper_arm_cx, 0, 0) * Tdisp(elbow_dx, 0, 0) * Troty(elbow) * Tdisp(forearm_cx, 0, 0);
+        frame upper_arm_frame;
+        TOG[upper_arm_frame] = Tdisp(0, 0, shoulder_dz) * Trotz(shoulder);
+        TOG[upper_arm] = TOG[upper_arm_frame] * Tdisp(upper_arm_cx, 0, 0);
+        TOG[forearm] = TOG[upper_arm_frame] * Tdisp(elbow_dx, 0, 0) * Troty(elbow) * Tdisp(forearm_cx, 0, 0);
         // link `base_link` is fixed to the ground: its mass (5.0 kg) does not move
         shape ground: cylinder(0.08, 0.1, axis = z, at = (0.0, 0.0, 0.05));
         shape upper_arm: cylinder(0.03, 0.5, axis = x, color = "#3366cc");
@@ -120,12 +122,16 @@ mbs::multibody! {
         body left_arm { mass = left_arm_m; inertia = (left_arm_ixx, left_arm_iyy, left_arm_izz, left_arm_ixy, left_arm_ixz, left_arm_iyz); }
         body right_arm { mass = right_arm_m; inertia = (right_arm_ixx, right_arm_iyy, right_arm_izz, right_arm_ixy, right_arm_ixz, right_arm_iyz); }
         body finger { mass = finger_m; inertia = (finger_ixx, finger_iyy, finger_izz); }
-        TOG[torso] = Tdisp(0, 0, mount_dz) * Trotz(0.3) * Tdisp(0, 0, waist_dz) * Trotz(waist) * Tdisp(torso_cx, torso_cy, torso_cz);
-        TOG[head_mount] = TOG[torso] * Tdisp(-torso_cx, -torso_cy, -torso_cz) * Tdisp(0, 0, neck_mount_dz) * Troty(0.15);
+        frame torso_frame;
+        TOG[torso_frame] = Tdisp(0, 0, mount_dz) * Trotz(0.3) * Tdisp(0, 0, waist_dz) * Trotz(waist);
+        TOG[torso] = TOG[torso_frame] * Tdisp(torso_cx, torso_cy, torso_cz);
+        TOG[head_mount] = TOG[torso_frame] * Tdisp(0, 0, neck_mount_dz) * Troty(0.15);
         TOG[head] = TOG[head_mount] * Tdisp(0, 0, neck_dz) * Trotz(neck) * Tdisp(head_cx, 0, head_cz);
-        TOG[left_arm] = TOG[torso] * Tdisp(-torso_cx, -torso_cy, -torso_cz) * Tdisp(0, left_shoulder_dy, left_shoulder_dz) * Trotz(0.3) * Troty(0.2) * Trotx(0.1) * Trotx(left_shoulder) * Tdisp(0, left_arm_cy, 0);
-        TOG[right_arm] = TOG[torso] * Tdisp(-torso_cx, -torso_cy, -torso_cz) * Tdisp(0, right_shoulder_dy, right_shoulder_dz) * Trotz(-0.3) * Troty(0.2) * Trotx(-0.1) * Troty(-right_shoulder) * Tdisp(right_arm_cx, right_arm_cy, right_arm_cz);
-        TOG[finger] = TOG[right_arm] * Tdisp(-right_arm_cx, -right_arm_cy, -right_arm_cz) * Tdisp(0, wrist_mount_dy, 0) * Troty(0.4) * Tdisp(finger_joint_dx, finger_joint_dy, 0) * Trotx(0.3) * Trotz(finger_joint) * Tdisp(0, finger_cy, 0);
+        TOG[left_arm] = TOG[torso_frame] * Tdisp(0, left_shoulder_dy, left_shoulder_dz) * Trotz(0.3) * Troty(0.2) * Trotx(0.1) * Trotx(left_shoulder) * Tdisp(0, left_arm_cy, 0);
+        frame right_arm_frame;
+        TOG[right_arm_frame] = TOG[torso_frame] * Tdisp(0, right_shoulder_dy, right_shoulder_dz) * Trotz(-0.3) * Troty(0.2) * Trotx(-0.1) * Troty(-right_shoulder);
+        TOG[right_arm] = TOG[right_arm_frame] * Tdisp(right_arm_cx, right_arm_cy, right_arm_cz);
+        TOG[finger] = TOG[right_arm_frame] * Tdisp(0, wrist_mount_dy, 0) * Troty(0.4) * Tdisp(finger_joint_dx, finger_joint_dy, 0) * Trotx(0.3) * Trotz(finger_joint) * Tdisp(0, finger_cy, 0);
         // link `base` is fixed to the ground: its mass (10.0 kg) does not move
         // link `base`: a visual turned off the link's axes is not drawn
         shape torso: box(0.2, 0.3, 0.6, at = (0.00887975174119749, (-0.01105229398850611), 0.02959600938488205));
@@ -184,10 +190,14 @@ mbs::multibody! {
         body rotor { mass = rotor_m; inertia = (rotor_ixx, rotor_iyy, rotor_izz, rotor_ixy, 0, 0); }
         body pin { mass = pin_m; inertia = (pin_ixx, pin_iyy, pin_izz); }
         body wheel { mass = wheel_m; inertia = (wheel_ixx, wheel_iyy, wheel_izz); }
-        TOG[carriage] = Tdisp(rail_joint_dx, 0, rail_joint_dz) * Tdisp(rail_joint, 0, 0) * Tdisp(0, 0, carriage_cz);
-        TOG[rotor] = TOG[carriage] * Tdisp(0, 0, -carriage_cz) * Tdisp(0, 0, tilt_dz) * Trotz(0.5) * Trotn(0.0, 0.6, 0.8, tilt) * Tdisp(rotor_cx, rotor_cy, rotor_cz);
-        TOG[pin] = TOG[rotor] * Tdisp(-rotor_cx, -rotor_cy, -rotor_cz) * Tdisp(pin_slide_dx, 0, pin_slide_dz) * Tdisp(0.5773502691896258 * pin_slide, 0.5773502691896258 * pin_slide, 0.5773502691896258 * pin_slide);
-        TOG[wheel] = TOG[carriage] * Tdisp(0, 0, -carriage_cz) * Tdisp(wheel_joint_dx, 0, 0) * Trotx(1.5707963267948966) * Trotz(-((-2.0) * tilt + 0.1));
+        frame carriage_frame;
+        TOG[carriage_frame] = Tdisp(rail_joint_dx, 0, rail_joint_dz) * Tdisp(rail_joint, 0, 0);
+        TOG[carriage] = TOG[carriage_frame] * Tdisp(0, 0, carriage_cz);
+        frame rotor_frame;
+        TOG[rotor_frame] = TOG[carriage_frame] * Tdisp(0, 0, tilt_dz) * Trotz(0.5) * Trotn(0.0, 0.6, 0.8, tilt);
+        TOG[rotor] = TOG[rotor_frame] * Tdisp(rotor_cx, rotor_cy, rotor_cz);
+        TOG[pin] = TOG[rotor_frame] * Tdisp(pin_slide_dx, 0, pin_slide_dz) * Tdisp(0.5773502691896258 * pin_slide, 0.5773502691896258 * pin_slide, 0.5773502691896258 * pin_slide);
+        TOG[wheel] = TOG[carriage_frame] * Tdisp(wheel_joint_dx, 0, 0) * Trotx(1.5707963267948966) * Trotz(-((-2.0) * tilt + 0.1));
         shape carriage: box(0.3, 0.2, 0.1, at = (0.0, 0.0, (-0.05)));
         gravity(0, 0, -g);
     }

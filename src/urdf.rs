@@ -99,11 +99,12 @@ pub enum UrdfError {
     /// A negative mass.
     #[error("link `{link}`: its mass is {mass}; a mass is positive (or 0 for a massless link)")]
     NegativeMass { link: String, mass: f64 },
-    /// An inertia tensor that is not positive definite.
+    /// An inertia tensor no rigid body has: a negative principal moment (the tensor is not
+    /// positive semi-definite), or principal moments that violate the triangle inequality.
     #[error(
         "link `{link}`: its inertia (ixx {ixx}, iyy {iyy}, izz {izz}, ixy {ixy}, ixz {ixz}, iyz \
-         {iyz}) is not positive definite; give the tensor about the centre of mass in the \
-         `<inertial><origin>` axes (all zeros for a point mass)"
+         {iyz}) is not a rigid body's: {problem}; give the tensor about the centre of mass in \
+         the `<inertial><origin>` axes, its entries those of the tensor (ixy = −∫xy dm)"
     )]
     Inertia {
         link: String,
@@ -113,6 +114,8 @@ pub enum UrdfError {
         ixy: f64,
         ixz: f64,
         iyz: f64,
+        /// what is wrong, as `multibody!` says it (`mbs::inertia::inertia_problem`)
+        problem: String,
     },
     /// A joint type the importer does not know.
     #[error(
@@ -781,15 +784,33 @@ impl Tree {
                     mass: i.mass,
                 });
             }
+        }
+        let tree = Tree {
+            root: roots[0],
+            children,
+            link_index,
+            joint_index,
+        };
+        // the links whose mass moves: what `multibody!` accepts (no negative principal moment,
+        // the triangle inequality); the ground's links (the root and what is fixed to it) and
+        // massless links do not enter the dynamics, so their tensors are not checked
+        let mut on_ground = vec![tree.root];
+        let mut k = 0;
+        while k < on_ground.len() {
+            for &j in &tree.children[on_ground[k]] {
+                if robot.joints[j].kind == JointKind::Fixed {
+                    on_ground.push(tree.link_index[&robot.joints[j].child]);
+                }
+            }
+            k += 1;
+        }
+        for (n, l) in robot.links.iter().enumerate() {
+            let Some(i) = &l.inertial else { continue };
+            if i.mass <= 0.0 || on_ground.contains(&n) {
+                continue;
+            }
             let [ixx, iyy, izz, ixy, ixz, iyz] = i.inertia;
-            let point = i.inertia.iter().all(|&x| x == 0.0);
-            // Sylvester's criterion on the leading minors
-            let d1 = ixx;
-            let d2 = ixx * iyy - ixy * ixy;
-            let d3 = ixx * (iyy * izz - iyz * iyz) - ixy * (ixy * izz - iyz * ixz)
-                + ixz * (ixy * iyz - iyy * ixz);
-            let definite = d1 > 0.0 && d2 > 0.0 && d3 > 0.0;
-            if !point && !definite {
+            if let Some(problem) = crate::inertia::inertia_problem(i.inertia) {
                 return Err(UrdfError::Inertia {
                     link: l.name.clone(),
                     ixx,
@@ -798,15 +819,10 @@ impl Tree {
                     ixy,
                     ixz,
                     iyz,
+                    problem,
                 });
             }
         }
-        let tree = Tree {
-            root: roots[0],
-            children,
-            link_index,
-            joint_index,
-        };
         if robot
             .joints
             .iter()

@@ -342,7 +342,32 @@ fn bad_descriptions_are_typed_errors_naming_the_culprit() {
         matches!(&e, UrdfError::Inertia { link, .. } if link == "b"),
         "{e}"
     );
-    assert!(e.to_string().contains("not positive definite"), "{e}");
+    assert!(e.to_string().contains("must not be negative"), "{e}");
+    // no rigid body has a moment larger than the sum of the other two: `multibody!` would
+    // refuse it, so the importer does
+    let flat = r#"<link name="a"/><link name="b"><inertial><mass value="1"/>
+        <inertia ixx="1" iyy="1" izz="3"/></inertial></link>"#;
+    let e = error(&robot(&format!(
+        "{flat}{}",
+        joint("j", "revolute", "a", "b")
+    )));
+    assert!(
+        matches!(&e, UrdfError::Inertia { link, problem, .. } if link == "b" && problem.contains("triangle")),
+        "{e}"
+    );
+    // … unless its mass does not move: the root link is the ground
+    let root = r#"<link name="a"><inertial><mass value="1"/>
+        <inertia ixx="1" iyy="1" izz="3"/></inertial></link>"#;
+    let moving = r#"<link name="c"><inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1"/></inertial></link>"#;
+    let text = import(&robot(&format!(
+        "{root}{moving}{}",
+        joint("j", "revolute", "a", "c")
+    )));
+    assert!(
+        text.unwrap()
+            .model
+            .contains("link `a` is fixed to the ground")
+    );
 
     let e = error(&robot(&format!(
         "{LINKS}{}",

@@ -29,6 +29,9 @@ struct Args {
     /// where to write the robot's package (default: target/urdf/NAME)
     #[arg(long)]
     dir: Option<PathBuf>,
+    /// free the root link (a floating joint from the ground) instead of fixing it
+    #[arg(long)]
+    floating_base: bool,
     /// only import, count and write the package; do not build or run it
     #[arg(long)]
     no_run: bool,
@@ -48,7 +51,10 @@ fn main() -> ExitCode {
 }
 
 fn run(args: Args) -> Result<(), String> {
-    let imported = mbs::urdf::import_file(&args.urdf).map_err(|e| e.to_string())?;
+    let options = mbs::urdf::ImportOptions {
+        floating_base: args.floating_base,
+    };
+    let imported = mbs::urdf::import_file(&args.urdf, options).map_err(|e| e.to_string())?;
     let file = args.urdf.file_name().unwrap_or(args.urdf.as_os_str());
     let block = imported.block(&file.to_string_lossy());
     print_counts(&block, &imported.name)?;

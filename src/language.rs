@@ -272,13 +272,13 @@
 //!
 //! ## Importing URDF
 //!
-//! `mbs import urdf robot.urdf > robot.rs` (feature `urdf`; in Rust
+//! `mbs import urdf robot.urdf [--floating-base] > robot.rs` (feature `urdf`; in Rust
 //! [`urdf::import`](crate::urdf::import)) writes a robot's URDF description as a `multibody!`
 //! block, a starting point to edit (effects, scenes, shapes):
 //!
 //! | URDF | `multibody!` |
 //! |---|---|
-//! | the root link | the `ground` (its mass does not move: a comment says so) |
+//! | the root link | the `ground` (its mass does not move: a comment says so); with `--floating-base` ([`ImportOptions`](crate::urdf::ImportOptions)) a body on a `floating` joint `floating_base` (a drone, a legged robot) |
 //! | `<link>` with `<inertial>` | `body`; TOG at the centre of mass (`<inertial><origin xyz>`), axes parallel to the link frame; `param`s `{link}_m`, `{link}_cx`…, `{link}_ixx`… (an `<inertial><origin rpy>` is rotated into those axes); when other links hang from the link, a `frame {link}_frame` at the joint carries them |
 //! | `<link>` without mass | `frame` at the link frame |
 //! | `<joint><origin xyz rpy>` | `Tdisp({joint}_dx, {joint}_dy, {joint}_dz) * Trotz(yaw) * Troty(pitch) * Trotx(roll)` (URDF's R = Rz·Ry·Rx) |

@@ -15,7 +15,8 @@
 //!   stays a `frame`); `floating` is three translations and the Euler angles z, y, x; `planar`
 //!   two translations in the plane and a rotation about its normal; a `mimic` joint follows
 //!   its leader (`multiplier * leader + offset`) without a coordinate of its own;
-//! - the root link is the ground; `gravity(0, 0, -g)` (z up, as in ROS);
+//! - the root link is the ground (or, with [`ImportOptions::floating_base`], a body on a
+//!   floating joint); `gravity(0, 0, -g)` (z up, as in ROS);
 //! - box, cylinder and sphere visuals become `shape` statements; meshes a comment.
 //!
 //! Masses, centres of mass, inertias and joint offsets (`{joint}_dx`, …) are parameters; angles
@@ -174,22 +175,69 @@ impl Imported {
     }
 }
 
-/// Reads a URDF file and imports it ([`import`]).
-pub fn import_file(path: &Path) -> Result<Imported, UrdfError> {
+/// How a robot is imported.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ImportOptions {
+    /// Free the root link: a `floating` joint `floating_base` from the ground to it (a drone, a
+    /// legged robot), instead of fixing it to the ground.
+    pub floating_base: bool,
+}
+
+/// Reads a URDF file and imports it ([`import_with`]).
+pub fn import_file(path: &Path, options: ImportOptions) -> Result<Imported, UrdfError> {
     let text = std::fs::read_to_string(path).map_err(|e| UrdfError::Io {
         path: path.display().to_string(),
         message: e.to_string(),
     })?;
-    import(&text)
+    import_with(&text, options)
+}
+
+/// Imports the URDF text `urdf` as a `multibody!` model, its root link fixed to the ground.
+pub fn import(urdf: &str) -> Result<Imported, UrdfError> {
+    import_with(urdf, ImportOptions::default())
 }
 
 /// Imports the URDF text `urdf` as a `multibody!` model.
-pub fn import(urdf: &str) -> Result<Imported, UrdfError> {
+pub fn import_with(urdf: &str, options: ImportOptions) -> Result<Imported, UrdfError> {
     let doc = Document::parse(urdf).map_err(|e| UrdfError::Xml {
         message: e.to_string(),
     })?;
-    let robot = read_robot(&doc)?;
-    let tree = Tree::new(&robot)?;
+    let mut robot = read_robot(&doc)?;
+    let mut tree = Tree::new(&robot)?;
+    if options.floating_base {
+        let fresh = |wanted: &str, taken: &dyn Fn(&str) -> bool| {
+            let mut name = wanted.to_string();
+            let mut k = 2;
+            while taken(&name) {
+                name = format!("{wanted}_{k}");
+                k += 1;
+            }
+            name
+        };
+        let world = fresh("world", &|n| robot.links.iter().any(|l| l.name == n));
+        let joint = fresh("floating_base", &|n| {
+            robot.joints.iter().any(|j| j.name == n)
+        });
+        robot.joints.insert(
+            0,
+            Joint {
+                name: joint,
+                kind: JointKind::Floating,
+                parent: world.clone(),
+                child: robot.links[tree.root].name.clone(),
+                origin: Origin::default(),
+                axis: [1.0, 0.0, 0.0],
+                limit: None,
+                mimic: None,
+            },
+        );
+        robot.links.push(Link {
+            name: world,
+            inertial: None,
+            visuals: Vec::new(),
+        });
+        tree = Tree::new(&robot)?;
+    }
     Ok(Writer::new(&robot, &tree).write())
 }
 

@@ -4,8 +4,8 @@
 //! for the blocks of a file, exactly as the macro emits it, pretty-printed, then a table of
 //! operation counts per generated function and the generation time.
 //!
-//! `mbs import urdf FILE.urdf > model.rs` writes a robot's URDF description as a `multibody!`
-//! block to edit (feature `urdf`; see `mbs::urdf`).
+//! `mbs import urdf FILE.urdf [--floating-base] > model.rs` writes a robot's URDF description
+//! as a `multibody!` block to edit (feature `urdf`; see `mbs::urdf`).
 
 use clap::{Parser, Subcommand};
 use mbs_symbolic::expand::{Expansion, expand_models, multibody_blocks};
@@ -50,6 +50,10 @@ enum ImportFormat {
     Urdf {
         /// the URDF file
         file: PathBuf,
+        /// free the root link (a floating joint `floating_base` from the ground) instead of
+        /// fixing it to the ground
+        #[arg(long)]
+        floating_base: bool,
     },
 }
 
@@ -70,8 +74,12 @@ fn main() -> ExitCode {
         },
         #[cfg(feature = "urdf")]
         Command::Import {
-            format: ImportFormat::Urdf { file },
-        } => match mbs::urdf::import_file(&file) {
+            format:
+                ImportFormat::Urdf {
+                    file,
+                    floating_base,
+                },
+        } => match mbs::urdf::import_file(&file, mbs::urdf::ImportOptions { floating_base }) {
             Ok(imported) => {
                 let source = file.file_name().unwrap_or(file.as_os_str());
                 print!("{}", imported.block(&source.to_string_lossy()));

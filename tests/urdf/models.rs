@@ -263,3 +263,52 @@ mbs::multibody! {
     }
 }
 }
+
+pub mod drone {
+// Imported from drone.urdf by `mbs import urdf`: a starting point to edit (effects,
+// scenes, shapes). Link frames are at the joints; a body's frame is at its centre of
+// mass, axes parallel to its link frame.
+mbs::multibody! {
+    /// The `drone` robot, imported from its URDF description.
+    pub model Drone {
+        param g = 9.81;
+        // link `base_link`: mass (kg), centre of mass in the link frame (m), inertia about it (kg·m²)
+        param base_link_m = 1.5;
+        param base_link_cx = 0.01;
+        param base_link_cz = -0.02;
+        param base_link_ixx = 0.020199334221587588;
+        param base_link_iyy = 0.025;
+        param base_link_izz = 0.039800665778412424;
+        param base_link_ixy = 0.000995004165278026;
+        param base_link_ixz = 0.001986693307950613;
+        param base_link_iyz = -9.983341664682815e-5;
+        // link `camera`: mass (kg), centre of mass in the link frame (m), inertia about it (kg·m²)
+        param camera_m = 0.2;
+        param camera_cx = 0.02;
+        param camera_cz = -0.01;
+        param camera_ixx = 0.0001;
+        param camera_iyy = 0.0002;
+        param camera_izz = 0.0002;
+        // joint origins in the parent link frame (m)
+        param gimbal_dx = 0.1;
+        param gimbal_dz = -0.05;
+        // floating joint `floating_base`: position, then Euler angles about z (yaw), y (pitch), x (roll);
+        // the orientation is singular at pitch = ±π/2
+        dof floating_base_x = 0.0;
+        dof floating_base_y = 0.0;
+        dof floating_base_z = 0.0;
+        dof floating_base_roll = 0.0;
+        dof floating_base_pitch = 0.0;
+        dof floating_base_yaw = 0.0;
+        dof gimbal = 0.0; // revolute, limits [-1.5, 0.5] rad, effort 1.0 N·m, velocity 3.0 rad/s
+        body base_link { mass = base_link_m; inertia = (base_link_ixx, base_link_iyy, base_link_izz, base_link_ixy, base_link_ixz, base_link_iyz); }
+        body camera { mass = camera_m; inertia = (camera_ixx, camera_iyy, camera_izz); }
+        frame base_link_frame;
+        TOG[base_link_frame] = Tdisp(floating_base_x, floating_base_y, floating_base_z) * Trotz(floating_base_yaw) * Troty(floating_base_pitch) * Trotx(floating_base_roll);
+        TOG[base_link] = TOG[base_link_frame] * Tdisp(base_link_cx, 0, base_link_cz);
+        TOG[camera] = TOG[base_link_frame] * Tdisp(gimbal_dx, 0, gimbal_dz) * Troty(gimbal) * Tdisp(camera_cx, 0, camera_cz);
+        shape base_link: box(0.4, 0.4, 0.06, at = ((-0.01), 0.0, 0.02));
+        gravity(0, 0, -g);
+    }
+}
+}

@@ -352,9 +352,10 @@
 //! Bad descriptions are [`UrdfError`](crate::urdf::UrdfError)s, never a panic: XML that is not
 //! well-formed, a missing element or attribute (with its line), a number that does not parse,
 //! two links or joints of one name, a joint naming an unknown link, a link with two parent
-//! joints, a cycle, none or several root links, a negative mass, a moving link's inertia that no
-//! rigid body has (a negative principal moment, or one larger than the sum of the other two:
-//! what `multibody!` refuses; the ground's links are not checked), a joint type other than the six above, an axis of zero length, a
+//! joints, a cycle, none or several root links, a negative mass, a body's inertia that no rigid
+//! body has (a negative principal moment, or one larger than the sum of the other two: what
+//! `multibody!` refuses; checked on the sum with the links fixed to it, not on the ground's
+//! links), a joint type other than the six above, an axis of zero length, a
 //! mimic of an unknown, fixed or mimicking joint, a joint that moves no mass (M would be
 //! singular), a robot without a moving joint. `examples/urdf.rs` imports a robot, prints its
 //! op counts, then builds and simulates it.

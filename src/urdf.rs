@@ -102,13 +102,21 @@ pub enum UrdfError {
     NegativeMass { link: String, mass: f64 },
     /// An inertia tensor no rigid body has: a negative principal moment (the tensor is not
     /// positive semi-definite), or principal moments that violate the triangle inequality.
+    /// Checked for what moves: a body's tensor about its centre of mass in its link axes,
+    /// links fixed to it included (the ground's links are not checked).
     #[error(
-        "link `{link}`: its inertia (ixx {ixx}, iyy {iyy}, izz {izz}, ixy {ixy}, ixz {ixz}, iyz \
-         {iyz}) is not a rigid body's: {problem}; give the tensor about the centre of mass in \
-         the `<inertial><origin>` axes, its entries those of the tensor (ixy = −∫xy dm)"
+        "link `{link}`{}: its inertia about the centre of mass in the link axes (ixx {ixx}, iyy \
+         {iyy}, izz {izz}, ixy {ixy}, ixz {ixz}, iyz {iyz}) is not a rigid body's: {problem}; \
+         correct the `<inertia>` (about the centre of mass in the `<inertial><origin>` axes, \
+         ixy = −∫xy dm)",
+        if .merged.is_empty() { String::new() } else {
+            format!(" (with {}, fixed to it)", .merged.iter().map(|m| format!("`{m}`")).collect::<Vec<_>>().join(", "))
+        }
     )]
     Inertia {
         link: String,
+        /// the links fixed to it, whose inertias are included
+        merged: Vec<String>,
         ixx: f64,
         iyy: f64,
         izz: f64,
@@ -203,8 +211,12 @@ pub fn import_with(urdf: &str, options: ImportOptions) -> Result<Imported, UrdfE
         message: e.to_string(),
     })?;
     let mut robot = read_robot(&doc)?;
-    let mut tree = Tree::new(&robot)?;
-    if options.floating_base {
+    // the root, if there is exactly one (otherwise the tree's check says what is wrong)
+    let children: HashSet<&str> = robot.joints.iter().map(|j| j.child.as_str()).collect();
+    let roots: Vec<usize> = (0..robot.links.len())
+        .filter(|&i| !children.contains(robot.links[i].name.as_str()))
+        .collect();
+    if let (true, &[root]) = (options.floating_base, roots.as_slice()) {
         let fresh = |wanted: &str, taken: &dyn Fn(&str) -> bool| {
             let mut name = wanted.to_string();
             let mut k = 2;
@@ -224,7 +236,7 @@ pub fn import_with(urdf: &str, options: ImportOptions) -> Result<Imported, UrdfE
                 name: joint,
                 kind: JointKind::Floating,
                 parent: world.clone(),
-                child: robot.links[tree.root].name.clone(),
+                child: robot.links[root].name.clone(),
                 origin: Origin::default(),
                 axis: [1.0, 0.0, 0.0],
                 limit: None,
@@ -236,9 +248,9 @@ pub fn import_with(urdf: &str, options: ImportOptions) -> Result<Imported, UrdfE
             inertial: None,
             visuals: Vec::new(),
         });
-        tree = Tree::new(&robot)?;
     }
-    Ok(Writer::new(&robot, &tree).write())
+    let tree = Tree::new(&robot)?;
+    Writer::new(&robot, &tree).write()
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -839,38 +851,6 @@ impl Tree {
             link_index,
             joint_index,
         };
-        // the links whose mass moves: what `multibody!` accepts (no negative principal moment,
-        // the triangle inequality); the ground's links (the root and what is fixed to it) and
-        // massless links do not enter the dynamics, so their tensors are not checked
-        let mut on_ground = vec![tree.root];
-        let mut k = 0;
-        while k < on_ground.len() {
-            for &j in &tree.children[on_ground[k]] {
-                if robot.joints[j].kind == JointKind::Fixed {
-                    on_ground.push(tree.link_index[&robot.joints[j].child]);
-                }
-            }
-            k += 1;
-        }
-        for (n, l) in robot.links.iter().enumerate() {
-            let Some(i) = &l.inertial else { continue };
-            if i.mass <= 0.0 || on_ground.contains(&n) {
-                continue;
-            }
-            let [ixx, iyy, izz, ixy, ixz, iyz] = i.inertia;
-            if let Some(problem) = crate::inertia::inertia_problem(i.inertia) {
-                return Err(UrdfError::Inertia {
-                    link: l.name.clone(),
-                    ixx,
-                    iyy,
-                    izz,
-                    ixy,
-                    ixz,
-                    iyz,
-                    problem,
-                });
-            }
-        }
         if robot
             .joints
             .iter()
@@ -1160,7 +1140,7 @@ impl<'a> Writer<'a> {
     }
 
     /// Decides which entity holds each link and gathers the merged masses.
-    fn group(&mut self, order: &[(usize, Option<usize>)]) {
+    fn group(&mut self, order: &[(usize, Option<usize>)]) -> Result<(), UrdfError> {
         for &(l, j) in order {
             let Some(j) = j else { continue };
             let joint = &self.robot.joints[j];
@@ -1235,12 +1215,40 @@ impl<'a> Writer<'a> {
             e.mass = mass;
             e.com = com;
             e.inertia = inertia;
+            // what `multibody!` accepts: no negative principal moment, the triangle inequality
+            let t = [
+                inertia[0][0],
+                inertia[1][1],
+                inertia[2][2],
+                inertia[0][1],
+                inertia[0][2],
+                inertia[1][2],
+            ];
+            if let Some(problem) = crate::inertia::inertia_problem(t) {
+                let [ixx, iyy, izz, ixy, ixz, iyz] = t;
+                return Err(UrdfError::Inertia {
+                    link: self.robot.links[e.link].name.clone(),
+                    merged: e.merged[1..]
+                        .iter()
+                        .filter(|(l, _)| mass_of(&self.robot.links[*l]) > 0.0)
+                        .map(|(l, _)| self.robot.links[*l].name.clone())
+                        .collect(),
+                    ixx,
+                    iyy,
+                    izz,
+                    ixy,
+                    ixz,
+                    iyz,
+                    problem,
+                });
+            }
         }
+        Ok(())
     }
 
-    fn write(mut self) -> Imported {
+    fn write(mut self) -> Result<Imported, UrdfError> {
         let order = self.order();
-        self.group(&order);
+        self.group(&order)?;
         let name = camel(&self.robot.name);
         // coordinates first (dofs are declared before the poses that use them)
         for &(_, j) in &order {
@@ -1297,7 +1305,7 @@ impl<'a> Writer<'a> {
         s.push_str(&self.items);
         s.push_str(&self.shapes);
         s.push_str("        gravity(0, 0, -g);\n    }\n");
-        Imported { name, model: s }
+        Ok(Imported { name, model: s })
     }
 
     fn declare_dofs(&mut self, j: usize) {

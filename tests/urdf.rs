@@ -394,7 +394,21 @@ fn bad_descriptions_are_typed_errors_naming_the_culprit() {
         matches!(&e, UrdfError::Inertia { link, problem, .. } if link == "b" && problem.contains("triangle")),
         "{e}"
     );
-    // … unless its mass does not move: the root link is the ground
+    // … unless a link fixed to it makes the sum a rigid body's tensor (as real files need: a
+    // base of 1e-6 everywhere carrying the trunk)
+    let junk = r#"<link name="a"/><link name="b"><inertial><mass value="0.01"/>
+        <inertia ixx="1e-6" iyy="1e-6" izz="1e-6" ixy="1e-6" ixz="1e-6" iyz="1e-6"/></inertial></link>
+        <link name="c"><inertial><mass value="5"/><inertia ixx="0.1" iyy="0.1" izz="0.1"/></inertial></link>"#;
+    let hinge = joint("j", "revolute", "a", "b");
+    let fixed = joint("k", "fixed", "b", "c");
+    assert!(import(&robot(&format!("{junk}{hinge}{fixed}"))).is_ok());
+    let moving = joint("k", "revolute", "b", "c");
+    let e = error(&robot(&format!("{junk}{hinge}{moving}")));
+    assert!(
+        matches!(&e, UrdfError::Inertia { link, merged, .. } if link == "b" && merged.is_empty()),
+        "{e}"
+    );
+    // … or its mass does not move: the root link is the ground
     let root = r#"<link name="a"><inertial><mass value="1"/>
         <inertia ixx="1" iyy="1" izz="3"/></inertial></link>"#;
     let moving = r#"<link name="c"><inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1"/></inertial></link>"#;

@@ -150,7 +150,8 @@ pub enum UrdfError {
     /// No joint moves: there is nothing to simulate.
     #[error(
         "the robot has no joint that moves (every joint is fixed, or there is none): give it a \
-         revolute, continuous, prismatic, floating or planar joint"
+         revolute, continuous, prismatic, floating or planar joint, or free its root link \
+         (`--floating-base`, `ImportOptions::floating_base`)"
     )]
     NoMotion,
     /// A joint that moves no mass: the mass matrix would be singular.

@@ -133,7 +133,7 @@ fn write_package(dir: &Path, snake: &str, name: &str, block: &str) -> Result<(),
     std::fs::create_dir_all(dir.join("src"))
         .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
     let manifest = format!(
-        "[package]\nname = \"{}\"\nversion = \"0.1.0\"\nedition = \"2024\"\npublish = false\n\n\
+        "[package]\nname = \"{}-model\"\nversion = \"0.1.0\"\nedition = \"2024\"\npublish = false\n\n\
          [dependencies]\nmbs = {{ path = {:?} }}\n\n# a package of its own, not a member of an \
          enclosing workspace\n[workspace]\n",
         snake.replace('_', "-"),

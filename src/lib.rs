@@ -44,6 +44,7 @@
 //! | `work_precision` | `mbs::work_precision`, work–precision studies | `plot`, cpu-time |
 //! | `cli` | `mbs::cli`, the per-system programs' command line | `plot`, `anim`, `gltf`, clap, indicatif, cpu-time |
 //! | `expand` | the `mbs` program (`mbs expand`) | mbs-symbolic, syn, prettyplease, clap |
+//! | `urdf` | `mbs::urdf`, URDF robots as `multibody!` source (`mbs import urdf` with `expand`) | roxmltree |
 //!
 //! With `default-features = false` you get [`multibody!`], the runtime ([`Model`], the schemes,
 //! [`simulate`], [`analysis`], CSV and JSON output) and this documentation, nothing else:
@@ -66,6 +67,8 @@ pub mod language;
 pub mod plot;
 #[cfg(feature = "spectral")]
 pub mod spectral;
+#[cfg(feature = "urdf")]
+pub mod urdf;
 #[cfg(feature = "work_precision")]
 pub mod work_precision;
 

@@ -5,6 +5,9 @@
 //! name;`, and the modules of workspace crates it names in `use`), exactly as the macro emits
 //! it, pretty-printed, then a table of operation counts per generated function and the
 //! generation time. Errors are reported with file:line:col, after every model is tried.
+//!
+//! `mbs import urdf FILE.urdf [--floating-base] > model.rs` writes a robot's URDF description
+//! as a `multibody!` block to edit (feature `urdf`; see `mbs::urdf`).
 
 use clap::{Parser, Subcommand};
 use mbs_symbolic::codegen::Generated;
@@ -35,6 +38,26 @@ enum Command {
         #[arg(long)]
         counts_only: bool,
     },
+    /// Write a robot description as a `multibody!` block (on standard output)
+    #[cfg(feature = "urdf")]
+    Import {
+        #[command(subcommand)]
+        format: ImportFormat,
+    },
+}
+
+#[cfg(feature = "urdf")]
+#[derive(Subcommand)]
+enum ImportFormat {
+    /// a URDF file: links, joints, inertias, visuals
+    Urdf {
+        /// the URDF file
+        file: PathBuf,
+        /// free the root link (a floating joint `floating_base` from the ground) instead of
+        /// fixing it to the ground
+        #[arg(long)]
+        floating_base: bool,
+    },
 }
 
 fn main() -> ExitCode {
@@ -56,6 +79,24 @@ fn main() -> ExitCode {
                 ExitCode::FAILURE
             }
         }
+        #[cfg(feature = "urdf")]
+        Command::Import {
+            format:
+                ImportFormat::Urdf {
+                    file,
+                    floating_base,
+                },
+        } => match mbs::urdf::import_file(&file, mbs::urdf::ImportOptions { floating_base }) {
+            Ok(imported) => {
+                let source = file.file_name().unwrap_or(file.as_os_str());
+                print!("{}", imported.block(&source.to_string_lossy()));
+                ExitCode::SUCCESS
+            }
+            Err(e) => {
+                eprintln!("error: {}: {e}", file.display());
+                ExitCode::FAILURE
+            }
+        },
     }
 }
 

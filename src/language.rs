@@ -193,7 +193,7 @@
 //! they share) is a `Trot…` about ±n — a joint, as in `TOG[B] = TOG[A] * Tdisp(…) *
 //! Trotz(q[1]) * …` — θ is the sum of those rotations' angles, here `q[1]`: no trigonometry,
 //! and the spring costs what `generalized_force(q[1], -k * (q[1] - θ0) - c * qd[1])` costs
-//! (a chain of 8 bars with one at each joint: 236 flops for h either way). Otherwise θ is
+//! (a chain of 8 bars with one at each joint: 234 flops for h either way). Otherwise θ is
 //! read from the relative rotation R = R_Aᵀ R_B as atan2(n·vee(R − Rᵀ), tr R − nᵀ R n), the
 //! angle of R when it is a rotation about n (and its twist about n when it is not), in
 //! (−π, π]. Either way the load is the generalised force −(k (θ − θ0) + c θ̇) ∂θ/∂q, the

@@ -9,6 +9,9 @@
 //! Regenerate it with `MBS_BLESS=1 cargo test --release --test urdf`. Bad descriptions give
 //! typed errors naming the link or joint.
 
+#[path = "common/blessed.rs"]
+mod blessed;
+
 mod imported {
     include!("urdf/models.rs");
 }
@@ -51,19 +54,7 @@ fn source() -> String {
 
 #[test]
 fn committed_models_are_current() {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/urdf/models.rs");
-    let text = source();
-    let committed = std::fs::read_to_string(path).unwrap_or_default();
-    if committed != text {
-        if std::env::var_os("MBS_BLESS").is_some() {
-            std::fs::write(path, &text).expect("writing the model file");
-        } else {
-            panic!(
-                "tests/urdf/models.rs is stale: regenerate it with \
-                 `MBS_BLESS=1 cargo test --release --test urdf`"
-            );
-        }
-    }
+    blessed::assert_current("tests/urdf/models.rs", &source(), "urdf");
 }
 
 mbs::multibody! {

@@ -29,7 +29,7 @@
 //! generated kinematics against the old one's (the map's exactness).
 //!
 //! Run with `cargo run --release --example chart_switch` (`-- --switch 0.3` moves the
-//! threshold, `-- --t-end 40` the end).
+//! threshold, `-- --t-end 40` the end, `-- --h 1e-4` generalized-α's step).
 
 use mbs::{Integrator, Simulation};
 use mbs::{Kinematics, Model, Options, Output, Parameters, Scheme, SimError, StepControl};
@@ -245,16 +245,24 @@ impl Run {
     }
 }
 
+/// The run's settings: end, switching threshold on |cos q1|, fixed step of gen-α.
+struct Setup {
+    t_end: f64,
+    switch: f64,
+    h: f64,
+}
+
 fn options(
     scheme: &Scheme,
     t0: f64,
-    t_end: f64,
+    setup: &Setup,
     q: [f64; 3],
     qd: [f64; 3],
     h0: Option<f64>,
 ) -> Options {
+    let t_end = setup.t_end;
     let step = if matches!(scheme, Scheme::GenAlpha(_)) {
-        StepControl::Fixed { h: 1e-3 }
+        StepControl::Fixed { h: setup.h }
     } else {
         StepControl::Adaptive {
             rtol: 1e-10,
@@ -372,14 +380,8 @@ fn max_diff(a: &M3, b: &M3) -> f64 {
 
 /// The tumble from (q, q̇) on ZYX for `t_end`, carried as `variant` says, leaving a chart
 /// when its |cos q1| falls below `switch`.
-fn tumble(
-    scheme: Scheme,
-    q: [f64; 3],
-    qd: [f64; 3],
-    t_end: f64,
-    variant: Variant,
-    switch: f64,
-) -> Run {
+fn tumble(scheme: Scheme, q: [f64; 3], qd: [f64; 3], variant: Variant, setup: &Setup) -> Run {
+    let (t_end, switch) = (setup.t_end, setup.switch);
     let a = Tumble::default();
     let b = TumbleZxy::default();
     let mut c = TumbleRecentred::default();
@@ -405,7 +407,7 @@ fn tumble(
     };
     let (mut t, mut q, mut qd, mut h0, mut on_a) = (0.0, q, qd, None, true);
     loop {
-        let o = options(&scheme, t, t_end, q, qd, h0);
+        let o = options(&scheme, t, setup, q, qd, h0);
         let end = match (variant, on_a) {
             (Variant::Recentred, _) => {
                 segment(c.clone(), scheme, o, threshold, &reference, &mut run)
@@ -455,6 +457,12 @@ fn tumble(
                 run.map_w = run
                     .map_w
                     .max(dw / w.iter().map(|x| x * x).sum::<f64>().sqrt());
+                assert!(
+                    run.map_r < 1e-13 && run.map_w < 1e-13,
+                    "the map between charts is not exact at t = {ts}: R {:.1e}, ω {:.1e}",
+                    run.map_r,
+                    run.map_w
+                );
                 run.switches += 1;
                 run.restarts_at.push(ts);
                 (t, q, qd, h0, on_a) = (ts, qn, qdn, Some(h), !on_a);
@@ -464,16 +472,22 @@ fn tumble(
 }
 
 fn main() {
-    let mut switch = 0.5;
-    let mut t_end = 20.0;
+    let mut setup = Setup {
+        t_end: 20.0,
+        switch: 0.5,
+        h: 1e-3,
+    };
     let args: Vec<String> = std::env::args().skip(1).collect();
     for pair in args.chunks(2) {
         let value = pair.get(1).and_then(|v| v.parse::<f64>().ok());
         match (pair[0].as_str(), value) {
-            ("--switch", Some(v)) if v > 0.0 && v < 1.0 => switch = v,
-            ("--t-end", Some(v)) if v > 0.0 => t_end = v,
+            ("--switch", Some(v)) if v > 0.0 && v < 1.0 => setup.switch = v,
+            ("--t-end", Some(v)) if v > 0.0 => setup.t_end = v,
+            ("--h", Some(v)) if v > 0.0 => setup.h = v,
             _ => {
-                eprintln!("usage: chart_switch [--switch C in (0, 1)] [--t-end T]");
+                eprintln!(
+                    "usage: chart_switch [--switch C in (0, 1)] [--t-end T] [--h H (gen-α's step)]"
+                );
                 std::process::exit(2);
             }
         }
@@ -492,7 +506,8 @@ fn main() {
     }
     println!();
     println!(
-        "tumble, {t_end} s; a chart is left when |cos q1| < {switch}; DOPRI5 and Radau5 at rtol 1e-10, atol 1e-12; gen-alpha (ρ∞ default) at h = 1e-3"
+        "tumble, {} s; a chart is left when |cos q1| < {}; DOPRI5 and Radau5 at rtol 1e-10, atol 1e-12; gen-alpha (ρ∞ default) at h = {}",
+        setup.t_end, setup.switch, setup.h
     );
     let starts = [
         ("MODELS.md start", [0.0, 0.0, 0.0], [1e-3, 0.0, 10.0]),
@@ -508,9 +523,9 @@ fn main() {
             for variant in [Variant::Single, Variant::TwoCharts, Variant::Recentred] {
                 let how = variant.label();
                 // CPU time: the least of `REPEAT` runs (the same run each time)
-                let mut r = tumble(scheme, q, qd, t_end, variant, switch);
+                let mut r = tumble(scheme, q, qd, variant, &setup);
                 for _ in 1..REPEAT {
-                    let again = tumble(scheme, q, qd, t_end, variant, switch);
+                    let again = tumble(scheme, q, qd, variant, &setup);
                     r.cpu = r.cpu.min(again.cpu);
                 }
                 println!(

@@ -23,29 +23,9 @@ use pendulum3::Pendulum3;
 #[path = "common/alloc.rs"]
 mod alloc;
 mod common;
+use common::{fixed, with_method};
 
 const INDEX2: ConstraintMethod = ConstraintMethod::Index2;
-
-fn with_method(base: Options, method: ConstraintMethod) -> Options {
-    Options {
-        output: Output::Last,
-        energy: false,
-        constraints: ConstraintOptions {
-            method,
-            ..Default::default()
-        },
-        ..base
-    }
-}
-
-/// Fixed steps of 1/k with Newton converged well below the errors measured.
-fn fixed(k: u32) -> Options {
-    let mut o = Options::fixed(1.0, 1.0 / k as f64);
-    o.newton.atol = 1e-14;
-    o.newton.rtol = 1e-14;
-    o.newton.max_iterations = 20;
-    o
-}
 
 fn run<M: Model + 'static>(model: M, scheme: Scheme, o: Options) -> (Trajectory, Stats) {
     match simulate(model, scheme, o) {

@@ -16,14 +16,13 @@
 //! invariant ẋ² + ẏ² − λ − y is λ's error and follows it, not rtol; x ẋ + y ẏ follows the
 //! velocity error of the last step.
 
-use mbs::{
-    ConstraintMethod, ConstraintOptions, Options, Output, Scheme, Simulation, Stats, Trajectory,
-    simulate,
-};
+use mbs::{ConstraintMethod, Options, Output, Scheme, Simulation, Stats, Trajectory, simulate};
 use mbs_models::pendulum3;
 use pendulum3::Pendulum3;
 #[path = "common/alloc.rs"]
 mod alloc;
+mod common;
+use common::{fixed, with_method};
 
 /// (x, y, ẋ, ẏ, λ) at t = 1 from `tests/reference/pendulum3.json`.
 fn reference() -> [f64; 5] {
@@ -37,27 +36,6 @@ fn reference() -> [f64; 5] {
     let s = &json["state"];
     let v = |k: &str| s[k].as_f64().unwrap_or_else(|| panic!("state.{k}"));
     [v("x"), v("y"), v("xd"), v("yd"), v("lam")]
-}
-
-fn with_method(base: Options, method: ConstraintMethod) -> Options {
-    Options {
-        output: Output::Last,
-        energy: false,
-        constraints: ConstraintOptions {
-            method,
-            ..Default::default()
-        },
-        ..base
-    }
-}
-
-/// Fixed steps of 1/k with Newton converged well below the errors measured.
-fn fixed(k: u32) -> Options {
-    let mut o = Options::fixed(1.0, 1.0 / k as f64);
-    o.newton.atol = 1e-14;
-    o.newton.rtol = 1e-14;
-    o.newton.max_iterations = 20;
-    o
 }
 
 fn run(scheme: Scheme, o: Options, method: ConstraintMethod) -> ([f64; 5], Stats) {

@@ -1,7 +1,7 @@
 //! Helpers shared by the integration tests: exact solutions and reference data.
 #![allow(dead_code)]
 
-use mbs::{Model, Trajectory};
+use mbs::{ConstraintMethod, ConstraintOptions, Model, Options, Output, Trajectory};
 
 /// The seed2dof system: M = I, K = [[k1 + k2, −k2], [−k2, k2]], q0 = (0, 1), qd0 = 0.
 pub const K1: f64 = 79.15;
@@ -108,4 +108,26 @@ pub fn constraint_residuals<M: Model>(m: &M, t: &Trajectory) -> (f64, f64) {
         }
     }
     (worst, worst_rate)
+}
+
+/// `base` keeping the last sample only, without energy, closing loops with `method`.
+pub fn with_method(base: Options, method: ConstraintMethod) -> Options {
+    Options {
+        output: Output::Last,
+        energy: false,
+        constraints: ConstraintOptions {
+            method,
+            ..Default::default()
+        },
+        ..base
+    }
+}
+
+/// Fixed steps of 1/k over 1 s with Newton converged well below the errors measured.
+pub fn fixed(k: u32) -> Options {
+    let mut o = Options::fixed(1.0, 1.0 / k as f64);
+    o.newton.atol = 1e-14;
+    o.newton.rtol = 1e-14;
+    o.newton.max_iterations = 20;
+    o
 }

@@ -112,6 +112,27 @@ impl Radau {
         }
     }
 
+    /// bv = M r_v: the velocity row's bracket of the constrained estimates (index 3 and 2).
+    pub(super) fn mass_times_rv(&mut self) {
+        let n = self.n;
+        for i in 0..n {
+            self.bv[i] = (0..n).map(|j| self.m[i + n * j] * self.rv[j]).sum();
+        }
+    }
+
+    /// The weighted norm of `err` over (q, qd, λ), the weights taken from the states before
+    /// and after the step (stacked into `y0`, `y1`).
+    pub(super) fn error_with_multipliers(&mut self, cur: &State, next: &State, tol: &Tol) -> f64 {
+        let (n, nc) = (self.n, self.nc);
+        self.y0[..n].copy_from_slice(&cur.q);
+        self.y0[n..2 * n].copy_from_slice(&cur.qd);
+        self.y0[2 * n..].copy_from_slice(&cur.lambda[..nc]);
+        self.y1[..n].copy_from_slice(&next.q);
+        self.y1[n..2 * n].copy_from_slice(&next.qd);
+        self.y1[2 * n..].copy_from_slice(&next.lambda[..nc]);
+        tol.weights.error_norm(&self.err, &self.y0, &self.y1)
+    }
+
     /// Index 3: RADAU5's estimate for the DAE E y' = f(y), y = (q, v, λ), f = (v, h + Bᵀλ,
     /// Φ), with the velocity errors weighted by h and the multipliers' by h² (RADAU5's
     /// scaling of index-2 and index-3 components).
@@ -128,18 +149,10 @@ impl Radau {
         self.embedded_difference(cur, h);
         // the velocity row's bracket M r_v (γ₀h f_v(y₀) = g M qdd₀ with qdd₀, λ₀ consistent);
         // the constraint row's γ₀h Φ(q₀) ≈ 0 (|Φ(q₀)| is within the Newton tolerance)
-        for i in 0..n {
-            self.bv[i] = (0..n).map(|j| self.m[i + n * j] * self.rv[j]).sum();
-        }
+        self.mass_times_rv();
         self.phix.fill(0.0);
         self.filter3(p, g, h);
-        self.y0[..n].copy_from_slice(&cur.q);
-        self.y0[n..2 * n].copy_from_slice(&cur.qd);
-        self.y0[2 * n..].copy_from_slice(&cur.lambda[..nc]);
-        self.y1[..n].copy_from_slice(&next.q);
-        self.y1[n..2 * n].copy_from_slice(&next.qd);
-        self.y1[2 * n..].copy_from_slice(&next.lambda[..nc]);
-        let mut err = tol.weights.error_norm(&self.err, &self.y0, &self.y1);
+        let mut err = self.error_with_multipliers(cur, next, tol);
         if err >= 1.0 && (self.first || self.reject) {
             // RADAU5: f(y₀ + err) in place of f(y₀); its velocity row, less M qdd₀, is
             // −(τ(q₀ + e_q, v₀ + e_v, qdd₀) − Bᵀ(λ₀ + e_λ)) up to O(e_q) terms

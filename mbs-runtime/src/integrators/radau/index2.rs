@@ -126,20 +126,12 @@ impl Radau {
                     .map(|j| self.k.db[j] * self.bmu[j * n + r])
                     .sum::<f64>();
         }
-        for i in 0..n {
-            self.bv[i] = (0..n).map(|j| self.m[i + n * j] * self.rv[j]).sum();
-        }
+        self.mass_times_rv();
         // γ₀h Φ(q₀) and γ₀h Φ̇(q₀, v₀): below the constraint tolerance, taken as 0
         self.phix.fill(0.0);
         self.psix.fill(0.0);
         self.filter2(p, g, h);
-        self.y0[..n].copy_from_slice(&cur.q);
-        self.y0[n..2 * n].copy_from_slice(&cur.qd);
-        self.y0[2 * n..].copy_from_slice(&cur.lambda[..nc]);
-        self.y1[..n].copy_from_slice(&next.q);
-        self.y1[n..2 * n].copy_from_slice(&next.qd);
-        self.y1[2 * n..].copy_from_slice(&next.lambda[..nc]);
-        let mut err = tol.weights.error_norm(&self.err, &self.y0, &self.y1);
+        let mut err = self.error_with_multipliers(cur, next, tol);
         if err >= 1.0 && (self.first || self.reject) {
             // RADAU5: f(y₀ + err) in place of f(y₀); its position row less f_q(y₀) is
             // e_v + B₀ᵀe_μ (e_μ still in `tmp`)

@@ -27,6 +27,10 @@ use std::collections::{HashMap, HashSet};
 use std::fmt::Write as _;
 use std::path::Path;
 
+// the edit distance of `multibody!`'s suggestions, shared as `op_count.rs` is
+#[path = "../mbs-symbolic/src/dsl/edit_distance.rs"]
+mod edit_distance;
+
 /// What is wrong with a URDF description. Each message names the link or joint and the fix.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum UrdfError {
@@ -683,22 +687,8 @@ struct Tree {
 }
 
 fn did_you_mean<'a>(name: &str, candidates: impl Iterator<Item = &'a str>) -> String {
-    let distance = |a: &str, b: &str| {
-        let b: Vec<char> = b.chars().collect();
-        let mut prev: Vec<usize> = (0..=b.len()).collect();
-        for (i, ca) in a.chars().enumerate() {
-            let mut cur = vec![i + 1; b.len() + 1];
-            for (j, &cb) in b.iter().enumerate() {
-                cur[j + 1] = (prev[j] + usize::from(ca != cb))
-                    .min(prev[j + 1] + 1)
-                    .min(cur[j] + 1);
-            }
-            prev = cur;
-        }
-        prev[b.len()]
-    };
     candidates
-        .map(|c| (distance(name, c), c))
+        .map(|c| (edit_distance::distance(name, c), c))
         .filter(|(d, c)| *d <= (name.len().max(c.len()) / 3).max(1))
         .min()
         .map(|(_, c)| format!("; did you mean `{c}`?"))

@@ -4,6 +4,7 @@
 
 pub mod ast;
 pub mod check;
+pub mod edit_distance;
 pub mod names;
 pub mod parse;
 pub mod repeat;

@@ -523,6 +523,14 @@ impl<M: Model, E: Efforts> Model for WithEfforts<M, E> {
     fn user_evaluations(&self) -> usize {
         self.evaluations.get()
     }
+
+    fn chart(&self, joint: usize) -> [[f64; 3]; 3] {
+        self.model.chart(joint)
+    }
+
+    fn set_chart(&mut self, joint: usize, r: [[f64; 3]; 3]) {
+        self.model.set_chart(joint, r);
+    }
 }
 
 /// An n × n matrix into the top-left of a big × big one, `diag` on the rest of the diagonal

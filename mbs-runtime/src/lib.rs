@@ -35,8 +35,8 @@ pub use integrators::{
     simulate_with,
 };
 pub use model::{
-    Energy, FrameKinematics, Kinematics, Model, ModelInfo, OpCount, OpsTable, Parameters,
-    PointKinematics, Pose, ShapeInfo, ShapeKind,
+    Energy, FrameKinematics, IDENTITY3, Kinematics, Model, ModelInfo, OpCount, OpsTable,
+    Parameters, PointKinematics, Pose, RotationJoint, ShapeInfo, ShapeKind,
 };
 /// The matrices of [`Linearization`] (nalgebra's), named without a dependency of one's own.
 pub use nalgebra::DMatrix;

@@ -59,7 +59,31 @@ pub struct ModelInfo {
     /// what to draw: the declared `shape` statements in order, then one default shape for
     /// each body that declares none (its equivalent box, `declared: false`)
     pub shapes: &'static [ShapeInfo],
+    /// the joints written `Tball(…)` or `Tfree(…)`, in declaration order: their orientation
+    /// is read in a chart the runtime moves ([`Model::chart`])
+    pub rotation_joints: &'static [RotationJoint],
 }
+
+/// A spherical (`Tball(a, b, c)`) or free (`Tfree(x, y, z, a, b, c)`) joint. Its rotation is
+/// `R_ref · Rz(a) · Ry(b) · Rx(c)` relative to the frame before it, where `R_ref`, the chart,
+/// is a rotation matrix the model holds at run time ([`Model::chart`]) and (a, b, c) are ZYX
+/// angles, singular where cos b = 0. The runtime keeps |cos b| away from 0 by re-centring:
+/// it sets `R_ref` to the joint's current rotation and the angles to zero, which changes
+/// neither the motion nor M's conditioning elsewhere.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct RotationJoint {
+    /// the frame (body) the joint moves: an index into [`ModelInfo::frames`]
+    pub frame: usize,
+    /// the coordinates of a, b and c (indices into q)
+    pub angles: [usize; 3],
+    /// `Tfree`: the coordinates of the translation (x, y, z), along the axes of the frame
+    /// before the joint, in front of the chart (so a re-centring leaves them unchanged);
+    /// `None` for `Tball`
+    pub translation: Option<[usize; 3]>,
+}
+
+/// The identity rotation, the chart of every rotation joint when a model is built.
+pub const IDENTITY3: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 
 /// A shape drawn with a body or frame (or the ground): a DSL `shape` statement, or the
 /// default of a body that declares none. Lengths in the model's units, in the axes of the
@@ -405,5 +429,20 @@ pub trait Model {
     /// Evaluations of user code so far (efforts written in Rust and their differences).
     fn user_evaluations(&self) -> usize {
         0
+    }
+
+    /// The chart of rotation joint `joint` ([`ModelInfo::rotation_joints`]): the reference
+    /// rotation `R_ref` (`r[i][j]`: row i, column j) its angles are measured from. The
+    /// identity when the model is built, and for models without rotation joints.
+    fn chart(&self, joint: usize) -> [[f64; 3]; 3] {
+        let _ = joint;
+        IDENTITY3
+    }
+
+    /// Moves the chart of rotation joint `joint` to `r` (a rotation matrix; the caller maps
+    /// the joint's angles and rates so the motion does not change). Models without rotation
+    /// joints ignore it.
+    fn set_chart(&mut self, joint: usize, r: [[f64; 3]; 3]) {
+        let _ = (joint, r);
     }
 }

@@ -607,7 +607,7 @@ fn emit_scene(
     }
     let pty = format!("{}Params", sys.name);
     let info = format!(
-        "static INFO: ::mbs::ModelInfo = ::mbs::ModelInfo {{ name: {name:?}, scene: {scene:?}, dofs: {dofs}, inputs: {inputs}, frames: {frames}, is_body: &[{is_body}], points: {points}, params: {params}, effects: {effects}, constraints: {constraints}, independent: &[{independent}], formulation: {form:?}, has_tangents: {tan}, ops: &[{ops}], shapes: {shapes} }};",
+        "static INFO: ::mbs::ModelInfo = ::mbs::ModelInfo {{ name: {name:?}, scene: {scene:?}, dofs: {dofs}, inputs: {inputs}, frames: {frames}, is_body: &[{is_body}], points: {points}, params: {params}, effects: {effects}, constraints: {constraints}, independent: &[{independent}], formulation: {form:?}, has_tangents: {tan}, ops: &[{ops}], shapes: {shapes}, rotation_joints: &[] }};",
         name = ty,
         scene = scene_name,
         dofs = str_list(sys.dofs.iter().map(|d| d.name.clone())),

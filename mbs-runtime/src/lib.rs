@@ -12,6 +12,7 @@
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod analysis;
+pub mod charts;
 pub mod efforts;
 pub mod elements;
 pub mod error;

@@ -445,6 +445,14 @@ pub struct Options {
     /// the spread of its inertia)
     #[serde(default = "default_singularity_tol")]
     pub singularity_tol: f64,
+    /// re-centre the chart of a rotation joint (`Tball`, `Tfree`: ZYX angles a, b, c read in a
+    /// chart the model holds) when |cos b| falls below this after an accepted step (default
+    /// 0.5, b at ±60°; 0 never re-centres, and the joint stops at gimbal lock like any Euler
+    /// angles): the chart moves to the joint's current rotation and its angles to zero,
+    /// rates and accelerations mapped exactly, the scheme keeping its step (see
+    /// [`crate::charts`]). Models without rotation joints ignore it
+    #[serde(default = "default_chart_switch")]
+    pub chart_switch: f64,
     /// record the poses of every body and frame at each output (default false)
     pub frames: bool,
     /// record kinetic and potential energy at each output (default true)
@@ -469,6 +477,7 @@ impl Default for Options {
             iteration_matrix: IterationMatrix::default(),
             stability_check: true,
             singularity_tol: default_singularity_tol(),
+            chart_switch: default_chart_switch(),
             frames: false,
             energy: true,
             constraints: ConstraintOptions::default(),
@@ -478,6 +487,10 @@ impl Default for Options {
 
 fn default_singularity_tol() -> f64 {
     1e-4
+}
+
+fn default_chart_switch() -> f64 {
+    0.5
 }
 
 fn invalid(name: &'static str, value: impl ToString, reason: &'static str) -> Failure {
@@ -642,6 +655,13 @@ impl Options {
                 "singularity_tol",
                 self.singularity_tol,
                 "must be in [0, 1) (0 disables the check)",
+            ));
+        }
+        if !(0.0..1.0).contains(&self.chart_switch) {
+            return Err(invalid(
+                "chart_switch",
+                self.chart_switch,
+                "must be in [0, 1): the |cos b| of a rotation joint below which its chart is re-centred (0 never re-centres)",
             ));
         }
         if self.max_steps == 0 {

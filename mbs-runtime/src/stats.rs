@@ -30,6 +30,8 @@ pub struct Stats {
     pub repartitions: usize,
     /// calls of sampled controllers
     pub samples: usize,
+    /// re-centrings of the charts of rotation joints (`Options::chart_switch`)
+    pub chart_switches: usize,
     /// evaluations of user efforts (none yet: reserved for user force hooks)
     pub user_efforts: usize,
     /// evaluations of energy (for outputs)
@@ -136,6 +138,13 @@ impl fmt::Display for Stats {
         )?;
         if self.samples > 0 {
             writeln!(f, "controllers: {} samples", self.samples)?;
+        }
+        if self.chart_switches > 0 {
+            writeln!(
+                f,
+                "rotation joints: {} re-centrings of their charts",
+                self.chart_switches
+            )?;
         }
         if self.constraints > 0 {
             writeln!(

@@ -26,6 +26,21 @@ pub struct Trajectory {
     /// its gradient
     #[serde(default)]
     pub lambda_data: Vec<f64>,
+    /// the rotation joints (`Tball`, `Tfree`), each named by the frame it moves
+    #[serde(default)]
+    pub joint_names: Vec<String>,
+    /// per output, per rotation joint: its rotation relative to the frame before it, a unit
+    /// quaternion `[x, y, z, w]` whose sign is continuous from one output to the next (the
+    /// orientation without charts: its angles among q jump where the chart is re-centred)
+    #[serde(default)]
+    pub orientation_data: Vec<f64>,
+    /// per output, per rotation joint: the number of the chart its angles are read in, an
+    /// index into `charts[joint]` (0 is the model's chart at the start)
+    #[serde(default)]
+    pub chart_data: Vec<u32>,
+    /// per rotation joint, every chart it has used, in order, as quaternions `[x, y, z, w]`
+    #[serde(default)]
+    pub charts: Vec<Vec<[f64; 4]>>,
     /// energy at each output (empty when not recorded)
     pub energy: Vec<Energy>,
     /// poses of every frame at each output (empty when not recorded)
@@ -102,6 +117,34 @@ impl Trajectory {
         Some((0..self.len()).map(|i| self.lambda(i)[k]).collect())
     }
 
+    /// The rotation of every rotation joint at output `i`, 4 numbers `[x, y, z, w]` each.
+    pub fn orientation(&self, i: usize) -> &[f64] {
+        let n = 4 * self.joint_names.len();
+        &self.orientation_data[i * n..(i + 1) * n]
+    }
+
+    /// The chart of rotation joint `joint` at output `i` as a rotation matrix (rows): the
+    /// rotation its angles are measured from, `R = chart · Rz(a) · Ry(b) · Rx(c)`.
+    pub fn chart(&self, i: usize, joint: usize) -> [[f64; 3]; 3] {
+        let k = self.chart_data[i * self.joint_names.len() + joint] as usize;
+        let [x, y, z, w] = self.charts[joint][k];
+        let q = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(w, x, y, z));
+        crate::charts::array(q.to_rotation_matrix().matrix())
+    }
+
+    /// The chart numbers of every rotation joint at output `i` (indices into `charts`).
+    pub fn chart_numbers(&self, i: usize) -> &[u32] {
+        let n = self.joint_names.len();
+        &self.chart_data[i * n..(i + 1) * n]
+    }
+
+    /// Records the rotation joints of the output just pushed: their orientations (4 numbers
+    /// each) and chart numbers.
+    pub(crate) fn push_joints(&mut self, orientation: &[f64], charts: &[u32]) {
+        self.orientation_data.extend_from_slice(orientation);
+        self.chart_data.extend_from_slice(charts);
+    }
+
     /// Poses of every frame at output `i` (empty unless recorded).
     pub fn poses_at(&self, i: usize) -> &[Pose] {
         let n = self.frame_names.len();
@@ -163,7 +206,9 @@ impl Trajectory {
 
     /// CSV with a header of named columns: `t`, then per coordinate its name (`q[0]`, or the
     /// DSL name such as `knee`), then `qd[…]` and `qdd[…]` per coordinate as the DSL writes
-    /// them (`qd[0]`, `qd[knee]`), then `NAME.lambda` per constraint, then `kinetic, potential,
+    /// them (`qd[0]`, `qd[knee]`), then `NAME.lambda` per constraint, then per rotation joint
+    /// `FRAME.qx, FRAME.qy, FRAME.qz, FRAME.qw` (its rotation, a quaternion continuous
+    /// across re-centrings) and `FRAME.chart` (the chart number), then `kinetic, potential,
     /// total` when energy was recorded. [`CsvWriter`] writes the same file as outputs come.
     pub fn write_csv(&self, w: impl Write) -> io::Result<()> {
         let mut csv = CsvWriter::new(w);
@@ -178,6 +223,8 @@ impl Trajectory {
         self.qd_data.clear();
         self.qdd_data.clear();
         self.lambda_data.clear();
+        self.orientation_data.clear();
+        self.chart_data.clear();
         self.energy.clear();
         self.poses.clear();
     }
@@ -192,6 +239,12 @@ impl Trajectory {
             from.qdd(i),
             from.lambda(i),
         );
+        if !from.joint_names.is_empty() {
+            self.push_joints(from.orientation(i), from.chart_numbers(i));
+            if self.charts.len() < from.charts.len() {
+                self.charts = from.charts.clone();
+            }
+        }
         if from.energy.len() == from.len() {
             self.energy.push(from.energy[i]);
         }
@@ -255,6 +308,9 @@ impl<W: Write> CsvWriter<W> {
             {
                 write!(w, ",{v:e}")?;
             }
+            for (o, c) in tr.orientation(i).chunks(4).zip(tr.chart_numbers(i)) {
+                write!(w, ",{:e},{:e},{:e},{:e},{c}", o[0], o[1], o[2], o[3])?;
+            }
             if with_energy {
                 let e = tr.energy.get(i).copied().unwrap_or(Energy {
                     kinetic: f64::NAN,
@@ -293,6 +349,11 @@ impl<W: Write> CsvWriter<W> {
         }
         for name in &tr.constraint_names {
             header.push(format!("{name}.lambda"));
+        }
+        for name in &tr.joint_names {
+            for c in ["qx", "qy", "qz", "qw", "chart"] {
+                header.push(format!("{name}.{c}"));
+            }
         }
         if with_energy {
             header.extend(["kinetic", "potential", "total"].map(String::from));

@@ -244,6 +244,7 @@ fn validate(&self) -> ::core::result::Result<(), ::mbs::ParamError> {{ {never} }
         nframes,
         npoints,
         nc: 0,
+        charts: 0,
     };
     for ty in scenes {
         code.push_str(&format!(

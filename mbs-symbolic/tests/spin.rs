@@ -189,6 +189,7 @@ fn same_equations(fast: &SymbolicModel, slow: &SymbolicModel) {
                 params: &pf,
                 u: &[],
                 lambda: &[],
+                charts: &[],
             };
             let es = SliceEnv {
                 t,
@@ -198,6 +199,7 @@ fn same_equations(fast: &SymbolicModel, slow: &SymbolicModel) {
                 params: &ps,
                 u: &[],
                 lambda: &[],
+                charts: &[],
             };
             let (f, s) = (&mf.scenes[0], &ms.scenes[0]);
             let pairs: Vec<(Vec<ExprId>, Vec<ExprId>)> = vec![

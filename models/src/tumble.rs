@@ -1,6 +1,7 @@
 //! tumble (`tests/reference/MODELS.md`): a free rigid body spinning about its intermediate
-//! axis, on ZYX Euler angles ([`Tumble`], MODELS.md's) and on XYZ angles ([`TumbleXyz`]),
-//! which every flip drives through their singularity.
+//! axis, on ZYX Euler angles ([`Tumble`], MODELS.md's), on XYZ angles ([`TumbleXyz`]), which
+//! every flip drives through their singularity, and on a spherical joint ([`TumbleBall`]),
+//! which runs through every orientation.
 
 mbs::multibody! {
     /// tumble (MODELS.md): a free rigid body, 0.12 kg, principal inertias (1.7231e-4, 6.58e-6,
@@ -29,5 +30,19 @@ mbs::multibody! {
         option tangents;
         body b { mass = 0.12; inertia = (1.7231e-4, 6.58e-6, 1.7243e-4); }
         TOG[b] = Trotx(q[0]) * Troty(q[1]) * Trotz(q[2]);
+    }
+}
+
+mbs::multibody! {
+    /// tumble's body and spin on a spherical joint (`Tball`): ZYX angles read in a chart the
+    /// runtime re-centres before gimbal lock, so the flips never stop the run. The same start
+    /// as [`Tumble`] (the chart starts at the identity).
+    pub model TumbleBall {
+        dof q[0] = 0.0, qd = 1e-3;
+        dof q[1] = 0.0;
+        dof q[2] = 0.0, qd = 10.0;
+        option tangents;
+        body b { mass = 0.12; inertia = (1.7231e-4, 6.58e-6, 1.7243e-4); }
+        TOG[b] = Tball(q[0], q[1], q[2]);
     }
 }

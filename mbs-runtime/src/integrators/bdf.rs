@@ -108,6 +108,7 @@ use super::newton::AccelNewton;
 use super::problem::Problem;
 use super::step_control::{elementary_factor, optimal_factor};
 use super::{Attempt, Control, State, Step, Stepper};
+use crate::charts::Recentring;
 use crate::error::Failure;
 use crate::linalg::{cholesky, cholesky_solve};
 use crate::model::Model;
@@ -369,6 +370,19 @@ impl<M: Model> Stepper<M> for Bdf {
         self.spectrum.forget();
         self.drop_votes = 0;
         Ok(())
+    }
+
+    /// The history is of the old chart: BDF starts again at order 1 (as after a sample),
+    /// with fresh matrices.
+    fn rechart(
+        &mut self,
+        p: &mut Problem<M>,
+        s: &State,
+        ctl: &Control,
+        _moved: &[Recentring],
+    ) -> Result<(), Failure> {
+        self.newton.forget();
+        self.start(p, s, ctl)
     }
 
     fn attempt(&mut self, step: Step<'_, M>) -> Result<Attempt, Failure> {

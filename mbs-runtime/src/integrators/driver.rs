@@ -11,6 +11,7 @@ use super::sim_error::SimError;
 use super::step_control::{StepBounds, Tolerances, initial_step};
 use super::stepper::{Attempt, Control, Step, Stepper};
 use super::{Integrator, State};
+use crate::charts::{self, Recentring};
 use crate::error::Failure;
 use crate::model::{Model, Pose};
 use crate::options::{Options, Output, Scheme, StepControl};
@@ -64,6 +65,12 @@ pub struct Simulation<M: Model> {
     assembly: Option<Assembly>,
     /// sampled controllers: period, samples taken, the controller
     controllers: Vec<(f64, u64, Box<dyn Controller>)>,
+    /// rotation joints: the re-centrings of the last accepted step, each joint's chart
+    /// number and last recorded quaternion, and a buffer of orientations to record
+    moved: Vec<Recentring>,
+    chart_numbers: Vec<u32>,
+    last_quaternion: Vec<Option<[f64; 4]>>,
+    orientations: Vec<f64>,
 }
 
 impl<M: Model + 'static> Simulation<M> {
@@ -129,6 +136,10 @@ impl<M: Model + 'static> Simulation<M> {
         };
         let out_times = output_times(&options);
         let mut traj = names.trajectory();
+        let joints = problem.model.info().rotation_joints;
+        traj.charts = (0..joints.len())
+            .map(|j| vec![chart_quaternion(&problem.model.chart(j))])
+            .collect();
         let expected = match &options.output {
             Output::Steps => 1024,
             Output::Last => 1,
@@ -155,6 +166,10 @@ impl<M: Model + 'static> Simulation<M> {
             options,
             assembly,
             controllers,
+            moved: Vec::with_capacity(joints.len()),
+            chart_numbers: vec![0; joints.len()],
+            last_quaternion: vec![None; joints.len()],
+            orientations: Vec::with_capacity(4 * joints.len()),
         };
         sim.outputs_at_start();
         Ok(sim)
@@ -231,6 +246,19 @@ impl<M: Model + 'static> Simulation<M> {
 
     fn record(&mut self, s: &State) {
         self.traj.push(s.t, &s.q, &s.qd, &s.qdd, &s.lambda);
+        let model = &self.problem.model;
+        let joints = model.info().rotation_joints;
+        if !joints.is_empty() {
+            self.orientations.clear();
+            for (j, joint) in joints.iter().enumerate() {
+                let u = charts::joint_rotation(&model.chart(j), joint, &s.q);
+                let x = charts::quaternion_near(&u, self.last_quaternion[j]);
+                self.last_quaternion[j] = Some(x);
+                self.orientations.extend_from_slice(&x);
+            }
+            self.traj
+                .push_joints(&self.orientations, &self.chart_numbers);
+        }
         if self.options.energy {
             let e = self.problem.energy(s.t, &s.q, &s.qd);
             self.traj.energy.push(e);
@@ -284,6 +312,36 @@ impl<M: Model + 'static> Simulation<M> {
                 }
             }
         }
+    }
+
+    /// After an accepted step: re-centres the charts of the rotation joints whose |cos b|
+    /// fell below `Options::chart_switch`, maps the state (its accelerations too) and lets
+    /// the scheme carry on from it with its step.
+    fn recentre(&mut self) -> Result<(), Failure> {
+        let threshold = self.options.chart_switch;
+        if threshold == 0.0 || self.chart_numbers.is_empty() {
+            return Ok(());
+        }
+        let cur = &mut self.cur;
+        charts::recentre_below(
+            &mut self.problem.model,
+            threshold,
+            &mut cur.q,
+            &mut cur.qd,
+            Some(&mut cur.qdd),
+            &mut self.moved,
+        );
+        if self.moved.is_empty() {
+            return Ok(());
+        }
+        for r in &self.moved {
+            self.traj.charts[r.joint].push(chart_quaternion(&r.chart));
+            self.chart_numbers[r.joint] = (self.traj.charts[r.joint].len() - 1) as u32;
+        }
+        self.problem.stats.chart_switches += self.moved.len();
+        self.problem.chart_changed();
+        self.stepper
+            .rechart(&mut self.problem, &self.cur, &self.ctl, &self.moved)
     }
 
     /// The next sample instant of any controller (infinite without).
@@ -395,6 +453,9 @@ impl<M: Model + 'static> Simulation<M> {
                     self.stepper
                         .accepted(&mut self.problem, &self.prev, &self.cur);
                     self.outputs_after_step();
+                    if let Err(kind) = self.recentre() {
+                        return Err(self.fail(kind, h));
+                    }
                     if self.cur.t == t_stop && !self.controllers.is_empty() {
                         if let Err(kind) = self.sample() {
                             return Err(self.fail(kind, h));
@@ -495,6 +556,8 @@ struct Names {
     dofs: Vec<String>,
     frames: Vec<String>,
     constraints: Vec<String>,
+    /// rotation joints, by the frame each moves
+    joints: Vec<String>,
 }
 
 impl Names {
@@ -505,15 +568,22 @@ impl Names {
             dofs: own(info.dofs),
             frames: own(info.frames),
             constraints: own(info.constraints),
+            joints: info
+                .rotation_joints
+                .iter()
+                .map(|j| info.frames[j.frame].to_string())
+                .collect(),
         }
     }
 
     fn trajectory(&self) -> Trajectory {
-        Trajectory::new(
+        let mut t = Trajectory::new(
             self.dofs.clone(),
             self.frames.clone(),
             self.constraints.clone(),
-        )
+        );
+        t.joint_names = self.joints.clone();
+        t
     }
 
     /// A failure before the first step: at t₀, with an empty trajectory.
@@ -575,7 +645,27 @@ fn initial_state<M: Model>(
         cur.qd.copy_from_slice(qd0);
     }
     problem.check("q0", &cur.q)?;
-    problem.check("qd0", &cur.qd)
+    problem.check("qd0", &cur.qd)?;
+    // a rotation joint that starts near gimbal lock starts in a chart centred on it
+    if options.chart_switch > 0.0 {
+        let mut moved = Vec::new();
+        charts::recentre_below(
+            &mut problem.model,
+            options.chart_switch,
+            &mut cur.q,
+            &mut cur.qd,
+            None,
+            &mut moved,
+        );
+        problem.stats.chart_switches += moved.len();
+    }
+    Ok(())
+}
+
+/// A chart (rows of a rotation matrix) as a quaternion `[x, y, z, w]`, w ≥ 0.
+fn chart_quaternion(c: &[[f64; 3]; 3]) -> [f64; 4] {
+    let m = nalgebra::Matrix3::from_fn(|r, k| c[r][k]);
+    charts::quaternion_near(&nalgebra::UnitQuaternion::from_matrix(&m), None)
 }
 
 /// A constrained model: the constraint method, the assembly of q₀ and qd₀, the partition

@@ -10,6 +10,7 @@ use super::at::{Affine, Weights};
 use super::newton::AccelNewton;
 use super::problem::Problem;
 use super::{Attempt, Control, State, Step, Stepper};
+use crate::charts::Recentring;
 use crate::error::Failure;
 use crate::model::Model;
 
@@ -38,6 +39,17 @@ impl<M: Model> Stepper<M> for Midpoint {
     fn start(&mut self, _p: &mut Problem<M>, s: &State, _ctl: &Control) -> Result<(), Failure> {
         self.a.copy_from_slice(&s.qdd);
         Ok(())
+    }
+
+    fn rechart(
+        &mut self,
+        p: &mut Problem<M>,
+        s: &State,
+        ctl: &Control,
+        _moved: &[Recentring],
+    ) -> Result<(), Failure> {
+        self.newton.forget();
+        self.start(p, s, ctl)
     }
 
     fn attempt(&mut self, step: Step<'_, M>) -> Result<Attempt, Failure> {

@@ -107,6 +107,7 @@ use super::newton::{AccelNewton, NewtonTol};
 use super::problem::{Loops, Problem};
 use super::step_control::next_step;
 use super::{Attempt, Control, State, Step, Stepper};
+use crate::charts::Recentring;
 use crate::error::Failure;
 use crate::model::Model;
 use crate::options::{GenAlphaParams, HhtParams, NewmarkParams};
@@ -229,6 +230,23 @@ impl<M: Model> Stepper<M> for AlphaFamily {
                 self.lam = vec![0.0; c.nc];
             }
         }
+        Ok(())
+    }
+
+    /// The auxiliary acceleration is mapped as an acceleration; the velocities' estimate
+    /// starts again (its last acceleration is of another configuration).
+    fn rechart(
+        &mut self,
+        _p: &mut Problem<M>,
+        _s: &State,
+        _ctl: &Control,
+        moved: &[Recentring],
+    ) -> Result<(), Failure> {
+        for r in moved {
+            r.map_acceleration(&mut self.a);
+        }
+        self.h_prev = None;
+        self.newton.forget();
         Ok(())
     }
 

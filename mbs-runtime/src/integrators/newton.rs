@@ -154,6 +154,12 @@ impl AccelNewton {
         self.enable(nc, false, scaled, tol_phi);
     }
 
+    /// Drops the factorised matrix: the next solve makes a fresh one (a rotation joint's
+    /// chart moved, so the coordinates mean another configuration).
+    pub fn forget(&mut self) {
+        self.valid = false;
+    }
+
     /// Solves the stabilized index-2 step for (a, λ, ν) from now on (see the module notes):
     /// as [`AccelNewton::enable_index3`], with Φ̇ = 0 too. Each step's B₀ is set by
     /// [`AccelNewton::index2_start`].

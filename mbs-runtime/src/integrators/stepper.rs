@@ -5,6 +5,7 @@ use super::State;
 use super::newton::NewtonTol;
 use super::problem::Problem;
 use super::step_control::Tolerances;
+use crate::charts::Recentring;
 use crate::error::Failure;
 use crate::model::Model;
 use crate::stats::ErrorTest;
@@ -56,6 +57,20 @@ pub(crate) trait Stepper<M: Model> {
     /// The components the local error test measures with adaptive steps (after `start`).
     fn error_test(&self, _p: &Problem<M>) -> ErrorTest {
         ErrorTest::PositionsVelocities
+    }
+    /// Called after the driver re-centred the charts of rotation joints at the accepted
+    /// state `s` (`moved` says which, and maps accelerations of the old charts into the new
+    /// ones). The step size stays the driver's; by default the scheme starts again from `s`.
+    /// A scheme that keeps matrices or history in the coordinates drops or maps them.
+    fn rechart(
+        &mut self,
+        p: &mut Problem<M>,
+        s: &State,
+        ctl: &Control,
+        moved: &[Recentring],
+    ) -> Result<(), Failure> {
+        let _ = moved;
+        self.start(p, s, ctl)
     }
     /// Called once the driver has accepted the step from `prev` to `cur`.
     fn accepted(&mut self, _p: &mut Problem<M>, _prev: &State, _cur: &State) {}

@@ -128,6 +128,9 @@ pub struct Sizes {
     pub nframes: usize,
     pub npoints: usize,
     pub nc: usize,
+    /// rotation joints: when there are any, the model overrides `chart` and `set_chart`,
+    /// reading and writing its field `charts`
+    pub charts: usize,
 }
 
 /// `impl ::mbs::Model for {ty}` with parameter struct `pty`: the constants, then every method
@@ -144,6 +147,7 @@ pub fn model_impl(
         nframes,
         npoints,
         nc,
+        charts,
     } = sizes;
     let mut s = format!(
         "impl ::mbs::Model for {ty} {{
@@ -169,6 +173,12 @@ const NC: usize = {nc};
             m.receiver,
             body(m)
         ));
+    }
+    if *charts > 0 {
+        s.push_str(
+            "fn chart(&self, joint: usize) -> [[f64; 3]; 3] {\nself.charts[joint]\n}\n\
+             fn set_chart(&mut self, joint: usize, r: [[f64; 3]; 3]) {\nself.charts[joint] = r;\n}\n",
+        );
     }
     s.push_str("}\n");
     s

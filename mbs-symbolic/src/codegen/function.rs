@@ -12,6 +12,9 @@ pub struct RustNames<'a> {
     pub params: &'a [ParamDef],
     /// path of the parameter struct: `self.params` in models, `self` in the parameter struct
     pub params_path: &'a str,
+    /// path of the charts of rotation joints (`[[[f64; 3]; 3]; K]`): `self.charts` in models,
+    /// the argument `charts` of the constraint functions on the parameter struct
+    pub charts_path: &'a str,
 }
 
 impl Naming for RustNames<'_> {
@@ -24,6 +27,7 @@ impl Naming for RustNames<'_> {
             Var::Param(i) => format!("p_{}", self.params[i as usize].name),
             Var::Input(i) => format!("u_{i}"),
             Var::Lambda(i) => format!("lambda_{i}"),
+            Var::Chart(i) => format!("r_{i}"),
         }
     }
 
@@ -39,6 +43,10 @@ impl Naming for RustNames<'_> {
             }
             Var::Input(i) => format!("let u_{i} = u[{i}];"),
             Var::Lambda(i) => format!("let lambda_{i} = lambda[{i}];"),
+            Var::Chart(i) => {
+                let (j, r, c) = (i / 9, i % 9 / 3, i % 3);
+                format!("let r_{i} = {}[{j}][{r}][{c}];", self.charts_path)
+            }
         }
     }
 }

@@ -289,22 +289,25 @@ fn emit_params(
     let names = RustNames {
         params: &sys.params,
         params_path: "self",
+        charts_path: "charts",
     };
     let mut derived = collect(emit_fn(a, &spec, &names), missing, |s, _| s).unwrap_or_default();
     // the constraints are the same in every scene: emitted once, here
+    // ... and read the charts of rotation joints, which the models hold, as an argument
     let c = &model.constraints;
-    let mut specs = vec![FnSpec::new("__constraints", args("constraints"))];
+    let with_charts = |name: &str| format!("charts: &[[[f64; 3]; 3]], {}", args(name));
+    let mut specs = vec![FnSpec::new("__constraints", &with_charts("constraints"))];
     specs[0].vector("phi", &c.phi);
-    let mut f = FnSpec::new("__constraint_jacobian", args("constraint_jacobian"));
+    let mut f = FnSpec::new("__constraint_jacobian", &with_charts("constraint_jacobian"));
     f.matrix(a, "b", &c.b);
     specs.push(f);
-    let mut f = FnSpec::new("__constraint_rate", args("constraint_rate"));
+    let mut f = FnSpec::new("__constraint_rate", &with_charts("constraint_rate"));
     f.vector("phi_t", &c.phi_t);
     specs.push(f);
-    let mut f = FnSpec::new("__constraint_bias", args("constraint_bias"));
+    let mut f = FnSpec::new("__constraint_bias", &with_charts("constraint_bias"));
     f.vector("gamma", &c.gamma);
     specs.push(f);
-    let mut f = FnSpec::new("__constraint_tangent", args("constraint_tangent"));
+    let mut f = FnSpec::new("__constraint_tangent", &with_charts("constraint_tangent"));
     f.matrix(a, "k", &c.tangent);
     specs.push(f);
     let labels = [
@@ -390,6 +393,7 @@ fn emit_scene(
     let names = RustNames {
         params: &sys.params,
         params_path: "self.params",
+        charts_path: "self.charts",
     };
     // the methods to emit, with the label of their op-count row (none for initial_state)
     let mut specs: Vec<(FnSpec, Option<&str>)> = Vec::new();
@@ -607,7 +611,7 @@ fn emit_scene(
     }
     let pty = format!("{}Params", sys.name);
     let info = format!(
-        "static INFO: ::mbs::ModelInfo = ::mbs::ModelInfo {{ name: {name:?}, scene: {scene:?}, dofs: {dofs}, inputs: {inputs}, frames: {frames}, is_body: &[{is_body}], points: {points}, params: {params}, effects: {effects}, constraints: {constraints}, independent: &[{independent}], formulation: {form:?}, has_tangents: {tan}, ops: &[{ops}], shapes: {shapes}, rotation_joints: &[] }};",
+        "static INFO: ::mbs::ModelInfo = ::mbs::ModelInfo {{ name: {name:?}, scene: {scene:?}, dofs: {dofs}, inputs: {inputs}, frames: {frames}, is_body: &[{is_body}], points: {points}, params: {params}, effects: {effects}, constraints: {constraints}, independent: &[{independent}], formulation: {form:?}, has_tangents: {tan}, ops: &[{ops}], shapes: {shapes}, rotation_joints: &[{joints}] }};",
         name = ty,
         scene = scene_name,
         dofs = str_list(sys.dofs.iter().map(|d| d.name.clone())),
@@ -631,6 +635,15 @@ fn emit_scene(
             .join(", "),
         tan = eq.tangents.is_some(),
         shapes = shapes::literal(&shapes::shapes(sys)),
+        joints = sys
+            .rotation_joints
+            .iter()
+            .map(|j| format!(
+                "::mbs::RotationJoint {{ frame: {}, angles: {:?}, translation: {:?} }}",
+                j.frame, j.angles, j.translation
+            ))
+            .collect::<Vec<_>>()
+            .join(", "),
         ops = ops
             .iter()
             .map(|(n, c)| format!("({n:?}, {})", runtime_ops(*c)))
@@ -650,6 +663,7 @@ fn emit_scene(
         nframes: sys.frames.len(),
         npoints: sys.points.len(),
         nc: sys.constraints.len(),
+        charts: sys.rotation_joints.len(),
     };
     let model_impl = api::model_impl(&ty, &pty, &sizes, |m| {
         match m.name {
@@ -663,22 +677,30 @@ fn emit_scene(
         "power" => "let mut e = [0.0f64; 1];\nself.__power(t, q, qd, u, &mut e);\ne[0]".into(),
         // the constraint functions live on the parameter struct, shared by every scene
         name if name.starts_with("constraint") => {
-            format!("self.params.__{name}({})", m.call())
+            format!("self.params.__{name}(&self.charts, {})", m.call())
         }
         name => format!("self.__{name}({})", m.call()),
     }
     });
+    let nj = sys.rotation_joints.len();
     let _ = write!(
         code,
-        "{doc}#[derive(Clone, Debug, Default, PartialEq)]
+        "{doc}#[derive(Clone, Debug, PartialEq)]
 {vis} struct {ty} {{
 params: {pty},
+/// the chart of each rotation joint ([`::mbs::Model::chart`])
+charts: [[[f64; 3]; 3]; {nj}],
+}}
+impl ::core::default::Default for {ty} {{
+fn default() -> Self {{
+Self {{ params: ::core::default::Default::default(), charts: [::mbs::IDENTITY3; {nj}] }}
+}}
 }}
 impl {ty} {{
 /// The model with `params`, after checking them.
 pub fn new(params: {pty}) -> ::core::result::Result<Self, ::mbs::ParamError> {{
 ::mbs::Parameters::validate(&params)?;
-Ok(Self {{ params }})
+Ok(Self {{ params, charts: [::mbs::IDENTITY3; {nj}] }})
 }}
 }}
 #[automatically_derived]

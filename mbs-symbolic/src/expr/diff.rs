@@ -85,8 +85,13 @@ impl Arena {
                     Var::Qd(_) => self.zero(),
                     Var::T => self.one(),
                     // jerk, parameters and inputs: never differentiated in time by the
-                    // generator (the checker keeps inputs and velocities out of positions)
-                    Var::Qdd(_) | Var::Param(_) | Var::Input(_) | Var::Lambda(_) => self.zero(),
+                    // generator (the checker keeps inputs and velocities out of positions);
+                    // a chart is constant between re-centrings
+                    Var::Qdd(_)
+                    | Var::Param(_)
+                    | Var::Input(_)
+                    | Var::Lambda(_)
+                    | Var::Chart(_) => self.zero(),
                 },
             },
             Node::Add(a, b) => {

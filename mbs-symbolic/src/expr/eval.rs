@@ -23,6 +23,9 @@ pub struct SliceEnv<'a> {
     pub params: &'a [f64],
     pub u: &'a [f64],
     pub lambda: &'a [f64],
+    /// the charts of rotation joints, 9 entries each (row-major); missing entries read as
+    /// the identity's
+    pub charts: &'a [f64],
 }
 
 impl Env for SliceEnv<'_> {
@@ -36,6 +39,11 @@ impl Env for SliceEnv<'_> {
             Var::Param(i) => get(self.params, i),
             Var::Input(i) => get(self.u, i),
             Var::Lambda(i) => get(self.lambda, i),
+            Var::Chart(i) => match self.charts.get(i as usize) {
+                Some(&v) => v,
+                // the identity: entries 0, 4 and 8 of each 3 × 3 block are 1
+                None => f64::from(u8::from(i % 9 % 4 == 0)),
+            },
         }
     }
 }

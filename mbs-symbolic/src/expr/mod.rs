@@ -46,6 +46,10 @@ pub enum Var {
     Input(u16),
     /// Lagrange multiplier `λ[i]` of constraint i (in generated constraint tangents)
     Lambda(u16),
+    /// entry `i = 9 j + 3 r + c` of the chart of rotation joint `j`: row r, column c of the
+    /// reference rotation the joint's angles are measured from, held by the model at run time
+    /// and constant in time between re-centrings
+    Chart(u16),
 }
 
 impl Var {
@@ -58,7 +62,7 @@ impl Var {
             Var::Qdd(i) => 80 + i as u32 % 40,
             Var::T => 120,
             Var::Param(i) => 121 + i as u32 % 4,
-            Var::Input(i) | Var::Lambda(i) => 125 + i as u32 % 3,
+            Var::Input(i) | Var::Lambda(i) | Var::Chart(i) => 125 + i as u32 % 3,
         };
         1u128 << bit
     }
@@ -74,6 +78,7 @@ impl fmt::Display for Var {
             Var::Param(i) => write!(f, "p{i}"),
             Var::Input(i) => write!(f, "u{i}"),
             Var::Lambda(i) => write!(f, "l{i}"),
+            Var::Chart(i) => write!(f, "r{i}"),
         }
     }
 }

@@ -149,6 +149,8 @@ impl Arena {
             Var::Input(idx(r)?)
         } else if let Some(r) = tok.strip_prefix('l') {
             Var::Lambda(idx(r)?)
+        } else if let Some(r) = tok.strip_prefix('r') {
+            Var::Chart(idx(r)?)
         } else {
             return Err(format!("unknown atom `{tok}`"));
         };

@@ -32,6 +32,7 @@ pub fn rotations(a: &mut Arena, tree: &Tree) -> Vec<Option<M3>> {
         .iter()
         .map(|n| match n.factor {
             Some(Factor::Rot { axis, angle }) => Some(s::rotation(a, axis, angle)),
+            Some(Factor::Chart(j)) => Some(s::chart(a, j)),
             _ => None,
         })
         .collect()
@@ -78,6 +79,16 @@ pub fn body_kinematics(
                 let al = s::add(a, al, t2);
                 let acc = s::mul_mtv(a, &r, p.a);
                 BodyKin { w, v, al, a: acc }
+            }
+            // a constant rotation: the parent's motion in the new axes
+            Factor::Chart(_) => {
+                let r = rots[n].unwrap();
+                BodyKin {
+                    w: s::mul_mtv(a, &r, p.w),
+                    v: s::mul_mtv(a, &r, p.v),
+                    al: s::mul_mtv(a, &r, p.al),
+                    a: s::mul_mtv(a, &r, p.a),
+                }
             }
             Factor::Disp(d) => {
                 let dd = [a.dt(d[0]), a.dt(d[1]), a.dt(d[2])];
@@ -179,6 +190,7 @@ pub fn newton_euler(
                     ];
                     s::dot(a, dd, f)
                 }
+                Factor::Chart(_) => unreachable!("a chart moves no coordinate"),
             };
             tau[k as usize] = a.add(tau[k as usize], t);
         }
@@ -187,7 +199,7 @@ pub fn newton_euler(
             continue;
         }
         let (fp, mp) = match fac {
-            Factor::Rot { .. } => {
+            Factor::Rot { .. } | Factor::Chart(_) => {
                 let r = rots[n].unwrap();
                 (s::mul_mv(a, &r, f), s::mul_mv(a, &r, m))
             }
@@ -336,6 +348,7 @@ fn motion(a: &mut Arena, fac: &Factor, k: u16) -> (V3, V3) {
                 a.diff(dv[2], Var::Q(k)),
             ],
         ),
+        Factor::Chart(_) => (z, z),
     }
 }
 
@@ -439,7 +452,7 @@ pub fn crba(sys: &mut System, tree: &Tree) -> Vec<Vec<ExprId>> {
                     m[r][col] = a.add(m[r][col], c);
                 }
                 match fx {
-                    Factor::Rot { .. } => {
+                    Factor::Rot { .. } | Factor::Chart(_) => {
                         let r = rots[x].unwrap();
                         lin = s::mul_mv(a, &r, lin);
                         ang = s::mul_mv(a, &r, ang);

@@ -84,6 +84,12 @@ pub fn sym(t: &[ExprId; 6]) -> M3 {
     [[t[0], t[3], t[4]], [t[3], t[1], t[5]], [t[4], t[5], t[2]]]
 }
 
+/// The chart of rotation joint `j`: the run-time matrix `Var::Chart(9 j + 3 r + c)`.
+pub fn chart(a: &mut Arena, j: u16) -> M3 {
+    let e = |a: &mut Arena, r: u16, c: u16| a.var(crate::expr::Var::Chart(9 * j + 3 * r + c));
+    [0, 1, 2].map(|r| [e(a, r, 0), e(a, r, 1), e(a, r, 2)])
+}
+
 /// Rotation by `angle` about the unit `axis` (columns: the rotated frame's axes). Coordinate
 /// axes give the elementary matrices directly; other axes use Rodrigues' formula.
 pub fn rotation(a: &mut Arena, axis: V3, angle: ExprId) -> M3 {

@@ -26,6 +26,8 @@ pub struct System {
     pub constraints: Vec<ConstraintDef>,
     /// shapes to draw (`shape` statements), evaluated with the default parameters
     pub shapes: Vec<ShapeDef>,
+    /// spherical and free joints, whose charts are `Factor::Chart(j)`
+    pub rotation_joints: Vec<RotationJointDef>,
     pub options: Options,
 }
 
@@ -92,6 +94,23 @@ pub enum Factor {
     Disp([ExprId; 3]),
     /// `Trotx/Troty/Trotz(a)`, `Trotn(nx, ny, nz, a)`: rotation by `angle` about the unit `axis`
     Rot { axis: [ExprId; 3], angle: ExprId },
+    /// the chart of rotation joint `j` ([`System::rotation_joints`]): a rotation by the
+    /// matrix the model holds at run time ([`crate::expr::Var::Chart`]), constant between
+    /// re-centrings; `Tball(a, b, c)` is `Chart(j)·Rz(a)·Ry(b)·Rx(c)`
+    Chart(u16),
+}
+
+/// A spherical joint `Tball(a, b, c)` or a free joint `Tfree(x, y, z, a, b, c)`: ZYX angles
+/// (a, b, c) measured from a chart the runtime re-centres before they reach gimbal lock
+/// (cos b = 0), after a translation (x, y, z) in the axes of the frame before the joint.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RotationJointDef {
+    /// the first frame whose pose contains the joint
+    pub frame: usize,
+    /// the coordinates of a, b, c
+    pub angles: [usize; 3],
+    /// `Tfree`: the coordinates of x, y, z
+    pub translation: Option<[usize; 3]>,
 }
 
 /// A body (with inertia) or a massless frame. Its frame is at G for a body.
@@ -292,6 +311,7 @@ impl System {
             scenes: Vec::new(),
             constraints: Vec::new(),
             shapes: Vec::new(),
+            rotation_joints: Vec::new(),
             options: Options::default(),
         }
     }
@@ -402,6 +422,35 @@ impl System {
     /// Constant displacement.
     pub fn disp(&mut self, d: [f64; 3]) -> Factor {
         Factor::Disp(self.vec3(d))
+    }
+
+    /// A spherical joint on coordinates `angles` (ZYX), or a free joint with the
+    /// translation coordinates `translation` in front, for frame `frame`: its factors.
+    pub fn rotation_joint(
+        &mut self,
+        frame: usize,
+        angles: [usize; 3],
+        translation: Option<[usize; 3]>,
+    ) -> Vec<Factor> {
+        self.rotation_joints.push(RotationJointDef {
+            frame,
+            angles,
+            translation,
+        });
+        let j = (self.rotation_joints.len() - 1) as u16;
+        let mut f = Vec::new();
+        if let Some(t) = translation {
+            f.push(Factor::Disp(t.map(|k| self.q(k))));
+        }
+        f.push(Factor::Chart(j));
+        for (axis, k) in [[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]]
+            .into_iter()
+            .zip(angles)
+        {
+            let angle = self.q(k);
+            f.push(self.rot(axis, angle));
+        }
+        f
     }
 
     /// Declares a body (with `inertia`) or a massless frame at `TOG[parent] * factors…`;

@@ -161,6 +161,7 @@ impl Tree {
         let roots: Vec<ExprId> = match f {
             Factor::Disp(d) => d.to_vec(),
             Factor::Rot { angle, .. } => vec![angle],
+            Factor::Chart(_) => return Vec::new(),
         };
         a.vars_of(&roots)
             .into_iter()

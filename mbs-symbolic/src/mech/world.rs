@@ -117,6 +117,14 @@ impl World {
                         ab: par.ab,
                     }
                 }
+                // a constant rotation: the origin, velocities and accelerations are the parent's
+                Factor::Chart(j) => {
+                    let rel = s::chart(a, j);
+                    NodeKin {
+                        r: s::mul_mm(a, &par.r, &rel),
+                        ..par
+                    }
+                }
                 Factor::Disp(d) => {
                     let dw = s::mul_mv(a, &par.r, d);
                     let p = s::add(a, par.p, dw);

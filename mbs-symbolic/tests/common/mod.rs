@@ -1060,11 +1060,13 @@ pub fn add_force_elements(
                 .factors
                 .iter()
                 .filter_map(|x| match x {
-                    Factor::Rot { axis, .. } => Some(*axis),
+                    Factor::Rot { axis, .. } => Some(Some(*axis)),
+                    // a chart turns about every axis
+                    Factor::Chart(_) => Some(None),
                     Factor::Disp(_) => None,
                 })
                 .collect::<Vec<_>>();
-            (rots.len() == 1).then(|| rots[0])
+            (rots.len() == 1).then(|| rots[0]).flatten()
         };
         let joints: Vec<(usize, [ExprId; 3])> = (0..nf)
             .filter_map(|f| one_rotation(&f).map(|n| (f, n)))
@@ -1133,6 +1135,7 @@ pub fn eval(
         params: &params,
         u: &[],
         lambda: &[],
+        charts: &[],
     };
     model.sys.arena.eval(roots, &env)
 }

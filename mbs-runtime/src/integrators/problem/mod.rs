@@ -193,6 +193,12 @@ impl<M: Model> Problem<M> {
         self.cache_valid = false;
     }
 
+    /// The chart of a rotation joint moved: the same coordinates now mean another
+    /// configuration, so nothing evaluated before is reused.
+    pub fn chart_changed(&mut self) {
+        self.cache_valid = false;
+    }
+
     /// Name of coordinate `i` for messages: `q[3]` or `q[3] (knee)`.
     pub fn label(&self, i: usize) -> String {
         self.labels[i].clone()

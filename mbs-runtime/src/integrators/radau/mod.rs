@@ -293,6 +293,7 @@ use super::constrained::Mode;
 use super::problem::Problem;
 use super::step_control::{Predictive, Tolerances};
 use super::{Attempt, Control, State, Step, Stepper};
+use crate::charts::Recentring;
 use crate::error::Failure;
 use crate::linalg::{C64, Lu};
 use crate::model::Model;
@@ -558,6 +559,21 @@ impl<M: Model> Stepper<M> for Radau {
         self.reject = false;
         self.control.restart();
         self.faccon = 1.0;
+        Ok(())
+    }
+
+    /// Fresh matrices and no extrapolation of the last step's stages (they are of the old
+    /// chart); the step-size controller keeps its history.
+    fn rechart(
+        &mut self,
+        _p: &mut Problem<M>,
+        _s: &State,
+        _ctl: &Control,
+        _moved: &[Recentring],
+    ) -> Result<(), Failure> {
+        self.jac_valid = false;
+        self.need_jac = true;
+        self.h_prev = 0.0;
         Ok(())
     }
 

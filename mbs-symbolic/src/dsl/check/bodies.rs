@@ -353,7 +353,7 @@ impl Checker {
                     continue;
                 }
             }
-            if let Some(f) = self.lower_factor(leaf, what) {
+            if let Some(f) = self.lower_factor(leaf, what, fi) {
                 factors.extend(f);
             }
         }
@@ -438,10 +438,189 @@ impl Checker {
         }
     }
 
-    /// One transform factor; `None` after an error, an empty list for an identity.
-    pub(super) fn lower_factor(&mut self, e: &Expr, what: &'static str) -> Option<Vec<Factor>> {
-        const TRANSFORMS: &str =
-            "Tdisp(x, y, z), Trotx(a), Troty(a), Trotz(a) and Trotn(nx, ny, nz, a)";
+    /// The angle coordinates of every `Tball`/`Tfree` of the TOG products (no errors:
+    /// `lower_factor` reports them), so that their uses elsewhere are refused wherever they
+    /// come in the source.
+    pub(super) fn note_joint_angles(&mut self, def: &ModelDef) {
+        for item in &def.items {
+            let Item::Tog { chain, .. } = item else {
+                continue;
+            };
+            let mut leaves = Vec::new();
+            let before = self.errors.len();
+            self.flatten_product(chain, &mut leaves);
+            self.errors.truncate(before);
+            for leaf in leaves {
+                let Expr::Call(call) = leaf else { continue };
+                let Expr::Path(p) = &*call.func else { continue };
+                let joint = match p.path.get_ident().map(|i| i.to_string()).as_deref() {
+                    Some("Tball") => 0,
+                    Some("Tfree") => 3,
+                    _ => continue,
+                };
+                for arg in call.args.iter().skip(joint) {
+                    if let Some(k) = self.coordinate_silent(arg) {
+                        self.joint_angles.insert(k, text(leaf));
+                    }
+                }
+            }
+        }
+    }
+
+    /// The coordinate `e` names (`q[2]`, `knee`, `q[knee]`), without reporting anything.
+    fn coordinate_silent(&self, e: &Expr) -> Option<usize> {
+        let named = |id: &Ident| match self.scalars.get(&id.to_string()) {
+            Some(Scalar::Dof(i)) => Some(*i),
+            _ => None,
+        };
+        match e {
+            Expr::Path(p) => named(p.path.get_ident()?),
+            Expr::Index(ix) if matches!(&*ix.expr, Expr::Path(p) if p.path.is_ident("q")) => {
+                match &*ix.index {
+                    Expr::Lit(syn::ExprLit {
+                        lit: syn::Lit::Int(l),
+                        ..
+                    }) => l
+                        .base10_parse::<usize>()
+                        .ok()
+                        .filter(|&i| i < self.sys.dofs.len()),
+                    Expr::Path(p) => named(p.path.get_ident()?),
+                    _ => None,
+                }
+            }
+            _ => None,
+        }
+    }
+
+    /// A use of coordinate `k` (or its rate) outside its `Tball`/`Tfree`, on `at`: an error
+    /// when `k` is the angle of such a joint. Returns whether it was refused.
+    pub(super) fn joint_angle_used(&mut self, k: usize, at: &impl ToTokens, what: &str) -> bool {
+        let Some(joint) = self.joint_angles.get(&k).cloned() else {
+            return false;
+        };
+        let name = repeat::display(&self.sys.dofs[k].name);
+        let what = if what.is_empty() {
+            "forces, poses or constraints"
+        } else {
+            what
+        };
+        self.error_at(
+            at,
+            format!("`{name}` is an angle of `{joint}`, measured from a chart that the runtime moves to stay clear of gimbal lock, so it has no fixed meaning and cannot appear in {what}: act on the orientation instead (a `torque`, a `bushing` or a `rotational_spring` between frames, a force at a point)"),
+        );
+        true
+    }
+
+    /// `Tball(a, b, c)` or `Tfree(x, y, z, a, b, c)` on frame `frame`: the factors of the
+    /// joint, registered in `sys.rotation_joints` (the same arguments again are the same
+    /// joint: absolute poses repeat it).
+    fn lower_joint(
+        &mut self,
+        call: &syn::ExprCall,
+        name: &Ident,
+        frame: usize,
+    ) -> Option<Vec<Factor>> {
+        let free = name == "Tfree";
+        let usage = if free {
+            "Tfree(x, y, z, a, b, c)"
+        } else {
+            "Tball(a, b, c)"
+        };
+        let args: Vec<&Expr> = call.args.iter().collect();
+        if !self.arity_ok(call, name, args.len(), if free { 6 } else { 3 }, usage) {
+            return None;
+        }
+        let mut ks: Vec<usize> = Vec::new();
+        for arg in &args {
+            let Some(k) = self.coordinate_silent(arg) else {
+                let kind = if free {
+                    "a free joint's translation and ZYX angles"
+                } else {
+                    "a spherical joint's ZYX angles"
+                };
+                self.error_at(
+                    *arg,
+                    format!("the arguments of `{usage}` are coordinates, {kind} (`dof` names or `q[i]`), found `{}`: declare a coordinate, `dof a = 0.0;`, and pass it", text(*arg)),
+                );
+                return None;
+            };
+            if let Some(p) = ks.iter().position(|&j| j == k) {
+                self.error_at(
+                    *arg,
+                    format!("`{}` is argument {} and {} of `{}`: the joint needs {} different coordinates", text(*arg), p + 1, ks.len() + 1, text(call), args.len()),
+                );
+                return None;
+            }
+            ks.push(k);
+        }
+        let angles = [ks[ks.len() - 3], ks[ks.len() - 2], ks[ks.len() - 1]];
+        let translation = free.then(|| [ks[0], ks[1], ks[2]]);
+        let joints = &self.sys.rotation_joints;
+        if let Some(j) = joints
+            .iter()
+            .position(|d| d.angles == angles && d.translation == translation)
+        {
+            return Some(self.joint_factors(j));
+        }
+        // a coordinate of another joint
+        for d in joints {
+            let theirs: Vec<usize> = d
+                .angles
+                .iter()
+                .chain(d.translation.iter().flatten())
+                .copied()
+                .collect();
+            if let Some(&k) = ks.iter().find(|k| theirs.contains(k)) {
+                let dof = repeat::display(&self.sys.dofs[k].name);
+                let body = repeat::display(&self.sys.frames[d.frame].name);
+                let joint = self
+                    .joint_angles
+                    .get(&d.angles[0])
+                    .cloned()
+                    .unwrap_or_default();
+                self.error_at(
+                    call,
+                    format!("`{dof}` already belongs to `{joint}` in the pose of `{body}`: a coordinate belongs to one `Tball` or `Tfree` (write that joint again, with the same arguments, to share it)"),
+                );
+                return None;
+            }
+        }
+        self.sys.rotation_joints.push(RotationJointDef {
+            frame,
+            angles,
+            translation,
+        });
+        Some(self.joint_factors(self.sys.rotation_joints.len() - 1))
+    }
+
+    /// The factors of rotation joint `j`: its translation, its chart, Rz(a)·Ry(b)·Rx(c).
+    fn joint_factors(&mut self, j: usize) -> Vec<Factor> {
+        let d = self.sys.rotation_joints[j];
+        let a = &mut self.sys.arena;
+        let (z, o) = (a.zero(), a.one());
+        let mut f = Vec::new();
+        if let Some(t) = d.translation {
+            f.push(Factor::Disp(t.map(|k| a.var(Var::Q(k as u16)))));
+        }
+        f.push(Factor::Chart(j as u16));
+        for (axis, k) in [[z, z, o], [z, o, z], [o, z, z]].into_iter().zip(d.angles) {
+            f.push(Factor::Rot {
+                axis,
+                angle: a.var(Var::Q(k as u16)),
+            });
+        }
+        f
+    }
+
+    /// One transform factor; `None` after an error, an empty list for an identity. `frame`
+    /// is the frame whose pose it is part of.
+    pub(super) fn lower_factor(
+        &mut self,
+        e: &Expr,
+        what: &'static str,
+        frame: usize,
+    ) -> Option<Vec<Factor>> {
+        const TRANSFORMS: &str = "Tdisp(x, y, z), Trotx(a), Troty(a), Trotz(a), Trotn(nx, ny, nz, a), Tball(a, b, c) and Tfree(x, y, z, a, b, c)";
         let not_a_transform = |c: &mut Checker, found: &str| {
             c.error_at(
                 e,
@@ -478,6 +657,7 @@ impl Checker {
             Some(vec![Factor::Rot { axis, angle }])
         };
         match name.to_string().as_str() {
+            "Tball" | "Tfree" => self.lower_joint(call, name, frame),
             "Tdisp" => {
                 if !arity(self, 3, "Tdisp(x, y, z)") {
                     return None;
@@ -526,7 +706,9 @@ impl Checker {
                 rot(self, n)
             }
             other => {
-                let known = ["Tdisp", "Trotx", "Troty", "Trotz", "Trotn"];
+                let known = [
+                    "Tdisp", "Trotx", "Troty", "Trotz", "Trotn", "Tball", "Tfree",
+                ];
                 self.error(
                     name.span(),
                     format!(

@@ -5,6 +5,11 @@ use super::*;
 impl Checker {
     /// `q[2]` or a coordinate name.
     pub(super) fn dof_ref(&mut self, e: &Expr) -> Option<usize> {
+        let k = self.dof_ref_inner(e)?;
+        (!self.joint_angle_used(k, e, "a generalised force")).then_some(k)
+    }
+
+    fn dof_ref_inner(&mut self, e: &Expr) -> Option<usize> {
         match e {
             Expr::Index(ix) if matches!(&*ix.expr, Expr::Path(p) if p.path.is_ident("q")) => {
                 self.index_of(&ix.index, "q", e)
@@ -329,6 +334,9 @@ impl Checker {
                 let Some(i) = self.index_of(&ix.index, &v, e) else {
                     return self.sys.arena.zero();
                 };
+                if v != "u" && self.joint_angle_used(i, ix, a.what) {
+                    return self.sys.arena.zero();
+                }
                 self.sys.arena.var(mk(i as u16))
             }
             Expr::Call(c) => self.lower_call(c, a),
@@ -381,6 +389,9 @@ impl Checker {
             Some(Scalar::Dof(i)) => {
                 if !a.q {
                     return self.not_allowed(id, &format!("coordinate `{s}`"), "q", a);
+                }
+                if self.joint_angle_used(i, id, a.what) {
+                    return self.sys.arena.zero();
                 }
                 self.sys.arena.var(Var::Q(i as u16))
             }
@@ -547,7 +558,7 @@ impl Checker {
                 };
                 return self.sys.arena.powi(x, n);
             }
-            "Tdisp" | "Trotx" | "Troty" | "Trotz" | "Trotn" => {
+            "Tdisp" | "Trotx" | "Troty" | "Trotz" | "Trotn" | "Tball" | "Tfree" => {
                 self.error(id.span(), format!("`{name}` is a transform, not a number: transforms appear only in the products of `TOG[…] = …;`"));
                 return self.sys.arena.zero();
             }

@@ -177,6 +177,9 @@ struct Checker {
     origin: Origin,
     frame_origins: Vec<Origin>,
     dof_origins: Vec<Origin>,
+    /// the angle coordinates of every `Tball`/`Tfree`, found before lowering (a pass over
+    /// the TOG products), with the joint as written: they may appear nowhere else
+    joint_angles: FxHashMap<usize, String>,
 }
 
 /// A checked model and the spans that generation-time errors point at.
@@ -214,6 +217,7 @@ pub fn check(def: &ModelDef) -> Result<Checked, syn::Error> {
         origin: None,
         frame_origins: Vec::new(),
         dof_origins: Vec::new(),
+        joint_angles: FxHashMap::default(),
     };
     c.sys.docs = def.docs.clone();
     c.declare(def);
@@ -566,6 +570,7 @@ impl Checker {
     /// Pass 2: lower every statement in order.
     fn lower_items(&mut self, def: &ModelDef) {
         self.note_tog_starts(def);
+        self.note_joint_angles(def);
         // points first: effects may name points declared after them
         for (item, origin) in def.items.iter().zip(&def.origins) {
             self.origin = origin.clone();
@@ -723,6 +728,7 @@ impl Checker {
                 let roots: Vec<ExprId> = match *fac {
                     Factor::Disp(d) => d.to_vec(),
                     Factor::Rot { angle, .. } => vec![angle],
+                    Factor::Chart(_) => Vec::new(),
                 };
                 for v in self.sys.arena.vars_of(&roots) {
                     if let Var::Q(k) = v {

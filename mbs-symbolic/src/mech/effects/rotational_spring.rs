@@ -101,8 +101,11 @@ fn along_tree(
         } else {
             (1.0, &mut nb)
         };
-        if let Some(Factor::Rot { axis, angle }) = tree.nodes[*cur].factor {
-            terms.push((side * same_axis(a, axis, n)?, angle));
+        match tree.nodes[*cur].factor {
+            Some(Factor::Rot { axis, angle }) => terms.push((side * same_axis(a, axis, n)?, angle)),
+            // a chart turns about every axis
+            Some(Factor::Chart(_)) => return None,
+            _ => {}
         }
         *cur = tree.nodes[*cur].parent;
     }

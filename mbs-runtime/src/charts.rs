@@ -1,0 +1,273 @@
+//! Rotation joints (`Tball`, `Tfree`) and their charts: a joint's rotation is
+//! `R = C · Rz(a) · Ry(b) · Rx(c)`, with ZYX angles (a, b, c) among the coordinates and the
+//! chart `C` a rotation the model holds ([`Model::chart`]). The angles are singular where
+//! cos b = 0; re-centring moves the chart to the joint's current rotation (C ← C·R_zyx(a, b, c))
+//! and the angles to zero, mapping the rates and accelerations exactly through the joint's
+//! angular velocity in its own axes, so the motion does not change. A free joint's
+//! translation comes before the chart and is left as it is.
+//!
+//! Here: the ZYX rotation and its angular-velocity Jacobian, the quaternion of a joint, and
+//! [`Recentring`], the map of one re-centring applied to a state and to any acceleration.
+
+use crate::model::{Model, RotationJoint};
+use nalgebra::{Matrix3, Rotation3, UnitQuaternion};
+
+/// `Rz(a) · Ry(b) · Rx(c)` (nalgebra's roll c, pitch b, yaw a).
+pub fn zyx(angles: [f64; 3]) -> Matrix3<f64> {
+    Rotation3::from_euler_angles(angles[2], angles[1], angles[0]).into_inner()
+}
+
+/// A matrix as rows, the layout of [`Model::chart`].
+pub fn array(m: &Matrix3<f64>) -> [[f64; 3]; 3] {
+    [0, 1, 2].map(|r| [m[(r, 0)], m[(r, 1)], m[(r, 2)]])
+}
+
+/// The angular velocity of the joint in its own (child) axes, `J(b, c) · (ȧ, ḃ, ċ)`.
+pub fn body_rates(angles: [f64; 3], rates: [f64; 3]) -> [f64; 3] {
+    let (sb, cb) = angles[1].sin_cos();
+    let (sc, cc) = angles[2].sin_cos();
+    let [ad, bd, cd] = rates;
+    [
+        cd - ad * sb,
+        bd * cc + ad * cb * sc,
+        -bd * sc + ad * cb * cc,
+    ]
+}
+
+/// `J̇ · q̇`: the angular acceleration in the joint's axes when the angles' accelerations are
+/// zero.
+fn body_bias(angles: [f64; 3], rates: [f64; 3]) -> [f64; 3] {
+    let (sb, cb) = angles[1].sin_cos();
+    let (sc, cc) = angles[2].sin_cos();
+    let [ad, bd, cd] = rates;
+    [
+        -ad * bd * cb,
+        -bd * cd * sc + ad * (-bd * sb * sc + cd * cb * cc),
+        -bd * cd * cc + ad * (-bd * sb * cc - cd * cb * sc),
+    ]
+}
+
+/// The rates at zero angles that give the angular velocity `w` (joint axes): at (0, 0, 0),
+/// ω = (ċ, ḃ, ȧ).
+fn rates_at_zero(w: [f64; 3]) -> [f64; 3] {
+    [w[2], w[1], w[0]]
+}
+
+/// The joint's angles of coordinates `q`.
+pub fn angles_of(joint: &RotationJoint, q: &[f64]) -> [f64; 3] {
+    joint.angles.map(|k| q[k])
+}
+
+/// How far the joint's chart is from gimbal lock: |cos b|, 1 at its centre, 0 at the lock.
+pub fn chart_quality(joint: &RotationJoint, q: &[f64]) -> f64 {
+    q[joint.angles[1]].cos().abs()
+}
+
+/// The rotation of the joint relative to the frame before it, `C · Rz(a) · Ry(b) · Rx(c)`,
+/// as a unit quaternion.
+pub fn joint_rotation(
+    chart: &[[f64; 3]; 3],
+    joint: &RotationJoint,
+    q: &[f64],
+) -> UnitQuaternion<f64> {
+    let c = Matrix3::from_fn(|r, k| chart[r][k]);
+    let r = c * zyx(angles_of(joint, q));
+    UnitQuaternion::from_matrix(&r)
+}
+
+/// The joint's rotation as `[x, y, z, w]` (the order of [`crate::Pose::quaternion`]), of the
+/// sign nearest `prev` (continuous from one output to the next; w ≥ 0 without `prev`).
+pub fn quaternion_near(u: &UnitQuaternion<f64>, prev: Option<[f64; 4]>) -> [f64; 4] {
+    let v = u.as_ref().coords; // (i, j, k, w)
+    let mut x = [v[0], v[1], v[2], v[3]];
+    let flip = match prev {
+        Some(p) => p.iter().zip(&x).map(|(a, b)| a * b).sum::<f64>() < 0.0,
+        None => x[3] < 0.0,
+    };
+    if flip {
+        x = x.map(|c| -c);
+    }
+    x
+}
+
+/// One re-centring of joint `joint`: what it changed, to map states and accelerations of the
+/// old chart into the new one.
+#[derive(Clone, Copy, Debug)]
+pub struct Recentring {
+    pub joint: usize,
+    /// the coordinates of the angles
+    angles: [usize; 3],
+    /// angles and rates before (old chart)
+    q: [f64; 3],
+    qd: [f64; 3],
+    /// rates after (new chart, angles zero)
+    qd_new: [f64; 3],
+    /// the new chart
+    pub chart: [[f64; 3]; 3],
+}
+
+impl Recentring {
+    /// Re-centres joint `index` (`joint` its description) at the state (q, qd): the new
+    /// chart, and the state's angles and rates in it (written into `q` and `qd`).
+    pub fn at(
+        index: usize,
+        joint: &RotationJoint,
+        chart: &[[f64; 3]; 3],
+        q: &mut [f64],
+        qd: &mut [f64],
+    ) -> Recentring {
+        let angles = angles_of(joint, q);
+        let rates = joint.angles.map(|k| qd[k]);
+        let new = joint_rotation(chart, joint, q);
+        let qd_new = rates_at_zero(body_rates(angles, rates));
+        for (i, &k) in joint.angles.iter().enumerate() {
+            q[k] = 0.0;
+            qd[k] = qd_new[i];
+        }
+        Recentring {
+            joint: index,
+            angles: joint.angles,
+            q: angles,
+            qd: rates,
+            qd_new,
+            chart: array(new.to_rotation_matrix().matrix()),
+        }
+    }
+
+    /// Maps an acceleration of the old chart at the re-centred state (the state's own q̈, or
+    /// a scheme's acceleration-like variable) into the new chart: the same angular
+    /// acceleration of the joint, ω̇ = J q̈ + J̇ q̇, read at zero angles.
+    pub fn map_acceleration(&self, x: &mut [f64]) {
+        let acc = self.angles.map(|k| x[k]);
+        let j = body_rates(self.q, acc);
+        let b = body_bias(self.q, self.qd);
+        let wd = [j[0] + b[0], j[1] + b[1], j[2] + b[2]];
+        // at zero angles J̇'q̇' = (−ȧ'ḃ', ȧ'ċ', −ḃ'ċ'), J' the permutation (c, b, a)
+        let [ad, bd, cd] = self.qd_new;
+        let new = [wd[2] + bd * cd, wd[1] - ad * cd, wd[0] + ad * bd];
+        for (i, &k) in self.angles.iter().enumerate() {
+            x[k] = new[i];
+        }
+    }
+}
+
+/// Re-centres every joint of `model` whose chart quality at `q` is below `threshold`:
+/// sets the model's charts, maps q, qd (and qdd) in place, and returns what moved.
+pub fn recentre_below<M: Model>(
+    model: &mut M,
+    threshold: f64,
+    q: &mut [f64],
+    qd: &mut [f64],
+    qdd: Option<&mut [f64]>,
+    moved: &mut Vec<Recentring>,
+) {
+    moved.clear();
+    let joints = model.info().rotation_joints;
+    for (j, joint) in joints.iter().enumerate() {
+        if chart_quality(joint, q) < threshold {
+            let r = Recentring::at(j, joint, &model.chart(j), q, qd);
+            model.set_chart(j, r.chart);
+            moved.push(r);
+        }
+    }
+    if let Some(a) = qdd {
+        for r in moved.iter() {
+            r.map_acceleration(a);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn joint() -> RotationJoint {
+        RotationJoint {
+            frame: 0,
+            angles: [0, 1, 2],
+            translation: None,
+        }
+    }
+
+    fn rot(q: &[f64], chart: &[[f64; 3]; 3]) -> Matrix3<f64> {
+        joint_rotation(chart, &joint(), q)
+            .to_rotation_matrix()
+            .into_inner()
+    }
+
+    /// ω (joint axes) by central differences of R(t) = C·E(q + t q̇): skew(Rᵀ Ṙ).
+    fn omega_fd(q: &[f64], qd: &[f64], chart: &[[f64; 3]; 3]) -> [f64; 3] {
+        let h = 1e-6;
+        let at = |s: f64| {
+            let x: Vec<f64> = q.iter().zip(qd).map(|(a, b)| a + s * b).collect();
+            rot(&x, chart)
+        };
+        let rd = (at(h) - at(-h)) / (2.0 * h);
+        let w = at(0.0).transpose() * rd;
+        [w[(2, 1)], w[(0, 2)], w[(1, 0)]]
+    }
+
+    #[test]
+    fn zyx_is_rz_ry_rx() {
+        let (a, b, c) = (0.3, -0.7, 1.1);
+        let rz = Rotation3::from_axis_angle(&nalgebra::Vector3::z_axis(), a);
+        let ry = Rotation3::from_axis_angle(&nalgebra::Vector3::y_axis(), b);
+        let rx = Rotation3::from_axis_angle(&nalgebra::Vector3::x_axis(), c);
+        let e = (rz * ry * rx).into_inner();
+        assert!((zyx([a, b, c]) - e).norm() < 1e-15);
+    }
+
+    #[test]
+    fn body_rates_are_the_angular_velocity_in_joint_axes() {
+        let chart = [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]];
+        let (q, qd) = ([0.4, 1.2, -2.0], [0.7, -1.3, 2.2]);
+        let w = body_rates(q, qd);
+        let fd = omega_fd(&q, &qd, &chart);
+        for i in 0..3 {
+            assert!((w[i] - fd[i]).abs() < 1e-8, "{w:?} {fd:?}");
+        }
+    }
+
+    #[test]
+    fn recentring_keeps_the_rotation_its_rate_and_its_acceleration() {
+        let chart = array(&zyx([0.2, 0.5, -0.3]));
+        let (q0, qd0, qdd0) = ([0.4, 1.35, -2.0], [0.7, -1.3, 2.2], [3.0, -0.4, 1.7]);
+        let (mut q, mut qd, mut qdd) = (q0, qd0, qdd0);
+        let r = Recentring::at(0, &joint(), &chart, &mut q, &mut qd);
+        r.map_acceleration(&mut qdd);
+        assert_eq!(q, [0.0; 3]);
+        // the same rotation
+        assert!((rot(&q0, &chart) - rot(&q, &r.chart)).norm() < 1e-15);
+        // the same angular velocity
+        let (w0, w1) = (body_rates(q0, qd0), body_rates(q, qd));
+        for i in 0..3 {
+            assert!((w0[i] - w1[i]).abs() < 1e-15);
+        }
+        // the same angular acceleration: ω̇ by differences along each chart's motion
+        let wdot = |q: [f64; 3], qd: [f64; 3], qdd: [f64; 3], c: &[[f64; 3]; 3]| {
+            let h = 1e-5;
+            let w_at = |s: f64| {
+                let x: Vec<f64> = (0..3)
+                    .map(|i| q[i] + s * qd[i] + 0.5 * s * s * qdd[i])
+                    .collect();
+                let v: Vec<f64> = (0..3).map(|i| qd[i] + s * qdd[i]).collect();
+                // world axes: R ω_joint
+                let w = body_rates([x[0], x[1], x[2]], [v[0], v[1], v[2]]);
+                rot(&x, c) * nalgebra::Vector3::from(w)
+            };
+            (w_at(h) - w_at(-h)) / (2.0 * h)
+        };
+        let a0 = wdot(q0, qd0, qdd0, &chart);
+        let a1 = wdot(q, qd, qdd, &r.chart);
+        assert!((a0 - a1).norm() < 1e-8, "{a0} {a1}");
+    }
+
+    #[test]
+    fn quaternions_keep_their_sign_from_one_output_to_the_next() {
+        let u = UnitQuaternion::from_euler_angles(0.1, 0.2, 3.1);
+        let x = quaternion_near(&u, None);
+        assert!(x[3] >= 0.0);
+        let y = quaternion_near(&u, Some(x.map(|c| -c)));
+        assert_eq!(y, x.map(|c| -c));
+    }
+}

@@ -46,6 +46,7 @@ fn tangents_match_finite_differences() {
         let desc = random_desc(&mut rng, opts(if seed < 12 { 6 } else { 12 }));
         let n = desc.ndof;
         let mut built = to_system(&desc, &mut rng);
+        let charts = built.charts.clone();
         if seed % 2 == 1 {
             add_loads(&mut rng, &mut built.sys, n, &mut [0; 7]);
         }
@@ -58,14 +59,22 @@ fn tangents_match_finite_differences() {
         let kc: Vec<ExprId> = k.iter().chain(c).flatten().copied().collect();
         for s in 0..2 {
             let (t, q, qd, qdd) = random_state(&mut rng, n);
-            let exact = eval(&model, &kc, t, &q, &qd, &qdd);
+            let exact = eval_charts(&model, &kc, (t, &q, &qd, &qdd), &charts);
             let (k_ex, c_ex) = exact.split_at(n * n);
             // columns j of the finite differences, stored row-major
             let mut k_fd = vec![0.0; n * n];
             let mut c_fd = vec![0.0; n * n];
             for j in 0..n {
-                let dq = fd_q(&|x| eval(&model, &tau, t, x, &qd, &qdd), &q, j);
-                let dqd = fd_q(&|x| eval(&model, &tau, t, &q, x, &qdd), &qd, j);
+                let dq = fd_q(
+                    &|x| eval_charts(&model, &tau, (t, x, &qd, &qdd), &charts),
+                    &q,
+                    j,
+                );
+                let dqd = fd_q(
+                    &|x| eval_charts(&model, &tau, (t, &q, x, &qdd), &charts),
+                    &qd,
+                    j,
+                );
                 for i in 0..n {
                     k_fd[i * n + j] = dq[i];
                     c_fd[i * n + j] = dqd[i];
@@ -73,7 +82,7 @@ fn tangents_match_finite_differences() {
             }
             // normalised by the largest entry, floored at 1 % of |τ| (per unit of q or qd):
             // some trees have K or C ≈ 0, where the differences are pure round-off
-            let tau0 = eval(&model, &tau, t, &q, &qd, &qdd);
+            let tau0 = eval_charts(&model, &tau, (t, &q, &qd, &qdd), &charts);
             let floor = 1e-2 * tau0.iter().fold(0.0f64, |m, v| m.max(v.abs()));
             let at = || format!("seed {}, state {s}, {n} dof", 1000 + seed);
             wk.see(rel_err_floor(k_ex, &k_fd, floor), at);

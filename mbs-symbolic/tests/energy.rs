@@ -25,6 +25,7 @@ fn oracle_h(
     frame_link: &[(usize, V3)],
     effects: &[usize],
     state: (f64, &[f64], &[f64]),
+    charts: &[f64],
     regimes: &mut [usize; 3],
 ) -> Vec<f64> {
     let (t, q, qd) = state;
@@ -32,7 +33,7 @@ fn oracle_h(
     let vels = oracle.link_velocities(q, qd, t);
     let mut ext = vec![[0.0; 6]; poses.len()];
     let mut qgen = vec![0.0; q.len()];
-    let ev = |e: &[ExprId]| eval(model, e, t, q, qd, &[]);
+    let ev = |e: &[ExprId]| eval_charts(model, e, (t, q, qd, &[]), charts);
     let ev3 = |e: &[ExprId; 3]| {
         let v = ev(e);
         [v[0], v[1], v[2]]
@@ -309,6 +310,7 @@ fn balance(
         );
         let n = desc.ndof;
         let mut built = to_system(&desc, &mut rng);
+        let charts = built.charts.clone();
         let (springs, losses) = add_loads(&mut rng, &mut built.sys, n, tally);
         let (mut cons, mut full) = (vec![springs], vec![springs, losses]);
         if elements {
@@ -354,7 +356,7 @@ fn balance(
             for s in 0..STATES {
                 let (t, q, qd, _) = random_state(&mut rng, n);
                 let z = vec![0.0; n];
-                let v = eval(&model, &roots, t, &q, &qd, &z);
+                let v = eval_charts(&model, &roots, (t, &q, &qd, &z), &charts);
                 let mh = |k: usize| {
                     let o = 4 + k * (n * n + n);
                     let m: Vec<Vec<f64>> = v[o..o + n * n].chunks(n).map(|r| r.to_vec()).collect();
@@ -372,13 +374,14 @@ fn balance(
                     &frame_link,
                     &eq.effects,
                     (t, &q, &qd),
+                    &charts,
                     &mut out.regimes,
                 );
                 out.oracle
                     .see(rel_err(&h_vp, &h_ref).max(rel_err(&h_rec, &h_ref)), at);
                 for (m, h) in [(&m_vp, &h_vp), (&m_rec, &h_rec)] {
                     let qdd = solve_spd(m, h);
-                    let v = eval(&model, &roots[..4], t, &q, &qd, &qdd);
+                    let v = eval_charts(&model, &roots[..4], (t, &q, &qd, &qdd), &charts);
                     let (de, dk, dp, p) = (v[0], v[1], v[2], v[3]);
                     let scale = p.abs().max(dk.abs()).max(dp.abs());
                     let err = (de - p).abs() / scale;

@@ -18,6 +18,7 @@ fn pendulum_link(kind: Kind, axis: V3, drive: Drive, mass: f64, com: V3, i: [f64
         parent: None,
         offset: [0.0; 3],
         fixed: Vec::new(),
+        chart: false,
         kind,
         axis,
         drive,
@@ -205,6 +206,7 @@ impl Checks {
         let oracle = Oracle::new(desc);
         let built = to_system(desc, rng);
         let bodies = built.body.clone();
+        let charts = built.charts.clone();
         let model = SymbolicModel::build(built.sys);
         let eq = &model.scenes[0];
         let mut roots = Vec::new();
@@ -221,7 +223,7 @@ impl Checks {
         }
         for s in 0..STATES {
             let (t, q, qd, qdd) = random_state(rng, n);
-            let v = eval(&model, &roots, t, &q, &qd, &qdd);
+            let v = eval_charts(&model, &roots, (t, &q, &qd, &qdd), &charts);
             let mut it = 0;
             let mut take = |k: usize| {
                 let s = v[it..it + k].to_vec();
@@ -309,6 +311,7 @@ fn random_trees_match_oracle() {
     let mut checks = Checks::default();
     let (mut branching, mut prismatic, mut revolute, mut rheonomic, mut driven, mut coupled) =
         (0, 0, 0, 0, 0, 0);
+    let mut charts = 0;
     let mut max_dof = 0;
     let mut dof_hist = [0usize; 13];
     for seed in 0..TREES {
@@ -325,6 +328,7 @@ fn random_trees_match_oracle() {
             }
             rheonomic += l.drive.rheonomic() as usize;
             driven += l.drive.dof.is_none() as usize;
+            charts += l.chart as usize;
         }
         let mut used = vec![0; n];
         for l in &desc.links {
@@ -338,7 +342,8 @@ fn random_trees_match_oracle() {
     println!(
         "{TREES} trees x {STATES} states; dof histogram {dof_hist:?}; {branching} branching; \
          {revolute} revolute, {prismatic} prismatic joints; {rheonomic} rheonomic, {driven} \
-         purely time-driven; {coupled} trees with a coordinate driving two joints"
+         purely time-driven; {coupled} trees with a coordinate driving two joints; {charts} \
+         fixed rotations read from charts at run time"
     );
     checks.check();
     assert_eq!(max_dof, 12);
@@ -347,6 +352,7 @@ fn random_trees_match_oracle() {
         "{branching} branching trees"
     );
     assert!(prismatic > 20 && revolute > 20 && rheonomic > 20 && driven > 10 && coupled > 3);
+    assert!(charts > 50, "{charts} charts");
 }
 
 /// Translations along a revolute joint's axis — the centre of mass on the axis, a child's

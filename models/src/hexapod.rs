@@ -83,7 +83,7 @@ mbs::multibody! {
         dof x = 0.0; dof y = 0.0; dof z = 0.5;
         dof psi = 0.0; dof theta = 0.0; dof phi = 0.0;
         body base { mass = m_base; inertia = (base_ixx, base_iyy, base_izz); }
-        TOG[base] = Tdisp(x, y, z) * Trotz(psi) * Troty(theta) * Trotx(phi);
+        TOG[base] = Tfree(x, y, z, psi, theta, phi);
 
         // One leg, hip at (hx, hy, 0) in the base frame: hip yaw a[k], thigh pitch b[k], knee
         // pitch c[k]; the pantograph link and coupler follow the thigh and knee angles, the

@@ -339,6 +339,10 @@ pub struct Link {
     pub offset: V3,
     /// (unit axis, angle), applied in order after the offset
     pub fixed: Vec<(V3, f64)>,
+    /// the fixed rotations are given to the generator as a chart (`Factor::Chart`): a
+    /// rotation matrix it reads at run time, as a `Tball`'s (the oracle sees the same
+    /// rotations); drawn for links with two fixed rotations
+    pub chart: bool,
     pub kind: Kind,
     pub axis: V3,
     pub drive: Drive,
@@ -443,9 +447,11 @@ pub fn random_desc(rng: &mut Rng, o: GenOpts) -> Desc {
         } else {
             [0.0; 3]
         };
-        let fixed = (0..rng.below(3))
+        let fixed: Vec<(V3, f64)> = (0..rng.below(3))
             .map(|_| (rng.axis(), rng.range(-PI, PI)))
             .collect();
+        // no draw of its own, so that the trees of every seed stay what they were
+        let chart = fixed.len() == 2;
         let kind = if rng.chance(0.3) {
             Kind::Prismatic
         } else {
@@ -461,6 +467,7 @@ pub fn random_desc(rng: &mut Rng, o: GenOpts) -> Desc {
             parent,
             offset,
             fixed,
+            chart,
             kind,
             axis: rng.axis(),
             drive,
@@ -736,6 +743,8 @@ pub struct Built {
     pub link_frame: Vec<Option<usize>>,
     /// index of the always-on gravity effect
     pub gravity_effect: Option<usize>,
+    /// the values of the charts (`Link::chart`), 9 per chart, row-major
+    pub charts: Vec<f64>,
 }
 
 fn is_zero(v: V3) -> bool {
@@ -755,6 +764,7 @@ pub fn to_system(d: &Desc, rng: &mut Rng) -> Built {
     let mut paths: Vec<Vec<Factor>> = Vec::new();
     let mut body = Vec::new();
     let mut link_frame = Vec::new();
+    let mut charts = Vec::new();
     for (i, l) in d.links.iter().enumerate() {
         // the joint variable
         let a = &mut sys.arena;
@@ -785,9 +795,18 @@ pub fn to_system(d: &Desc, rng: &mut Rng) -> Built {
         if !is_zero(l.offset) {
             own.push(sys.disp(l.offset));
         }
-        for &(ax, an) in &l.fixed {
-            let an = sys.num(an);
-            own.push(sys.rot(ax, an));
+        if l.chart {
+            let r = l
+                .fixed
+                .iter()
+                .fold(eye3(), |r, &(ax, an)| mm(&r, &rodrigues(ax, an)));
+            own.push(Factor::Chart((charts.len() / 9) as u16));
+            charts.extend(r.iter().flatten());
+        } else {
+            for &(ax, an) in &l.fixed {
+                let an = sys.num(an);
+                own.push(sys.rot(ax, an));
+            }
         }
         own.push(match l.kind {
             Kind::Revolute => sys.rot(l.axis, th),
@@ -840,6 +859,7 @@ pub fn to_system(d: &Desc, rng: &mut Rng) -> Built {
         body,
         link_frame,
         gravity_effect,
+        charts,
     }
 }
 
@@ -1117,7 +1137,7 @@ pub fn add_force_elements(
 // Evaluation and numerics
 // ---------------------------------------------------------------------------------------
 
-/// Values of `roots` at a state (parameters at their defaults).
+/// Values of `roots` at a state (parameters at their defaults, charts the identity).
 pub fn eval(
     model: &SymbolicModel,
     roots: &[ExprId],
@@ -1125,6 +1145,16 @@ pub fn eval(
     q: &[f64],
     qd: &[f64],
     qdd: &[f64],
+) -> Vec<f64> {
+    eval_charts(model, roots, (t, q, qd, qdd), &[])
+}
+
+/// [`eval`] with the values of the charts (9 each, row-major).
+pub fn eval_charts(
+    model: &SymbolicModel,
+    roots: &[ExprId],
+    (t, q, qd, qdd): (f64, &[f64], &[f64], &[f64]),
+    charts: &[f64],
 ) -> Vec<f64> {
     let params = model.sys.param_defaults();
     let env = SliceEnv {
@@ -1135,7 +1165,7 @@ pub fn eval(
         params: &params,
         u: &[],
         lambda: &[],
-        charts: &[],
+        charts,
     };
     model.sys.arena.eval(roots, &env)
 }

@@ -18,7 +18,9 @@
 //! | [`slidercrank`] | a slider-crank, with its loop as constraints and in closed form |
 //! | [`dc_motor`] | an arm driven by a DC motor under a sampled PI controller |
 //! | [`springpend`] | a point mass on a stiff spring (polar coordinates) |
-//! | [`tumble`] | a free body tumbling about its intermediate axis, on two sets of Euler angles |
+//! | [`tumble`] | a free body tumbling about its intermediate axis, on two sets of Euler angles and on a spherical joint |
+//! | [`top`] | a fast symmetric top on its tip whose axis passes through the vertical, on a spherical joint and on Euler angles |
+//! | [`spherical_pendulum`] | a ball on a rod swinging through the bottom, on a spherical joint and on Euler angles |
 //! | [`structural`] | models whose mass matrix is singular by construction |
 //! | [`undefined_force`] | a pendulum whose generalized force is undefined after, or from, t = 0.5 |
 
@@ -36,7 +38,9 @@ pub mod hexapod;
 pub mod pendulum3;
 pub mod seed2dof;
 pub mod slidercrank;
+pub mod spherical_pendulum;
 pub mod springpend;
 pub mod structural;
+pub mod top;
 pub mod tumble;
 pub mod undefined_force;

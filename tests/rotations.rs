@@ -259,3 +259,98 @@ fn every_scheme_runs_the_tumble_through_its_flips() {
         }
     }
 }
+
+/// The sleeping top — spinning upright, exactly where its ZYX angles lock — linearised in the
+/// chart centred on it: the poles are the closed form's, ±iω± with
+/// I1' ω² − L3 ω + m g l = 0 (L3 = I3 ω3, I1' the transverse inertia about the tip), and a
+/// double zero for the spin angle, which the equations do not depend on.
+#[test]
+fn the_sleeping_top_linearised_through_gimbal_lock_has_the_closed_form_poles() {
+    let (m, l, i1, i3, g, w3) = (0.1, 0.04, 2e-5, 4e-5, 9.81, 200.0);
+    let it = i1 + m * l * l;
+    let model = Top::default();
+    // upright: body x along world z, b = −π/2 in the identity chart; spin ω3 about body x
+    let q = [0.0, -std::f64::consts::FRAC_PI_2, 0.0];
+    let qd = [0.0, 0.0, w3];
+    let lin = mbs::linearize(&model, 0.0, &q, &qd, &[], mbs::IterationMatrix::Auto).unwrap();
+    assert_eq!(lin.charts.len(), 1);
+    assert_eq!(lin.q, vec![0.0; 3]);
+    let poles = mbs::modes(&lin, None).unwrap();
+    let mut im: Vec<f64> = poles.modes.iter().map(|p| p.im.abs()).collect();
+    im.sort_by(f64::total_cmp);
+    let l3 = i3 * w3;
+    let disc = (l3 * l3 - 4.0 * it * m * g * l).sqrt();
+    let (slow, fast) = ((l3 - disc) / (2.0 * it), (l3 + disc) / (2.0 * it));
+    println!(
+        "sleeping top: poles {:?}; closed form ±{slow:.6}i, ±{fast:.6}i",
+        poles.modes.iter().map(|p| (p.re, p.im)).collect::<Vec<_>>()
+    );
+    let re = poles.modes.iter().fold(0.0f64, |a, p| a.max(p.re.abs()));
+    assert!(re < 1e-9 * fast, "{re}");
+    let found: Vec<f64> = im.iter().copied().filter(|&w| w > 1e-6).collect();
+    assert_eq!(found.len(), 2, "{im:?}");
+    assert!((found[0] - slow).abs() < 1e-9 * slow && (found[1] - fast).abs() < 1e-9 * fast);
+    // slower, below L3² = 4 I1' m g l, the upright top is unstable: a real pole pair
+    let slow_top = mbs_models::top::TopParams {
+        w3: 50.0,
+        ..Default::default()
+    };
+    let model = Top::new(slow_top).unwrap();
+    let lin = mbs::linearize(
+        &model,
+        0.0,
+        &q,
+        &[0.0, 0.0, 50.0],
+        &[],
+        mbs::IterationMatrix::Auto,
+    )
+    .unwrap();
+    let unstable = mbs::modes(&lin, None)
+        .unwrap()
+        .modes
+        .iter()
+        .any(|p| p.re > 1.0);
+    assert!(unstable);
+}
+
+mbs::multibody! {
+    /// A spherical pendulum whose bob sits off the rod's axis (so that its spin about the rod
+    /// lifts it; only turning about the vertical is free): the ZYX angles of its start chart
+    /// are singular where the rod points down.
+    model OffsetPendulum {
+        dof a = 0.0; dof b = 0.0; dof c = 0.0;
+        body bob { mass = 1.0; inertia = (0.01, 0.02, 0.02); }
+        TOG[bob] = Tball(a, b, c) * Tdisp(1.0, 0.0, 0.2);
+        gravity(0, 0, -9.81);
+    }
+}
+
+/// The equilibrium of a spherical pendulum from a start 0.5 rad from hanging, the hanging
+/// position being where its ZYX chart at the start locks: Newton in a chart centred on the
+/// start finds it, stable in its two tilts.
+#[test]
+fn statics_find_an_equilibrium_where_the_starting_chart_locks() {
+    let model = OffsetPendulum::default();
+    let options = mbs::StaticsOptions {
+        q0: Some(vec![0.4, std::f64::consts::FRAC_PI_2 - 0.5, -0.3]),
+        ..Default::default()
+    };
+    let eq = mbs::static_equilibrium(&model, &options).unwrap();
+    println!("{eq}");
+    assert_eq!(eq.charts.len(), 1);
+    // the bob's centre hangs right below the pivot, at its distance √(1 + 0.2²)
+    let mut posed = model.clone();
+    posed.set_chart(0, eq.charts[0]);
+    let mut poses = vec![mbs::Pose::default(); 1];
+    posed.frames(0.0, &eq.q, &mut poses);
+    let p = poses[0].position;
+    let d = (1.0f64 + 0.04).sqrt();
+    assert!(
+        p[0].abs() < 1e-9 && p[1].abs() < 1e-9 && (p[2] + d).abs() < 1e-9,
+        "{p:?}"
+    );
+    // two stiff tilts; turning about the vertical through the pivot costs nothing
+    assert_eq!(eq.stability, mbs::Stability::Neutral);
+    let e = &eq.stiffness_eigenvalues;
+    assert!(e[0].abs() < 1e-9 && e[1] > 1.0 && e[2] > 1.0, "{e:?}");
+}

@@ -151,6 +151,38 @@ impl Recentring {
     }
 }
 
+/// Re-centres every rotation joint of `model` at (q, qd) (its angles become zero, its
+/// chart its orientation: the best-conditioned chart, whose angles are the small rotation
+/// in the joint's own axes, δ(a, b, c) ≈ (δθz, δθy, δθx)), except the joints with a
+/// coordinate in `keep` (coordinates held at their value); maps q and qd in place.
+pub fn recentre<M: Model>(model: &mut M, q: &mut [f64], qd: &mut [f64], keep: &[usize]) {
+    let joints = model.info().rotation_joints;
+    for (j, joint) in joints.iter().enumerate() {
+        if joint.angles.iter().any(|k| keep.contains(k)) {
+            continue;
+        }
+        let r = Recentring::at(j, joint, &model.chart(j), q, qd);
+        model.set_chart(j, r.chart);
+    }
+}
+
+/// The charts of every rotation joint of `model`.
+pub fn charts_of<M: Model>(model: &M) -> Vec<[[f64; 3]; 3]> {
+    (0..model.info().rotation_joints.len())
+        .map(|j| model.chart(j))
+        .collect()
+}
+
+/// Whether some rotation joint of `model` is read, at `q`, in a chart of quality below
+/// `threshold` (|cos b| < threshold).
+pub fn below<M: Model>(model: &M, q: &[f64], threshold: f64) -> bool {
+    model
+        .info()
+        .rotation_joints
+        .iter()
+        .any(|j| chart_quality(j, q) < threshold)
+}
+
 /// Re-centres every joint of `model` whose chart quality at `q` is below `threshold`:
 /// sets the model's charts, maps q, qd (and qdd) in place, and returns what moved.
 pub fn recentre_below<M: Model>(

@@ -92,6 +92,11 @@ pub struct Linearization {
     /// whether the constraint terms are exact: false when ∂γ/∂q or ∂(∂Φ/∂t)/∂q, taken by
     /// central differences, were not identically zero (moving states, rheonomic constraints)
     pub constraint_terms_exact: bool,
+    /// the charts of the rotation joints (`Tball`, `Tfree`) the linearisation is in: each
+    /// centred on the joint's orientation at the state, whose angles in `q` are then zero and
+    /// whose deviations δ(a, b, c) are the small rotation (δθz, δθy, δθx) in the joint's own
+    /// axes (empty without rotation joints)
+    pub charts: Vec<[[f64; 3]; 3]>,
 }
 
 /// K = ∂τ/∂q and C = ∂τ/∂qd at (q, qd, qdd), exact or by central differences of τ.
@@ -185,8 +190,11 @@ fn state_space(
 
 /// Linearises `model` about (t, q, qd, u); K and C by `how` (Auto: exact tangents when
 /// generated). With constraints, in the independent coordinates (see the module
-/// documentation); the state must then be consistent.
-pub fn linearize<M: Model>(
+/// documentation); the state must then be consistent. Rotation joints are first re-centred
+/// on their orientation at the state (q and qd read in the model's charts), so that their
+/// angles are linearised in their tangent space, away from gimbal lock
+/// ([`Linearization::charts`]).
+pub fn linearize<M: Model + Clone>(
     model: &M,
     t: f64,
     q: &[f64],
@@ -196,7 +204,6 @@ pub fn linearize<M: Model>(
 ) -> Result<Linearization, AnalysisError> {
     let n = M::NQ;
     let nu = M::NU;
-    let info = model.info();
     for (name, v, len) in [("q", q, n), ("qd", qd, n), ("u", u, nu)] {
         if v.len() != len {
             return Err(Failure::InvalidOption {
@@ -208,6 +215,29 @@ pub fn linearize<M: Model>(
         }
         check(model, name, v)?;
     }
+    if model.info().rotation_joints.is_empty() {
+        return linearize_in_chart(model, t, q, qd, u, how);
+    }
+    let mut centred = model.clone();
+    let (mut q, mut qd) = (q.to_vec(), qd.to_vec());
+    crate::charts::recentre(&mut centred, &mut q, &mut qd, &[]);
+    let mut lin = linearize_in_chart(&centred, t, &q, &qd, u, how)?;
+    lin.charts = crate::charts::charts_of(&centred);
+    Ok(lin)
+}
+
+/// [`linearize`] in the model's charts, the inputs checked.
+fn linearize_in_chart<M: Model>(
+    model: &M,
+    t: f64,
+    q: &[f64],
+    qd: &[f64],
+    u: &[f64],
+    how: IterationMatrix,
+) -> Result<Linearization, AnalysisError> {
+    let n = M::NQ;
+    let nu = M::NU;
+    let info = model.info();
     let (mut m, mut h) = (vec![0.0; n * n], vec![0.0; n]);
     model.dynamics(t, q, qd, u, &mut m, &mut h);
     check(model, "M", &m)?;
@@ -268,6 +298,7 @@ pub fn linearize<M: Model>(
             lambda: Vec::new(),
             constraint_tangent: DMatrix::zeros(0, 0),
             constraint_terms_exact: true,
+            charts: Vec::new(),
         });
     }
 
@@ -405,5 +436,6 @@ pub fn linearize<M: Model>(
         lambda,
         constraint_tangent: g,
         constraint_terms_exact,
+        charts: Vec::new(),
     })
 }

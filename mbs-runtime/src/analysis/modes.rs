@@ -13,6 +13,7 @@ use super::AnalysisError;
 use super::linearize::Linearization;
 use crate::error::Failure;
 use crate::linalg::{C64, Field, Lu};
+use nalgebra::DMatrix;
 use serde::Serialize;
 use std::fmt;
 use std::io::{self, Write};
@@ -47,6 +48,28 @@ pub struct Modes {
     pub modes: Vec<Mode>,
 }
 
+/// The eigenvalues of A from its Schur form. nalgebra's QR iteration can cycle on matrices
+/// of exact structure (seen on the sleeping top's: zeros and equal entries where the
+/// exceptional shifts never break the tie) and `complex_eigenvalues` iterates without bound;
+/// here the iterations are bounded, and a matrix the iteration cannot reduce is tried again
+/// after a similarity by a fixed Householder reflection (same eigenvalues, no structure),
+/// then reported as an error rather than a hang.
+fn eigenvalues(a: &DMatrix<f64>) -> Result<Vec<nalgebra::Complex<f64>>, AnalysisError> {
+    let n = a.nrows();
+    let schur = |m: DMatrix<f64>| nalgebra::linalg::Schur::try_new(m, f64::EPSILON, 200 * n);
+    let s = schur(a.clone()).or_else(|| {
+        let v = nalgebra::DVector::from_fn(n, |i, _| 1.0 + (i as f64 * 0.618_034).fract());
+        let h = DMatrix::identity(n, n) - (&v * v.transpose()) * (2.0 / v.norm_squared());
+        schur(&h * a * &h)
+    });
+    let s = s.ok_or(Failure::SingularMatrix {
+        matrix: "A (its Schur decomposition did not converge)",
+        rcond: 0.0,
+        coordinates: Vec::new(),
+    })?;
+    Ok(s.complex_eigenvalues().iter().copied().collect())
+}
+
 /// Computes the modes of `lin` whose frequency is within `window` (Hz, inclusive), or all.
 pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, AnalysisError> {
     let n2 = lin.a.nrows();
@@ -65,7 +88,7 @@ pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, A
             modes: Vec::new(),
         });
     }
-    let eig = lin.a.clone().complex_eigenvalues();
+    let eig = eigenvalues(&lin.a)?;
     let scale = lin.a.iter().fold(1.0f64, |m, x| m.max(x.abs()));
     let mut out = Vec::new();
     let mut lu = Lu::<C64>::new(n2);

@@ -96,6 +96,10 @@ pub struct Equilibrium {
     pub lambda: Vec<f64>,
     /// largest |Φ_i| at `q` (0 without constraints)
     pub constraint_residual: f64,
+    /// the charts of the rotation joints (`Tball`, `Tfree`) `q` is read in: centred on each
+    /// joint's orientation at the start, and again on the equilibrium's if Newton took a
+    /// joint towards its chart's gimbal lock (empty without rotation joints)
+    pub charts: Vec<[[f64; 3]; 3]>,
 }
 
 impl Equilibrium {
@@ -193,7 +197,11 @@ pub(super) fn stiffness<M: Model>(
 
 /// Finds q with h(q, 0, t, u) = 0 on the free coordinates, from `options.q0`; with
 /// constraints, q and λ with h(q, 0, t, u) + Bᵀλ = 0 on the free coordinates and Φ(q, t) = 0.
-pub fn static_equilibrium<M: Model>(
+/// Rotation joints (`Tball`, `Tfree`) whose angles are free are solved for in charts centred
+/// on their orientation at `q0` (`q0` read in the model's charts); when Newton ends a joint
+/// far from its chart's centre (|cos b| < 0.5), it starts again there in a chart centred on
+/// it ([`Equilibrium::charts`]).
+pub fn static_equilibrium<M: Model + Clone>(
     model: &M,
     options: &StaticsOptions,
 ) -> Result<Equilibrium, AnalysisError> {
@@ -247,11 +255,33 @@ pub fn static_equilibrium<M: Model>(
     }
     check(model, "q0", &q)?;
     let free: Vec<usize> = (0..n).filter(|i| !options.locked.contains(i)).collect();
-    if M::NC == 0 {
-        unconstrained(model, options, q, &u, &free)
-    } else {
-        constrained(model, options, q, &u, &free)
+    let solve = |model: &M, q: Vec<f64>| {
+        if M::NC == 0 {
+            unconstrained(model, options, q, &u, &free)
+        } else {
+            constrained(model, options, q, &u, &free)
+        }
+    };
+    if model.info().rotation_joints.is_empty() {
+        return solve(model, q);
     }
+    let mut centred = model.clone();
+    let (mut q, mut zero) = (q, vec![0.0; n]);
+    crate::charts::recentre(&mut centred, &mut q, &mut zero, &options.locked);
+    let mut eq = solve(&centred, q)?;
+    // a restart or two, each from a chart centred on where Newton went
+    for _ in 0..3 {
+        if !crate::charts::below(&centred, &eq.q, 0.5) {
+            break;
+        }
+        let mut q = eq.q.clone();
+        crate::charts::recentre(&mut centred, &mut q, &mut zero, &options.locked);
+        let done = eq.iterations;
+        eq = solve(&centred, q)?;
+        eq.iterations += done;
+    }
+    eq.charts = crate::charts::charts_of(&centred);
+    Ok(eq)
 }
 
 fn unconstrained<M: Model>(
@@ -337,6 +367,7 @@ fn unconstrained<M: Model>(
         constraint_names: Vec::new(),
         lambda: Vec::new(),
         constraint_residual: 0.0,
+        charts: Vec::new(),
     })
 }
 
@@ -570,6 +601,7 @@ fn constrained<M: Model>(
         stability,
         constraint_names: names.iter().map(|s| s.to_string()).collect(),
         lambda,
+        charts: Vec::new(),
     })
 }
 

@@ -354,3 +354,65 @@ fn statics_find_an_equilibrium_where_the_starting_chart_locks() {
     let e = &eq.stiffness_eigenvalues;
     assert!(e[0].abs() < 1e-9 && e[1] > 1.0 && e[2] > 1.0, "{e:?}");
 }
+
+/// What a trajectory says of a rotation joint is continuous across re-centrings: the poses
+/// (which the HTML animation and the glTF file play) and the quaternion columns, while the
+/// angles jump; each output's chart and angles give its pose back.
+#[test]
+fn outputs_are_continuous_across_recentrings() {
+    let o = Options {
+        t_end: 20.0,
+        output: Output::Every { dt: 0.01 },
+        frames: true,
+        ..adaptive(20.0, 1e-8)
+    };
+    let (tr, st) = simulate(TumbleBall::default(), Scheme::Dopri5, turned(o)).unwrap();
+    assert!(st.chart_switches >= 2);
+    assert_eq!(tr.joint_names, vec!["b".to_string()]);
+    let charts: Vec<u32> = (0..tr.len()).map(|i| tr.chart_numbers(i)[0]).collect();
+    assert_eq!(*charts.last().unwrap() as usize, st.chart_switches);
+    assert_eq!(tr.charts[0].len(), st.chart_switches + 1);
+    let (mut jumps, mut worst_pose, mut worst_step) = (0, 0.0f64, 0.0f64);
+    for i in 0..tr.len() {
+        // the pose, the quaternion and chart · Rz(a) Ry(b) Rx(c) agree
+        let pose = tr.poses_at(i)[0].rotation;
+        let quat = matrix(tr.orientation(i));
+        let c = tr.chart(i, 0);
+        let q = tr.q(i);
+        let e = mbs::charts::zyx([q[0], q[1], q[2]]);
+        for r in 0..3 {
+            for k in 0..3 {
+                let ce: f64 = (0..3).map(|m| c[r][m] * e[(m, k)]).sum();
+                worst_pose = worst_pose
+                    .max((pose[r][k] - quat[r][k]).abs())
+                    .max((ce - quat[r][k]).abs());
+            }
+        }
+        if i > 0 {
+            // |ω| ≤ 10.1 rad/s: a quaternion moves by at most ½|ω|dt per output
+            let dq: f64 = (0..4)
+                .map(|k| (tr.orientation(i)[k] - tr.orientation(i - 1)[k]).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            worst_step = worst_step.max(dq);
+            let da = (0..3)
+                .map(|k| (q[k] - tr.q(i - 1)[k]).abs())
+                .fold(0.0, f64::max);
+            jumps += (charts[i] != charts[i - 1] && da > 0.2) as usize;
+        }
+    }
+    println!(
+        "{} outputs, {} charts: poses vs quaternions vs chart·E(q) {worst_pose:.1e}, largest quaternion step {worst_step:.3}, {jumps} jumps of the angles at re-centrings",
+        tr.len(),
+        st.chart_switches + 1
+    );
+    assert!(worst_pose < 1e-12);
+    assert!(worst_step < 0.5 * 10.1 * 0.01 * 1.01);
+    assert!(jumps >= 1);
+    // the CSV carries the quaternion and the chart number
+    let mut csv = Vec::new();
+    tr.write_csv(&mut csv).unwrap();
+    let text = String::from_utf8(csv).unwrap();
+    let header = text.lines().next().unwrap();
+    assert!(header.contains(",b.qx,b.qy,b.qz,b.qw,b.chart,"), "{header}");
+}

@@ -42,7 +42,10 @@ fn hexapod_sizes_and_names() {
     let info = model.info();
     assert_eq!(Hexapod::NQ, 24);
     assert_eq!(info.is_body.iter().filter(|&&b| b).count(), 49);
-    assert_eq!(Hexapod::NPOINTS, 6);
+    // the six feet, then the base's eight corners
+    assert_eq!(Hexapod::NPOINTS, 14);
+    assert_eq!(info.points[5], "foot[5]");
+    assert_eq!(info.points[6], "corner[0]");
     assert_eq!(
         &info.dofs[..9],
         ["x", "y", "z", "psi", "theta", "phi", "a[0]", "b[0]", "c[0]"]
@@ -113,7 +116,7 @@ fn hexapod_feet_hang_above_the_ground_at_the_start() {
     model.initial_state(&mut q, &mut qd);
     let mut kin = mbs::Kinematics::new::<Hexapod>();
     model.kinematics(0.0, &q, &qd, &mut kin);
-    for (k, foot) in kin.points.iter().enumerate() {
+    for (k, foot) in kin.points[..6].iter().enumerate() {
         let z = foot.position[2];
         assert!((0.0..0.02).contains(&z), "foot {k} at height {z}");
     }

@@ -75,7 +75,8 @@ fn foot_forces(model: &HexapodStanding, q: &[f64], qd: &[f64]) -> Vec<(f64, f64,
     let p = model.params();
     let mut kin = Kinematics::new::<HexapodStanding>();
     model.kinematics(0.0, q, qd, &mut kin);
-    kin.points
+    // the six feet are the first points (the base's corners follow)
+    kin.points[..6]
         .iter()
         .map(|foot| {
             let (z, v) = (foot.position[2], foot.velocity);

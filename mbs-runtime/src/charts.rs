@@ -166,6 +166,15 @@ pub fn recentre<M: Model>(model: &mut M, q: &mut [f64], qd: &mut [f64], keep: &[
     }
 }
 
+/// Sets the charts of `model` to those output `i` of `tr` was read in, so that the model's
+/// functions (kinematics, energies, M and h) evaluate that output's q and qd as the
+/// simulation did.
+pub fn use_charts_of<M: Model>(model: &mut M, tr: &crate::Trajectory, i: usize) {
+    for j in 0..tr.joint_names.len() {
+        model.set_chart(j, tr.chart(i, j));
+    }
+}
+
 /// The charts of every rotation joint of `model`.
 pub fn charts_of<M: Model>(model: &M) -> Vec<[[f64; 3]; 3]> {
     (0..model.info().rotation_joints.len())

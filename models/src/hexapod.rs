@@ -1,6 +1,11 @@
 //! hexapod: a 24-dof, 49-body walking robot in the spirit of the seed's AMRU5
 //! (`tests/reference/MODELS.md`). Used by `examples/hexapod.rs`, `tests/hexapod_model.rs`,
-//! `tests/hexapod_standing.rs` and the benchmarks.
+//! `tests/hexapod_standing.rs`, `tests/hexapod_somersault.rs` and the benchmarks.
+//!
+//! The base is on a free joint, `Tfree(x, y, z, psi, theta, phi)`: (x, y, z) its position in
+//! world axes, (psi, theta, phi) ZYX angles in a chart the runtime re-centres before the
+//! pitch theta reaches ±90°, so the robot may turn over. The points `corner[0..8]` are the
+//! base's corners (±0.5, ±0.3, ±0.075).
 //!
 //! Legs are numbered k = 2i + j with the hip at (hx_i, hy_j, 0) in the base frame,
 //! hx = (0.4, 0, −0.4), hy = (0.3, −0.3): 0 front left, 1 front right, 2 middle left, … 5 rear
@@ -10,9 +15,10 @@
 //! the pantograph link and coupler follow their products literally (no closed loop), the motor
 //! rotors turn 100 times as fast as their joints.
 //!
-//! Two scenes: `Free` (gravity only; also named `Hexapod`, the type of the contact-free
-//! figures) and `Standing` (`HexapodStanding`: the feet's ground contact and a PD controller
-//! on every leg joint). Dropped from the start, the standing robot comes to rest in about
+//! Three scenes: `Free` (gravity only; also named `Hexapod`, the type of the contact-free
+//! figures), `Standing` (`HexapodStanding`: the feet's ground contact and a PD controller
+//! on every leg joint) and `Tumbling` (`HexapodTumbling`: `Standing` with the base's corners
+//! in ground contact too, for a robot that lands on its back or side). Dropped from the start, the standing robot comes to rest in about
 //! 2.5 s on its middle and rear feet: every leg points forward (+x) from its hip, so the feet
 //! stand in rows at x ≈ 0.78, 0.38, −0.01 m and the centre of mass (x ≈ 0.09 m) is behind the
 //! middle row; the front feet hang 0.6 mm above the ground.
@@ -133,11 +139,27 @@ mbs::multibody! {
             }
         }
 
+        // Ground contact of the base's eight corners, for a robot that lands on its back or
+        // side (the scene `Tumbling`).
+        for i in 0..2 {
+            for j in 0..2 {
+                for k in 0..2 {
+                    point corner[4 * i + 2 * j + k] on base at (0.5 * (1 - 2 * i), 0.3 * (1 - 2 * j), 0.075 * (1 - 2 * k));
+                }
+            }
+        }
+        effect hull {
+            for i in 0..8 {
+                contact(corner[i], k = k_contact, c = c_contact, mu = mu, eps = eps);
+            }
+        }
+
         scene Free = [];
         scene Standing = [contact, pd];
+        scene Tumbling = [contact, pd, hull];
     }
 }
 
 /// The hexapod without contact or controllers (gravity only): the type of the contact-free
-/// figures (M+h 5,760 flops).
+/// figures (M+h 6,192 flops).
 pub type Hexapod = HexapodFree;

@@ -12,7 +12,8 @@
 //!   roll–pitch–yaw, R = Rz·Ry·Rx) then its motion: `Trotx/y/z(q)` about a coordinate axis,
 //!   `Trotn(nx, ny, nz, q)` about another, `Tdisp` along the axis for a prismatic joint;
 //! - `fixed` joints merge the child's mass and inertia into its parent (a massless child
-//!   stays a `frame`); `floating` is three translations and the Euler angles z, y, x; `planar`
+//!   stays a `frame`); `floating` is `Tfree`: three translations and the Euler angles z, y, x
+//!   in a chart the runtime re-centres before gimbal lock; `planar`
 //!   two translations in the plane and a rotation about its normal; a `mimic` joint follows
 //!   its leader (`multiplier * leader + offset`) without a coordinate of its own;
 //! - the root link is the ground (or, with [`ImportOptions::floating_base`], a body on a
@@ -1341,8 +1342,9 @@ impl<'a> Writer<'a> {
                     .collect();
                 let _ = writeln!(
                     self.dofs,
-                    "        // floating joint `{}`: position, then Euler angles about z (yaw), y \
-                     (pitch), x (roll);\n        // the orientation is singular at pitch = ±π/2",
+                    "        // floating joint `{}`: position in the parent's axes, then Euler angles about \
+                     z (yaw), y (pitch), x (roll)\n        // read in a chart the runtime re-centres \
+                     before pitch reaches ±π/2 (`Tfree`)",
                     joint.name
                 );
                 for n in &names {
@@ -1542,10 +1544,10 @@ impl<'a> Writer<'a> {
                 });
             }
             JointKind::Floating => {
-                f.push(format!("Tdisp({}, {}, {})", m[0], m[1], m[2]));
-                f.push(format!("Trotz({})", m[5]));
-                f.push(format!("Troty({})", m[4]));
-                f.push(format!("Trotx({})", m[3]));
+                f.push(format!(
+                    "Tfree({}, {}, {}, {}, {}, {})",
+                    m[0], m[1], m[2], m[5], m[4], m[3]
+                ));
             }
             JointKind::Planar => {
                 let (x, y, th) = (&m[0], &m[1], &m[2]);

@@ -237,8 +237,8 @@ mbs::multibody! {
         param free_dz = 1.0;
         param table_dx = 2.0;
         param wall_dy = 0.3;
-        // floating joint `free`: position, then Euler angles about z (yaw), y (pitch), x (roll);
-        // the orientation is singular at pitch = ±π/2
+        // floating joint `free`: position in the parent's axes, then Euler angles about z (yaw), y (pitch), x (roll)
+        // read in a chart the runtime re-centres before pitch reaches ±π/2 (`Tfree`)
         dof free_x = 0.0;
         dof free_y = 0.0;
         dof free_z = 0.0;
@@ -256,7 +256,7 @@ mbs::multibody! {
         body drone { mass = drone_m; inertia = (drone_ixx, drone_iyy, drone_izz, drone_ixy, drone_ixz, drone_iyz); }
         body sled { mass = sled_m; inertia = (sled_ixx, sled_iyy, sled_izz); }
         body puck { mass = puck_m; inertia = (puck_ixx, puck_iyy, puck_izz); }
-        TOG[drone] = Tdisp(0, 0, free_dz) * Tdisp(free_x, free_y, free_z) * Trotz(free_yaw) * Troty(free_pitch) * Trotx(free_roll) * Tdisp(drone_cx, 0, drone_cz);
+        TOG[drone] = Tdisp(0, 0, free_dz) * Tfree(free_x, free_y, free_z, free_yaw, free_pitch, free_roll) * Tdisp(drone_cx, 0, drone_cz);
         TOG[sled] = Tdisp(table_dx, 0, 0) * Tdisp(table_x, table_y, 0) * Trotz(table_theta);
         TOG[puck] = TOG[sled] * Tdisp(0, wall_dy, 0) * Tdisp(wall_y, (-0.8) * wall_x, 0.6 * wall_x) * Trotn(0.0, 0.6, 0.8, wall_theta) * Tdisp(puck_cx, 0, 0);
         gravity(0, 0, -g);
@@ -292,8 +292,8 @@ mbs::multibody! {
         // joint origins in the parent link frame (m)
         param gimbal_dx = 0.1;
         param gimbal_dz = -0.05;
-        // floating joint `floating_base`: position, then Euler angles about z (yaw), y (pitch), x (roll);
-        // the orientation is singular at pitch = ±π/2
+        // floating joint `floating_base`: position in the parent's axes, then Euler angles about z (yaw), y (pitch), x (roll)
+        // read in a chart the runtime re-centres before pitch reaches ±π/2 (`Tfree`)
         dof floating_base_x = 0.0;
         dof floating_base_y = 0.0;
         dof floating_base_z = 0.0;
@@ -304,7 +304,7 @@ mbs::multibody! {
         body base_link { mass = base_link_m; inertia = (base_link_ixx, base_link_iyy, base_link_izz, base_link_ixy, base_link_ixz, base_link_iyz); }
         body camera { mass = camera_m; inertia = (camera_ixx, camera_iyy, camera_izz); }
         frame base_link_frame;
-        TOG[base_link_frame] = Tdisp(floating_base_x, floating_base_y, floating_base_z) * Trotz(floating_base_yaw) * Troty(floating_base_pitch) * Trotx(floating_base_roll);
+        TOG[base_link_frame] = Tfree(floating_base_x, floating_base_y, floating_base_z, floating_base_yaw, floating_base_pitch, floating_base_roll);
         TOG[base_link] = TOG[base_link_frame] * Tdisp(base_link_cx, 0, base_link_cz);
         TOG[camera] = TOG[base_link_frame] * Tdisp(gimbal_dx, 0, gimbal_dz) * Troty(gimbal) * Tdisp(camera_cx, 0, camera_cz);
         shape base_link: box(0.4, 0.4, 0.06, at = ((-0.01), 0.0, 0.02));

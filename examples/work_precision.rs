@@ -5,8 +5,8 @@
 //! cargo run --release --example work_precision -- --model dpend --out docs/figures
 //! ```
 //!
-//! `--model` is seed2dof, dpend, chain8, slidercrank, hexapod, fourbar, pendulum3, fastlink or
-//! all; `--out DIR` writes
+//! `--model` is seed2dof, dpend, chain8, slidercrank, hexapod, fourbar, pendulum3, fastlink,
+//! tumble, top or all; `--out DIR` writes
 //! `DIR/wp_MODEL.csv` and `DIR/wp_MODEL.svg`; `--repeats N` times each run N times and keeps
 //! the best (default 5; fewer for a run past 1 s). Each model in its natural setting:
 //!
@@ -32,6 +32,14 @@
 //!   Radau5 and generalized-α in the stabilized index-2 form where the scheme accepts it (the
 //!   output says when it is refused and skipped).
 //!
+//! - tumble (`TumbleBall`, the body on a spherical joint) to 10 s from MODELS.md's start,
+//!   every 0.25 s, against a self-computed reference (DOPRI5 at rtol 1e-13, checked by Radau5
+//!   at 1e-13), with DOPRI5, Radau5, BDF and generalized-α on its ZYX twin (`Tumble`, which
+//!   survives this start) measured the same way (rotations as matrices and angular
+//!   velocities, `Study::euler_angles`);
+//! - top (`Top`, on its spherical joint) to 2 s, every 0.05 s, likewise; its ZYX twin
+//!   (`TopZyx`) stops at the axis's first passage through the vertical, and its rows say so.
+//!
 //! Every study prints its table (failures included), the cheapest run per scheme to 3, 5, 7
 //! and 9 significant digits, and how long it took. Points with no correct digit (error ≥ 1)
 //! are in the table and the CSV but not on the chart.
@@ -44,6 +52,8 @@ use mbs_models::hexapod;
 use mbs_models::pendulum3;
 use mbs_models::seed2dof;
 use mbs_models::slidercrank;
+use mbs_models::top;
+use mbs_models::tumble;
 
 use clap::Parser;
 use mbs::work_precision::{Reference, Setting, Study, Sweep, WorkPrecision, decades, halvings};
@@ -56,7 +66,8 @@ use std::time::Instant;
 
 #[derive(Parser, Debug)]
 struct Args {
-    /// seed2dof, dpend, chain8, slidercrank, hexapod, fourbar, pendulum3, fastlink or all
+    /// seed2dof, dpend, chain8, slidercrank, hexapod, fourbar, pendulum3, fastlink, tumble,
+    /// top or all
     #[arg(long, default_value = "all")]
     model: String,
     /// write DIR/wp_MODEL.csv and DIR/wp_MODEL.svg
@@ -67,7 +78,7 @@ struct Args {
     repeats: usize,
 }
 
-const MODELS: [&str; 8] = [
+const MODELS: [&str; 10] = [
     "seed2dof",
     "dpend",
     "chain8",
@@ -76,6 +87,8 @@ const MODELS: [&str; 8] = [
     "fourbar",
     "pendulum3",
     "fastlink",
+    "tumble",
+    "top",
 ];
 
 fn newmark() -> Scheme {
@@ -395,6 +408,87 @@ fn study(name: &str, repeats: usize) -> WorkPrecision {
                 ..Study::new("fastlink", r)
             });
             s.run(&fastlink::FastLink::default()).expect("study")
+        }
+        "tumble" => {
+            // the body on a spherical joint; its ZYX twin, which survives this start (closest
+            // |cos b| 0.19), measured the same way against the same reference
+            let model = tumble::TumbleBall::default();
+            let r = Reference::compute(
+                &model,
+                samples(10.0, 40),
+                (Scheme::Dopri5, Setting::Rtol(1e-13)),
+                Some((Scheme::Radau5, Setting::Rtol(1e-13))),
+                &mbs::Options::default(),
+            )
+            .expect("reference run");
+            let plan = Plan {
+                dopri5: (3, 12),
+                bdf: (3, 11),
+                radau3: (3, 11),
+                radau5: (3, 12),
+                order2: (3, 9),
+                rk4: (0.02, 8),
+                midpoint: (0.01, 7),
+                euler: None,
+            };
+            let s = finish(Study {
+                sweeps: sweeps(&plan),
+                ..Study::new("tumble (Tball)", r.clone())
+            });
+            let mut wp = s.run(&model).expect("study");
+            let euler = finish(Study {
+                sweeps: vec![
+                    Sweep::adaptive(Scheme::Dopri5, &decades(3, 12)).labelled("dopri5 ZYX"),
+                    Sweep::adaptive(Scheme::Radau5, &decades(3, 12)).labelled("radau5 ZYX"),
+                    Sweep::adaptive(bdf(), &decades(3, 11)).labelled("bdf ZYX"),
+                    Sweep::adaptive(gen_alpha(), &decades(3, 9)).labelled("gen-alpha ZYX"),
+                ],
+                euler_angles: vec![[0, 1, 2]],
+                ..Study::new("tumble (ZYX)", r)
+            });
+            let zyx = euler.run(&tumble::Tumble::default()).expect("study");
+            wp.rows.extend(zyx.rows);
+            wp.title = "tumble (Tball, and ZYX angles)".into();
+            wp
+        }
+        "top" => {
+            // the top on a spherical joint; its ZYX twin stops at the first passage of the
+            // axis through the vertical (its rows say so)
+            let model = top::Top::default();
+            let r = Reference::compute(
+                &model,
+                samples(2.0, 40),
+                (Scheme::Dopri5, Setting::Rtol(1e-13)),
+                Some((Scheme::Radau5, Setting::Rtol(1e-13))),
+                &mbs::Options::default(),
+            )
+            .expect("reference run");
+            let plan = Plan {
+                dopri5: (3, 12),
+                bdf: (3, 11),
+                radau3: (3, 11),
+                radau5: (3, 12),
+                order2: (3, 9),
+                rk4: (2e-3, 7),
+                midpoint: (1e-3, 7),
+                euler: None,
+            };
+            let s = finish(Study {
+                sweeps: sweeps(&plan),
+                ..Study::new("top (Tball)", r.clone())
+            });
+            let mut wp = s.run(&model).expect("study");
+            let euler = finish(Study {
+                sweeps: vec![
+                    Sweep::adaptive(Scheme::Dopri5, &[1e-4, 1e-7, 1e-10]).labelled("dopri5 ZYX"),
+                ],
+                euler_angles: vec![[0, 1, 2]],
+                ..Study::new("top (ZYX)", r)
+            });
+            wp.rows
+                .extend(euler.run(&top::TopZyx::default()).expect("study").rows);
+            wp.title = "top (Tball, and ZYX angles)".into();
+            wp
         }
         other => {
             eprintln!("unknown model `{other}`: use {} or all", MODELS.join(", "));

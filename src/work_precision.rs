@@ -6,7 +6,10 @@
 //! work–precision diagram (error against CPU time, log–log, one line per scheme) through
 //! [`crate::plot`].
 //!
-//! **Error measure.** The state is y = (q, qd), all coordinates then all velocities. At a
+//! **Error measure.** The state is y = (q, qd), all coordinates then all velocities; a
+//! rotation joint (`Tball`, `Tfree`, or Euler angles named by [`Study::euler_angles`]) is
+//! measured without its chart: its three angles by the nine entries of its rotation, its
+//! rates by its angular velocity in its own axes ([`state_size`]). At a
 //! sampled time t the error of a run is the mixed relative error of the Test Set for IVP
 //! Solvers (Mazzia & Magherini), with an absolute floor `a` for components near zero:
 //!
@@ -54,8 +57,8 @@
 
 use crate::plot::{Chart, PlotError, Series};
 use crate::{
-    ConstraintMethod, Failure, Model, Options, Output, Scheme, SimError, Stats, StepControl,
-    Trajectory, simulate,
+    ConstraintMethod, Failure, Model, Options, Output, RotationJoint, Scheme, SimError, Stats,
+    StepControl, Trajectory, simulate,
 };
 use std::fmt::{self, Write as _};
 use std::path::Path;
@@ -332,7 +335,7 @@ impl Reference {
         let check_states = match check {
             Some((scheme, setting)) => {
                 let (tc, _) = simulate(model.clone(), scheme, opts(setting)).map_err(Box::new)?;
-                Some(states_of(&tc))
+                Some(states_of(&tc, model.info().rotation_joints))
             }
             None => None,
         };
@@ -345,7 +348,7 @@ impl Reference {
                 check,
                 note: String::new(),
             },
-            states: states_of(&tr),
+            states: states_of(&tr, model.info().rotation_joints),
             times,
             check: check_states,
         })
@@ -396,11 +399,60 @@ impl Reference {
     }
 }
 
-/// (q, qd) of every output of a trajectory.
-fn states_of(tr: &Trajectory) -> Vec<Vec<f64>> {
+/// The state a run is measured by at every output of a trajectory: (q, qd), each rotation
+/// joint's three angles replaced by the nine entries of its rotation (row-major) and its
+/// three rates by its angular velocity in its own axes, which do not depend on the chart the
+/// angles are read in ([`state_size`] numbers).
+fn states_of(tr: &Trajectory, joints: &[RotationJoint]) -> Vec<Vec<f64>> {
     (0..tr.len())
-        .map(|i| tr.q(i).iter().chain(tr.qd(i)).copied().collect())
+        .map(|i| {
+            let (q, qd) = (tr.q(i), tr.qd(i));
+            if joints.is_empty() {
+                return q.iter().chain(qd).copied().collect();
+            }
+            let mut y = Vec::with_capacity(state_size(q.len(), joints.len()));
+            let angle = |k: usize| joints.iter().position(|j| j.angles.contains(&k));
+            for k in 0..q.len() {
+                match angle(k) {
+                    Some(j) if joints[j].angles[0] == k => {
+                        // Euler angles of a model without charts: the identity
+                        let chart = if j < tr.joint_names.len() {
+                            tr.chart(i, j)
+                        } else {
+                            crate::IDENTITY3
+                        };
+                        let r = crate::charts::joint_rotation(&chart, &joints[j], q);
+                        let m = r.to_rotation_matrix();
+                        y.extend((0..9).map(|e| m[(e / 3, e % 3)]));
+                    }
+                    Some(_) => {}
+                    None => y.push(q[k]),
+                }
+            }
+            for k in 0..q.len() {
+                match angle(k) {
+                    Some(j) if joints[j].angles[0] == k => {
+                        let [a, b, c] = joints[j].angles;
+                        y.extend(crate::charts::body_rates(
+                            [q[a], q[b], q[c]],
+                            [qd[a], qd[b], qd[c]],
+                        ));
+                    }
+                    Some(_) => {}
+                    None => y.push(qd[k]),
+                }
+            }
+            y
+        })
         .collect()
+}
+
+/// The length of a measured state ([`Reference`]'s states) of a model with `nq` coordinates
+/// and `joints` rotation joints (`Tball`, `Tfree`): q then qd, each joint's angles as the 9
+/// entries of its rotation and its rates as its angular velocity in its own axes, in place
+/// of its first angle and first rate.
+pub fn state_size(nq: usize, joints: usize) -> usize {
+    2 * nq + 6 * joints
 }
 
 /// max_i |y_i − r_i| / (a + |r_i|): the Test Set's mixed error with absolute floor `a`.
@@ -436,6 +488,10 @@ pub struct Study {
     /// everything else of a run (t0, initial state, constraint options, iteration matrix,
     /// max_steps …); its t_end, step, output and energy are set by the study
     pub options: Options,
+    /// ZYX Euler angles (a, b, c) of a model without rotation joints, measured as a rotation
+    /// joint's are (its rotation and angular velocity, [`state_size`]), so that the model
+    /// compares with a twin on `Tball`/`Tfree` against the same reference (default none)
+    pub euler_angles: Vec<[usize; 3]>,
 }
 
 /// Why a study could not run.
@@ -448,7 +504,9 @@ pub enum StudyError {
     BadTimes { t0: f64, times: Vec<f64> },
     #[error("the reference has {states} states for {times} times")]
     StatesTimes { states: usize, times: usize },
-    #[error("reference state {index} has {len} components; the model needs {expected} (q then qd)")]
+    #[error(
+        "reference state {index} has {len} components; the model needs {expected} (q then qd, a rotation joint's angles as the 9 entries of its rotation and its rates as its angular velocity)"
+    )]
     StateSize {
         index: usize,
         len: usize,
@@ -475,6 +533,7 @@ impl Study {
             repeat_budget: Duration::from_secs(1),
             clock: Clock::best(),
             options: Options::default(),
+            euler_angles: Vec::new(),
         }
     }
 
@@ -507,7 +566,7 @@ impl Study {
         o
     }
 
-    fn validate(&self, nq: usize) -> Result<(), StudyError> {
+    fn validate(&self, nq: usize, joints: usize) -> Result<(), StudyError> {
         let r = &self.reference;
         if r.times.is_empty() {
             return Err(StudyError::NoTimes);
@@ -529,11 +588,12 @@ impl Study {
                     times: r.times.len(),
                 });
             }
-            if let Some((index, y)) = states.iter().enumerate().find(|(_, y)| y.len() != 2 * nq) {
+            let expected = state_size(nq, joints);
+            if let Some((index, y)) = states.iter().enumerate().find(|(_, y)| y.len() != expected) {
                 return Err(StudyError::StateSize {
                     index,
                     len: y.len(),
-                    expected: 2 * nq,
+                    expected,
                 });
             }
         }
@@ -558,7 +618,7 @@ impl Study {
 
     /// Runs every setting of every sweep on a clone of `model`, in order, one at a time.
     pub fn run<M: Model + Clone + 'static>(&self, model: &M) -> Result<WorkPrecision, StudyError> {
-        self.validate(M::NQ)?;
+        self.validate(M::NQ, self.joints(model).len())?;
         let mut rows = Vec::new();
         for sweep in &self.sweeps {
             for &setting in &sweep.settings {
@@ -575,6 +635,7 @@ impl Study {
             repeats: self.repeats,
             clock: self.clock,
             reference_error: self.reference.estimated_error(self.floor),
+            rotations: !self.joints(model).is_empty(),
             rows,
         })
     }
@@ -629,9 +690,21 @@ impl Study {
         }
     }
 
+    /// The rotation joints a run is measured by: the model's, or `euler_angles` read as
+    /// joints with the identity chart.
+    fn joints<M: Model>(&self, model: &M) -> Vec<RotationJoint> {
+        let mut joints = model.info().rotation_joints.to_vec();
+        joints.extend(self.euler_angles.iter().map(|&angles| RotationJoint {
+            frame: 0,
+            angles,
+            translation: None,
+        }));
+        joints
+    }
+
     fn measure<M: Model>(&self, model: &M, tr: &Trajectory) -> Result<Accuracy, RunFailure> {
         let r = &self.reference;
-        let y = states_of(tr);
+        let y = states_of(tr, &self.joints(model));
         let times_match = y.len() == r.times.len()
             && tr
                 .t
@@ -742,6 +815,9 @@ pub struct WorkPrecision {
     pub clock: Clock,
     /// the reference's estimated error (at t_end, max over samples), when it was checked
     pub reference_error: Option<(f64, f64)>,
+    /// whether rotations are measured by their matrices and angular velocities (a model with
+    /// rotation joints or [`Study::euler_angles`])
+    pub rotations: bool,
     pub rows: Vec<Row>,
 }
 
@@ -914,9 +990,14 @@ impl fmt::Display for WorkPrecision {
         }
         writeln!(
             f,
-            "error e(t) = max_i |y_i − y_ref,i| / ({} + |y_ref,i|) over y = (q, qd); mescd = −log10 e(t_end); \
+            "error e(t) = max_i |y_i − y_ref,i| / ({} + |y_ref,i|) over y = (q, qd){}; mescd = −log10 e(t_end); \
              e_max over {} sampled times; adaptive runs at atol = {}·rtol",
             short(self.floor),
+            if self.rotations {
+                ", rotations as matrices and angular velocities"
+            } else {
+                ""
+            },
             self.samples,
             short(self.atol_factor)
         )?;

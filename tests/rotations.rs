@@ -9,75 +9,11 @@
 //!   stops: energy and vertical angular momentum drift ≤ 1e-8 over 2 s at rtol 1e-10;
 //! - a spherical pendulum swinging through the bottom (`SphericalPendulum`), likewise.
 
-use mbs::charts::body_rates;
-use mbs::{Failure, Model, Options, Output, Scheme, StepControl, Trajectory, simulate};
+use mbs::{Failure, Model, Options, Output, Scheme, StepControl, simulate};
+use mbs_models::conserved::{drifts, from_vertical, rotation};
 use mbs_models::spherical_pendulum::{SphericalPendulum, SphericalPendulumZyx};
 use mbs_models::top::{Top, TopZyx};
-use mbs_models::tumble::TumbleBall;
-
-type V3 = [f64; 3];
-
-/// Rotation matrix (rows) of the quaternion [x, y, z, w].
-fn matrix(q: &[f64]) -> [[f64; 3]; 3] {
-    let (x, y, z, w) = (q[0], q[1], q[2], q[3]);
-    [
-        [
-            1.0 - 2.0 * (y * y + z * z),
-            2.0 * (x * y - z * w),
-            2.0 * (x * z + y * w),
-        ],
-        [
-            2.0 * (x * y + z * w),
-            1.0 - 2.0 * (x * x + z * z),
-            2.0 * (y * z - x * w),
-        ],
-        [
-            2.0 * (x * z - y * w),
-            2.0 * (y * z + x * w),
-            1.0 - 2.0 * (x * x + y * y),
-        ],
-    ]
-}
-
-fn mul(r: &[[f64; 3]; 3], v: V3) -> V3 {
-    [0, 1, 2].map(|i| r[i][0] * v[0] + r[i][1] * v[1] + r[i][2] * v[2])
-}
-
-/// Angular momentum in world axes of a single body on rotation joint 0 of a trajectory,
-/// about the joint's centre: R · I · ω, with I diagonal in the body's axes about that centre
-/// and ω from the joint's angles and rates (its own axes, whatever the chart).
-fn momentum(tr: &Trajectory, i: usize, inertia: V3) -> V3 {
-    let (q, qd) = (tr.q(i), tr.qd(i));
-    let w = body_rates([q[0], q[1], q[2]], [qd[0], qd[1], qd[2]]);
-    let r = matrix(&tr.orientation(i)[..4]);
-    mul(&r, [0, 1, 2].map(|k| inertia[k] * w[k]))
-}
-
-/// Largest relative drift of the energy and of the momentum (the whole vector, or its
-/// vertical component `Some(2)`), over every output.
-fn drifts(tr: &Trajectory, inertia: V3, component: Option<usize>) -> (f64, f64) {
-    let e0 = tr.energy[0].total();
-    let de = tr
-        .energy
-        .iter()
-        .map(|e| ((e.total() - e0) / e0).abs())
-        .fold(0.0, f64::max);
-    let l0 = momentum(tr, 0, inertia);
-    let scale = match component {
-        Some(k) => l0[k].abs(),
-        None => l0.iter().map(|x| x * x).sum::<f64>().sqrt(),
-    };
-    let dl = (0..tr.len())
-        .map(|i| {
-            let l = momentum(tr, i, inertia);
-            match component {
-                Some(k) => (l[k] - l0[k]).abs(),
-                None => (0..3).map(|k| (l[k] - l0[k]).powi(2)).sum::<f64>().sqrt(),
-            }
-        })
-        .fold(0.0, f64::max);
-    (de, dl / scale)
-}
+use mbs_models::tumble::{INERTIA, PHI0, TumbleBall, turned_start};
 
 fn adaptive(t_end: f64, rtol: f64) -> Options {
     Options {
@@ -92,9 +28,6 @@ fn adaptive(t_end: f64, rtol: f64) -> Options {
     }
 }
 
-/// The tumble's principal inertias (body x, y, z).
-const TUMBLE: V3 = [1.7231e-4, 6.58e-6, 1.7243e-4];
-
 #[test]
 fn tumble_on_a_ball_joint_keeps_energy_and_momentum_through_its_flips() {
     for (scheme, bound) in [
@@ -104,7 +37,7 @@ fn tumble_on_a_ball_joint_keeps_energy_and_momentum_through_its_flips() {
     ] {
         let (tr, st) = simulate(TumbleBall::default(), scheme, adaptive(20.0, 1e-10))
             .unwrap_or_else(|e| panic!("{}: {e}", scheme.name()));
-        let (de, dl) = drifts(&tr, TUMBLE, None);
+        let (de, dl) = drifts(&tr, INERTIA, None);
         println!(
             "tumble, {}: {} re-centrings, energy drift {de:.2e}, momentum drift {dl:.2e}; {} steps",
             scheme.name(),
@@ -130,9 +63,7 @@ fn top_runs_through_the_vertical_where_its_euler_angles_stop() {
         let (de, dlz) = drifts(&tr, inertia, Some(2));
         // the angle of the axis (body x) to the vertical, its passages within 0.05 rad of it
         // (local minima) and the closest one
-        let theta: Vec<f64> = (0..tr.len())
-            .map(|i| mul(&matrix(tr.orientation(i)), [1.0, 0.0, 0.0])[2].acos())
-            .collect();
+        let theta = from_vertical(&tr, false);
         let passages = (1..theta.len() - 1)
             .filter(|&i| theta[i] < 0.05 && theta[i] <= theta[i - 1] && theta[i] < theta[i + 1])
             .count();
@@ -167,8 +98,8 @@ fn spherical_pendulum_swings_through_the_bottom() {
         let (tr, st) = simulate(SphericalPendulum::default(), scheme, adaptive(3.0, 1e-10))
             .unwrap_or_else(|e| panic!("{}: {e}", scheme.name()));
         let (de, dlz) = drifts(&tr, inertia, Some(2));
-        let closest = (0..tr.len())
-            .map(|i| (-mul(&matrix(tr.orientation(i)), [1.0, 0.0, 0.0])[2]).acos())
+        let closest = from_vertical(&tr, true)
+            .into_iter()
             .fold(f64::INFINITY, f64::min);
         println!(
             "spherical pendulum, {}: {} re-centrings, closest to the bottom {closest:.2e} rad, energy drift {de:.2e}, L_z drift {dlz:.2e}; {} steps",
@@ -192,14 +123,11 @@ fn spherical_pendulum_swings_through_the_bottom() {
     let _ = SphericalPendulum::default().info();
 }
 
-/// The spin phase that makes the accurate flip of the tumble on ZYX angles meet their
-/// singularity at t ≈ 8.0 s (`tests/hard_cases/tumble.rs`): the start turned by φ0 about
-/// world x, the same body rates (10, 0, 1e-3) rad/s.
-const PHI0: f64 = -1.487_927_615_474_704;
-
+/// The tumble's start turned by φ0 about world x, whose accurate flip meets the singularity
+/// of its ZYX twin at t ≈ 8.0 s (`tests/hard_cases/tumble.rs`).
 fn turned(mut o: Options) -> Options {
-    o.q0 = Some(vec![0.0, 0.0, PHI0]);
-    o.qd0 = Some(vec![1e-3 * PHI0.cos(), -1e-3 * PHI0.sin(), 10.0]);
+    let (q0, qd0) = turned_start(PHI0);
+    (o.q0, o.qd0) = (Some(q0), Some(qd0));
     o
 }
 
@@ -243,7 +171,7 @@ fn every_scheme_runs_the_tumble_through_its_flips() {
         for (how, o, bound) in runs {
             let (tr, st) = simulate(TumbleBall::default(), scheme, turned(o))
                 .unwrap_or_else(|e| panic!("{} {how}: {e}", scheme.name()));
-            let (de, dl) = drifts(&tr, TUMBLE, None);
+            let (de, dl) = drifts(&tr, INERTIA, None);
             println!(
                 "tumble turned by φ0, {:<9} {how:<8}: {:>2} re-centrings, energy drift {de:.1e}, momentum drift {dl:.1e}, {} steps",
                 scheme.name(),
@@ -376,7 +304,7 @@ fn outputs_are_continuous_across_recentrings() {
     for i in 0..tr.len() {
         // the pose, the quaternion and chart · Rz(a) Ry(b) Rx(c) agree
         let pose = tr.poses_at(i)[0].rotation;
-        let quat = matrix(tr.orientation(i));
+        let quat = rotation(tr.orientation(i));
         let c = tr.chart(i, 0);
         let q = tr.q(i);
         let e = mbs::charts::zyx([q[0], q[1], q[2]]);

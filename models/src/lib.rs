@@ -22,6 +22,7 @@
 //! | [`top`] | a fast symmetric top on its tip whose axis passes through the vertical, on a spherical joint and on Euler angles |
 //! | [`spherical_pendulum`] | a ball on a rod swinging through the bottom, on a spherical joint and on Euler angles |
 //! | [`structural`] | models whose mass matrix is singular by construction |
+//! | [`conserved`] | (not a model) energy and angular momentum of the rotation models, without charts |
 //! | [`undefined_force`] | a pendulum whose generalized force is undefined after, or from, t = 0.5 |
 
 pub mod arm3d_6;
@@ -29,6 +30,7 @@ pub mod chain16_stiff;
 pub mod chain24;
 pub mod chain30_stiff;
 pub mod chain8;
+pub mod conserved;
 pub mod dc_motor;
 pub mod dpend;
 pub mod dpend_cartesian;

@@ -46,3 +46,21 @@ mbs::multibody! {
         TOG[b] = Tball(q[0], q[1], q[2]);
     }
 }
+
+/// The principal inertias of the tumble's body about body x, y, z (kg m²), as in its models.
+pub const INERTIA: [f64; 3] = [1.7231e-4, 6.58e-6, 1.7243e-4];
+
+/// The spin phase that makes the accurate flip of [`Tumble`] (ZYX) meet its singularity at
+/// t ≈ 8.0 s: −π/2 − φ*, φ* = 3.0587 rad the azimuth (atan2(z, y)) of body x when it crosses
+/// the plane x = 0 in the run from MODELS.md's start (DOPRI5, rtol 1e-10, at t = 8.0033 s).
+pub const PHI0: f64 = -1.487_927_615_474_704;
+
+/// MODELS.md's start turned by `phi` about world x, on ZYX angles (those of [`Tumble`] and
+/// [`TumbleBall`] at the identity chart): (q0, qd0), the same body rates (10, 0, 1e-3) rad/s
+/// about body (x, y, z).
+pub fn turned_start(phi: f64) -> (Vec<f64>, Vec<f64>) {
+    (
+        vec![0.0, 0.0, phi],
+        vec![1e-3 * phi.cos(), -1e-3 * phi.sin(), 10.0],
+    )
+}

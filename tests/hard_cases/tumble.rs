@@ -31,21 +31,7 @@
 
 use crate::support::{Work, all_finite, check_work, work};
 use mbs::{Failure, Model, Options, Scheme, SimError, Stats, Trajectory, simulate};
-use mbs_models::tumble::{Tumble, TumbleXyz};
-
-/// The spin phase that makes the accurate ZYX flip meet the singularity: −π/2 − φ*, φ* =
-/// 3.0587 rad the azimuth (atan2(z, y)) of body x when it crosses the plane x = 0 in the
-/// run from MODELS.md's start (DOPRI5, rtol 1e-10, at t = 8.0033 s).
-const PHI0: f64 = -1.487_927_615_474_704;
-
-/// MODELS.md's tumble start turned by φ about world x: the same body rates (10, 0, 1e-3)
-/// rad/s about body (x, y, z).
-fn turned_start(phi: f64) -> (Vec<f64>, Vec<f64>) {
-    (
-        vec![0.0, 0.0, phi],
-        vec![1e-3 * phi.cos(), -1e-3 * phi.sin(), 10.0],
-    )
-}
+use mbs_models::tumble::{PHI0, Tumble, TumbleXyz, turned_start};
 
 /// How a run ended.
 #[derive(Debug, PartialEq)]

@@ -33,16 +33,19 @@ pub fn apply(r: &[[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
     [0, 1, 2].map(|i| r[i][0] * v[0] + r[i][1] * v[1] + r[i][2] * v[2])
 }
 
-/// Angular momentum, world axes, of the single body on rotation joint 0 (angles q[0..3])
-/// about the joint's centre: R · I · ω, with `inertia` the body's principal moments about that
-/// centre along the joint's axes.
+/// Angular momentum, world axes, of the single body on rotation joint 0 (angles q[0..3];
+/// or, for a twin without rotation joints, on the ZYX angles q[0..3]) about the joint's
+/// centre: R · I · ω, with `inertia` the body's principal moments about that centre along the
+/// joint's axes.
 pub fn momentum(tr: &Trajectory, i: usize, inertia: [f64; 3]) -> [f64; 3] {
     let (q, qd) = (tr.q(i), tr.qd(i));
     let w = body_rates([q[0], q[1], q[2]], [qd[0], qd[1], qd[2]]);
-    apply(
-        &rotation(&tr.orientation(i)[..4]),
-        [0, 1, 2].map(|k| inertia[k] * w[k]),
-    )
+    let r = if tr.joint_names.is_empty() {
+        mbs::charts::array(&mbs::charts::zyx([q[0], q[1], q[2]]))
+    } else {
+        rotation(&tr.orientation(i)[..4])
+    };
+    apply(&r, [0, 1, 2].map(|k| inertia[k] * w[k]))
 }
 
 /// Largest relative drift over every output of the energy and of the angular momentum (the

@@ -74,9 +74,49 @@
 //! | `Tdisp(x, y, z)` | translation, in the axes of the frame it starts from |
 //! | `Trotx(a)`, `Troty(a)`, `Trotz(a)` | rotation by `a` about x, y, z |
 //! | `Trotn(nx, ny, nz, a)` | rotation by `a` about the unit axis (nx, ny, nz) |
+//! | `Tball(a, b, c)` | a spherical joint: ZYX angles of three coordinates, in a chart the runtime re-centres before gimbal lock (below) |
+//! | `Tfree(x, y, z, a, b, c)` | a free joint: the translation (x, y, z) in the axes of the frame it starts from, then `Tball(a, b, c)` |
 //!
 //! Arguments are expressions of `q`, `t` (rheonomic, imposed motion) and parameters, never of
-//! velocities or inputs.
+//! velocities or inputs; those of `Tball` and `Tfree` are coordinates.
+//!
+//! ### Rotation joints
+//!
+//! Every set of three angles locks somewhere: ZYX angles (a, b, c) where cos b = 0, and a
+//! model written with `Trotz(a) * Troty(b) * Trotx(c)` stops there with
+//! `SingularConfiguration`. `Tball(a, b, c)` is the same rotation read in a chart `C` the
+//! model holds, `R = C · Rz(a) · Ry(b) · Rx(c)` (`C` is the identity when the model is built,
+//! so the declared initial angles mean what they say). After each accepted step the runtime
+//! moves the chart of a joint whose |cos b| fell below `Options::chart_switch` (0.5) to the
+//! joint's rotation and its angles to zero, its rates and accelerations mapped exactly: the
+//! motion does not change, and the joint never reaches gimbal lock. The angles of a joint
+//! thus have no fixed meaning and may appear in no other expression, force, pose or
+//! constraint (a compile error); act on the orientation with a `torque`, a `bushing` or a
+//! `rotational_spring` between frames, or a force at a point. A trajectory records each
+//! joint's orientation as a quaternion and the chart of every output
+//! ([`crate::Trajectory::orientation`], [`crate::Trajectory::chart`]).
+//!
+//! The same arguments again are the same joint (absolute poses repeat it); a coordinate
+//! belongs to one joint. A `Tfree`'s translation comes before the chart and keeps its meaning
+//! (it may be used elsewhere); at the root it is in world axes, which couples it to the
+//! chart in M (the hexapod: 6,192 flops for M and h against 5,760 on Euler angles). Written
+//! `Tball(a, b, c) * Tdisp(x, y, z)`, the translation is in the body's own axes and the chart
+//! stays out of M (5,743), at the price of coordinates x, y, z that turn with the body.
+//!
+//! ```
+//! mbs::multibody! {
+//!     /// A top on its tip, its axis along body x.
+//!     model Top {
+//!         param w3 = 200.0;
+//!         dof a = 0.0; dof b = -0.9; dof c = 0.0, qd = w3;
+//!         body top { mass = 0.1; inertia = (4e-5, 2e-5, 2e-5); }
+//!         TOG[top] = Tball(a, b, c) * Tdisp(0.04, 0, 0);
+//!         gravity(0, 0, -9.81);
+//!     }
+//! }
+//! use mbs::Model;
+//! assert_eq!(Top::default().info().rotation_joints.len(), 1);
+//! ```
 //!
 //! A translation along the axis of the rotation just before it commutes with that rotation,
 //! and the generator moves it in front: `TOG[rotor] = TOG[arm] * Trotz(50 * q[0]) * Tdisp(0, 0,

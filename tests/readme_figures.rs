@@ -121,6 +121,9 @@ fn rounds_to(value: f64, printed: &str) -> bool {
 fn labels(name: &str) -> &'static [&'static str] {
     match name {
         "DOPRI5" => &["dopri5"],
+        "DOPRI5 on ZYX" => &["dopri5 ZYX"],
+        "Radau5 on ZYX" => &["radau5 ZYX"],
+        "BDF on ZYX" => &["bdf ZYX"],
         "RK4" => &["rk4"],
         "BDF" => &["bdf"],
         "Radau5" => &["radau5"],
@@ -285,7 +288,9 @@ fn the_work_precision_table_quotes_the_committed_csv_files() {
             "hexapod",
             "fourbar",
             "pendulum3",
-            "fastlink"
+            "fastlink",
+            "tumble",
+            "top"
         ]
     );
     println!("{figures} figures of the README's table match docs/figures/wp_*.csv");

@@ -24,28 +24,20 @@
 //!
 //! Times are the least wall-clock time of 3 runs, outputs at every step included.
 
-use mbs::{
-    IterationMatrix, Model, Options, Output, Scheme, SimError, Stats, StepControl, Trajectory,
-    simulate,
-};
-use mbs_models::conserved::{drifts, from_vertical};
-use mbs_models::hexapod::{Hexapod, HexapodStanding, HexapodTumbling};
+use mbs::{IterationMatrix, Model, Options, Output, Scheme, SimError, Stats, Trajectory, simulate};
+use mbs_models::conserved::{drifts, energy_drift, from_vertical};
+use mbs_models::hexapod::{Hexapod, HexapodStanding, HexapodTumbling, thrown};
 use mbs_models::spherical_pendulum::{SphericalPendulum, SphericalPendulumZyx};
 use mbs_models::top::{Top, TopZyx};
 use mbs_models::tumble::{INERTIA, PHI0, Tumble, TumbleBall, turned_start};
 use mbs_symbolic::expand::{Expansion, expand_models, multibody_blocks};
 use std::time::{Duration, Instant};
 
+/// Adaptive steps at `rtol` (atol = rtol/100), an output at every step.
 fn adaptive(t_end: f64, rtol: f64) -> Options {
     Options {
-        t_end,
-        step: StepControl::Adaptive {
-            rtol,
-            atol: rtol * 1e-2,
-            h0: None,
-        },
         output: Output::Steps,
-        ..Options::default()
+        ..Options::adaptive(t_end, rtol)
     }
 }
 
@@ -238,15 +230,8 @@ fn through_the_vertical() {
 
 fn hexapod() {
     println!("\n4. The hexapod thrown from 1 m, pitching at 16 rad/s and rolling at 1 rad/s\n");
-    let start = |q: &mut Vec<f64>, qd: &mut Vec<f64>| {
-        q[2] = 1.0;
-        qd[4] = 16.0;
-        qd[5] = 1.0;
-    };
     let model = Hexapod::default();
-    let (mut q, mut qd) = (vec![0.0; Hexapod::NQ], vec![0.0; Hexapod::NQ]);
-    model.initial_state(&mut q, &mut qd);
-    start(&mut q, &mut qd);
+    let (q, qd) = thrown(&model, 16.0);
     for scheme in [Scheme::Dopri5, Scheme::Radau5] {
         let o = Options {
             q0: Some(q.clone()),
@@ -255,13 +240,7 @@ fn hexapod() {
         };
         let (r, cpu) = timed(&model, scheme, &o);
         let (tr, st) = r.expect("the free hexapod somersaults");
-        let e0 = tr.energy[0].total();
-        let scale = tr.energy[0].kinetic.max(e0.abs());
-        let de = tr
-            .energy
-            .iter()
-            .map(|e| (e.total() - e0).abs() / scale)
-            .fold(0.0, f64::max);
+        let de = energy_drift(&tr);
         println!(
             "free, 1 s, rtol 1e-9, {:<7}: {} re-centrings, energy drift {de:.1e}, {} steps, {:.1} ms",
             scheme.name(),

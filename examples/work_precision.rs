@@ -410,17 +410,7 @@ fn study(name: &str, repeats: usize) -> WorkPrecision {
             s.run(&fastlink::FastLink::default()).expect("study")
         }
         "tumble" => {
-            // the body on a spherical joint; its ZYX twin, which survives this start (closest
-            // |cos b| 0.19), measured the same way against the same reference
-            let model = tumble::TumbleBall::default();
-            let r = Reference::compute(
-                &model,
-                samples(10.0, 40),
-                (Scheme::Dopri5, Setting::Rtol(1e-13)),
-                Some((Scheme::Radau5, Setting::Rtol(1e-13))),
-                &mbs::Options::default(),
-            )
-            .expect("reference run");
+            // its ZYX twin survives this start (closest |cos b| 0.19)
             let plan = Plan {
                 dopri5: (3, 12),
                 bdf: (3, 11),
@@ -431,38 +421,25 @@ fn study(name: &str, repeats: usize) -> WorkPrecision {
                 midpoint: (0.01, 7),
                 euler: None,
             };
-            let s = finish(Study {
-                sweeps: sweeps(&plan),
-                ..Study::new("tumble (Tball)", r.clone())
-            });
-            let mut wp = s.run(&model).expect("study");
-            let euler = finish(Study {
-                sweeps: vec![
-                    Sweep::adaptive(Scheme::Dopri5, &decades(3, 12)).labelled("dopri5 ZYX"),
-                    Sweep::adaptive(Scheme::Radau5, &decades(3, 12)).labelled("radau5 ZYX"),
-                    Sweep::adaptive(bdf(), &decades(3, 11)).labelled("bdf ZYX"),
-                    Sweep::adaptive(gen_alpha(), &decades(3, 9)).labelled("gen-alpha ZYX"),
-                ],
-                euler_angles: vec![[0, 1, 2]],
-                ..Study::new("tumble (ZYX)", r)
-            });
-            let zyx = euler.run(&tumble::Tumble::default()).expect("study");
-            wp.rows.extend(zyx.rows);
-            wp.title = "tumble (Tball, and ZYX angles)".into();
-            wp
+            let twin = vec![
+                Sweep::adaptive(Scheme::Dopri5, &decades(3, 12)).labelled("dopri5 ZYX"),
+                Sweep::adaptive(Scheme::Radau5, &decades(3, 12)).labelled("radau5 ZYX"),
+                Sweep::adaptive(bdf(), &decades(3, 11)).labelled("bdf ZYX"),
+                Sweep::adaptive(gen_alpha(), &decades(3, 9)).labelled("gen-alpha ZYX"),
+            ];
+            let (model, zyx) = (tumble::TumbleBall::default(), tumble::Tumble::default());
+            rotation_study(
+                "tumble",
+                (&model, &zyx),
+                samples(10.0, 40),
+                &plan,
+                twin,
+                finish,
+            )
         }
         "top" => {
-            // the top on a spherical joint; its ZYX twin stops at the first passage of the
-            // axis through the vertical (its rows say so)
-            let model = top::Top::default();
-            let r = Reference::compute(
-                &model,
-                samples(2.0, 40),
-                (Scheme::Dopri5, Setting::Rtol(1e-13)),
-                Some((Scheme::Radau5, Setting::Rtol(1e-13))),
-                &mbs::Options::default(),
-            )
-            .expect("reference run");
+            // its ZYX twin stops at the first passage of the axis through the vertical (its
+            // rows say so)
             let plan = Plan {
                 dopri5: (3, 12),
                 bdf: (3, 11),
@@ -473,28 +450,55 @@ fn study(name: &str, repeats: usize) -> WorkPrecision {
                 midpoint: (1e-3, 7),
                 euler: None,
             };
-            let s = finish(Study {
-                sweeps: sweeps(&plan),
-                ..Study::new("top (Tball)", r.clone())
-            });
-            let mut wp = s.run(&model).expect("study");
-            let euler = finish(Study {
-                sweeps: vec![
-                    Sweep::adaptive(Scheme::Dopri5, &[1e-4, 1e-7, 1e-10]).labelled("dopri5 ZYX"),
-                ],
-                euler_angles: vec![[0, 1, 2]],
-                ..Study::new("top (ZYX)", r)
-            });
-            wp.rows
-                .extend(euler.run(&top::TopZyx::default()).expect("study").rows);
-            wp.title = "top (Tball, and ZYX angles)".into();
-            wp
+            let twin =
+                vec![Sweep::adaptive(Scheme::Dopri5, &[1e-4, 1e-7, 1e-10]).labelled("dopri5 ZYX")];
+            let (model, zyx) = (top::Top::default(), top::TopZyx::default());
+            rotation_study("top", (&model, &zyx), samples(2.0, 40), &plan, twin, finish)
         }
         other => {
             eprintln!("unknown model `{other}`: use {} or all", MODELS.join(", "));
             std::process::exit(2);
         }
     }
+}
+
+/// A rotation model on its spherical joint and its twin on ZYX Euler angles (angles q[0..3]),
+/// the same motion: the model's sweeps of `plan` and the twin's `twin_sweeps`, both measured
+/// by rotation matrices and angular velocities against one reference (DOPRI5 on the model
+/// at rtol 1e-13, checked by Radau5 at 1e-13), in one table.
+fn rotation_study<M, Z>(
+    name: &str,
+    (model, twin): (&M, &Z),
+    times: Vec<f64>,
+    plan: &Plan,
+    twin_sweeps: Vec<Sweep>,
+    finish: impl Fn(Study) -> Study,
+) -> WorkPrecision
+where
+    M: Model + Clone + 'static,
+    Z: Model + Clone + 'static,
+{
+    let r = Reference::compute(
+        model,
+        times,
+        (Scheme::Dopri5, Setting::Rtol(1e-13)),
+        Some((Scheme::Radau5, Setting::Rtol(1e-13))),
+        &mbs::Options::default(),
+    )
+    .expect("reference run");
+    let s = finish(Study {
+        sweeps: sweeps(plan),
+        ..Study::new(format!("{name} (Tball)"), r.clone())
+    });
+    let mut wp = s.run(model).expect("study");
+    let euler = finish(Study {
+        sweeps: twin_sweeps,
+        euler_angles: vec![[0, 1, 2]],
+        ..Study::new(format!("{name} (ZYX)"), r)
+    });
+    wp.rows.extend(euler.run(twin).expect("study").rows);
+    wp.title = format!("{name} (Tball, and ZYX angles)");
+    wp
 }
 
 /// The cheapest run per label reaching `digits` (mescd), sorted by CPU time.

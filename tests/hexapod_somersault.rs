@@ -11,18 +11,8 @@
 //! base's angles in q are relative to the chart they were integrated in.
 
 use mbs::{Model, Options, Output, Scheme, StepControl, Trajectory, simulate};
-use mbs_models::hexapod::{Hexapod, HexapodTumbling};
-
-/// The start: the model's (legs at their PD references), the base 1 m up, pitching at
-/// `pitch` rad/s and rolling at 1 rad/s.
-fn thrown<M: Model>(model: &M, pitch: f64) -> (Vec<f64>, Vec<f64>) {
-    let (mut q, mut qd) = (vec![0.0; M::NQ], vec![0.0; M::NQ]);
-    model.initial_state(&mut q, &mut qd);
-    q[2] = 1.0;
-    qd[4] = pitch;
-    qd[5] = 1.0;
-    (q, qd)
-}
+use mbs_models::conserved::energy_drift;
+use mbs_models::hexapod::{Hexapod, HexapodTumbling, thrown};
 
 /// World z of the base's z axis (1 upright, −1 on its back), from its quaternion.
 fn up(tr: &Trajectory, i: usize) -> f64 {
@@ -56,13 +46,7 @@ fn the_free_hexapod_somersaults_keeping_its_energy() {
             options(1.0, 1e-9, start.clone()),
         )
         .unwrap_or_else(|e| panic!("{}: {e}", scheme.name()));
-        let e0 = tr.energy[0].total();
-        let scale = tr.energy[0].kinetic.max(e0.abs());
-        let de = tr
-            .energy
-            .iter()
-            .map(|e| (e.total() - e0).abs() / scale)
-            .fold(0.0, f64::max);
+        let de = energy_drift(&tr);
         let lowest = (0..tr.len()).map(|i| up(&tr, i)).fold(1.0, f64::min);
         println!(
             "free hexapod, {}: {} re-centrings, base z axis down to {lowest:.2}, energy drift {de:.1e}; {} steps",

@@ -15,16 +15,11 @@ use mbs_models::spherical_pendulum::{SphericalPendulum, SphericalPendulumZyx};
 use mbs_models::top::{Top, TopZyx};
 use mbs_models::tumble::{INERTIA, PHI0, TumbleBall, turned_start};
 
+/// Adaptive steps at `rtol` (atol = rtol/100), an output at every step.
 fn adaptive(t_end: f64, rtol: f64) -> Options {
     Options {
-        t_end,
-        step: StepControl::Adaptive {
-            rtol,
-            atol: rtol * 1e-2,
-            h0: None,
-        },
         output: Output::Steps,
-        ..Options::default()
+        ..Options::adaptive(t_end, rtol)
     }
 }
 

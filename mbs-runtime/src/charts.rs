@@ -22,6 +22,14 @@ pub fn array(m: &Matrix3<f64>) -> [[f64; 3]; 3] {
     [0, 1, 2].map(|r| [m[(r, 0)], m[(r, 1)], m[(r, 2)]])
 }
 
+/// The rotation matrix (rows) of a unit quaternion `[x, y, z, w]` (the order of
+/// [`crate::Pose::quaternion`] and of the trajectory's orientations).
+pub fn matrix_of(q: [f64; 4]) -> [[f64; 3]; 3] {
+    let [x, y, z, w] = q;
+    let u = UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(w, x, y, z));
+    array(u.to_rotation_matrix().matrix())
+}
+
 /// The angular velocity of the joint in its own (child) axes, `J(b, c) · (ȧ, ḃ, ċ)`.
 pub fn body_rates(angles: [f64; 3], rates: [f64; 3]) -> [f64; 3] {
     let (sb, cb) = angles[1].sin_cos();

@@ -127,9 +127,7 @@ impl Trajectory {
     /// rotation its angles are measured from, `R = chart · Rz(a) · Ry(b) · Rx(c)`.
     pub fn chart(&self, i: usize, joint: usize) -> [[f64; 3]; 3] {
         let k = self.chart_data[i * self.joint_names.len() + joint] as usize;
-        let [x, y, z, w] = self.charts[joint][k];
-        let q = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(w, x, y, z));
-        crate::charts::array(q.to_rotation_matrix().matrix())
+        crate::charts::matrix_of(self.charts[joint][k])
     }
 
     /// The chart numbers of every rotation joint at output `i` (indices into `charts`).

@@ -8,24 +8,7 @@ use mbs::charts::body_rates;
 
 /// Rotation matrix (rows) of a quaternion `[x, y, z, w]`.
 pub fn rotation(q: &[f64]) -> [[f64; 3]; 3] {
-    let (x, y, z, w) = (q[0], q[1], q[2], q[3]);
-    [
-        [
-            1.0 - 2.0 * (y * y + z * z),
-            2.0 * (x * y - z * w),
-            2.0 * (x * z + y * w),
-        ],
-        [
-            2.0 * (x * y + z * w),
-            1.0 - 2.0 * (x * x + z * z),
-            2.0 * (y * z - x * w),
-        ],
-        [
-            2.0 * (x * z - y * w),
-            2.0 * (y * z + x * w),
-            1.0 - 2.0 * (x * x + y * y),
-        ],
-    ]
+    mbs::charts::matrix_of([q[0], q[1], q[2], q[3]])
 }
 
 /// R · v.
@@ -81,4 +64,15 @@ pub fn from_vertical(tr: &Trajectory, down: bool) -> Vec<f64> {
     (0..tr.len())
         .map(|i| (s * apply(&rotation(tr.orientation(i)), [1.0, 0.0, 0.0])[2]).acos())
         .collect()
+}
+
+/// Largest |E(t) − E(0)| over every output, relative to the larger of the start's kinetic
+/// energy and |E(0)| (a body thrown with E(0) near zero).
+pub fn energy_drift(tr: &Trajectory) -> f64 {
+    let e0 = tr.energy[0].total();
+    let scale = tr.energy[0].kinetic.max(e0.abs());
+    tr.energy
+        .iter()
+        .map(|e| (e.total() - e0).abs() / scale)
+        .fold(0.0, f64::max)
 }

@@ -163,3 +163,14 @@ mbs::multibody! {
 /// The hexapod without contact or controllers (gravity only): the type of the contact-free
 /// figures (M+h 6,192 flops).
 pub type Hexapod = HexapodFree;
+
+/// The hexapod thrown: `model`'s declared state (legs at their PD references) with the base
+/// 1 m up, pitching at `pitch` rad/s and rolling at 1 rad/s: (q0, qd0).
+pub fn thrown<M: mbs::Model>(model: &M, pitch: f64) -> (Vec<f64>, Vec<f64>) {
+    let (mut q, mut qd) = (vec![0.0; M::NQ], vec![0.0; M::NQ]);
+    model.initial_state(&mut q, &mut qd);
+    q[2] = 1.0;
+    qd[4] = pitch;
+    qd[5] = 1.0;
+    (q, qd)
+}

@@ -10,7 +10,7 @@
 //! - a spherical pendulum swinging through the bottom (`SphericalPendulum`), likewise.
 
 use mbs::{Failure, Model, Options, Output, Scheme, StepControl, simulate};
-use mbs_models::conserved::{drifts, from_vertical, rotation};
+use mbs_models::conserved::{drifts, energy_drift, from_vertical, rotation};
 use mbs_models::spherical_pendulum::{SphericalPendulum, SphericalPendulumZyx};
 use mbs_models::top::{Top, TopZyx};
 use mbs_models::tumble::{INERTIA, PHI0, TumbleBall, turned_start};
@@ -338,4 +338,100 @@ fn outputs_are_continuous_across_recentrings() {
     let text = String::from_utf8(csv).unwrap();
     let header = text.lines().next().unwrap();
     assert!(header.contains(",b.qx,b.qy,b.qz,b.qw,b.chart,"), "{header}");
+}
+
+mbs::multibody! {
+    /// A double spherical pendulum: a rod on a ball joint at the pivot, a second rod on a
+    /// ball joint at its end (a joint inside a chain), each with its mass at its far end.
+    model DoubleBall {
+        dof a1 = 0.0, qd = 1.5; dof b1 = 0.9; dof c1 = 0.0;
+        dof a2 = 0.0, qd = 1.0; dof b2 = 0.2, qd = 6.0; dof c2 = 0.0, qd = 0.5;
+        body upper { mass = 1.0; inertia = (0.001, 0.02, 0.02); }
+        body lower { mass = 0.5; inertia = (0.001, 0.01, 0.01); }
+        TOG[upper] = Tball(a1, b1, c1) * Tdisp(0.5, 0, 0);
+        TOG[lower] = TOG[upper] * Tdisp(0.5, 0, 0) * Tball(a2, b2, c2) * Tdisp(0.4, 0, 0);
+        gravity(0, 0, -9.81);
+    }
+}
+
+mbs::multibody! {
+    /// [`DoubleBall`] with both charts fixed at the rotations of `charts()` (as constant
+    /// `Trotn` factors), to compare the generated code of a chart with its constant.
+    model DoubleFixed {
+        dof a1 = 0.0; dof b1 = 0.0; dof c1 = 0.0;
+        dof a2 = 0.0; dof b2 = 0.0; dof c2 = 0.0;
+        body upper { mass = 1.0; inertia = (0.001, 0.02, 0.02); }
+        body lower { mass = 0.5; inertia = (0.001, 0.01, 0.01); }
+        TOG[upper] = Trotn(0.6, 0.0, 0.8, 0.7) * Trotz(a1) * Troty(b1) * Trotx(c1) * Tdisp(0.5, 0, 0);
+        TOG[lower] = TOG[upper] * Tdisp(0.5, 0, 0) * Trotn(0.0, 0.6, -0.8, -1.1) * Trotz(a2) * Troty(b2) * Trotx(c2) * Tdisp(0.4, 0, 0);
+        gravity(0, 0, -9.81);
+    }
+}
+
+/// Rodrigues' rotation about the unit axis `n`.
+fn rodrigues(n: [f64; 3], angle: f64) -> [[f64; 3]; 3] {
+    let (s, c) = angle.sin_cos();
+    let k = [[0.0, -n[2], n[1]], [n[2], 0.0, -n[0]], [-n[1], n[0], 0.0]];
+    let mut r = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            let kk: f64 = (0..3).map(|m| k[i][m] * k[m][j]).sum();
+            r[i][j] = f64::from(u8::from(i == j)) + s * k[i][j] + (1.0 - c) * kk;
+        }
+    }
+    r
+}
+
+/// A chart read at run time gives the generated code of the same rotation written as a
+/// constant: M, h and the poses of a chain with a ball joint at its root and one inside it.
+#[test]
+fn charts_inside_a_chain_are_their_rotations() {
+    let mut ball = DoubleBall::default();
+    ball.set_chart(0, rodrigues([0.6, 0.0, 0.8], 0.7));
+    ball.set_chart(1, rodrigues([0.0, 0.6, -0.8], -1.1));
+    let fixed = DoubleFixed::default();
+    let n = 6;
+    let mut worst = 0.0f64;
+    for k in 0..5 {
+        let q: Vec<f64> = (0..n)
+            .map(|i| (1.3 * (i + 7 * k) as f64 + 0.4).sin())
+            .collect();
+        let qd: Vec<f64> = (0..n)
+            .map(|i| 2.0 * (0.9 * (i + 3 * k) as f64).cos())
+            .collect();
+        let (mut m1, mut h1, mut m2, mut h2) =
+            (vec![0.0; 36], vec![0.0; 6], vec![0.0; 36], vec![0.0; 6]);
+        ball.dynamics(0.0, &q, &qd, &[], &mut m1, &mut h1);
+        fixed.dynamics(0.0, &q, &qd, &[], &mut m2, &mut h2);
+        let mut p1 = vec![mbs::Pose::default(); 2];
+        let mut p2 = vec![mbs::Pose::default(); 2];
+        ball.frames(0.0, &q, &mut p1);
+        fixed.frames(0.0, &q, &mut p2);
+        let scale = m2.iter().chain(&h2).fold(1.0f64, |s, x| s.max(x.abs()));
+        for (x, y) in m1.iter().chain(&h1).zip(m2.iter().chain(&h2)) {
+            worst = worst.max((x - y).abs() / scale);
+        }
+        for (a, b) in p1.iter().zip(&p2) {
+            for i in 0..3 {
+                worst = worst.max((a.position[i] - b.position[i]).abs());
+            }
+        }
+    }
+    println!("a ball joint's chart against its constant rotation: {worst:.1e}");
+    assert!(worst < 1e-13, "{worst:e}");
+}
+
+/// A double spherical pendulum, one joint inside the chain, through its chaotic motion: both
+/// charts re-centred, energy conserved.
+#[test]
+fn a_ball_joint_inside_a_chain_runs_through() {
+    let (tr, st) = simulate(DoubleBall::default(), Scheme::Dopri5, adaptive(5.0, 1e-10)).unwrap();
+    let de = energy_drift(&tr);
+    let per_joint: Vec<u32> = (0..2).map(|j| tr.chart_numbers(tr.len() - 1)[j]).collect();
+    println!(
+        "double spherical pendulum, 5 s: re-centrings per joint {per_joint:?}, energy drift {de:.1e}, {} steps",
+        st.steps
+    );
+    assert!(per_joint.iter().all(|&c| c >= 1), "{per_joint:?}");
+    assert!(de < 1e-8, "{de:e}");
 }

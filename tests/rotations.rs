@@ -499,3 +499,32 @@ fn closed_loops_through_a_ball_joint_run_through() {
         assert!(drift < 1e-9, "{drift:e}");
     }
 }
+
+/// Inverse dynamics along the top's run, each output read in its own charts, is zero (the
+/// motion is free): the accelerations the driver maps at a re-centring are the motion's.
+#[test]
+fn inverse_dynamics_along_a_recentred_run_is_zero() {
+    let (tr, st) = simulate(
+        Top::default(),
+        Scheme::Dopri5,
+        Options {
+            output: Output::Every { dt: 0.001 },
+            ..Options::adaptive(2.0, 1e-10)
+        },
+    )
+    .unwrap();
+    assert!(st.chart_switches >= 1);
+    let mut model = Top::default();
+    let (mut worst, mut scale) = (0.0f64, 0.0f64);
+    let mut tau = [0.0; 3];
+    for i in 0..tr.len() {
+        mbs::charts::use_charts_of(&mut model, &tr, i);
+        model.inverse_dynamics(tr.t[i], tr.q(i), tr.qd(i), tr.qdd(i), &[], &mut tau);
+        let (mut m, mut h) = ([0.0; 9], [0.0; 3]);
+        model.dynamics(tr.t[i], tr.q(i), tr.qd(i), &[], &mut m, &mut h);
+        scale = h.iter().fold(scale, |s, x| s.max(x.abs()));
+        worst = tau.iter().fold(worst, |w, x| w.max(x.abs()));
+    }
+    println!("top: largest |τ| along the run {worst:.1e} (largest |h| {scale:.1e})");
+    assert!(worst < 1e-6 * scale, "{worst:e}");
+}

@@ -67,3 +67,39 @@ fn steps_allocate_nothing_after_warm_up() {
         alloc::assert_no_allocation(sim, &format!("{} with {}", scheme.name(), method.name()));
     }
 }
+
+/// Re-centring the chart of a rotation joint allocates nothing either: the spherical pendulum
+/// swings through the bottom, where its joint's chart moves, inside the 200 steps watched
+/// (its first re-centring comes at t ≈ 0.3 s, after the 20 steps of warm-up, at most 0.1 s;
+/// the re-centrings are counted).
+#[test]
+fn recentring_allocates_nothing() {
+    use mbs::Integrator;
+    use mbs_models::spherical_pendulum::SphericalPendulum;
+    for scheme in Scheme::all() {
+        let mut modes = vec![Options::fixed(100.0, 5e-3)];
+        if scheme.is_adaptive() {
+            modes.push(Options {
+                h_max: 5e-3,
+                ..Options::adaptive(100.0, 1e-7)
+            });
+        }
+        for base in modes {
+            let opts = Options {
+                output: Output::Every { dt: 0.01 },
+                ..base
+            };
+            let sim = Simulation::new(SphericalPendulum::default(), scheme, opts)
+                .unwrap_or_else(|e| panic!("{}: {e}", scheme.name()));
+            let mut switches = 0;
+            alloc::assert_no_allocation_then(sim, scheme.name(), |s| {
+                switches = s.stats().chart_switches;
+            });
+            assert!(
+                switches > 0,
+                "{}: no re-centring in the window",
+                scheme.name()
+            );
+        }
+    }
+}

@@ -162,6 +162,13 @@ impl Trajectory {
         self.qdd_data.reserve(outputs * n);
         self.lambda_data
             .reserve(outputs * self.constraint_names.len());
+        let joints = self.joint_names.len();
+        self.orientation_data.reserve(outputs * 4 * joints);
+        self.chart_data.reserve(outputs * joints);
+        for charts in self.charts.iter_mut() {
+            // re-centrings are rare: room for 16 before the list grows
+            charts.reserve(16);
+        }
         if energy {
             self.energy.reserve(outputs);
         }

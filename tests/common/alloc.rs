@@ -39,7 +39,17 @@ pub fn allocations() -> usize {
 }
 
 /// 20 steps of warm-up, then 200 steps that must not allocate.
-pub fn assert_no_allocation<M: mbs::Model + 'static>(mut sim: mbs::Simulation<M>, what: &str) {
+pub fn assert_no_allocation<M: mbs::Model + 'static>(sim: mbs::Simulation<M>, what: &str) {
+    assert_no_allocation_then(sim, what, |_| {});
+}
+
+/// [`assert_no_allocation`], then `after` sees the simulation.
+#[allow(dead_code)]
+pub fn assert_no_allocation_then<M: mbs::Model + 'static>(
+    mut sim: mbs::Simulation<M>,
+    what: &str,
+    after: impl FnOnce(&mbs::Simulation<M>),
+) {
     use mbs::Integrator;
     for _ in 0..20 {
         sim.step().unwrap();
@@ -53,4 +63,5 @@ pub fn assert_no_allocation<M: mbs::Model + 'static>(mut sim: mbs::Simulation<M>
         allocated, 0,
         "{what} allocated {allocated} times in 200 steps"
     );
+    after(&sim);
 }

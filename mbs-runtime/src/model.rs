@@ -363,6 +363,35 @@ pub trait Model {
     /// M (NQ × NQ) and h(q, qd, t, u) (NQ) together, sharing their common work.
     fn dynamics(&self, t: f64, q: &[f64], qd: &[f64], u: &[f64], m: &mut [f64], h: &mut [f64]);
 
+    /// qdd = M⁻¹ h at (t, q, qd, u) (NQ), with the pivot of every coordinate in the
+    /// factorisation used (NQ): their product is det M, and a pivot that is not positive
+    /// means M is singular there (qdd is then not finite). Generated models solve without a
+    /// dense factorisation, by articulated bodies or by sparse LᵀDL, whichever costs fewer
+    /// flops (the op-count row `forward_dynamics (…)` names it); the default evaluates M and h
+    /// and factorises M by dense Cholesky, allocating (models written by hand).
+    fn forward_dynamics(
+        &self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        u: &[f64],
+        qdd: &mut [f64],
+        pivots: &mut [f64],
+    ) {
+        let n = Self::NQ;
+        let mut m = vec![0.0; n * n];
+        self.dynamics(t, q, qd, u, &mut m, qdd);
+        let ok = crate::linalg::cholesky(&mut m, n).is_ok();
+        for (j, p) in pivots.iter_mut().enumerate() {
+            *p = if ok { m[j + n * j] * m[j + n * j] } else { 0.0 };
+        }
+        if ok {
+            crate::linalg::cholesky_solve(&m, n, qdd);
+        } else {
+            qdd.fill(f64::NAN);
+        }
+    }
+
     /// τ = M qdd − h (NQ): the generalised forces that produce qdd.
     fn inverse_dynamics(
         &self,

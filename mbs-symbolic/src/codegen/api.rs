@@ -91,6 +91,14 @@ pub const METHODS: &[Method] = &[
     ),
 ];
 
+/// `forward_dynamics`, which has a default in the trait (a dense solve) that every generated
+/// model overrides.
+pub const FORWARD_DYNAMICS: Method = method(
+    "forward_dynamics",
+    "t: f64, q: &[f64], qd: &[f64], u: &[f64], qdd: &mut [f64], pivots: &mut [f64]",
+    "",
+);
+
 /// The method `name` of the table.
 pub fn method_named(name: &str) -> &'static Method {
     METHODS
@@ -134,7 +142,7 @@ pub struct Sizes {
 }
 
 /// `impl ::mbs::Model for {ty}` with parameter struct `pty`: the constants, then every method
-/// of [`METHODS`] with the body `body(method)`.
+/// of [`METHODS`] and [`FORWARD_DYNAMICS`] with the body `body(method)`.
 pub fn model_impl(
     ty: &str,
     pty: &str,
@@ -159,7 +167,7 @@ const NPOINTS: usize = {npoints};
 const NC: usize = {nc};
 "
     );
-    for m in METHODS {
+    for m in METHODS.iter().chain([&FORWARD_DYNAMICS]) {
         let args = m.args.replace("{P}", pty);
         let ret = if m.ret.is_empty() {
             String::new()

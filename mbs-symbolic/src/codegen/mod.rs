@@ -402,6 +402,11 @@ fn emit_scene(
     f.matrix(a, "m", &mb.m);
     f.vector("h", &mb.h);
     specs.push((f, Some("dynamics (M, h)")));
+    let mut f = FnSpec::new("__forward_dynamics", api::FORWARD_DYNAMICS.args);
+    f.vector("qdd", &eq.forward.qdd);
+    f.vector("pivots", &eq.forward.pivots);
+    let forward_label = format!("forward_dynamics ({})", eq.forward.method.name());
+    specs.push((f, Some(&forward_label)));
     let mut f = FnSpec::new("__mass_matrix", args("mass_matrix"));
     f.matrix(a, "m", &mb.m);
     specs.push((f, Some("mass_matrix")));

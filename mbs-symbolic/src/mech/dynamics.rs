@@ -2,6 +2,7 @@
 //! (or the one the model forces), tangents when asked for, energies, power, static forces.
 
 use super::effects::Loads;
+use super::forward::{Forward, articulated, ltdl};
 use super::recursive::{body_kinematics, crba, newton_euler, spinning_body_motion};
 use super::spin::spinning_frames;
 
@@ -60,6 +61,8 @@ pub struct SceneEquations {
     pub potential: ExprId,
     /// power of the non-conservative effects
     pub power: ExprId,
+    /// qdd = M⁻¹ h without a dense factorisation, in the cheaper form
+    pub forward: Forward,
 }
 
 impl SceneEquations {
@@ -147,6 +150,10 @@ impl SceneEquations {
                 .collect();
             (k, c)
         });
+        let forward = match formulation {
+            Formulation::VirtualPower => forward_dynamics(sys, tree, &vp),
+            Formulation::Recursive => forward_dynamics(sys, tree, &rec),
+        };
         let (kinetic, potential) = energies(sys, tree, world, &loads);
         let power = loads.power.unwrap_or(sys.arena.zero());
         SceneEquations {
@@ -164,7 +171,25 @@ impl SceneEquations {
             kinetic,
             potential,
             power,
+            forward,
         }
+    }
+}
+
+/// The cheaper, by flops, of articulated bodies (when the tree allows it) and sparse LᵀDL,
+/// applied to `mb`'s h.
+fn forward_dynamics(sys: &mut System, tree: &Tree, mb: &MassBias) -> Forward {
+    let sparse = ltdl(&mut sys.arena, &mb.m, &mb.h);
+    match articulated(sys, tree, &mb.h) {
+        Some(aba) => {
+            let cost = |f: &Forward| crate::expr::ops(&sys.arena, &f.roots()).flops();
+            if cost(&aba) < cost(&sparse) {
+                aba
+            } else {
+                sparse
+            }
+        }
+        None => sparse,
     }
 }
 

@@ -4,6 +4,7 @@
 pub mod constraints;
 pub mod dynamics;
 pub mod effects;
+pub mod forward;
 pub mod model;
 pub mod recursive;
 pub mod spatial;

@@ -2,7 +2,7 @@
 //! (or the one the model forces), tangents when asked for, energies, power, static forces.
 
 use super::effects::Loads;
-use super::forward::{Forward, articulated, ltdl};
+use super::forward::{Forward, articulated, ltdl, ltdl_estimate};
 use super::recursive::{body_kinematics, crba, newton_euler, spinning_body_motion};
 use super::spin::spinning_frames;
 
@@ -179,17 +179,20 @@ impl SceneEquations {
 /// The cheaper, by flops, of articulated bodies (when the tree allows it) and sparse LᵀDL,
 /// applied to `mb`'s h.
 fn forward_dynamics(sys: &mut System, tree: &Tree, mb: &MassBias) -> Forward {
+    let Some(aba) = articulated(sys, tree, &mb.h) else {
+        return ltdl(&mut sys.arena, &mb.m, &mb.h);
+    };
+    let cost = |a: &Arena, f: &Forward| crate::expr::ops(a, &f.roots()).flops();
+    let aba_cost = cost(&sys.arena, &aba);
+    // two flops per multiply–subtract: far above, LᵀDL is not worth building (long chains)
+    if 2 * ltdl_estimate(&sys.arena, &mb.m) > 4 * aba_cost {
+        return aba;
+    }
     let sparse = ltdl(&mut sys.arena, &mb.m, &mb.h);
-    match articulated(sys, tree, &mb.h) {
-        Some(aba) => {
-            let cost = |f: &Forward| crate::expr::ops(&sys.arena, &f.roots()).flops();
-            if cost(&aba) < cost(&sparse) {
-                aba
-            } else {
-                sparse
-            }
-        }
-        None => sparse,
+    if aba_cost < cost(&sys.arena, &sparse) {
+        aba
+    } else {
+        sparse
     }
 }
 

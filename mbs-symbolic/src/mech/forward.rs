@@ -51,6 +51,32 @@ impl Forward {
     }
 }
 
+/// Multiply–subtract pairs sparse LᵀDL of `m` would take, from its structure alone (entries
+/// that are the number 0 stay 0 unless filled): a cheap bound that spares building the
+/// factorisation of a long chain, where articulated bodies win by far.
+pub fn ltdl_estimate(a: &Arena, m: &[Vec<ExprId>]) -> usize {
+    let n = m.len();
+    let mut nz: Vec<Vec<bool>> = m
+        .iter()
+        .map(|row| row.iter().map(|&e| !a.is_num(e, 0.0)).collect())
+        .collect();
+    let mut ops = 0;
+    for k in (0..n).rev() {
+        for i in (0..k).rev() {
+            if !nz[k][i] {
+                continue;
+            }
+            for j in 0..=i {
+                if nz[k][j] {
+                    nz[i][j] = true;
+                    ops += 1;
+                }
+            }
+        }
+    }
+    ops
+}
+
 /// qdd = M⁻¹ h by sparse LᵀDL of the symmetric `m` (rows of expressions).
 pub fn ltdl(a: &mut Arena, m: &[Vec<ExprId>], h: &[ExprId]) -> Forward {
     let n = h.len();

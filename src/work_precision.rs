@@ -29,7 +29,7 @@
 //! other processes on a busy machine do not inflate, wall time where it cannot be read; the wall time is kept too. Both are the
 //! best of up to [`Study::repeats`] repeats; the repeats stop early once a row has used
 //! [`Study::repeat_budget`], and the count is in the `reps` column. Steps, rejections (error
-//! test, Newton), evaluations of the model (M+h, M, τ, tangents: [`Stats::evaluations`]) and
+//! test, Newton), evaluations of the model (M+h, forward dynamics, M, τ, tangents: [`Stats::evaluations`]) and
 //! LU/Cholesky factorisations come from the run's [`Stats`]. A run that fails is a row of its
 //! own with the typed [`Failure`], the time it reached and the work it had done: nothing is
 //! dropped. The chart leaves out failures and runs without a correct digit (e ≥ 1).
@@ -821,7 +821,7 @@ pub struct WorkPrecision {
     pub rows: Vec<Row>,
 }
 
-const CSV_HEADER: &str = "model,scheme,label,constraints,setting,value,status,mescd,error_end,error_max,t_worst,drift,cpu_s,wall_s,repeats,steps,rejected_error,rejected_newton,evaluations,dynamics,mass_matrix,inverse_dynamics,tangents,factorizations,newton_iterations,failure,t_failure,message";
+const CSV_HEADER: &str = "model,scheme,label,constraints,setting,value,status,mescd,error_end,error_max,t_worst,drift,cpu_s,wall_s,repeats,steps,rejected_error,rejected_newton,evaluations,dynamics,forward_dynamics,mass_matrix,inverse_dynamics,tangents,factorizations,newton_iterations,failure,t_failure,message";
 
 fn csv_field(s: &str) -> String {
     if s.contains([',', '"', '\n']) {
@@ -859,7 +859,7 @@ impl WorkPrecision {
             };
             let _ = writeln!(
                 out,
-                "{},{},{},{},{},{:e},{status},{acc},{:e},{:e},{},{},{},{},{},{},{},{},{},{},{},{fail}",
+                "{},{},{},{},{},{:e},{status},{acc},{:e},{:e},{},{},{},{},{},{},{},{},{},{},{},{},{fail}",
                 csv_field(&self.title),
                 r.scheme.name(),
                 csv_field(&r.label),
@@ -874,6 +874,7 @@ impl WorkPrecision {
                 s.rejected_newton,
                 s.evaluations(),
                 s.dynamics,
+                s.forward_dynamics,
                 s.mass_matrix,
                 s.inverse_dynamics,
                 s.tangents,
@@ -1003,7 +1004,7 @@ impl fmt::Display for WorkPrecision {
         )?;
         writeln!(
             f,
-            "CPU: {} of one run, best of `reps` (≤ {}); evals = M+h, M, τ and tangent evaluations; LU = factorisations",
+            "CPU: {} of one run, best of `reps` (≤ {}); evals = M+h, forward-dynamics, M, τ and tangent evaluations; LU = factorisations",
             self.clock.name(),
             self.repeats
         )?;

@@ -103,7 +103,7 @@ pub enum Failure {
         coordinates: Vec<String>,
     },
     #[error(
-        "the coordinates reach a singular configuration at {coordinate} = {value:.6} (Euler angles at gimbal lock, joint axes lining up, a coordinate that stops moving mass): the mass matrix is nearly singular along {} (a Cholesky pivot fell to {ratio:.1e} of its start value, below singularity_tol = {tolerance:.0e}); describe this motion with other coordinates",
+        "the coordinates reach a singular configuration at {coordinate} = {value:.6} (Euler angles at gimbal lock, joint axes lining up, a coordinate that stops moving mass): the mass matrix is nearly singular along {} (a pivot of its factorisation fell to {ratio:.1e} of its start value, below singularity_tol = {tolerance:.0e}); describe this motion with other coordinates",
         dependent.join(", ")
     )]
     SingularConfiguration {
@@ -114,7 +114,8 @@ pub enum Failure {
         /// the coordinates of the near-null vector of M (scaled by its start diagonal): the
         /// ones that move the bodies alike, or no longer move them
         dependent: Vec<String>,
-        /// the Cholesky pivot of M that fell most, over its start value
+        /// the pivot of M's factorisation (dense Cholesky, or the generated forward dynamics)
+        /// that fell most, over its start value
         ratio: f64,
         /// `Options::singularity_tol`
         tolerance: f64,

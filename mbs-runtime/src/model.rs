@@ -345,6 +345,10 @@ pub trait Model {
     /// number of scalar constraints Φ(q, t) = 0; the equations are then
     /// M qdd = h + Bᵀλ, Φ = 0 with B = ∂Φ/∂q
     const NC: usize;
+    /// whether [`Model::forward_dynamics`] is generated (articulated bodies or sparse LᵀDL,
+    /// no dense factorisation): the runtime then solves M qdd = h of an open-loop model with
+    /// it; otherwise (models written by hand, `WithEfforts`) with a dense Cholesky of M
+    const FORWARD_DYNAMICS_GENERATED: bool = false;
 
     /// Names, sizes, formulation and op counts.
     fn info(&self) -> &'static ModelInfo;

@@ -429,12 +429,14 @@ pub struct Options {
     pub stability_check: bool,
     /// stop with `Failure::SingularConfiguration` when the coordinates approach a singular
     /// configuration (Euler angles at gimbal lock, joint axes lining up, a coordinate that
-    /// stops moving mass): when a Cholesky pivot L_jj² of the mass matrix falls below this
-    /// fraction of its value at the start (default 1e-4; 0 disables). L_jj² is the inertia of
-    /// coordinate j that the coordinates before it cannot produce; each is compared with its
-    /// own start value, so metres and radians do not mix. Watched wherever M is factorised
-    /// (the start, every evaluation of the explicit schemes and implicit midpoint, index-1
-    /// forms) and, for the other implicit schemes, at every iteration matrix that evaluates M
+    /// stops moving mass): when a pivot of the mass matrix's factorisation falls below this
+    /// fraction of its value at the start (default 1e-4; 0 disables). A Cholesky pivot L_jj²
+    /// is the inertia of coordinate j that the coordinates before it cannot produce, a pivot
+    /// of the generated forward dynamics (articulated bodies, LᵀDL) the one the coordinates
+    /// after it cannot; each is compared with its own start value of the same kind, so
+    /// metres and radians do not mix. Watched wherever M qdd = h is solved (the start, every
+    /// evaluation of the explicit schemes and implicit midpoint, index-1 forms) and, for the
+    /// other implicit schemes, at every iteration matrix that evaluates M
     /// (one Cholesky factorisation of M each, counted in `Stats::condition_checks`); the
     /// Newmark family and BDF with iteration matrices by finite differences of τ, which do not
     /// evaluate M, watch every accepted state instead (one evaluation and one Cholesky

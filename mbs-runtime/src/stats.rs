@@ -16,6 +16,9 @@ pub struct Stats {
     pub rejected_newton: usize,
     /// evaluations of M and h together (`Model::dynamics`)
     pub dynamics: usize,
+    /// evaluations of qdd by the generated forward dynamics (`Model::forward_dynamics`:
+    /// articulated bodies or sparse LᵀDL, neither M nor a dense factorisation)
+    pub forward_dynamics: usize,
     /// evaluations of M alone
     pub mass_matrix: usize,
     /// evaluations of τ = M qdd − h (`Model::inverse_dynamics`)
@@ -43,7 +46,8 @@ pub struct Stats {
     /// Cholesky factorisations of M made only to watch for a singular configuration
     /// (implicit schemes, at each iteration matrix that evaluates M, or at each accepted step
     /// of the Newmark family and BDF when their iteration matrices are finite differences of
-    /// τ: `Options::singularity_tol`)
+    /// τ: `Options::singularity_tol`), and once at the start of an implicit scheme when the
+    /// generated forward dynamics solved for the start's accelerations (the reference)
     pub condition_checks: usize,
     /// Newton iterations, all steps together
     pub newton_iterations: usize,
@@ -95,9 +99,14 @@ impl fmt::Display for ErrorTest {
 }
 
 impl Stats {
-    /// Evaluations of the model's equations of any kind (M+h, M, τ, tangents).
+    /// Evaluations of the model's equations of any kind (M+h, forward dynamics, M, τ,
+    /// tangents).
     pub fn evaluations(&self) -> usize {
-        self.dynamics + self.mass_matrix + self.inverse_dynamics + self.tangents
+        self.dynamics
+            + self.forward_dynamics
+            + self.mass_matrix
+            + self.inverse_dynamics
+            + self.tangents
     }
 
     pub(crate) fn record_step(&mut self, h: f64) {
@@ -128,8 +137,9 @@ impl fmt::Display for Stats {
         )?;
         writeln!(
             f,
-            "evaluations: {} M+h, {} M, {} τ, {} tangents, {} user efforts, {} energy",
+            "evaluations: {} M+h, {} forward dynamics, {} M, {} τ, {} tangents, {} user efforts, {} energy",
             self.dynamics,
+            self.forward_dynamics,
             self.mass_matrix,
             self.inverse_dynamics,
             self.tangents,

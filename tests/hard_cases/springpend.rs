@@ -120,44 +120,44 @@ fn springpend_stiffness_sweep() {
         "springpend",
         &snapshots,
         &[
-            [47, 4, 0, 2, 17, 300, 17, 86, 253, 100, 17], // MODELS.md start r = 1 + 9.81/k, radau5 k 1e2
-            [383, 29, 0, 2, 30, 1692, 30, 418, 1542, 564, 30], // MODELS.md start r = 1 + 9.81/k, radau5 k 1e4
-            [2547, 317, 0, 4, 316, 10620, 316, 3258, 9950, 3540, 316], // MODELS.md start r = 1 + 9.81/k, radau5 k 1e6
+            [47, 4, 0, 0, 2, 18, 300, 17, 84, 251, 100, 18], // MODELS.md start r = 1 + 9.81/k, radau5 k 1e2
+            [383, 29, 0, 0, 2, 31, 1692, 30, 416, 1540, 564, 31], // MODELS.md start r = 1 + 9.81/k, radau5 k 1e4
+            [2547, 317, 0, 0, 4, 317, 10620, 316, 3254, 9946, 3540, 317], // MODELS.md start r = 1 + 9.81/k, radau5 k 1e6
             [
-                14320, 3016, 0, 38, 2981, 65844, 2981, 26506, 61306, 21948, 2981,
+                14688, 3098, 0, 0, 48, 3054, 67557, 3053, 26940, 62870, 22519, 3054,
             ], // MODELS.md start r = 1 + 9.81/k, radau5 k 1e8
-            [135, 7, 0, 2, 18, 163, 18, 20, 165, 163, 18], // MODELS.md start r = 1 + 9.81/k, bdf k 1e2
-            [748, 93, 0, 2, 146, 994, 146, 148, 996, 994, 146], // MODELS.md start r = 1 + 9.81/k, bdf k 1e4
-            [4867, 603, 0, 2, 891, 6538, 891, 893, 6540, 6538, 891], // MODELS.md start r = 1 + 9.81/k, bdf k 1e6
+            [135, 7, 0, 0, 2, 19, 163, 18, 18, 163, 163, 19], // MODELS.md start r = 1 + 9.81/k, bdf k 1e2
+            [748, 93, 0, 0, 2, 147, 994, 146, 146, 994, 994, 147], // MODELS.md start r = 1 + 9.81/k, bdf k 1e4
+            [4867, 603, 0, 0, 2, 892, 6538, 891, 891, 6538, 6538, 892], // MODELS.md start r = 1 + 9.81/k, bdf k 1e6
             [
-                21072, 1781, 0, 2, 2680, 28496, 2680, 2682, 28498, 28496, 2680,
+                21196, 1845, 0, 0, 2, 2782, 28732, 2781, 2781, 28732, 28732, 2782,
             ], // MODELS.md start r = 1 + 9.81/k, bdf k 1e8
-            [180, 2, 0, 2, 27, 381, 27, 29, 383, 381, 27], // MODELS.md start r = 1 + 9.81/k, gen-alpha k 1e2
-            [250, 37, 0, 2, 102, 645, 102, 104, 647, 645, 102], // MODELS.md start r = 1 + 9.81/k, gen-alpha k 1e4
-            [423, 232, 0, 2, 386, 1929, 386, 388, 1931, 1929, 386], // MODELS.md start r = 1 + 9.81/k, gen-alpha k 1e6
+            [180, 2, 0, 0, 2, 28, 381, 27, 27, 381, 381, 28], // MODELS.md start r = 1 + 9.81/k, gen-alpha k 1e2
+            [250, 37, 0, 0, 2, 103, 645, 102, 102, 645, 645, 103], // MODELS.md start r = 1 + 9.81/k, gen-alpha k 1e4
+            [423, 232, 0, 0, 2, 387, 1929, 386, 386, 1929, 1929, 387], // MODELS.md start r = 1 + 9.81/k, gen-alpha k 1e6
             [
-                4836, 4573, 0, 2, 6992, 15128, 6992, 6994, 15130, 15128, 6992,
+                4836, 4554, 0, 0, 2, 6974, 15122, 6973, 6973, 15122, 15122, 6974,
             ], // MODELS.md start r = 1 + 9.81/k, gen-alpha k 1e8
-            [42, 7, 0, 296, 0, 0, 0, 296, 296, 0, 0], // MODELS.md start r = 1 + 9.81/k, dopri5 k 1e2
-            [321, 32, 0, 2120, 0, 0, 0, 2120, 2120, 0, 0], // MODELS.md start r = 1 + 9.81/k, dopri5 k 1e4
-            [2267, 340, 0, 15644, 0, 0, 0, 15644, 15644, 0, 0], // MODELS.md start r = 1 + 9.81/k, dopri5 k 1e6
-            [14439, 2618, 0, 102344, 0, 0, 0, 102344, 102344, 0, 0], // MODELS.md start r = 1 + 9.81/k, dopri5 k 1e8
-            [44, 5, 0, 2, 15, 288, 15, 58, 243, 96, 15], // slow-manifold start r = 1 + 9.81 cos 0.5/k, radau5 k 1e2
-            [128, 30, 0, 3, 30, 663, 30, 267, 604, 221, 30], // slow-manifold start r = 1 + 9.81 cos 0.5/k, radau5 k 1e4
-            [19, 0, 0, 2, 12, 108, 12, 38, 93, 36, 12], // slow-manifold start r = 1 + 9.81 cos 0.5/k, radau5 k 1e6
-            [17, 0, 0, 2, 1, 87, 1, 24, 77, 29, 1], // slow-manifold start r = 1 + 9.81 cos 0.5/k, radau5 k 1e8
-            [120, 7, 0, 2, 19, 149, 19, 21, 151, 149, 19], // slow-manifold start r = 1 + 9.81 cos 0.5/k, bdf k 1e2
-            [326, 54, 0, 2, 77, 482, 77, 79, 484, 482, 77], // slow-manifold start r = 1 + 9.81 cos 0.5/k, bdf k 1e4
-            [850, 6, 0, 2, 15, 906, 15, 17, 908, 906, 15], // slow-manifold start r = 1 + 9.81 cos 0.5/k, bdf k 1e6
-            [853, 6, 0, 2, 15, 961, 15, 17, 963, 961, 15], // slow-manifold start r = 1 + 9.81 cos 0.5/k, bdf k 1e8
-            [177, 2, 0, 2, 33, 329, 33, 35, 331, 329, 33], // slow-manifold start r = 1 + 9.81 cos 0.5/k, gen-alpha k 1e2
-            [180, 2, 0, 2, 40, 398, 40, 42, 400, 398, 40], // slow-manifold start r = 1 + 9.81 cos 0.5/k, gen-alpha k 1e4
-            [180, 2, 0, 2, 41, 317, 41, 43, 319, 317, 41], // slow-manifold start r = 1 + 9.81 cos 0.5/k, gen-alpha k 1e6
-            [183, 2, 0, 2, 47, 645, 47, 49, 647, 645, 47], // slow-manifold start r = 1 + 9.81 cos 0.5/k, gen-alpha k 1e8
-            [38, 4, 0, 254, 0, 0, 0, 254, 254, 0, 0], // slow-manifold start r = 1 + 9.81 cos 0.5/k, dopri5 k 1e2
-            [133, 29, 0, 974, 0, 0, 0, 974, 974, 0, 0], // slow-manifold start r = 1 + 9.81 cos 0.5/k, dopri5 k 1e4
-            [685, 176, 0, 5168, 0, 0, 0, 5168, 5168, 0, 0], // slow-manifold start r = 1 + 9.81 cos 0.5/k, dopri5 k 1e6
-            [8970, 2681, 0, 69908, 0, 0, 0, 69908, 69908, 0, 0], // slow-manifold start r = 1 + 9.81 cos 0.5/k, dopri5 k 1e8
+            [42, 7, 0, 0, 296, 0, 0, 0, 0, 0, 0, 0], // MODELS.md start r = 1 + 9.81/k, dopri5 k 1e2
+            [321, 32, 0, 0, 2120, 0, 0, 0, 0, 0, 0, 0], // MODELS.md start r = 1 + 9.81/k, dopri5 k 1e4
+            [2265, 335, 0, 0, 15602, 0, 0, 0, 0, 0, 0, 0], // MODELS.md start r = 1 + 9.81/k, dopri5 k 1e6
+            [14440, 2624, 0, 0, 102386, 0, 0, 0, 0, 0, 0, 0], // MODELS.md start r = 1 + 9.81/k, dopri5 k 1e8
+            [44, 5, 0, 0, 2, 16, 288, 15, 56, 241, 96, 16], // slow-manifold start r = 1 + 9.81 cos 0.5/k, radau5 k 1e2
+            [128, 30, 0, 0, 3, 31, 663, 30, 264, 601, 221, 31], // slow-manifold start r = 1 + 9.81 cos 0.5/k, radau5 k 1e4
+            [19, 0, 0, 0, 2, 13, 108, 12, 36, 91, 36, 13], // slow-manifold start r = 1 + 9.81 cos 0.5/k, radau5 k 1e6
+            [17, 0, 0, 0, 2, 2, 87, 1, 22, 75, 29, 2], // slow-manifold start r = 1 + 9.81 cos 0.5/k, radau5 k 1e8
+            [120, 7, 0, 0, 2, 20, 149, 19, 19, 149, 149, 20], // slow-manifold start r = 1 + 9.81 cos 0.5/k, bdf k 1e2
+            [326, 54, 0, 0, 2, 78, 482, 77, 77, 482, 482, 78], // slow-manifold start r = 1 + 9.81 cos 0.5/k, bdf k 1e4
+            [850, 6, 0, 0, 2, 16, 906, 15, 15, 906, 906, 16], // slow-manifold start r = 1 + 9.81 cos 0.5/k, bdf k 1e6
+            [853, 6, 0, 0, 2, 16, 961, 15, 15, 961, 961, 16], // slow-manifold start r = 1 + 9.81 cos 0.5/k, bdf k 1e8
+            [177, 2, 0, 0, 2, 34, 329, 33, 33, 329, 329, 34], // slow-manifold start r = 1 + 9.81 cos 0.5/k, gen-alpha k 1e2
+            [180, 2, 0, 0, 2, 41, 398, 40, 40, 398, 398, 41], // slow-manifold start r = 1 + 9.81 cos 0.5/k, gen-alpha k 1e4
+            [180, 2, 0, 0, 2, 42, 317, 41, 41, 317, 317, 42], // slow-manifold start r = 1 + 9.81 cos 0.5/k, gen-alpha k 1e6
+            [183, 2, 0, 0, 2, 48, 645, 47, 47, 645, 645, 48], // slow-manifold start r = 1 + 9.81 cos 0.5/k, gen-alpha k 1e8
+            [38, 4, 0, 0, 254, 0, 0, 0, 0, 0, 0, 0], // slow-manifold start r = 1 + 9.81 cos 0.5/k, dopri5 k 1e2
+            [133, 29, 0, 0, 974, 0, 0, 0, 0, 0, 0, 0], // slow-manifold start r = 1 + 9.81 cos 0.5/k, dopri5 k 1e4
+            [684, 173, 0, 0, 5144, 0, 0, 0, 0, 0, 0, 0], // slow-manifold start r = 1 + 9.81 cos 0.5/k, dopri5 k 1e6
+            [8971, 2663, 0, 0, 69806, 0, 0, 0, 0, 0, 0, 0], // slow-manifold start r = 1 + 9.81 cos 0.5/k, dopri5 k 1e8
         ],
     );
 }

@@ -3,10 +3,10 @@
 
 use mbs::{Stats, Trajectory};
 
-/// steps, rejected by the error test, rejected by Newton, M+h, M, τ, tangents,
+/// steps, rejected by the error test, rejected by Newton, M+h, forward dynamics, M, τ, tangents,
 /// factorisations, solves, Newton iterations, Cholesky factorisations of M for the
 /// singularity watch (`Stats::condition_checks`)
-pub type Work = [usize; 11];
+pub type Work = [usize; 12];
 
 pub fn work(s: &Stats) -> Work {
     [
@@ -14,6 +14,7 @@ pub fn work(s: &Stats) -> Work {
         s.rejected_error,
         s.rejected_newton,
         s.dynamics,
+        s.forward_dynamics,
         s.mass_matrix,
         s.inverse_dynamics,
         s.tangents,
@@ -28,7 +29,7 @@ pub fn work(s: &Stats) -> Work {
 /// expected table), then compares: a change that alters the work of a hard case fails here.
 pub fn check_work(case: &str, got: &[(String, Work)], expected: &[Work]) {
     println!(
-        "{case}: work (steps, rej. error, rej. Newton, M+h, M, τ, tangents, factorisations, solves, Newton iterations, M checks)"
+        "{case}: work (steps, rej. error, rej. Newton, M+h, forward, M, τ, tangents, factorisations, solves, Newton iterations, M checks)"
     );
     for (name, w) in got {
         println!("    {w:?}, // {name}");

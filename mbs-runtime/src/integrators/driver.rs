@@ -110,6 +110,7 @@ impl<M: Model + 'static> Simulation<M> {
                     &mut problem,
                     &mut controllers,
                     options.singularity_tol,
+                    scheme.is_implicit(),
                     &mut cur,
                 )?;
                 Ok(assembly)
@@ -700,6 +701,7 @@ fn first_sample<M: Model>(
     problem: &mut Problem<M>,
     controllers: &mut [(f64, u64, Box<dyn Controller>)],
     singularity_tol: f64,
+    implicit: bool,
     cur: &mut State,
 ) -> Result<(), Failure> {
     for (_, count, c) in controllers.iter_mut() {
@@ -709,7 +711,7 @@ fn first_sample<M: Model>(
     }
     problem.inputs_changed();
     problem.accel(cur.t, &cur.q.clone(), &cur.qd.clone(), &mut cur.qdd)?;
-    problem.watch_from_start(singularity_tol);
+    problem.watch_from_start(singularity_tol, cur.t, &cur.q, implicit)?;
     if let Some(c) = problem.loops.closed() {
         cur.lambda.copy_from_slice(&c.lambda);
     }

@@ -165,6 +165,7 @@ const NU: usize = {nu};
 const NFRAMES: usize = {nframes};
 const NPOINTS: usize = {npoints};
 const NC: usize = {nc};
+const FORWARD_DYNAMICS_GENERATED: bool = true;
 "
     );
     for m in METHODS.iter().chain([&FORWARD_DYNAMICS]) {

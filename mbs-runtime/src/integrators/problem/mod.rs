@@ -1,5 +1,5 @@
 //! The model as the schemes see it: evaluations counted, results checked (a non-finite value
-//! is named by its coordinate), forward dynamics by Cholesky, residuals τ, and iteration
+//! is named by its coordinate), forward dynamics (generated, or by Cholesky), residuals τ, and iteration
 //! matrices M + γ'·C_t + β'·K_t, all on buffers allocated once.
 //!
 //! A constrained model run by a method other than index 3 is, for the schemes, the ODE
@@ -24,7 +24,7 @@ use crate::linalg::{cholesky, cholesky_solve};
 use crate::model::Model;
 use crate::options::IterationMatrix;
 use crate::stats::Stats;
-use watch::worst_pivot;
+use watch::{worst_pivot, worst_pivot_of};
 
 pub(crate) struct Problem<M: Model> {
     pub model: M,
@@ -47,6 +47,11 @@ pub(crate) struct Problem<M: Model> {
     /// the Cholesky pivots L_jj² of M and its diagonal at the start
     start_pivots: Vec<f64>,
     start_diagonal: Vec<f64>,
+    /// whether M qdd = h is solved by the generated forward dynamics (open loops, a model
+    /// that has them), the pivots of its last solve and of the solve at the start
+    forward: bool,
+    pivots: Vec<f64>,
+    start_forward: Vec<f64>,
     /// M factorised only to watch its conditioning (implicit schemes)
     mchk: Vec<f64>,
     labels: Vec<String>,
@@ -134,6 +139,9 @@ impl<M: Model> Problem<M> {
             singularity_tol: 0.0,
             start_pivots: z(),
             start_diagonal: z(),
+            forward: M::FORWARD_DYNAMICS_GENERATED,
+            pivots: z(),
+            start_forward: z(),
             mchk: vec![0.0; n * n],
             labels,
             m: vec![0.0; n * n],
@@ -243,6 +251,11 @@ impl<M: Model> Problem<M> {
         Ok(())
     }
 
+    /// qdd of an open-loop model: by its generated forward dynamics when it has them, their
+    /// pivots watched against those at the start; by M, h and a dense Cholesky factorisation
+    /// otherwise, and whenever the forward solve gives a pivot not above 1e-14 of the largest
+    /// (the dense Cholesky's test) or a value that is not finite (a failure path: the dense
+    /// path names the coordinate).
     fn plain_accel(
         &mut self,
         t: f64,
@@ -251,6 +264,24 @@ impl<M: Model> Problem<M> {
         qdd: &mut [f64],
     ) -> Result<(), Failure> {
         self.inputs_at(t)?;
+        if self.forward {
+            self.model
+                .forward_dynamics(t, q, qd, &self.u, qdd, &mut self.pivots);
+            self.stats.forward_dynamics += 1;
+            if let Some(f) = self.model.take_failure() {
+                return Err(f);
+            }
+            // the dense Cholesky's test: every pivot above 1e-14 of the largest
+            let scale = self.pivots.iter().fold(0.0f64, |m, p| m.max(*p));
+            let positive = self.pivots.iter().all(|p| *p > 1e-14 * scale) && scale.is_finite();
+            if positive && qdd.iter().all(|a| a.is_finite()) {
+                if self.watching() {
+                    let (ratio, j) = worst_pivot_of(&self.pivots, &self.start_forward);
+                    self.judge(ratio, j, t, q)?;
+                }
+                return Ok(());
+            }
+        }
         self.model
             .dynamics(t, q, qd, &self.u, &mut self.m, &mut self.h);
         self.stats.dynamics += 1;

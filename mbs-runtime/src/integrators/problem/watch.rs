@@ -1,5 +1,6 @@
-//! Singular configurations and singular matrices: the Cholesky pivots of M watched against
-//! their start values, and the failures that name the coordinates involved.
+//! Singular configurations and singular matrices: the pivots of M (Cholesky, or the generated
+//! forward dynamics) watched against their start values, and the failures that name the
+//! coordinates involved.
 
 use super::Problem;
 use crate::error::Failure;
@@ -70,15 +71,41 @@ impl<M: Model> Problem<M> {
         }
     }
 
-    /// Watches for singular configurations from now on, with the factor of M at the start
-    /// (the last one made, in `chol`) as the reference.
-    pub fn watch_from_start(&mut self, tolerance: f64) {
+    /// Watches for singular configurations from now on, with the pivots of the solve of
+    /// M qdd = h at the start (t, q) as the reference: those of the generated forward
+    /// dynamics when they solved it, and the Cholesky factor of M (the last one made, in
+    /// `chol`), which an open-loop model solved by forward dynamics factorises here only
+    /// when `implicit` (its schemes watch M through their iteration matrices).
+    pub fn watch_from_start(
+        &mut self,
+        tolerance: f64,
+        t: f64,
+        q: &[f64],
+        implicit: bool,
+    ) -> Result<(), Failure> {
         let n = self.n;
+        let by_forward = self.forward && self.loops.closed().is_none();
+        if by_forward {
+            self.start_forward.copy_from_slice(&self.pivots);
+            if implicit && tolerance > 0.0 {
+                self.model.mass_matrix(t, q, &mut self.chol);
+                self.stats.mass_matrix += 1;
+                self.check("M", &self.chol)?;
+                self.stats.condition_checks += 1;
+                cholesky(&mut self.chol, n).map_err(|s| self.singular_mass(&self.chol, s))?;
+            } else {
+                // no M at the start: a singular configuration is then described with the
+                // diagonal of M where it is found (`start_diagonal` stays 0)
+                self.singularity_tol = tolerance;
+                return Ok(());
+            }
+        }
         for j in 0..n {
             self.start_pivots[j] = self.chol[j + n * j] * self.chol[j + n * j];
             self.start_diagonal[j] = (0..=j).map(|k| self.chol[j + n * k].powi(2)).sum();
         }
         self.singularity_tol = tolerance;
+        Ok(())
     }
 
     /// Whether singular configurations are watched (after the start, with a tolerance).
@@ -137,11 +164,16 @@ impl<M: Model> Problem<M> {
             Some((0..n).map(|i| (l[i + n * i] * l[i + n * i]).ln()).sum())
         };
         self.model.mass_matrix(t, q, &mut l);
+        // the diagonal of M at the start, or here when the start did not evaluate M
+        let d: Vec<f64> = if self.start_diagonal.iter().all(|x| *x > 0.0) {
+            self.start_diagonal.iter().map(|x| x.sqrt()).collect()
+        } else {
+            (0..n).map(|j| l[j + n * j].abs().sqrt()).collect()
+        };
         let factored = cholesky(&mut l, n).is_ok();
         self.stats.mass_matrix += 1;
         self.stats.factorizations += 1;
         // inverse iteration on S = D₀^-1/2 M D₀^-1/2: x ← D₀^1/2 M⁻¹ D₀^1/2 x
-        let d: Vec<f64> = self.start_diagonal.iter().map(|x| x.sqrt()).collect();
         let mut x = vec![1.0; n];
         if factored {
             for _ in 0..8 {
@@ -197,6 +229,20 @@ impl<M: Model> Problem<M> {
 /// coordinates before it cannot produce: it falls when coordinate j starts to move the bodies
 /// as a combination of the others does (Euler angles at gimbal lock, aligned joint axes), or
 /// stops moving mass; each pivot is compared with its own start value, so units do not mix.
+/// The pivot of a forward-dynamics solve (articulated bodies or LᵀDL, from the last
+/// coordinate) that fell most relative to its start value, and its coordinate: the same
+/// test as [`worst_pivot`] on another elimination order (the product of the pivots is det M
+/// in both).
+pub(super) fn worst_pivot_of(pivots: &[f64], start: &[f64]) -> (f64, usize) {
+    let mut worst = (f64::INFINITY, 0);
+    for (j, (p, s)) in pivots.iter().zip(start).enumerate() {
+        if p / s < worst.0 {
+            worst = (p / s, j);
+        }
+    }
+    worst
+}
+
 pub(super) fn worst_pivot(l: &[f64], n: usize, start: &[f64]) -> (f64, usize) {
     let mut worst = (f64::INFINITY, 0);
     for j in 0..n {

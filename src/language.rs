@@ -372,6 +372,7 @@
 //! | `for i in 0..n { … }` | the statements once for each integer `i` from 0 to n − 1 (`0..=n` includes n); at model level and inside `effect` blocks; nestable |
 //! | `body bar[i] { … }`, `dof b[i]`, `point tip[i] on bar[i] at …`, `param k[i] = …` | indexed names: the index is a constant integer expression (`i`, `i - 1`, `2 * i + 1`, `i / 2`, `i % 2`: integer arithmetic) |
 //! | `TOG[bar[i]] = TOG[bar[i-1]] * …;`, `q[b[i]]`, `qd[b[i]]` | indexed names wherever names go |
+//! | `q[2 * i + 1]`, `qd[i + 1]`, `u[i]` | the coordinate or input of that number (integer arithmetic, as in indexed names) |
 //! | `Tdisp(i * l, 0, 0)` | elsewhere the loop variable is a number |
 //! | `part Leg(k, hx, hy) { … }` | a template of statements, declared at model level (above or below its instances); its name starts with an uppercase letter |
 //! | `Leg(0, 0.4, 0.3);` | an instance: the part's statements with each argument replaced by the tokens given for it |

@@ -385,3 +385,41 @@ fn a_loop_that_does_not_expand_is_an_error_of_systems_from_str() {
     .expect_err("an error");
     assert!(e.contains("a loop range must be constant integers"), "{e}");
 }
+
+/// A coordinate indexed by integer arithmetic on a loop variable (`q[2*k + 1]`) is that
+/// coordinate: an arm whose joints alternate z and y, written in pairs, generates the code of
+/// the arm written out; `qd[…]` and `u[…]` take the value as well.
+#[test]
+fn integer_arithmetic_indexes_coordinates_and_inputs() {
+    let looped = "model Arm { param c = 0.1;
+        for i in 0..5 { dof q[i] = 0.2; body link[i] { mass = 1.0; inertia = (0.01, 0.02, 0.02); } }
+        input f0; input f1;
+        TOG[link[0]] = Trotz(q[0]) * Tdisp(0.15, 0, 0);
+        for k in 0..2 {
+            TOG[link[2*k+1]] = TOG[link[2*k]] * Tdisp(0.3, 0, 0) * Troty(q[2*k+1]);
+            TOG[link[2*k+2]] = TOG[link[2*k+1]] * Tdisp(0.3, 0, 0) * Trotz(q[2*k+2]);
+            generalized_force(q[2*k+1], u[k] - c * qd[2 * k + 1]);
+        }
+        gravity(0, 0, -9.81);
+    }";
+    let mut written = String::from("model Arm { param c = 0.1;\n");
+    for i in 0..5 {
+        written += &format!(
+            "dof q[{i}] = 0.2; body link[{i}] {{ mass = 1.0; inertia = (0.01, 0.02, 0.02); }}\n"
+        );
+    }
+    written += "input f0; input f1;\nTOG[link[0]] = Trotz(q[0]) * Tdisp(0.15, 0, 0);\n";
+    for k in 0..2 {
+        let (a, b, c) = (2 * k, 2 * k + 1, 2 * k + 2);
+        written += &format!(
+            "TOG[link[{b}]] = TOG[link[{a}]] * Tdisp(0.3, 0, 0) * Troty(q[{b}]);
+             TOG[link[{c}]] = TOG[link[{b}]] * Tdisp(0.3, 0, 0) * Trotz(q[{c}]);
+             generalized_force(q[{b}], u[{k}] - c * qd[{b}]);\n"
+        );
+    }
+    written += "gravity(0, 0, -9.81);\n}";
+    same(
+        &generate(looped).expect("looped"),
+        &generate(&written).expect("written"),
+    );
+}

@@ -644,6 +644,15 @@ impl Expander {
         let mut out: Vec<TokenTree> = Vec::new();
         for t in ts {
             match t {
+                // `q[2 * 0 + 1]` after substitution: the language's vectors take the value
+                TokenTree::Group(g) if vector_of_language(out.last()) && constant(&g).is_some() => {
+                    let v = constant(&g).expect("just checked");
+                    let mut lit = Literal::u64_unsuffixed(v);
+                    lit.set_span(g.span());
+                    let mut ng = Group::new(Delimiter::Bracket, TokenTree::Literal(lit).into());
+                    ng.set_span(g.span());
+                    out.push(TokenTree::Group(ng));
+                }
                 TokenTree::Group(g)
                     if !(touches(&g.stream(), &[])
                         || g.delimiter() == Delimiter::Bracket && indexable(out.last())) =>
@@ -698,6 +707,22 @@ impl Expander {
     }
 }
 
+/// Whether `[…]` after this token indexes a vector of the language (`q`, `qd`, `qdd`, `u`):
+/// a constant integer expression there is replaced by its value.
+fn vector_of_language(before: Option<&TokenTree>) -> bool {
+    matches!(before, Some(TokenTree::Ident(id)) if matches!(id.to_string().as_str(), "q" | "qd" | "qdd" | "u"))
+}
+
+/// The value of `[…]` when it is a constant integer expression of more than one token (a
+/// lone number or name stays as written).
+fn constant(g: &Group) -> Option<u64> {
+    if g.delimiter() != Delimiter::Bracket || g.stream().into_iter().count() < 2 {
+        return None;
+    }
+    let e = syn::parse2::<syn::Expr>(g.stream()).ok()?;
+    eval(&e).ok().and_then(|v| u64::try_from(v).ok())
+}
+
 /// Whether `[…]` after this token is an index to fold into a name.
 fn indexable(before: Option<&TokenTree>) -> bool {
     match before {
@@ -716,7 +741,9 @@ fn touches(ts: &TokenStream, env: &[(String, Binding)]) -> bool {
         match &t {
             TokenTree::Ident(id) if env.iter().any(|(n, _)| id == n) => return true,
             TokenTree::Group(g) => {
-                if g.delimiter() == Delimiter::Bracket && indexable(before.as_ref()) {
+                if g.delimiter() == Delimiter::Bracket && indexable(before.as_ref())
+                    || vector_of_language(before.as_ref()) && constant(g).is_some()
+                {
                     return true;
                 }
                 if touches(&g.stream(), env) {

@@ -1,0 +1,111 @@
+#!/usr/bin/env bash
+# Compile time and peak memory of one model in a crate of its own, dependencies built first
+# and not timed: release builds of a 24-joint spatial arm, a 32-bar planar chain, the
+# hexapod with exact tangents and a 200-bar chain, then a debug build of the arm.
+#
+#   benches/compile_time.sh            # all cases
+#   benches/compile_time.sh chain32    # one case (arm24, chain32, hexapod, chain200, arm24-dev)
+#
+# Each timed build compiles the model crate from scratch (its artifacts cleaned, no
+# incremental cache); the peak memory is the largest resident set of the build's processes
+# (GNU time's %M, which covers the compiler and the proc-macro it runs).
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+dir="$(mktemp -d)"
+trap 'rm -rf "$dir"' EXIT
+mkdir -p "$dir/src"
+cat > "$dir/Cargo.toml" <<TOML
+[package]
+name = "one_model"
+version = "0.0.0"
+edition = "2024"
+[dependencies]
+mbs = { path = "$root" }
+[workspace]
+TOML
+
+chain() { # n bars
+    cat <<RS
+mbs::multibody! {
+    pub model Model {
+        param l = 0.5; param m = 1.0; param g = 9.81;
+        for i in 0..$1 {
+            dof q[i] = 0.3;
+            body bar[i] { mass = m; inertia = (m*l*l/12, 0, m*l*l/12); }
+        }
+        TOG[bar[0]] = Trotz(q[0]) * Tdisp(0, -l/2, 0);
+        for i in 1..$1 {
+            TOG[bar[i]] = TOG[bar[i-1]] * Tdisp(0, -l/2, 0) * Trotz(q[i]) * Tdisp(0, -l/2, 0);
+        }
+        gravity(0, -g, 0);
+    }
+}
+RS
+}
+
+arm() { # 2k joints, axes z, y alternating
+    local half=$(($1 / 2)) last=$(($1 - 1)) before=$(($1 - 2))
+    cat <<RS
+mbs::multibody! {
+    pub model Model {
+        param g = 9.81; param len = 0.3; param w = 0.05; param m = 1.0;
+        let ixx = m * (w * w + w * w) / 12;
+        let iyy = m * (len * len + w * w) / 12;
+        for i in 0..$1 {
+            dof q[i] = 0.2;
+            body link[i] { mass = m; inertia = (ixx, iyy, iyy); }
+        }
+        TOG[link[0]] = Trotz(q[0]) * Tdisp(len / 2, 0, 0);
+        for k in 0..$((half - 1)) {
+            TOG[link[2*k+1]] = TOG[link[2*k]] * Tdisp(len / 2, 0, 0) * Troty(q[2*k+1]) * Tdisp(len / 2, 0, 0);
+            TOG[link[2*k+2]] = TOG[link[2*k+1]] * Tdisp(len / 2, 0, 0) * Trotz(q[2*k+2]) * Tdisp(len / 2, 0, 0);
+        }
+        TOG[link[$last]] = TOG[link[$before]] * Tdisp(len / 2, 0, 0) * Troty(q[$last]) * Tdisp(len / 2, 0, 0);
+        gravity(0, 0, -g);
+    }
+}
+RS
+}
+
+hexapod() { # the hexapod of models/src with `option tangents;` before its closing braces
+    sed 's/^    }$/        option tangents;\n    }/' "$root/models/src/hexapod.rs"
+    echo 'pub type Model = Hexapod;'
+}
+
+cat > "$dir/src/main.rs" <<'RS'
+mod model;
+use mbs::Model;
+fn main() {
+    let m = model::Model::default();
+    let n = model::Model::NQ;
+    let (q, z) = (vec![0.1; n], vec![0.0; n]);
+    let (mut qdd, mut p) = (vec![0.0; n], vec![0.0; n]);
+    m.forward_dynamics(0.0, &q, &z, &vec![0.0; model::Model::NU], &mut qdd, &mut p);
+    println!("{} dof, qdd[0] = {:.6}", n, qdd[0]);
+}
+RS
+
+cd "$dir"
+export CARGO_TARGET_DIR="$dir/target"
+# for every build, the untimed ones too: a change of it rebuilds the path dependencies
+export CARGO_INCREMENTAL=0
+cases=("${@:-arm24 chain32 hexapod chain200 arm24-dev}")
+for case in ${cases[@]}; do
+    profile=release
+    case "$case" in
+        arm24) arm 24 > src/model.rs ;;
+        chain32) chain 32 > src/model.rs ;;
+        chain200) chain 200 > src/model.rs ;;
+        hexapod) hexapod > src/model.rs ;;
+        arm24-dev) arm 24 > src/model.rs; profile=dev ;;
+        *) echo "unknown case $case" >&2; exit 2 ;;
+    esac
+    flag=$([ "$profile" = release ] && echo --release || true)
+    # dependencies (and a first build of the model) untimed
+    cargo build -q $flag 2>/dev/null || cargo build $flag
+    cargo clean -q -p one_model $flag
+    /usr/bin/time -f "%e %M" -o "$dir/time" cargo build -q $flag
+    read -r secs kib < "$dir/time"
+    printf '%-10s %-7s build of the model crate: %6.1f s, peak %5.2f GB; ' "$case" "$profile" "$secs" "$(echo "$kib / 1048576" | bc -l)"
+    cargo run -q $flag 2>/dev/null
+done

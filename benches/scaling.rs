@@ -1,0 +1,152 @@
+//! Forward dynamics at every size: qdd = M⁻¹h by the generated `forward_dynamics`
+//! (articulated bodies or sparse LᵀDL) against the dense path (M and h, then Cholesky and two
+//! triangular solves), in the same run, for planar chains of 2 to 32 bars and spatial arms of
+//! 6 to 24 joints (criterion).
+//!
+//! ```text
+//! cargo bench -p mbs-benches --bench scaling
+//! ```
+//!
+//! Prints the op counts of both paths per model first, then criterion's figures, then a
+//! table of medians: ns per call, the ratio forward/dense and the goal it is held to
+//! (≤ 0.55× at 2 dof, ≤ 0.6× at 8–16, ≤ 0.45× at 24–32).
+
+#[path = "scaling/models.rs"]
+mod models;
+
+use criterion::Criterion;
+use mbs::Model;
+use std::hint::black_box;
+use std::path::PathBuf;
+
+use mbs_models::arm3d_6::Arm3d6;
+use mbs_models::chain8::Chain8;
+use mbs_models::chain24::Chain24;
+use models::{Arm3d12, Arm3d24, Chain2, Chain4, Chain16, Chain32};
+
+/// The state every model is measured at (as in `eval.rs`).
+fn test_state(n: usize) -> (Vec<f64>, Vec<f64>) {
+    let q = (0..n).map(|i| 0.5 * (1.3 * i as f64 + 0.4).sin()).collect();
+    let qd = (0..n).map(|i| 0.7 * (0.9 * i as f64 + 0.2).cos()).collect();
+    (q, qd)
+}
+
+/// Flops of a generated function, by the start of its op-count row, and the row's label.
+fn flops<M: Model>(model: &M, row: &str) -> (String, usize) {
+    model
+        .info()
+        .ops
+        .iter()
+        .find(|(name, _)| name.starts_with(row))
+        .map(|(name, c)| (name.to_string(), c.flops()))
+        .expect("generated models count their functions")
+}
+
+/// Flops of the dense Cholesky factorisation (n³/3 + n²/2 multiply-adds counted as 2, n
+/// square roots) and of its two triangular solves (2n²).
+fn dense_flops(n: usize) -> usize {
+    (n * n * n) / 3 * 2 + n * n + n + 2 * n * n
+}
+
+fn op_counts<M: Model>(name: &str, model: &M) {
+    let n = M::NQ;
+    let (_, mh) = flops(model, "dynamics");
+    let (label, fwd) = flops(model, "forward_dynamics");
+    println!(
+        "{name:<9} {n:>3} dof  dense: M + h {mh:>6} + Cholesky and solves {:>6} = {:>6} flops; {label}: {fwd:>6} flops, {:>4.0} per dof",
+        dense_flops(n),
+        mh + dense_flops(n),
+        fwd as f64 / n as f64
+    );
+}
+
+fn bench_model<M: Model>(c: &mut Criterion, name: &str, model: M) {
+    let n = M::NQ;
+    let (q, qd) = test_state(n);
+    let u = vec![0.0; M::NU];
+    let (mut m, mut h) = (vec![0.0; n * n], vec![0.0; n]);
+    let (mut qdd, mut pivots) = (vec![0.0; n], vec![0.0; n]);
+    let mut g = c.benchmark_group(format!("scaling_{name}"));
+    g.bench_function("dense", |b| {
+        b.iter(|| {
+            model.dynamics(0.0, black_box(&q), black_box(&qd), &u, &mut m, &mut h);
+            mbs::linalg::cholesky(&mut m, n).expect("M positive definite");
+            mbs::linalg::cholesky_solve(&m, n, &mut h);
+        })
+    });
+    g.bench_function("forward", |b| {
+        b.iter(|| {
+            let (q, qd) = (black_box(&q), black_box(&qd));
+            model.forward_dynamics(0.0, q, qd, &u, &mut qdd, &mut pivots)
+        })
+    });
+    g.finish();
+}
+
+/// The models, their sizes and the goal of each (the largest ratio forward/dense allowed).
+const MODELS: [(&str, usize, f64); 9] = [
+    ("chain2", 2, 0.55),
+    ("chain4", 4, 0.6),
+    ("chain8", 8, 0.6),
+    ("chain16", 16, 0.6),
+    ("chain32", 32, 0.45),
+    ("arm3d_6", 6, 0.6),
+    ("arm3d_12", 12, 0.6),
+    ("arm3d_24", 24, 0.45),
+    ("chain24", 24, 0.45),
+];
+
+/// criterion's median of `group/id` in ns, from its estimates file (none in test mode).
+fn median_ns(group: &str, id: &str) -> Option<f64> {
+    let dir = std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target"));
+    let path = dir
+        .join("criterion")
+        .join(group)
+        .join(id)
+        .join("new/estimates.json");
+    let text = std::fs::read_to_string(path).ok()?;
+    let v: serde_json::Value = serde_json::from_str(&text).ok()?;
+    v["median"]["point_estimate"].as_f64()
+}
+
+fn main() {
+    op_counts("chain2", &Chain2::default());
+    op_counts("chain4", &Chain4::default());
+    op_counts("chain8", &Chain8::default());
+    op_counts("chain16", &Chain16::default());
+    op_counts("chain24", &Chain24::default());
+    op_counts("chain32", &Chain32::default());
+    op_counts("arm3d_6", &Arm3d6::default());
+    op_counts("arm3d_12", &Arm3d12::default());
+    op_counts("arm3d_24", &Arm3d24::default());
+    let mut c = Criterion::default().configure_from_args();
+    bench_model(&mut c, "chain2", Chain2::default());
+    bench_model(&mut c, "chain4", Chain4::default());
+    bench_model(&mut c, "chain8", Chain8::default());
+    bench_model(&mut c, "chain16", Chain16::default());
+    bench_model(&mut c, "chain24", Chain24::default());
+    bench_model(&mut c, "chain32", Chain32::default());
+    bench_model(&mut c, "arm3d_6", Arm3d6::default());
+    bench_model(&mut c, "arm3d_12", Arm3d12::default());
+    bench_model(&mut c, "arm3d_24", Arm3d24::default());
+    c.final_summary();
+    let mut rows = Vec::new();
+    for (name, n, goal) in MODELS {
+        let group = format!("scaling_{name}");
+        if let (Some(d), Some(f)) = (median_ns(&group, "dense"), median_ns(&group, "forward")) {
+            rows.push((name, n, d, f, goal));
+        }
+    }
+    if rows.len() == MODELS.len() {
+        println!("\nmedians (ns per call)      dense   forward   ratio   goal");
+        for (name, n, d, f, goal) in rows {
+            let verdict = if f / d <= goal { "met" } else { "MISSED" };
+            println!(
+                "{name:<9} {n:>3} dof  {d:>10.1} {f:>9.1}   {:>5.2}×  ≤ {goal:.2}× {verdict}",
+                f / d
+            );
+        }
+    }
+}

@@ -24,47 +24,15 @@ mbs = { path = "$root" }
 [workspace]
 TOML
 
+# the shapes of the scaling benchmark (`chain!`, `arm!`), one model named `Model`
+shapes="$root/benches/scaling/shapes.rs"
 chain() { # n bars
-    cat <<RS
-mbs::multibody! {
-    pub model Model {
-        param l = 0.5; param m = 1.0; param g = 9.81;
-        for i in 0..$1 {
-            dof q[i] = 0.3;
-            body bar[i] { mass = m; inertia = (m*l*l/12, 0, m*l*l/12); }
-        }
-        TOG[bar[0]] = Trotz(q[0]) * Tdisp(0, -l/2, 0);
-        for i in 1..$1 {
-            TOG[bar[i]] = TOG[bar[i-1]] * Tdisp(0, -l/2, 0) * Trotz(q[i]) * Tdisp(0, -l/2, 0);
-        }
-        gravity(0, -g, 0);
-    }
+    cat "$shapes"
+    echo "chain!(Model, $1);"
 }
-RS
-}
-
-arm() { # 2k joints, axes z, y alternating
-    local half=$(($1 / 2)) last=$(($1 - 1)) before=$(($1 - 2))
-    cat <<RS
-mbs::multibody! {
-    pub model Model {
-        param g = 9.81; param len = 0.3; param w = 0.05; param m = 1.0;
-        let ixx = m * (w * w + w * w) / 12;
-        let iyy = m * (len * len + w * w) / 12;
-        for i in 0..$1 {
-            dof q[i] = 0.2;
-            body link[i] { mass = m; inertia = (ixx, iyy, iyy); }
-        }
-        TOG[link[0]] = Trotz(q[0]) * Tdisp(len / 2, 0, 0);
-        for k in 0..$((half - 1)) {
-            TOG[link[2*k+1]] = TOG[link[2*k]] * Tdisp(len / 2, 0, 0) * Troty(q[2*k+1]) * Tdisp(len / 2, 0, 0);
-            TOG[link[2*k+2]] = TOG[link[2*k+1]] * Tdisp(len / 2, 0, 0) * Trotz(q[2*k+2]) * Tdisp(len / 2, 0, 0);
-        }
-        TOG[link[$last]] = TOG[link[$before]] * Tdisp(len / 2, 0, 0) * Troty(q[$last]) * Tdisp(len / 2, 0, 0);
-        gravity(0, 0, -g);
-    }
-}
-RS
+arm() { # n joints, n even
+    cat "$shapes"
+    echo "arm!(Model, $1, $(($1 / 2 - 1)), $(($1 - 1)), $(($1 - 2)));"
 }
 
 hexapod() { # the hexapod of models/src with `option tangents;` before its closing braces

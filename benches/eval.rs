@@ -9,6 +9,9 @@
 //! the dense path (M and h, then Cholesky and two triangular solves) — for dpend, arm3d_6,
 //! chains of 8 to 30 bars and the hexapod.
 
+mod common;
+
+use common::test_state;
 use criterion::{Criterion, criterion_group, criterion_main};
 use mbs::Model;
 use std::hint::black_box;
@@ -20,12 +23,6 @@ use mbs_models::chain24;
 use mbs_models::chain30_stiff;
 use mbs_models::dpend;
 use mbs_models::hexapod;
-
-fn test_state(n: usize) -> (Vec<f64>, Vec<f64>) {
-    let q = (0..n).map(|i| 0.5 * (1.3 * i as f64 + 0.4).sin()).collect();
-    let qd = (0..n).map(|i| 0.7 * (0.9 * i as f64 + 0.2).cos()).collect();
-    (q, qd)
-}
 
 fn bench_model<M: Model>(c: &mut Criterion, name: &str, model: M) {
     let n = M::NQ;

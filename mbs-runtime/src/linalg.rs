@@ -21,6 +21,10 @@ pub fn norm1(a: &[f64], n: usize) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// The smallest pivot a factorisation of M accepts, relative to the largest diagonal entry
+/// (Cholesky) or pivot (forward dynamics): below it M is taken as singular.
+pub const PIVOT_FLOOR: f64 = 1e-14;
+
 /// Cholesky factor L (lower triangle of `a`, overwritten) of a symmetric positive definite
 /// matrix. Only the lower triangle of `a` is read.
 pub fn cholesky(a: &mut [f64], n: usize) -> Result<(), Singular> {
@@ -30,7 +34,7 @@ pub fn cholesky(a: &mut [f64], n: usize) -> Result<(), Singular> {
         for k in 0..j {
             d -= a[j + n * k] * a[j + n * k];
         }
-        if !(d > 1e-14 * scale) || !d.is_finite() {
+        if !(d > PIVOT_FLOOR * scale) || !d.is_finite() {
             let rcond = if scale > 0.0 {
                 (d.max(0.0) / scale).sqrt()
             } else {

@@ -643,16 +643,20 @@ impl Expander {
     fn fold_indices(&mut self, ts: TokenStream, origin: &Origin) -> TokenStream {
         let mut out: Vec<TokenTree> = Vec::new();
         for t in ts {
+            // `q[2 * 0 + 1]` after substitution: the language's vectors take the value
+            let value = match &t {
+                TokenTree::Group(g) if vector_of_language(out.last()) => constant(g),
+                _ => None,
+            };
+            if let Some(v) = value {
+                let mut lit = Literal::u64_unsuffixed(v);
+                lit.set_span(t.span());
+                let mut ng = Group::new(Delimiter::Bracket, TokenTree::Literal(lit).into());
+                ng.set_span(t.span());
+                out.push(TokenTree::Group(ng));
+                continue;
+            }
             match t {
-                // `q[2 * 0 + 1]` after substitution: the language's vectors take the value
-                TokenTree::Group(g) if vector_of_language(out.last()) && constant(&g).is_some() => {
-                    let v = constant(&g).expect("just checked");
-                    let mut lit = Literal::u64_unsuffixed(v);
-                    lit.set_span(g.span());
-                    let mut ng = Group::new(Delimiter::Bracket, TokenTree::Literal(lit).into());
-                    ng.set_span(g.span());
-                    out.push(TokenTree::Group(ng));
-                }
                 TokenTree::Group(g)
                     if !(touches(&g.stream(), &[])
                         || g.delimiter() == Delimiter::Bracket && indexable(out.last())) =>

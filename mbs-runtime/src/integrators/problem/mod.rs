@@ -1,6 +1,6 @@
 //! The model as the schemes see it: evaluations counted, results checked (a non-finite value
-//! is named by its coordinate), forward dynamics (generated, or by Cholesky), residuals τ, and iteration
-//! matrices M + γ'·C_t + β'·K_t, all on buffers allocated once.
+//! is named by its coordinate), forward dynamics (generated, or by Cholesky), residuals τ,
+//! and iteration matrices M + γ'·C_t + β'·K_t, all on buffers allocated once.
 //!
 //! A constrained model run by a method other than index 3 is, for the schemes, the ODE
 //! qdd = f(t, q, qd) of its index-1 form (projection, Baumgarte, partitioning): `accel` is f,
@@ -20,7 +20,7 @@ mod watch;
 
 use super::constrained::{Constrained, Mode};
 use crate::error::Failure;
-use crate::linalg::{cholesky, cholesky_solve};
+use crate::linalg::{PIVOT_FLOOR, cholesky, cholesky_solve};
 use crate::model::Model;
 use crate::options::IterationMatrix;
 use crate::stats::Stats;
@@ -253,8 +253,8 @@ impl<M: Model> Problem<M> {
 
     /// qdd of an open-loop model: by its generated forward dynamics when it has them, their
     /// pivots watched against those at the start; by M, h and a dense Cholesky factorisation
-    /// otherwise, and whenever the forward solve gives a pivot not above 1e-14 of the largest
-    /// (the dense Cholesky's test) or a value that is not finite (a failure path: the dense
+    /// otherwise, and whenever the forward solve gives a pivot not above `PIVOT_FLOOR` of the
+    /// largest (the dense Cholesky's test) or a value that is not finite (a failure path: the dense
     /// path names the coordinate).
     fn plain_accel(
         &mut self,
@@ -271,12 +271,14 @@ impl<M: Model> Problem<M> {
             if let Some(f) = self.model.take_failure() {
                 return Err(f);
             }
-            // the dense Cholesky's test: every pivot above 1e-14 of the largest
+            // the dense Cholesky's test, against the largest pivot
             let scale = self.pivots.iter().fold(0.0f64, |m, p| m.max(*p));
-            let positive = self.pivots.iter().all(|p| *p > 1e-14 * scale) && scale.is_finite();
+            let positive =
+                self.pivots.iter().all(|p| *p > PIVOT_FLOOR * scale) && scale.is_finite();
             if positive && qdd.iter().all(|a| a.is_finite()) {
                 if self.watching() {
-                    let (ratio, j) = worst_pivot_of(&self.pivots, &self.start_forward);
+                    let (ratio, j) =
+                        worst_pivot_of(self.pivots.iter().copied(), &self.start_forward);
                     self.judge(ratio, j, t, q)?;
                 }
                 return Ok(());

@@ -229,24 +229,17 @@ impl<M: Model> Problem<M> {
 /// coordinates before it cannot produce: it falls when coordinate j starts to move the bodies
 /// as a combination of the others does (Euler angles at gimbal lock, aligned joint axes), or
 /// stops moving mass; each pivot is compared with its own start value, so units do not mix.
-/// The pivot of a forward-dynamics solve (articulated bodies or LᵀDL, from the last
-/// coordinate) that fell most relative to its start value, and its coordinate: the same
-/// test as [`worst_pivot`] on another elimination order (the product of the pivots is det M
-/// in both).
-pub(super) fn worst_pivot_of(pivots: &[f64], start: &[f64]) -> (f64, usize) {
-    let mut worst = (f64::INFINITY, 0);
-    for (j, (p, s)) in pivots.iter().zip(start).enumerate() {
-        if p / s < worst.0 {
-            worst = (p / s, j);
-        }
-    }
-    worst
+pub(super) fn worst_pivot(l: &[f64], n: usize, start: &[f64]) -> (f64, usize) {
+    worst_pivot_of((0..n).map(|j| l[j + n * j] * l[j + n * j]), start)
 }
 
-pub(super) fn worst_pivot(l: &[f64], n: usize, start: &[f64]) -> (f64, usize) {
+/// The same test on pivots given one per coordinate, such as those of the generated forward
+/// dynamics (articulated bodies or LᵀDL, eliminated from the last coordinate: another order,
+/// the same product det M).
+pub(super) fn worst_pivot_of(pivots: impl Iterator<Item = f64>, start: &[f64]) -> (f64, usize) {
     let mut worst = (f64::INFINITY, 0);
-    for j in 0..n {
-        let ratio = l[j + n * j] * l[j + n * j] / start[j];
+    for (j, (p, s)) in pivots.zip(start).enumerate() {
+        let ratio = p / s;
         if ratio < worst.0 {
             worst = (ratio, j);
         }

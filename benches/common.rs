@@ -1,8 +1,26 @@
 //! What the benchmarks share.
 
+use std::path::PathBuf;
+
 /// The state every model is measured at: q and qd of `n` coordinates, away from any symmetry.
 pub fn test_state(n: usize) -> (Vec<f64>, Vec<f64>) {
     let q = (0..n).map(|i| 0.5 * (1.3 * i as f64 + 0.4).sin()).collect();
     let qd = (0..n).map(|i| 0.7 * (0.9 * i as f64 + 0.2).cos()).collect();
     (q, qd)
+}
+
+/// criterion's median of `group/id` in ns, from its estimates file (none in test mode).
+#[allow(dead_code)] // not every benchmark reads criterion's medians
+pub fn median_ns(group: &str, id: &str) -> Option<f64> {
+    let dir = std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target"));
+    let path = dir
+        .join("criterion")
+        .join(group)
+        .join(id)
+        .join("new/estimates.json");
+    let text = std::fs::read_to_string(path).ok()?;
+    let v: serde_json::Value = serde_json::from_str(&text).ok()?;
+    v["median"]["point_estimate"].as_f64()
 }

@@ -15,11 +15,10 @@ mod common;
 #[path = "scaling/models.rs"]
 mod models;
 
-use common::test_state;
+use common::{median_ns, test_state};
 use criterion::Criterion;
 use mbs::Model;
 use std::hint::black_box;
-use std::path::PathBuf;
 
 use mbs_models::arm3d_6::Arm3d6;
 use mbs_models::chain8::Chain8;
@@ -85,21 +84,6 @@ fn bench_model<M: Model>(
     });
     g.finish();
     (name, n, goal)
-}
-
-/// criterion's median of `group/id` in ns, from its estimates file (none in test mode).
-fn median_ns(group: &str, id: &str) -> Option<f64> {
-    let dir = std::env::var_os("CARGO_TARGET_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target"));
-    let path = dir
-        .join("criterion")
-        .join(group)
-        .join(id)
-        .join("new/estimates.json");
-    let text = std::fs::read_to_string(path).ok()?;
-    let v: serde_json::Value = serde_json::from_str(&text).ok()?;
-    v["median"]["point_estimate"].as_f64()
 }
 
 fn main() {

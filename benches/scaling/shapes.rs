@@ -6,9 +6,10 @@
 //   previous link's frame, 0.3 m boxes of 1 kg along x, q(0) = 0.2 rad, gravity along −z (as
 //   `arm3d_6`); `pairs` = n/2 − 1, `last` = n − 1, `before_last` = n − 2 (the language's
 //   loop ranges and indices outside loops are written numbers).
+// Options of the language follow as identifiers: `chain!(Name, 16, batch)`.
 
 macro_rules! chain {
-    ($name:ident, $n:tt) => {
+    ($name:ident, $n:tt $(, $option:ident)*) => {
         mbs::multibody! {
             /// Planar chain of uniform bars.
             pub model $name {
@@ -22,13 +23,14 @@ macro_rules! chain {
                     TOG[bar[i]] = TOG[bar[i-1]] * Tdisp(0, -l/2, 0) * Trotz(q[i]) * Tdisp(0, -l/2, 0);
                 }
                 gravity(0, -g, 0);
+                $(option $option;)*
             }
         }
     };
 }
 
 macro_rules! arm {
-    ($name:ident, $n:tt, $pairs:tt, $last:tt, $before:tt) => {
+    ($name:ident, $n:tt, $pairs:tt, $last:tt, $before:tt $(, $option:ident)*) => {
         mbs::multibody! {
             /// Spatial arm of revolute joints, axes z, y alternating.
             pub model $name {
@@ -46,6 +48,7 @@ macro_rules! arm {
                 }
                 TOG[link[$last]] = TOG[link[$before]] * Tdisp(len / 2, 0, 0) * Troty(q[$last]) * Tdisp(len / 2, 0, 0);
                 gravity(0, 0, -g);
+                $(option $option;)*
             }
         }
     };

@@ -18,6 +18,7 @@ pub mod elements;
 pub mod error;
 pub mod inertia;
 pub mod integrators;
+pub mod lanes;
 pub mod linalg;
 pub mod model;
 mod op_count;
@@ -35,6 +36,7 @@ pub use integrators::{
     Assembly, Controller, Inputs, Integrator, SimError, Simulation, State, assemble, simulate,
     simulate_with,
 };
+pub use lanes::{F64x4, LANES};
 pub use model::{
     Energy, FrameKinematics, IDENTITY3, Kinematics, Model, ModelInfo, OpCount, OpsTable,
     Parameters, PointKinematics, Pose, RotationJoint, ShapeInfo, ShapeKind,

@@ -5,6 +5,7 @@
 //! other lengths is a programming error and panics.
 
 use crate::error::{ModelError, ParamError};
+use crate::lanes::{F64x4, lane_by_lane};
 use serde::{Deserialize, Serialize, de::DeserializeOwned};
 use std::fmt;
 
@@ -349,6 +350,10 @@ pub trait Model {
     /// no dense factorisation): the runtime then solves M qdd = h of an open-loop model with
     /// it; otherwise (models written by hand, `WithEfforts`) with a dense Cholesky of M
     const FORWARD_DYNAMICS_GENERATED: bool = false;
+    /// whether [`Model::dynamics_x4`] and [`Model::forward_dynamics_x4`] are generated code
+    /// on [`F64x4`] (`option batch;`); otherwise they call the one-state functions lane by
+    /// lane
+    const BATCH_GENERATED: bool = false;
 
     /// Names, sizes, formulation and op counts.
     fn info(&self) -> &'static ModelInfo;
@@ -394,6 +399,41 @@ pub trait Model {
         } else {
             qdd.fill(f64::NAN);
         }
+    }
+
+    /// [`Model::dynamics`] at four states at once (`t`, `q`, `qd`, `u`, `m`, `h` hold one
+    /// state per lane, see [`crate::lanes`]). Generated with SIMD arithmetic when the model
+    /// asks for it (`option batch;`, [`Model::BATCH_GENERATED`]); the default calls
+    /// [`Model::dynamics`] lane by lane, allocating.
+    #[allow(clippy::too_many_arguments)]
+    fn dynamics_x4(
+        &self,
+        t: F64x4,
+        q: &[F64x4],
+        qd: &[F64x4],
+        u: &[F64x4],
+        m: &mut [F64x4],
+        h: &mut [F64x4],
+    ) {
+        lane_by_lane(t, [q, qd, u], [m, h], |t, [q, qd, u], [m, h]| {
+            self.dynamics(t, q, qd, u, m, h)
+        });
+    }
+
+    /// [`Model::forward_dynamics`] at four states at once, as [`Model::dynamics_x4`].
+    #[allow(clippy::too_many_arguments)]
+    fn forward_dynamics_x4(
+        &self,
+        t: F64x4,
+        q: &[F64x4],
+        qd: &[F64x4],
+        u: &[F64x4],
+        qdd: &mut [F64x4],
+        pivots: &mut [F64x4],
+    ) {
+        lane_by_lane(t, [q, qd, u], [qdd, pivots], |t, [q, qd, u], [a, p]| {
+            self.forward_dynamics(t, q, qd, u, a, p)
+        });
     }
 
     /// τ = M qdd − h (NQ): the generalised forces that produce qdd.

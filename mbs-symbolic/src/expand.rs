@@ -245,6 +245,7 @@ fn validate(&self) -> ::core::result::Result<(), ::mbs::ParamError> {{ {never} }
         npoints,
         nc: 0,
         charts: 0,
+        batch: false,
     };
     for ty in scenes {
         code.push_str(&format!(

@@ -99,6 +99,22 @@ pub const FORWARD_DYNAMICS: Method = method(
     "",
 );
 
+/// The batch methods (four states at once on `::mbs::F64x4` lanes), which have defaults in
+/// the trait (lane by lane) that models with `option batch;` override; the arguments are
+/// those of `dynamics` and `forward_dynamics` with lanes for `f64`.
+pub const BATCH: [Method; 2] = [
+    method(
+        "dynamics_x4",
+        "t: ::mbs::F64x4, q: &[::mbs::F64x4], qd: &[::mbs::F64x4], u: &[::mbs::F64x4], m: &mut [::mbs::F64x4], h: &mut [::mbs::F64x4]",
+        "",
+    ),
+    method(
+        "forward_dynamics_x4",
+        "t: ::mbs::F64x4, q: &[::mbs::F64x4], qd: &[::mbs::F64x4], u: &[::mbs::F64x4], qdd: &mut [::mbs::F64x4], pivots: &mut [::mbs::F64x4]",
+        "",
+    ),
+];
+
 /// The method `name` of the table.
 pub fn method_named(name: &str) -> &'static Method {
     METHODS
@@ -139,10 +155,13 @@ pub struct Sizes {
     /// rotation joints: when there are any, the model overrides `chart` and `set_chart`,
     /// reading and writing its field `charts`
     pub charts: usize,
+    /// `option batch;`: the model overrides the methods of [`BATCH`]
+    pub batch: bool,
 }
 
 /// `impl ::mbs::Model for {ty}` with parameter struct `pty`: the constants, then every method
-/// of [`METHODS`] and [`FORWARD_DYNAMICS`] with the body `body(method)`.
+/// of [`METHODS`] and [`FORWARD_DYNAMICS`] (and [`BATCH`] with `sizes.batch`) with the body
+/// `body(method)`.
 pub fn model_impl(
     ty: &str,
     pty: &str,
@@ -156,6 +175,7 @@ pub fn model_impl(
         npoints,
         nc,
         charts,
+        batch,
     } = sizes;
     let mut s = format!(
         "impl ::mbs::Model for {ty} {{
@@ -166,9 +186,15 @@ const NFRAMES: usize = {nframes};
 const NPOINTS: usize = {npoints};
 const NC: usize = {nc};
 const FORWARD_DYNAMICS_GENERATED: bool = true;
+const BATCH_GENERATED: bool = {batch};
 "
     );
-    for m in METHODS.iter().chain([&FORWARD_DYNAMICS]) {
+    let batch_methods = if *batch { &BATCH[..] } else { &[] };
+    for m in METHODS
+        .iter()
+        .chain([&FORWARD_DYNAMICS])
+        .chain(batch_methods)
+    {
         let args = m.args.replace("{P}", pty);
         let ret = if m.ret.is_empty() {
             String::new()

@@ -2,7 +2,7 @@
 //! are more than [`MAX_LETS`](crate::expr::cse::MAX_LETS) temporaries.
 
 use crate::expr::cse::Schedule;
-use crate::expr::emit::{MissingDerivative, Naming, emit};
+use crate::expr::emit::{LANES_TYPE, MissingDerivative, Naming, Numbers, emit};
 use crate::expr::{Arena, ExprId, OpCount, Var};
 use crate::mech::system::ParamDef;
 use std::fmt::Write;
@@ -61,6 +61,8 @@ pub struct FnSpec {
     /// statements before the computation (buffer resets)
     pub prelude: Vec<String>,
     pub outputs: Vec<(String, ExprId)>,
+    /// `f64`, or lanes of several states (the batch functions of `option batch;`)
+    pub numbers: Numbers,
 }
 
 impl FnSpec {
@@ -72,6 +74,23 @@ impl FnSpec {
             call,
             prelude: Vec::new(),
             outputs: Vec::new(),
+            numbers: Numbers::Scalar,
+        }
+    }
+
+    /// A method on lanes of four states: its arguments' `f64` (but the charts') become
+    /// lanes.
+    pub fn lanes(name: &str, args: &str) -> FnSpec {
+        let mut f = FnSpec::new(name, &args.replace("f64", LANES_TYPE));
+        f.numbers = Numbers::Lanes;
+        f
+    }
+
+    /// The zero of the function's numbers.
+    fn zero(&self) -> String {
+        match self.numbers {
+            Numbers::Scalar => "0.0".into(),
+            Numbers::Lanes => format!("{LANES_TYPE}::ZERO"),
         }
     }
 
@@ -80,7 +99,8 @@ impl FnSpec {
     pub fn matrix(&mut self, a: &Arena, target: &str, rows: &[Vec<ExprId>]) {
         let n = rows.len();
         if rows.iter().flatten().any(|&e| a.is_num(e, 0.0)) {
-            self.prelude.push(format!("{target}.fill(0.0);"));
+            self.prelude
+                .push(format!("{target}.fill({});", self.zero()));
         }
         for (i, row) in rows.iter().enumerate() {
             for (j, &e) in row.iter().enumerate() {
@@ -108,20 +128,35 @@ pub fn emit_fn(
     let roots: Vec<ExprId> = spec.outputs.iter().map(|o| o.1).collect();
     let targets: Vec<String> = spec.outputs.iter().map(|o| o.0.clone()).collect();
     let sch = Schedule::new(arena, &roots);
-    let em = emit(arena, &sch, &targets, names)?;
+    let em = emit(arena, &sch, &targets, names, spec.numbers)?;
+    let number = match spec.numbers {
+        Numbers::Scalar => "f64",
+        Numbers::Lanes => LANES_TYPE,
+    };
+    // batch code is compiled for 256-bit registers on x86-64 whatever the build's target CPU
+    // (the trait method checks the processor before calling it)
+    let simd = match spec.numbers {
+        Numbers::Scalar => "",
+        Numbers::Lanes => {
+            "#[cfg_attr(target_arch = \"x86_64\", target_feature(enable = \"avx2\"))]\n"
+        }
+    };
     let mut s = String::new();
     let prelude: String = spec.prelude.iter().map(|p| format!("{p}\n")).collect();
     if em.chunks.len() == 1 {
         let _ = writeln!(
             s,
-            "#[inline]\nfn {}(&self, {}) {{\n{prelude}{}}}",
+            "#[inline]\n{simd}fn {}(&self, {}) {{\n{prelude}{}}}",
             spec.name, spec.args, em.chunks[0]
         );
     } else {
         let _ = write!(
             s,
-            "#[inline]\nfn {}(&self, {}) {{\n{prelude}let mut w = [0.0f64; {}];\n",
-            spec.name, spec.args, em.workspace
+            "#[inline]\n{simd}fn {}(&self, {}) {{\n{prelude}let mut w = [{}; {}];\n",
+            spec.name,
+            spec.args,
+            spec.zero(),
+            em.workspace
         );
         for k in 0..em.chunks.len() {
             let _ = writeln!(s, "self.{}_part{k}({}, &mut w);", spec.name, spec.call);
@@ -130,7 +165,7 @@ pub fn emit_fn(
         for (k, c) in em.chunks.iter().enumerate() {
             let _ = writeln!(
                 s,
-                "#[inline(never)]\nfn {}_part{k}(&self, {}, w: &mut [f64]) {{\n{c}}}",
+                "#[inline(never)]\n{simd}fn {}_part{k}(&self, {}, w: &mut [{number}]) {{\n{c}}}",
                 spec.name, spec.args
             );
         }

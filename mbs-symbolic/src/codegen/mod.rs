@@ -407,6 +407,17 @@ fn emit_scene(
     f.vector("pivots", &eq.forward.pivots);
     let forward_label = format!("forward_dynamics ({})", eq.forward.method.name());
     specs.push((f, Some(&forward_label)));
+    if sys.options.batch {
+        // the same outputs on lanes of four states, no op-count rows of their own
+        let mut f = FnSpec::lanes("__dynamics_x4", args("dynamics"));
+        f.matrix(a, "m", &mb.m);
+        f.vector("h", &mb.h);
+        specs.push((f, None));
+        let mut f = FnSpec::lanes("__forward_dynamics_x4", api::FORWARD_DYNAMICS.args);
+        f.vector("qdd", &eq.forward.qdd);
+        f.vector("pivots", &eq.forward.pivots);
+        specs.push((f, None));
+    }
     let mut f = FnSpec::new("__mass_matrix", args("mass_matrix"));
     f.matrix(a, "m", &mb.m);
     specs.push((f, Some("mass_matrix")));
@@ -669,6 +680,7 @@ fn emit_scene(
         npoints: sys.points.len(),
         nc: sys.constraints.len(),
         charts: sys.rotation_joints.len(),
+        batch: sys.options.batch,
     };
     let model_impl = api::model_impl(&ty, &pty, &sizes, |m| {
         match m.name {
@@ -683,6 +695,21 @@ fn emit_scene(
         // the constraint functions live on the parameter struct, shared by every scene
         name if name.starts_with("constraint") => {
             format!("self.params.__{name}(&self.charts, {})", m.call())
+        }
+        // SIMD code where the processor runs it, else the one-state function lane by lane
+        name @ ("dynamics_x4" | "forward_dynamics_x4") => {
+            let one = name.trim_end_matches("_x4");
+            let (a, b) = if one == "dynamics" { ("m", "h") } else { ("qdd", "pivots") };
+            format!(
+                "if ::mbs::lanes::simd_available() {{
+#[allow(unused_unsafe)]
+// SAFETY: the processor has the features the batch code is compiled for
+unsafe {{ self.__{name}({}) }}
+}} else {{
+::mbs::lanes::lane_by_lane(t, [q, qd, u], [{a}, {b}], |t, [q, qd, u], [{a}, {b}]| ::mbs::Model::{one}(self, t, q, qd, u, {a}, {b}))
+}}",
+                m.call()
+            )
         }
         name => format!("self.__{name}({})", m.call()),
     }

@@ -14,6 +14,27 @@ pub trait Naming {
     fn bind(&self, v: Var) -> String;
 }
 
+/// The number type of emitted code.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Numbers {
+    /// `f64`
+    Scalar,
+    /// several states at once: arguments, outputs and workspace slots are [`LANES_TYPE`];
+    /// in the body every value that depends on the arguments is a `Simd` (a vector register),
+    /// parameters and constants stay `f64` and meet them through mixed operators and the
+    /// functions of `Math` (`Math::sin(x)`), which take either
+    Lanes,
+}
+
+/// The lanes type of [`Numbers::Lanes`] in arguments, outputs and workspace (the runtime's
+/// `F64x4`).
+pub const LANES_TYPE: &str = "::mbs::F64x4";
+/// The lanes type in registers, which values that depend on the states have in the body of
+/// a lanes function (`Simd::new` loads an `F64x4`).
+const SIMD_TYPE: &str = "::mbs::lanes::Simd";
+/// The functions of lanes code (`Math`, and `Math2` for two arguments), on `f64` or `Simd`.
+const MATH: &str = "::mbs::lanes::Math";
+
 /// A user function's derivative that the code needs but the model does not supply.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct MissingDerivative {
@@ -49,6 +70,7 @@ struct Writer<'a> {
     missing: Vec<MissingDerivative>,
     /// identifier of each leaf, computed once
     var_names: rustc_hash::FxHashMap<Var, String>,
+    numbers: Numbers,
 }
 
 /// Rust literal of a number.
@@ -162,6 +184,35 @@ impl Writer<'_> {
                 out.push_str(" * ");
                 self.expr(a, Prec::Atom, out);
             }
+            // lanes: the functions of `Math`/`Math2`, which take `f64` or lanes alike
+            Node::Func(f, a) if self.numbers == Numbers::Lanes => {
+                let name = match f {
+                    Func::Sign => "sign",
+                    Func::Step => "step",
+                    Func::Pos => "pos",
+                    f => f.name(),
+                };
+                let _ = write!(out, "{MATH}::{name}(");
+                self.expr(a, Prec::Add, out);
+                out.push(')');
+            }
+            Node::Powi(a, k) if self.numbers == Numbers::Lanes => {
+                let _ = write!(out, "{MATH}::powi(");
+                self.expr(a, Prec::Add, out);
+                let _ = write!(out, ", {k})");
+            }
+            Node::Pow(a, b) | Node::Atan2(a, b) if self.numbers == Numbers::Lanes => {
+                let f = if matches!(self.arena.node(n), Node::Pow(..)) {
+                    "powf"
+                } else {
+                    "atan2"
+                };
+                let _ = write!(out, "{MATH}2::{f}(");
+                self.expr(a, Prec::Add, out);
+                out.push_str(", ");
+                self.expr(b, Prec::Add, out);
+                out.push(')');
+            }
             Node::Powi(a, k) => {
                 self.expr(a, Prec::Atom, out);
                 let _ = write!(out, ".powi({k})");
@@ -198,6 +249,11 @@ impl Writer<'_> {
             }
             Node::Call(f, k, a) => {
                 let uf = &self.arena.user_fns()[f as usize];
+                if self.numbers == Numbers::Lanes {
+                    let _ = write!(out, "{MATH}::map(");
+                    self.expr(a, Prec::Add, out);
+                    out.push_str(", ");
+                }
                 match uf.paths.get(k as usize) {
                     Some(p) => out.push_str(p),
                     None => {
@@ -211,12 +267,34 @@ impl Writer<'_> {
                         out.push_str("f64::from");
                     }
                 }
-                out.push('(');
-                self.expr(a, Prec::Add, out);
-                out.push(')');
+                if self.numbers == Numbers::Lanes {
+                    out.push(')');
+                } else {
+                    out.push('(');
+                    self.expr(a, Prec::Add, out);
+                    out.push(')');
+                }
             }
         }
     }
+
+    /// Writes the value of `n` where it is stored (an output, a workspace slot): lanes in
+    /// [`Numbers::Lanes`] (`X::from(n)`, from lanes in registers or from an `f64`).
+    fn stored(&mut self, n: ExprId, out: &mut String) {
+        if self.numbers == Numbers::Lanes {
+            out.push_str(LANES_TYPE);
+            out.push_str("::from(");
+            self.expr(n, Prec::Add, out);
+            out.push(')');
+        } else {
+            self.expr(n, Prec::Add, out);
+        }
+    }
+}
+
+/// Whether leaf `v` differs between the states of a batch (parameters and charts do not).
+fn varies(v: Var) -> bool {
+    !matches!(v, Var::Param(_) | Var::Chart(_))
 }
 
 /// Appends a non-negative integer without the formatting machinery (slow unoptimised).
@@ -288,6 +366,7 @@ pub fn emit(
     sch: &Schedule,
     targets: &[String],
     naming: &dyn Naming,
+    numbers: Numbers,
 ) -> Result<Emitted, Vec<MissingDerivative>> {
     assert_eq!(targets.len(), sch.outputs.len(), "one target per output");
     let nchunks = sch.chunks.len();
@@ -324,6 +403,7 @@ pub fn emit(
         naming,
         missing: Vec::new(),
         var_names: Default::default(),
+        numbers,
     };
     let mut chunks = Vec::with_capacity(nchunks);
     for (c, r) in sch.chunks.iter().enumerate() {
@@ -333,17 +413,21 @@ pub fn emit(
         vars.dedup();
         for &v in vars.iter() {
             let _ = writeln!(s, "{}", naming.bind(v));
+            if numbers == Numbers::Lanes && varies(v) {
+                let name = w.var(v).to_string();
+                let _ = writeln!(s, "let {name} = {SIMD_TYPE}::new({name});");
+            }
         }
         let loads = &mut chunk_loads[c];
         loads.sort_unstable();
         loads.dedup();
         for &l in loads.iter() {
-            let _ = writeln!(
-                s,
-                "let {} = w[{}];",
-                w.name_string(l),
-                slot[l.index()].unwrap()
-            );
+            let (name, k) = (w.name_string(l), slot[l.index()].unwrap());
+            if numbers == Numbers::Lanes {
+                let _ = writeln!(s, "let {name} = {SIMD_TYPE}::new(w[{k}]);");
+            } else {
+                let _ = writeln!(s, "let {name} = w[{k}];");
+            }
         }
         for &n in &sch.lets[r.clone()] {
             s.push_str("let ");
@@ -352,14 +436,16 @@ pub fn emit(
             w.body(n, &mut s);
             s.push_str(";\n");
             if let Some(k) = slot[n.index()] {
-                let _ = writeln!(s, "w[{k}] = {};", w.name_string(n));
+                let _ = write!(s, "w[{k}] = ");
+                w.stored(n, &mut s);
+                s.push_str(";\n");
             }
         }
         for (i, &o) in sch.outputs.iter().enumerate() {
             if sch.output_chunk[i] as usize == c {
                 s.push_str(&targets[i]);
                 s.push_str(" = ");
-                w.expr(o, Prec::Add, &mut s);
+                w.stored(o, &mut s);
                 s.push_str(";\n");
             }
         }
@@ -381,7 +467,7 @@ pub fn emit(
 mod tests {
     use super::super::cse::Schedule;
     use super::super::{Arena, Var};
-    use super::{Naming, emit};
+    use super::{Naming, Numbers, emit};
 
     struct N;
     impl Naming for N {
@@ -406,7 +492,14 @@ mod tests {
         let p = a.mul(s, sx);
         let d = a.sub(y, p);
         let sch = Schedule::new(&a, &[d, sx]);
-        let e = emit(&a, &sch, &["out[0]".into(), "out[1]".into()], &N).unwrap();
+        let e = emit(
+            &a,
+            &sch,
+            &["out[0]".into(), "out[1]".into()],
+            &N,
+            Numbers::Scalar,
+        )
+        .unwrap();
         assert_eq!(e.chunks.len(), 1);
         let code = &e.chunks[0];
         assert!(code.contains("let sin_q0 = q0.sin();"), "{code}");
@@ -426,7 +519,14 @@ mod tests {
         let f = a.mul(s, p);
         let g = a.add(s, y);
         let sch = Schedule::new(&a, &[f, g]);
-        let e = emit(&a, &sch, &["out[0]".into(), "out[1]".into()], &N).unwrap();
+        let e = emit(
+            &a,
+            &sch,
+            &["out[0]".into(), "out[1]".into()],
+            &N,
+            Numbers::Scalar,
+        )
+        .unwrap();
         let code = &e.chunks[0];
         assert!(code.contains("(q0 - q1).max(0.0)"), "{code}");
         assert!(code.contains("if q0 > 0.0 { 1.0 } else { 0.0 }"), "{code}");
@@ -448,7 +548,7 @@ mod tests {
         let sch = Schedule::with_max_lets(&a, &outs, 3);
         assert!(sch.chunks.len() > 1);
         let targets: Vec<String> = (0..outs.len()).map(|i| format!("out[{i}]")).collect();
-        let e = emit(&a, &sch, &targets, &N).unwrap();
+        let e = emit(&a, &sch, &targets, &N, Numbers::Scalar).unwrap();
         assert!(e.workspace > 0);
         assert!(e.chunks[1].contains("= w["), "{}", e.chunks[1]);
         assert!(
@@ -456,5 +556,38 @@ mod tests {
                 .iter()
                 .all(|c| c.matches("let x").count() <= 3 + e.workspace)
         );
+    }
+
+    #[test]
+    fn lanes_load_states_into_registers_and_call_math() {
+        let mut a = Arena::new();
+        let x = a.var(Var::Q(0));
+        let p = a.var(Var::Param(0));
+        let mut acc = x;
+        let mut outs = Vec::new();
+        for i in 0..5 {
+            let s = a.sin(acc);
+            let c = a.num(i as f64 + 2.0);
+            let cs = a.mul(c, s);
+            acc = a.add(cs, p);
+            let pos = a.func(crate::expr::Func::Pos, acc);
+            outs.push(pos);
+        }
+        let sch = Schedule::with_max_lets(&a, &outs, 3);
+        let targets: Vec<String> = (0..outs.len()).map(|i| format!("out[{i}]")).collect();
+        let e = emit(&a, &sch, &targets, &N, Numbers::Lanes).unwrap();
+        let all = e.chunks.concat();
+        // the state in a register, the parameter as it is; functions through Math; outputs
+        // and the workspace as F64x4
+        assert!(
+            all.contains("let q0 = ::mbs::lanes::Simd::new(q0);"),
+            "{all}"
+        );
+        assert!(!all.contains("Simd::new(p0)"), "{all}");
+        assert!(all.contains("::mbs::lanes::Math::sin("), "{all}");
+        assert!(all.contains("::mbs::lanes::Math::pos("), "{all}");
+        assert!(all.contains("out[0] = ::mbs::F64x4::from("), "{all}");
+        assert!(all.contains("= ::mbs::lanes::Simd::new(w["), "{all}");
+        assert!(all.contains("] = ::mbs::F64x4::from("), "{all}");
     }
 }

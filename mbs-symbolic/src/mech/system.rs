@@ -291,6 +291,8 @@ pub enum Formulation {
 pub struct Options {
     /// emit exact tangents K_t = ∂τ/∂q and C_t = ∂τ/∂qd
     pub tangents: bool,
+    /// emit `dynamics_x4` and `forward_dynamics_x4`: four states at once on SIMD lanes
+    pub batch: bool,
     /// force a formulation; `None` picks the cheaper by op count
     pub formulation: Option<Formulation>,
 }

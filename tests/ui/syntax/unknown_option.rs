@@ -5,6 +5,7 @@ mbs::multibody! {
         TOG[bar] = Trotz(q[0]) * Tdisp(0, -0.5, 0);
         option tangent;
         option formulation = lagrange;
+        option batch = 4;
     }
 }
 

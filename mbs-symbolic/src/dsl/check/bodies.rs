@@ -7,6 +7,7 @@ impl Checker {
     pub(super) fn lower_option(&mut self, key: &Ident, value: Option<&Expr>) {
         match (key.to_string().as_str(), value) {
             ("tangents", None) => self.sys.options.tangents = true,
+            ("batch", None) => self.sys.options.batch = true,
             ("formulation", Some(Expr::Path(p))) if p.path.get_ident().is_some() => {
                 let v = p.path.get_ident().unwrap();
                 self.sys.options.formulation = match v.to_string().as_str() {
@@ -19,8 +20,8 @@ impl Checker {
                 }
             }
             ("formulation", _) => self.error(key.span(), "write `option formulation = recursive;` or `option formulation = virtual_power;`"),
-            ("tangents", Some(v)) => self.error(v.span(), "write `option tangents;` (it takes no value)"),
-            (other, _) => self.error(key.span(), format!("unknown option `{other}`: the options are `tangents` and `formulation = recursive | virtual_power`")),
+            (name @ ("tangents" | "batch"), Some(v)) => self.error(v.span(), format!("write `option {name};` (it takes no value)")),
+            (other, _) => self.error(key.span(), format!("unknown option `{other}`: the options are `tangents`, `batch` and `formulation = recursive | virtual_power`")),
         }
     }
 

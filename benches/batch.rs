@@ -1,0 +1,113 @@
+//! Four states at once: the batch functions of `option batch;` (`dynamics_x4`,
+//! `forward_dynamics_x4`, SIMD on `F64x4` lanes) against four calls of the one-state functions,
+//! in the same run, on a 16-bar chain and a 12-joint spatial arm (criterion).
+//!
+//! ```text
+//! cargo bench -p mbs-benches --bench batch
+//! ```
+//!
+//! Prints criterion's figures, then a table of medians: ns for four states each way and the
+//! throughput of the batch relative to the one-state path (goal ≥ 3×).
+
+mod common;
+#[path = "scaling/models.rs"]
+mod models;
+
+use common::{median_ns, test_state};
+use criterion::Criterion;
+use mbs::{F64x4, LANES, Model};
+use std::hint::black_box;
+
+use models::{Arm3d12, Chain16};
+
+/// Throughput goal of the batch: states per second relative to the one-state path.
+const GOAL: f64 = 3.0;
+
+/// Four states near the test state, one slice per state.
+fn four_states(n: usize) -> Vec<(Vec<f64>, Vec<f64>)> {
+    (0..LANES)
+        .map(|k| {
+            let (mut q, mut qd) = test_state(n);
+            for (i, (a, b)) in q.iter_mut().zip(qd.iter_mut()).enumerate() {
+                *a += 0.05 * ((i + 3 * k) as f64).sin();
+                *b -= 0.1 * ((2 * i + k) as f64).cos();
+            }
+            (q, qd)
+        })
+        .collect()
+}
+
+fn pack(states: &[&[f64]]) -> Vec<F64x4> {
+    let mut out = vec![F64x4::ZERO; states[0].len()];
+    mbs::lanes::pack([states[0], states[1], states[2], states[3]], &mut out);
+    out
+}
+
+/// Measures both functions both ways on `model`.
+fn bench_model<M: Model>(c: &mut Criterion, name: &'static str, model: M) -> &'static str {
+    assert!(M::BATCH_GENERATED, "{name} has `option batch;`");
+    let n = M::NQ;
+    let states = four_states(n);
+    let qs: Vec<&[f64]> = states.iter().map(|s| s.0.as_slice()).collect();
+    let qds: Vec<&[f64]> = states.iter().map(|s| s.1.as_slice()).collect();
+    let (q4, qd4) = (pack(&qs), pack(&qds));
+    let u = vec![0.0; M::NU];
+    let u4 = vec![F64x4::ZERO; M::NU];
+    let (mut m, mut h) = (vec![0.0; n * n], vec![0.0; n]);
+    let (mut a, mut p) = (vec![0.0; n], vec![0.0; n]);
+    let (mut m4, mut h4) = (vec![F64x4::ZERO; n * n], vec![F64x4::ZERO; n]);
+    let (mut a4, mut p4) = (vec![F64x4::ZERO; n], vec![F64x4::ZERO; n]);
+    let t4 = F64x4::ZERO;
+    let mut g = c.benchmark_group(format!("batch_{name}"));
+    g.bench_function("dynamics_one_state_x4", |b| {
+        b.iter(|| {
+            for (q, qd) in black_box(&states) {
+                model.dynamics(0.0, q, qd, &u, &mut m, &mut h);
+            }
+        })
+    });
+    g.bench_function("dynamics_lanes", |b| {
+        b.iter(|| model.dynamics_x4(t4, black_box(&q4), black_box(&qd4), &u4, &mut m4, &mut h4))
+    });
+    g.bench_function("forward_one_state_x4", |b| {
+        b.iter(|| {
+            for (q, qd) in black_box(&states) {
+                model.forward_dynamics(0.0, q, qd, &u, &mut a, &mut p);
+            }
+        })
+    });
+    g.bench_function("forward_lanes", |b| {
+        b.iter(|| {
+            model.forward_dynamics_x4(t4, black_box(&q4), black_box(&qd4), &u4, &mut a4, &mut p4)
+        })
+    });
+    g.finish();
+    name
+}
+
+fn main() {
+    let mut c = Criterion::default().configure_from_args();
+    let names = [
+        bench_model(&mut c, "chain16", Chain16::default()),
+        bench_model(&mut c, "arm3d_12", Arm3d12::default()),
+    ];
+    c.final_summary();
+    // criterion's medians exist after a measuring run (`cargo bench`), not in test mode
+    println!("\nmedians, ns for {LANES} states   one state ×{LANES}    lanes   throughput   goal");
+    for name in names {
+        let group = format!("batch_{name}");
+        for (f, one, lanes) in [
+            ("dynamics", "dynamics_one_state_x4", "dynamics_lanes"),
+            ("forward_dynamics", "forward_one_state_x4", "forward_lanes"),
+        ] {
+            let (Some(o), Some(l)) = (median_ns(&group, one), median_ns(&group, lanes)) else {
+                return;
+            };
+            let verdict = if o / l >= GOAL { "met" } else { "MISSED" };
+            println!(
+                "{name:<9} {f:<17} {o:>12.1} {l:>9.1}   {:>8.2}×   ≥ {GOAL:.0}× {verdict}",
+                o / l
+            );
+        }
+    }
+}

@@ -1,0 +1,158 @@
+//! Four states at once (`option batch;`): `dynamics_x4` and `forward_dynamics_x4` agree with
+//! the one-state functions lane by lane, to 1e-12 relative, on a model that uses every kind of
+//! function the generated code may call (a free base with its chart, contacts with `pos`,
+//! `step` and friction, a Rust function, an input, time) and on a 24-joint arm whose functions
+//! are split into chunks; a model without the option answers through the trait's lane-by-lane
+//! default.
+
+#![allow(unused_macros)]
+
+use mbs::{F64x4, Kinematics, LANES, Model};
+
+include!("../benches/scaling/shapes.rs");
+
+arm!(Arm24, 24, 11, 23, 22, batch);
+
+fn push(x: f64) -> f64 {
+    0.2 * x.tanh()
+}
+
+mbs::multibody! {
+    /// A box on a free joint touching the ground at two corners, with an arm on a hinge
+    /// pushed by a Rust function of its angle, an input and a force varying in time.
+    model Mixed {
+        param k = 1e4; param c = 50.0; param mu = 0.6; param g = 9.81;
+        extern fn push = [push];
+        dof x = 0.1; dof y = -0.05; dof z = 0.02, qd = -0.3;
+        dof a = 0.2; dof b = -0.1; dof r = 0.3, qd = 1.5;
+        dof hinge = 0.4, qd = -2.0;
+        input torque;
+        body base { mass = 2.0; inertia = (0.02, 0.03, 0.04); }
+        body arm { mass = 0.5; inertia = (0.001, 0.01, 0.01); }
+        point corner0 on base at (0.1, 0.05, -0.03);
+        point corner1 on base at (-0.1, -0.05, -0.03);
+        TOG[base] = Tfree(x, y, z, a, b, r);
+        TOG[arm] = TOG[base] * Tdisp(0.1, 0, 0.05) * Troty(hinge) * Tdisp(0.15, 0, 0);
+        gravity(0, 0, -g);
+        contact(corner0, k = k, c = c, mu = mu);
+        contact(corner1, k = k, c = c, mu = mu);
+        generalized_force(hinge, push(hinge) + torque + 0.1 * sin(3 * t) - 0.05 * sqrt(1 + hinge * hinge) - 0.01 * atan2(z, 0.3 + x));
+        option batch;
+    }
+}
+
+/// Four states about the model's start (deterministic), as lanes and one slice per state.
+fn states<M: Model>(model: &M, spread: f64) -> (Vec<Vec<f64>>, Vec<Vec<f64>>) {
+    let n = M::NQ;
+    let (mut q0, mut qd0) = (vec![0.0; n], vec![0.0; n]);
+    model.initial_state(&mut q0, &mut qd0);
+    let mut qs = Vec::new();
+    let mut qds = Vec::new();
+    for k in 0..LANES {
+        let s = |i: usize, j: usize| (((i * 7 + k * 13 + j) % 11) as f64 / 5.0 - 1.0) * spread;
+        qs.push(q0.iter().enumerate().map(|(i, v)| v + s(i, 0)).collect());
+        qds.push(
+            qd0.iter()
+                .enumerate()
+                .map(|(i, v)| v + 3.0 * s(i, 5))
+                .collect(),
+        );
+    }
+    (qs, qds)
+}
+
+fn pack(states: &[Vec<f64>]) -> Vec<F64x4> {
+    let mut out = vec![F64x4::ZERO; states[0].len()];
+    mbs::lanes::pack([&states[0], &states[1], &states[2], &states[3]], &mut out);
+    out
+}
+
+fn close(lane: f64, one: f64, scale: f64, what: &str) {
+    assert!(
+        (lane - one).abs() <= 1e-12 * scale,
+        "{what}: batch {lane} vs one state {one} (scale {scale})"
+    );
+}
+
+/// Both batch functions against the one-state functions at four states; returns the worst
+/// relative difference.
+fn compare<M: Model>(model: &M, spread: f64) -> f64 {
+    let n = M::NQ;
+    let (qs, qds) = states(model, spread);
+    let us: Vec<Vec<f64>> = (0..LANES)
+        .map(|k| vec![0.3 * k as f64 - 0.4; M::NU])
+        .collect();
+    let ts = [0.0, 0.1, 0.25, 1.3];
+    let (q, qd) = (pack(&qs), pack(&qds));
+    let u = if M::NU > 0 { pack(&us) } else { Vec::new() };
+    let t = F64x4::from(ts);
+    let (mut m4, mut h4) = (vec![F64x4::ZERO; n * n], vec![F64x4::ZERO; n]);
+    let (mut a4, mut p4) = (vec![F64x4::ZERO; n], vec![F64x4::ZERO; n]);
+    model.dynamics_x4(t, &q, &qd, &u, &mut m4, &mut h4);
+    model.forward_dynamics_x4(t, &q, &qd, &u, &mut a4, &mut p4);
+    let (mut m, mut h) = (vec![0.0; n * n], vec![0.0; n]);
+    let (mut a, mut p) = (vec![0.0; n], vec![0.0; n]);
+    let mut worst = 0.0f64;
+    for k in 0..LANES {
+        model.dynamics(ts[k], &qs[k], &qds[k], &us[k], &mut m, &mut h);
+        model.forward_dynamics(ts[k], &qs[k], &qds[k], &us[k], &mut a, &mut p);
+        let max = |v: &[f64]| v.iter().fold(f64::MIN_POSITIVE, |s, x| s.max(x.abs()));
+        for (what, lanes, one) in [
+            ("M", &m4, &m),
+            ("h", &h4, &h),
+            ("qdd", &a4, &a),
+            ("pivots", &p4, &p),
+        ] {
+            let scale = max(one);
+            for (i, (l, o)) in lanes.iter().zip(one.iter()).enumerate() {
+                close(l.lane(k), *o, scale, &format!("{what}[{i}] of lane {k}"));
+                worst = worst.max((l.lane(k) - o).abs() / scale);
+            }
+        }
+    }
+    worst
+}
+
+#[test]
+fn every_function_of_the_language_on_lanes() {
+    const { assert!(Mixed::BATCH_GENERATED) };
+    let model = Mixed::default();
+    // the corners are in contact in some lanes and not in others
+    let (qs, qds) = states(&model, 0.05);
+    let mut kin = Kinematics::new::<Mixed>();
+    let mut heights = Vec::new();
+    for (q, qd) in qs.iter().zip(&qds) {
+        model.kinematics(0.0, q, qd, &mut kin);
+        heights.extend(kin.points.iter().map(|p| p.position[2]));
+    }
+    assert!(
+        heights.iter().any(|z| *z < 0.0) && heights.iter().any(|z| *z > 0.0),
+        "{heights:?}"
+    );
+    let worst = compare(&model, 0.05);
+    println!("Mixed: worst relative difference {worst:.1e}");
+}
+
+#[test]
+fn chunked_functions_on_lanes() {
+    let model = Arm24::default();
+    const { assert!(Arm24::BATCH_GENERATED) };
+    // more temporaries than one function holds (1,500): the code is split into chunks that
+    // pass values through a workspace of lanes
+    let (_, dynamics) = model
+        .info()
+        .ops
+        .iter()
+        .find(|(label, _)| label.starts_with("dynamics"))
+        .unwrap();
+    assert!(dynamics.lets > 1500, "{dynamics:?}");
+    let worst = compare(&model, 0.3);
+    println!("Arm24: worst relative difference {worst:.1e}");
+}
+
+#[test]
+fn models_without_the_option_answer_lane_by_lane() {
+    let model = mbs_models::dpend::DoublePendulum::default();
+    const { assert!(!mbs_models::dpend::DoublePendulum::BATCH_GENERATED) };
+    assert_eq!(compare(&model, 0.3), 0.0);
+}

@@ -4,8 +4,8 @@
 //! cargo run --release --example integrator_bench
 //! ```
 //!
-//! 1. Overhead per step: the wall time of a step minus the time of the evaluations it made,
-//!    in units of one M+h evaluation, per scheme, on dpend and on the (contact-free) hexapod,
+//! 1. Overhead per step: the wall time of a step minus the time of the evaluations it made
+//!    (M+h, τ, M, forward dynamics), in units of one M+h evaluation, per scheme, on dpend and on the (contact-free) hexapod,
 //!    with fixed steps.
 //! 2. dpend over 10 s: the CPU time and evaluations each scheme needs for 6 correct digits at
 //!    t = 10 s against `tests/reference/dpend.json`: rtol from 1e-6 to 1e-14, or h halved from
@@ -26,8 +26,8 @@ fn test_state(n: usize) -> (Vec<f64>, Vec<f64>) {
     )
 }
 
-/// Seconds per call of M+h and of τ at the test state.
-fn evaluation_times<M: Model>(model: &M) -> (f64, f64) {
+/// Seconds per call of M+h, of τ and of forward dynamics at the test state.
+fn evaluation_times<M: Model>(model: &M) -> (f64, f64, f64) {
     let n = M::NQ;
     let (q, qd) = test_state(n);
     let (mut m, mut h, mut tau) = (vec![0.0; n * n], vec![0.0; n], vec![0.0; n]);
@@ -49,19 +49,33 @@ fn evaluation_times<M: Model>(model: &M) -> (f64, f64) {
             &mut tau,
         );
     }
-    (t_dyn, t0.elapsed().as_secs_f64() / reps as f64)
+    let t_tau = t0.elapsed().as_secs_f64() / reps as f64;
+    let (mut qdd, mut pivots) = (vec![0.0; n], vec![0.0; n]);
+    let t0 = Instant::now();
+    for _ in 0..reps {
+        model.forward_dynamics(
+            0.0,
+            black_box(&q),
+            black_box(&qd),
+            &u,
+            &mut qdd,
+            &mut pivots,
+        );
+    }
+    (t_dyn, t_tau, t0.elapsed().as_secs_f64() / reps as f64)
 }
 
 fn overhead<M: Model + Clone + 'static>(name: &str, model: M, h: f64, t_end: f64) {
-    let (t_dyn, t_tau) = evaluation_times(&model);
+    let (t_dyn, t_tau, t_fwd) = evaluation_times(&model);
     println!(
-        "\n{name}: one M+h {:.0} ns, one τ {:.0} ns; fixed step h = {h} s to t = {t_end} s",
+        "\n{name}: one M+h {:.0} ns, one τ {:.0} ns, one forward dynamics {:.0} ns; fixed step h = {h} s to t = {t_end} s",
         t_dyn * 1e9,
-        t_tau * 1e9
+        t_tau * 1e9,
+        t_fwd * 1e9
     );
     println!(
-        "  {:<10} {:>10} {:>12} {:>10} {:>10} {:>22}",
-        "scheme", "steps", "µs/step", "M+h/step", "τ/step", "overhead (M+h units)"
+        "  {:<10} {:>10} {:>12} {:>10} {:>10} {:>10} {:>22}",
+        "scheme", "steps", "µs/step", "M+h/step", "τ/step", "fwd/step", "overhead (M+h units)"
     );
     for scheme in Scheme::all() {
         let opts = Options {
@@ -76,15 +90,17 @@ fn overhead<M: Model + Clone + 'static>(name: &str, model: M, h: f64, t_end: f64
             Ok((_, st)) => {
                 let s = st.steps as f64;
                 let evals = st.dynamics as f64 * t_dyn
-                    + (st.inverse_dynamics + st.mass_matrix) as f64 * t_tau;
+                    + (st.inverse_dynamics + st.mass_matrix) as f64 * t_tau
+                    + st.forward_dynamics as f64 * t_fwd;
                 let over = (wall - evals) / s / t_dyn;
                 println!(
-                    "  {:<10} {:>10} {:>12.3} {:>10.2} {:>10.2} {:>22.2}",
+                    "  {:<10} {:>10} {:>12.3} {:>10.2} {:>10.2} {:>10.2} {:>22.2}",
                     scheme.name(),
                     st.steps,
                     wall / s * 1e6,
                     st.dynamics as f64 / s,
                     st.inverse_dynamics as f64 / s,
+                    st.forward_dynamics as f64 / s,
                     over
                 );
             }

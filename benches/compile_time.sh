@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # Compile time and peak memory of one model in a crate of its own, dependencies built first
 # and not timed: release builds of a 24-joint spatial arm, a 32-bar planar chain, the
-# hexapod with exact tangents and a 200-bar chain, then a debug build of the arm.
+# hexapod with exact tangents and a 200-bar chain, then a debug build of the arm, and the arm
+# with the batch functions of `option batch;`.
 #
 #   benches/compile_time.sh            # all cases
-#   benches/compile_time.sh chain32    # one case (arm24, chain32, hexapod, chain200, arm24-dev)
+#   benches/compile_time.sh chain32    # one case (arm24, chain32, hexapod, chain200, arm24-dev,
+#                                      # arm24-batch: the arm with `option batch;`)
 #
 # Each timed build compiles the model crate from scratch (its artifacts cleaned, no
 # incremental cache); the peak memory is the largest resident set of the build's processes
@@ -30,9 +32,11 @@ chain() { # n bars
     cat "$shapes"
     echo "chain!(Model, $1);"
 }
-arm() { # n joints, n even
+arm() { # n joints, n even; then options of the language
     cat "$shapes"
-    echo "arm!(Model, $1, $(($1 / 2 - 1)), $(($1 - 1)), $(($1 - 2)));"
+    local n=$1
+    shift
+    echo "arm!(Model, $n, $((n / 2 - 1)), $((n - 1)), $((n - 2))${*:+, $*});"
 }
 
 hexapod() { # the hexapod of models/src with `option tangents;` before its closing braces
@@ -41,15 +45,21 @@ hexapod() { # the hexapod of models/src with `option tangents;` before its closi
 }
 
 cat > "$dir/src/main.rs" <<'RS'
+#[allow(unused_macros)]
 mod model;
-use mbs::Model;
+use mbs::{F64x4, Model};
 fn main() {
     let m = model::Model::default();
     let n = model::Model::NQ;
     let (q, z) = (vec![0.1; n], vec![0.0; n]);
     let (mut qdd, mut p) = (vec![0.0; n], vec![0.0; n]);
     m.forward_dynamics(0.0, &q, &z, &vec![0.0; model::Model::NU], &mut qdd, &mut p);
-    println!("{} dof, qdd[0] = {:.6}", n, qdd[0]);
+    // the batch function too (lane by lane without `option batch;`)
+    let (q4, z4) = (vec![F64x4::splat(0.1); n], vec![F64x4::ZERO; n]);
+    let (mut a4, mut p4) = (z4.clone(), z4.clone());
+    let u4 = vec![F64x4::ZERO; model::Model::NU];
+    m.forward_dynamics_x4(F64x4::ZERO, &q4, &z4, &u4, &mut a4, &mut p4);
+    println!("{} dof, qdd[0] = {:.6} ({:.6} in a batch)", n, qdd[0], a4[0].lane(0));
 }
 RS
 
@@ -57,7 +67,7 @@ cd "$dir"
 export CARGO_TARGET_DIR="$dir/target"
 # for every build, the untimed ones too: a change of it rebuilds the path dependencies
 export CARGO_INCREMENTAL=0
-cases=("${@:-arm24 chain32 hexapod chain200 arm24-dev}")
+cases=("${@:-arm24 chain32 hexapod chain200 arm24-dev arm24-batch}")
 for case in ${cases[@]}; do
     profile=release
     case "$case" in
@@ -66,6 +76,7 @@ for case in ${cases[@]}; do
         chain200) chain 200 > src/model.rs ;;
         hexapod) hexapod > src/model.rs ;;
         arm24-dev) arm 24 > src/model.rs; profile=dev ;;
+        arm24-batch) arm 24 batch > src/model.rs ;;
         *) echo "unknown case $case" >&2; exit 2 ;;
     esac
     flag=$([ "$profile" = release ] && echo --release || true)

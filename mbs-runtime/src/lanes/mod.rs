@@ -1,21 +1,21 @@
-//! Four states at once: [`F64x4`], the number type of the batch functions
+//! Four states at once: [`F64x4`], the lanes of the batch functions' arguments and results
 //! ([`Model::dynamics_x4`](crate::Model::dynamics_x4),
 //! [`Model::forward_dynamics_x4`](crate::Model::forward_dynamics_x4)) that `option batch;`
 //! generates.
 //!
 //! A batch holds coordinate `i` of four states in one `F64x4` (structure of arrays): `q[i]`
 //! is `[q_i of state 0, …, q_i of state 3]`. [`pack`] and [`unpack`] convert from and to
-//! one slice per state. Arithmetic is element by element on `[f64; 4]`, which the compiler
-//! turns into one vector instruction per operation: 256-bit on x86-64, where the generated
-//! batch code is compiled for AVX2 and runs when the processor has it ([`simd_available`]).
-//! sin and cos are polynomials computed element by element ([`F64x4::sin_cos`]); tan, the
-//! inverse functions and exp are the `wide` crate's vector polynomials (within 2 ulp of
-//! `f64`'s functions); the others (hyperbolic ones, ln, powf, Rust functions of the
-//! model) are applied lane by lane.
+//! one slice per state.
 //!
-//! The generated batch code is the scalar code with `F64x4` for the values that vary between
-//! states: parameters and constants stay `f64` and meet lanes through the mixed operators
-//! below.
+//! Inside the generated functions the values that differ between states are [`Simd`]: on
+//! x86-64 one AVX register each, every operation one AVX instruction (the functions are
+//! compiled for AVX2 and entered when [`simd_available`]; otherwise [`lane_by_lane`] calls
+//! the one-state functions). Parameters and constants stay `f64`; the functions of the
+//! language are [`Math`] and [`Math2`], on `f64` or `Simd` alike. sin and cos are
+//! polynomials on all four lanes ([`F64x4::sin_cos`], the same in AVX registers); tan, the
+//! inverse functions and exp are the `wide` crate's vector polynomials (within 2 ulp of
+//! `f64`'s functions); the others (hyperbolic ones, ln, powf, Rust functions of the model)
+//! are applied lane by lane. `F64x4`'s own arithmetic is element by element.
 
 use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub};
 use wide::f64x4;

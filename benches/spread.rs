@@ -68,7 +68,7 @@ fn cases() -> Vec<Case> {
 }
 
 /// Median ns per call of `f` over `samples` samples of about `sample` each.
-fn median_ns(f: &mut dyn FnMut(), samples: usize, sample: Duration) -> f64 {
+fn timed_ns(f: &mut dyn FnMut(), samples: usize, sample: Duration) -> f64 {
     // calls per sample, from a first estimate after a warm-up
     let start = Instant::now();
     let mut calls = 0u64;
@@ -96,7 +96,7 @@ fn child(brief: bool) {
         (31, Duration::from_millis(20))
     };
     for (name, mut f) in cases() {
-        println!("{name}\t{:.1}", median_ns(&mut *f, samples, sample));
+        println!("{name}\t{:.1}", timed_ns(&mut *f, samples, sample));
     }
 }
 

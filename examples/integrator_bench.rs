@@ -26,43 +26,41 @@ fn test_state(n: usize) -> (Vec<f64>, Vec<f64>) {
     )
 }
 
+/// Seconds per call of `f`, over `reps` calls.
+fn per_call(reps: usize, mut f: impl FnMut()) -> f64 {
+    let t0 = Instant::now();
+    for _ in 0..reps {
+        f();
+    }
+    t0.elapsed().as_secs_f64() / reps as f64
+}
+
 /// Seconds per call of M+h, of τ and of forward dynamics at the test state.
 fn evaluation_times<M: Model>(model: &M) -> (f64, f64, f64) {
     let n = M::NQ;
     let (q, qd) = test_state(n);
     let (mut m, mut h, mut tau) = (vec![0.0; n * n], vec![0.0; n], vec![0.0; n]);
+    let (mut qdd, mut pivots) = (vec![0.0; n], vec![0.0; n]);
     let u = vec![0.0; M::NU];
     let reps = 200_000 / n.max(1);
-    let t0 = Instant::now();
-    for _ in 0..reps {
-        model.dynamics(0.0, black_box(&q), black_box(&qd), &u, &mut m, &mut h);
-    }
-    let t_dyn = t0.elapsed().as_secs_f64() / reps as f64;
-    let t0 = Instant::now();
-    for _ in 0..reps {
+    let (q, qd) = (&q, &qd);
+    let t_dyn = per_call(reps, || {
+        model.dynamics(0.0, black_box(q), black_box(qd), &u, &mut m, &mut h)
+    });
+    let t_tau = per_call(reps, || {
         model.inverse_dynamics(
             0.0,
-            black_box(&q),
-            black_box(&qd),
+            black_box(q),
+            black_box(qd),
             black_box(&h),
             &u,
             &mut tau,
-        );
-    }
-    let t_tau = t0.elapsed().as_secs_f64() / reps as f64;
-    let (mut qdd, mut pivots) = (vec![0.0; n], vec![0.0; n]);
-    let t0 = Instant::now();
-    for _ in 0..reps {
-        model.forward_dynamics(
-            0.0,
-            black_box(&q),
-            black_box(&qd),
-            &u,
-            &mut qdd,
-            &mut pivots,
-        );
-    }
-    (t_dyn, t_tau, t0.elapsed().as_secs_f64() / reps as f64)
+        )
+    });
+    let t_fwd = per_call(reps, || {
+        model.forward_dynamics(0.0, black_box(q), black_box(qd), &u, &mut qdd, &mut pivots)
+    });
+    (t_dyn, t_tau, t_fwd)
 }
 
 fn overhead<M: Model + Clone + 'static>(name: &str, model: M, h: f64, t_end: f64) {

@@ -120,7 +120,7 @@ impl F64x4 {
     /// x = k π/2 + r with π/2 in three parts (fdlibm's split: k π/2 exact for |k| < 2²⁰),
     /// |r| ≤ π/4, Cephes' minimax polynomials of sin and cos on it, the quadrant k mod 4
     /// choosing and signing them. Lanes beyond |x| = 1e5 (where the split loses digits) take
-    /// `f64::sin_cos` instead.
+    /// `f64::sin` and `f64::cos` instead.
     #[inline(always)]
     pub fn sin_cos(self) -> (F64x4, F64x4) {
         use sincos::{C, PIO2_1, PIO2_2, PIO2_3, REDUCE_LIMIT, S};

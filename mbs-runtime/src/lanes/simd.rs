@@ -51,35 +51,38 @@ pub trait Math2<B> {
     fn powf(self, y: B) -> Self::Output;
 }
 
-macro_rules! f64_math {
-    ($($f:ident),*) => {
-        impl Math for f64 {
-            $(#[inline(always)] fn $f(self) -> f64 { f64::$f(self) })*
-            #[inline(always)]
-            fn sign(self) -> f64 {
-                if self == 0.0 { 0.0 } else { self.signum() }
-            }
-            #[inline(always)]
-            fn step(self) -> f64 {
-                if self > 0.0 { 1.0 } else { 0.0 }
-            }
-            #[inline(always)]
-            fn pos(self) -> f64 {
-                self.max(0.0)
-            }
-            #[inline(always)]
-            fn powi(self, k: i32) -> f64 {
-                f64::powi(self, k)
-            }
-            #[inline(always)]
-            fn map(self, f: impl Fn(f64) -> f64) -> f64 {
-                f(self)
-            }
+/// `Math` for a type from its inherent functions of the same names (`<T>::sin(x)`…), and
+/// the items it writes out itself.
+macro_rules! math_by_name {
+    ($ty:ty; $($f:ident),*; $($own:item)*) => {
+        impl $crate::lanes::Math for $ty {
+            $(#[inline(always)] fn $f(self) -> $ty { <$ty>::$f(self) })*
+            $($own)*
         }
     };
 }
-f64_math!(
-    sin, cos, tan, asin, acos, atan, sinh, cosh, tanh, exp, ln, sqrt, abs
+math_by_name!(
+    f64; sin, cos, tan, asin, acos, atan, sinh, cosh, tanh, exp, ln, sqrt, abs;
+    #[inline(always)]
+    fn sign(self) -> f64 {
+        if self == 0.0 { 0.0 } else { self.signum() }
+    }
+    #[inline(always)]
+    fn step(self) -> f64 {
+        if self > 0.0 { 1.0 } else { 0.0 }
+    }
+    #[inline(always)]
+    fn pos(self) -> f64 {
+        self.max(0.0)
+    }
+    #[inline(always)]
+    fn powi(self, k: i32) -> f64 {
+        f64::powi(self, k)
+    }
+    #[inline(always)]
+    fn map(self, f: impl Fn(f64) -> f64) -> f64 {
+        f(self)
+    }
 );
 
 impl Math2<f64> for f64 {
@@ -118,7 +121,7 @@ pub(super) fn powi_by_squaring<T: Copy + std::ops::Mul<Output = T>>(
 
 #[cfg(not(target_arch = "x86_64"))]
 mod portable {
-    use super::{F64x4, Math, Math2};
+    use super::{F64x4, Math2};
 
     /// [`F64x4`] itself where there are no AVX registers.
     pub type Simd = F64x4;
@@ -131,72 +134,9 @@ mod portable {
         }
     }
 
-    impl Math for F64x4 {
-        #[inline(always)]
-        fn sin(self) -> F64x4 {
-            F64x4::sin(self)
-        }
-        // … the rest through F64x4's own methods
-        #[inline(always)]
-        fn cos(self) -> F64x4 {
-            F64x4::cos(self)
-        }
-        #[inline(always)]
-        fn tan(self) -> F64x4 {
-            F64x4::tan(self)
-        }
-        #[inline(always)]
-        fn asin(self) -> F64x4 {
-            F64x4::asin(self)
-        }
-        #[inline(always)]
-        fn acos(self) -> F64x4 {
-            F64x4::acos(self)
-        }
-        #[inline(always)]
-        fn atan(self) -> F64x4 {
-            F64x4::atan(self)
-        }
-        #[inline(always)]
-        fn sinh(self) -> F64x4 {
-            F64x4::sinh(self)
-        }
-        #[inline(always)]
-        fn cosh(self) -> F64x4 {
-            F64x4::cosh(self)
-        }
-        #[inline(always)]
-        fn tanh(self) -> F64x4 {
-            F64x4::tanh(self)
-        }
-        #[inline(always)]
-        fn exp(self) -> F64x4 {
-            F64x4::exp(self)
-        }
-        #[inline(always)]
-        fn ln(self) -> F64x4 {
-            F64x4::ln(self)
-        }
-        #[inline(always)]
-        fn sqrt(self) -> F64x4 {
-            F64x4::sqrt(self)
-        }
-        #[inline(always)]
-        fn abs(self) -> F64x4 {
-            F64x4::abs(self)
-        }
-        #[inline(always)]
-        fn sign(self) -> F64x4 {
-            F64x4::sign(self)
-        }
-        #[inline(always)]
-        fn step(self) -> F64x4 {
-            F64x4::step(self)
-        }
-        #[inline(always)]
-        fn pos(self) -> F64x4 {
-            F64x4::pos(self)
-        }
+    math_by_name!(
+        F64x4; sin, cos, tan, asin, acos, atan, sinh, cosh, tanh, exp, ln, sqrt, abs,
+        sign, step, pos;
         #[inline(always)]
         fn powi(self, k: i32) -> F64x4 {
             F64x4::powi(self, k)
@@ -205,7 +145,7 @@ mod portable {
         fn map(self, f: impl Fn(f64) -> f64) -> F64x4 {
             F64x4::map(self, f)
         }
-    }
+    );
 
     macro_rules! two {
         ($a:ty, $b:ty) => {
@@ -267,12 +207,17 @@ mod avx {
             F64x4::from(a)
         }
 
+        /// The lanes `v` in a register like `self` (which proves AVX2).
+        #[inline(always)]
+        fn load(self, v: F64x4) -> Simd {
+            // SAFETY: `self` proves AVX2; an unaligned load from a valid array
+            Simd(unsafe { _mm256_loadu_pd(v.to_array().as_ptr()) })
+        }
+
         /// A function of [`F64x4`] (lane by lane or `wide`'s).
         #[inline(always)]
         fn via(self, f: impl Fn(F64x4) -> F64x4) -> Simd {
-            let a = f(self.lanes()).to_array();
-            // SAFETY: `self` proves AVX2; an unaligned load from a valid array
-            Simd(unsafe { _mm256_loadu_pd(a.as_ptr()) })
+            self.load(f(self.lanes()))
         }
 
         /// sin and cos together, as [`F64x4::sin_cos`] in AVX registers.
@@ -285,8 +230,7 @@ mod avx {
                 let abs = _mm256_andnot_pd(_mm256_set1_pd(-0.0), x);
                 let ok = _mm256_cmp_pd::<_CMP_LE_OQ>(abs, _mm256_set1_pd(REDUCE_LIMIT));
                 if _mm256_movemask_pd(ok) != 0b1111 {
-                    let s = self.lanes();
-                    return (self.via(|_| s.map(f64::sin)), self.via(|_| s.map(f64::cos)));
+                    return (self.via(|s| s.map(f64::sin)), self.via(|s| s.map(f64::cos)));
                 }
                 // written without closures: everything inlines into the AVX2 caller
                 macro_rules! set {
@@ -486,12 +430,12 @@ mod avx {
                 #[inline(always)]
                 fn atan2(self, x: $b) -> Simd {
                     let like = $like(&self, &x);
-                    like.via(|_| F64x4::from(self).atan2(F64x4::from(x)))
+                    like.load(F64x4::from(self).atan2(F64x4::from(x)))
                 }
                 #[inline(always)]
                 fn powf(self, y: $b) -> Simd {
                     let like = $like(&self, &y);
-                    like.via(|_| F64x4::from(self).powf(F64x4::from(y)))
+                    like.load(F64x4::from(self).powf(F64x4::from(y)))
                 }
             }
         };

@@ -86,21 +86,13 @@ impl FnSpec {
         f
     }
 
-    /// The zero of the function's numbers.
-    fn zero(&self) -> String {
-        match self.numbers {
-            Numbers::Scalar => "0.0".into(),
-            Numbers::Lanes => format!("{LANES_TYPE}::ZERO"),
-        }
-    }
-
     /// Adds a dense matrix output given by rows, stored column-major (`target[i + rows*j]`);
     /// zeros are written by one `fill`.
     pub fn matrix(&mut self, a: &Arena, target: &str, rows: &[Vec<ExprId>]) {
         let n = rows.len();
         if rows.iter().flatten().any(|&e| a.is_num(e, 0.0)) {
             self.prelude
-                .push(format!("{target}.fill({});", self.zero()));
+                .push(format!("{target}.fill({});", self.numbers.zero()));
         }
         for (i, row) in rows.iter().enumerate() {
             for (j, &e) in row.iter().enumerate() {
@@ -129,10 +121,7 @@ pub fn emit_fn(
     let targets: Vec<String> = spec.outputs.iter().map(|o| o.0.clone()).collect();
     let sch = Schedule::new(arena, &roots);
     let em = emit(arena, &sch, &targets, names, spec.numbers)?;
-    let number = match spec.numbers {
-        Numbers::Scalar => "f64",
-        Numbers::Lanes => LANES_TYPE,
-    };
+    let number = spec.numbers.type_name();
     // batch code is compiled for 256-bit registers on x86-64 whatever the build's target CPU
     // (the trait method checks the processor before calling it)
     let simd = match spec.numbers {
@@ -155,7 +144,7 @@ pub fn emit_fn(
             "#[inline]\n{simd}fn {}(&self, {}) {{\n{prelude}let mut w = [{}; {}];\n",
             spec.name,
             spec.args,
-            spec.zero(),
+            spec.numbers.zero(),
             em.workspace
         );
         for k in 0..em.chunks.len() {

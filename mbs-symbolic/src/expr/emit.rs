@@ -26,6 +26,24 @@ pub enum Numbers {
     Lanes,
 }
 
+impl Numbers {
+    /// The type of arguments, outputs and workspace slots.
+    pub fn type_name(self) -> &'static str {
+        match self {
+            Numbers::Scalar => "f64",
+            Numbers::Lanes => LANES_TYPE,
+        }
+    }
+
+    /// The zero of that type.
+    pub fn zero(self) -> String {
+        match self {
+            Numbers::Scalar => "0.0".into(),
+            Numbers::Lanes => format!("{LANES_TYPE}::ZERO"),
+        }
+    }
+}
+
 /// The lanes type of [`Numbers::Lanes`] in arguments, outputs and workspace (the runtime's
 /// `F64x4`).
 pub const LANES_TYPE: &str = "::mbs::F64x4";
@@ -186,13 +204,7 @@ impl Writer<'_> {
             }
             // lanes: the functions of `Math`/`Math2`, which take `f64` or lanes alike
             Node::Func(f, a) if self.numbers == Numbers::Lanes => {
-                let name = match f {
-                    Func::Sign => "sign",
-                    Func::Step => "step",
-                    Func::Pos => "pos",
-                    f => f.name(),
-                };
-                let _ = write!(out, "{MATH}::{name}(");
+                let _ = write!(out, "{MATH}::{}(", f.name());
                 self.expr(a, Prec::Add, out);
                 out.push(')');
             }
@@ -249,13 +261,8 @@ impl Writer<'_> {
             }
             Node::Call(f, k, a) => {
                 let uf = &self.arena.user_fns()[f as usize];
-                if self.numbers == Numbers::Lanes {
-                    let _ = write!(out, "{MATH}::map(");
-                    self.expr(a, Prec::Add, out);
-                    out.push_str(", ");
-                }
-                match uf.paths.get(k as usize) {
-                    Some(p) => out.push_str(p),
+                let path = match uf.paths.get(k as usize) {
+                    Some(p) => p.as_str(),
                     None => {
                         let m = MissingDerivative {
                             function: uf.name.clone(),
@@ -264,15 +271,22 @@ impl Writer<'_> {
                         if !self.missing.contains(&m) {
                             self.missing.push(m);
                         }
-                        out.push_str("f64::from");
+                        "f64::from"
                     }
-                }
-                if self.numbers == Numbers::Lanes {
-                    out.push(')');
-                } else {
-                    out.push('(');
-                    self.expr(a, Prec::Add, out);
-                    out.push(')');
+                };
+                match self.numbers {
+                    Numbers::Scalar => {
+                        out.push_str(path);
+                        out.push('(');
+                        self.expr(a, Prec::Add, out);
+                        out.push(')');
+                    }
+                    // lanes: the Rust function lane by lane
+                    Numbers::Lanes => {
+                        let _ = write!(out, "{MATH}::map(");
+                        self.expr(a, Prec::Add, out);
+                        let _ = write!(out, ", {path})");
+                    }
                 }
             }
         }

@@ -29,6 +29,7 @@ use std::f64::consts::PI;
 fn main() {
     let args = mbs::cli::RunArgs::parse();
     let model = Arm3d6::default();
+    args.sweep_if_asked(&model, 2.0);
     if !args.quiet {
         common::show(&model);
     }

@@ -51,6 +51,7 @@ fn statics(model: &model::DoublePendulum) -> Result<(), AnalysisError> {
 fn main() {
     let args = mbs::cli::RunArgs::parse();
     let model = model::DoublePendulum::default();
+    args.sweep_if_asked(&model, 10.0);
     if !args.quiet {
         common::show(&model);
         if let Err(e) = statics(&model) {

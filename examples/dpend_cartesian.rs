@@ -25,6 +25,7 @@ use mbs::Output;
 fn main() {
     let args = mbs::cli::RunArgs::parse();
     let t_end = 10.0;
+    args.sweep_if_asked(&model::DoublePendulumCartesian::default(), t_end);
     if !args.quiet {
         common::show(&model::DoublePendulumCartesian::default());
         println!();

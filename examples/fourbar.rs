@@ -24,6 +24,7 @@ use mbs::Model;
 fn main() {
     let args = mbs::cli::RunArgs::parse();
     let model = model::FourBar::default();
+    args.sweep_if_asked(&model, 10.0);
     if !args.quiet {
         common::show(&model);
         let (mut q, mut qd) = ([0.0; 3], [0.0; 3]);

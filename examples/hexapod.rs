@@ -185,6 +185,10 @@ fn main() {
     if args.dt.is_none() {
         args.dt = Some(0.01);
     }
+    match args.scene.as_deref() {
+        Some("Free") => args.sweep_if_asked(&Hexapod::default(), 1.0),
+        _ => args.sweep_if_asked(&HexapodStanding::default(), 5.0),
+    }
     if !args.quiet {
         let model = Hexapod::default();
         common::show(&model);

@@ -102,6 +102,7 @@ fn steps_per_period() {
 fn main() {
     let args = mbs::cli::RunArgs::parse();
     let model = model::Seed2dof::default();
+    args.sweep_if_asked(&model, 10.0);
     if !args.quiet {
         common::show(&model);
         if let Err(e) = print_modes(&model) {

@@ -25,6 +25,7 @@ use mbs::Output;
 fn main() {
     let args = mbs::cli::RunArgs::parse();
     let t_end = 2.0;
+    args.sweep_if_asked(&model::SliderCrank::default(), t_end);
     if !args.quiet {
         println!("form (a):");
         common::show(&model::SliderCrank::default());

@@ -144,6 +144,7 @@ fn write_package(dir: &Path, snake: &str, name: &str, block: &str) -> Result<(),
          fn main() {{\n    use mbs::Model;\n    \
          let args = mbs::cli::RunArgs::parse_with_defaults(&[(\"t_end\", \"2\")]);\n    \
          let model = {name}::default();\n    \
+         args.sweep_if_asked(&model, 2.0);\n    \
          if !args.quiet {{\n        let info = model.info();\n        \
          println!(\"{{}}: {{}} dof, {{}} bodies\", info.name, {name}::NQ, info.body_count());\n    }}\n    \
          if let Err(e) = args.run(model, 2.0) {{\n        eprintln!(\"error: {{e}}\");\n        \

@@ -94,6 +94,36 @@ pub struct RunArgs {
     /// the scene to run, for programs whose model has several (each program lists its own)
     #[arg(long)]
     pub scene: Option<String>,
+    /// run the sweep of this plan (TOML, see `mbs::sweep`) into --out DIR instead of one run:
+    /// every run on every core, a row per run in DIR/results.csv; run again to resume
+    #[arg(long, value_name = "PLAN.toml")]
+    pub sweep: Option<PathBuf>,
+    /// with --sweep: run only shard INDEX/COUNT of the runs into DIR/parts/ (a Slurm array
+    /// task)
+    #[arg(long, value_name = "INDEX/COUNT", requires = "sweep")]
+    pub shard: Option<String>,
+    /// with --sweep: write the run list, a manifest and DIR/sweep.sbatch, a Slurm job array
+    /// (the plan's [slurm] table), and run nothing
+    #[arg(long, requires = "sweep", conflicts_with_all = ["shard", "merge"])]
+    pub slurm: bool,
+    /// with --sweep: merge the array tasks' parts into DIR/results.csv, or list the missing
+    /// runs
+    #[arg(long, requires = "sweep", conflicts_with = "shard")]
+    pub merge: bool,
+    /// with --sweep: threads (default: every core, or RAYON_NUM_THREADS)
+    #[arg(long, requires = "sweep")]
+    pub threads: Option<usize>,
+}
+
+/// What `--sweep` did.
+#[derive(Debug)]
+pub enum SweepReport {
+    /// the runs (all, or a shard's) were made
+    Ran(crate::sweep::Summary),
+    /// `--slurm`: the folder is ready and this is the script to submit
+    Prepared { script: PathBuf, runs: usize },
+    /// `--merge`: the parts were merged
+    Merged(crate::sweep::MergeReport),
 }
 
 /// What a run gives: the outputs, the work, the time.
@@ -149,6 +179,16 @@ pub enum RunError {
     },
     #[error("unknown scene `{given}`: this program has {known}")]
     UnknownScene { given: String, known: String },
+    #[error("{0}")]
+    Sweep(#[from] crate::sweep::SweepError),
+    #[error("this program makes one run at a time: it does not offer --sweep")]
+    SweepNotOffered,
+    #[error("--sweep needs --out DIR: the folder of the sweep's plan, run list and table")]
+    SweepWithoutOut,
+    #[error(
+        "this program's model has inputs driven by Rust code, which a sweep cannot copy to its threads; run it once at a time, or write the sweep with mbs::sweep"
+    )]
+    SweepWithInputs,
     #[error("cannot draw or export {path}: {reason}")]
     Plot { path: PathBuf, reason: String },
     #[error("cannot write {path}: {source}")]
@@ -239,28 +279,29 @@ fn shorten(h: f64) -> f64 {
     (h / scale).floor() * scale
 }
 
-/// `auto`, `index3`, `index2`, `projection`, `partitioning` or `baumgarte:ALPHA,BETA`.
+/// The lines a sweep prints when it ends.
+fn sweep_summary(s: &crate::sweep::Summary) -> String {
+    let mut text = format!(
+        "{} runs: {} made now ({} failed), {} done before; {:.2} s wall, {:.2} s CPU on {} threads; table {}",
+        s.runs,
+        s.ran,
+        s.failed,
+        s.skipped,
+        s.wall.as_secs_f64(),
+        s.cpu.as_secs_f64(),
+        s.threads,
+        s.table.display()
+    );
+    if s.stopped {
+        text.push_str("\nstopped before every run was made: the same command resumes it");
+    }
+    text
+}
+
+/// `auto`, `index3`, `index2`, `projection`, `partitioning` or `baumgarte:ALPHA,BETA`
+/// ([`ConstraintMethod::from_name`]).
 pub fn parse_constraint_method(s: &str) -> Result<ConstraintMethod, String> {
-    let bad = || {
-        format!(
-            "unknown constraint method `{s}`: use auto, index3, index2, projection, partitioning or baumgarte:ALPHA,BETA"
-        )
-    };
-    Ok(match s {
-        "auto" => ConstraintMethod::Auto,
-        "index3" => ConstraintMethod::Index3,
-        "index2" => ConstraintMethod::Index2,
-        "projection" => ConstraintMethod::Projection,
-        "partitioning" => ConstraintMethod::Partitioning,
-        _ => {
-            let rest = s.strip_prefix("baumgarte:").ok_or_else(bad)?;
-            let (a, b) = rest.split_once(',').ok_or_else(bad)?;
-            ConstraintMethod::Baumgarte {
-                alpha: a.trim().parse().map_err(|_| bad())?,
-                beta: b.trim().parse().map_err(|_| bad())?,
-            }
-        }
-    })
+    ConstraintMethod::from_name(s)
 }
 
 /// Runs in progress in this process, and whether Ctrl-C asked them to stop.
@@ -462,7 +503,106 @@ impl RunArgs {
         model: M,
         default_t_end: f64,
     ) -> Result<RunReport, RunError> {
+        if self.sweep.is_some() {
+            return Err(RunError::SweepNotOffered);
+        }
         self.run_with(model, default_t_end, Inputs::new())
+    }
+
+    /// `--sweep PLAN.toml --out DIR`: the sweep of the plan over copies of `model`
+    /// ([`crate::sweep`]), each run starting from these arguments' scheme and options with the
+    /// plan's `[simulation]` on top, reporting [`Metrics::final_state`]; a summary on standard
+    /// output unless `--quiet`, a progress bar on standard error. With `--shard`, one shard
+    /// into `DIR/parts/`; with `--slurm`, the job array's files and nothing run; with
+    /// `--merge`, the parts merged. Runs that fail are rows of the table, not errors; Ctrl-C
+    /// starts no further run, and running the same command again resumes.
+    ///
+    /// [`Metrics::final_state`]: crate::sweep::Metrics::final_state
+    pub fn sweep<M: Model + Clone + Sync + 'static>(
+        &self,
+        model: M,
+        default_t_end: f64,
+    ) -> Result<SweepReport, RunError> {
+        use crate::sweep::{Plan, Shard, Sweep, merge};
+        let plan_path = self.sweep.as_deref().ok_or(RunError::SweepWithoutOut)?;
+        let dir = self.out.as_deref().ok_or(RunError::SweepWithoutOut)?;
+        if self.merge {
+            let m = merge(dir)?;
+            if !self.quiet {
+                println!(
+                    "merged {} runs ({} failed) from {} parts into {}",
+                    m.runs,
+                    m.failed,
+                    m.parts,
+                    m.table.display()
+                );
+            }
+            return Ok(SweepReport::Merged(m));
+        }
+        let scheme = Scheme::from_name(&self.scheme)
+            .ok_or_else(|| RunError::UnknownScheme(self.scheme.clone()))?;
+        let plan = Plan::load(plan_path)?;
+        let runs = plan.runs(plan_path.parent().unwrap_or(Path::new(".")))?;
+        let mut options = self.options(default_t_end);
+        options.frames = false;
+        watch_ctrl_c();
+        let sweep = Sweep::new(|| model.clone(), &plan, scheme, options)?
+            .progress(!self.quiet)
+            .stop_flag(&INTERRUPTED);
+        let sweep = match self.threads {
+            Some(n) => sweep.threads(n),
+            None => sweep,
+        };
+        if self.slurm {
+            let exe = std::env::current_exe().map_err(|source| RunError::Io {
+                path: PathBuf::from("the running program"),
+                source,
+            })?;
+            let mut command = vec![exe.display().to_string()];
+            if let Some(scene) = &self.scene {
+                command.extend(["--scene".to_string(), scene.clone()]);
+            }
+            let script = sweep.write_slurm(dir, &runs, &command)?;
+            if !self.quiet {
+                println!(
+                    "{} runs in {} array tasks: submit with `sbatch {}`, then merge with --merge",
+                    runs.len(),
+                    plan.slurm.tasks,
+                    script.display()
+                );
+            }
+            return Ok(SweepReport::Prepared {
+                script,
+                runs: runs.len(),
+            });
+        }
+        let running = Running::start();
+        let summary = match &self.shard {
+            Some(s) => sweep.run_shard(dir, &runs, Shard::parse(s)?)?,
+            None => sweep.run(dir, &runs)?,
+        };
+        drop(running);
+        if !self.quiet {
+            println!("{}", sweep_summary(&summary));
+        }
+        Ok(SweepReport::Ran(summary))
+    }
+
+    /// For a program's `main`: with `--sweep`, runs [`RunArgs::sweep`] on copies of `model` and
+    /// ends the program (status 0, or 1 with the error on standard error); without it, returns
+    /// and the program goes on to its single run.
+    pub fn sweep_if_asked<M: Model + Clone + Sync + 'static>(&self, model: &M, default_t_end: f64) {
+        if self.sweep.is_none() {
+            return;
+        }
+        let status = match self.sweep(model.clone(), default_t_end) {
+            Ok(_) => 0,
+            Err(e) => {
+                eprintln!("error: {e}");
+                1
+            }
+        };
+        std::process::exit(status);
     }
 
     /// [`RunArgs::run`] for a model with inputs u: driven by a function of time and sampled
@@ -473,6 +613,9 @@ impl RunArgs {
         default_t_end: f64,
         inputs: Inputs,
     ) -> Result<RunReport, RunError> {
+        if self.sweep.is_some() {
+            return Err(RunError::SweepWithInputs);
+        }
         let scheme = Scheme::from_name(&self.scheme)
             .ok_or_else(|| RunError::UnknownScheme(self.scheme.clone()))?;
         let info = model.info();

@@ -44,6 +44,7 @@
 //! | `work_precision` | `mbs::work_precision`, work–precision studies | `plot`, cpu-time |
 //! | `cli` | `mbs::cli`, the per-system programs' command line | `plot`, `anim`, `gltf`, clap, indicatif, cpu-time |
 //! | `expand` | the `mbs` program (`mbs expand`) | mbs-symbolic, syn, prettyplease, clap |
+//! | `sweep` | `mbs::sweep`, many runs on every core or a Slurm job array | rayon, toml, csv, rand, indicatif, cpu-time, serde_json |
 //! | `urdf` | `mbs::urdf`, URDF robots as `multibody!` source (`mbs import urdf` with `expand`) | roxmltree |
 //!
 //! With `default-features = false` you get [`multibody!`], the runtime ([`Model`], the schemes,
@@ -67,6 +68,8 @@ pub mod language;
 pub mod plot;
 #[cfg(feature = "spectral")]
 pub mod spectral;
+#[cfg(feature = "sweep")]
+pub mod sweep;
 #[cfg(feature = "urdf")]
 pub mod urdf;
 #[cfg(feature = "work_precision")]

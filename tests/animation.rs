@@ -593,6 +593,8 @@ fn headless(browser: &Path, profile: &Path, page: &Path, args: &[&str]) -> (Stri
         "--window-size=900,650",
         "--virtual-time-budget=2000",
     ]);
+    // a fresh profile: one left by a browser killed mid-run holds a lock the next one refuses
+    let _ = std::fs::remove_dir_all(profile);
     cmd.arg(format!("--user-data-dir={}", profile.display()));
     cmd.args(args);
     cmd.arg(format!("file://{}", page.display()));

@@ -6,6 +6,9 @@ use std::io::{BufRead, BufReader};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
+mod common;
+use common::example;
+
 mbs::multibody! {
     /// A pendulum with a damper in one scene of two.
     pub model Swing {
@@ -285,25 +288,6 @@ fn a_long_run_holds_a_bounded_number_of_outputs() {
     let kept = report.trajectory.len();
     assert!((MAX_KEPT..=MAX_KEPT + 2).contains(&kept), "{kept}");
     let _ = std::fs::remove_dir_all(&dir);
-}
-
-/// An example program, built by Cargo if it is not up to date.
-fn example(name: &str) -> std::path::PathBuf {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| env!("CARGO").to_string());
-    let mut build = Command::new(cargo);
-    build.args(["build", "--quiet", "--example", name]);
-    if !cfg!(debug_assertions) {
-        build.arg("--release");
-    }
-    let status = build
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .status()
-        .unwrap();
-    assert!(status.success(), "cargo build --example {name}");
-    // target/PROFILE/deps/cli-HASH → target/PROFILE/examples/NAME
-    let exe = std::env::current_exe().unwrap();
-    let path = exe.parent().unwrap().parent().unwrap().join("examples");
-    path.join(format!("{name}{}", std::env::consts::EXE_SUFFIX))
 }
 
 #[cfg(unix)]

@@ -369,6 +369,31 @@ impl ConstraintMethod {
             ConstraintMethod::Partitioning => "partitioning",
         }
     }
+
+    /// The method of a name as on the command line: `auto`, `index3`, `index2`,
+    /// `projection`, `partitioning` or `baumgarte:ALPHA,BETA`; the error says what is known.
+    pub fn from_name(s: &str) -> Result<ConstraintMethod, String> {
+        let bad = || {
+            format!(
+                "unknown constraint method `{s}`: use auto, index3, index2, projection, partitioning or baumgarte:ALPHA,BETA"
+            )
+        };
+        Ok(match s {
+            "auto" => ConstraintMethod::Auto,
+            "index3" => ConstraintMethod::Index3,
+            "index2" => ConstraintMethod::Index2,
+            "projection" => ConstraintMethod::Projection,
+            "partitioning" => ConstraintMethod::Partitioning,
+            _ => {
+                let rest = s.strip_prefix("baumgarte:").ok_or_else(bad)?;
+                let (a, b) = rest.split_once(',').ok_or_else(bad)?;
+                ConstraintMethod::Baumgarte {
+                    alpha: a.trim().parse().map_err(|_| bad())?,
+                    beta: b.trim().parse().map_err(|_| bad())?,
+                }
+            }
+        })
+    }
 }
 
 /// Settings for constrained models (ignored when the model has no constraints).

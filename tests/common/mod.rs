@@ -131,3 +131,22 @@ pub fn fixed(k: u32) -> Options {
     o.newton.max_iterations = 20;
     o
 }
+
+/// An example program, built by Cargo if it is not up to date.
+pub fn example(name: &str) -> std::path::PathBuf {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| env!("CARGO").to_string());
+    let mut build = std::process::Command::new(cargo);
+    build.args(["build", "--quiet", "--example", name]);
+    if !cfg!(debug_assertions) {
+        build.arg("--release");
+    }
+    let status = build
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .status()
+        .unwrap();
+    assert!(status.success(), "cargo build --example {name}");
+    // target/PROFILE/deps/cli-HASH → target/PROFILE/examples/NAME
+    let exe = std::env::current_exe().unwrap();
+    let path = exe.parent().unwrap().parent().unwrap().join("examples");
+    path.join(format!("{name}{}", std::env::consts::EXE_SUFFIX))
+}

@@ -237,12 +237,19 @@ impl<M: Model + 'static> Simulation<M> {
     }
 
     /// Trajectory and work counters (records the final state for `Output::Last`).
-    pub fn finish(mut self) -> (Trajectory, Stats) {
+    pub fn finish(self) -> (Trajectory, Stats) {
+        let (_, traj, stats) = self.finish_with_model();
+        (traj, stats)
+    }
+
+    /// [`Simulation::finish`], handing back the model too (its charts as the run left them),
+    /// for quantities computed from the trajectory afterwards (a sweep's metrics).
+    pub fn finish_with_model(mut self) -> (M, Trajectory, Stats) {
         if self.options.output == Output::Last && self.traj.is_empty() {
             self.record_cur();
         }
         self.problem.stats.user_efforts = self.problem.model.user_evaluations();
-        (self.traj, self.problem.stats)
+        (self.problem.model, self.traj, self.problem.stats)
     }
 
     fn record(&mut self, s: &State) {

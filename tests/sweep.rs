@@ -1,0 +1,326 @@
+//! `mbs::sweep`: plans, parallel runs, resumed sweeps, failures as rows, shards and their merge.
+
+use mbs::sweep::{Metrics, Plan, Shard, Sweep, SweepError, merge};
+use mbs::{Kinematics, Model, Options, Scheme, StepControl, simulate};
+use mbs_models::{dpend::DoublePendulum, seed2dof::Seed2dof};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("mbs-sweep-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+fn base() -> Options {
+    Options {
+        t_end: 2.0,
+        step: StepControl::Adaptive {
+            rtol: 1e-7,
+            atol: 1e-9,
+            h0: None,
+        },
+        ..Options::default()
+    }
+}
+
+/// The table without its last column (CPU time, which differs from run to run).
+fn without_cpu(path: &Path) -> Vec<String> {
+    let text = std::fs::read_to_string(path).unwrap();
+    text.lines()
+        .map(|l| l[..l.rfind(',').unwrap()].to_string())
+        .collect()
+}
+
+fn column(path: &Path, name: &str) -> Vec<String> {
+    let mut r = csv::Reader::from_path(path).unwrap();
+    let i = r.headers().unwrap().iter().position(|h| h == name).unwrap();
+    r.records().map(|rec| rec.unwrap()[i].to_string()).collect()
+}
+
+/// The tip of bar 2 at the last output: a metric that needs the model.
+fn tip_metrics() -> Metrics<DoublePendulum> {
+    Metrics::new(["tip_x", "tip_y"], |model: &DoublePendulum, tr| {
+        let last = tr.len() - 1;
+        let mut k = Kinematics::new::<DoublePendulum>();
+        model.kinematics(tr.t[last], tr.q(last), tr.qd(last), &mut k);
+        vec![k.points[0].position[0], k.points[0].position[1]]
+    })
+}
+
+#[test]
+fn every_row_of_a_grid_is_the_run_made_alone() {
+    let plan = Plan::from_toml(
+        r#"
+        [sweep]
+        design = "grid"
+        [[vary]]
+        name = "l"
+        values = [0.8, 1.0, 1.3]
+        [[vary]]
+        name = "scheme"
+        values = ["dopri5", "radau5"]
+        [[vary]]
+        name = "qd0[1]"
+        range = [0.0, 1.0]
+        count = 2
+        "#,
+    )
+    .unwrap();
+    let runs = plan.runs(Path::new(".")).unwrap();
+    assert_eq!(runs.len(), 12);
+    let dir = scratch("grid");
+    let sweep = Sweep::new(DoublePendulum::default, &plan, Scheme::Dopri5, base())
+        .unwrap()
+        .metrics(tip_metrics());
+    let s = sweep.run(&dir, &runs).unwrap();
+    assert_eq!((s.runs, s.ran, s.failed, s.skipped), (12, 12, 0, 0));
+    let table = dir.join("results.csv");
+    let (tip_x, steps) = (column(&table, "tip_x"), column(&table, "steps"));
+    // run 7: l = 1.3 (7 / 4 = 1), scheme dopri5 (7 / 2 % 2 = 1 → radau5), qd0[1] = 1
+    for (i, (l, scheme, w)) in [(0.8, Scheme::Dopri5, 0.0), (1.0, Scheme::Radau5, 1.0)]
+        .into_iter()
+        .enumerate()
+    {
+        let run = [0, 7][i];
+        let mut model = DoublePendulum::default();
+        let mut p = model.params().clone();
+        p.l = l;
+        model.set_params(p).unwrap();
+        let (mut q, mut qd) = ([0.0; 2], [0.0; 2]);
+        model.initial_state(&mut q, &mut qd);
+        qd[1] = w;
+        let options = Options {
+            q0: Some(q.to_vec()),
+            qd0: Some(qd.to_vec()),
+            ..base()
+        };
+        let (tr, stats) = simulate(model.clone(), scheme, options).unwrap();
+        let last = tr.len() - 1;
+        let mut k = Kinematics::new::<DoublePendulum>();
+        model.kinematics(tr.t[last], tr.q(last), tr.qd(last), &mut k);
+        assert_eq!(
+            tip_x[run],
+            format!("{:?}", k.points[0].position[0]),
+            "run {run}"
+        );
+        assert_eq!(steps[run], stats.steps.to_string());
+    }
+    assert_eq!(column(&table, "scheme")[7], "radau5");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn threads_do_not_change_the_table() {
+    let plan = Plan::from_toml(
+        "[sweep]\ndesign = \"lhs\"\nruns = 24\nseed = 5\n[[vary]]\nname = \"l\"\nuniform = [0.5, 2]\n\
+         [[vary]]\nname = \"q0.q[0]\"\nuniform = [0.1, 3]\n[[vary]]\nname = \"rtol\"\nlog_uniform = [1e-9, 1e-5]\n",
+    )
+    .unwrap();
+    let runs = plan.runs(Path::new(".")).unwrap();
+    let (a, b) = (scratch("threads1"), scratch("threads3"));
+    let make = || Sweep::new(DoublePendulum::default, &plan, Scheme::Dopri5, base()).unwrap();
+    make().threads(1).run(&a, &runs).unwrap();
+    let s = make().threads(3).run(&b, &runs).unwrap();
+    assert_eq!(s.threads, 3);
+    let (ta, tb) = (
+        without_cpu(&a.join("results.csv")),
+        without_cpu(&b.join("results.csv")),
+    );
+    assert_eq!(ta.len(), 25);
+    assert_eq!(ta, tb);
+    // rows in run order whatever order the threads finished in
+    let order: Vec<String> = (0..24).map(|i| i.to_string()).collect();
+    assert_eq!(column(&b.join("results.csv"), "run"), order);
+    let _ = std::fs::remove_dir_all(&a);
+    let _ = std::fs::remove_dir_all(&b);
+}
+
+#[test]
+fn a_sweep_started_again_makes_only_the_missing_runs() {
+    let plan = Plan::from_toml(
+        "[sweep]\ndesign = \"monte-carlo\"\nruns = 30\nseed = 11\n[[vary]]\nname = \"m\"\nnormal = [1, 0.1]\n",
+    )
+    .unwrap();
+    let runs = plan.runs(Path::new(".")).unwrap();
+    let dir = scratch("resume");
+    let calls = std::sync::Arc::new(AtomicUsize::new(0));
+    let counted = |calls: std::sync::Arc<AtomicUsize>| {
+        Metrics::new(["q1_end"], move |_: &DoublePendulum, tr| {
+            calls.fetch_add(1, Ordering::SeqCst);
+            vec![tr.q(tr.len() - 1)[1]]
+        })
+    };
+    let make = || Sweep::new(DoublePendulum::default, &plan, Scheme::Dopri5, base()).unwrap();
+    make()
+        .metrics(counted(calls.clone()))
+        .run(&dir, &runs)
+        .unwrap();
+    assert_eq!(calls.load(Ordering::SeqCst), 30);
+    let table = dir.join("results.csv");
+    let full = without_cpu(&table);
+    // a kill after run 9, in the middle of writing run 10's row
+    let text = std::fs::read_to_string(&table).unwrap();
+    let cut: usize = text.lines().take(11).map(|l| l.len() + 1).sum::<usize>() + 7;
+    std::fs::write(&table, &text[..cut]).unwrap();
+    let s = make()
+        .metrics(counted(calls.clone()))
+        .run(&dir, &runs)
+        .unwrap();
+    assert_eq!((s.skipped, s.ran), (10, 20));
+    assert_eq!(calls.load(Ordering::SeqCst), 50);
+    assert_eq!(without_cpu(&table), full);
+    // a third start has nothing to do
+    let s = make()
+        .metrics(counted(calls.clone()))
+        .run(&dir, &runs)
+        .unwrap();
+    assert_eq!((s.skipped, s.ran), (30, 0));
+    // other metrics make other columns: that table is another sweep's
+    assert!(matches!(
+        make().run(&dir, &runs),
+        Err(SweepError::Table { .. })
+    ));
+    // another plan in the same folder is refused
+    let other = Plan::from_toml(
+        "[sweep]\ndesign = \"monte-carlo\"\nruns = 30\nseed = 12\n[[vary]]\nname = \"m\"\nnormal = [1, 0.1]\n",
+    )
+    .unwrap();
+    let err = Sweep::new(DoublePendulum::default, &other, Scheme::Dopri5, base())
+        .unwrap()
+        .run(&dir, &other.runs(Path::new(".")).unwrap())
+        .unwrap_err();
+    assert!(matches!(err, SweepError::OtherSweep { .. }), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn failed_runs_are_rows_that_say_why() {
+    // seed2dof's fast mode (ω ≈ 45 rad/s) at rk4 steps of 0.1 s is unstable; k1 < 0 is
+    // refused by the parameter check
+    let plan = Plan::from_toml(
+        "[sweep]\ndesign = \"list\"\nfile = \"runs.csv\"\n[simulation]\nscheme = \"rk4\"\nt_end = 1.0\n",
+    )
+    .unwrap();
+    let dir = scratch("failures");
+    std::fs::create_dir_all(&dir).unwrap();
+    let list = dir.join("list");
+    std::fs::create_dir_all(&list).unwrap();
+    std::fs::write(
+        list.join("runs.csv"),
+        "h,k1\n0.001,79.15\n0.1,79.15\n0.001,-5\n",
+    )
+    .unwrap();
+    let runs = plan.runs(&list).unwrap();
+    let out = dir.join("out");
+    let s = Sweep::new(Seed2dof::default, &plan, Scheme::Dopri5, base())
+        .unwrap()
+        .run(&out, &runs)
+        .unwrap();
+    assert_eq!((s.ran, s.failed), (3, 2));
+    let table = out.join("results.csv");
+    assert_eq!(column(&table, "status"), ["ok", "failed", "failed"]);
+    assert_eq!(
+        column(&table, "failure"),
+        ["", "UnstableStep", "InvalidRun"]
+    );
+    assert!(
+        column(&table, "message")[2].contains("k1"),
+        "{:?}",
+        column(&table, "message")
+    );
+    // the unstable run stopped early, its work counted; the refused one did no work
+    let t: f64 = column(&table, "t_reached")[1].parse().unwrap();
+    assert!(t < 1.0);
+    assert_ne!(column(&table, "steps")[1], "");
+    assert_eq!(column(&table, "steps")[2], "");
+    assert_eq!(column(&table, "t_end")[1], "");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_panicking_metric_fails_its_row_not_the_sweep() {
+    let plan =
+        Plan::from_toml("[sweep]\ndesign = \"grid\"\n[[vary]]\nname = \"l\"\nvalues = [1, 2]\n")
+            .unwrap();
+    let runs = plan.runs(Path::new(".")).unwrap();
+    let dir = scratch("panic");
+    let metrics = Metrics::new(["x"], |m: &DoublePendulum, _| {
+        assert!(m.params().l < 1.5, "too long");
+        vec![1.0]
+    });
+    let s = Sweep::new(DoublePendulum::default, &plan, Scheme::Dopri5, base())
+        .unwrap()
+        .metrics(metrics)
+        .run(&dir, &runs)
+        .unwrap();
+    assert_eq!(s.failed, 1);
+    let table = dir.join("results.csv");
+    assert_eq!(column(&table, "failure"), ["", "Panic"]);
+    assert!(column(&table, "message")[1].contains("too long"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn unknown_variables_are_refused_before_any_run() {
+    let plan =
+        Plan::from_toml("[sweep]\ndesign = \"grid\"\n[[vary]]\nname = \"length\"\nvalues = [1]\n")
+            .unwrap();
+    let Err(e) = Sweep::new(DoublePendulum::default, &plan, Scheme::Dopri5, base()) else {
+        panic!("`length` accepted")
+    };
+    let text = e.to_string();
+    assert!(
+        text.contains("`length`") && text.contains("l, m, g") && text.contains("q[0]"),
+        "{text}"
+    );
+    let plan =
+        Plan::from_toml("[sweep]\ndesign = \"grid\"\n[[vary]]\nname = \"q0[2]\"\nvalues = [1]\n")
+            .unwrap();
+    assert!(Sweep::new(DoublePendulum::default, &plan, Scheme::Dopri5, base()).is_err());
+}
+
+#[test]
+fn shards_merge_into_the_table_of_the_whole_sweep() {
+    let plan = Plan::from_toml(
+        "[sweep]\ndesign = \"monte-carlo\"\nruns = 17\nseed = 2\n[[vary]]\nname = \"l\"\nuniform = [0.5, 1.5]\n\
+         [slurm]\ntasks = 3\n",
+    )
+    .unwrap();
+    let runs = plan.runs(Path::new(".")).unwrap();
+    let (whole, parts) = (scratch("whole"), scratch("parts"));
+    let make = || Sweep::new(DoublePendulum::default, &plan, Scheme::Dopri5, base()).unwrap();
+    make().run(&whole, &runs).unwrap();
+    let script = make()
+        .write_slurm(&parts, &runs, &["program".to_string()])
+        .unwrap();
+    let text = std::fs::read_to_string(&script).unwrap();
+    assert!(
+        text.contains("#SBATCH --array=0-2") && text.contains("--shard \"$SLURM_ARRAY_TASK_ID/3\"")
+    );
+    // shards 0 and 2 only: the merge lists the runs of shard 1 (runs 5..11)
+    for k in [0, 2] {
+        let shard = Shard { index: k, count: 3 };
+        make().run_shard(&parts, &runs, shard).unwrap();
+    }
+    let err = merge(&parts).unwrap_err();
+    assert!(
+        matches!(&err, SweepError::Missing { missing: 6, tasks, .. } if tasks == "1"),
+        "{err}"
+    );
+    let missing = std::fs::read_to_string(parts.join("missing.csv")).unwrap();
+    assert_eq!(missing.lines().nth(1), Some("5,1"));
+    make()
+        .run_shard(&parts, &runs, Shard::parse("1/3").unwrap())
+        .unwrap();
+    let m = merge(&parts).unwrap();
+    assert_eq!((m.runs, m.parts), (17, 3));
+    assert!(!parts.join("missing.csv").exists());
+    assert_eq!(
+        without_cpu(&parts.join("results.csv")),
+        without_cpu(&whole.join("results.csv"))
+    );
+    assert!(Shard::parse("3/3").is_err() && Shard::parse("1").is_err());
+    let _ = std::fs::remove_dir_all(&whole);
+    let _ = std::fs::remove_dir_all(&parts);
+}

@@ -132,6 +132,42 @@ fn rk4_on_dpend_past_its_limit_stops_before_any_non_finite_value() {
     assert!(all_finite(&e.trajectory));
 }
 
+#[test]
+fn dopri5_with_a_fixed_step_past_its_limit_stops_and_below_it_runs() {
+    // seed2dof's fast mode, ω₂ ≈ 63 rad/s, at h = 0.5 s: this once ran to the end and
+    // returned q ≈ 1e24 as if it were an answer
+    let e = simulate(
+        seed2dof::Seed2dof::default(),
+        Scheme::Dopri5,
+        Options::fixed(2.0, 0.5),
+    )
+    .unwrap_err();
+    println!("{e}");
+    let Failure::UnstableStep {
+        h_rho,
+        limit,
+        h_stable,
+        ..
+    } = e.kind
+    else {
+        panic!("{e}")
+    };
+    assert!(
+        h_rho > limit && limit == 0.997,
+        "an oscillating mode: {limit}"
+    );
+    assert!(all_finite(&e.trajectory));
+    // the advised step runs, and the motion stays bounded (|q₂| ≤ 1 exactly)
+    let (tr, _) = simulate(
+        seed2dof::Seed2dof::default(),
+        Scheme::Dopri5,
+        Options::fixed(2.0, 0.9 * h_stable),
+    )
+    .unwrap();
+    let q = tr.q(tr.len() - 1)[1];
+    assert!(q.is_finite() && q.abs() < 1.01, "{q}");
+}
+
 mbs::multibody! {
     /// A slider on a stiff spring with a stiff damper (k = c = 1e4): λ ≈ −1e4 and −1. Once the
     /// fast mode has decayed (a millisecond) the motion is slow, but an explicit scheme's step

@@ -448,9 +448,10 @@ pub struct Options {
     pub max_steps: usize,
     pub newton: NewtonOptions,
     pub iteration_matrix: IterationMatrix,
-    /// explicit fixed-step schemes estimate the largest eigenvalue of the dynamics (one extra
-    /// evaluation every 8 steps) and stop with `UnstableStep` when h·ρ leaves the scheme's
-    /// stability region (default true)
+    /// explicit fixed-step schemes (explicit Euler, RK4, DOPRI5 with a fixed step) estimate the
+    /// largest eigenvalue of the dynamics (two extra evaluations every 16 steps, every 4 near
+    /// the limit) and stop with `UnstableStep` when h·ρ leaves the scheme's stability region
+    /// (default true)
     pub stability_check: bool,
     /// stop with `Failure::SingularConfiguration` when the coordinates approach a singular
     /// configuration (Euler angles at gimbal lock, joint axes lining up, a coordinate that

@@ -38,6 +38,12 @@ pub(crate) struct Explicit {
     qs: Vec<f64>,
     vs: [Vec<f64>; 3],
     acc: [Vec<f64>; 3],
+    watch: StabilityWatch,
+}
+
+/// The estimate of the dynamics' largest |λ| that fixed-step explicit schemes (these and
+/// DOPRI5 without step control) check their step against (see the module's docs).
+pub(crate) struct StabilityWatch {
     /// power iteration on J²: the direction δ = (dq, dv), J δ = (jq, jv), scratch
     dq: Vec<f64>,
     dv: Vec<f64>,
@@ -73,14 +79,49 @@ fn norm2(a: &[f64], b: &[f64]) -> f64 {
 impl Explicit {
     fn new(kind: Kind, n: usize) -> Explicit {
         let z = || vec![0.0; n];
-        let (mut dq, mut dv) = (z(), z());
-        seed_direction(&mut dq, &mut dv);
         Explicit {
             kind,
             n,
             qs: z(),
             vs: [z(), z(), z()],
             acc: [z(), z(), z()],
+            watch: StabilityWatch::new(n),
+        }
+    }
+
+    pub fn euler(n: usize) -> Explicit {
+        Explicit::new(Kind::Euler, n)
+    }
+
+    pub fn rk4(n: usize) -> Explicit {
+        Explicit::new(Kind::Rk4, n)
+    }
+
+    fn name(&self) -> &'static str {
+        match self.kind {
+            Kind::Euler => "explicit Euler",
+            Kind::Rk4 => "RK4",
+        }
+    }
+}
+
+/// Radius of the stability interval of h·λ on the axes (RK4: min(2√2, 2.785) on the
+/// imaginary and real axes; Euler: 2 on the real axis, and on an oscillating mode the h·ω
+/// at which its amplitude doubles in one period, since it is unstable for any).
+fn limit(kind: Kind, oscillating: bool) -> f64 {
+    match kind {
+        Kind::Euler if oscillating => EULER_OSCILLATING,
+        Kind::Euler => 2.0,
+        Kind::Rk4 => 2.785,
+    }
+}
+
+impl StabilityWatch {
+    pub(crate) fn new(n: usize) -> StabilityWatch {
+        let z = || vec![0.0; n];
+        let (mut dq, mut dv) = (z(), z());
+        seed_direction(&mut dq, &mut dv);
+        StabilityWatch {
             dq,
             dv,
             jq: z(),
@@ -99,30 +140,56 @@ impl Explicit {
         }
     }
 
-    pub fn euler(n: usize) -> Explicit {
-        Explicit::new(Kind::Euler, n)
-    }
-
-    pub fn rk4(n: usize) -> Explicit {
-        Explicit::new(Kind::Rk4, n)
-    }
-
-    fn name(&self) -> &'static str {
-        match self.kind {
-            Kind::Euler => "explicit Euler",
-            Kind::Rk4 => "RK4",
+    /// Before a step of size h from `cur`: every 16 steps, every 4 within a factor 2 of the
+    /// limit and after a lurch, estimates ρ and refuses the step with `UnstableStep` when h·ρ
+    /// exceeds `limit(oscillating)` (the scheme's stability radius for the kind of mode).
+    pub(crate) fn check<M: Model>(
+        &mut self,
+        p: &mut Problem<M>,
+        cur: &State,
+        h: f64,
+        scheme: &'static str,
+        limit: impl Fn(bool) -> f64,
+    ) -> Result<(), Failure> {
+        let every = if h * self.rho > 0.5 * limit(self.oscillating) {
+            4
+        } else {
+            16
+        };
+        if !(self.steps % every == 0 || self.lurched) {
+            return Ok(());
         }
+        self.rho = self.estimate_rho(p, cur)?;
+        // at the start, and before refusing a step, iterate until the estimate settles:
+        // one iteration from the seed direction can be far below ρ, and the message
+        // advises a step from it
+        if self.steps == 0 || h * self.rho > limit(self.oscillating) {
+            for _ in 0..30 {
+                let last = self.rho;
+                self.rho = self.estimate_rho(p, cur)?;
+                if (self.rho - last).abs() <= 1e-3 * self.rho {
+                    break;
+                }
+            }
+        }
+        let h_rho = h * self.rho;
+        let limit = limit(self.oscillating);
+        if h_rho > limit {
+            return Err(Failure::UnstableStep {
+                scheme,
+                rho: self.rho,
+                h_rho,
+                limit,
+                h_stable: limit / self.rho,
+            });
+        }
+        Ok(())
     }
 
-    /// Radius of the stability interval of h·λ on the axes (RK4: min(2√2, 2.785) on the
-    /// imaginary and real axes; Euler: 2 on the real axis, and on an oscillating mode the h·ω
-    /// at which its amplitude doubles in one period, since it is unstable for any).
-    fn limit(&self) -> f64 {
-        match self.kind {
-            Kind::Euler if self.oscillating => EULER_OSCILLATING,
-            Kind::Euler => 2.0,
-            Kind::Rk4 => 2.785,
-        }
+    /// After an accepted step from `cur` to `next`.
+    pub(crate) fn accepted(&mut self, cur: &State, next: &State) {
+        self.lurched = lurched(cur, next);
+        self.steps += 1;
     }
 
     /// One power-iteration step on J²; returns the estimate of ρ(J).
@@ -212,36 +279,10 @@ impl Probe {
 impl<M: Model> Stepper<M> for Explicit {
     fn attempt(&mut self, step: Step<'_, M>) -> Result<Attempt, Failure> {
         let Step(p, cur, h, ctl, next) = step;
-        // every 16 steps, every 4 within a factor 2 of the limit
-        let every = if h * self.rho > 0.5 * self.limit() {
-            4
-        } else {
-            16
-        };
-        if ctl.stability_check && (self.steps % every == 0 || self.lurched) {
-            self.rho = self.estimate_rho(p, cur)?;
-            // at the start, and before refusing a step, iterate until the estimate settles:
-            // one iteration from the seed direction can be far below ρ, and the message
-            // advises a step from it
-            if self.steps == 0 || h * self.rho > self.limit() {
-                for _ in 0..30 {
-                    let last = self.rho;
-                    self.rho = self.estimate_rho(p, cur)?;
-                    if (self.rho - last).abs() <= 1e-3 * self.rho {
-                        break;
-                    }
-                }
-            }
-            let h_rho = h * self.rho;
-            if h_rho > self.limit() {
-                return Err(Failure::UnstableStep {
-                    scheme: self.name(),
-                    rho: self.rho,
-                    h_rho,
-                    limit: self.limit(),
-                    h_stable: self.limit() / self.rho,
-                });
-            }
+        if ctl.stability_check {
+            let kind = self.kind;
+            self.watch
+                .check(p, cur, h, self.name(), |osc| limit(kind, osc))?;
         }
         let n = self.n;
         let t = cur.t;
@@ -288,8 +329,7 @@ impl<M: Model> Stepper<M> for Explicit {
         p.check("q", &next.q)?;
         p.check("qd", &next.qd)?;
         p.accel(t + h, &next.q, &next.qd, &mut next.qdd)?;
-        self.lurched = lurched(cur, next);
-        self.steps += 1;
+        self.watch.accepted(cur, next);
         Ok(Attempt::Accepted { h_next: h })
     }
 }

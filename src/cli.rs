@@ -14,6 +14,13 @@
 //!                 coordinates.svg, energy.svg, animation.html (offline, in any browser),
 //!                 motion.gltf (Blender, glTF viewers) and stats.json
 //! --quiet         print nothing but errors
+//!
+//! --sweep PLAN    run the plan's many runs into --out DIR instead of one (mbs::sweep):
+//!                 DIR/results.csv, a row per run; run again to resume
+//!   --threads N   threads (default: every core)
+//!   --slurm       write DIR/sweep.sbatch, a Slurm job array, and run nothing
+//!   --shard K/N   run shard K of N into DIR/parts/ (what an array task runs)
+//!   --merge       merge the parts into DIR/results.csv, or list the missing runs
 //! ```
 //!
 //! Runs longer than about a second show a progress bar (on standard error); every run ends
@@ -103,7 +110,7 @@ pub struct RunArgs {
     #[arg(long, value_name = "INDEX/COUNT", requires = "sweep")]
     pub shard: Option<String>,
     /// with --sweep: write the run list, a manifest and DIR/sweep.sbatch, a Slurm job array
-    /// (the plan's [slurm] table), and run nothing
+    /// (the plan's `[slurm]` table), and run nothing
     #[arg(long, requires = "sweep", conflicts_with_all = ["shard", "merge"])]
     pub slurm: bool,
     /// with --sweep: merge the array tasks' parts into DIR/results.csv, or list the missing

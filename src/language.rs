@@ -552,7 +552,7 @@
 //!
 //! | mistake | message |
 //! |---|---|
-//! | `param u = 1.0;` (or a body, coordinate, … named `t q qd qdd u PI E TAU ground TOG`) | "`u` is reserved for the inputs u[k]: give this parameter another name", once: its uses are not reported again |
+//! | `param u = 1.0;` (or a body, coordinate, … named `t q qd qdd u PI E TAU ground TOG`) | "`u` is reserved for the inputs u\[k\]: give this parameter another name", once: its uses are not reported again |
 //! | `TOG[a] = TOG[b] * …; TOG[b] = TOG[a] * …;` | "the poses form a cycle, `a → b → a`: each starts from the next, so none is ever placed; …" |
 //! | `Tdisp(0, -sqrt(-1.0), 0)`, `ln(0)`, `asin(2)`, `exp(1000)`, `1e400` | "`sqrt(-1.0)` is NaN (not a number): an argument is outside the domain of the function or operation, …; correct the constant", on those tokens: constants fold when the model is compiled (`1/0`: "division by zero") |
 //! | `body arm { mass = 1.0; inertia = (…); inertia_z = 0.1; }` | "body `arm` has its inertia twice: give either `inertia = (…);` or one moment `inertia_z = …;`" |

@@ -33,7 +33,7 @@
 //!
 //! ## Cargo features
 //!
-//! The tools around the models are behind features, all on by default:
+//! The tools around the models are behind features, all but `parquet` on by default:
 //!
 //! | feature | what | brings in |
 //! |---|---|---|
@@ -45,6 +45,7 @@
 //! | `cli` | `mbs::cli`, the per-system programs' command line | `plot`, `anim`, `gltf`, clap, indicatif, cpu-time |
 //! | `expand` | the `mbs` program (`mbs expand`) | mbs-symbolic, syn, prettyplease, clap |
 //! | `sweep` | `mbs::sweep`, many runs on every core or a Slurm job array | rayon, toml, csv, rand, indicatif, cpu-time, serde_json |
+//! | `parquet` (not default) | a sweep's table also as Parquet (`mbs::sweep::parquet`) | `sweep`, parquet |
 //! | `urdf` | `mbs::urdf`, URDF robots as `multibody!` source (`mbs import urdf` with `expand`) | roxmltree |
 //!
 //! With `default-features = false` you get [`multibody!`], the runtime ([`Model`], the schemes,

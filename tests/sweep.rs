@@ -324,3 +324,52 @@ fn shards_merge_into_the_table_of_the_whole_sweep() {
     let _ = std::fs::remove_dir_all(&whole);
     let _ = std::fs::remove_dir_all(&parts);
 }
+
+/// The Parquet file of a complete sweep holds the CSV table, typed, with nulls where the CSV
+/// is empty (a failed run's metrics).
+#[test]
+fn a_complete_sweep_is_also_a_parquet_file_of_the_same_table() {
+    use parquet::file::reader::{FileReader, SerializedFileReader};
+    use parquet::record::Field;
+    let plan = Plan::from_toml(
+        "[sweep]\ndesign = \"grid\"\n[[vary]]\nname = \"scheme\"\nvalues = [\"dopri5\", \"rk4\"]\n\
+         [[vary]]\nname = \"h\"\nvalues = [0.001, 0.5]\n",
+    )
+    .unwrap();
+    let runs = plan.runs(Path::new(".")).unwrap();
+    let dir = scratch("parquet");
+    let s = Sweep::new(Seed2dof::default, &plan, Scheme::Dopri5, base())
+        .unwrap()
+        .run(&dir, &runs)
+        .unwrap();
+    assert_eq!(s.failed, 2, "dopri5 and rk4 at h = 0.5 are unstable");
+    let csv_rows: Vec<csv::StringRecord> = csv::Reader::from_path(dir.join("results.csv"))
+        .unwrap()
+        .records()
+        .map(Result::unwrap)
+        .collect();
+    let file = std::fs::File::open(dir.join("results.parquet")).unwrap();
+    let reader = SerializedFileReader::new(file).unwrap();
+    assert_eq!(reader.metadata().file_metadata().num_rows(), 4);
+    for (row, rec) in reader.get_row_iter(None).unwrap().zip(&csv_rows) {
+        let row = row.unwrap();
+        let fields: Vec<(String, Field)> = row
+            .get_column_iter()
+            .map(|(n, f)| (n.clone(), f.clone()))
+            .collect();
+        assert_eq!(fields.len(), rec.len());
+        for ((name, field), text) in fields.iter().zip(rec.iter()) {
+            match field {
+                Field::Null => assert_eq!(text, "", "{name}"),
+                Field::Long(i) => assert_eq!(i.to_string(), text, "{name}"),
+                Field::Double(x) => assert_eq!(*x, text.parse::<f64>().unwrap(), "{name}"),
+                Field::Str(s) => assert_eq!(s, text, "{name}"),
+                other => panic!("{name}: {other:?}"),
+            }
+        }
+        // the failure's columns are strings, numbers are numbers
+        assert!(matches!(fields[2].1, Field::Str(_) | Field::Null));
+        assert!(matches!(fields[0].1, Field::Long(_)));
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -33,8 +33,12 @@
 //! cargo run --release --example dpend -- --sweep sweep/plan.toml --out sweep --merge
 //! ```
 //!
-//! The table reads directly in pandas (`pd.read_csv("sweep/results.csv")`) and polars.
+//! The table reads directly in pandas (`pd.read_csv("sweep/results.csv")`) and polars; with
+//! the `parquet` feature a complete sweep or merge also writes `results.parquet`
+//! (`pd.read_parquet`, `pl.read_parquet`), typed columns and nulls for empty fields.
 
+#[cfg(feature = "parquet")]
+pub mod parquet;
 mod plan;
 pub mod slurm;
 mod table;
@@ -441,13 +445,21 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
 
     /// Runs every run into `dir/results.csv` (after [`Sweep::prepare`]), skipping those the
     /// table has.
+    /// With the `parquet` feature, a sweep with every run in its table also writes
+    /// `dir/results.parquet` ([`parquet`]).
     pub fn run(&self, dir: &Path, runs: &RunList) -> Result<Summary, SweepError> {
         self.prepare(dir, runs)?;
-        self.run_range(runs, 0..runs.len(), &dir.join("results.csv"))
+        let table = dir.join("results.csv");
+        let summary = self.run_range(runs, 0..runs.len(), &table)?;
+        #[cfg(feature = "parquet")]
+        if !summary.stopped {
+            parquet::write(&table, &dir.join("results.parquet"))?;
+        }
+        Ok(summary)
     }
 
     /// Runs one shard into `dir/parts/part-K-of-N.csv` (the folder prepared by `--slurm`,
-    /// [`slurm::write`]), skipping the runs its part has.
+    /// [`Sweep::write_slurm`]), skipping the runs its part has.
     pub fn run_shard(
         &self,
         dir: &Path,

@@ -119,7 +119,8 @@ pub struct MergeReport {
 /// Merges the parts of a job array (`dir/parts/part-K-of-N.csv`, N from `dir/manifest.json`)
 /// into `dir/results.csv` in run order, streaming. Every run of `dir/runs.csv` must be present
 /// once: otherwise the missing runs are listed in `dir/missing.csv` (run, shard), nothing is
-/// merged, and the error names the array tasks to submit again.
+/// merged, and the error names the array tasks to submit again. With the `parquet` feature
+/// it also writes `dir/results.parquet`.
 pub fn merge(dir: &Path) -> Result<MergeReport, SweepError> {
     let manifest = slurm::Manifest::read(dir)?;
     let n = manifest.runs;
@@ -214,6 +215,8 @@ pub fn merge(dir: &Path) -> Result<MergeReport, SweepError> {
     }
     let _ = std::fs::remove_file(dir.join("missing.csv"));
     std::fs::rename(&tmp, &table).map_err(io(&table))?;
+    #[cfg(feature = "parquet")]
+    super::parquet::write(&table, &dir.join("results.parquet"))?;
     Ok(MergeReport {
         runs: n,
         failed,

@@ -35,6 +35,15 @@ pub enum ModelError {
         "model `{model}` was generated without tangents: add `option tangents;` to its multibody! block, or use an iteration matrix that needs none"
     )]
     TangentsNotGenerated { model: &'static str },
+    #[error(
+        "model `{model}` has no sensitive parameters: mark those you want derivatives for, `param k = 1e4 sensitive;`"
+    )]
+    NoSensitiveParameters { model: &'static str },
+    #[error("sensitivities of model `{model}` are not available: {reason}")]
+    SensitivitiesUnsupported {
+        model: &'static str,
+        reason: &'static str,
+    },
 }
 
 /// `x` with at most 10 significant digits and no trailing zeros (`0.2394270743`, `2.5`,

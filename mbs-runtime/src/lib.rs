@@ -23,6 +23,7 @@ pub mod linalg;
 pub mod model;
 mod op_count;
 pub mod options;
+pub mod sensitivity;
 pub mod stats;
 pub mod trajectory;
 
@@ -47,5 +48,6 @@ pub use options::{
     BdfParams, ConstraintMethod, ConstraintOptions, GenAlphaParams, HhtParams, IterationMatrix,
     NewmarkParams, NewtonOptions, Options, Output, Scheme, StepControl,
 };
+pub use sensitivity::Sensitivities;
 pub use stats::{ErrorTest, Stats};
 pub use trajectory::{CsvWriter, Observer, Trajectory};

@@ -354,6 +354,9 @@ pub trait Model {
     /// on [`F64x4`] (`option batch;`); otherwise they call the one-state functions lane by
     /// lane
     const BATCH_GENERATED: bool = false;
+    /// the parameters marked `sensitive` in the model (`param k = 1e4 sensitive;`), in
+    /// declaration order: the columns of [`Model::parameter_tangents`]
+    const SENSITIVE: &'static [&'static str] = &[];
 
     /// Names, sizes, formulation and op counts.
     fn info(&self) -> &'static ModelInfo;
@@ -460,6 +463,25 @@ pub trait Model {
         k: &mut [f64],
         c: &mut [f64],
     ) -> Result<(), ModelError>;
+
+    /// ∂τ/∂p (NQ × NS, column-major, NS = `SENSITIVE.len()`) at (t, q, qd, qdd, u): how the
+    /// generalised forces that produce qdd change with each sensitive parameter, all else
+    /// fixed; τ = M qdd − h, so it is ∂M/∂p·qdd − ∂h/∂p (∂h/∂p alone at qdd = 0). Generated
+    /// exactly for the parameters marked `sensitive`; an error for models without any.
+    fn parameter_tangents(
+        &self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        u: &[f64],
+        dtau: &mut [f64],
+    ) -> Result<(), crate::error::ModelError> {
+        let _ = (t, q, qd, qdd, u, dtau);
+        Err(crate::error::ModelError::NoSensitiveParameters {
+            model: self.info().name,
+        })
+    }
 
     /// h(q, 0, t, u): forces at rest, for statics (NQ).
     fn static_forces(&self, t: f64, q: &[f64], u: &[f64], h: &mut [f64]);

@@ -246,6 +246,7 @@ fn validate(&self) -> ::core::result::Result<(), ::mbs::ParamError> {{ {never} }
         nc: 0,
         charts: 0,
         batch: false,
+        sensitive: Vec::new(),
     };
     for ty in scenes {
         code.push_str(&format!(

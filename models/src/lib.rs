@@ -17,6 +17,7 @@
 //! | [`fastlink`] | a fast two-loop linkage of five light bodies thrown by a stiff spring |
 //! | [`slidercrank`] | a slider-crank, with its loop as constraints and in closed form |
 //! | [`dc_motor`] | an arm driven by a DC motor under a sampled PI controller |
+//! | [`sprung_arm`] | a double pendulum on rotational springs, three parameters marked `sensitive` |
 //! | [`springpend`] | a point mass on a stiff spring (polar coordinates) |
 //! | [`tumble`] | a free body tumbling about its intermediate axis, on two sets of Euler angles and on a spherical joint |
 //! | [`top`] | a fast symmetric top on its tip whose axis passes through the vertical, on a spherical joint and on Euler angles |
@@ -42,6 +43,7 @@ pub mod seed2dof;
 pub mod slidercrank;
 pub mod spherical_pendulum;
 pub mod springpend;
+pub mod sprung_arm;
 pub mod structural;
 pub mod top;
 pub mod tumble;

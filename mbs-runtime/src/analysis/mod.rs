@@ -19,6 +19,7 @@ mod inverse;
 mod linearize;
 mod modes;
 mod reduce;
+mod sensitivity;
 mod statics;
 
 pub use inverse::{
@@ -27,6 +28,7 @@ pub use inverse::{
 };
 pub use linearize::{CONSISTENCY_TOLERANCE, Linearization, linearize};
 pub use modes::{Mode, Modes, modes};
+pub use sensitivity::{StaticSensitivity, static_sensitivity};
 pub use statics::{Equilibrium, Stability, StaticsOptions, static_equilibrium};
 
 use crate::error::Failure;

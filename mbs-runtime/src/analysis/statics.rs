@@ -171,11 +171,7 @@ pub(super) fn stiffness<M: Model>(
             .map_err(|e| Failure::InvalidOption {
                 name: "stiffness",
                 value: "Exact".into(),
-                reason: match e {
-                    crate::error::ModelError::TangentsNotGenerated { .. } => {
-                        "the model has no tangents: add `option tangents;`"
-                    }
-                },
+                reason: crate::integrators::model_error_reason(&e),
             })?;
         return check(model, "stiffness", k);
     }

@@ -47,6 +47,7 @@ pub use sim_error::SimError;
 
 pub(crate) use dense::lerp_lambda;
 pub(crate) use inputs::InputFn;
+pub(crate) use problem::model_error_reason;
 pub(crate) use stepper::{Attempt, Control, Step, Stepper};
 
 use crate::stats::Stats;

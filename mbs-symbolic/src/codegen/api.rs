@@ -99,6 +99,14 @@ pub const FORWARD_DYNAMICS: Method = method(
     "",
 );
 
+/// `parameter_tangents`, which has a default in the trait (an error) that models with
+/// parameters marked `sensitive` override.
+pub const PARAMETER_TANGENTS: Method = method(
+    "parameter_tangents",
+    "t: f64, q: &[f64], qd: &[f64], qdd: &[f64], u: &[f64], dtau: &mut [f64]",
+    "::core::result::Result<(), ::mbs::ModelError>",
+);
+
 /// The batch methods (four states at once on `::mbs::F64x4` lanes), which have defaults in
 /// the trait (lane by lane) that models with `option batch;` override; the arguments are
 /// those of `dynamics` and `forward_dynamics` with lanes for `f64`.
@@ -157,11 +165,14 @@ pub struct Sizes {
     pub charts: usize,
     /// `option batch;`: the model overrides the methods of [`BATCH`]
     pub batch: bool,
+    /// the parameters marked `sensitive` (field names): the model overrides
+    /// [`PARAMETER_TANGENTS`] and sets `SENSITIVE`
+    pub sensitive: Vec<String>,
 }
 
 /// `impl ::mbs::Model for {ty}` with parameter struct `pty`: the constants, then every method
-/// of [`METHODS`] and [`FORWARD_DYNAMICS`] (and [`BATCH`] with `sizes.batch`) with the body
-/// `body(method)`.
+/// of [`METHODS`] and [`FORWARD_DYNAMICS`] (and [`BATCH`] with `sizes.batch`,
+/// [`PARAMETER_TANGENTS`] with sensitive parameters) with the body `body(method)`.
 pub fn model_impl(
     ty: &str,
     pty: &str,
@@ -176,6 +187,7 @@ pub fn model_impl(
         nc,
         charts,
         batch,
+        sensitive,
     } = sizes;
     let mut s = format!(
         "impl ::mbs::Model for {ty} {{
@@ -189,11 +201,24 @@ const FORWARD_DYNAMICS_GENERATED: bool = true;
 const BATCH_GENERATED: bool = {batch};
 "
     );
+    if !sensitive.is_empty() {
+        let names: Vec<String> = sensitive.iter().map(|n| format!("{n:?}")).collect();
+        s.push_str(&format!(
+            "const SENSITIVE: &'static [&'static str] = &[{}];\n",
+            names.join(", ")
+        ));
+    }
     let batch_methods = if *batch { &BATCH[..] } else { &[] };
+    let sensitivity_methods = if sensitive.is_empty() {
+        &[][..]
+    } else {
+        std::slice::from_ref(&PARAMETER_TANGENTS)
+    };
     for m in METHODS
         .iter()
         .chain([&FORWARD_DYNAMICS])
         .chain(batch_methods)
+        .chain(sensitivity_methods)
     {
         let args = m.args.replace("{P}", pty);
         let ret = if m.ret.is_empty() {

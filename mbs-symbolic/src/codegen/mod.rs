@@ -430,6 +430,11 @@ fn emit_scene(
         f.matrix(a, "c", ct);
         specs.push((f, Some("tangents (K, C)")));
     }
+    if let Some(dp) = &eq.param_tangents {
+        let mut f = FnSpec::new("__parameter_tangents", api::PARAMETER_TANGENTS.args);
+        f.matrix(a, "dtau", dp);
+        specs.push((f, Some("parameter_tangents (∂τ/∂p)")));
+    }
     let mut f = FnSpec::new("__static_forces", args("static_forces"));
     f.vector("h", &eq.static_h);
     specs.push((f, Some("static_forces")));
@@ -681,6 +686,12 @@ fn emit_scene(
         nc: sys.constraints.len(),
         charts: sys.rotation_joints.len(),
         batch: sys.options.batch,
+        sensitive: sys
+            .params
+            .iter()
+            .filter(|p| p.sensitive)
+            .map(|p| p.name.clone())
+            .collect(),
     };
     let model_impl = api::model_impl(&ty, &pty, &sizes, |m| {
         match m.name {
@@ -690,6 +701,7 @@ fn emit_scene(
             "::mbs::Parameters::validate(&params)?;\nself.params = params;\nOk(())".into()
         }
         "tangents" => tangents_body.clone(),
+        "parameter_tangents" => format!("self.__parameter_tangents({})", m.call()) + ";\nOk(())",
         "energy" => "let mut e = [0.0f64; 2];\nself.__energy(t, q, qd, &mut e);\n::mbs::Energy { kinetic: e[0], potential: e[1] }".into(),
         "power" => "let mut e = [0.0f64; 1];\nself.__power(t, q, qd, u, &mut e);\ne[0]".into(),
         // the constraint functions live on the parameter struct, shared by every scene

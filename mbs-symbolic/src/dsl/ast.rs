@@ -48,8 +48,12 @@ pub enum DofName {
 /// A statement inside the model block.
 #[derive(Clone)]
 pub enum Item {
-    /// `param l = 1.0;`
-    Param { name: Ident, value: Expr },
+    /// `param l = 1.0;`, `param k = 1e4 sensitive;` (generate ∂τ/∂k)
+    Param {
+        name: Ident,
+        value: Expr,
+        sensitive: bool,
+    },
     /// `let I = m*l*l/12;` (an alias, substituted where used)
     Let { name: Ident, value: Expr },
     /// `dof q[0] = PI/2;`, `dof knee = 0.2, qd = 1.0;`

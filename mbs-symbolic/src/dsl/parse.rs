@@ -253,8 +253,25 @@ fn parse_item(input: ParseStream) -> syn::Result<Item> {
                 )
             })?;
             let value: Expr = input.parse()?;
+            let mut sensitive = false;
+            if input.peek(Ident) {
+                let word: Ident = input.parse()?;
+                if word != "sensitive" {
+                    return Err(syn::Error::new(
+                        word.span(),
+                        format!(
+                            "after a parameter's value only `sensitive` may follow (`param {name} = … sensitive;` generates ∂τ/∂{name}), not `{word}`"
+                        ),
+                    ));
+                }
+                sensitive = true;
+            }
             semi(input, "`param`")?;
-            Ok(Item::Param { name, value })
+            Ok(Item::Param {
+                name,
+                value,
+                sensitive,
+            })
         }
         "dof" => {
             input.parse::<Ident>()?;

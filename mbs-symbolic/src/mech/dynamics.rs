@@ -57,6 +57,8 @@ pub struct SceneEquations {
     pub input_matrix: Matrix,
     /// K_t = ∂τ/∂q and C_t = ∂τ/∂qd (dense, row-major), when the model asks for them
     pub tangents: Option<(Matrix, Matrix)>,
+    /// ∂τ/∂p (NQ × NS) for the parameters marked `sensitive`, in declaration order
+    pub param_tangents: Option<Matrix>,
     pub kinetic: ExprId,
     pub potential: ExprId,
     /// power of the non-conservative effects
@@ -150,6 +152,22 @@ impl SceneEquations {
                 .collect();
             (k, c)
         });
+        // ∂τ/∂p of the parameters marked `sensitive` (NQ × NS), the derivatives flowing
+        // through every `let` and derived value since those are expressions of the parameters
+        let sensitive: Vec<u16> = (0..sys.params.len())
+            .filter(|&i| sys.params[i].sensitive)
+            .map(|i| i as u16)
+            .collect();
+        let param_tangents = (!sensitive.is_empty()).then(|| {
+            tau.iter()
+                .map(|&t| {
+                    sensitive
+                        .iter()
+                        .map(|&p| a.diff(t, Var::Param(p)))
+                        .collect()
+                })
+                .collect::<Matrix>()
+        });
         let forward = match formulation {
             Formulation::VirtualPower => forward_dynamics(sys, tree, &vp),
             Formulation::Recursive => forward_dynamics(sys, tree, &rec),
@@ -168,6 +186,7 @@ impl SceneEquations {
             static_h,
             input_matrix,
             tangents,
+            param_tangents,
             kinetic,
             potential,
             power,

@@ -65,6 +65,8 @@ pub const IDENTITY: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0
 pub struct ParamDef {
     pub name: String,
     pub default: f64,
+    /// `param k = 1e4 sensitive;`: the model gets ∂τ/∂k (`Model::parameter_tangents`)
+    pub sensitive: bool,
 }
 
 #[derive(Clone, Debug)]
@@ -373,6 +375,7 @@ impl System {
         self.params.push(ParamDef {
             name: name.into(),
             default,
+            sensitive: false,
         });
         self.arena.var(Var::Param((self.params.len() - 1) as u16))
     }

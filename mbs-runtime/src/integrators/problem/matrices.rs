@@ -192,10 +192,15 @@ impl<M: Model> Problem<M> {
     }
 }
 
-pub(super) fn model_error_reason(e: &crate::error::ModelError) -> &'static str {
+/// What to do about a [`crate::error::ModelError`], in a few words.
+pub(crate) fn model_error_reason(e: &crate::error::ModelError) -> &'static str {
     match e {
         crate::error::ModelError::TangentsNotGenerated { .. } => {
             "the model has no tangents: add `option tangents;` to its multibody! block"
         }
+        crate::error::ModelError::NoSensitiveParameters { .. } => {
+            "the model has no sensitive parameters: mark them, `param k = 1e4 sensitive;`"
+        }
+        crate::error::ModelError::SensitivitiesUnsupported { reason, .. } => reason,
     }
 }

@@ -15,6 +15,7 @@
 
 mod index1;
 mod matrices;
+pub(crate) use matrices::model_error_reason;
 mod projection;
 mod watch;
 

@@ -322,7 +322,11 @@ impl Checker {
         for (item, origin) in def.items.iter().zip(&def.origins) {
             self.origin = origin.clone();
             match item {
-                Item::Param { name, value } => {
+                Item::Param {
+                    name,
+                    value,
+                    sensitive,
+                } => {
                     if self.reserved(name, "parameter") || self.duplicate_scalar(name) {
                         continue;
                     }
@@ -362,6 +366,7 @@ impl Checker {
                     self.sys.params.push(ParamDef {
                         name: field,
                         default,
+                        sensitive: *sensitive,
                     });
                     self.defaults.push(default);
                 }

@@ -36,12 +36,7 @@ impl Journal {
             let f = OpenOptions::new().write(true).open(path).map_err(io)?;
             f.set_len(keep as u64).map_err(io)?;
             let mut r = csv::Reader::from_reader(bytes.as_slice());
-            let header: Vec<String> = r
-                .headers()
-                .map_err(|e| bad(e.to_string()))?
-                .iter()
-                .map(String::from)
-                .collect();
+            let header = header(&mut r).map_err(bad)?;
             if keep > 0 && header != columns {
                 return Err(bad(format!(
                     "its columns ({}) are not this sweep's ({}): choose another folder",
@@ -94,6 +89,12 @@ impl Journal {
             reason: e.to_string(),
         }
     }
+}
+
+/// A table's column names.
+fn header(r: &mut csv::Reader<&[u8]>) -> Result<Vec<String>, String> {
+    let h = r.headers().map_err(|e| e.to_string())?;
+    Ok(h.iter().map(String::from).collect())
 }
 
 /// The complete lines of a table: a task killed while writing leaves its last row out.
@@ -158,13 +159,7 @@ pub fn merge(dir: &Path) -> Result<MergeReport, SweepError> {
             };
             let text = complete_lines(&path)?;
             let mut r = csv::Reader::from_reader(text.as_slice());
-            let header: Vec<String> = r
-                .headers()
-                .map_err(|e| bad(e.to_string()))?
-                .iter()
-                .map(String::from)
-                .collect();
-            if header != manifest.columns {
+            if header(&mut r).map_err(bad)? != manifest.columns {
                 return Err(bad("its columns are not the manifest's".into()));
             }
             for rec in r.records() {

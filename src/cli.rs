@@ -596,13 +596,15 @@ impl RunArgs {
     }
 
     /// For a program's `main`: with `--sweep`, runs [`RunArgs::sweep`] on copies of `model` and
-    /// ends the program (status 0, or 1 with the error on standard error); without it, returns
-    /// and the program goes on to its single run.
+    /// ends the program (status 0; 130 when Ctrl-C stopped it before every run was made; 1
+    /// with the error on standard error); without it, returns and the program goes on to its
+    /// single run.
     pub fn sweep_if_asked<M: Model + Clone + Sync + 'static>(&self, model: &M, default_t_end: f64) {
         if self.sweep.is_none() {
             return;
         }
         let status = match self.sweep(model.clone(), default_t_end) {
+            Ok(SweepReport::Ran(s)) if s.stopped => 130,
             Ok(_) => 0,
             Err(e) => {
                 eprintln!("error: {e}");

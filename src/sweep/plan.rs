@@ -112,6 +112,8 @@ pub struct SimulationSpec {
 /// One varied quantity: a parameter of the model (its name), an initial coordinate or
 /// velocity (`q0[i]`, `qd0[i]`, `q0.NAME`, `qd0.NAME`) or a simulation setting (`scheme`,
 /// `t_end`, `h`, `rtol`, `atol`), with its values (grid) or its distribution (random designs).
+/// As on the command line, a run that varies `rtol` and not `atol` has atol = rtol/100, and
+/// one that varies `rtol` runs with step control even if `[simulation]` gives `h`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Variable {

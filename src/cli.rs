@@ -475,14 +475,7 @@ impl RunArgs {
     /// The options these arguments describe, with `t_end` as the default end time.
     pub fn options(&self, t_end: f64) -> Options {
         let t_end = self.t_end.unwrap_or(t_end);
-        let step = match self.h {
-            Some(h) => StepControl::Fixed { h },
-            None => StepControl::Adaptive {
-                rtol: self.rtol,
-                atol: self.atol.unwrap_or(self.rtol * 1e-2),
-                h0: None,
-            },
-        };
+        let step = StepControl::from_settings(self.h, self.rtol, self.atol);
         let output = match self.dt {
             Some(dt) => Output::Every { dt },
             None => Output::Steps,

@@ -241,6 +241,21 @@ pub enum StepControl {
     },
 }
 
+impl StepControl {
+    /// The command line's convention: a fixed step `h` when given, else adaptive with `rtol`
+    /// and `atol` (rtol/100 when not given).
+    pub fn from_settings(h: Option<f64>, rtol: f64, atol: Option<f64>) -> StepControl {
+        match h {
+            Some(h) => StepControl::Fixed { h },
+            None => StepControl::Adaptive {
+                rtol,
+                atol: atol.unwrap_or(rtol * 1e-2),
+                h0: None,
+            },
+        }
+    }
+}
+
 impl Default for StepControl {
     /// Adaptive, rtol 1e-6, atol 1e-8.
     fn default() -> Self {

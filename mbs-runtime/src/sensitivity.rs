@@ -104,17 +104,19 @@ impl<M: Model + 'static> Sensitivities<M> {
         &tr.qd(i)[n * (1 + p)..n * (2 + p)]
     }
 
-    /// M, the wrapped h (the first NQ), and the sensitivities' forces into `s.haug`.
-    fn evaluate(&self, s: &mut Scratch, t: f64, x: &[f64], xd: &[f64], u: &[f64]) {
+    /// M, the wrapped h (the first NQ), and the sensitivities' forces into `s.haug`; whether
+    /// M was factorised (its Cholesky factor in `s.l`).
+    fn evaluate(&self, s: &mut Scratch, t: f64, x: &[f64], xd: &[f64], u: &[f64]) -> bool {
         let n = M::NQ;
         let (q, qd) = (&x[..n], &xd[..n]);
         self.model.dynamics(t, q, qd, u, &mut s.m, &mut s.h);
         s.l.copy_from_slice(&s.m);
         s.qdd.copy_from_slice(&s.h);
-        if cholesky(&mut s.l, n).is_ok() {
+        let factorised = cholesky(&mut s.l, n).is_ok();
+        if factorised {
             cholesky_solve(&s.l, n, &mut s.qdd);
         } else {
-            // the runtime's own factorisation of the whole matrix reports the singularity
+            // the runtime's checks of the pivots and of the accelerations report it
             s.qdd.fill(f64::NAN);
         }
         // checked at construction: both are generated
@@ -133,6 +135,7 @@ impl<M: Model + 'static> Sensitivities<M> {
                 s.haug[n * (1 + j) + i] = f;
             }
         }
+        factorised
     }
 
     /// diag(M, …, M) from `s.m`.
@@ -218,9 +221,8 @@ impl<M: Model + 'static> Model for Sensitivities<M> {
         pivots: &mut [f64],
     ) {
         let s = &mut *self.scratch.borrow_mut();
-        self.evaluate(s, t, q, qd, u);
+        let ok = self.evaluate(s, t, q, qd, u);
         let n = M::NQ;
-        let ok = s.qdd.iter().all(|x| !x.is_nan());
         for b in 0..=M::SENSITIVE.len() {
             let block = &mut qdd[b * n..(b + 1) * n];
             block.copy_from_slice(&s.haug[b * n..(b + 1) * n]);

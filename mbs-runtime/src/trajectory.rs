@@ -209,6 +209,18 @@ impl Trajectory {
         )
     }
 
+    /// [`Trajectory::energy_drift`] relative to max(|E(t0)|, max kinetic energy), the scale of
+    /// the motion's energies (`None` when energy was not recorded).
+    pub fn relative_energy_drift(&self) -> Option<f64> {
+        let drift = self.energy_drift()?;
+        let scale = self
+            .energy
+            .iter()
+            .map(|e| e.kinetic.abs())
+            .fold(self.energy.first()?.total().abs(), f64::max);
+        Some(if scale > 0.0 { drift / scale } else { drift })
+    }
+
     /// CSV with a header of named columns: `t`, then per coordinate its name (`q[0]`, or the
     /// DSL name such as `knee`), then `qd[…]` and `qdd[…]` per coordinate as the DSL writes
     /// them (`qd[0]`, `qd[knee]`), then `NAME.lambda` per constraint, then per rotation joint

@@ -152,7 +152,7 @@ impl<M: Model> Metrics<M> {
                 v.extend_from_slice(tr.q(last));
                 v.extend_from_slice(tr.qd(last));
             }
-            v.push(relative_energy_drift(tr));
+            v.push(tr.relative_energy_drift().unwrap_or(f64::NAN));
             v
         })
     }
@@ -160,19 +160,6 @@ impl<M: Model> Metrics<M> {
     pub fn names(&self) -> &[String] {
         &self.names
     }
-}
-
-/// max |E(t) − E(0)| relative to max(|E(0)|, max kinetic energy), NaN without energies.
-fn relative_energy_drift(tr: &Trajectory) -> f64 {
-    let Some(drift) = tr.energy_drift() else {
-        return f64::NAN;
-    };
-    let scale = tr
-        .energy
-        .iter()
-        .map(|e| e.kinetic.abs())
-        .fold(tr.energy.first().map_or(0.0, |e| e.total().abs()), f64::max);
-    if scale > 0.0 { drift / scale } else { drift }
 }
 
 /// What a run's variable sets.
@@ -403,8 +390,10 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
     /// Writes `dir/plan.toml` (the plan with the simulation settings the runs start from) and
     /// `dir/runs.csv`, or checks that the folder holds this sweep already.
     pub fn prepare(&self, dir: &Path, runs: &RunList) -> Result<(), SweepError> {
-        let io = |path: PathBuf| move |source| SweepError::Io { path, source };
-        std::fs::create_dir_all(dir).map_err(io(dir.to_path_buf()))?;
+        std::fs::create_dir_all(dir).map_err(|source| SweepError::Io {
+            path: dir.to_path_buf(),
+            source,
+        })?;
         let list = dir.join("runs.csv");
         let text = runs.to_csv();
         match std::fs::read_to_string(&list) {
@@ -414,10 +403,14 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
                     dir: dir.to_path_buf(),
                 });
             }
-            Err(_) => std::fs::write(&list, &text).map_err(io(list.clone()))?,
+            Err(_) => replace(&list, &text)?,
         }
         let plan = dir.join("plan.toml");
-        std::fs::write(&plan, self.effective_plan().to_toml()).map_err(io(plan.clone()))
+        let text = self.effective_plan().to_toml();
+        if std::fs::read_to_string(&plan).ok().as_deref() != Some(text.as_str()) {
+            replace(&plan, &text)?;
+        }
+        Ok(())
     }
 
     /// The plan with `[simulation]` filled in with the settings the runs start from, so that
@@ -772,14 +765,7 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
             options.q0 = Some(q);
             options.qd0 = Some(qd);
         }
-        options.step = match h {
-            Some(h) => StepControl::Fixed { h },
-            None => StepControl::Adaptive {
-                rtol,
-                atol: atol.unwrap_or(rtol * 1e-2),
-                h0: None,
-            },
-        };
+        options.step = StepControl::from_settings(h, rtol, atol);
         Ok((scheme, options))
     }
 }
@@ -804,6 +790,18 @@ struct Row {
     fields: Vec<String>,
     failed: bool,
     cpu: Duration,
+}
+
+/// Writes `text` to `path` through a file beside it renamed over it: array tasks preparing the
+/// same folder at once never read a half-written plan or run list.
+fn replace(path: &Path, text: &str) -> Result<(), SweepError> {
+    let io = |source| SweepError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let tmp = path.with_extension(format!("tmp{}", std::process::id()));
+    std::fs::write(&tmp, text).map_err(io)?;
+    std::fs::rename(&tmp, path).map_err(io)
 }
 
 /// Numbers as Rust's shortest text that reads back to the same `f64` (`NaN`, `inf`).

@@ -118,9 +118,10 @@ pub struct MergeReport {
 }
 
 /// Merges the parts of a job array (`dir/parts/part-K-of-N.csv`, N from `dir/manifest.json`)
-/// into `dir/results.csv` in run order, streaming. Every run of `dir/runs.csv` must be present
-/// once: otherwise the missing runs are listed in `dir/missing.csv` (run, shard), nothing is
-/// merged, and the error names the array tasks to submit again. With the `parquet` feature
+/// into `dir/results.csv` in run order, one part in memory at a time. Every run of
+/// `dir/runs.csv` must be present once: otherwise the missing runs are listed in
+/// `dir/missing.csv` (run, shard), nothing is merged, and the error names the array tasks to
+/// submit again. With the `parquet` feature
 /// it also writes `dir/results.parquet`.
 pub fn merge(dir: &Path) -> Result<MergeReport, SweepError> {
     let manifest = slurm::Manifest::read(dir)?;

@@ -1,5 +1,6 @@
 //! Parameter sensitivities of the sprung arm (`models/src/sprung_arm.rs`, three parameters
-//! marked `sensitive`): how its equilibrium moves with them (`static_sensitivity`), then
+//! marked `sensitive`): how its equilibrium moves with them (`static_sensitivity`) and its
+//! poles (`pole_sensitivity`), then
 //! dq(t)/dp integrated with the motion (`mbs::Sensitivities`) by three schemes, against
 //! central differences of plain runs, and what they cost: steps, evaluations and CPU time
 //! with and without (best of 5 runs each).
@@ -8,7 +9,7 @@
 //! cargo run --release --example sensitivity
 //! ```
 
-use mbs::analysis::{StaticsOptions, static_equilibrium, static_sensitivity};
+use mbs::analysis::{StaticsOptions, pole_sensitivity, static_equilibrium, static_sensitivity};
 use mbs::{
     Model, Options, Output, Parameters, Scheme, Sensitivities, StepControl, Trajectory, simulate,
 };
@@ -70,6 +71,25 @@ fn main() {
             s.get(0, p).unwrap_or(f64::NAN),
             s.get(1, p).unwrap_or(f64::NAN)
         );
+    }
+
+    // how the poles move along the equilibria: dλ/dp from the left and right eigenvectors
+    let poles = pole_sensitivity(&model, &eq, &statics).expect("pole sensitivity");
+    println!("poles at the equilibrium and their sensitivities (exact, generated M', C', K'):");
+    for (i, mode) in poles.modes.modes.iter().enumerate() {
+        println!(
+            "  mode {i}: f = {:.4} Hz, ζ = {:.4}",
+            mode.frequency_hz, mode.damping_ratio
+        );
+        for p in &poles.params {
+            let (dre, dim) = poles.dpole(i, p).unwrap_or((f64::NAN, f64::NAN));
+            println!(
+                "    d/d{p:<3}: dλ = {dre:>11.6} {:+.6}i 1/s,  df = {:>10.6} Hz,  dζ = {:>10.6}",
+                dim,
+                poles.dfrequency(i, p).unwrap_or(f64::NAN),
+                poles.ddamping(i, p).unwrap_or(f64::NAN)
+            );
+        }
     }
 
     // dq(2 s)/dp by central differences of plain runs at rtol 1e-12

@@ -101,6 +101,145 @@ fn equilibria_move_with_the_parameters_as_differences_say() {
     assert!(s.get(0, "k1").unwrap() != 0.0);
 }
 
+/// M, C, K at rest at q.
+fn rest_matrices(model: &SprungArm, q: &[f64]) -> [Vec<f64>; 3] {
+    let (mut m, mut h, mut k, mut c) = (vec![0.0; 4], vec![0.0; 2], vec![0.0; 4], vec![0.0; 4]);
+    model.dynamics(0.0, q, &[0.0; 2], &[], &mut m, &mut h);
+    model
+        .tangents(0.0, q, &[0.0; 2], &[0.0; 2], &[], &mut k, &mut c)
+        .unwrap();
+    [m, c, k]
+}
+
+#[test]
+fn generated_second_derivatives_at_rest_match_central_differences() {
+    let model = SprungArm::default();
+    let (q, dir) = ([0.7, -0.4], [0.3, -1.1]);
+    let (mut dm, mut dc, mut dk) = (vec![0.0; 16], vec![0.0; 16], vec![0.0; 16]);
+    model
+        .rest_tangent_derivatives(0.0, &q, &dir, &[], &mut dm, &mut dc, &mut dk)
+        .unwrap();
+    let generated = [&dm, &dc, &dk];
+    let check = |what: &str, block: usize, plus: [Vec<f64>; 3], minus: [Vec<f64>; 3], e: f64| {
+        for x in 0..3 {
+            for i in 0..4 {
+                let diff = (plus[x][i] - minus[x][i]) / (2.0 * e);
+                let exact = generated[x][4 * block + i];
+                assert!(
+                    (exact - diff).abs() <= 1e-7 * exact.abs().max(1.0),
+                    "{what}: matrix {x} entry {i}: generated {exact}, differences {diff}"
+                );
+            }
+        }
+    };
+    // block 0: along the direction in q
+    let e = 1e-5;
+    let qp: Vec<f64> = (0..2).map(|i| q[i] + e * dir[i]).collect();
+    let qm: Vec<f64> = (0..2).map(|i| q[i] - e * dir[i]).collect();
+    check(
+        "along dq",
+        0,
+        rest_matrices(&model, &qp),
+        rest_matrices(&model, &qm),
+        e,
+    );
+    // block 1 + j: by parameter j
+    for (j, name) in SprungArm::SENSITIVE.iter().enumerate() {
+        let p0 = model.params().values()[j];
+        let e = 1e-5 * p0;
+        let plus = rest_matrices(&with(name, p0 + e), &q);
+        let minus = rest_matrices(&with(name, p0 - e), &q);
+        check(name, 1 + j, plus, minus, e);
+    }
+    assert!(dk.iter().any(|x| x.abs() > 1e-3) && dm.iter().any(|x| x.abs() > 1e-3));
+    // without sensitive parameters: the typed error
+    let e = PlainArm::default()
+        .rest_tangent_derivatives(0.0, &[0.1], &[1.0], &[], &mut [0.0], &mut [0.0], &mut [0.0])
+        .unwrap_err();
+    assert!(matches!(e, ModelError::NoSensitiveParameters { .. }), "{e}");
+}
+
+#[test]
+fn poles_move_with_the_parameters_as_differences_say() {
+    use mbs::analysis::{linearize, modes, pole_sensitivity};
+    let options = StaticsOptions {
+        tolerance: 1e-13,
+        ..StaticsOptions::default()
+    };
+    let poles_of = |model: &SprungArm, start: &[f64]| {
+        let start = StaticsOptions {
+            q0: Some(start.to_vec()),
+            ..options.clone()
+        };
+        let eq = static_equilibrium(model, &start).unwrap();
+        let lin = linearize(
+            model,
+            0.0,
+            &eq.q,
+            &[0.0; 2],
+            &[],
+            mbs::IterationMatrix::Exact,
+        )
+        .unwrap();
+        modes(&lin, None).unwrap()
+    };
+    let model = SprungArm::default();
+    let eq = static_equilibrium(&model, &options).unwrap();
+    let s = pole_sensitivity(&model, &eq, &options).unwrap();
+    assert_eq!(s.params, ["l", "m", "k1"]);
+    assert_eq!(s.modes.modes.len(), 2);
+    assert!(
+        s.modes.modes.iter().all(|m| m.im > 0.0),
+        "two oscillating modes"
+    );
+    for (j, name) in s.params.iter().enumerate() {
+        let p0 = model.params().values()[j];
+        let e = 1e-5 * p0;
+        let plus = poles_of(&with(name, p0 + e), &eq.q);
+        let minus = poles_of(&with(name, p0 - e), &eq.q);
+        for (i, mode) in s.modes.modes.iter().enumerate() {
+            let (dre, dim) = s.dpole(i, name).unwrap();
+            let diff_re = (plus.modes[i].re - minus.modes[i].re) / (2.0 * e);
+            let diff_im = (plus.modes[i].im - minus.modes[i].im) / (2.0 * e);
+            let diff_f = (plus.modes[i].frequency_hz - minus.modes[i].frequency_hz) / (2.0 * e);
+            let diff_z = (plus.modes[i].damping_ratio - minus.modes[i].damping_ratio) / (2.0 * e);
+            println!(
+                "mode {i} ({:.3} Hz) d/d{name}: λ' = {dre:.8} + {dim:.8}i (differences {diff_re:.8} + {diff_im:.8}i)",
+                mode.frequency_hz
+            );
+            let size = dre.hypot(dim).max(1e-3);
+            assert!(
+                (dre - diff_re).abs() <= 1e-6 * size && (dim - diff_im).abs() <= 1e-6 * size,
+                "mode {i}, {name}: ({dre}, {dim}) vs ({diff_re}, {diff_im})"
+            );
+            let df = s.dfrequency(i, name).unwrap();
+            assert!(
+                (df - diff_f).abs() <= 1e-6 * df.abs().max(1e-3),
+                "{df} vs {diff_f}"
+            );
+            let dz = s.ddamping(i, name).unwrap();
+            assert!(
+                (dz - diff_z).abs() <= 1e-6 * dz.abs().max(1e-4),
+                "{dz} vs {diff_z}"
+            );
+        }
+    }
+    // every parameter moves the first pole
+    assert!(
+        s.params
+            .iter()
+            .all(|p| s.dfrequency(0, p).unwrap().abs() > 1e-3)
+    );
+    // a locked coordinate is refused
+    let locked = StaticsOptions {
+        locked: vec![1],
+        ..options.clone()
+    };
+    let eq = static_equilibrium(&model, &locked).unwrap();
+    let err = pole_sensitivity(&model, &eq, &locked).unwrap_err();
+    assert!(err.to_string().contains("locked"), "{err}");
+}
+
 /// q(t_end), qd(t_end) of a plain run at tight tolerances.
 fn end_state(model: SprungArm, t_end: f64) -> (Vec<f64>, Vec<f64>) {
     let options = mbs::Options {

@@ -36,6 +36,10 @@ pub trait Efforts: 'static {
     const NX: usize = 0;
     /// their names (NX of them)
     const STATE_NAMES: &'static [&'static str] = &[];
+    /// whether [`Efforts::efforts`] reads frames ([`Effort::frame`]); when false only the
+    /// points' kinematics are computed at each evaluation ([`Model::point_kinematics`], a
+    /// fraction of the cost on a model of many bodies) and the frames' are left unset
+    const FRAMES: bool = true;
     /// x(0) (NX)
     fn initial_states(&self, _x: &mut [f64]) {}
     /// Adds the efforts at the state in `e` (world axes). An `Err` stops the run.
@@ -62,7 +66,8 @@ pub struct Effort<'a> {
 }
 
 impl Effort<'_> {
-    /// Kinematics of frame (or body) `i` (`ModelInfo::frame_index`).
+    /// Kinematics of frame (or body) `i` (`ModelInfo::frame_index`); unset when the user
+    /// part says it reads no frames ([`Efforts::FRAMES`]).
     pub fn frame(&self, i: usize) -> &FrameKinematics {
         &self.kin.frames[i]
     }
@@ -129,6 +134,8 @@ struct Scratch {
     qp: Vec<f64>,
     vp: Vec<f64>,
     up: Vec<f64>,
+    /// Cholesky factor of the wrapped M (forward dynamics)
+    l: Vec<f64>,
 }
 
 /// A generated model with efforts and extra states written in Rust: a [`Model`] with
@@ -162,6 +169,7 @@ impl<M: Model + 'static, E: Efforts> WithEfforts<M, E> {
             qp: z(big),
             vp: z(big),
             up: z(M::NU),
+            l: z(n * n),
         };
         let info = extended_info::<M, E>(model.info());
         WithEfforts {
@@ -228,7 +236,12 @@ impl<M: Model, E: Efforts> WithEfforts<M, E> {
     ) -> bool {
         let n = M::NQ;
         self.evaluations.set(self.evaluations.get() + 1);
-        self.model.kinematics(t, &q[..n], &qd[..n], &mut s.kin);
+        if E::FRAMES {
+            self.model.kinematics(t, &q[..n], &qd[..n], &mut s.kin);
+        } else {
+            self.model
+                .point_kinematics(t, &q[..n], &qd[..n], &mut s.kin);
+        }
         let (qg, xd) = if into_1 {
             (&mut s.qg1, &mut s.xd1)
         } else {
@@ -287,9 +300,47 @@ impl<M: Model, E: Efforts> Model for WithEfforts<M, E> {
     const NFRAMES: usize = M::NFRAMES;
     const NPOINTS: usize = M::NPOINTS;
     const NC: usize = M::NC;
+    /// one Cholesky factorisation of the wrapped M; the extra states have unit mass
+    const FORWARD_DYNAMICS_GENERATED: bool = true;
 
     fn info(&self) -> &'static ModelInfo {
         self.info
+    }
+
+    /// qdd from the wrapped M (NQ_M × NQ_M, dense Cholesky) and h plus the user's efforts;
+    /// the extra states' derivatives as they are. Pivots: L_jj² of the wrapped M (0 where it
+    /// is not positive definite), 1 for the extra states.
+    fn forward_dynamics(
+        &self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        u: &[f64],
+        qdd: &mut [f64],
+        pivots: &mut [f64],
+    ) {
+        let n = M::NQ;
+        let s = &mut *self.scratch.borrow_mut();
+        self.model
+            .dynamics(t, &q[..n], &qd[..n], u, &mut s.m, &mut s.h);
+        if !self.user(s, t, q, qd, u, false) {
+            qdd.fill(f64::NAN);
+            pivots.fill(0.0);
+            return;
+        }
+        s.l.copy_from_slice(&s.m);
+        let ok = crate::linalg::cholesky(&mut s.l, n).is_ok();
+        for i in 0..n {
+            qdd[i] = s.h[i] + s.qg[i];
+            pivots[i] = if ok { s.l[i + n * i].powi(2) } else { 0.0 };
+        }
+        if ok {
+            crate::linalg::cholesky_solve(&s.l, n, &mut qdd[..n]);
+        } else {
+            qdd[..n].fill(f64::NAN);
+        }
+        qdd[n..].copy_from_slice(&s.xd);
+        pivots[n..].fill(1.0);
     }
 
     fn params(&self) -> &Self::Params {

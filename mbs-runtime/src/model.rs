@@ -483,6 +483,30 @@ pub trait Model {
         })
     }
 
+    /// How the matrices of the motion about a state at rest (qd = qdd = 0) change: M,
+    /// C = ∂τ/∂qd and K = ∂τ/∂q, each NQ × NQ·(1 + NS) column-major in blocks of NQ × NQ.
+    /// Block 0 is the derivative along the coordinates' direction `dq` (Σₖ ∂X/∂qₖ dqₖ),
+    /// block 1 + j the partial derivative by sensitive parameter j; along the equilibria,
+    /// dX/dpⱼ = block 0 with `dq` = ∂q_eq/∂pⱼ, plus block 1 + j. Generated exactly for models
+    /// with parameters marked `sensitive` and `option tangents;` (pole sensitivities); an
+    /// error for the others.
+    #[allow(clippy::too_many_arguments)]
+    fn rest_tangent_derivatives(
+        &self,
+        t: f64,
+        q: &[f64],
+        dq: &[f64],
+        u: &[f64],
+        dm: &mut [f64],
+        dc: &mut [f64],
+        dk: &mut [f64],
+    ) -> Result<(), crate::error::ModelError> {
+        let _ = (t, q, dq, u, dm, dc, dk);
+        Err(crate::error::ModelError::NoSensitiveParameters {
+            model: self.info().name,
+        })
+    }
+
     /// h(q, 0, t, u): forces at rest, for statics (NQ).
     fn static_forces(&self, t: f64, q: &[f64], u: &[f64], h: &mut [f64]);
 
@@ -514,6 +538,12 @@ pub trait Model {
 
     /// Poses, velocities, Jacobians and bias accelerations of every frame and point.
     fn kinematics(&self, t: f64, q: &[f64], qd: &[f64], out: &mut Kinematics);
+
+    /// The points' part of [`Model::kinematics`] alone (`out.points`; `out.frames` is left
+    /// as it was): generated models compute nothing else, the default all of it.
+    fn point_kinematics(&self, t: f64, q: &[f64], qd: &[f64], out: &mut Kinematics) {
+        self.kinematics(t, q, qd, out);
+    }
 
     /// A failure of user code during the evaluations since the last call (efforts written in
     /// Rust, [`crate::WithEfforts`]), taken once; generated models have none.

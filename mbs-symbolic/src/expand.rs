@@ -247,6 +247,7 @@ fn validate(&self) -> ::core::result::Result<(), ::mbs::ParamError> {{ {never} }
         charts: 0,
         batch: false,
         sensitive: Vec::new(),
+        rest_derivatives: false,
     };
     for ty in scenes {
         code.push_str(&format!(

@@ -14,6 +14,7 @@
 //! | linearisation | M, B_u, B, Hessians of Φ, G; K, C with tangents | K, C without tangents; with constraints ∂γ/∂q and ∂(∂Φ/∂t)/∂q (identically zero at rest with scleronomic constraints, then exact) |
 //! | modes | eigen-decomposition of A | — |
 //! | inverse dynamics | τ, and τ_a, λ from one LU of [S Bᵀ] | — |
+//! | sensitivities | ∂τ/∂p, dq_eq/dp; dλ/dp of poles from generated M′, C′, K′ | K without tangents (statics only) |
 
 mod inverse;
 mod linearize;
@@ -28,7 +29,7 @@ pub use inverse::{
 };
 pub use linearize::{CONSISTENCY_TOLERANCE, Linearization, linearize};
 pub use modes::{Mode, Modes, modes};
-pub use sensitivity::{StaticSensitivity, static_sensitivity};
+pub use sensitivity::{PoleSensitivity, StaticSensitivity, pole_sensitivity, static_sensitivity};
 pub use statics::{Equilibrium, Stability, StaticsOptions, static_equilibrium};
 
 use crate::error::Failure;

@@ -106,3 +106,212 @@ pub fn static_sensitivity<M: Model + Clone>(
         dq_dp,
     })
 }
+
+/// How the poles of the motion about an equilibrium move with each sensitive parameter.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct PoleSensitivity {
+    /// the sensitive parameters
+    pub params: Vec<&'static str>,
+    /// the modes at the equilibrium, as [`modes`](super::modes) gives them (one per conjugate
+    /// pair or real pole, by frequency)
+    pub modes: super::Modes,
+    /// dλ/dp of each mode's pole (Im λ ≥ 0), `(re, im)`, mode-major: entry `i * NS + j` is
+    /// mode i and parameter j
+    pub dpole_dp: Vec<(f64, f64)>,
+}
+
+impl PoleSensitivity {
+    /// dλ/dp of mode `i` and the parameter named `param`, `(re, im)` (1/s per unit of p).
+    pub fn dpole(&self, i: usize, param: &str) -> Option<(f64, f64)> {
+        let j = self.params.iter().position(|p| *p == param)?;
+        (i < self.modes.modes.len()).then(|| self.dpole_dp[i * self.params.len() + j])
+    }
+
+    /// d f/dp of mode `i`'s natural frequency f = |λ|/2π (Hz per unit of p).
+    pub fn dfrequency(&self, i: usize, param: &str) -> Option<f64> {
+        let (dre, dim) = self.dpole(i, param)?;
+        let mode = &self.modes.modes[i];
+        let mag = mode.re.hypot(mode.im);
+        (mag > 0.0).then(|| (mode.re * dre + mode.im * dim) / mag / (2.0 * std::f64::consts::PI))
+    }
+
+    /// d ζ/dp of mode `i`'s damping ratio ζ = −Re λ/|λ|.
+    pub fn ddamping(&self, i: usize, param: &str) -> Option<f64> {
+        let (dre, dim) = self.dpole(i, param)?;
+        let mode = &self.modes.modes[i];
+        let mag = mode.re.hypot(mode.im);
+        let dmag = (mode.re * dre + mode.im * dim) / mag;
+        (mag > 0.0).then(|| -(dre * mag - mode.re * dmag) / (mag * mag))
+    }
+}
+
+/// The poles of `model`'s motion about the equilibrium `eq` (found with `options`) and their
+/// derivatives by each sensitive parameter, along the equilibria: the equilibrium moves
+/// (dq/dp from [`static_sensitivity`]) and M, C, K with it and with p.
+///
+/// With Q(λ) = λ²M + λC + K (C = ∂τ/∂qd, K = ∂τ/∂q at rest), a simple pole λ with right
+/// and left eigenvectors Q(λ)x = 0, yᴴQ(λ) = 0 moves by
+/// dλ/dp = −yᴴ(λ²M' + λC' + K')x / yᴴ(2λM + C)x, where X' = dX/dp along the equilibria comes
+/// from the generated second derivatives ([`Model::rest_tangent_derivatives`]). Exact to
+/// rounding for simple poles; a repeated pole has no derivative and is reported as an error.
+/// Needs `option tangents;`; models with constraints and equilibria with locked coordinates
+/// (not at rest on them) are refused.
+pub fn pole_sensitivity<M: Model + Clone>(
+    model: &M,
+    eq: &Equilibrium,
+    options: &StaticsOptions,
+) -> Result<PoleSensitivity, AnalysisError> {
+    use crate::linalg::{C64, Field};
+    let n = M::NQ;
+    let ns = M::SENSITIVE.len();
+    let refuse = |reason: &'static str| {
+        AnalysisError::from(Failure::InvalidOption {
+            name: "model",
+            value: model.info().name.to_string(),
+            reason,
+        })
+    };
+    if !options.locked.is_empty() {
+        return Err(Failure::InvalidOption {
+            name: "locked",
+            value: format!("{:?}", options.locked),
+            reason: "poles are those of a free equilibrium: a locked coordinate is not at rest",
+        }
+        .into());
+    }
+    let dq = static_sensitivity(model, eq, options)?;
+    let mut m = model.clone();
+    for (j, r) in eq.charts.iter().enumerate() {
+        m.set_chart(j, *r);
+    }
+    let u = options.u.clone().unwrap_or_else(|| vec![0.0; M::NU]);
+    let zero = vec![0.0; n];
+    // M, C, K at rest
+    let (mut mass, mut h) = (vec![0.0; n * n], vec![0.0; n]);
+    m.dynamics(options.t, &eq.q, &zero, &u, &mut mass, &mut h);
+    let (mut k, mut c) = (vec![0.0; n * n], vec![0.0; n * n]);
+    m.tangents(options.t, &eq.q, &zero, &zero, &u, &mut k, &mut c)
+        .map_err(|e| refuse(crate::integrators::model_error_reason(&e)))?;
+    check(&m, "M", &mass)?;
+    check(&m, "K", &k)?;
+    check(&m, "C", &c)?;
+    // M', C', K' along the equilibria, one n × n block per parameter
+    let nb = n * n;
+    let (mut dm, mut dc, mut dk) = (
+        vec![0.0; nb * (1 + ns)],
+        vec![0.0; nb * (1 + ns)],
+        vec![0.0; nb * (1 + ns)],
+    );
+    let mut along: Vec<Vec<f64>> = Vec::with_capacity(3 * ns);
+    for p in 0..ns {
+        let dir = &dq.dq_dp[n * p..n * (p + 1)];
+        m.rest_tangent_derivatives(options.t, &eq.q, dir, &u, &mut dm, &mut dc, &mut dk)
+            .map_err(|e| refuse(crate::integrators::model_error_reason(&e)))?;
+        for x in [&dm, &dc, &dk] {
+            check(&m, "∂(M, C, K)/∂p", x)?;
+            along.push(
+                (0..nb)
+                    .map(|i| x[i] + x[nb * (1 + p) + i])
+                    .collect::<Vec<f64>>(),
+            );
+        }
+    }
+    let lin = super::linearize(
+        &m,
+        options.t,
+        &eq.q,
+        &zero,
+        &u,
+        crate::options::IterationMatrix::Auto,
+    )?;
+    let modes = super::modes(&lin, None)?;
+    let real = |x: f64| C64::new(x, 0.0);
+    let conj = |z: C64| C64::new(z.re, -z.im);
+    let scale = [&mass, &c, &k]
+        .iter()
+        .flat_map(|x| x.iter())
+        .fold(1.0f64, |s, x| s.max(x.abs()));
+    let mut dpole_dp = Vec::with_capacity(modes.modes.len() * ns);
+    let mut q_right = Lu::<C64>::new(n);
+    let mut q_left = Lu::<C64>::new(n);
+    for mode in &modes.modes {
+        let lambda = C64::new(mode.re, mode.im);
+        // Q(μ) and Q(μ)ᴴ with μ a hair off λ, for inverse iteration
+        let mag = mode.re.hypot(mode.im);
+        let mu = lambda + C64::new(1e-9 * mag.max(1.0), 1e-9 * mag.max(1.0));
+        {
+            let (a, b) = (q_right.matrix_mut(), q_left.matrix_mut());
+            for j in 0..n {
+                for i in 0..n {
+                    let e = mu * mu * real(mass[i + n * j])
+                        + mu * real(c[i + n * j])
+                        + real(k[i + n * j]);
+                    a[i + n * j] = e;
+                    b[j + n * i] = conj(e);
+                }
+            }
+        }
+        let singular = || -> AnalysisError {
+            Failure::SingularMatrix {
+                matrix: "λ²M + λC + K (the pole's eigenvectors)",
+                rcond: 0.0,
+                coordinates: Vec::new(),
+            }
+            .into()
+        };
+        q_right.factor().map_err(|_| singular())?;
+        q_left.factor().map_err(|_| singular())?;
+        let start = |i: usize| C64::new(1.0 + 0.1 * i as f64, 0.05 * i as f64);
+        let (mut x, mut y): (Vec<C64>, Vec<C64>) =
+            ((0..n).map(start).collect(), (0..n).map(start).collect());
+        for _ in 0..3 {
+            q_right.solve(&mut x);
+            q_left.solve(&mut y);
+            for v in [&mut x, &mut y] {
+                let nv = v.iter().map(|z| z.abs()).fold(0.0, f64::max);
+                for z in v.iter_mut() {
+                    *z = *z / real(nv);
+                }
+            }
+        }
+        // yᴴ A x for a real n × n matrix A
+        let form = |a: &dyn Fn(usize) -> C64| -> C64 {
+            let mut s = C64::default();
+            for j in 0..n {
+                for i in 0..n {
+                    s = s + conj(y[i]) * a(i + n * j) * x[j];
+                }
+            }
+            s
+        };
+        let denom = form(&|ij| real(2.0) * lambda * real(mass[ij]) + real(c[ij]));
+        if denom.abs() <= 1e-10 * scale {
+            return Err(refuse(
+                "a pole is repeated (or defective): it has no derivative by the parameters",
+            ));
+        }
+        for p in 0..ns {
+            let (dmp, dcp, dkp) = (&along[3 * p], &along[3 * p + 1], &along[3 * p + 2]);
+            let num = form(&|ij| {
+                lambda * lambda * real(dmp[ij]) + lambda * real(dcp[ij]) + real(dkp[ij])
+            });
+            let d = C64::default() - num / denom;
+            // a real pole moves along the real axis
+            let im = if mode.im == 0.0 { 0.0 } else { d.im };
+            dpole_dp.push((d.re, im));
+        }
+    }
+    check(
+        &m,
+        "dλ/dp",
+        &dpole_dp
+            .iter()
+            .flat_map(|&(a, b)| [a, b])
+            .collect::<Vec<_>>(),
+    )?;
+    Ok(PoleSensitivity {
+        params: M::SENSITIVE.to_vec(),
+        modes,
+        dpole_dp,
+    })
+}

@@ -99,11 +99,27 @@ pub const FORWARD_DYNAMICS: Method = method(
     "",
 );
 
+/// `point_kinematics`, which has a default in the trait (all of `kinematics`) that every
+/// generated model overrides with the points' part alone.
+pub const POINT_KINEMATICS: Method = method(
+    "point_kinematics",
+    "t: f64, q: &[f64], qd: &[f64], out: &mut ::mbs::Kinematics",
+    "",
+);
+
 /// `parameter_tangents`, which has a default in the trait (an error) that models with
 /// parameters marked `sensitive` override.
 pub const PARAMETER_TANGENTS: Method = method(
     "parameter_tangents",
     "t: f64, q: &[f64], qd: &[f64], qdd: &[f64], u: &[f64], dtau: &mut [f64]",
+    "::core::result::Result<(), ::mbs::ModelError>",
+);
+
+/// `rest_tangent_derivatives`, which has a default in the trait (an error) that models with
+/// parameters marked `sensitive` and `option tangents;` override.
+pub const REST_TANGENT_DERIVATIVES: Method = method(
+    "rest_tangent_derivatives",
+    "t: f64, q: &[f64], dq: &[f64], u: &[f64], dm: &mut [f64], dc: &mut [f64], dk: &mut [f64]",
     "::core::result::Result<(), ::mbs::ModelError>",
 );
 
@@ -168,6 +184,8 @@ pub struct Sizes {
     /// the parameters marked `sensitive` (field names): the model overrides
     /// [`PARAMETER_TANGENTS`] and sets `SENSITIVE`
     pub sensitive: Vec<String>,
+    /// the model overrides [`REST_TANGENT_DERIVATIVES`] (sensitive parameters and tangents)
+    pub rest_derivatives: bool,
 }
 
 /// `impl ::mbs::Model for {ty}` with parameter struct `pty`: the constants, then every method
@@ -188,6 +206,7 @@ pub fn model_impl(
         charts,
         batch,
         sensitive,
+        rest_derivatives,
     } = sizes;
     let mut s = format!(
         "impl ::mbs::Model for {ty} {{
@@ -209,14 +228,14 @@ const BATCH_GENERATED: bool = {batch};
         ));
     }
     let batch_methods = if *batch { &BATCH[..] } else { &[] };
-    let sensitivity_methods = if sensitive.is_empty() {
-        &[][..]
-    } else {
-        std::slice::from_ref(&PARAMETER_TANGENTS)
+    let sensitivity_methods = match (sensitive.is_empty(), rest_derivatives) {
+        (true, _) => &[][..],
+        (false, false) => std::slice::from_ref(&PARAMETER_TANGENTS),
+        (false, true) => &[PARAMETER_TANGENTS, REST_TANGENT_DERIVATIVES][..],
     };
     for m in METHODS
         .iter()
-        .chain([&FORWARD_DYNAMICS])
+        .chain([&FORWARD_DYNAMICS, &POINT_KINEMATICS])
         .chain(batch_methods)
         .chain(sensitivity_methods)
     {

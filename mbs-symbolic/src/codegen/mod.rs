@@ -435,6 +435,17 @@ fn emit_scene(
         f.matrix(a, "dtau", dp);
         specs.push((f, Some("parameter_tangents (∂τ/∂p)")));
     }
+    if let Some([dm, dc, dk]) = &eq.rest_tangent_derivatives {
+        // the direction δq is passed as `qd`, the variables the matrices at rest are free of
+        let mut f = FnSpec::new(
+            "__rest_tangent_derivatives",
+            "t: f64, q: &[f64], qd: &[f64], u: &[f64], dm: &mut [f64], dc: &mut [f64], dk: &mut [f64]",
+        );
+        f.matrix(a, "dm", dm);
+        f.matrix(a, "dc", dc);
+        f.matrix(a, "dk", dk);
+        specs.push((f, Some("rest_tangent_derivatives (M', C', K')")));
+    }
     let mut f = FnSpec::new("__static_forces", args("static_forces"));
     f.vector("h", &eq.static_h);
     specs.push((f, Some("static_forces")));
@@ -479,24 +490,29 @@ fn emit_scene(
         fk.matrix(a, &format!("out.frames[{i}].jw"), &dense3(a, &k.jw, n));
     }
     specs.push((f, Some("frames")));
+    // the points' part again alone, for efforts that read only points
+    let mut fp = FnSpec::new("__point_kinematics", args("kinematics"));
     for (i, pk) in model.points.iter().enumerate() {
-        for r in 0..3 {
-            fk.outputs
-                .push((format!("out.points[{i}].position[{r}]"), pk.position[r]));
-            fk.outputs
-                .push((format!("out.points[{i}].velocity[{r}]"), pk.velocity[r]));
-            fk.outputs.push((
-                format!("out.points[{i}].bias_acceleration[{r}]"),
-                pk.bias[r],
-            ));
+        for g in [&mut fk, &mut fp] {
+            for r in 0..3 {
+                g.outputs
+                    .push((format!("out.points[{i}].position[{r}]"), pk.position[r]));
+                g.outputs
+                    .push((format!("out.points[{i}].velocity[{r}]"), pk.velocity[r]));
+                g.outputs.push((
+                    format!("out.points[{i}].bias_acceleration[{r}]"),
+                    pk.bias[r],
+                ));
+            }
+            g.matrix(
+                a,
+                &format!("out.points[{i}].jv"),
+                &dense3(a, &pk.jacobian, n),
+            );
         }
-        fk.matrix(
-            a,
-            &format!("out.points[{i}].jv"),
-            &dense3(a, &pk.jacobian, n),
-        );
     }
     specs.push((fk, Some("kinematics")));
+    specs.push((fp, Some("point_kinematics")));
     let mut f = FnSpec::new("__initial_state", args("initial_state"));
     let q0: Vec<ExprId> = sys.dofs.iter().map(|d| d.q0).collect();
     let qd0: Vec<ExprId> = sys.dofs.iter().map(|d| d.qd0).collect();
@@ -692,6 +708,7 @@ fn emit_scene(
             .filter(|p| p.sensitive)
             .map(|p| p.name.clone())
             .collect(),
+        rest_derivatives: sys.options.tangents && sys.params.iter().any(|p| p.sensitive),
     };
     let model_impl = api::model_impl(&ty, &pty, &sizes, |m| {
         match m.name {
@@ -702,6 +719,9 @@ fn emit_scene(
         }
         "tangents" => tangents_body.clone(),
         "parameter_tangents" => format!("self.__parameter_tangents({})", m.call()) + ";\nOk(())",
+        "rest_tangent_derivatives" => {
+            format!("self.__rest_tangent_derivatives({})", m.call()) + ";\nOk(())"
+        }
         "energy" => "let mut e = [0.0f64; 2];\nself.__energy(t, q, qd, &mut e);\n::mbs::Energy { kinetic: e[0], potential: e[1] }".into(),
         "power" => "let mut e = [0.0f64; 1];\nself.__power(t, q, qd, u, &mut e);\ne[0]".into(),
         // the constraint functions live on the parameter struct, shared by every scene

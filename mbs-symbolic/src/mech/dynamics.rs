@@ -59,6 +59,12 @@ pub struct SceneEquations {
     pub tangents: Option<(Matrix, Matrix)>,
     /// ∂τ/∂p (NQ × NS) for the parameters marked `sensitive`, in declaration order
     pub param_tangents: Option<Matrix>,
+    /// With sensitive parameters and tangents: how M, C = ∂τ/∂qd and K = ∂τ/∂q at rest
+    /// (qd = qdd = 0) change, as three NQ × NQ·(1 + NS) matrices [M', C', K'] whose block 0 is
+    /// the derivative along a direction δq (the variables `Qd` stand for δq, which the
+    /// matrices at rest no longer contain) and block 1 + j the partial derivative by
+    /// sensitive parameter j: what pole sensitivities need along the equilibria
+    pub rest_tangent_derivatives: Option<[Matrix; 3]>,
     pub kinetic: ExprId,
     pub potential: ExprId,
     /// power of the non-conservative effects
@@ -168,6 +174,47 @@ impl SceneEquations {
                 })
                 .collect::<Matrix>()
         });
+        let rest_tangent_derivatives = match (&tangents, param_tangents.is_some()) {
+            (Some((k, c)), true) => {
+                let mut rest = FxHashMap::default();
+                for j in 0..nd {
+                    rest.insert(Var::Qd(j as u16), a.zero());
+                    rest.insert(Var::Qdd(j as u16), a.zero());
+                }
+                let m: Matrix = tau
+                    .iter()
+                    .map(|&t| (0..nd).map(|j| a.diff(t, Var::Qdd(j as u16))).collect())
+                    .collect();
+                let mut at_rest = |x: &Matrix| -> Matrix {
+                    x.iter().map(|row| a.substitute(row, &rest)).collect()
+                };
+                let rested = [at_rest(&m), at_rest(c), at_rest(k)];
+                Some(rested.map(|x| {
+                    x.iter()
+                        .map(|row| {
+                            let mut out = Vec::with_capacity(nd * (1 + sensitive.len()));
+                            for &e in row {
+                                let terms: Vec<ExprId> = (0..nd)
+                                    .map(|k| {
+                                        let d = a.diff(e, Var::Q(k as u16));
+                                        let v = a.var(Var::Qd(k as u16));
+                                        a.mul(d, v)
+                                    })
+                                    .collect();
+                                out.push(a.sum(terms));
+                            }
+                            for &p in &sensitive {
+                                for &e in row {
+                                    out.push(a.diff(e, Var::Param(p)));
+                                }
+                            }
+                            out
+                        })
+                        .collect()
+                }))
+            }
+            _ => None,
+        };
         let forward = match formulation {
             Formulation::VirtualPower => forward_dynamics(sys, tree, &vp),
             Formulation::Recursive => forward_dynamics(sys, tree, &rec),
@@ -187,6 +234,7 @@ impl SceneEquations {
             input_matrix,
             tangents,
             param_tangents,
+            rest_tangent_derivatives,
             kinetic,
             potential,
             power,

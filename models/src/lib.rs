@@ -12,6 +12,7 @@
 //! | [`chain16_stiff`] | a chain of 16 bars with torsional springs of 1e6 N·m/rad in its joints |
 //! | [`chain30_stiff`] | a swinging chain of 30 light bars with undamped stiff torsional springs |
 //! | [`hexapod`] | 24-dof walking robot, free and standing on its feet |
+//! | [`hexapod_walker`] | the hexapod built to walk: outward legs, DC motors, gait generator, leg inverse kinematics, 1 kHz PIDs, terrain |
 //! | [`pendulum3`] | Cash's index-3 pendulum in Cartesian coordinates |
 //! | [`fourbar`] | a crank-rocker four-bar loop |
 //! | [`fastlink`] | a fast two-loop linkage of five light bodies thrown by a stiff spring |
@@ -38,6 +39,7 @@ pub mod dpend_cartesian;
 pub mod fastlink;
 pub mod fourbar;
 pub mod hexapod;
+pub mod hexapod_walker;
 pub mod pendulum3;
 pub mod seed2dof;
 pub mod slidercrank;

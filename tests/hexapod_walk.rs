@@ -1,0 +1,206 @@
+//! The hexapod walks (`models/src/hexapod_walker.rs`, `examples/hexapod_walk.rs`): the
+//! figures the example prints, asserted with margins on the runs it makes, under the 1 kHz
+//! sampled controller with the example's scheme (RK4, 0.2 ms).
+//!
+//! - tripod gait on flat ground: ≥ 2 m forward at ≥ 0.1 m/s, heading error ≤ 5°, no foot
+//!   slipping more than 1 cm during one contact, base height within ±1 cm of its set point
+//!   after the first cycle;
+//! - a turn on the spot and the 5 cm step climbed;
+//! - the continuous-time PIDs and the sampled controller walk alike;
+//! - the leg's inverse kinematics inverts its forward kinematics;
+//! - faults: an unreachable start is a typed error, an unreachable target during the walk
+//!   is recorded (the controller holds its voltages) or, with the continuous PIDs, a typed
+//!   failure that keeps the trajectory; saturated motors and feet that find no ground where
+//!   the controller expects it are modelled, never a panic.
+
+use mbs::{Options, Output, Scheme, StepControl};
+use mbs_models::hexapod_walker::*;
+
+fn options(t_end: f64) -> Options {
+    Options {
+        t_end,
+        step: StepControl::Fixed { h: 2e-4 },
+        output: Output::Every { dt: 0.005 },
+        ..Options::default()
+    }
+}
+
+fn run(walker: &Walker, t_end: f64) -> (Walk, Figures) {
+    let w = walk(walker, Control::Sampled, Scheme::Rk4, options(t_end)).expect("reachable start");
+    if let Some(e) = &w.failure {
+        panic!("the walk stopped: {e}");
+    }
+    let f = w.figures();
+    println!("{f:#?}");
+    (w, f)
+}
+
+#[test]
+fn tripod_walks_two_metres_straight_on_flat_ground() {
+    let walker = Walker::new(GaitParams::new(Gait::Tripod, 0.15));
+    let (w, f) = run(&walker, 16.0);
+    assert!(f.distance >= 2.0, "walked {} m", f.distance);
+    assert!(f.speed >= 0.1, "speed {} m/s", f.speed);
+    assert!(f.heading_error_deg <= 5.0, "{}°", f.heading_error_deg);
+    assert!(f.lateral.abs() <= 0.02, "{} m sideways", f.lateral);
+    assert!(f.max_slip <= 0.01, "a foot slipped {} m", f.max_slip);
+    assert!(
+        f.height_error <= 0.01,
+        "base height off by {} m",
+        f.height_error
+    );
+    // every foot stepped: about a contact per leg and cycle
+    assert!(f.contacts >= 6 * 14, "{} contacts", f.contacts);
+    assert!(w.log.failure.is_none());
+    assert_eq!(w.stats.samples, 16_001);
+    // the motors did the work: energy drawn, no voltage pinned at the supply
+    assert!(f.energy > 0.0 && f.cost_of_transport.is_finite());
+    assert!(f.saturated < 0.01, "{}", f.saturated);
+}
+
+#[test]
+fn turns_on_the_spot() {
+    let mut gait = GaitParams::new(Gait::Tripod, 0.0);
+    gait.yaw_rate = 0.2;
+    let (_, f) = run(&Walker::new(gait.clone()), 8.0);
+    let planned = (gait.yaw_rate * gait.ramp_integral(8.0)).to_degrees();
+    assert!(planned > 75.0, "{planned}");
+    assert!(
+        (f.turned_deg - planned).abs() <= 5.0,
+        "turned {}° of {planned}°",
+        f.turned_deg
+    );
+    assert!(
+        f.distance.hypot(f.lateral) <= 0.03,
+        "{} {}",
+        f.distance,
+        f.lateral
+    );
+    assert!(f.max_slip <= 0.01, "{}", f.max_slip);
+}
+
+#[test]
+fn climbs_a_5_cm_step() {
+    let mut walker = Walker::new(GaitParams::new(Gait::Tripod, 0.15));
+    walker.gait.step_height = 0.08;
+    walker.terrain = Terrain::step(0.6, 0.05);
+    let (_, f) = run(&walker, 10.0);
+    // every foot on the step at the end, the base at its set point above it
+    assert!(
+        f.lowest_foot_end >= 0.045,
+        "lowest foot {} m",
+        f.lowest_foot_end
+    );
+    assert!(f.distance >= 1.2, "{}", f.distance);
+    assert!(f.height_error <= 0.01, "{}", f.height_error);
+    assert!(f.max_slip <= 0.01, "{}", f.max_slip);
+}
+
+#[test]
+fn sampled_and_continuous_controllers_walk_alike() {
+    let walker = Walker::new(GaitParams::new(Gait::Tripod, 0.15));
+    let sampled = walk(&walker, Control::Sampled, Scheme::Rk4, options(3.0)).unwrap();
+    let continuous = walk(&walker, Control::Continuous, Scheme::Rk4, options(3.0)).unwrap();
+    assert!(sampled.failure.is_none() && continuous.failure.is_none());
+    let (a, b) = (&sampled.trajectory, &continuous.trajectory);
+    assert_eq!(a.len(), b.len());
+    let mut worst = [0.0f64; 3];
+    for i in 0..a.len() {
+        for (k, c) in [0, 2, 4].into_iter().enumerate() {
+            worst[k] = worst[k].max((a.q(i)[c] - b.q(i)[c]).abs());
+        }
+    }
+    println!(
+        "largest differences: x {:.2e} m, z {:.2e} m, pitch {:.2e} rad",
+        worst[0], worst[1], worst[2]
+    );
+    // a 1 kHz zero-order hold against the continuous law: tenths of a millimetre at most
+    assert!(
+        worst[0] < 2e-4 && worst[1] < 5e-5 && worst[2] < 1e-4,
+        "{worst:?}"
+    );
+    // but not the same run
+    assert!(worst[1] > 0.0);
+    let (ea, eb) = (sampled.figures().energy, continuous.figures().energy);
+    assert!((ea - eb).abs() < 0.02 * ea, "{ea} J vs {eb} J");
+}
+
+#[test]
+fn leg_inverse_kinematics_inverts_the_forward_kinematics() {
+    for leg in 0..LEGS {
+        for &(a, b, c) in &[(0.0, 0.3, -0.3), (0.2, -0.1, 0.4), (-0.3, 0.5, 0.1)] {
+            let p = leg_fk(leg, a, b, c);
+            let j = leg_ik(leg, p).unwrap();
+            let back = leg_fk(leg, j[0], j[1], j[2]);
+            for k in 0..3 {
+                assert!(
+                    (back[k] - p[k]).abs() < 1e-12,
+                    "leg {leg}: {p:?} vs {back:?}"
+                );
+            }
+            assert!(
+                (j[0] - a).abs() < 1e-12 && (j[1] - b).abs() < 1e-12 && (j[2] - c).abs() < 1e-12
+            );
+        }
+    }
+    let e = leg_ik(2, [0.0, 2.0, -0.4]).unwrap_err();
+    assert_eq!(e.leg, 2);
+    assert!(e.to_string().contains("cannot reach"), "{e}");
+}
+
+#[test]
+fn faults_are_modelled_or_typed() {
+    // a start the legs cannot reach: a typed error before any step
+    let mut gait = GaitParams::new(Gait::Tripod, 0.15);
+    gait.height = 0.9;
+    let e = walk(
+        &Walker::new(gait),
+        Control::Sampled,
+        Scheme::Rk4,
+        options(1.0),
+    )
+    .err();
+    assert!(e.is_some_and(|e| e.to_string().contains("cannot reach")));
+
+    // strides the legs cannot reach (2.5 m/s asks for 1.4 m): the sampled controller holds
+    // its voltages and says so; the continuous PIDs stop the run with a typed failure that
+    // keeps the trajectory
+    let walker = Walker::new(GaitParams::new(Gait::Tripod, 2.5));
+    let w = walk(&walker, Control::Sampled, Scheme::Rk4, options(1.5)).unwrap();
+    let (t, e) = w.log.failure.as_ref().expect("recorded");
+    assert!(
+        *t > walker.gait.start && e.to_string().contains("cannot reach"),
+        "{t} {e}"
+    );
+    let w = walk(&walker, Control::Continuous, Scheme::Rk4, options(1.5)).unwrap();
+    let failure = w.failure.as_ref().expect("a typed failure");
+    assert!(
+        matches!(failure.kind, mbs::Failure::UserEffort { .. }),
+        "{failure}"
+    );
+    assert!(failure.to_string().contains("cannot reach"), "{failure}");
+    assert!(w.trajectory.len() > 100 && *w.trajectory.t.last().unwrap() > walker.gait.start);
+
+    // motors on a 6 V supply saturate: modelled (voltages clipped), no panic
+    let mut walker = Walker::new(GaitParams::new(Gait::Tripod, 0.15));
+    walker.motor.v_max = 6.0;
+    let w = walk(&walker, Control::Sampled, Scheme::Rk4, options(3.0)).unwrap();
+    let f = w.figures();
+    assert!(f.saturated > 0.0 && f.peak_voltage <= 6.0, "{f:?}");
+
+    // the controller expects a 5 cm step the ground does not have: feet lose their contact
+    // where it plans them; whatever happens is a trajectory or a typed failure
+    let mut walker = Walker::new(GaitParams::new(Gait::Tripod, 0.15));
+    walker.terrain = Terrain::step(0.6, 0.05);
+    let w = walk_on(
+        &walker,
+        &Terrain::default(),
+        Control::Sampled,
+        Scheme::Rk4,
+        options(6.0),
+    )
+    .unwrap();
+    assert!(w.trajectory.len() > 100);
+    let f = w.figures();
+    assert!(f.contacts > 0 && f.distance.is_finite());
+}

@@ -332,13 +332,8 @@ impl<M: Model, E: Efforts> Model for WithEfforts<M, E> {
         let ok = crate::linalg::cholesky(&mut s.l, n).is_ok();
         for i in 0..n {
             qdd[i] = s.h[i] + s.qg[i];
-            pivots[i] = if ok { s.l[i + n * i].powi(2) } else { 0.0 };
         }
-        if ok {
-            crate::linalg::cholesky_solve(&s.l, n, &mut qdd[..n]);
-        } else {
-            qdd[..n].fill(f64::NAN);
-        }
+        crate::linalg::solve_with_pivots(&s.l, n, ok, &mut qdd[..n], &mut pivots[..n]);
         qdd[n..].copy_from_slice(&s.xd);
         pivots[n..].fill(1.0);
     }

@@ -61,6 +61,19 @@ pub fn cholesky_solve(l: &[f64], n: usize, b: &mut [f64]) {
     backward(l, n, b);
 }
 
+/// What a forward-dynamics solve by a dense factorisation gives: `x` ← L⁻ᵀL⁻¹x and the pivots
+/// L_jj² (n of each) when the factorisation `l` succeeded (`ok`), else NaN and zeros.
+pub fn solve_with_pivots(l: &[f64], n: usize, ok: bool, x: &mut [f64], pivots: &mut [f64]) {
+    for (j, p) in pivots.iter_mut().enumerate() {
+        *p = if ok { l[j + n * j] * l[j + n * j] } else { 0.0 };
+    }
+    if ok {
+        cholesky_solve(l, n, x);
+    } else {
+        x.fill(f64::NAN);
+    }
+}
+
 /// Solves L y = b in place (L lower triangular, from [`cholesky`]).
 pub fn forward(l: &[f64], n: usize, b: &mut [f64]) {
     for i in 0..n {

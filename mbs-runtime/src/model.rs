@@ -394,14 +394,7 @@ pub trait Model {
         let mut m = vec![0.0; n * n];
         self.dynamics(t, q, qd, u, &mut m, qdd);
         let ok = crate::linalg::cholesky(&mut m, n).is_ok();
-        for (j, p) in pivots.iter_mut().enumerate() {
-            *p = if ok { m[j + n * j] * m[j + n * j] } else { 0.0 };
-        }
-        if ok {
-            crate::linalg::cholesky_solve(&m, n, qdd);
-        } else {
-            qdd.fill(f64::NAN);
-        }
+        crate::linalg::solve_with_pivots(&m, n, ok, qdd, pivots);
     }
 
     /// [`Model::dynamics`] at four states at once (`t`, `q`, `qd`, `u`, `m`, `h` hold one

@@ -226,14 +226,7 @@ impl<M: Model + 'static> Model for Sensitivities<M> {
         for b in 0..=M::SENSITIVE.len() {
             let block = &mut qdd[b * n..(b + 1) * n];
             block.copy_from_slice(&s.haug[b * n..(b + 1) * n]);
-            if ok {
-                cholesky_solve(&s.l, n, block);
-            } else {
-                block.fill(f64::NAN);
-            }
-            for j in 0..n {
-                pivots[b * n + j] = if ok { s.l[j + n * j].powi(2) } else { 0.0 };
-            }
+            crate::linalg::solve_with_pivots(&s.l, n, ok, block, &mut pivots[b * n..(b + 1) * n]);
         }
     }
 

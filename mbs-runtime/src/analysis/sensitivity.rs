@@ -13,6 +13,16 @@ use crate::error::Failure;
 use crate::linalg::Lu;
 use crate::model::Model;
 
+/// The error refusing `model` for `reason`.
+fn refusal<M: Model>(model: &M, reason: &'static str) -> AnalysisError {
+    Failure::InvalidOption {
+        name: "model",
+        value: model.info().name.to_string(),
+        reason,
+    }
+    .into()
+}
+
 /// dq/dp at an equilibrium: one column per sensitive parameter.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct StaticSensitivity {
@@ -43,13 +53,7 @@ pub fn static_sensitivity<M: Model + Clone>(
 ) -> Result<StaticSensitivity, AnalysisError> {
     let n = M::NQ;
     let ns = M::SENSITIVE.len();
-    let refuse = |reason: &'static str| {
-        AnalysisError::from(Failure::InvalidOption {
-            name: "model",
-            value: model.info().name.to_string(),
-            reason,
-        })
-    };
+    let refuse = |reason| refusal(model, reason);
     if ns == 0 {
         return Err(refuse(
             "it has no sensitive parameters: mark them, `param k = 1e4 sensitive;`",
@@ -164,13 +168,7 @@ pub fn pole_sensitivity<M: Model + Clone>(
     use crate::linalg::{C64, Field};
     let n = M::NQ;
     let ns = M::SENSITIVE.len();
-    let refuse = |reason: &'static str| {
-        AnalysisError::from(Failure::InvalidOption {
-            name: "model",
-            value: model.info().name.to_string(),
-            reason,
-        })
-    };
+    let refuse = |reason| refusal(model, reason);
     if !options.locked.is_empty() {
         return Err(Failure::InvalidOption {
             name: "locked",

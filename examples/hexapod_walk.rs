@@ -85,10 +85,14 @@ fn print_figures(label: &str, f: &Figures) {
         f.pitch_range_deg,
         f.roll_range_deg
     );
+    let cot = if f.cost_of_transport.is_finite() {
+        format!("{:.3}", f.cost_of_transport)
+    } else {
+        "n/a (no distance)".into()
+    };
     println!(
-        "  motors: {:.1} J drawn, cost of transport {:.3}, peak current {:.1} A, peak voltage {:.1} V ({:.2} % of samples saturated)",
+        "  motors: {:.1} J drawn, cost of transport {cot}, peak current {:.1} A, peak voltage {:.1} V ({:.2} % of samples saturated)",
         f.energy,
-        f.cost_of_transport,
         f.peak_current,
         f.peak_voltage,
         100.0 * f.saturated

@@ -297,6 +297,10 @@ fn stance_point(p: [f64; 3], v: [f64; 2], w: f64, tau: f64) -> [f64; 3] {
     ]
 }
 
+/// The share of a swing at its start (and end) during which the foot only rises (and
+/// lowers): it moves across in between.
+const ACROSS_START: f64 = 0.2;
+
 /// How wide the gait generator rounds the terrain's edges (m): [`Terrain::planned_height`].
 pub const EDGE: f64 = 0.04;
 
@@ -350,10 +354,11 @@ impl BasePose {
 /// [`GaitParams::ramp`]) plus the central controller's corrections `dv` (base frame) and
 /// `dw`, over `terrain`: a stance foot stays where it touched down while the base moves on,
 /// a swing foot returns on a smooth arc lifted by `step_height` (zero vertical speed at
-/// lift-off and touch-down; the lift also grows over the first cycle). Heights
+/// lift-off and touch-down). Until `g.start` the targets are those of the start (a leg in
+/// its swing then is held up, the robot standing on the others). Heights
 /// follow the terrain under each foot: a foot's target depth below the base is the terrain
 /// height there minus the base's reference height, `g.height` above the mean terrain height
-/// under the six neutral foot points. Before `g.start` every foot stays at its neutral point.
+/// under the six neutral foot points.
 pub fn foot_targets(
     g: &GaitParams,
     terrain: &Terrain,
@@ -384,7 +389,8 @@ pub fn foot_targets(
         let (s, c) = (-(a1 - a0)).sin_cos();
         [c * f[0] - s * f[1] - (x1 - x0), s * f[0] + c * f[1], p[2]]
     };
-    let lift_scale = g.ramp(t);
+    // the gait's clock stands still until the start: the targets then are those of the start
+    let t = t.max(g.start);
     for (leg, target) in out.iter_mut().enumerate() {
         let p = neutral_points[leg];
         let cycles = (t - g.start) / g.period + g.gait.offset(leg);
@@ -402,10 +408,15 @@ pub fn foot_targets(
             let from = at(p, t_td + ts / 2.0, t_lo);
             let to = at(p, t_next + ts / 2.0, t_next);
             let (z0, z1) = (ground(from), ground(to));
-            // across smoothly; up to the touch-down height by mid-swing; lifted
+            // lifted first, across in the middle 60 % of the swing (a foot that lags its
+            // target in height would otherwise drag), up to the touch-down height by
+            // mid-swing
             let smooth = |x: f64| x * x * (3.0 - 2.0 * x);
-            let (across, up) = (smooth(s), smooth((2.0 * s).min(1.0)));
-            let lift = lift_scale * g.step_height * 0.5 * (1.0 - (2.0 * PI * s).cos());
+            let (across, up) = (
+                smooth(((s - ACROSS_START) / (1.0 - 2.0 * ACROSS_START)).clamp(0.0, 1.0)),
+                smooth((2.0 * s).min(1.0)),
+            );
+            let lift = g.step_height * 0.5 * (1.0 - (2.0 * PI * s).cos());
             [
                 from[0] + (to[0] - from[0]) * across,
                 from[1] + (to[1] - from[1]) * across,
@@ -1008,7 +1019,8 @@ pub struct Figures {
     pub pitch_range_deg: f64,
     pub roll_range_deg: f64,
     /// electrical energy drawn (J), cost of transport E / (m g d), peak |current| (A),
-    /// peak |voltage| (V) and the fraction of samples with a saturated voltage
+    /// peak |voltage| (V) and the fraction of samples with a saturated voltage (the cost of
+    /// transport is infinite for a walk of less than 1 cm)
     pub energy: f64,
     pub cost_of_transport: f64,
     pub peak_current: f64,
@@ -1105,7 +1117,8 @@ impl Walk {
         let mut m = vec![0.0; n * n];
         model.mass_matrix(0.0, self.q(0), &mut m);
         let weight = m[0] * model.params().g;
-        f.cost_of_transport = if d_end.abs() > 1e-6 {
+        // (no cost of transport for a walk that goes nowhere: a turn on the spot)
+        f.cost_of_transport = if d_end.abs() > 0.01 {
             f.energy / (weight * d_end.abs())
         } else {
             f64::INFINITY

@@ -102,11 +102,10 @@ fn print_figures(label: &str, f: &Figures) {
 
 fn main() {
     use clap::{CommandFactory, FromArgMatches};
-    // this program's defaults: RK4 at 0.2 ms (five steps per control period), outputs every
-    // 5 ms
+    // this program's defaults: RK4 (at 0.2 ms unless --h: five steps per control period),
+    // outputs every 5 ms
     let command = Args::command()
         .mut_arg("scheme", |a| a.default_value("rk4"))
-        .mut_arg("h", |a| a.default_value("2e-4"))
         .mut_arg("dt", |a| a.default_value("0.005"));
     let args = Args::from_arg_matches(&command.get_matches()).unwrap_or_else(|e| e.exit());
     if let Err(e) = run(&args) {
@@ -119,7 +118,11 @@ fn run(args: &Args) -> Result<(), String> {
     let walker = walker(args)?;
     let scheme = Scheme::from_name(&args.run.scheme)
         .ok_or_else(|| format!("unknown scheme `{}`", args.run.scheme))?;
-    let options = args.run.options(16.0);
+    let mut options = args.run.options(16.0);
+    if args.run.h.is_none() && scheme == Scheme::Rk4 {
+        // RK4 has no error estimate: a fixed step, five per control period
+        options.step = mbs::StepControl::Fixed { h: 2e-4 };
+    }
     let control = if args.continuous {
         Control::Continuous
     } else {

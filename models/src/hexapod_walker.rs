@@ -820,28 +820,28 @@ pub type ContinuousDrive = Drive<true>;
 pub const ENERGY: usize = JOINTS;
 
 impl<const PID: bool> Drive<PID> {
-    /// The motors' voltages at the state in `e`.
-    fn voltages(&self, e: &Effort) -> Result<[f64; JOINTS], String> {
+    /// The motors' voltages at the state in `e` and, with the continuous PIDs, the angle
+    /// errors their integrals follow (zero for the sampled controller).
+    fn voltages(&self, e: &Effort) -> Result<([f64; JOINTS], [f64; JOINTS]), String> {
+        let (mut v, mut errors) = ([0.0; JOINTS], [0.0; JOINTS]);
         if !PID {
-            let mut v = [0.0; JOINTS];
             v.copy_from_slice(&e.u[..JOINTS]);
-            return Ok(v);
+            return Ok((v, errors));
         }
         let (targets, rates) = self
             .walker
             .targets_and_rates(e.t, e.q)
             .map_err(|u| u.to_string())?;
-        let mut v = [0.0; JOINTS];
+        let vmax = self.walker.motor.v_max;
         for j in 0..JOINTS {
-            let err = targets[j] - e.q[FIRST_JOINT + j];
+            errors[j] = targets[j] - e.q[FIRST_JOINT + j];
             let rate = rates[j] - e.qd[FIRST_JOINT + j];
-            let vmax = self.walker.motor.v_max;
             v[j] = self
                 .walker
-                .pid_voltage(err, e.x[JOINTS + 1 + j], rate)
+                .pid_voltage(errors[j], e.x[JOINTS + 1 + j], rate)
                 .clamp(-vmax, vmax);
         }
-        Ok(v)
+        Ok((v, errors))
     }
 }
 
@@ -871,7 +871,7 @@ impl<const PID: bool> Efforts for Drive<PID> {
     }
 
     fn state_derivatives(&mut self, e: &Effort, xd: &mut [f64]) -> Result<(), String> {
-        let v = self.voltages(e)?;
+        let (v, errors) = self.voltages(e)?;
         let motor = &self.walker.motor;
         let mut power = 0.0;
         for j in 0..JOINTS {
@@ -881,13 +881,7 @@ impl<const PID: bool> Efforts for Drive<PID> {
         }
         xd[ENERGY] = power;
         if PID {
-            let (targets, _) = self
-                .walker
-                .targets_and_rates(e.t, e.q)
-                .map_err(|u| u.to_string())?;
-            for j in 0..JOINTS {
-                xd[JOINTS + 1 + j] = targets[j] - e.q[FIRST_JOINT + j];
-            }
+            xd[JOINTS + 1..].copy_from_slice(&errors);
         }
         Ok(())
     }

@@ -153,6 +153,16 @@
 //! `generalized_force(q[0], -k * pos(q[0] - 0.1))`. Exact tangents see their derivatives
 //! away from the kink, not the jump.
 //!
+//! `spline(x, [(x0, y0), (x1, y1), …])` is the natural cubic spline through the points
+//! (x0 < x1 < …, at least two; numbers known when the model is generated): cubic between
+//! knots with continuous slope and curvature, zero curvature at both ends, and beyond the
+//! ends the straight line of the end value and slope. Its derivatives are generated like any
+//! other (up to the third, constant between knots), so a joint that is not a classical one —
+//! a knee whose centre glides with its angle — is written with its published points:
+//! `fn g5(a) = spline(a, [(-2.1, 0.012), (-1.4, 0.006), (0.0, 0.0)]);` then
+//! `TOG[tibia] = TOG[femur] * Tdisp(g5(knee), g6(knee), 0) * Trotz(knee)`. Generated code holds
+//! the tables as `Params::SPLINES` ([`crate::Spline`]).
+//!
 //! ## Effects
 //!
 //! | effect | meaning |
@@ -170,6 +180,8 @@
 //! | `contact(p, k = …, c = …, mu = …);` | penalty contact of a point or body origin with the ground plane z = 0 (below) |
 //! | `contact(p, k = …, plane = y, offset = h0);` | with the fixed plane n·x = h0: `plane` is its unit normal pointing out of the ground, `x`, `y`, `z` (default), `-z`, … or `(nx, ny, nz)`; `offset` default 0 |
 //! | `contact(body, sphere = r, k = …, …);` | a sphere of radius r centred at the body's origin (or at a point) |
+//! | `contact(p, ellipsoid = (a, b, c), k = …, …);` | an ellipsoid centred at a point or body origin, semi-axes a, b, c along the axes of its body (or frame) |
+//! | `contact(p, k = …, exponent = 1.5, dissipation = d, …);` | Hunt–Crossley normal force k δ^e (1 + d δ̇) instead of the linear k δ (below) |
 //! | `rotational_spring(A, B, axis = z, k = …, angle0 = θ0);` | a linear rotational spring between two bodies or frames (either may be `ground`) about an axis (`x`, `y`, `z` or a unit `(nx, ny, nz)`, in A's axes): the torque −k (θ − θ0) about the axis on B and the opposite on A, θ the angle of B relative to A about it (below); potential ½ k (θ − θ0)²; `angle0` default 0; `c = …` adds a damper |
 //! | `rotational_damper(A, B, axis = z, c = …);` | the torque −c θ̇ about the axis on B, the opposite on A |
 //! | `bushing(A, B, k = (kx, ky, kz), kr = (…), c = (…), cr = (…));` | six-axis linear spring–damper between the origins and axes of two bodies or frames (either may be `ground`), coefficients along A's axes; one value sets all three axes; each of `k kr c cr` defaults to 0 (at least one) |
@@ -192,8 +204,20 @@
 //! - potential ½ k pos(δ)², the potential of the elastic part k pos(δ) (a contact without
 //!   `c` and `mu` is conservative: its normal force is k pos(δ)).
 //!
-//! `k` is required and positive; `c` ≥ 0 (default 0), `mu` ≥ 0, `eps` > 0, `sphere` > 0. A
-//! point contact applies no moment about the point; a sphere with friction rolls. At first
+//! An **ellipsoid** with semi-axes D = diag(a, b, c) along its body's axes R touches the plane
+//! at its support point along −n, x − R D² m / s with m = Rᵀ n and s = sqrt(mᵀ D² m), computed
+//! in closed form in the generated code: δ = h0 − n·x + s, and the normal force and friction
+//! act at that point (whose velocity has n·v = −δ̇ exactly, so the energy identity holds).
+//! Equal semi-axes give the sphere. The **Hunt–Crossley** law replaces the linear spring by
+//! k pos(δ)^e (1 + d δ̇): `exponent = e` (a number ≥ 1; 1.5 is Hertz's law for curved
+//! surfaces, k then in N/m^1.5) and `dissipation = d` ≥ 0 (s/m; Hunt and Crossley's
+//! d = 3α/2 with α from the coefficient of restitution, e ≈ 1 − α v at impact speed v), with
+//! potential k pos(δ)^(e+1)/(e + 1); `c` still adds c δ̇, and the force never pulls:
+//! F_n = step(δ)·pos(k pos(δ)^e (1 + d δ̇) + c δ̇).
+//!
+//! `k` is required and positive; `c` ≥ 0 (default 0), `mu` ≥ 0, `eps` > 0, `sphere` > 0,
+//! semi-axes > 0, `dissipation` ≥ 0. A point contact applies no moment about the point; a
+//! sphere or an ellipsoid with friction rolls. At first
 //! touch the normal force jumps to c δ̇ (integrators with error control take small steps
 //! there); c ≈ 2 ζ √(k m) gives a damping ratio ζ for a mass m on the contact.
 //!

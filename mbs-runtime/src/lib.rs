@@ -24,6 +24,7 @@ pub mod model;
 mod op_count;
 pub mod options;
 pub mod sensitivity;
+pub mod spline;
 pub mod stats;
 pub mod trajectory;
 
@@ -49,5 +50,6 @@ pub use options::{
     NewmarkParams, NewtonOptions, Options, Output, Scheme, StepControl,
 };
 pub use sensitivity::Sensitivities;
+pub use spline::Spline;
 pub use stats::{ErrorTest, Stats};
 pub use trajectory::{CsvWriter, Observer, Trajectory};

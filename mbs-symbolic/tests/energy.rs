@@ -141,6 +141,9 @@ fn oracle_h(
                 Load::Contact {
                     at,
                     radius,
+                    ellipsoid,
+                    exponent,
+                    dissipation,
                     normal,
                     offset,
                     k,
@@ -151,11 +154,37 @@ fn oracle_h(
                     let (x, v, la) = point(at);
                     let (l, rl) = la.expect("contacts are on bodies");
                     let n = ev3(normal);
-                    let p = ev(&[*radius, *offset, *k, *c, *mu, *eps]);
+                    let p = ev(&[*radius, *offset, *k, *c, *mu, *eps, *exponent, *dissipation]);
                     let (r, h0, k, c, mu, eps) = (p[0], p[1], p[2], p[3], p[4], p[5]);
-                    let delta = h0 + r - dot(n, x);
-                    let nv = dot(n, v);
-                    let raw = k * delta - c * nv;
+                    let (e, d) = (p[6], p[7]);
+                    let rot = poses[l].0;
+                    let wl = [vels[l][0], vels[l][1], vels[l][2]];
+                    let w = mv(&rot, wl);
+                    // the point where the forces act, relative to x (world), its velocity and
+                    // the penetration: an ellipsoid's support point along −n, in closed form
+                    // from the link's axes, or the sphere's lowest point x − r n
+                    let (arm, vc, delta) = match ellipsoid {
+                        Some(axes) => {
+                            let ax = ev3(axes);
+                            let m = mv(&tr(&rot), n);
+                            let u = [
+                                ax[0] * ax[0] * m[0],
+                                ax[1] * ax[1] * m[1],
+                                ax[2] * ax[2] * m[2],
+                            ];
+                            let s = dot(m, u).sqrt();
+                            let arm = mv(&rot, scale(-1.0 / s, u));
+                            (arm, add(v, cross(w, arm)), h0 - dot(n, x) + s)
+                        }
+                        None => {
+                            let arm = scale(-r, n);
+                            (arm, add(v, cross(w, arm)), h0 + r - dot(n, x))
+                        }
+                    };
+                    // n·v of the contact point (for an ellipsoid it is −δ̇; for a sphere, n·v
+                    // of its centre)
+                    let nv = dot(n, vc);
+                    let raw = k * delta.max(0.0).powf(e) * (1.0 - d * nv) - c * nv;
                     regimes[if delta <= 0.0 {
                         0
                     } else if raw > 0.0 {
@@ -164,11 +193,7 @@ fn oracle_h(
                         2
                     }] += 1;
                     let f_n = if delta > 0.0 { raw.max(0.0) } else { 0.0 };
-                    // the force acts at the contact point x − r n, a material point of link l
-                    let rot = poses[l].0;
-                    let w = mv(&rot, [vels[l][0], vels[l][1], vels[l][2]]);
-                    let arm = scale(-r, n);
-                    let vc = add(v, cross(w, arm));
+                    // the force acts at the contact point, a material point of link l
                     let vt = sub(vc, scale(nv, n));
                     let ft = scale(-mu * f_n / (dot(vt, vt) + eps * eps).sqrt(), vt);
                     let at_contact = add(rl, mv(&tr(&rot), arm));
@@ -291,7 +316,7 @@ fn balance(
     seed0: u64,
     elements: bool,
     tally: &mut [usize; 7],
-    el_tally: &mut [usize; 6],
+    el_tally: &mut [usize; 8],
 ) -> Balance {
     let mut out = Balance {
         max_power: f64::NEG_INFINITY,
@@ -403,7 +428,7 @@ fn balance(
 #[test]
 fn energy_balance_with_loads() {
     let mut tally = [0usize; 7];
-    let b = balance(3000, false, &mut tally, &mut [0; 6]);
+    let b = balance(3000, false, &mut tally, &mut [0; 8]);
     println!(
         "{TREES} trees x {STATES} states x 2 scenes; loads: {} springs, {} dampers, {} world \
          forces, {} body-frame forces, {} torques, {} torques with reaction, {} generalised forces",
@@ -417,7 +442,7 @@ fn energy_balance_with_loads() {
     assert!(tally.iter().all(|&c| c >= 5), "{tally:?}");
 }
 
-/// The same with contacts (points and spheres, damping, friction), bushings and rotational
+/// The same with contacts (points, spheres and ellipsoids, linear or Hunt–Crossley, damping, friction), bushings and rotational
 /// springs: an undamped bushing, an undamped, frictionless contact and an undamped rotational
 /// spring join the conservative scene (the bushing's elastic torque must be exactly the
 /// gradient of ½ θᵀ K_r θ, the rotational spring's that of ½ k (θ − θ0)², for the balance to
@@ -425,14 +450,24 @@ fn energy_balance_with_loads() {
 /// full one.
 #[test]
 fn energy_balance_with_contacts_and_bushings() {
-    let mut el = [0usize; 6];
+    let mut el = [0usize; 8];
     let b = balance(5000, true, &mut [0; 7], &mut el);
     println!(
         "{TREES} trees x {STATES} states x 3 scenes; {} point contacts, {} sphere contacts, \
-         {} bushings to the ground, {} between frames, {} rotational springs about a joint's \
-         axis, {} about a random axis; contact states: {} separated, {} pressing, {} \
-         penetrating with F_n clipped to 0",
-        el[0], el[1], el[2], el[3], el[4], el[5], b.regimes[0], b.regimes[1], b.regimes[2]
+         {} ellipsoid contacts, {} Hunt–Crossley, {} bushings to the ground, {} between \
+         frames, {} rotational springs about a joint's axis, {} about a random axis; contact \
+         states: {} separated, {} pressing, {} penetrating with F_n clipped to 0",
+        el[0],
+        el[1],
+        el[2],
+        el[3],
+        el[4],
+        el[5],
+        el[6],
+        el[7],
+        b.regimes[0],
+        b.regimes[1],
+        b.regimes[2]
     );
     b.vp_rec.check(
         "M, h with force elements: virtual power vs recursive",

@@ -15,6 +15,9 @@ pub struct RustNames<'a> {
     /// path of the charts of rotation joints (`[[[f64; 3]; 3]; K]`): `self.charts` in models,
     /// the argument `charts` of the constraint functions on the parameter struct
     pub charts_path: &'a str,
+    /// path of the model's splines (`[::mbs::Spline; K]`), an associated constant of the
+    /// parameter struct
+    pub splines_path: &'a str,
 }
 
 impl Naming for RustNames<'_> {
@@ -48,6 +51,9 @@ impl Naming for RustNames<'_> {
                 format!("let r_{i} = {}[{j}][{r}][{c}];", self.charts_path)
             }
         }
+    }
+    fn spline(&self, s: u16) -> String {
+        format!("{}[{s}]", self.splines_path)
     }
 }
 

@@ -192,6 +192,32 @@ fn emit_params(
         "impl ::core::default::Default for {ty} {{\nfn default() -> Self {{\nSelf {{ {} }}\n}}\n}}",
         fields.join(", ")
     );
+    if !a.splines().is_empty() {
+        let list = |v: Vec<String>| format!("[{}]", v.join(", "));
+        let lit = |x: &f64| crate::expr::emit::literal(*x);
+        let tables: Vec<String> = a
+            .splines()
+            .iter()
+            .map(|s| {
+                format!(
+                    "::mbs::Spline::from_table(&{}, &{})",
+                    list(s.knots.iter().map(lit).collect()),
+                    list(
+                        s.coefficients
+                            .iter()
+                            .map(|c| list(c.iter().map(lit).collect()))
+                            .collect()
+                    )
+                )
+            })
+            .collect();
+        let _ = writeln!(
+            code,
+            "#[allow(clippy::all)]\nimpl {ty} {{\n/// The natural cubic splines of the model's `spline(x, [(x0, y0), …])`: knots, and the coefficients c0 + c1 s + c2 s² + c3 s³ of each interval.\npub const SPLINES: [::mbs::Spline; {}] = [{}];\n}}",
+            tables.len(),
+            tables.join(",\n")
+        );
+    }
     // validation: masses, inertias, spring stiffnesses as functions of the parameters
     let mut spec = FnSpec::new("__derived", "v: &mut [f64]");
     let mut checks = Vec::new();
@@ -233,6 +259,8 @@ fn emit_params(
                 }
                 Load::Contact {
                     radius,
+                    ellipsoid,
+                    dissipation,
                     k: stiff,
                     c,
                     mu,
@@ -245,6 +273,10 @@ fn emit_params(
                     coefficients.push((el.clone(), "c", *c, false));
                     coefficients.push((el.clone(), "mu", *mu, false));
                     coefficients.push((el.clone(), "eps", *eps, true));
+                    coefficients.push((el.clone(), "dissipation", *dissipation, false));
+                    for axis in ellipsoid.iter().flatten() {
+                        coefficients.push((el.clone(), "ellipsoid", *axis, true));
+                    }
                     coefficients.push((el, "radius", *radius, false));
                 }
                 Load::Bushing {
@@ -286,10 +318,12 @@ fn emit_params(
             }
         }
     }
+    let splines = format!("{ty}::SPLINES");
     let names = RustNames {
         params: &sys.params,
         params_path: "self",
         charts_path: "charts",
+        splines_path: &splines,
     };
     let mut derived = collect(emit_fn(a, &spec, &names), missing, |s, _| s).unwrap_or_default();
     // the constraints are the same in every scene: emitted once, here
@@ -390,10 +424,12 @@ fn emit_scene(
     let a = &sys.arena;
     let n = sys.ndof();
     let ty = scene_type(sys, eq.scene);
+    let splines = format!("{}Params::SPLINES", sys.name);
     let names = RustNames {
         params: &sys.params,
         params_path: "self.params",
         charts_path: "self.charts",
+        splines_path: &splines,
     };
     // the methods to emit, with the label of their op-count row (none for initial_state)
     let mut specs: Vec<(FnSpec, Option<&str>)> = Vec::new();

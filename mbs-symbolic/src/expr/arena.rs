@@ -1,6 +1,6 @@
 //! Storage: nodes in creation order, a hash map for hash-consing, and per-node dependency masks.
 
-use super::{ExprId, Node, UserFn, Var, num_bits};
+use super::{ExprId, Node, SplineTable, UserFn, Var, num_bits};
 use rustc_hash::FxHashMap;
 
 /// A hash-consed expression arena: structurally equal nodes get the same id, so common
@@ -15,6 +15,7 @@ pub struct Arena {
     /// memo of derivatives: (node, direction) packed by [`Dir::key`] -> derivative
     pub(super) dmemo: FxHashMap<u64, ExprId>,
     pub(super) user_fns: Vec<UserFn>,
+    pub(super) splines: Vec<SplineTable>,
 }
 
 /// Direction of differentiation.
@@ -67,6 +68,7 @@ impl Arena {
             slots: vec![u32::MAX; 1 << 17],
             dmemo: FxHashMap::default(),
             user_fns: Vec::new(),
+            splines: Vec::new(),
         };
         let z = a.intern(Node::Num(num_bits(0.0)));
         let o = a.intern(Node::Num(num_bits(1.0)));
@@ -141,6 +143,20 @@ impl Arena {
 
     pub fn user_fns(&self) -> &[UserFn] {
         &self.user_fns
+    }
+
+    /// Registers a spline and returns its number (equal tables share one).
+    pub fn spline_table(&mut self, s: SplineTable) -> u16 {
+        if let Some(i) = self.splines.iter().position(|g| *g == s) {
+            return i as u16;
+        }
+        self.splines.push(s);
+        (self.splines.len() - 1) as u16
+    }
+
+    /// The splines of the model, by number.
+    pub fn splines(&self) -> &[SplineTable] {
+        &self.splines
     }
 
     /// Inserts a node as is (no rules): callers are the canonicalising constructors.
@@ -268,6 +284,7 @@ fn node_hash(n: &Node) -> u64 {
         Node::Func(f, x) => (10 + f as u64 * 16, x.0 as u64, 0),
         Node::Atan2(x, y) => (11, x.0 as u64, y.0 as u64),
         Node::Call(f, o, x) => (12 + ((f as u64) << 8 | o as u64) * 16, x.0 as u64, 0),
+        Node::Spline(s, o, x) => (13 + ((s as u64) << 8 | o as u64) * 16, x.0 as u64, 0),
     };
     let h = (tag ^ a.wrapping_mul(0x9E3779B97F4A7C15)).wrapping_mul(0xff51afd7ed558ccd)
         ^ b.wrapping_mul(0xc4ceb9fe1a85ec53);

@@ -27,7 +27,11 @@ pub fn ops_of_nodes(arena: &Arena, nodes: &[ExprId]) -> OpCount {
             Node::Div(..) => c.divs += 1,
             Node::Neg(..) => c.adds += 1,
             Node::Powi(_, k) => c.muls += (k.unsigned_abs() as usize).saturating_sub(1),
-            Node::Pow(..) | Node::Func(..) | Node::Atan2(..) | Node::Call(..) => c.funcs += 1,
+            Node::Pow(..)
+            | Node::Func(..)
+            | Node::Atan2(..)
+            | Node::Call(..)
+            | Node::Spline(..) => c.funcs += 1,
         }
     }
     c

@@ -73,7 +73,11 @@ impl Schedule {
             depth[n.index()] = d;
             let expensive = matches!(
                 node,
-                Node::Func(..) | Node::Pow(..) | Node::Atan2(..) | Node::Call(..)
+                Node::Func(..)
+                    | Node::Pow(..)
+                    | Node::Atan2(..)
+                    | Node::Call(..)
+                    | Node::Spline(..)
             );
             let output_only = is_output[n.index()] && uses[n.index()] == 1;
             if !output_only && (uses[n.index()] > 1 || expensive || d > MAX_INLINE_DEPTH) {

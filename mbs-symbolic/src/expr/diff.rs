@@ -127,8 +127,17 @@ impl Arena {
                 self.mul(p, da)
             }
             Node::Pow(a, b) => {
-                // (a^b)' = a^b (b' ln a + b a'/a)
                 let (da, db) = (d(self, a), d(self, b));
+                if db == self.zero() {
+                    // (a^b)' = b a^(b−1) a' for an exponent constant in this direction: no
+                    // ln a and no division by a, so a = 0 (pos(δ)^1.5 out of contact) gives 0
+                    let one = self.one();
+                    let e = self.sub(b, one);
+                    let p = self.pow(a, e);
+                    let p = self.mul(b, p);
+                    return self.mul(p, da);
+                }
+                // (a^b)' = a^b (b' ln a + b a'/a)
                 let la = self.func(Func::Ln, a);
                 let x = self.mul(db, la);
                 let y = self.mul(b, da);
@@ -155,6 +164,11 @@ impl Arena {
             Node::Call(f, k, a) => {
                 let da = d(self, a);
                 let c = self.call(f, k + 1, a);
+                self.mul(c, da)
+            }
+            Node::Spline(s, k, a) => {
+                let da = d(self, a);
+                let c = self.spline(s, k + 1, a);
                 self.mul(c, da)
             }
         }
@@ -225,6 +239,7 @@ impl Arena {
                 Node::Func(f, a) => self.func(f, r(&memo, a)),
                 Node::Atan2(a, b) => self.atan2(r(&memo, a), r(&memo, b)),
                 Node::Call(f, k, a) => self.call(f, k, r(&memo, a)),
+                Node::Spline(s, k, a) => self.spline(s, k, r(&memo, a)),
             };
             memo.insert(n, new);
         }

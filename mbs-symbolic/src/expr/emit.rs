@@ -12,6 +12,11 @@ pub trait Naming {
     fn var(&self, v: Var) -> String;
     /// Statement that binds the identifier of `v` from the function's arguments.
     fn bind(&self, v: Var) -> String;
+    /// Path of spline number `s` of the arena, an [`mbs::Spline`](../../../mbs_runtime/spline/struct.Spline.html)
+    /// (`eval(order, x)`).
+    fn spline(&self, s: u16) -> String {
+        format!("SPLINES[{s}]")
+    }
 }
 
 /// The number type of emitted code.
@@ -286,6 +291,21 @@ impl Writer<'_> {
                         let _ = write!(out, "{MATH}::map(");
                         self.expr(a, Prec::Add, out);
                         let _ = write!(out, ", {path})");
+                    }
+                }
+            }
+            Node::Spline(s, k, a) => {
+                let path = self.naming.spline(s);
+                match self.numbers {
+                    Numbers::Scalar => {
+                        let _ = write!(out, "{path}.eval({k}, ");
+                        self.expr(a, Prec::Add, out);
+                        out.push(')');
+                    }
+                    Numbers::Lanes => {
+                        let _ = write!(out, "{MATH}::map(");
+                        self.expr(a, Prec::Add, out);
+                        let _ = write!(out, ", |x| {path}.eval({k}, x))");
                     }
                 }
             }

@@ -68,6 +68,7 @@ impl Arena {
                 Node::Func(f, a) => f.apply(g(a)),
                 Node::Atan2(y, x) => g(y).atan2(g(x)),
                 Node::Call(f, k, a) => env.call(f, k, g(a)),
+                Node::Spline(s, k, a) => self.splines()[s as usize].eval(k, g(a)),
             };
             val[n.index()] = v;
         }

@@ -10,10 +10,14 @@ pub mod emit;
 mod eval;
 pub mod sexpr;
 mod simplify;
+#[path = "../../../mbs-runtime/src/spline.rs"]
+#[allow(dead_code)]
+mod spline;
 
 pub use arena::Arena;
 pub use count::{OpCount, ops, ops_of_nodes};
 pub use eval::{Env, SliceEnv};
+pub use spline::{SplineError, evaluate as spline_value, natural_coefficients};
 
 use std::fmt;
 
@@ -203,6 +207,29 @@ pub struct UserFn {
     pub paths: Vec<String>,
 }
 
+/// A natural cubic spline of the language (`spline(x, [(x0, y0), …])`): its knots and the
+/// coefficients of its intervals, computed when the model is generated.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SplineTable {
+    pub knots: Vec<f64>,
+    pub coefficients: Vec<[f64; 4]>,
+}
+
+impl SplineTable {
+    /// The natural cubic spline through `points`, or why there is none.
+    pub fn natural(points: &[(f64, f64)]) -> Result<SplineTable, SplineError> {
+        Ok(SplineTable {
+            coefficients: natural_coefficients(points)?,
+            knots: points.iter().map(|p| p.0).collect(),
+        })
+    }
+
+    /// Derivative number `order` at `x` (0: the value).
+    pub fn eval(&self, order: u8, x: f64) -> f64 {
+        spline_value(&self.knots, &self.coefficients, order, x)
+    }
+}
+
 /// One node of the DAG. Commutative operands are stored in canonical order (a number first,
 /// otherwise by id); the rules in `simplify.rs` keep nodes in canonical form.
 #[derive(Clone, Copy, PartialEq, Eq, Hash, Debug)]
@@ -224,6 +251,8 @@ pub enum Node {
     Atan2(ExprId, ExprId),
     /// derivative number `order` of user function number `f`, at the argument
     Call(u16, u8, ExprId),
+    /// derivative number `order` (< 4) of spline number `s` of the arena, at the argument
+    Spline(u16, u8, ExprId),
 }
 
 impl Node {
@@ -232,7 +261,11 @@ impl Node {
         let z = ExprId(0);
         match *self {
             Node::Num(_) | Node::Var(_) => ([z, z], 0),
-            Node::Neg(a) | Node::Powi(a, _) | Node::Func(_, a) | Node::Call(_, _, a) => ([a, z], 1),
+            Node::Neg(a)
+            | Node::Powi(a, _)
+            | Node::Func(_, a)
+            | Node::Call(_, _, a)
+            | Node::Spline(_, _, a) => ([a, z], 1),
             Node::Add(a, b)
             | Node::Sub(a, b)
             | Node::Mul(a, b)

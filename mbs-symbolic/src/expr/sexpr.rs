@@ -1,6 +1,6 @@
 //! S-expression printing and parsing, for tests and debugging:
 //! `(+ (* 2 (sin q0)) p1)`. Leaves are numbers, `q0 qd0 qdd0 t p0 u0`; operators are
-//! `+ - * / neg powi pow atan2 call` and the function names of [`Func`] (`pos`, `step`, …). Parsing goes
+//! `+ - * / neg powi pow atan2 call spline` and the function names of [`Func`] (`pos`, `step`, …). Parsing goes
 //! through the canonicalising constructors, so `parse(print(e)) == e` for every node `e`.
 //!
 //! Printing expands shared nodes, so the text can be exponentially larger than the DAG.
@@ -37,6 +37,7 @@ impl Arena {
                     Node::Func(f, _) => f.name().to_string(),
                     Node::Atan2(..) => "atan2".to_string(),
                     Node::Call(f, o, _) => format!("call {f} {o}"),
+                    Node::Spline(f, o, _) => format!("spline {f} {o}"),
                     Node::Num(_) | Node::Var(_) => unreachable!(),
                 };
                 s.push('(');
@@ -103,11 +104,17 @@ impl Arena {
                 let a = self.parse_tok(toks, pos)?;
                 self.powi(a, k)
             }
-            "call" => {
+            "call" | "spline" => {
                 let f = int(toks, pos)? as u16;
                 let o = int(toks, pos)? as u8;
                 let a = self.parse_tok(toks, pos)?;
-                self.call(f, o, a)
+                if head == "call" {
+                    self.call(f, o, a)
+                } else if (f as usize) < self.splines().len() {
+                    self.spline(f, o, a)
+                } else {
+                    return Err(format!("unknown spline {f}"));
+                }
             }
             name => match Func::from_name(name) {
                 Some(f) => {

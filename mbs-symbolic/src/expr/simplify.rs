@@ -408,6 +408,19 @@ impl Arena {
         self.intern(Node::Atan2(y, x))
     }
 
+    /// Derivative number `order` of spline `s` at `x`: a number when `x` is one, zero from
+    /// the fourth derivative on (the spline is cubic between knots).
+    pub fn spline(&mut self, s: u16, order: u8, x: ExprId) -> ExprId {
+        if order >= 4 {
+            return self.zero();
+        }
+        if let Some(v) = self.as_num(x) {
+            let y = self.splines[s as usize].eval(order, v);
+            return self.num(y);
+        }
+        self.intern(Node::Spline(s, order, x))
+    }
+
     /// Derivative number `order` of user function `f` at `x`.
     pub fn call(&mut self, f: u16, order: u8, x: ExprId) -> ExprId {
         self.intern(Node::Call(f, order, x))

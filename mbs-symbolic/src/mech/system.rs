@@ -189,11 +189,22 @@ pub enum Load {
     /// F_n = step(δ) pos(k δ + c δ̇) along n (never pulling), regularised Coulomb friction
     /// F_t = −μ F_n v_t / sqrt(|v_t|² + eps²) at the contact point x − radius·n (v_t its
     /// velocity less its normal part). The elastic part k pos(δ) derives from the potential
-    /// ½ k pos(δ)²; damping and friction count in the power
+    /// ½ k pos(δ)²; damping and friction count in the power.
+    ///
+    /// With `ellipsoid` (semi-axes along the axes of `at`'s frame, centred at `at`), δ is the
+    /// depth of the ellipsoid's support point along −n, where the forces act. With `exponent`
+    /// e and `dissipation` d (Hunt–Crossley), F_n = step(δ) pos(k pos(δ)^e (1 + d δ̇) + c δ̇),
+    /// potential k pos(δ)^(e+1) / (e + 1)
     Contact {
         at: Attach,
         /// 0 for a point
         radius: ExprId,
+        /// semi-axes of an ellipsoid in the axes of `at`'s frame
+        ellipsoid: Option<[ExprId; 3]>,
+        /// exponent e ≥ 1 of the elastic force k pos(δ)^e (1 for a linear contact)
+        exponent: ExprId,
+        /// Hunt–Crossley dissipation d ≥ 0 (s/m): the elastic force times (1 + d δ̇)
+        dissipation: ExprId,
         normal: [ExprId; 3],
         offset: ExprId,
         k: ExprId,

@@ -999,15 +999,16 @@ pub fn add_loads(
 
 /// Adds random force elements: an effect `elastic` (a bushing without damping, a contact
 /// without damping or friction and an undamped rotational spring, conservative) and an effect
-/// `contacts` (1 to 3 penalty contacts of points or spheres with friction, a damped bushing
-/// and a damped rotational spring). The planes are placed so that most contacts penetrate at
-/// the random states. Returns the two effects; `tally` counts point contacts, sphere
-/// contacts, bushings to the ground, bushings between two frames, rotational springs about
-/// a joint's axis and rotational springs about a random axis.
+/// `contacts` (1 to 3 penalty contacts of points, spheres or ellipsoids with friction, linear
+/// or Hunt–Crossley, a damped bushing and a damped rotational spring). The planes are placed
+/// so that most contacts penetrate at the random states. Returns the two effects; `tally`
+/// counts point contacts, sphere contacts, ellipsoid contacts, Hunt–Crossley contacts,
+/// bushings to the ground, bushings between two frames, rotational springs about a joint's
+/// axis and rotational springs about a random axis.
 pub fn add_force_elements(
     rng: &mut Rng,
     sys: &mut System,
-    tally: &mut [usize; 6],
+    tally: &mut [usize; 8],
 ) -> (usize, usize) {
     let nf = sys.frames.len();
     let mut bushing = |rng: &mut Rng, sys: &mut System, damped: bool| {
@@ -1018,7 +1019,7 @@ pub fn add_force_elements(
                 break b;
             }
         };
-        tally[if a.is_none() || b.is_none() { 2 } else { 3 }] += 1;
+        tally[if a.is_none() || b.is_none() { 4 } else { 5 }] += 1;
         let mut v = |lo: f64, hi: f64| {
             let x = [rng.range(lo, hi), rng.range(lo, hi), rng.range(lo, hi)];
             sys.vec3(x)
@@ -1037,13 +1038,32 @@ pub fn add_force_elements(
     // the first contact without damping and friction: conservative
     for i in 0..2 + rng.below(3) {
         let at = attach(rng, sys, false);
-        let radius = if rng.chance(0.5) {
-            tally[1] += 1;
+        let shape = rng.below(3);
+        tally[shape] += 1;
+        let radius = if shape == 1 {
             sys.num(rng.range(0.05, 0.3))
         } else {
-            tally[0] += 1;
             sys.arena.zero()
         };
+        let ellipsoid = (shape == 2).then(|| {
+            let ax = [
+                rng.range(0.05, 0.3),
+                rng.range(0.05, 0.3),
+                rng.range(0.05, 0.3),
+            ];
+            sys.vec3(ax)
+        });
+        // Hunt–Crossley: Hertz's exponent, and a dissipation in damped contacts
+        let hertz = rng.chance(0.5);
+        if hertz {
+            tally[3] += 1;
+        }
+        let exponent = sys.num(if hertz { 1.5 } else { 1.0 });
+        let dissipation = sys.num(if hertz && i > 0 {
+            rng.range(0.1, 2.0)
+        } else {
+            0.0
+        });
         let normal = random_unit(rng, sys);
         let offset = sys.num(rng.range(-0.3, 1.5));
         let k = sys.num(rng.range(50.0, 500.0));
@@ -1063,6 +1083,9 @@ pub fn add_force_elements(
         to.push(Load::Contact {
             at,
             radius,
+            ellipsoid,
+            exponent,
+            dissipation,
             normal,
             offset,
             k,
@@ -1092,11 +1115,11 @@ pub fn add_force_elements(
             .filter_map(|f| one_rotation(&f).map(|n| (f, n)))
             .collect();
         let (a, b, axis) = if !joints.is_empty() && rng.chance(0.5) {
-            tally[4] += 1;
+            tally[6] += 1;
             let (f, n) = joints[rng.below(joints.len())];
             (sys.frames[f].parent, Some(f), n)
         } else {
-            tally[5] += 1;
+            tally[7] += 1;
             let a = (!rng.chance(0.25)).then(|| rng.below(nf));
             let b = loop {
                 let b = (!rng.chance(0.25)).then(|| rng.below(nf));

@@ -489,6 +489,68 @@ impl Checker {
         e
     }
 
+    /// The table of `spline(x, [(x0, y0), …])`: numbers known when the model is generated,
+    /// abscissae strictly increasing; registered in the arena, its number returned.
+    fn spline_table(&mut self, e: &Expr, a: Allow, usage: &str) -> Option<u16> {
+        let Expr::Array(arr) = e else {
+            self.error_at(
+                e,
+                format!(
+                    "the points of a spline are an array of pairs, found `{}`: write `{usage}`",
+                    text(e)
+                ),
+            );
+            return None;
+        };
+        let mut points = Vec::with_capacity(arr.elems.len());
+        for el in &arr.elems {
+            let pair = match el {
+                Expr::Tuple(t) if t.elems.len() == 2 => [&t.elems[0], &t.elems[1]],
+                _ => {
+                    self.error_at(
+                        el,
+                        format!(
+                            "each point of a spline is a pair `(x, y)`, found `{}`: write `{usage}`",
+                            text(el)
+                        ),
+                    );
+                    return None;
+                }
+            };
+            let mut xy = [0.0; 2];
+            for (v, c) in xy.iter_mut().zip(pair) {
+                let id = self.lower(c, a);
+                match self.sys.arena.as_num(id) {
+                    Some(n) => *v = n,
+                    None => {
+                        self.error_at(
+                            c,
+                            format!(
+                                "the points of a spline are numbers known when the model is generated, found `{}`: write the value (parameters cannot move a spline's points)",
+                                text(c)
+                            ),
+                        );
+                        return None;
+                    }
+                }
+            }
+            points.push((xy[0], xy[1]));
+        }
+        match SplineTable::natural(&points) {
+            Ok(t) => Some(self.sys.arena.spline_table(t)),
+            Err(err) => {
+                let at: &dyn ToTokens = match &err {
+                    SplineError::NotFinite { index } | SplineError::NotIncreasing { index, .. } => {
+                        &arr.elems[*index]
+                    }
+                    SplineError::TooFewPoints { .. } => arr,
+                };
+                self.error_at(&at.to_token_stream(), err);
+                None
+            }
+        }
+    }
+
     pub(super) fn lower_call(&mut self, c: &syn::ExprCall, a: Allow) -> ExprId {
         let Expr::Path(p) = &*c.func else {
             self.error_at(
@@ -558,6 +620,17 @@ impl Checker {
                 };
                 return self.sys.arena.powi(x, n);
             }
+            "spline" => {
+                const USAGE: &str = "spline(x, [(x0, y0), (x1, y1), …])";
+                if !arity(self, 2, USAGE) {
+                    return self.sys.arena.zero();
+                }
+                let x = self.lower(args[0], a);
+                return match self.spline_table(args[1], a, USAGE) {
+                    Some(s) => self.sys.arena.spline(s, 0, x),
+                    None => self.sys.arena.zero(),
+                };
+            }
             "Tdisp" | "Trotx" | "Troty" | "Trotz" | "Trotn" | "Tball" | "Tfree" => {
                 self.error(id.span(), format!("`{name}` is a transform, not a number: transforms appear only in the products of `TOG[…] = …;`"));
                 return self.sys.arena.zero();
@@ -618,7 +691,7 @@ impl Checker {
             None => {
                 let mut names: Vec<String> = self.fns.keys().cloned().collect();
                 names.extend(Func::ALL.iter().map(|f| f.name().to_string()));
-                names.extend(["atan2", "pow", "powi"].map(String::from));
+                names.extend(["atan2", "pow", "powi", "spline"].map(String::from));
                 self.error(
                     id.span(),
                     format!(

@@ -5,7 +5,7 @@
 use super::ast::{BodyRef, DofName, EffectStmt, Item, ModelDef};
 use super::names::did_you_mean;
 use super::repeat::{self, Origin};
-use crate::expr::{ExprId, Func, SliceEnv, UserFn, Var};
+use crate::expr::{ExprId, Func, SliceEnv, SplineError, SplineTable, UserFn, Var};
 use crate::mech::system::*;
 use proc_macro2::{Span, TokenStream};
 use quote::ToTokens;
@@ -555,7 +555,9 @@ impl Checker {
 
     fn duplicate_fn(&mut self, name: &Ident) -> bool {
         let s = name.to_string();
-        if Func::from_name(&s).is_some() || matches!(s.as_str(), "atan2" | "powi" | "pow") {
+        if Func::from_name(&s).is_some()
+            || matches!(s.as_str(), "atan2" | "powi" | "pow" | "spline")
+        {
             self.error(
                 name.span(),
                 format!("`{name}` is a built-in function: give yours another name"),

@@ -1,5 +1,6 @@
-//! `contact(point, k = …[, c = …][, mu = …][, eps = …][, plane = …][, offset = …][, sphere = …])`:
-//! penalty contact of a point, or a sphere centred at it, with a world plane.
+//! `contact(point, k = …[, c = …][, mu = …][, eps = …][, plane = …][, offset = …]
+//! [, sphere = r | ellipsoid = (a, b, c)][, exponent = e][, dissipation = d])`: penalty
+//! contact of a point, or a sphere or ellipsoid centred at it, with a world plane.
 
 use super::*;
 
@@ -7,7 +8,18 @@ const CONTACT_USAGE: &str = "contact(point, k = …[, c = …][, mu = …])";
 
 pub(super) const KIND: Kind = Kind {
     name: "contact",
-    named: &["k", "c", "mu", "eps", "plane", "offset", "sphere"],
+    named: &[
+        "k",
+        "c",
+        "mu",
+        "eps",
+        "plane",
+        "offset",
+        "sphere",
+        "ellipsoid",
+        "exponent",
+        "dissipation",
+    ],
     lower: |c, s| c.lower_contact(s).into_iter().collect(),
 };
 
@@ -157,6 +169,51 @@ impl Checker {
             }
             None => self.sys.arena.zero(),
         };
+        let ellipsoid = match named("ellipsoid") {
+            Some(e) => {
+                if named("sphere").is_some() {
+                    let key = &s.named.iter().find(|(k, _)| k == "ellipsoid").unwrap().0;
+                    self.error(
+                        key.span(),
+                        "a contact is a sphere or an ellipsoid, not both: keep `sphere = r` or `ellipsoid = (a, b, c)`",
+                    );
+                }
+                let axes = self.triple(
+                    e,
+                    param("the semi-axes of a contact ellipsoid"),
+                    "the `ellipsoid` of a contact (its semi-axes)",
+                );
+                for v in axes.iter().flatten() {
+                    self.positive(*v, e, "a semi-axis of a contact `ellipsoid`");
+                }
+                Some(axes)
+            }
+            None => None,
+        };
+        let exponent = match named("exponent") {
+            Some(e) => {
+                let v = self.lower(e, param("the exponent of a contact force"));
+                match self.sys.arena.as_num(v) {
+                    Some(x) if x >= 1.0 => {}
+                    Some(x) => self.error_at(
+                        e,
+                        format!("the `exponent` of a contact must be at least 1 (1 linear, 1.5 Hertz), it is {x}: a smaller one makes the force's slope infinite at first touch"),
+                    ),
+                    None => self.error_at(
+                        e,
+                        format!("the `exponent` of a contact is a number known when the model is generated, found `{}`: write its value (1 linear, 1.5 Hertz)", text(e)),
+                    ),
+                }
+                v
+            }
+            None => self.sys.arena.one(),
+        };
+        let dissipation = coef(
+            self,
+            "dissipation",
+            "a Hunt–Crossley dissipation",
+            "the Hunt–Crossley `dissipation` of a contact",
+        );
         let normal = match named("plane") {
             Some(e) => self.plane_normal(e),
             None => {
@@ -164,9 +221,16 @@ impl Checker {
                 Some([z, z, o])
             }
         };
+        let ellipsoid = match ellipsoid {
+            Some(axes) => Some(axes?),
+            None => None,
+        };
         Some(Load::Contact {
             at: at?,
             radius,
+            ellipsoid,
+            exponent,
+            dissipation,
             normal: normal?,
             offset,
             k: k?,

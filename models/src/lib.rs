@@ -13,6 +13,7 @@
 //! | [`chain30_stiff`] | a swinging chain of 30 light bars with undamped stiff torsional springs |
 //! | [`hexapod`] | 24-dof walking robot, free and standing on its feet |
 //! | [`hexapod_walker`] | the hexapod built to walk: outward legs, DC motors, gait generator, leg inverse kinematics, 1 kHz PIDs, terrain |
+//! | [`human`] | human lower limbs for walking: 14 bodies, 23 coordinates, spline knee, patella, six contact ellipsoids per foot |
 //! | [`pendulum3`] | Cash's index-3 pendulum in Cartesian coordinates |
 //! | [`fourbar`] | a crank-rocker four-bar loop |
 //! | [`fastlink`] | a fast two-loop linkage of five light bodies thrown by a stiff spring |
@@ -40,6 +41,7 @@ pub mod fastlink;
 pub mod fourbar;
 pub mod hexapod;
 pub mod hexapod_walker;
+pub mod human;
 pub mod pendulum3;
 pub mod seed2dof;
 pub mod slidercrank;

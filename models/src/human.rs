@@ -1,0 +1,671 @@
+//! Human lower limbs for walking: 14 bodies, 11 joints, 23 coordinates, six contact
+//! ellipsoids under each foot.
+//!
+//! **Sources.** Segment masses, centres of mass, inertias, joint positions and axes are those
+//! of OpenSim's gait2392 model (opensim-org/opensim-models, `gait2392_simbody.osim`: a 75 kg,
+//! 1.8 m subject, anthropometry after Delp et al. 1990 and Anderson & Pandy 1999), except the
+//! toes' third moment of inertia, taken from its sibling gait10dof18musc (gait2392's
+//! 0.001 kg·m² breaks the triangle inequality of a rigid body, which mbs refuses); the knee's
+//! tibia translates in the femur as natural cubic splines of the knee angle through that
+//! model's points (Yamaguchi & Zajac's knee), and the patella moves with the knee along the
+//! splines of Rajagopal et al. 2015's patellofemoral joint. Axes as in OpenSim: x forward,
+//! y up, z to the right; angles in gait2392's conventions (knee flexion negative, ankle
+//! dorsiflexion positive).
+//!
+//! **Coordinates** (23): the pelvis on a free joint `Tfree(px, py, pz, pa, pb, pc)` (6), the
+//! lumbar joint's extension, bending and rotation (3), and per leg k (0 right, 1 left) hip
+//! flexion, adduction and rotation, knee, ankle, subtalar and toes (7). Each leg is one
+//! instance of `part Leg(k, s)` (s = 1 right, −1 left: the left leg mirrored through the
+//! sagittal plane).
+//!
+//! **Bodies** (14): torso (head, arms and trunk), pelvis, and per leg femur, patella, tibia,
+//! talus, calcaneus, toes.
+//!
+//! **Contact**: six ellipsoids per foot (heel, lateral midfoot, first and fifth metatarsal
+//! heads on the calcaneus; hallux and lesser toes on the toes), Hunt–Crossley with Hertz's
+//! exponent and regularised Coulomb friction against the ground y = 0. Their placement is
+//! this model's own (soles 1 cm below the calcaneus' origin), not gait2392's.
+//!
+//! **Driving it** (Rust): [`GaitTable`] reads a cycle of joint angles (the stored one is
+//! OpenSim's tutorial normal gait, `models/data/normal_gait.tsv`), [`GaitReference`] fits
+//! each angle with a Fourier series, and [`Tracking`] (an [`Efforts`] part) holds the joints
+//! on the reference with stiff spring–dampers, optionally the pelvis' orientation with a
+//! residual torque. [`ground_forces`] recomputes each foot's ground reaction from the
+//! kinematics for reports.
+
+mbs::multibody! {
+    /// Human lower limbs (gait2392 segments, spline knee, patella), pelvis free, feet on
+    /// ellipsoids.
+    pub model Human {
+        param k_foot = 2e6; param d_foot = 1.0; param mu_foot = 0.8; param eps_foot = 0.01;
+        // the tibia's origin in the femur's axes against the knee angle (gait2392)
+        fn knee_x(a) = spline(a, [(-2.0944, -0.0032), (-1.74533, 0.00179), (-1.39626, 0.00411),
+            (-1.0472, 0.0041), (-0.698132, 0.00212), (-0.349066, -0.001), (-0.174533, -0.0031),
+            (0.197344, -0.005227), (0.337395, -0.005435), (0.490178, -0.005574),
+            (1.52146, -0.005435), (2.0944, -0.00525)]);
+        fn knee_y(a) = spline(a, [(-2.0944, -0.4226), (-1.22173, -0.4082), (-0.523599, -0.399),
+            (-0.349066, -0.3976), (-0.174533, -0.3966), (0.159149, -0.395264), (2.0944, -0.396)]);
+        // the patella against the knee's flexion b = −knee (Rajagopal 2015)
+        fn patella_x(b) = spline(b, [(0.0, 0.0524), (0.174533, 0.0488), (0.349066, 0.0437),
+            (0.523599, 0.0371), (0.698132, 0.0296), (0.872665, 0.0216), (1.0472, 0.0136),
+            (1.22173, 0.0057), (1.39626, -0.0019), (1.5708, -0.0088), (1.74533, -0.0148),
+            (1.91986, -0.0196), (2.0944, -0.0227)]);
+        fn patella_y(b) = spline(b, [(0.0, -0.0108), (0.174533, -0.019), (0.349066, -0.0263),
+            (0.523599, -0.0322), (0.698132, -0.0367), (0.872665, -0.0395), (1.0472, -0.0408),
+            (1.22173, -0.0404), (1.39626, -0.0384), (1.5708, -0.0349), (1.74533, -0.0301),
+            (1.91986, -0.0245), (2.0944, -0.0187)]);
+        fn patella_angle(b) = spline(b, [(0.0, 0.00113686), (0.174533, -0.00629212),
+            (0.349066, -0.105582), (0.523599, -0.253683), (0.698132, -0.414245),
+            (0.872665, -0.579047), (1.0472, -0.747244), (1.22173, -0.91799), (1.39626, -1.09044),
+            (1.5708, -1.26379), (1.74533, -1.43763), (1.91986, -1.61186), (2.0944, -1.78634)]);
+
+        // the joint axes as the model gives them (8 digits), made unit
+        let n_ankle = sqrt(powi(0.10501355, 2) + powi(0.17402245, 2) + powi(0.97912632, 2));
+        let n_subtalar = sqrt(powi(0.78717961, 2) + powi(0.60474746, 2) + powi(0.12094949, 2));
+        let n_mtp = sqrt(powi(0.5809544, 2) + powi(0.81393611, 2));
+
+        dof px = 0.0; dof py = 0.94; dof pz = 0.0; dof pa = 0.0; dof pb = 0.0; dof pc = 0.0;
+        dof lumbar_extension = 0.0; dof lumbar_bending = 0.0; dof lumbar_rotation = 0.0;
+
+        frame pelvis_o;
+        TOG[pelvis_o] = Tfree(px, py, pz, pa, pb, pc);
+        body pelvis { mass = 11.777; inertia = (0.1028, 0.0871, 0.0579); }
+        TOG[pelvis] = TOG[pelvis_o] * Tdisp(-0.0707, 0, 0);
+        body torso { mass = 34.2366; inertia = (1.4745, 0.7555, 1.4314); }
+        TOG[torso] = TOG[pelvis_o] * Tdisp(-0.1007, 0.0815, 0) * Trotz(lumbar_extension)
+            * Trotx(lumbar_bending) * Troty(lumbar_rotation) * Tdisp(-0.03, 0.32, 0);
+
+        part Leg(k, s) {
+            dof hip_flexion[k] = 0.0; dof hip_adduction[k] = 0.0; dof hip_rotation[k] = 0.0;
+            dof knee[k] = 0.0; dof ankle[k] = 0.0; dof subtalar[k] = 0.0; dof mtp[k] = 0.0;
+            frame femur_o[k]; frame tibia_o[k]; frame calcn_o[k]; frame toes_o[k];
+            body femur[k] { mass = 9.3014; inertia = (0.1339, 0.0351, 0.1412); }
+            body patella[k] { mass = 0.0862; inertia = (2.87e-6, 1.311e-5, 1.311e-5); }
+            body tibia[k] { mass = 3.7075; inertia = (0.0504, 0.0051, 0.0511); }
+            body talus[k] { mass = 0.1; inertia = (0.001, 0.001, 0.001); }
+            body calcn[k] { mass = 1.25; inertia = (0.0014, 0.0039, 0.0041); }
+            body toes[k] { mass = 0.2166; inertia = (0.0001, 0.0002, 0.0001); }
+            // hip: flexion about z, adduction about x, rotation about y (mirrored on the left)
+            TOG[femur_o[k]] = TOG[pelvis_o] * Tdisp(-0.0707, -0.0661, 0.0835 * s)
+                * Trotz(hip_flexion[k]) * Trotx(s * hip_adduction[k]) * Troty(s * hip_rotation[k]);
+            TOG[femur[k]] = TOG[femur_o[k]] * Tdisp(0, -0.17, 0);
+            TOG[tibia_o[k]] = TOG[femur_o[k]] * Tdisp(knee_x(knee[k]), knee_y(knee[k]), 0)
+                * Trotz(knee[k]);
+            TOG[tibia[k]] = TOG[tibia_o[k]] * Tdisp(0, -0.1867, 0);
+            TOG[patella[k]] = TOG[femur_o[k]]
+                * Tdisp(-0.00809 + patella_x(-knee[k]), -0.40796 + patella_y(-knee[k]), 0)
+                * Trotz(patella_angle(-knee[k])) * Tdisp(0.0018, 0.0264, 0);
+            TOG[talus[k]] = TOG[tibia_o[k]] * Tdisp(0, -0.43, 0)
+                * Trotn(-0.10501355 * s / n_ankle, -0.17402245 * s / n_ankle, 0.97912632 / n_ankle, ankle[k]);
+            TOG[calcn_o[k]] = TOG[talus[k]] * Tdisp(-0.04877, -0.04195, 0.00792 * s)
+                * Trotn(0.78717961 * s / n_subtalar, 0.60474746 * s / n_subtalar, -0.12094949 / n_subtalar, subtalar[k]);
+            TOG[calcn[k]] = TOG[calcn_o[k]] * Tdisp(0.1, 0.03, 0);
+            TOG[toes_o[k]] = TOG[calcn_o[k]] * Tdisp(0.1788, -0.002, 0.00108 * s)
+                * Trotn(-0.5809544 * s / n_mtp, 0, 0.81393611 / n_mtp, mtp[k]);
+            TOG[toes[k]] = TOG[toes_o[k]] * Tdisp(0.0346, 0.006, -0.0175 * s);
+            // the soles 1 cm below the calcaneus' origin
+            point heel[k] on calcn_o[k] at (0.035, 0.02, 0);
+            point midfoot[k] on calcn_o[k] at (0.1, 0.005, 0.025 * s);
+            point meta1[k] on calcn_o[k] at (0.17, 0.005, -0.025 * s);
+            point meta5[k] on calcn_o[k] at (0.15, 0.005, 0.035 * s);
+            point hallux[k] on toes_o[k] at (0.045, 0.0, -0.02 * s);
+            point lesser_toes[k] on toes_o[k] at (0.035, 0.0, 0.02 * s);
+            contact(heel[k], ellipsoid = (0.035, 0.03, 0.025), plane = y, k = k_foot, exponent = 1.5, dissipation = d_foot, mu = mu_foot, eps = eps_foot);
+            contact(midfoot[k], ellipsoid = (0.03, 0.015, 0.015), plane = y, k = k_foot, exponent = 1.5, dissipation = d_foot, mu = mu_foot, eps = eps_foot);
+            contact(meta1[k], ellipsoid = (0.02, 0.015, 0.015), plane = y, k = k_foot, exponent = 1.5, dissipation = d_foot, mu = mu_foot, eps = eps_foot);
+            contact(meta5[k], ellipsoid = (0.02, 0.015, 0.012), plane = y, k = k_foot, exponent = 1.5, dissipation = d_foot, mu = mu_foot, eps = eps_foot);
+            contact(hallux[k], ellipsoid = (0.025, 0.008, 0.012), plane = y, k = k_foot, exponent = 1.5, dissipation = d_foot, mu = mu_foot, eps = eps_foot);
+            contact(lesser_toes[k], ellipsoid = (0.02, 0.008, 0.015), plane = y, k = k_foot, exponent = 1.5, dissipation = d_foot, mu = mu_foot, eps = eps_foot);
+            shape femur[k]: cylinder(0.03, 0.4, axis = y);
+            shape tibia[k]: cylinder(0.025, 0.4, axis = y);
+            shape calcn[k]: box(0.2, 0.05, 0.08);
+            shape toes[k]: box(0.06, 0.02, 0.08);
+        }
+        Leg(0, 1);
+        Leg(1, -1);
+        shape pelvis: box(0.12, 0.12, 0.25);
+        shape torso: box(0.2, 0.6, 0.35);
+        gravity(0, -9.80665, 0);
+    }
+}
+
+use mbs::{Effort, Efforts, Kinematics, Model};
+
+/// The cycle of normal walking the model follows (see `models/data/normal_gait.tsv`).
+const NORMAL_GAIT: &str = include_str!("../data/normal_gait.tsv");
+
+/// A table of samples over one normalised gait cycle: column names and rows (`time` first).
+#[derive(Clone, Debug, PartialEq)]
+pub struct GaitTable {
+    pub names: Vec<String>,
+    pub rows: Vec<Vec<f64>>,
+}
+
+impl GaitTable {
+    /// The OpenSim tutorial's normal walking cycle (51 samples, angles in degrees).
+    pub fn normal() -> GaitTable {
+        GaitTable::parse(NORMAL_GAIT).expect("the stored table is well formed")
+    }
+
+    /// Parses tab- or space-separated text: `#` comments, a header of names, rows of numbers.
+    pub fn parse(text: &str) -> Result<GaitTable, String> {
+        let mut lines = text
+            .lines()
+            .map(str::trim)
+            .filter(|l| !l.is_empty() && !l.starts_with('#'));
+        let names: Vec<String> = lines
+            .next()
+            .ok_or("a gait table needs a header line of column names")?
+            .split_whitespace()
+            .map(String::from)
+            .collect();
+        let mut rows = Vec::new();
+        for (i, l) in lines.enumerate() {
+            let row = l
+                .split_whitespace()
+                .map(|v| {
+                    v.parse::<f64>()
+                        .map_err(|_| format!("row {}: `{v}` is not a number", i + 1))
+                })
+                .collect::<Result<Vec<f64>, String>>()?;
+            if row.len() != names.len() {
+                return Err(format!(
+                    "row {} has {} values for {} columns",
+                    i + 1,
+                    row.len(),
+                    names.len()
+                ));
+            }
+            rows.push(row);
+        }
+        Ok(GaitTable { names, rows })
+    }
+
+    /// The samples of column `name`.
+    pub fn column(&self, name: &str) -> Option<Vec<f64>> {
+        let j = self.names.iter().position(|n| n == name)?;
+        Some(self.rows.iter().map(|r| r[j]).collect())
+    }
+}
+
+/// A periodic function as a truncated Fourier series: a₀ + Σₖ aₖ cos(kωt) + bₖ sin(kωt).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Fourier {
+    pub a0: f64,
+    pub a: Vec<f64>,
+    pub b: Vec<f64>,
+    /// ω = 2π / period
+    pub omega: f64,
+}
+
+impl Fourier {
+    /// The least-squares fit with `harmonics` harmonics of `samples` taken uniformly over one
+    /// period (the sample at the period's end excluded): on uniform samples the discrete
+    /// Fourier sums are the least-squares coefficients.
+    pub fn fit(samples: &[f64], harmonics: usize, period: f64) -> Fourier {
+        let n = samples.len() as f64;
+        let a0 = samples.iter().sum::<f64>() / n;
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        for k in 1..=harmonics {
+            let (mut ak, mut bk) = (0.0, 0.0);
+            for (i, y) in samples.iter().enumerate() {
+                let x = std::f64::consts::TAU * (k * i) as f64 / n;
+                ak += y * x.cos();
+                bk += y * x.sin();
+            }
+            a.push(2.0 * ak / n);
+            b.push(2.0 * bk / n);
+        }
+        Fourier {
+            a0,
+            a,
+            b,
+            omega: std::f64::consts::TAU / period,
+        }
+    }
+
+    /// The value and its first and second time derivatives at `t`.
+    pub fn eval(&self, t: f64) -> [f64; 3] {
+        let mut out = [self.a0, 0.0, 0.0];
+        for (k, (a, b)) in self.a.iter().zip(&self.b).enumerate() {
+            let w = (k + 1) as f64 * self.omega;
+            let (s, c) = (w * t).sin_cos();
+            out[0] += a * c + b * s;
+            out[1] += w * (b * c - a * s);
+            out[2] -= w * w * (a * c + b * s);
+        }
+        out
+    }
+}
+
+/// The columns of the gait table that drive the model's coordinates (`None`: held at zero).
+const TRACKED: [(&str, Option<&str>); 17] = [
+    ("lumbar_extension", Some("lumbar_extension")),
+    ("lumbar_bending", Some("lumbar_bending")),
+    ("lumbar_rotation", Some("lumbar_rotation")),
+    ("hip_flexion[0]", Some("hip_flexion_r")),
+    ("hip_adduction[0]", Some("hip_adduction_r")),
+    ("hip_rotation[0]", Some("hip_rotation_r")),
+    ("knee[0]", Some("knee_angle_r")),
+    ("ankle[0]", Some("ankle_angle_r")),
+    ("subtalar[0]", None),
+    ("mtp[0]", None),
+    ("hip_flexion[1]", Some("hip_flexion_l")),
+    ("hip_adduction[1]", Some("hip_adduction_l")),
+    ("hip_rotation[1]", Some("hip_rotation_l")),
+    ("knee[1]", Some("knee_angle_l")),
+    ("ankle[1]", Some("ankle_angle_l")),
+    ("subtalar[1]", None),
+    ("mtp[1]", None),
+];
+
+/// The joint angles of a gait cycle as smooth periodic functions of time: for each of the
+/// model's 17 joint coordinates, a Fourier series fitted to a [`GaitTable`] (degrees
+/// converted to radians), the pelvis' orientation likewise.
+#[derive(Clone, Debug)]
+pub struct GaitReference {
+    /// duration of a cycle (s)
+    pub period: f64,
+    /// (coordinate of the model, its reference)
+    pub joints: Vec<(usize, Fourier)>,
+    /// pelvis tilt (about z), list (about x) and rotation (about y), gait2392's order
+    pub pelvis: [Fourier; 3],
+    /// the time of the cycle at t = 0 (0: right heel strike)
+    pub offset: f64,
+}
+
+impl GaitReference {
+    /// The fit of `table` with `harmonics` harmonics, one cycle lasting `period`; the
+    /// coordinates found by name in `info`.
+    pub fn fit(
+        table: &GaitTable,
+        info: &mbs::ModelInfo,
+        period: f64,
+        harmonics: usize,
+    ) -> Result<GaitReference, String> {
+        // one period of samples: the last row repeats the first cycle's start
+        let n = table.rows.len() - 1;
+        let series = |name: &str| -> Result<Fourier, String> {
+            let col = table
+                .column(name)
+                .ok_or_else(|| format!("the gait table has no column `{name}`"))?;
+            let rad: Vec<f64> = col[..n].iter().map(|d| d.to_radians()).collect();
+            Ok(Fourier::fit(&rad, harmonics, period))
+        };
+        let zero = Fourier::fit(&[0.0; 4], 0, period);
+        let mut joints = Vec::new();
+        for (dof, col) in TRACKED {
+            let i = info
+                .dofs
+                .iter()
+                .position(|d| *d == dof)
+                .ok_or_else(|| format!("the model has no coordinate `{dof}`"))?;
+            let f = match col {
+                Some(c) => series(c)?,
+                None => zero.clone(),
+            };
+            joints.push((i, f));
+        }
+        Ok(GaitReference {
+            offset: 0.0,
+            period,
+            joints,
+            pelvis: [
+                series("pelvis_tilt")?,
+                series("pelvis_list")?,
+                series("pelvis_rotation")?,
+            ],
+        })
+    }
+
+    /// A still posture: the anatomical one (every joint at zero) with both ankles
+    /// dorsiflexed by `ankle` (rad) and the pelvis tilted forward as much, so that the feet
+    /// are flat and the body leans forward as one piece: in the anatomical posture itself
+    /// the centre of mass lies just behind the heels' support points.
+    pub fn still(info: &mbs::ModelInfo, ankle: f64) -> Result<GaitReference, String> {
+        let constant = |v: f64| Fourier::fit(&[v; 4], 0, 1.0);
+        let zero = || constant(0.0);
+        let mut joints = Vec::new();
+        for (dof, _) in TRACKED {
+            let i = info
+                .dofs
+                .iter()
+                .position(|d| *d == dof)
+                .ok_or_else(|| format!("the model has no coordinate `{dof}`"))?;
+            let v = if dof.starts_with("ankle") { ankle } else { 0.0 };
+            joints.push((i, constant(v)));
+        }
+        Ok(GaitReference {
+            period: 1.0,
+            joints,
+            pelvis: [constant(-ankle), zero(), zero()],
+            offset: 0.0,
+        })
+    }
+
+    /// Joint `k` of `joints` at `t`: angle, rate, acceleration.
+    pub fn joint(&self, k: usize, t: f64) -> [f64; 3] {
+        self.joints[k].1.eval(t + self.offset)
+    }
+
+    /// The pelvis' rotation matrix at `t`: Rz(tilt) Rx(list) Ry(rotation).
+    pub fn pelvis_rotation(&self, t: f64) -> [[f64; 3]; 3] {
+        let [a, b, c] = [0, 1, 2].map(|k| self.pelvis[k].eval(t + self.offset)[0]);
+        let rz = rot(2, a);
+        let rx = rot(0, b);
+        let ry = rot(1, c);
+        mul(&mul(&rz, &rx), &ry)
+    }
+}
+
+fn rot(axis: usize, a: f64) -> [[f64; 3]; 3] {
+    let (s, c) = a.sin_cos();
+    let mut r = [[0.0; 3]; 3];
+    let (i, j) = ((axis + 1) % 3, (axis + 2) % 3);
+    r[axis][axis] = 1.0;
+    r[i][i] = c;
+    r[j][j] = c;
+    r[i][j] = -s;
+    r[j][i] = s;
+    r
+}
+
+fn mul(x: &[[f64; 3]; 3], y: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    std::array::from_fn(|i| std::array::from_fn(|j| (0..3).map(|k| x[i][k] * y[k][j]).sum()))
+}
+
+/// Stiff tracking of a [`GaitReference`]: a torque kp (q_ref − q) + kd (q̇_ref − q̇) on each
+/// joint coordinate (an action–reaction pair between the bodies the joint connects), the
+/// pelvis left free. The torques are the joint moments that make the model follow the cycle.
+#[derive(Clone, Debug)]
+pub struct Tracking {
+    pub reference: GaitReference,
+    /// stiffness (N·m/rad) and damping (N·m·s/rad)
+    pub kp: f64,
+    pub kd: f64,
+    /// stiffness and damping of a residual torque from the ground on the pelvis toward its
+    /// reference orientation (0, 0: the pelvis free)
+    pub pelvis_kp: f64,
+    pub pelvis_kd: f64,
+    /// stiffness and damping of the toes' joints, which the gait table does not give: a
+    /// passive spring about zero (N·m/rad, N·m·s/rad)
+    pub toes_kp: f64,
+    pub toes_kd: f64,
+}
+
+/// vee of the antisymmetric part of a 3 × 3 matrix: (a − aᵀ)/2 as a vector.
+fn vee(a: &[[f64; 3]; 3]) -> [f64; 3] {
+    [
+        0.5 * (a[2][1] - a[1][2]),
+        0.5 * (a[0][2] - a[2][0]),
+        0.5 * (a[1][0] - a[0][1]),
+    ]
+}
+
+fn transpose(a: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    std::array::from_fn(|i| std::array::from_fn(|j| a[j][i]))
+}
+
+impl Tracking {
+    /// The residual torque on the pelvis (world axes) at time `t` for its orientation `r`
+    /// and angular velocity `w`: kp·θ + kd·(ω_ref − ω), θ the rotation vector (small-angle)
+    /// from the pelvis to its reference.
+    pub fn pelvis_torque(&self, t: f64, r: &[[f64; 3]; 3], w: [f64; 3]) -> [f64; 3] {
+        if self.pelvis_kp == 0.0 && self.pelvis_kd == 0.0 {
+            return [0.0; 3];
+        }
+        let rr = self.reference.pelvis_rotation(t);
+        let theta = vee(&mul(&rr, &transpose(r)));
+        // ω_ref = vee(Ṙ_ref R_refᵀ), Ṙ_ref by central differences
+        let dt = 1e-6;
+        let (p, m) = (
+            self.reference.pelvis_rotation(t + dt),
+            self.reference.pelvis_rotation(t - dt),
+        );
+        let rdot: [[f64; 3]; 3] =
+            std::array::from_fn(|i| std::array::from_fn(|j| (p[i][j] - m[i][j]) / (2.0 * dt)));
+        let wr = vee(&mul(&rdot, &transpose(&rr)));
+        [0, 1, 2].map(|k| self.pelvis_kp * theta[k] + self.pelvis_kd * (wr[k] - w[k]))
+    }
+}
+
+impl Tracking {
+    /// The tracking torque on each joint coordinate at (t, q, qd): (coordinate, torque).
+    pub fn torques<'a>(
+        &'a self,
+        t: f64,
+        q: &'a [f64],
+        qd: &'a [f64],
+    ) -> impl Iterator<Item = (usize, f64)> + 'a {
+        self.reference
+            .joints
+            .iter()
+            .enumerate()
+            .map(move |(k, (i, _))| {
+                let [r, rd, _] = self.reference.joint(k, t);
+                let (kp, kd) = if TRACKED[k].0.starts_with("mtp") {
+                    (self.toes_kp, self.toes_kd)
+                } else {
+                    (self.kp, self.kd)
+                };
+                (*i, kp * (r - q[*i]) + kd * (rd - qd[*i]))
+            })
+    }
+}
+
+/// The pelvis' origin frame in [`Human`]'s frames.
+const PELVIS_FRAME: usize = 0;
+
+impl Efforts for Tracking {
+    fn efforts(&mut self, e: &mut Effort) -> Result<(), String> {
+        let pelvis = e.frame(PELVIS_FRAME);
+        let torque = self.pelvis_torque(e.t, &pelvis.pose.rotation, pelvis.angular_velocity);
+        e.torque_on_frame(PELVIS_FRAME, torque);
+        let torques: [(usize, f64); 17] = {
+            let mut it = self.torques(e.t, e.q, e.qd);
+            std::array::from_fn(|_| it.next().expect("17 joints"))
+        };
+        for (i, tau) in torques {
+            e.generalized_force(i, tau);
+        }
+        Ok(())
+    }
+}
+
+/// The contact ellipsoids of one foot, as in the model: point name and semi-axes.
+pub const FOOT_ELLIPSOIDS: [(&str, [f64; 3]); 6] = [
+    ("heel", [0.035, 0.03, 0.025]),
+    ("midfoot", [0.03, 0.015, 0.015]),
+    ("meta1", [0.02, 0.015, 0.015]),
+    ("meta5", [0.02, 0.015, 0.012]),
+    ("hallux", [0.025, 0.008, 0.012]),
+    ("lesser_toes", [0.02, 0.008, 0.015]),
+];
+
+/// The support point of each of the 12 ellipsoids (feet k = 0, 1, in `FOOT_ELLIPSOIDS`'
+/// order) at the kinematics `kin`: its world position and velocity (the material point's).
+pub fn support_points(model: &Human, kin: &Kinematics) -> [[([f64; 3], [f64; 3]); 6]; 2] {
+    let info = model.info();
+    std::array::from_fn(|k| {
+        std::array::from_fn(|e| {
+            let (name, axes) = FOOT_ELLIPSOIDS[e];
+            let i = info
+                .point_index(&format!("{name}[{k}]"))
+                .expect("the foot's points");
+            let frame = if name == "hallux" || name == "lesser_toes" {
+                "toes_o"
+            } else {
+                "calcn_o"
+            };
+            let f = info
+                .frame_index(&format!("{frame}[{k}]"))
+                .expect("the foot's frames");
+            let (pt, fr) = (&kin.points[i], &kin.frames[f]);
+            let r = fr.pose.rotation;
+            // m = Rᵀ n with n = y; support point x − R D² m / s
+            let m = [r[1][0], r[1][1], r[1][2]];
+            let u = [0, 1, 2].map(|j| axes[j] * axes[j] * m[j]);
+            let s = (0..3).map(|j| m[j] * u[j]).sum::<f64>().sqrt();
+            let arm = [0, 1, 2].map(|row| -(0..3).map(|j| r[row][j] * u[j]).sum::<f64>() / s);
+            let w = fr.angular_velocity;
+            let x = [0, 1, 2].map(|j| pt.position[j] + arm[j]);
+            let v = [
+                pt.velocity[0] + w[1] * arm[2] - w[2] * arm[1],
+                pt.velocity[1] + w[2] * arm[0] - w[0] * arm[2],
+                pt.velocity[2] + w[0] * arm[1] - w[1] * arm[0],
+            ];
+            (x, v)
+        })
+    })
+}
+
+/// The force of the ground on each foot (world axes) at a state, recomputed from the
+/// kinematics with the model's contact law (for reports: the dynamics use the generated
+/// code).
+pub fn ground_forces(
+    model: &Human,
+    t: f64,
+    q: &[f64],
+    qd: &[f64],
+    kin: &mut Kinematics,
+) -> [[f64; 3]; 2] {
+    model.kinematics(t, q, qd, kin);
+    let p = model.params();
+    let sp = support_points(model, kin);
+    let mut out = [[0.0; 3]; 2];
+    for (foot, points) in out.iter_mut().zip(&sp) {
+        for (x, v) in points {
+            let delta = -x[1];
+            if delta <= 0.0 {
+                continue;
+            }
+            let fn_ = (p.k_foot * delta.powf(1.5) * (1.0 - p.d_foot * v[1])).max(0.0);
+            let vt = [v[0], 0.0, v[2]];
+            let r2 = (vt[0] * vt[0] + vt[2] * vt[2] + p.eps_foot * p.eps_foot).sqrt();
+            let c = -p.mu_foot * fn_ / r2;
+            foot[0] += c * vt[0];
+            foot[1] += fn_;
+            foot[2] += c * vt[2];
+        }
+    }
+    out
+}
+
+/// ZYX angles (a, b, c) of a rotation R = Rz(a) Ry(b) Rx(c), the pelvis' `Tfree` angles.
+fn zyx_angles(r: &[[f64; 3]; 3]) -> [f64; 3] {
+    [
+        r[1][0].atan2(r[0][0]),
+        (-r[2][0]).clamp(-1.0, 1.0).asin(),
+        r[2][1].atan2(r[2][2]),
+    ]
+}
+
+/// Depth of the start: how far the lowest ellipsoid is pressed into the ground (m).
+pub const START_DEPTH: f64 = 2e-3;
+
+/// The state at the start of a cycle of `reference` (right heel strike): every joint and
+/// the pelvis' orientation on their references (angles and rates), the pelvis at the height
+/// where the lowest ellipsoid is [`START_DEPTH`] into the ground, and moving so that the
+/// left foot's lowest support point, on the ground in its late stance, is at rest.
+pub fn cycle_start(model: &Human, reference: &GaitReference) -> (Vec<f64>, Vec<f64>) {
+    let n = Human::NQ;
+    let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
+    model.initial_state(&mut q, &mut qd);
+    for (k, (i, _)) in reference.joints.iter().enumerate() {
+        let [r, rd, _] = reference.joint(k, 0.0);
+        q[*i] = r;
+        qd[*i] = rd;
+    }
+    // the pelvis' angles and their rates (central differences of the angles)
+    let dt = 1e-6;
+    let ang = |t: f64| zyx_angles(&reference.pelvis_rotation(t));
+    let (a0, ap, am) = (ang(0.0), ang(dt), ang(-dt));
+    for j in 0..3 {
+        q[3 + j] = a0[j];
+        qd[3 + j] = (ap[j] - am[j]) / (2.0 * dt);
+    }
+    let mut kin = Kinematics::new::<Human>();
+    model.kinematics(0.0, &q, &qd, &mut kin);
+    let sp = support_points(model, &kin);
+    let lowest = sp
+        .iter()
+        .flatten()
+        .map(|(x, _)| x[1])
+        .fold(f64::INFINITY, f64::min);
+    q[1] -= lowest + START_DEPTH;
+    let v = walking_speed(model, reference);
+    qd[0] = v;
+    qd[1] = 0.0;
+    qd[2] = 0.0;
+    (q, qd)
+}
+
+/// The walking speed the reference implies: how fast the right midfoot moves backward
+/// relative to a pelvis moving with its reference orientation only, averaged over the flat
+/// part of the right foot's stance (15 % to 40 % of the cycle).
+pub fn walking_speed(model: &Human, reference: &GaitReference) -> f64 {
+    let n = Human::NQ;
+    let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
+    let mut kin = Kinematics::new::<Human>();
+    let samples = 11;
+    let mut sum = 0.0;
+    for s in 0..samples {
+        let t = reference.period * (0.15 + 0.25 * s as f64 / (samples - 1) as f64);
+        model.initial_state(&mut q, &mut qd);
+        qd.fill(0.0);
+        for (k, (i, _)) in reference.joints.iter().enumerate() {
+            let [r, rd, _] = reference.joint(k, t - reference.offset);
+            q[*i] = r;
+            qd[*i] = rd;
+        }
+        let dt = 1e-6;
+        let ang = |t: f64| zyx_angles(&reference.pelvis_rotation(t));
+        let t = t - reference.offset;
+        let (a0, ap, am) = (ang(t), ang(t + dt), ang(t - dt));
+        for j in 0..3 {
+            q[3 + j] = a0[j];
+            qd[3 + j] = (ap[j] - am[j]) / (2.0 * dt);
+        }
+        model.kinematics(t, &q, &qd, &mut kin);
+        sum -= support_points(model, &kin)[0][1].1[0];
+    }
+    sum / samples as f64
+}
+
+/// A run of the model following a gait cycle, and what it shows.
+#[derive(Debug)]
+pub struct GaitRun {
+    pub trajectory: mbs::Trajectory,
+    pub stats: mbs::Stats,
+    pub failure: Option<mbs::SimError>,
+    /// CPU time of the run (s)
+    pub cpu: f64,
+}
+
+/// The tracked model: [`Human`] with its joints driven by [`Tracking`].
+pub type Tracked = mbs::WithEfforts<Human, Tracking>;
+
+/// Runs the model from [`cycle_start`] while its joints track `tracking`'s reference.
+pub fn follow(tracking: Tracking, scheme: mbs::Scheme, mut options: mbs::Options) -> GaitRun {
+    let model = Human::default();
+    let (q, qd) = cycle_start(&model, &tracking.reference);
+    options.q0 = Some(q);
+    options.qd0 = Some(qd);
+    let start = std::time::Instant::now();
+    let result = mbs::simulate(mbs::WithEfforts::new(model, tracking), scheme, options);
+    let cpu = start.elapsed().as_secs_f64();
+    match result {
+        Ok((trajectory, stats)) => GaitRun {
+            trajectory,
+            stats,
+            failure: None,
+            cpu,
+        },
+        Err(e) => GaitRun {
+            trajectory: (*e.trajectory).clone(),
+            stats: (*e.stats).clone(),
+            failure: Some(e),
+            cpu,
+        },
+    }
+}

@@ -1,0 +1,231 @@
+//! The human lower-limb model (`mbs_models::human`): its data, its spline knee and patella,
+//! its foot contacts, and standing on them.
+//!
+//! - the mass matrix' translation block is the total mass of gait2392's segments plus the
+//!   patellas;
+//! - the tibia's origin and the patella sit on their splines' points;
+//! - the ground reaction recomputed from the kinematics equals the generated contacts';
+//! - the gait table's Fourier fit reproduces the samples;
+//! - with its joints held (ankles dorsiflexed 0.1 rad, the body leaning forward as one
+//!   piece) the model stands on its twelve ellipsoids: the ground carries its weight, half on
+//!   each foot, the pelvis stays within a centimetre.
+
+// the knots below are the sources' numbers (−1.0472 is a table value, not −π/3)
+#![allow(clippy::approx_constant)]
+
+use mbs::{Kinematics, Model, Options, Output, Scheme};
+use mbs_models::human::*;
+
+const G: f64 = 9.80665;
+/// gait2392's 75.1646 kg and two patellas of 0.0862 kg (Rajagopal 2015)
+const MASS: f64 = 75.1646 + 2.0 * 0.0862;
+
+fn frame(model: &Human, kin: &Kinematics, name: &str) -> mbs::Pose {
+    kin.frames[model.info().frame_index(name).expect(name)].pose
+}
+
+/// `b`'s origin in `a`'s axes.
+fn relative(a: &mbs::Pose, b: &mbs::Pose) -> [f64; 3] {
+    let d = [0, 1, 2].map(|i| b.position[i] - a.position[i]);
+    [0, 1, 2].map(|j| (0..3).map(|i| a.rotation[i][j] * d[i]).sum())
+}
+
+#[test]
+fn masses_and_the_knee_follow_their_sources() {
+    let model = Human::default();
+    let n = Human::NQ;
+    assert_eq!(n, 23);
+    assert_eq!(
+        model
+            .info()
+            .frames
+            .iter()
+            .zip(model.info().is_body)
+            .filter(|(_, b)| **b)
+            .count(),
+        14
+    );
+    let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
+    model.initial_state(&mut q, &mut qd);
+    let mut m = vec![0.0; n * n];
+    model.mass_matrix(0.0, &q, &mut m);
+    for i in 0..3 {
+        assert!(
+            (m[i + n * i] - MASS).abs() < 1e-9,
+            "M[{i}][{i}] = {}",
+            m[i + n * i]
+        );
+    }
+    // the tibia's origin in the femur's axes at knee angles on the knots of gait2392's
+    // splines; the patella's on Rajagopal's (flexion b = −knee)
+    let knee = model
+        .info()
+        .dofs
+        .iter()
+        .position(|d| *d == "knee[0]")
+        .unwrap();
+    let mut kin = Kinematics::new::<Human>();
+    // knots of both splines: −0.174533 and −0.349066 (x: −0.0031, −0.001; y: −0.3966,
+    // −0.3976); −1.0472 is a knot of x only (0.0041)
+    for (a, x, y) in [
+        (-0.174533, -0.0031, Some(-0.3966)),
+        (-0.349066, -0.001, Some(-0.3976)),
+        (-1.0472, 0.0041, None),
+    ] {
+        q[knee] = a;
+        model.kinematics(0.0, &q, &qd, &mut kin);
+        let femur = frame(&model, &kin, "femur_o[0]");
+        let r = relative(&femur, &frame(&model, &kin, "tibia_o[0]"));
+        assert!((r[0] - x).abs() < 1e-12, "knee_x({a}) = {}", r[0]);
+        if let Some(y) = y {
+            assert!((r[1] - y).abs() < 1e-12, "knee_y({a}) = {}", r[1]);
+        }
+    }
+    // patella at b = 1.0472 (knee −1.0472): origin (−0.00809 + 0.0136, −0.40796 − 0.0408)
+    // then turned by −0.747244 about z, its centre of mass (0.0018, 0.0264) from there
+    q[knee] = -1.0472;
+    model.kinematics(0.0, &q, &qd, &mut kin);
+    let femur = frame(&model, &kin, "femur_o[0]");
+    let p = relative(&femur, &frame(&model, &kin, "patella[0]"));
+    let (s, c) = (-0.747244f64).sin_cos();
+    let expect = [
+        -0.00809 + 0.0136 + c * 0.0018 - s * 0.0264,
+        -0.40796 - 0.0408 + s * 0.0018 + c * 0.0264,
+    ];
+    assert!(
+        (p[0] - expect[0]).abs() < 1e-12 && (p[1] - expect[1]).abs() < 1e-12,
+        "{p:?} vs {expect:?}"
+    );
+}
+
+#[test]
+fn recomputed_ground_forces_equal_the_generated_contacts() {
+    // at rest (qd = 0) the translation rows of the static forces are m g plus the contacts'
+    // total force: compare with the sum over both feet of the Rust recomputation, at poses
+    // of the gait cycle pressed into the ground
+    let model = Human::default();
+    let n = Human::NQ;
+    let reference = GaitReference::fit(&GaitTable::normal(), model.info(), 1.1, 8).unwrap();
+    let mut kin = Kinematics::new::<Human>();
+    let mut checked = 0;
+    for phase in [0.0, 0.1, 0.3, 0.5, 0.8] {
+        let mut r = reference.clone();
+        r.offset = phase * r.period;
+        let (mut q, _) = cycle_start(&model, &r);
+        q[1] -= 0.004;
+        let qd = vec![0.0; n];
+        let mut h = vec![0.0; n];
+        model.static_forces(0.0, &q, &[], &mut h);
+        let f = ground_forces(&model, 0.0, &q, &qd, &mut kin);
+        let total = [0, 1, 2].map(|j| f[0][j] + f[1][j]);
+        let generated = [h[0], h[1] + MASS * G, h[2]];
+        assert!(
+            total[1] > 100.0,
+            "pressed into the ground at phase {phase}: {total:?}"
+        );
+        for j in 0..3 {
+            assert!(
+                (total[j] - generated[j]).abs() < 1e-9 * total[1],
+                "phase {phase}, axis {j}: {} vs {}",
+                total[j],
+                generated[j]
+            );
+        }
+        checked += 1;
+    }
+    assert_eq!(checked, 5);
+}
+
+#[test]
+fn the_fourier_fit_reproduces_the_gait_table() {
+    let table = GaitTable::normal();
+    assert_eq!(table.rows.len(), 51);
+    let t = table.column("time").unwrap();
+    let mut worst = 0.0f64;
+    for name in [
+        "hip_flexion_r",
+        "knee_angle_r",
+        "ankle_angle_r",
+        "hip_adduction_l",
+        "lumbar_extension",
+    ] {
+        let col = table.column(name).unwrap();
+        let f = Fourier::fit(&col[..50], 8, 1.0);
+        for (ti, y) in t.iter().zip(&col).take(50) {
+            worst = worst.max((f.eval(*ti)[0] - y).abs());
+        }
+        // derivatives: central differences of the series itself
+        let d = 1e-5;
+        let [_, v, a] = f.eval(0.37);
+        let fd = (f.eval(0.37 + d)[0] - f.eval(0.37 - d)[0]) / (2.0 * d);
+        let fdd = (f.eval(0.37 + d)[1] - f.eval(0.37 - d)[1]) / (2.0 * d);
+        assert!(
+            (v - fd).abs() < 1e-5 * v.abs().max(1.0) && (a - fdd).abs() < 1e-4 * a.abs().max(1.0)
+        );
+    }
+    println!("8 harmonics: largest deviation from the table {worst:.3}°");
+    assert!(worst < 1.0, "{worst}°");
+}
+
+#[test]
+fn the_model_stands_on_its_feet() {
+    let model = Human::default();
+    let n = Human::NQ;
+    let reference = GaitReference::still(model.info(), 0.1).unwrap();
+    let (q0, qd0) = cycle_start(&model, &reference);
+    assert!(qd0.iter().all(|v| *v == 0.0));
+    let tracking = Tracking {
+        reference,
+        kp: 3000.0,
+        kd: 30.0,
+        pelvis_kp: 0.0,
+        pelvis_kd: 0.0,
+        toes_kp: 3000.0,
+        toes_kd: 30.0,
+    };
+    let mut q = q0.clone();
+    q.resize(n, 0.0);
+    let options = Options {
+        q0: Some(q0.clone()),
+        qd0: Some(qd0),
+        output: Output::Every { dt: 0.01 },
+        ..Options::adaptive(3.0, 1e-5)
+    };
+    let (tr, stats) = mbs::simulate(
+        mbs::WithEfforts::new(Human::default(), tracking),
+        Scheme::Radau5,
+        options,
+    )
+    .expect("standing is a regular run");
+    let last = tr.len() - 1;
+    let (ql, qdl) = (&tr.q(last)[..n], &tr.qd(last)[..n]);
+    let mut kin = Kinematics::new::<Human>();
+    let f = ground_forces(&model, tr.t[last], ql, qdl, &mut kin);
+    let weight = MASS * G;
+    println!(
+        "standing 3 s, radau5 rtol 1e-5: {} steps; pelvis pitch {:+.3e} rad, moved ({:+.2e}, {:+.2e}, {:+.2e}) m; \
+         ground carries {:.4} and {:.4} of the weight (right, left)",
+        stats.steps,
+        ql[3],
+        ql[0] - q0[0],
+        ql[1] - q0[1],
+        ql[2] - q0[2],
+        f[0][1] / weight,
+        f[1][1] / weight
+    );
+    println!(
+        "at the end: pelvis velocity ({:+.2e}, {:+.2e}) m/s, pitch rate {:+.2e} rad/s (a slow rocking that decays)",
+        qdl[0], qdl[1], qdl[3]
+    );
+    assert!(((f[0][1] + f[1][1]) / weight - 1.0).abs() < 0.01);
+    // symmetric stance: each foot about half
+    assert!((f[0][1] / weight - 0.5).abs() < 0.05 && (f[1][1] / weight - 0.5).abs() < 0.05);
+    for j in 0..3 {
+        assert!((ql[j] - q0[j]).abs() < 0.01, "pelvis drifted along {j}");
+        assert!(
+            qdl[j].abs() < 1e-2,
+            "pelvis still moving along {j}: {}",
+            qdl[j]
+        );
+    }
+}

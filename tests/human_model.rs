@@ -8,7 +8,9 @@
 //! - the gait table's Fourier fit reproduces the samples;
 //! - with its joints held (ankles dorsiflexed 0.1 rad, the body leaning forward as one
 //!   piece) the model stands on its twelve ellipsoids: the ground carries its weight, half on
-//!   each foot, the pelvis stays within a centimetre.
+//!   each foot, the pelvis stays within a centimetre;
+//! - passive joint moments: the law by hand, the viscous states' relaxation along a run,
+//!   and a collapsing body caught near its joints' ranges (without them its toes spin).
 
 // the knots below are the sources' numbers (−1.0472 is a table value, not −π/3)
 #![allow(clippy::approx_constant)]
@@ -228,4 +230,138 @@ fn the_model_stands_on_its_feet() {
             qdl[j]
         );
     }
+}
+
+#[test]
+fn passive_moments_follow_their_law_and_relax_toward_it() {
+    let model = Human::default();
+    let info = model.info();
+    let passive = PassiveJoints::new(info, 0.1, 0.01).unwrap();
+    // the law by hand: the knee 0.07 rad beyond its upper end pushes back into flexion
+    let knee = PASSIVE_LAWS.iter().find(|(n, _)| *n == "knee").unwrap().1;
+    let by_hand = -6.09 * (33.94f64 * 0.07).exp() + 11.03 * (-11.33f64 * 2.6).exp();
+    assert!((knee.elastic(0.2) - by_hand).abs() < 1e-12 * by_hand.abs());
+    assert!(knee.elastic(0.2) < -60.0 && knee.elastic(-1.0).abs() < 0.2);
+    // the viscous states, started at 0.5 N·m, relax toward −d q̇ with T = 10 ms: compared
+    // along a run (joints held by stiff tracking) with v' = −(v + d q̇)/T integrated between
+    // outputs (exponential integrator, q̇ linear between them)
+    let n = Human::NQ;
+    let reference = GaitReference::still(info, 0.1).unwrap();
+    let (q0, qd0) = cycle_start(&model, &reference);
+    let mut drive = passive.clone();
+    drive.tracking = Some(Tracking {
+        reference,
+        kp: 3000.0,
+        kd: 30.0,
+        pelvis_kp: 0.0,
+        pelvis_kd: 0.0,
+        toes_kp: 3000.0,
+        toes_kd: 30.0,
+    });
+    let (mut q, mut qd) = (q0.clone(), qd0.clone());
+    q.resize(n + 17, 0.0);
+    qd.resize(n + 17, 0.5);
+    let options = Options {
+        q0: Some(q),
+        qd0: Some(qd),
+        output: Output::Every { dt: 1e-4 },
+        ..Options::adaptive(0.05, 1e-8)
+    };
+    let (tr, _) = mbs::simulate(
+        mbs::WithEfforts::new(Human::default(), drive),
+        Scheme::Radau5,
+        options,
+    )
+    .expect("a regular run");
+    let mut worst = 0.0f64;
+    for (s, (k, _)) in passive.joints.iter().enumerate() {
+        let target = |i: usize| -passive.damping * tr.qd(i)[*k];
+        let mut v = 0.5;
+        for i in 1..tr.len() {
+            let h = tr.t[i] - tr.t[i - 1];
+            let e = (-h / 0.01f64).exp();
+            v = e * v + (1.0 - e) * 0.5 * (target(i - 1) + target(i));
+            worst = worst.max((tr.qd(i)[n + s] - v).abs());
+        }
+    }
+    let last = tr.len() - 1;
+    println!(
+        "viscous states from 0.5 N·m: {:.4} N·m at t = 5T (e^-5 · 0.5 = {:.4}); largest \
+         difference from their relaxation along the run, over 17 joints, {worst:.2e} N·m",
+        tr.qd(last)[n + 9],
+        0.5 * (-5.0f64).exp()
+    );
+    assert!(worst < 1e-3, "{worst}");
+}
+
+/// The farthest any of the 17 joints goes beyond its passive range, in a run (rad), and
+/// which joint.
+fn beyond_range(
+    tr: &mbs::Trajectory,
+    passive: &PassiveJoints,
+    info: &mbs::ModelInfo,
+) -> (f64, String) {
+    let mut worst = (0.0f64, String::new());
+    for i in 0..tr.len() {
+        for (j, l) in &passive.joints {
+            let q = tr.q(i)[*j];
+            let out = (l.range[0] - q).max(q - l.range[1]);
+            if out > worst.0 {
+                worst = (out, info.dofs[*j].to_string());
+            }
+        }
+    }
+    worst
+}
+
+#[test]
+fn passive_moments_catch_a_collapsing_body_near_its_joints_ranges() {
+    let model = Human::default();
+    let info = model.info();
+    let n = Human::NQ;
+    let passive = PassiveJoints::new(info, 0.1, 0.01).unwrap();
+    let reference = GaitReference::still(info, 0.1).unwrap();
+    let (q0, qd0) = cycle_start(&model, &reference);
+    let t_end = 1.0;
+    let options = |q: Vec<f64>, qd: Vec<f64>| Options {
+        q0: Some(q),
+        qd0: Some(qd),
+        output: Output::Every { dt: 0.005 },
+        ..Options::adaptive(t_end, 1e-5)
+    };
+    // without passive moments the body folds freely
+    let free = mbs::simulate(
+        Human::default(),
+        Scheme::Radau5,
+        options(q0.clone(), qd0.clone()),
+    );
+    let free = match free {
+        Ok((tr, _)) => tr,
+        Err(e) => (*e.trajectory).clone(),
+    };
+    let (mut q, mut qd) = (q0.clone(), qd0.clone());
+    q.resize(n + 17, 0.0);
+    qd.extend(passive.relaxed(&qd0));
+    let held = mbs::simulate(
+        mbs::WithEfforts::new(Human::default(), passive.clone()),
+        Scheme::Radau5,
+        options(q, qd),
+    );
+    let (held, stats) = match held {
+        Ok((tr, st)) => (tr, st),
+        Err(e) => panic!("with passive moments the collapse is a regular run: {e}"),
+    };
+    let (a, wa) = beyond_range(&free, &passive, info);
+    let (b, wb) = beyond_range(&held, &passive, info);
+    println!(
+        "collapse for {t_end} s: without passive moments a joint goes {a:.3} rad beyond its range ({wa}, to t = {:.2}); with them {b:.3} rad ({wb}, to t = {:.2}, {} steps)",
+        free.t.last().unwrap(),
+        held.t.last().unwrap(),
+        stats.steps
+    );
+    // the toes spin freely without them; with them the run goes to its end and the weak
+    // rotational laws (hip rotation: ±0.03 N·m at the range's ends) let a joint go furthest
+    assert!(a > 5.0, "{a}");
+    assert_eq!(*held.t.last().unwrap(), t_end);
+    assert!(b < 0.8, "{b} rad beyond ({wb})");
 }

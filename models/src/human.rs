@@ -30,8 +30,9 @@
 //! OpenSim's tutorial normal gait, `models/data/normal_gait.tsv`), [`GaitReference`] fits
 //! each angle with a Fourier series, and [`Tracking`] (an [`Efforts`] part) holds the joints
 //! on the reference with stiff spring–dampers, optionally the pelvis' orientation with a
-//! residual torque. [`ground_forces`] recomputes each foot's ground reaction from the
-//! kinematics for reports.
+//! residual torque. [`PassiveJoints`] adds passive joint moments (Anderson's laws, a viscous
+//! state per joint), with or without the tracking. [`ground_forces`] recomputes each foot's
+//! ground reaction from the kinematics for reports.
 
 mbs::multibody! {
     /// Human lower limbs (gait2392 segments, spline knee, patella), pelvis free, feet on
@@ -667,5 +668,183 @@ pub fn follow(tracking: Tracking, scheme: mbs::Scheme, mut options: mbs::Options
             failure: Some(e),
             cpu,
         },
+    }
+}
+
+/// The passive moment of one joint (Anderson 1999, as transcribed in Falisse et al. 2019's
+/// code): M(q, q̇) = K1 exp(K2 (q − θ2)) + K3 exp(K4 (q − θ1)) − d q̇, N·m on the coordinate,
+/// stiff beyond the range [θ1, θ2] and nearly free inside it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PassiveLaw {
+    pub k: [f64; 4],
+    /// lower and upper ends of the range (rad)
+    pub range: [f64; 2],
+}
+
+impl PassiveLaw {
+    /// The elastic part K1 exp(K2 (q − θ2)) + K3 exp(K4 (q − θ1)).
+    pub fn elastic(&self, q: f64) -> f64 {
+        let [k1, k2, k3, k4] = self.k;
+        k1 * (k2 * (q - self.range[1])).exp() + k3 * (k4 * (q - self.range[0])).exp()
+    }
+}
+
+/// The laws of the model's joints, in gait2392's conventions (the model's own): coordinate
+/// name (leg k written `[k]`), K1..K4, θ1, θ2. Source: antoinefalisse/3dpredictsim,
+/// `PassiveMoments/PassiveMomentsData.m` (the same numbers in KULeuvenNeuromechanics/PredSim
+/// and stanfordnmbl/opencap-processing), credited to F. C. Anderson's 1999 thesis.
+pub const PASSIVE_LAWS: [(&str, PassiveLaw); 10] = [
+    (
+        "hip_flexion",
+        law([-2.44, 5.05, 1.51, -21.88], [-0.6981, 1.81]),
+    ),
+    (
+        "hip_adduction",
+        law([-0.03, 14.94, 0.03, -14.94], [-0.5, 0.5]),
+    ),
+    (
+        "hip_rotation",
+        law([-0.03, 14.94, 0.03, -14.94], [-0.92, 0.92]),
+    ),
+    ("knee", law([-6.09, 33.94, 11.03, -11.33], [-2.4, 0.13])),
+    ("ankle", law([-2.03, 38.11, 0.18, -12.12], [-0.74, 0.52])),
+    (
+        "subtalar",
+        law([-60.21, 16.32, 60.21, -16.32], [-0.65, 0.65]),
+    ),
+    (
+        "mtp",
+        law([-0.9, 14.87, 0.18, -70.08], [0.0, 1.134_464_013_796_31]),
+    ),
+    (
+        "lumbar_extension",
+        law(
+            [-0.35, 30.72, 0.25, -20.36],
+            [-0.523_598_775_598_298_8, 0.17],
+        ),
+    ),
+    (
+        "lumbar_bending",
+        law(
+            [-0.25, 20.36, 0.25, -20.36],
+            [-0.349_065_850_398_865_9, 0.349_065_850_398_865_9],
+        ),
+    ),
+    (
+        "lumbar_rotation",
+        law(
+            [-0.25, 20.36, 0.25, -20.36],
+            [-0.349_065_850_398_865_9, 0.349_065_850_398_865_9],
+        ),
+    ),
+];
+
+const fn law(k: [f64; 4], range: [f64; 2]) -> PassiveLaw {
+    PassiveLaw { k, range }
+}
+
+/// Names of the passive moments' states (their viscous parts), in [`TRACKED`]'s order.
+const PASSIVE_STATES: [&str; 17] = [
+    "viscous:lumbar_extension",
+    "viscous:lumbar_bending",
+    "viscous:lumbar_rotation",
+    "viscous:hip_flexion[0]",
+    "viscous:hip_adduction[0]",
+    "viscous:hip_rotation[0]",
+    "viscous:knee[0]",
+    "viscous:ankle[0]",
+    "viscous:subtalar[0]",
+    "viscous:mtp[0]",
+    "viscous:hip_flexion[1]",
+    "viscous:hip_adduction[1]",
+    "viscous:hip_rotation[1]",
+    "viscous:knee[1]",
+    "viscous:ankle[1]",
+    "viscous:subtalar[1]",
+    "viscous:mtp[1]",
+];
+
+/// Passive joint moments with a differential equation per joint: on each of the 17 joints the
+/// law's elastic moment K1 exp(K2 (q − θ2)) + K3 exp(K4 (q − θ1)) acts at once, and its
+/// viscous moment v is a state that relaxes toward −d q̇ with a time constant T,
+/// v̇ = −(v + d q̇) / T (a Maxwell element, spring d/T in series with the damper d, in
+/// parallel with the elastic law: tissue whose damping has memory; T → 0 gives the law's
+/// −d q̇). Delaying the elastic part instead would pump energy into a joint pressed against
+/// its stiff range end (an effective damping d − k T < 0). Optionally with a [`Tracking`] of a
+/// gait cycle on top. A model wrapped without it ([`Tracked`]) has neither the moments nor
+/// their states.
+#[derive(Clone, Debug)]
+pub struct PassiveJoints {
+    /// (coordinate of the model, its law), in [`TRACKED`]'s order
+    pub joints: Vec<(usize, PassiveLaw)>,
+    /// viscous damping d (N·m·s/rad) of every joint
+    pub damping: f64,
+    /// time constant T of the moments' relaxation (s)
+    pub time_constant: f64,
+    pub tracking: Option<Tracking>,
+}
+
+impl PassiveJoints {
+    /// The laws of [`PASSIVE_LAWS`] on the coordinates of `info`, with damping `damping`
+    /// (Falisse et al. used 0.1 N·m·s/rad in PredSim, 0.001 in their 2019 code) and time
+    /// constant `time_constant`.
+    pub fn new(info: &mbs::ModelInfo, damping: f64, time_constant: f64) -> Result<Self, String> {
+        let mut joints = Vec::new();
+        for (dof, _) in TRACKED {
+            let base = dof.split('[').next().expect("a name");
+            let (_, l) = PASSIVE_LAWS
+                .iter()
+                .find(|(n, _)| *n == base)
+                .ok_or_else(|| format!("no passive law for `{dof}`"))?;
+            let i = info
+                .dofs
+                .iter()
+                .position(|d| *d == dof)
+                .ok_or_else(|| format!("the model has no coordinate `{dof}`"))?;
+            joints.push((i, *l));
+        }
+        Ok(PassiveJoints {
+            joints,
+            damping,
+            time_constant,
+            tracking: None,
+        })
+    }
+
+    /// The viscous moments −d q̇ of the 17 joints: the states of a run that begins relaxed.
+    pub fn relaxed(&self, qd: &[f64]) -> Vec<f64> {
+        self.joints
+            .iter()
+            .map(|(i, _)| -self.damping * qd[*i])
+            .collect()
+    }
+
+    /// The passive moment on joint `k` (in [`TRACKED`]'s order) at coordinate `q`, with
+    /// viscous state `v`.
+    pub fn moment(&self, k: usize, q: f64, v: f64) -> f64 {
+        self.joints[k].1.elastic(q) + v
+    }
+}
+
+impl Efforts for PassiveJoints {
+    const NX: usize = 17;
+    const STATE_NAMES: &'static [&'static str] = &PASSIVE_STATES;
+
+    fn efforts(&mut self, e: &mut Effort) -> Result<(), String> {
+        for (k, (i, l)) in self.joints.iter().enumerate() {
+            let m = l.elastic(e.q[*i]) + e.x[k];
+            e.generalized_force(*i, m);
+        }
+        match &mut self.tracking {
+            Some(t) => t.efforts(e),
+            None => Ok(()),
+        }
+    }
+
+    fn state_derivatives(&mut self, e: &Effort, xd: &mut [f64]) -> Result<(), String> {
+        for (k, (i, _)) in self.joints.iter().enumerate() {
+            xd[k] = -(e.x[k] + self.damping * e.qd[*i]) / self.time_constant;
+        }
+        Ok(())
     }
 }

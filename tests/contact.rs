@@ -8,6 +8,9 @@
 //! - small oscillations on a bushing at √(k/m) and √(k_r/I);
 //! - the static position of a mass on a preloaded spring.
 
+mod common;
+
+use common::fd_tangents;
 use mbs::{Kinematics, Model, Options, Output, Scheme, simulate};
 use nalgebra::{DMatrix, DVector};
 
@@ -89,33 +92,6 @@ mbs::multibody! {
     }
 }
 
-/// Central differences of τ(q, qd, qdd) at fixed qdd: (K, C), column-major like the model's.
-fn fd_tangents<M: Model>(m: &M, q: &[f64], qd: &[f64], qdd: &[f64]) -> (Vec<f64>, Vec<f64>) {
-    let n = M::NQ;
-    let (mut k, mut c) = (vec![0.0; n * n], vec![0.0; n * n]);
-    let (mut tp, mut tm) = (vec![0.0; n], vec![0.0; n]);
-    for j in 0..n {
-        for (var, out) in [(0, &mut k), (1, &mut c)] {
-            let (mut qp, mut qm, mut vp, mut vm) =
-                (q.to_vec(), q.to_vec(), qd.to_vec(), qd.to_vec());
-            let h = 1e-6;
-            if var == 0 {
-                qp[j] += h;
-                qm[j] -= h;
-            } else {
-                vp[j] += h;
-                vm[j] -= h;
-            }
-            m.inverse_dynamics(0.0, &qp, &vp, qdd, &[], &mut tp);
-            m.inverse_dynamics(0.0, &qm, &vm, qdd, &[], &mut tm);
-            for i in 0..n {
-                out[i + n * j] = (tp[i] - tm[i]) / (2.0 * h);
-            }
-        }
-    }
-    (k, c)
-}
-
 fn max_abs(v: &[f64]) -> f64 {
     v.iter().fold(0.0, |m, x| m.max(x.abs()))
 }
@@ -144,7 +120,7 @@ fn check_tangents<M: Model>(m: &M, q: &[f64], qd: &[f64], qdd: &[f64], what: &st
     let n = M::NQ;
     let (mut k, mut c) = (vec![0.0; n * n], vec![0.0; n * n]);
     m.tangents(0.0, q, qd, qdd, &[], &mut k, &mut c).unwrap();
-    let (kf, cf) = fd_tangents(m, q, qd, qdd);
+    let (kf, cf) = fd_tangents(m, q, qd, qdd, 1e-6);
     let rel = |x: &[f64], y: &[f64]| {
         let d: Vec<f64> = x.iter().zip(y).map(|(a, b)| a - b).collect();
         max_abs(&d) / max_abs(y).max(1e-300)

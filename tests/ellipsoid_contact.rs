@@ -7,6 +7,9 @@
 //! - exact tangents equal central differences in contact;
 //! - the energy identity dE/dt = power holds along a run where an egg drops, bounces and rolls.
 
+mod common;
+
+use common::fd_tangents;
 use mbs::{Model, Options, Output, Scheme, simulate};
 use nalgebra::{DMatrix, DVector};
 
@@ -154,33 +157,6 @@ fn a_tilted_ellipsoid_pushes_as_computed_by_hand() {
     }
 }
 
-/// Central differences of τ(q, qd, qdd) at fixed qdd: (K, C), column-major like the model's.
-fn fd_tangents<M: Model>(m: &M, q: &[f64], qd: &[f64], qdd: &[f64]) -> (Vec<f64>, Vec<f64>) {
-    let n = M::NQ;
-    let (mut k, mut c) = (vec![0.0; n * n], vec![0.0; n * n]);
-    let (mut tp, mut tm) = (vec![0.0; n], vec![0.0; n]);
-    for j in 0..n {
-        for (var, out) in [(0, &mut k), (1, &mut c)] {
-            let (mut qp, mut qm, mut vp, mut vm) =
-                (q.to_vec(), q.to_vec(), qd.to_vec(), qd.to_vec());
-            let h = 1e-7;
-            if var == 0 {
-                qp[j] += h;
-                qm[j] -= h;
-            } else {
-                vp[j] += h;
-                vm[j] -= h;
-            }
-            m.inverse_dynamics(0.0, &qp, &vp, qdd, &[], &mut tp);
-            m.inverse_dynamics(0.0, &qm, &vm, qdd, &[], &mut tm);
-            for i in 0..n {
-                out[i + n * j] = (tp[i] - tm[i]) / (2.0 * h);
-            }
-        }
-    }
-    (k, c)
-}
-
 /// Penetrations of the egg into the ground and of its nose's ellipsoid into the wall, from
 /// the model's kinematics and the support-point formula.
 fn penetrations(egg: &Egg, q: &[f64]) -> [f64; 2] {
@@ -219,7 +195,7 @@ fn exact_tangents_of_ellipsoid_contacts_match_central_differences() {
     let (mut k, mut c) = (vec![0.0; n * n], vec![0.0; n * n]);
     egg.tangents(0.0, &q, &qd, &qdd, &[], &mut k, &mut c)
         .unwrap();
-    let (kf, cf) = fd_tangents(&egg, &q, &qd, &qdd);
+    let (kf, cf) = fd_tangents(&egg, &q, &qd, &qdd, 1e-7);
     let rel = |x: &[f64], y: &[f64]| {
         let d: Vec<f64> = x.iter().zip(y).map(|(a, b)| a - b).collect();
         max_abs(&d) / max_abs(y)

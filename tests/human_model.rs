@@ -32,6 +32,19 @@ fn relative(a: &mbs::Pose, b: &mbs::Pose) -> [f64; 3] {
     [0, 1, 2].map(|j| (0..3).map(|i| a.rotation[i][j] * d[i]).sum())
 }
 
+/// Every joint held on `reference` by stiff spring–dampers (the toes' too), the pelvis free.
+fn held(reference: GaitReference) -> Tracking {
+    Tracking {
+        reference,
+        kp: 3000.0,
+        kd: 30.0,
+        pelvis_kp: 0.0,
+        pelvis_kd: 0.0,
+        toes_kp: 3000.0,
+        toes_kd: 30.0,
+    }
+}
+
 #[test]
 fn masses_and_the_knee_follow_their_sources() {
     let model = Human::default();
@@ -176,15 +189,7 @@ fn the_model_stands_on_its_feet() {
     let reference = GaitReference::still(model.info(), 0.1).unwrap();
     let (q0, qd0) = cycle_start(&model, &reference);
     assert!(qd0.iter().all(|v| *v == 0.0));
-    let tracking = Tracking {
-        reference,
-        kp: 3000.0,
-        kd: 30.0,
-        pelvis_kp: 0.0,
-        pelvis_kd: 0.0,
-        toes_kp: 3000.0,
-        toes_kd: 30.0,
-    };
+    let tracking = held(reference);
     let mut q = q0.clone();
     q.resize(n, 0.0);
     let options = Options {
@@ -249,15 +254,7 @@ fn passive_moments_follow_their_law_and_relax_toward_it() {
     let reference = GaitReference::still(info, 0.1).unwrap();
     let (q0, qd0) = cycle_start(&model, &reference);
     let mut drive = passive.clone();
-    drive.tracking = Some(Tracking {
-        reference,
-        kp: 3000.0,
-        kd: 30.0,
-        pelvis_kp: 0.0,
-        pelvis_kd: 0.0,
-        toes_kp: 3000.0,
-        toes_kd: 30.0,
-    });
+    drive.tracking = Some(held(reference));
     let (mut q, mut qd) = (q0.clone(), qd0.clone());
     q.resize(n + 17, 0.0);
     qd.resize(n + 17, 0.5);

@@ -239,6 +239,14 @@ impl Fourier {
     }
 }
 
+/// The number of coordinate `name` of the model `info` describes.
+fn dof_index(info: &mbs::ModelInfo, name: &str) -> Result<usize, String> {
+    info.dofs
+        .iter()
+        .position(|d| *d == name)
+        .ok_or_else(|| format!("the model has no coordinate `{name}`"))
+}
+
 /// The columns of the gait table that drive the model's coordinates (`None`: held at zero).
 const TRACKED: [(&str, Option<&str>); 17] = [
     ("lumbar_extension", Some("lumbar_extension")),
@@ -296,11 +304,7 @@ impl GaitReference {
         let zero = Fourier::fit(&[0.0; 4], 0, period);
         let mut joints = Vec::new();
         for (dof, col) in TRACKED {
-            let i = info
-                .dofs
-                .iter()
-                .position(|d| *d == dof)
-                .ok_or_else(|| format!("the model has no coordinate `{dof}`"))?;
+            let i = dof_index(info, dof)?;
             let f = match col {
                 Some(c) => series(c)?,
                 None => zero.clone(),
@@ -328,11 +332,7 @@ impl GaitReference {
         let zero = || constant(0.0);
         let mut joints = Vec::new();
         for (dof, _) in TRACKED {
-            let i = info
-                .dofs
-                .iter()
-                .position(|d| *d == dof)
-                .ok_or_else(|| format!("the model has no coordinate `{dof}`"))?;
+            let i = dof_index(info, dof)?;
             let v = if dof.starts_with("ankle") { ankle } else { 0.0 };
             joints.push((i, constant(v)));
         }
@@ -796,11 +796,7 @@ impl PassiveJoints {
                 .iter()
                 .find(|(n, _)| *n == base)
                 .ok_or_else(|| format!("no passive law for `{dof}`"))?;
-            let i = info
-                .dofs
-                .iter()
-                .position(|d| *d == dof)
-                .ok_or_else(|| format!("the model has no coordinate `{dof}`"))?;
+            let i = dof_index(info, dof)?;
             joints.push((i, *l));
         }
         Ok(PassiveJoints {

@@ -150,3 +150,36 @@ pub fn example(name: &str) -> std::path::PathBuf {
     let path = exe.parent().unwrap().parent().unwrap().join("examples");
     path.join(format!("{name}{}", std::env::consts::EXE_SUFFIX))
 }
+
+/// Central differences of τ(q, qd, qdd) at fixed qdd with step `h`: (K, C), column-major
+/// like the model's tangents.
+pub fn fd_tangents<M: Model>(
+    m: &M,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    h: f64,
+) -> (Vec<f64>, Vec<f64>) {
+    let n = M::NQ;
+    let (mut k, mut c) = (vec![0.0; n * n], vec![0.0; n * n]);
+    let (mut tp, mut tm) = (vec![0.0; n], vec![0.0; n]);
+    for j in 0..n {
+        for (var, out) in [(0, &mut k), (1, &mut c)] {
+            let (mut qp, mut qm, mut vp, mut vm) =
+                (q.to_vec(), q.to_vec(), qd.to_vec(), qd.to_vec());
+            if var == 0 {
+                qp[j] += h;
+                qm[j] -= h;
+            } else {
+                vp[j] += h;
+                vm[j] -= h;
+            }
+            m.inverse_dynamics(0.0, &qp, &vp, qdd, &[], &mut tp);
+            m.inverse_dynamics(0.0, &qm, &vm, qdd, &[], &mut tm);
+            for i in 0..n {
+                out[i + n * j] = (tp[i] - tm[i]) / (2.0 * h);
+            }
+        }
+    }
+    (k, c)
+}

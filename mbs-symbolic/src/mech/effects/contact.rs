@@ -145,11 +145,18 @@ fn linear_normal(b: &mut Build, delta: ExprId, nv: ExprId, k: ExprId, c: ExprId)
     if b.a.is_num(c, 0.0) {
         return elastic;
     }
-    b.dissipative = true;
     let a = &mut *b.a;
     let kd = a.mul(k, delta);
     let cn = a.mul(c, nv);
     let raw = a.sub(kd, cn);
+    gated(b, delta, nv, elastic, raw)
+}
+
+/// F_n = step(δ) pos(raw), a force that never pulls and acts in contact only; its part
+/// beyond the elastic one counts in the power (at the contact point's n·v = −δ̇).
+fn gated(b: &mut Build, delta: ExprId, nv: ExprId, elastic: ExprId, raw: ExprId) -> ExprId {
+    b.dissipative = true;
+    let a = &mut *b.a;
     let on = a.func(Func::Step, delta);
     let pr = a.func(Func::Pos, raw);
     let f_n = a.mul(on, pr);
@@ -182,7 +189,6 @@ fn hunt_crossley_normal(
     if b.a.is_num(c, 0.0) && b.a.is_num(d, 0.0) {
         return elastic;
     }
-    b.dissipative = true;
     let a = &mut *b.a;
     // δ̇ = −n·v
     let dn = a.mul(d, nv);
@@ -190,11 +196,5 @@ fn hunt_crossley_normal(
     let hc = a.mul(elastic, factor);
     let cn = a.mul(c, nv);
     let raw = a.sub(hc, cn);
-    let on = a.func(Func::Step, delta);
-    let pr = a.func(Func::Pos, raw);
-    let f_n = a.mul(on, pr);
-    let damping = a.sub(f_n, elastic);
-    let pw = a.mul(damping, nv);
-    b.add_power(pw);
-    f_n
+    gated(b, delta, nv, elastic, raw)
 }

@@ -392,6 +392,7 @@ pub struct Tracking {
     /// passive spring about zero (N·m/rad, N·m·s/rad)
     pub toes_kp: f64,
     pub toes_kd: f64,
+    pub guard: Guard,
 }
 
 /// vee of the antisymmetric part of a 3 × 3 matrix: (a − aᵀ)/2 as a vector.
@@ -408,6 +409,26 @@ fn transpose(a: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
 }
 
 impl Tracking {
+    /// Every joint held on `reference` with stiffness `kp` and damping `kd` (the toes' too),
+    /// the pelvis free, the [`Guard`] on.
+    pub fn new(
+        reference: GaitReference,
+        info: &mbs::ModelInfo,
+        kp: f64,
+        kd: f64,
+    ) -> Result<Tracking, String> {
+        Ok(Tracking {
+            reference,
+            kp,
+            kd,
+            pelvis_kp: 0.0,
+            pelvis_kd: 0.0,
+            toes_kp: kp,
+            toes_kd: kd,
+            guard: Guard::new(info)?,
+        })
+    }
+
     /// The residual torque on the pelvis (world axes) at time `t` for its orientation `r`
     /// and angular velocity `w`: kp·θ + kd·(ω_ref − ω), θ the rotation vector (small-angle)
     /// from the pelvis to its reference.
@@ -459,6 +480,7 @@ const PELVIS_FRAME: usize = 0;
 
 impl Efforts for Tracking {
     fn efforts(&mut self, e: &mut Effort) -> Result<(), String> {
+        self.guard.check(e.q, e.kin)?;
         let pelvis = e.frame(PELVIS_FRAME);
         let torque = self.pelvis_torque(e.t, &pelvis.pose.rotation, pelvis.angular_velocity);
         e.torque_on_frame(PELVIS_FRAME, torque);
@@ -486,38 +508,110 @@ pub const FOOT_ELLIPSOIDS: [(&str, [f64; 3]); 6] = [
 /// The support point of each of the 12 ellipsoids (feet k = 0, 1, in `FOOT_ELLIPSOIDS`'
 /// order) at the kinematics `kin`: its world position and velocity (the material point's).
 pub fn support_points(model: &Human, kin: &Kinematics) -> [[([f64; 3], [f64; 3]); 6]; 2] {
-    let info = model.info();
-    std::array::from_fn(|k| {
-        std::array::from_fn(|e| {
-            let (name, axes) = FOOT_ELLIPSOIDS[e];
-            let i = info
-                .point_index(&format!("{name}[{k}]"))
-                .expect("the foot's points");
+    Feet::of(model.info()).support_points(kin)
+}
+
+/// Where the feet's ellipsoids are in a model's kinematics: their centres' points and the
+/// frames whose axes they follow.
+#[derive(Clone, Copy, Debug)]
+pub struct Feet {
+    point: [[usize; 6]; 2],
+    frame: [[usize; 6]; 2],
+}
+
+impl Feet {
+    pub fn of(info: &mbs::ModelInfo) -> Feet {
+        let index = |k: usize, e: usize| {
+            let name = FOOT_ELLIPSOIDS[e].0;
             let frame = if name == "hallux" || name == "lesser_toes" {
                 "toes_o"
             } else {
                 "calcn_o"
             };
-            let f = info
-                .frame_index(&format!("{frame}[{k}]"))
-                .expect("the foot's frames");
-            let (pt, fr) = (&kin.points[i], &kin.frames[f]);
-            let r = fr.pose.rotation;
-            // m = Rᵀ n with n = y; support point x − R D² m / s
-            let m = [r[1][0], r[1][1], r[1][2]];
-            let u = [0, 1, 2].map(|j| axes[j] * axes[j] * m[j]);
-            let s = (0..3).map(|j| m[j] * u[j]).sum::<f64>().sqrt();
-            let arm = [0, 1, 2].map(|row| -(0..3).map(|j| r[row][j] * u[j]).sum::<f64>() / s);
-            let w = fr.angular_velocity;
-            let x = [0, 1, 2].map(|j| pt.position[j] + arm[j]);
-            let v = [
-                pt.velocity[0] + w[1] * arm[2] - w[2] * arm[1],
-                pt.velocity[1] + w[2] * arm[0] - w[0] * arm[2],
-                pt.velocity[2] + w[0] * arm[1] - w[1] * arm[0],
-            ];
-            (x, v)
+            (
+                info.point_index(&format!("{name}[{k}]"))
+                    .expect("the foot's points"),
+                info.frame_index(&format!("{frame}[{k}]"))
+                    .expect("the foot's frames"),
+            )
+        };
+        Feet {
+            point: std::array::from_fn(|k| std::array::from_fn(|e| index(k, e).0)),
+            frame: std::array::from_fn(|k| std::array::from_fn(|e| index(k, e).1)),
+        }
+    }
+
+    /// See [`support_points`].
+    pub fn support_points(&self, kin: &Kinematics) -> [[([f64; 3], [f64; 3]); 6]; 2] {
+        std::array::from_fn(|k| {
+            std::array::from_fn(|e| {
+                let axes = FOOT_ELLIPSOIDS[e].1;
+                let (pt, fr) = (&kin.points[self.point[k][e]], &kin.frames[self.frame[k][e]]);
+                let r = fr.pose.rotation;
+                // m = Rᵀ n with n = y; support point x − R D² m / s
+                let m = [r[1][0], r[1][1], r[1][2]];
+                let u = [0, 1, 2].map(|j| axes[j] * axes[j] * m[j]);
+                let s = (0..3).map(|j| m[j] * u[j]).sum::<f64>().sqrt();
+                let arm = [0, 1, 2].map(|row| -(0..3).map(|j| r[row][j] * u[j]).sum::<f64>() / s);
+                let w = fr.angular_velocity;
+                let x = [0, 1, 2].map(|j| pt.position[j] + arm[j]);
+                let v = [
+                    pt.velocity[0] + w[1] * arm[2] - w[2] * arm[1],
+                    pt.velocity[1] + w[2] * arm[0] - w[0] * arm[2],
+                    pt.velocity[2] + w[0] * arm[1] - w[1] * arm[0],
+                ];
+                (x, v)
+            })
         })
-    })
+    }
+}
+
+/// The knee splines' tables span [−KNEE_TABLE, KNEE_TABLE] (rad).
+pub const KNEE_TABLE: f64 = 2.0944;
+
+/// What a run of the model must not do silently, checked at every evaluation of the parts
+/// that drive it ([`Tracking`], [`PassiveJoints`]): a knee beyond its splines' tables (the
+/// tibia's translation would be extrapolated) and an ellipsoid deeper in the ground than its
+/// smallest semi-axis (the foot has passed through the ground). Each is an `Err` naming the
+/// coordinate or the ellipsoid, which stops the run with a typed failure, trajectory kept.
+#[derive(Clone, Copy, Debug)]
+pub struct Guard {
+    feet: Feet,
+    knees: [usize; 2],
+}
+
+impl Guard {
+    pub fn new(info: &mbs::ModelInfo) -> Result<Guard, String> {
+        Ok(Guard {
+            feet: Feet::of(info),
+            knees: [dof_index(info, "knee[0]")?, dof_index(info, "knee[1]")?],
+        })
+    }
+
+    /// `Err` with what went wrong, at (q, kin).
+    pub fn check(&self, q: &[f64], kin: &Kinematics) -> Result<(), String> {
+        for (k, &i) in self.knees.iter().enumerate() {
+            if q[i].abs() > KNEE_TABLE {
+                return Err(format!(
+                    "knee[{k}] = {:.4} rad is beyond the knee's tables [−{KNEE_TABLE}, {KNEE_TABLE}]: the tibia's translation is not known there",
+                    q[i]
+                ));
+            }
+        }
+        for (k, foot) in self.feet.support_points(kin).iter().enumerate() {
+            for (e, (x, _)) in foot.iter().enumerate() {
+                let (name, axes) = FOOT_ELLIPSOIDS[e];
+                let thin = axes.iter().copied().fold(f64::INFINITY, f64::min);
+                if -x[1] > thin {
+                    return Err(format!(
+                        "the ellipsoid {name}[{k}] is {:.4} m into the ground, deeper than its smallest semi-axis ({thin} m): it has passed through the ground",
+                        -x[1]
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
 /// The force of the ground on each foot (world axes) at a state, recomputed from the
@@ -782,6 +876,7 @@ pub struct PassiveJoints {
     /// time constant T of the moments' relaxation (s)
     pub time_constant: f64,
     pub tracking: Option<Tracking>,
+    pub guard: Guard,
 }
 
 impl PassiveJoints {
@@ -804,6 +899,7 @@ impl PassiveJoints {
             damping,
             time_constant,
             tracking: None,
+            guard: Guard::new(info)?,
         })
     }
 
@@ -827,6 +923,9 @@ impl Efforts for PassiveJoints {
     const STATE_NAMES: &'static [&'static str] = &PASSIVE_STATES;
 
     fn efforts(&mut self, e: &mut Effort) -> Result<(), String> {
+        if self.tracking.is_none() {
+            self.guard.check(e.q, e.kin)?;
+        }
         for (k, (i, l)) in self.joints.iter().enumerate() {
             let m = l.elastic(e.q[*i]) + e.x[k];
             e.generalized_force(*i, m);

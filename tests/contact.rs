@@ -10,9 +10,8 @@
 
 mod common;
 
-use common::fd_tangents;
+use common::{accelerations, energy_rate, fd_tangents};
 use mbs::{Kinematics, Model, Options, Output, Scheme, simulate};
-use nalgebra::{DMatrix, DVector};
 
 const G: f64 = 9.81;
 
@@ -174,32 +173,6 @@ fn exact_tangents_in_contact_match_central_differences() {
     check_tangents(&rig, &q, &qd, &qdd, "rig: sphere, tip, bushing, spring");
 }
 
-/// ∂/∂s of E along the motion: E(q + s qd + ½ s² qdd, qd + s qdd) by central differences.
-fn energy_rate<M: Model>(m: &M, t: f64, q: &[f64], qd: &[f64], qdd: &[f64]) -> f64 {
-    let s = 1e-6;
-    let at = |s: f64| {
-        let qs: Vec<f64> = (0..q.len())
-            .map(|i| q[i] + s * qd[i] + 0.5 * s * s * qdd[i])
-            .collect();
-        let vs: Vec<f64> = (0..q.len()).map(|i| qd[i] + s * qdd[i]).collect();
-        m.energy(t, &qs, &vs).total()
-    };
-    (at(s) - at(-s)) / (2.0 * s)
-}
-
-/// qdd = M⁻¹ h.
-fn accelerations<M: Model>(m: &M, t: f64, q: &[f64], qd: &[f64]) -> Vec<f64> {
-    let n = M::NQ;
-    let (mut mm, mut h) = (vec![0.0; n * n], vec![0.0; n]);
-    m.dynamics(t, q, qd, &[], &mut mm, &mut h);
-    let mm = DMatrix::from_column_slice(n, n, &mm);
-    mm.cholesky()
-        .expect("M positive definite")
-        .solve(&DVector::from_column_slice(&h))
-        .as_slice()
-        .to_vec()
-}
-
 #[test]
 fn energy_identity_along_a_run_with_every_force_element() {
     let rig = Rig::default();
@@ -213,7 +186,7 @@ fn energy_identity_along_a_run_with_every_force_element() {
     for i in 0..tr.len() {
         let (t, q, qd) = (tr.t[i], tr.q(i), tr.qd(i));
         let qdd = accelerations(&rig, t, q, qd);
-        let de = energy_rate(&rig, t, q, qd, &qdd);
+        let de = energy_rate(&rig, t, q, qd, &qdd, 1e-6);
         let p = rig.power(t, q, qd, &[]);
         // relative to the size of the power and of the kinetic energy's rate
         let scale = p.abs().max(de.abs()).max(1.0);

@@ -29,8 +29,7 @@
 //! **Driving it** (Rust): [`GaitTable`] reads a cycle of joint angles (the stored one is
 //! OpenSim's tutorial normal gait, `models/data/normal_gait.tsv`), [`GaitReference`] fits
 //! each angle with a Fourier series, and [`Tracking`] (an [`Efforts`] part) holds the joints
-//! on the reference with stiff spring–dampers, optionally the pelvis' orientation with a
-//! residual torque. [`PassiveJoints`] adds passive joint moments (Anderson's laws, a viscous
+//! on the reference with stiff spring–dampers, the pelvis free. [`PassiveJoints`] adds passive joint moments (Anderson's laws, a viscous
 //! state per joint), with or without the tracking. [`ground_forces`] recomputes each foot's
 //! ground reaction from the kinematics for reports.
 
@@ -225,6 +224,16 @@ impl Fourier {
         }
     }
 
+    /// The constant `v`.
+    pub fn constant(v: f64) -> Fourier {
+        Fourier {
+            a0: v,
+            a: Vec::new(),
+            b: Vec::new(),
+            omega: 0.0,
+        }
+    }
+
     /// The value and its first and second time derivatives at `t`.
     pub fn eval(&self, t: f64) -> [f64; 3] {
         let mut out = [self.a0, 0.0, 0.0];
@@ -301,7 +310,7 @@ impl GaitReference {
             let rad: Vec<f64> = col[..n].iter().map(|d| d.to_radians()).collect();
             Ok(Fourier::fit(&rad, harmonics, period))
         };
-        let zero = Fourier::fit(&[0.0; 4], 0, period);
+        let zero = Fourier::constant(0.0);
         let mut joints = Vec::new();
         for (dof, col) in TRACKED {
             let i = dof_index(info, dof)?;
@@ -328,18 +337,17 @@ impl GaitReference {
     /// are flat and the body leans forward as one piece: in the anatomical posture itself
     /// the centre of mass lies just behind the heels' support points.
     pub fn still(info: &mbs::ModelInfo, ankle: f64) -> Result<GaitReference, String> {
-        let constant = |v: f64| Fourier::fit(&[v; 4], 0, 1.0);
-        let zero = || constant(0.0);
+        let zero = || Fourier::constant(0.0);
         let mut joints = Vec::new();
         for (dof, _) in TRACKED {
             let i = dof_index(info, dof)?;
             let v = if dof.starts_with("ankle") { ankle } else { 0.0 };
-            joints.push((i, constant(v)));
+            joints.push((i, Fourier::constant(v)));
         }
         Ok(GaitReference {
             period: 1.0,
             joints,
-            pelvis: [constant(-ankle), zero(), zero()],
+            pelvis: [Fourier::constant(-ankle), zero(), zero()],
             offset: 0.0,
         })
     }
@@ -352,10 +360,7 @@ impl GaitReference {
     /// The pelvis' rotation matrix at `t`: Rz(tilt) Rx(list) Ry(rotation).
     pub fn pelvis_rotation(&self, t: f64) -> [[f64; 3]; 3] {
         let [a, b, c] = [0, 1, 2].map(|k| self.pelvis[k].eval(t + self.offset)[0]);
-        let rz = rot(2, a);
-        let rx = rot(0, b);
-        let ry = rot(1, c);
-        mul(&mul(&rz, &rx), &ry)
+        mul(&mul(&rot(2, a), &rot(0, b)), &rot(1, c))
     }
 }
 
@@ -384,28 +389,11 @@ pub struct Tracking {
     /// stiffness (N·m/rad) and damping (N·m·s/rad)
     pub kp: f64,
     pub kd: f64,
-    /// stiffness and damping of a residual torque from the ground on the pelvis toward its
-    /// reference orientation (0, 0: the pelvis free)
-    pub pelvis_kp: f64,
-    pub pelvis_kd: f64,
     /// stiffness and damping of the toes' joints, which the gait table does not give: a
     /// passive spring about zero (N·m/rad, N·m·s/rad)
     pub toes_kp: f64,
     pub toes_kd: f64,
     pub guard: Guard,
-}
-
-/// vee of the antisymmetric part of a 3 × 3 matrix: (a − aᵀ)/2 as a vector.
-fn vee(a: &[[f64; 3]; 3]) -> [f64; 3] {
-    [
-        0.5 * (a[2][1] - a[1][2]),
-        0.5 * (a[0][2] - a[2][0]),
-        0.5 * (a[1][0] - a[0][1]),
-    ]
-}
-
-fn transpose(a: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
-    std::array::from_fn(|i| std::array::from_fn(|j| a[j][i]))
 }
 
 impl Tracking {
@@ -421,37 +409,12 @@ impl Tracking {
             reference,
             kp,
             kd,
-            pelvis_kp: 0.0,
-            pelvis_kd: 0.0,
             toes_kp: kp,
             toes_kd: kd,
             guard: Guard::new(info)?,
         })
     }
 
-    /// The residual torque on the pelvis (world axes) at time `t` for its orientation `r`
-    /// and angular velocity `w`: kp·θ + kd·(ω_ref − ω), θ the rotation vector (small-angle)
-    /// from the pelvis to its reference.
-    pub fn pelvis_torque(&self, t: f64, r: &[[f64; 3]; 3], w: [f64; 3]) -> [f64; 3] {
-        if self.pelvis_kp == 0.0 && self.pelvis_kd == 0.0 {
-            return [0.0; 3];
-        }
-        let rr = self.reference.pelvis_rotation(t);
-        let theta = vee(&mul(&rr, &transpose(r)));
-        // ω_ref = vee(Ṙ_ref R_refᵀ), Ṙ_ref by central differences
-        let dt = 1e-6;
-        let (p, m) = (
-            self.reference.pelvis_rotation(t + dt),
-            self.reference.pelvis_rotation(t - dt),
-        );
-        let rdot: [[f64; 3]; 3] =
-            std::array::from_fn(|i| std::array::from_fn(|j| (p[i][j] - m[i][j]) / (2.0 * dt)));
-        let wr = vee(&mul(&rdot, &transpose(&rr)));
-        [0, 1, 2].map(|k| self.pelvis_kp * theta[k] + self.pelvis_kd * (wr[k] - w[k]))
-    }
-}
-
-impl Tracking {
     /// The tracking torque on each joint coordinate at (t, q, qd): (coordinate, torque).
     pub fn torques<'a>(
         &'a self,
@@ -475,20 +438,11 @@ impl Tracking {
     }
 }
 
-/// The pelvis' origin frame in [`Human`]'s frames.
-const PELVIS_FRAME: usize = 0;
-
 impl Efforts for Tracking {
     fn efforts(&mut self, e: &mut Effort) -> Result<(), String> {
         self.guard.check(e.q, e.kin)?;
-        let pelvis = e.frame(PELVIS_FRAME);
-        let torque = self.pelvis_torque(e.t, &pelvis.pose.rotation, pelvis.angular_velocity);
-        e.torque_on_frame(PELVIS_FRAME, torque);
-        let torques: [(usize, f64); 17] = {
-            let mut it = self.torques(e.t, e.q, e.qd);
-            std::array::from_fn(|_| it.next().expect("17 joints"))
-        };
-        for (i, tau) in torques {
+        let (q, qd) = (e.q, e.qd);
+        for (i, tau) in self.torques(e.t, q, qd) {
             e.generalized_force(i, tau);
         }
         Ok(())
@@ -663,22 +617,7 @@ pub const START_DEPTH: f64 = 2e-3;
 /// where the lowest ellipsoid is [`START_DEPTH`] into the ground, and moving so that the
 /// left foot's lowest support point, on the ground in its late stance, is at rest.
 pub fn cycle_start(model: &Human, reference: &GaitReference) -> (Vec<f64>, Vec<f64>) {
-    let n = Human::NQ;
-    let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
-    model.initial_state(&mut q, &mut qd);
-    for (k, (i, _)) in reference.joints.iter().enumerate() {
-        let [r, rd, _] = reference.joint(k, 0.0);
-        q[*i] = r;
-        qd[*i] = rd;
-    }
-    // the pelvis' angles and their rates (central differences of the angles)
-    let dt = 1e-6;
-    let ang = |t: f64| zyx_angles(&reference.pelvis_rotation(t));
-    let (a0, ap, am) = (ang(0.0), ang(dt), ang(-dt));
-    for j in 0..3 {
-        q[3 + j] = a0[j];
-        qd[3 + j] = (ap[j] - am[j]) / (2.0 * dt);
-    }
+    let (mut q, mut qd) = reference_state(model, reference, 0.0);
     let mut kin = Kinematics::new::<Human>();
     model.kinematics(0.0, &q, &qd, &mut kin);
     let sp = support_points(model, &kin);
@@ -699,70 +638,41 @@ pub fn cycle_start(model: &Human, reference: &GaitReference) -> (Vec<f64>, Vec<f
 /// relative to a pelvis moving with its reference orientation only, averaged over the flat
 /// part of the right foot's stance (15 % to 40 % of the cycle).
 pub fn walking_speed(model: &Human, reference: &GaitReference) -> f64 {
-    let n = Human::NQ;
-    let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
     let mut kin = Kinematics::new::<Human>();
+    let feet = Feet::of(model.info());
     let samples = 11;
     let mut sum = 0.0;
     for s in 0..samples {
-        let t = reference.period * (0.15 + 0.25 * s as f64 / (samples - 1) as f64);
-        model.initial_state(&mut q, &mut qd);
-        qd.fill(0.0);
-        for (k, (i, _)) in reference.joints.iter().enumerate() {
-            let [r, rd, _] = reference.joint(k, t - reference.offset);
-            q[*i] = r;
-            qd[*i] = rd;
-        }
-        let dt = 1e-6;
-        let ang = |t: f64| zyx_angles(&reference.pelvis_rotation(t));
-        let t = t - reference.offset;
-        let (a0, ap, am) = (ang(t), ang(t + dt), ang(t - dt));
-        for j in 0..3 {
-            q[3 + j] = a0[j];
-            qd[3 + j] = (ap[j] - am[j]) / (2.0 * dt);
-        }
+        let phase = reference.period * (0.15 + 0.25 * s as f64 / (samples - 1) as f64);
+        let t = phase - reference.offset;
+        let (q, qd) = reference_state(model, reference, t);
         model.kinematics(t, &q, &qd, &mut kin);
-        sum -= support_points(model, &kin)[0][1].1[0];
+        sum -= feet.support_points(&kin)[0][1].1[0];
     }
     sum / samples as f64
 }
 
-/// A run of the model following a gait cycle, and what it shows.
-#[derive(Debug)]
-pub struct GaitRun {
-    pub trajectory: mbs::Trajectory,
-    pub stats: mbs::Stats,
-    pub failure: Option<mbs::SimError>,
-    /// CPU time of the run (s)
-    pub cpu: f64,
-}
-
-/// The tracked model: [`Human`] with its joints driven by [`Tracking`].
-pub type Tracked = mbs::WithEfforts<Human, Tracking>;
-
-/// Runs the model from [`cycle_start`] while its joints track `tracking`'s reference.
-pub fn follow(tracking: Tracking, scheme: mbs::Scheme, mut options: mbs::Options) -> GaitRun {
-    let model = Human::default();
-    let (q, qd) = cycle_start(&model, &tracking.reference);
-    options.q0 = Some(q);
-    options.qd0 = Some(qd);
-    let start = std::time::Instant::now();
-    let result = mbs::simulate(mbs::WithEfforts::new(model, tracking), scheme, options);
-    let cpu = start.elapsed().as_secs_f64();
-    match result {
-        Ok((trajectory, stats)) => GaitRun {
-            trajectory,
-            stats,
-            failure: None,
-            cpu,
-        },
-        Err(e) => GaitRun {
-            trajectory: (*e.trajectory).clone(),
-            stats: (*e.stats).clone(),
-            failure: Some(e),
-            cpu,
-        },
+/// The model's state on `reference` at `t`: every joint and the pelvis' orientation on
+/// their references (angles and rates; the pelvis' ZYX rates by central differences of its
+/// angles), the pelvis' translation at the model's start and at rest.
+fn reference_state(model: &Human, reference: &GaitReference, t: f64) -> (Vec<f64>, Vec<f64>) {
+    let n = Human::NQ;
+    let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
+    model.initial_state(&mut q, &mut qd);
+    qd.fill(0.0);
+    for (k, (i, _)) in reference.joints.iter().enumerate() {
+        let [r, rd, _] = reference.joint(k, t);
+        q[*i] = r;
+        qd[*i] = rd;
     }
+    let dt = 1e-6;
+    let ang = |t: f64| zyx_angles(&reference.pelvis_rotation(t));
+    let (a0, ap, am) = (ang(t), ang(t + dt), ang(t - dt));
+    for j in 0..3 {
+        q[3 + j] = a0[j];
+        qd[3 + j] = (ap[j] - am[j]) / (2.0 * dt);
+    }
+    (q, qd)
 }
 
 /// The passive moment of one joint (Anderson 1999, as transcribed in Falisse et al. 2019's
@@ -865,7 +775,7 @@ const PASSIVE_STATES: [&str; 17] = [
 /// parallel with the elastic law: tissue whose damping has memory; T → 0 gives the law's
 /// −d q̇). Delaying the elastic part instead would pump energy into a joint pressed against
 /// its stiff range end (an effective damping d − k T < 0). Optionally with a [`Tracking`] of a
-/// gait cycle on top. A model wrapped without it ([`Tracked`]) has neither the moments nor
+/// gait cycle on top. A model wrapped without it (`WithEfforts<Human, Tracking>`) has neither the moments nor
 /// their states.
 #[derive(Clone, Debug)]
 pub struct PassiveJoints {

@@ -183,3 +183,29 @@ pub fn fd_tangents<M: Model>(
     }
     (k, c)
 }
+
+/// ∂/∂s of E along the motion: E(q + s qd + ½ s² qdd, qd + s qdd) by central differences
+/// of step `s`.
+pub fn energy_rate<M: Model>(m: &M, t: f64, q: &[f64], qd: &[f64], qdd: &[f64], s: f64) -> f64 {
+    let at = |s: f64| {
+        let qs: Vec<f64> = (0..q.len())
+            .map(|i| q[i] + s * qd[i] + 0.5 * s * s * qdd[i])
+            .collect();
+        let vs: Vec<f64> = (0..q.len()).map(|i| qd[i] + s * qdd[i]).collect();
+        m.energy(t, &qs, &vs).total()
+    };
+    (at(s) - at(-s)) / (2.0 * s)
+}
+
+/// qdd = M⁻¹ h (dense Cholesky).
+pub fn accelerations<M: Model>(m: &M, t: f64, q: &[f64], qd: &[f64]) -> Vec<f64> {
+    let n = M::NQ;
+    let (mut mm, mut h) = (vec![0.0; n * n], vec![0.0; n]);
+    m.dynamics(t, q, qd, &[], &mut mm, &mut h);
+    let mm = nalgebra::DMatrix::from_column_slice(n, n, &mm);
+    mm.cholesky()
+        .expect("M positive definite")
+        .solve(&nalgebra::DVector::from_column_slice(&h))
+        .as_slice()
+        .to_vec()
+}

@@ -134,11 +134,7 @@ impl Arena {
 
     /// Registers a user function and returns its number.
     pub fn user_fn(&mut self, f: UserFn) -> u16 {
-        if let Some(i) = self.user_fns.iter().position(|g| *g == f) {
-            return i as u16;
-        }
-        self.user_fns.push(f);
-        (self.user_fns.len() - 1) as u16
+        register(&mut self.user_fns, f)
     }
 
     pub fn user_fns(&self) -> &[UserFn] {
@@ -147,11 +143,7 @@ impl Arena {
 
     /// Registers a spline and returns its number (equal tables share one).
     pub fn spline_table(&mut self, s: SplineTable) -> u16 {
-        if let Some(i) = self.splines.iter().position(|g| *g == s) {
-            return i as u16;
-        }
-        self.splines.push(s);
-        (self.splines.len() - 1) as u16
+        register(&mut self.splines, s)
     }
 
     /// The splines of the model, by number.
@@ -265,6 +257,17 @@ impl Arena {
         vs.sort_unstable();
         vs.dedup();
         vs
+    }
+}
+
+/// The number of `x` in `list`, pushed there unless an equal entry is there already.
+fn register<T: PartialEq>(list: &mut Vec<T>, x: T) -> u16 {
+    match list.iter().position(|y| *y == x) {
+        Some(i) => i as u16,
+        None => {
+            list.push(x);
+            (list.len() - 1) as u16
+        }
     }
 }
 

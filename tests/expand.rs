@@ -223,6 +223,27 @@ fn expand_follows_modules_and_reports_every_error_with_its_place() {
         "{stderr}"
     );
 
+    // a module of a crate's `src` given alone finds its modules in a folder of its name
+    let dir = fixture(
+        "expand_module_alone",
+        &[
+            (
+                "src/legs.rs",
+                &format!("mod foot;\nmbs::multibody! {{ model Leg {{ {GOOD} }} }}\n"),
+            ),
+            (
+                "src/legs/foot.rs",
+                &format!("mbs::multibody! {{ model Foot {{ {GOOD} }} }}\n"),
+            ),
+        ],
+    );
+    let (ok, stdout, stderr) = run(&[
+        "expand",
+        dir.join("src/legs.rs").to_str().unwrap(),
+        "--counts-only",
+    ]);
+    assert!(ok && stdout.contains("model Foot:"), "{stderr}");
+
     // --scene: a scene of one of the models is shown alone; an unknown one is an error that
     // lists the scenes
     let (ok, stdout, _) = run(&[

@@ -28,8 +28,30 @@ pub fn sources(root: &Path) -> (Vec<Source>, Vec<SourceError>) {
         seen: Vec::new(),
         workspace: None,
     };
-    r.read(root.to_path_buf(), true, None);
+    r.read(root.to_path_buf(), finds_modules_beside(root), None);
     (r.out, r.errors)
+}
+
+/// Whether the `mod x;` of the file `root` are found beside it, as for a crate root
+/// (`lib.rs`, `main.rs`, `src/bin/*.rs`, an example, a test, a bench) or a `mod.rs`, rather
+/// than in a folder of its name, as for any other module of a crate's `src`
+/// (`src/human.rs` finds `mod muscles;` in `src/human/muscles.rs`).
+fn finds_modules_beside(root: &Path) -> bool {
+    let name = root
+        .file_name()
+        .and_then(|n| n.to_str())
+        .unwrap_or_default();
+    if matches!(name, "lib.rs" | "main.rs" | "mod.rs") {
+        return true;
+    }
+    let dirs: Vec<&str> = root
+        .parent()
+        .map(|d| d.iter().filter_map(|c| c.to_str()).collect())
+        .unwrap_or_default();
+    match dirs.iter().rposition(|d| *d == "src") {
+        Some(i) => dirs.get(i + 1) == Some(&"bin") && i + 2 == dirs.len(),
+        None => true,
+    }
 }
 
 struct Reader {

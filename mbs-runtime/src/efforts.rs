@@ -149,6 +149,13 @@ pub struct WithEfforts<M: Model, E: Efforts> {
     info: &'static ModelInfo,
 }
 
+/// A copy with fresh buffers and counters (what statics and linearisation ask of a model).
+impl<M: Model + Clone + 'static, E: Efforts + Clone> Clone for WithEfforts<M, E> {
+    fn clone(&self) -> Self {
+        WithEfforts::new(self.model.clone(), self.user.borrow().clone())
+    }
+}
+
 impl<M: Model + 'static, E: Efforts> WithEfforts<M, E> {
     pub fn new(model: M, efforts: E) -> WithEfforts<M, E> {
         let (n, nx) = (M::NQ, E::NX);

@@ -12,8 +12,11 @@
 //!   f = −K Δp − C Δv with Δp = R_Aᵀ(p_B − p_A), Δv its rate; torque on B
 //!   m = −Eᵀ K_r θ − C_r Ω with θ = ½(R₃₂ − R₂₃, R₁₃ − R₃₁, R₂₁ − R₁₂), R = R_Aᵀ R_B,
 //!   E = ½(tr R·I − R), Ω = R_Aᵀ(ω_B − ω_A); the opposite on A.
+//! - [`Path`]: a path through declared points (a cable's, a muscle's): length, lengthening
+//!   speed and ∂l/∂q from the points' kinematics, a tension applied along it.
 
 use crate::efforts::Effort;
+use crate::model::Kinematics;
 
 type V3 = [f64; 3];
 
@@ -265,5 +268,67 @@ impl Bushing {
             e.torque_on_frame(i, scale(-1.0, mw));
         }
         (f, m)
+    }
+}
+
+/// A path through declared points (origin, via points, insertion) along which a cable or a
+/// muscle pulls: its length l = Σ |p_{i+1} − p_i|, lengthening speed l̇ and gradient ∂l/∂q
+/// from the generated kinematics of the points (exact: the gradient is Σ u_iᵀ (J_{i+1} − J_i)
+/// with u_i the unit vector of segment i and J the points' Jacobians), so the moment arms
+/// −∂l/∂q are those of the kinematics, not of differences. A tension T acts at each point
+/// along its segments, pulling consecutive points together; its generalised force is
+/// −T ∂l/∂q.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Path {
+    /// the declared points (`ModelInfo::point_index`), from origin to insertion
+    pub points: Vec<usize>,
+}
+
+impl Path {
+    fn segments<'a>(&'a self, kin: &'a Kinematics) -> impl Iterator<Item = (V3, V3, f64)> + 'a {
+        self.points.windows(2).map(|w| {
+            let (a, b) = (&kin.points[w[0]], &kin.points[w[1]]);
+            let d = sub(b.position, a.position);
+            let l = dot(d, d).sqrt();
+            (scale(1.0 / l, d), sub(b.velocity, a.velocity), l)
+        })
+    }
+
+    /// Length and lengthening speed at the kinematics `kin`.
+    pub fn length(&self, kin: &Kinematics) -> (f64, f64) {
+        self.segments(kin)
+            .fold((0.0, 0.0), |(l, ld), (u, dv, s)| (l + s, ld + dot(u, dv)))
+    }
+
+    /// ∂l/∂q into `out` (one entry per coordinate of the model); the moment arm about
+    /// coordinate i is −out[i].
+    pub fn gradient(&self, kin: &Kinematics, out: &mut [f64]) {
+        out.fill(0.0);
+        for (w, (u, _, _)) in self.points.windows(2).zip(self.segments(kin)) {
+            let (ja, jb) = (&kin.points[w[0]].jv, &kin.points[w[1]].jv);
+            for (i, g) in out.iter_mut().enumerate() {
+                *g += (0..3)
+                    .map(|r| u[r] * (jb[3 * i + r] - ja[3 * i + r]))
+                    .sum::<f64>();
+            }
+        }
+    }
+
+    /// Applies the tension `tension` (N) along the path.
+    pub fn apply(&self, e: &mut Effort, tension: f64) {
+        let n = self.points.len();
+        for k in 0..n {
+            let p = e.point(self.points[k]).position;
+            let mut f = [0.0; 3];
+            if k > 0 {
+                let d = sub(e.point(self.points[k - 1]).position, p);
+                f = add(f, scale(tension / dot(d, d).sqrt(), d));
+            }
+            if k + 1 < n {
+                let d = sub(e.point(self.points[k + 1]).position, p);
+                f = add(f, scale(tension / dot(d, d).sqrt(), d));
+            }
+            e.force_at_point(self.points[k], f);
+        }
     }
 }

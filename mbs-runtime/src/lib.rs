@@ -21,6 +21,7 @@ pub mod integrators;
 pub mod lanes;
 pub mod linalg;
 pub mod model;
+pub mod muscle;
 mod op_count;
 pub mod options;
 pub mod sensitivity;

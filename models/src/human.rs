@@ -116,6 +116,33 @@ mbs::multibody! {
             contact(meta5[k], ellipsoid = (0.02, 0.015, 0.012), plane = y, k = k_foot, exponent = 1.5, dissipation = d_foot, mu = mu_foot, eps = eps_foot);
             contact(hallux[k], ellipsoid = (0.025, 0.008, 0.012), plane = y, k = k_foot, exponent = 1.5, dissipation = d_foot, mu = mu_foot, eps = eps_foot);
             contact(lesser_toes[k], ellipsoid = (0.02, 0.008, 0.015), plane = y, k = k_foot, exponent = 1.5, dissipation = d_foot, mu = mu_foot, eps = eps_foot);
+            // muscle paths (gait10dof18musc's points in the bodies' joint frames; the
+            // quadriceps insert on the patella, see `MUSCLES`)
+            point ham_o[k] on pelvis_o at (-0.12596, -0.10257, 0.06944 * s);
+            point hams_via[k] on tibia_o[k] at (-0.0301, -0.036, 0.02943 * s);
+            point hams_i[k] on tibia_o[k] at (-0.0234, -0.0563, 0.0343 * s);
+            point bfsh_o[k] on femur_o[k] at (0.005, -0.2111, 0.0234 * s);
+            point gmax_o[k] on pelvis_o at (-0.1349, 0.0176, 0.0563 * s);
+            point gmax_via[k] on pelvis_o at (-0.1376, -0.052, 0.0914 * s);
+            point gmax_via2[k] on femur_o[k] at (-0.0426, -0.053, 0.0293 * s);
+            point gmax_i[k] on femur_o[k] at (-0.0156, -0.1016, 0.0419 * s);
+            point ilps_o[k] on pelvis_o at (-0.0647, 0.0887, 0.0289 * s);
+            point ilps_via[k] on pelvis_o at (-0.0238, -0.057, 0.0759 * s);
+            point ilps_via2[k] on pelvis_o at (-0.0288, -0.0805, 0.0816 * s);
+            point ilps_via3[k] on femur_o[k] at (0.0016, -0.0507, 0.0038 * s);
+            point ilps_i[k] on femur_o[k] at (-0.0188, -0.0597, 0.0104 * s);
+            point rf_o[k] on pelvis_o at (-0.0295, -0.0311, 0.0968 * s);
+            point rf_i[k] on patella[k] at (0.0104, 0.0173, 0.0014 * s);
+            point vas_o[k] on femur_o[k] at (0.029, -0.1924, 0.031 * s);
+            point vas_via[k] on femur_o[k] at (0.0335, -0.2084, 0.0285 * s);
+            point vas_i[k] on patella[k] at (0.0041, 0.0216, 0.0018 * s);
+            point gas_o[k] on femur_o[k] at (-0.019, -0.3929, -0.0235 * s);
+            point gas_via[k] on femur_o[k] at (-0.03, -0.4022, -0.0258 * s);
+            point achilles[k] on calcn_o[k] at (0.0, 0.031, -0.0053 * s);
+            point sol_o[k] on tibia_o[k] at (-0.0024, -0.1533, 0.0071 * s);
+            point ta_o[k] on tibia_o[k] at (0.0179, -0.1624, 0.0115 * s);
+            point ta_via[k] on tibia_o[k] at (0.0329, -0.3951, -0.0177 * s);
+            point ta_i[k] on calcn_o[k] at (0.1166, 0.0178, -0.0305 * s);
             shape femur[k]: cylinder(0.03, 0.4, axis = y);
             shape tibia[k]: cylinder(0.025, 0.4, axis = y);
             shape calcn[k]: box(0.2, 0.05, 0.08);
@@ -128,6 +155,9 @@ mbs::multibody! {
         gravity(0, -9.80665, 0);
     }
 }
+
+mod muscles;
+pub use muscles::{MUSCLE_JOINTS, MUSCLES, MuscleData, MuscleDriven, Muscles, NM, moment_arms};
 
 use mbs::{Effort, Efforts, Kinematics, Model};
 
@@ -393,6 +423,8 @@ pub struct Tracking {
     /// passive spring about zero (N·m/rad, N·m·s/rad)
     pub toes_kp: f64,
     pub toes_kd: f64,
+    /// the toes' coordinates
+    toes: [usize; 2],
     pub guard: Guard,
 }
 
@@ -411,6 +443,7 @@ impl Tracking {
             kd,
             toes_kp: kp,
             toes_kd: kd,
+            toes: [dof_index(info, "mtp[0]")?, dof_index(info, "mtp[1]")?],
             guard: Guard::new(info)?,
         })
     }
@@ -428,13 +461,23 @@ impl Tracking {
             .enumerate()
             .map(move |(k, (i, _))| {
                 let [r, rd, _] = self.reference.joint(k, t);
-                let (kp, kd) = if TRACKED[k].0.starts_with("mtp") {
+                let (kp, kd) = if self.toes.contains(i) {
                     (self.toes_kp, self.toes_kd)
                 } else {
                     (self.kp, self.kd)
                 };
                 (*i, kp * (r - q[*i]) + kd * (rd - qd[*i]))
             })
+    }
+
+    /// Stops holding the coordinates `names` (they are left to other efforts: muscles).
+    pub fn release(&mut self, info: &mbs::ModelInfo, names: &[&str]) -> Result<(), String> {
+        let drop = names
+            .iter()
+            .map(|n| dof_index(info, n))
+            .collect::<Result<Vec<usize>, String>>()?;
+        self.reference.joints.retain(|(i, _)| !drop.contains(i));
+        Ok(())
     }
 }
 

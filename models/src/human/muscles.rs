@@ -1,0 +1,406 @@
+//! The legs' muscles: nine Hill-type musculotendon units per leg ([`mbs::muscle`], De Groote
+//! et al. 2016's curves and equilibrium) on the paths of OpenSim's gait10dof18musc model.
+//!
+//! **Sources.** Maximum isometric forces, optimal fibre lengths, tendon slack lengths,
+//! pennation angles and activation time constants (10 ms, 40 ms) are gait10dof18musc's
+//! (opensim-org/opensim-models, `Models/Gait10dof18musc/gait10dof18musc.osim`, whose
+//! muscles are Millard 2012 units; here they are De Groote 2016 units with those
+//! parameters). Its path points are declared in the model (`point … on …` in `part Leg`), in
+//! the joint frames of the bodies as OpenSim places them, mirrored for the left leg. Three
+//! of its conditional via points are treated as follows: the iliopsoas' third point (active
+//! for hip flexion in [−90°, 45°], all of walking) and the gastrocnemius' femoral condyle
+//! point (active for knee flexion under 45°) are always on the path, so that every length is
+//! a smooth function of the coordinates; the rectus femoris' and vasti's femoral points of
+//! deep flexion (beyond 84°) are left out. The quadriceps' moving insertions on the tibia
+//! (OpenSim's splines of the knee angle, standing in for the patella) are fixed points on
+//! this model's patella instead, which moves with the knee: the least-squares fit over knee
+//! angles −75°…3° follows OpenSim's points within 1.3 mm.
+
+use super::{Guard, PassiveJoints, TRACKED, dof_index};
+use mbs::elements::Path;
+use mbs::muscle::{Fibre, MIN_ACTIVATION, MuscleError, Musculotendon};
+use mbs::{Effort, Efforts, Kinematics};
+
+/// One muscle of a leg: name, F_max (N), l_opt (m), l_slack (m), α_opt (rad), and its path's
+/// points (the model's point names without the leg's index), origin first.
+pub struct MuscleData {
+    pub name: &'static str,
+    pub max_force: f64,
+    pub optimal_length: f64,
+    pub slack_length: f64,
+    pub pennation: f64,
+    pub path: &'static [&'static str],
+}
+
+const fn muscle(
+    name: &'static str,
+    [max_force, optimal_length, slack_length, pennation]: [f64; 4],
+    path: &'static [&'static str],
+) -> MuscleData {
+    MuscleData {
+        name,
+        max_force,
+        optimal_length,
+        slack_length,
+        pennation,
+        path,
+    }
+}
+
+/// The nine muscles of each leg (gait10dof18musc).
+pub const MUSCLES: [MuscleData; 9] = [
+    muscle(
+        "hamstrings",
+        [2700.0, 0.109, 0.326, 0.0],
+        &["ham_o", "hams_via", "hams_i"],
+    ),
+    muscle(
+        "bifemsh",
+        [804.0, 0.173, 0.089, 0.401_425_73],
+        &["bfsh_o", "hams_via", "hams_i"],
+    ),
+    muscle(
+        "glut_max",
+        [1944.0, 0.147, 0.127, 0.0],
+        &["gmax_o", "gmax_via", "gmax_via2", "gmax_i"],
+    ),
+    muscle(
+        "iliopsoas",
+        [2342.0, 0.1, 0.16, 0.139_626_34],
+        &["ilps_o", "ilps_via", "ilps_via2", "ilps_via3", "ilps_i"],
+    ),
+    muscle(
+        "rect_fem",
+        [1169.0, 0.114, 0.31, 0.087_266_46],
+        &["rf_o", "rf_i"],
+    ),
+    muscle(
+        "vasti",
+        [5000.0, 0.087, 0.136, 0.052_359_88],
+        &["vas_o", "vas_via", "vas_i"],
+    ),
+    muscle(
+        "gastroc",
+        [2500.0, 0.06, 0.39, 0.296_705_97],
+        &["gas_o", "gas_via", "achilles"],
+    ),
+    muscle(
+        "soleus",
+        [5137.0, 0.05, 0.25, 0.436_332_31],
+        &["sol_o", "achilles"],
+    ),
+    muscle(
+        "tib_ant",
+        [3000.0, 0.098, 0.223, 0.087_266_46],
+        &["ta_o", "ta_via", "ta_i"],
+    ),
+];
+
+/// Number of muscles of the model (both legs).
+pub const NM: usize = 18;
+
+/// The model's 18 muscles (right leg's nine, then the left's, in [`MUSCLES`]' order), each
+/// a unit and its path, and their excitations (constant over a run).
+#[derive(Clone, Debug)]
+pub struct Muscles {
+    pub units: Vec<(Musculotendon, Path)>,
+    /// excitation of each unit, in [0, 1]
+    pub excitation: Vec<f64>,
+}
+
+impl Muscles {
+    /// The units of [`MUSCLES`] on the points of the model `info`, unexcited.
+    pub fn new(info: &mbs::ModelInfo) -> Result<Muscles, String> {
+        let mut units = Vec::new();
+        for k in 0..2 {
+            for m in &MUSCLES {
+                let mut unit = Musculotendon::new(
+                    &format!("{}[{k}]", m.name),
+                    m.max_force,
+                    m.optimal_length,
+                    m.slack_length,
+                    m.pennation,
+                );
+                unit.activation_times = [0.01, 0.04];
+                let points = m
+                    .path
+                    .iter()
+                    .map(|p| {
+                        let name = format!("{p}[{k}]");
+                        info.point_index(&name)
+                            .ok_or_else(|| format!("the model has no point `{name}`"))
+                    })
+                    .collect::<Result<Vec<usize>, String>>()?;
+                units.push((unit, Path { points }));
+            }
+        }
+        Ok(Muscles {
+            units,
+            excitation: vec![0.0; NM],
+        })
+    }
+
+    /// The index of unit `name` (`"soleus[0]"`).
+    pub fn index(&self, name: &str) -> Option<usize> {
+        self.units.iter().position(|(u, _)| u.name == name)
+    }
+
+    /// Each unit's path length (m) at the kinematics `kin`.
+    pub fn lengths(&self, kin: &Kinematics) -> Vec<f64> {
+        self.units.iter().map(|(_, p)| p.length(kin).0).collect()
+    }
+
+    /// The fibre lengths (normalised) at which every unit is at rest at the kinematics `kin`
+    /// with activations `activation`: the muscles' states of a start in equilibrium.
+    pub fn equilibrium(
+        &self,
+        kin: &Kinematics,
+        activation: &[f64],
+    ) -> Result<Vec<f64>, MuscleError> {
+        self.units
+            .iter()
+            .zip(activation)
+            .map(|((u, p), a)| u.equilibrium(p.length(kin).0, *a))
+            .collect()
+    }
+}
+
+/// The coordinates the muscles act on in the sagittal plane (those gait10dof18musc leaves
+/// free): hip flexion, knee and ankle of each leg.
+pub const MUSCLE_JOINTS: [&str; 6] = [
+    "hip_flexion[0]",
+    "knee[0]",
+    "ankle[0]",
+    "hip_flexion[1]",
+    "knee[1]",
+    "ankle[1]",
+];
+
+impl Muscles {
+    /// Each unit's tendon force with its fibre at rest at the kinematics `kin` and
+    /// activations `a` (N).
+    pub fn forces_at_rest(&self, kin: &Kinematics, a: &[f64]) -> Result<Vec<f64>, MuscleError> {
+        self.units
+            .iter()
+            .zip(a)
+            .map(|((u, p), a)| {
+                let l = p.length(kin).0;
+                let lm = u.equilibrium(l, *a)?;
+                Ok(u.fibre(l, *a, lm)?.tendon_force)
+            })
+            .collect()
+    }
+
+    /// Constant excitations under which the muscles, at rest at the kinematics `kin`,
+    /// produce the generalised forces `moments` ((coordinate, N·m)) on those coordinates:
+    /// static optimisation, the least Σ (a − `baseline`)² with every activation in
+    /// [`MIN_ACTIVATION`, 1] (a baseline of 0 is the classical least Σ a²; a positive one
+    /// asks for co-contraction), by Newton on the moments (tendon forces linearised in the
+    /// activations by differences) with the least-change step and the units that reach a
+    /// bound held there. In steady state the activation equals the excitation.
+    pub fn excitations_for(
+        &self,
+        kin: &Kinematics,
+        moments: &[(usize, f64)],
+        baseline: f64,
+    ) -> Result<Vec<f64>, String> {
+        let floor = MIN_ACTIVATION;
+        let nq = kin.points.first().map_or(0, |p| p.jv.len() / 3);
+        let arms: Vec<Vec<f64>> = self
+            .units
+            .iter()
+            .map(|(_, p)| {
+                let mut g = vec![0.0; nq];
+                p.gradient(kin, &mut g);
+                moments.iter().map(|(i, _)| -g[*i]).collect()
+            })
+            .collect();
+        let nj = moments.len();
+        let mut a = vec![baseline.max(floor); NM];
+        let mut held = [false; NM];
+        let err = |e: MuscleError| e.to_string();
+        for _ in 0..50 {
+            let f = self.forces_at_rest(kin, &a).map_err(err)?;
+            let delta = 1e-6;
+            let up: Vec<f64> = a.iter().map(|x| x + delta).collect();
+            let fu = self.forces_at_rest(kin, &up).map_err(err)?;
+            let mut r = vec![0.0; nj];
+            for (j, (_, tau)) in moments.iter().enumerate() {
+                r[j] = tau - (0..NM).map(|m| arms[m][j] * f[m]).sum::<f64>();
+            }
+            let scale = moments.iter().map(|(_, t)| t.abs()).fold(1.0, f64::max);
+            if r.iter().all(|x| x.abs() < 1e-9 * scale) {
+                return Ok(a);
+            }
+            // A Δa = r over the free units, the new a nearest the baseline:
+            // a_free = baseline + Aᵀ y with (A Aᵀ) y = r + A (a_free − baseline)
+            let col = |m: usize, j: usize| arms[m][j] * (fu[m] - f[m]) / delta;
+            let free: Vec<usize> = (0..NM).filter(|m| !held[*m]).collect();
+            let mut rhs = r.clone();
+            let mut aat = mbs::DMatrix::<f64>::zeros(nj, nj);
+            for &m in &free {
+                for j in 0..nj {
+                    rhs[j] += col(m, j) * (a[m] - baseline);
+                    for k in 0..nj {
+                        aat[(j, k)] += col(m, j) * col(m, k);
+                    }
+                }
+            }
+            let y = aat
+                .lu()
+                .solve(&mbs::DMatrix::from_column_slice(nj, 1, &rhs))
+                .ok_or("the muscles left free cannot produce the moments asked for")?;
+            for &m in &free {
+                let v: f64 = baseline + (0..nj).map(|j| col(m, j) * y[j]).sum::<f64>();
+                if v < floor || v > 1.0 {
+                    held[m] = true;
+                }
+                a[m] = v.clamp(floor, 1.0);
+            }
+        }
+        Err("static optimisation of the excitations did not converge in 50 iterations".into())
+    }
+}
+
+/// Names of the extra states of [`MuscleDriven`] after the passive joints' 17: the 18
+/// activations, then the 18 normalised fibre lengths.
+const MUSCLE_STATES: [&str; 2 * NM] = [
+    "activation:hamstrings[0]",
+    "activation:bifemsh[0]",
+    "activation:glut_max[0]",
+    "activation:iliopsoas[0]",
+    "activation:rect_fem[0]",
+    "activation:vasti[0]",
+    "activation:gastroc[0]",
+    "activation:soleus[0]",
+    "activation:tib_ant[0]",
+    "activation:hamstrings[1]",
+    "activation:bifemsh[1]",
+    "activation:glut_max[1]",
+    "activation:iliopsoas[1]",
+    "activation:rect_fem[1]",
+    "activation:vasti[1]",
+    "activation:gastroc[1]",
+    "activation:soleus[1]",
+    "activation:tib_ant[1]",
+    "fibre:hamstrings[0]",
+    "fibre:bifemsh[0]",
+    "fibre:glut_max[0]",
+    "fibre:iliopsoas[0]",
+    "fibre:rect_fem[0]",
+    "fibre:vasti[0]",
+    "fibre:gastroc[0]",
+    "fibre:soleus[0]",
+    "fibre:tib_ant[0]",
+    "fibre:hamstrings[1]",
+    "fibre:bifemsh[1]",
+    "fibre:glut_max[1]",
+    "fibre:iliopsoas[1]",
+    "fibre:rect_fem[1]",
+    "fibre:vasti[1]",
+    "fibre:gastroc[1]",
+    "fibre:soleus[1]",
+    "fibre:tib_ant[1]",
+];
+
+const PASSIVE_N: usize = TRACKED.len();
+
+/// Every extra state's name: the passive joints' then the muscles'.
+const STATES: [&str; PASSIVE_N + 2 * NM] = {
+    let mut out = [""; PASSIVE_N + 2 * NM];
+    let mut i = 0;
+    while i < PASSIVE_N {
+        out[i] = super::PASSIVE_STATES[i];
+        i += 1;
+    }
+    while i < PASSIVE_N + 2 * NM {
+        out[i] = MUSCLE_STATES[i - PASSIVE_N];
+        i += 1;
+    }
+    out
+};
+
+/// The model driven by its muscles: passive joint moments ([`PassiveJoints`], 17 states)
+/// and the 18 muscles with their activations and fibre lengths (36 states), excitations as
+/// inputs (constant: [`Muscles::excitation`]), optionally a [`super::Tracking`] of the
+/// joints the muscles do not span (through the passive part's `tracking`). A fibre beyond
+/// its range stops the run with a typed failure naming the muscle, as the [`Guard`] does for
+/// the knee and the feet.
+#[derive(Clone, Debug)]
+pub struct MuscleDriven {
+    pub passive: PassiveJoints,
+    pub muscles: Muscles,
+}
+
+impl MuscleDriven {
+    /// The extra states of a start at the kinematics `kin` with velocities `qd`: relaxed
+    /// passive moments, activations equal to the excitations and fibres at rest.
+    pub fn initial_states(&self, kin: &Kinematics, qd: &[f64]) -> Result<Vec<f64>, String> {
+        let mut x = self.passive.relaxed(qd);
+        x.extend_from_slice(&self.muscles.excitation);
+        let fibres = self
+            .muscles
+            .equilibrium(kin, &self.muscles.excitation)
+            .map_err(|e| e.to_string())?;
+        x.extend(fibres);
+        Ok(x)
+    }
+
+    /// The guard of the passive part.
+    pub fn guard(&self) -> &Guard {
+        &self.passive.guard
+    }
+
+    /// Unit `i`'s fibre and tendon at the state in `e`.
+    pub fn fibre(&self, e: &Effort, i: usize) -> Result<Fibre, String> {
+        let (unit, path) = &self.muscles.units[i];
+        let (a, lm) = (e.x[PASSIVE_N + i], e.x[PASSIVE_N + NM + i]);
+        unit.fibre(path.length(e.kin).0, a, lm)
+            .map_err(|e| e.to_string())
+    }
+}
+
+impl Efforts for MuscleDriven {
+    const NX: usize = PASSIVE_N + 2 * NM;
+    const STATE_NAMES: &'static [&'static str] = &STATES;
+
+    fn efforts(&mut self, e: &mut Effort) -> Result<(), String> {
+        self.passive.efforts(e)?;
+        for i in 0..NM {
+            let f = self.fibre(e, i)?;
+            self.muscles.units[i].1.apply(e, f.tendon_force);
+        }
+        Ok(())
+    }
+
+    fn state_derivatives(&mut self, e: &Effort, xd: &mut [f64]) -> Result<(), String> {
+        self.passive.state_derivatives(e, &mut xd[..PASSIVE_N])?;
+        for i in 0..NM {
+            let a = e.x[PASSIVE_N + i];
+            xd[PASSIVE_N + i] = self.muscles.units[i]
+                .0
+                .activation_rate(self.muscles.excitation[i], a);
+            xd[PASSIVE_N + NM + i] = self.fibre(e, i)?.length_rate;
+        }
+        Ok(())
+    }
+}
+
+/// The moment arm −∂l/∂q of each unit about coordinate `dof` of the model `info` at `kin`.
+pub fn moment_arms(
+    muscles: &Muscles,
+    info: &mbs::ModelInfo,
+    kin: &Kinematics,
+    dof: &str,
+) -> Result<Vec<f64>, String> {
+    let i = dof_index(info, dof)?;
+    let mut g = vec![0.0; info.dofs.len()];
+    Ok(muscles
+        .units
+        .iter()
+        .map(|(_, p)| {
+            p.gradient(kin, &mut g);
+            -g[i]
+        })
+        .collect())
+}

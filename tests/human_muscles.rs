@@ -1,0 +1,400 @@
+//! The legs' muscles (`mbs::muscle`, `mbs::elements::Path`, `mbs_models::human::Muscles`):
+//!
+//! - De Groote 2016's curves meet their anchor points and invert exactly; a unit's tendon
+//!   force and fibre length rate and the activation rate equal SymPy's
+//!   `physics.biomechanics` (values below, computed with SymPy 1.14's
+//!   `MusculotendonDeGroote2016.with_defaults(…, FIBER_LENGTH_EXPLICIT)` and
+//!   `FirstOrderActivationDeGroote2016.with_defaults`, v_max = 10 l_opt);
+//! - the paths' ∂l/∂q from the generated point Jacobians equal central differences of the
+//!   length, and l̇ = ∂l/∂q · q̇;
+//! - the moment arms in the anatomical posture have each muscle's anatomical action (sign)
+//!   and a size of a few centimetres, on both legs alike;
+//! - a fibre at rest from `equilibrium` has zero length rate; the tension applied along a
+//!   path is the generalised force −T ∂l/∂q;
+//! - a muscle stretched beyond its fibre's range stops a run with a typed failure, the
+//!   trajectory kept;
+//! - standing on the muscles (mode 2): excitations from the statics of the held body and a
+//!   static optimisation (co-contraction about 0.5) keep it within 1 cm and 0.01 rad of its
+//!   equilibrium for a second; constant excitations have no feedback, and a slow fall starts
+//!   after about 1.5 s (printed).
+
+use mbs::elements::Path;
+use mbs::muscle::{self, MuscleError, Musculotendon};
+use mbs::{Effort, Efforts, Failure, Kinematics, Model, Options, Output, Scheme, WithEfforts};
+use mbs_models::human::*;
+
+#[test]
+fn curves_meet_their_anchor_points_and_sympy() {
+    assert!((muscle::active_force(1.0) - 1.0).abs() < 1e-2);
+    assert!(muscle::passive_force(1.0).abs() < 1e-15);
+    assert!((muscle::force_velocity(0.0) - 1.0).abs() < 3e-3);
+    assert!(muscle::force_velocity(-1.0).abs() < 0.02);
+    assert!(muscle::force_velocity(0.5) > 1.2);
+    // the tendon carries F_max at about 4.9 % strain
+    assert!((muscle::tendon_length(1.0) - 1.049).abs() < 1e-3);
+    for x in [-0.2, 0.0, 0.4, 1.0, 1.3] {
+        let lt = muscle::tendon_length(x);
+        assert!((muscle::tendon_force(lt) - x).abs() < 1e-12);
+    }
+    for v in [-0.9, -0.3, 0.0, 0.2, 0.8] {
+        let fv = muscle::force_velocity(v);
+        assert!((muscle::force_velocity_inverse(fv) - v).abs() < 1e-12);
+    }
+    let rel = |a: f64, b: f64| ((a - b) / b).abs();
+    assert!(
+        rel(
+            muscle::activation_rate(0.7, 0.2, [0.015, 0.06]),
+            41.6650777412621
+        ) < 1e-12
+    );
+    let soleus = Musculotendon::new("soleus", 5137.0, 0.05, 0.25, 0.43633231);
+    let vasti = Musculotendon::new("vasti", 5000.0, 0.087, 0.136, 0.05235988);
+    for (unit, l, a, lm, force, rate) in [
+        (&soleus, 0.30, 0.5, 1.0, 1015.12095423252, -2.81373031198483),
+        (
+            &soleus,
+            0.296,
+            0.2,
+            0.95,
+            662.704494931253,
+            -0.915104015066037,
+        ),
+        (&vasti, 0.226, 0.5, 0.95, 6402.88334287846, 160.609458436052),
+    ] {
+        let f = unit.fibre(l, a, lm).unwrap();
+        assert!(rel(f.tendon_force, force) < 1e-10, "{f:?}");
+        assert!(rel(f.length_rate, rate) < 1e-9, "{f:?}");
+    }
+}
+
+fn posture(model: &Human, joints: &[(&str, f64)]) -> (Vec<f64>, Vec<f64>) {
+    let n = Human::NQ;
+    let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
+    model.initial_state(&mut q, &mut qd);
+    for (name, v) in joints {
+        q[model.info().dofs.iter().position(|d| d == name).unwrap()] = *v;
+    }
+    (q, qd)
+}
+
+/// A posture of walking with every coordinate moving.
+fn walking_state(model: &Human) -> (Vec<f64>, Vec<f64>) {
+    let (mut q, mut qd) = (vec![0.0; Human::NQ], vec![0.0; Human::NQ]);
+    model.initial_state(&mut q, &mut qd);
+    for i in 0..Human::NQ {
+        q[i] += 0.2 * ((1.7 * i as f64).sin());
+        qd[i] = (0.9 * i as f64 + 0.3).cos();
+    }
+    (q, qd)
+}
+
+#[test]
+fn path_gradients_are_the_derivatives_of_the_lengths() {
+    let model = Human::default();
+    let muscles = Muscles::new(model.info()).unwrap();
+    let (q, qd) = walking_state(&model);
+    let n = Human::NQ;
+    let mut kin = Kinematics::new::<Human>();
+    let length = |q: &[f64], kin: &mut Kinematics| {
+        model.kinematics(0.0, q, &qd, kin);
+        muscles.lengths(kin)
+    };
+    model.kinematics(0.0, &q, &qd, &mut kin);
+    let mut grads = vec![vec![0.0; n]; NM];
+    for (g, (_, path)) in grads.iter_mut().zip(&muscles.units) {
+        path.gradient(&kin, g);
+        let (_, ld) = path.length(&kin);
+        let chain: f64 = g.iter().zip(&qd).map(|(a, b)| a * b).sum();
+        assert!(
+            (ld - chain).abs() < 1e-12 * (1.0 + ld.abs()),
+            "{ld} {chain}"
+        );
+    }
+    let h = 1e-6;
+    let mut worst: f64 = 0.0;
+    for i in 0..n {
+        let (mut qp, mut qm) = (q.clone(), q.clone());
+        qp[i] += h;
+        qm[i] -= h;
+        let (lp, lm) = (length(&qp, &mut kin), length(&qm, &mut kin));
+        for m in 0..NM {
+            let fd = (lp[m] - lm[m]) / (2.0 * h);
+            worst = worst.max((fd - grads[m][i]).abs());
+        }
+    }
+    assert!(worst < 1e-8, "worst difference {worst:e}");
+}
+
+#[test]
+fn moment_arms_have_the_muscles_anatomical_actions() {
+    let model = Human::default();
+    let muscles = Muscles::new(model.info()).unwrap();
+    let (q, qd) = posture(&model, &[]);
+    let mut kin = Kinematics::new::<Human>();
+    model.kinematics(0.0, &q, &qd, &mut kin);
+    // (joint, muscle, sign of the moment arm about the coordinate): flexion of the hip,
+    // extension of the knee and dorsiflexion of the ankle are positive
+    let actions = [
+        ("hip_flexion", "hamstrings", -1.0),
+        ("knee", "hamstrings", -1.0),
+        ("knee", "bifemsh", -1.0),
+        ("hip_flexion", "glut_max", -1.0),
+        ("hip_flexion", "iliopsoas", 1.0),
+        ("hip_flexion", "rect_fem", 1.0),
+        ("knee", "rect_fem", 1.0),
+        ("knee", "vasti", 1.0),
+        ("knee", "gastroc", -1.0),
+        ("ankle", "gastroc", -1.0),
+        ("ankle", "soleus", -1.0),
+        ("ankle", "tib_ant", 1.0),
+    ];
+    for k in 0..2 {
+        for (joint, name, sign) in actions {
+            let arms = moment_arms(&muscles, model.info(), &kin, &format!("{joint}[{k}]")).unwrap();
+            let m = muscles.index(&format!("{name}[{k}]")).unwrap();
+            let r = arms[m] * sign;
+            assert!(
+                (0.01..0.1).contains(&r),
+                "{name}[{k}] about {joint}[{k}]: moment arm {:.4} m",
+                arms[m]
+            );
+            // the other leg's muscles do not act on this joint
+            assert_eq!(arms[(m + NM / 2) % NM], 0.0);
+        }
+    }
+    // the legs mirror each other
+    for (a, b) in muscles.lengths(&kin)[..9]
+        .iter()
+        .zip(&muscles.lengths(&kin)[9..])
+    {
+        assert!((a - b).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn a_fibre_at_rest_has_no_length_rate_and_its_tension_is_the_generalised_force() {
+    let model = Human::default();
+    let (q, qd) = walking_state(&model);
+    let mut driven = MuscleDriven {
+        passive: PassiveJoints::new(model.info(), 0.1, 0.01).unwrap(),
+        muscles: Muscles::new(model.info()).unwrap(),
+    };
+    driven.muscles.excitation = (0..NM).map(|i| 0.05 + 0.05 * i as f64).collect();
+    let mut kin = Kinematics::new::<Human>();
+    model.kinematics(0.0, &q, &qd, &mut kin);
+    let x = driven.initial_states(&kin, &qd).unwrap();
+    for (i, (unit, path)) in driven.muscles.units.iter().enumerate() {
+        let f = unit
+            .fibre(path.length(&kin).0, x[17 + i], x[17 + NM + i])
+            .unwrap();
+        assert!(f.length_rate.abs() < 1e-9, "{}: {f:?}", unit.name);
+    }
+    // the tension along a path: −T ∂l/∂q
+    let n = Human::NQ;
+    let pull = Pull {
+        path: driven.muscles.units[3].1.clone(),
+        tension: 800.0,
+    };
+    let wrapped = WithEfforts::new(Human::default(), pull.clone());
+    let (mut m, mut h, mut h0) = (vec![0.0; n * n], vec![0.0; n], vec![0.0; n]);
+    wrapped.dynamics(0.0, &q, &qd, &[], &mut m, &mut h);
+    model.dynamics(0.0, &q, &qd, &[], &mut m, &mut h0);
+    let mut g = vec![0.0; n];
+    pull.path.gradient(&kin, &mut g);
+    for i in 0..n {
+        let q_path = h[i] - h0[i];
+        assert!(
+            (q_path + pull.tension * g[i]).abs() < 1e-9,
+            "{i}: {q_path} {}",
+            g[i]
+        );
+    }
+}
+
+/// A constant tension along a path.
+#[derive(Clone)]
+struct Pull {
+    path: Path,
+    tension: f64,
+}
+
+impl Efforts for Pull {
+    const FRAMES: bool = false;
+    fn efforts(&mut self, e: &mut Effort) -> Result<(), String> {
+        self.path.apply(e, self.tension);
+        Ok(())
+    }
+}
+
+#[test]
+fn a_fibre_beyond_its_range_is_a_typed_failure() {
+    let unit = Musculotendon::new("soleus", 5137.0, 0.05, 0.25, 0.43633231);
+    match unit.fibre(0.3, 0.5, 1.9) {
+        Err(MuscleError::FibreOutOfRange { muscle, .. }) => assert_eq!(muscle, "soleus"),
+        other => panic!("{other:?}"),
+    }
+    // a run: the right knee driven into flexion stretches the vasti beyond their range
+    let model = Human::default();
+    let info = model.info();
+    let mut driven = MuscleDriven {
+        passive: PassiveJoints::new(info, 0.1, 0.01).unwrap(),
+        muscles: Muscles::new(info).unwrap(),
+    };
+    driven.muscles.excitation = vec![0.02; NM];
+    let (mut q, mut qd) = posture(&model, &[]);
+    q[1] = 1.5; // in the air
+    let knee = info.dofs.iter().position(|d| *d == "knee[0]").unwrap();
+    qd[knee] = -6.0;
+    let mut kin = Kinematics::new::<Human>();
+    model.kinematics(0.0, &q, &qd, &mut kin);
+    let x = driven.initial_states(&kin, &qd).unwrap();
+    // the vasti may lengthen by a tenth of their optimal length
+    let vasti = driven.muscles.index("vasti[0]").unwrap();
+    driven.muscles.units[vasti].0.fibre_range = [0.4, x[17 + NM + vasti] + 0.1];
+    let (mut q0, mut qd0) = (q.clone(), qd.clone());
+    q0.extend(vec![0.0; x.len()]);
+    qd0.extend(x);
+    let options = Options {
+        q0: Some(q0),
+        qd0: Some(qd0),
+        output: Output::Every { dt: 0.01 },
+        ..Options::adaptive(0.2, 1e-5)
+    };
+    let err = mbs::simulate(
+        WithEfforts::new(Human::default(), driven),
+        Scheme::Radau5,
+        options,
+    )
+    .expect_err("the vasti leave their range");
+    println!("{err}");
+    match &err.kind {
+        Failure::UserEffort { .. } => {}
+        other => panic!("{other:?}"),
+    }
+    let message = err.to_string();
+    assert!(
+        message.contains("vasti[0]") && message.contains("range"),
+        "{message}"
+    );
+    assert!(err.t > 0.01 && err.trajectory.len() > 1, "{}", err.t);
+}
+
+#[test]
+fn the_model_stands_on_its_muscles_with_constant_excitations() {
+    let model = Human::default();
+    let info = model.info();
+    let n = Human::NQ;
+    // the posture: joints held on a still reference by stiff spring–dampers, the pelvis
+    // free; its static equilibrium on the feet (horizontal position and heading locked:
+    // at rest the ground's friction is zero, so they are neutral)
+    let reference = GaitReference::still(info, 0.1).unwrap();
+    let (q0, _) = cycle_start(&model, &reference);
+    let tracking = Tracking::new(reference, info, 3000.0, 30.0).unwrap();
+    let held = WithEfforts::new(Human::default(), tracking.clone());
+    let eq = mbs::static_equilibrium(
+        &held,
+        &mbs::StaticsOptions {
+            q0: Some(q0),
+            locked: vec![0, 2, 4],
+            tolerance: 1e-8,
+            ..Default::default()
+        },
+    )
+    .expect("the held body has a standing equilibrium");
+    let q = eq.q.clone();
+    let zero = vec![0.0; n];
+    // the moments the muscles must take over: the holding torque less the passive moment
+    let mut passive = PassiveJoints::new(info, 0.1, 0.01).unwrap();
+    let torques: Vec<(usize, f64)> = tracking.torques(0.0, &q, &zero).collect();
+    let moments: Vec<(usize, f64)> = MUSCLE_JOINTS
+        .iter()
+        .map(|name| {
+            let i = info.dofs.iter().position(|d| d == name).unwrap();
+            let tau = torques.iter().find(|(j, _)| *j == i).unwrap().1;
+            let (_, law) = passive.joints.iter().find(|(j, _)| *j == i).unwrap();
+            (i, tau - law.elastic(q[i]))
+        })
+        .collect();
+    let mut muscles = Muscles::new(info).unwrap();
+    let mut kin = Kinematics::new::<Human>();
+    model.kinematics(0.0, &q, &zero, &mut kin);
+    // co-contraction: the activations nearest 0.5 that produce the moments (the least
+    // Σ a² leaves the knees and ankles without stiffness: the body folds within 0.7 s)
+    muscles.excitation = muscles.excitations_for(&kin, &moments, 0.5).unwrap();
+    for k in 0..2 {
+        let arms_of =
+            |dof: &str| moment_arms(&muscles, info, &kin, &format!("{dof}[{k}]")).unwrap();
+        for (dof, (_, asked)) in ["hip_flexion", "knee", "ankle"]
+            .iter()
+            .zip(&moments[3 * k..])
+        {
+            let forces = muscles.forces_at_rest(&kin, &muscles.excitation).unwrap();
+            let made: f64 = arms_of(dof).iter().zip(&forces).map(|(r, f)| r * f).sum();
+            assert!(
+                (made - asked).abs() < 1e-6 * (1.0 + asked.abs()),
+                "{dof}[{k}]: {made} for {asked}"
+            );
+        }
+    }
+    println!("moments asked of the muscles (N·m): {moments:.2?}");
+    println!("excitations: {:.3?}", muscles.excitation);
+    // the joints the muscles do not span stay held (gait10dof18musc locks them)
+    let mut rest = tracking.clone();
+    rest.release(info, &MUSCLE_JOINTS).unwrap();
+    passive.tracking = Some(rest);
+    let driven = MuscleDriven { passive, muscles };
+    let x = driven.initial_states(&kin, &zero).unwrap();
+    let (mut qs, mut qds) = (q.clone(), zero.clone());
+    qs.extend(vec![0.0; x.len()]);
+    qds.extend(x);
+    let options = Options {
+        q0: Some(qs),
+        qd0: Some(qds),
+        output: Output::Every { dt: 0.01 },
+        ..Options::adaptive(2.0, 1e-5)
+    };
+    let clock = std::time::Instant::now();
+    let (tr, stats) = match mbs::simulate(
+        WithEfforts::new(Human::default(), driven),
+        Scheme::Radau5,
+        options,
+    ) {
+        Ok(r) => r,
+        Err(e) => panic!("standing on the muscles failed: {e}"),
+    };
+    let cpu = clock.elapsed().as_secs_f64();
+    let weight = (75.1646 + 2.0 * 0.0862) * 9.80665;
+    // the largest departure of any coordinate from the equilibrium up to each output
+    let mut worst = (0, 0.0);
+    let mut at_one = 0.0;
+    for s in 0..tr.len() {
+        for (i, (a, b)) in tr.q(s)[..n].iter().zip(&q).enumerate() {
+            let d = (a - b).abs();
+            if d > worst.1 {
+                worst = (i, d);
+            }
+        }
+        if tr.t[s] <= 1.0 + 1e-9 {
+            at_one = worst.1;
+        }
+    }
+    let last = tr.len() - 1;
+    let (ql, qdl) = (&tr.q(last)[..n], &tr.qd(last)[..n]);
+    let f = ground_forces(&model, tr.t[last], ql, qdl, &mut kin);
+    println!(
+        "standing on 18 muscles at constant excitations, radau5 rtol 1e-5: {} steps, {cpu:.2} s CPU for 2 s; \
+         largest departure from the equilibrium {at_one:.2e} within 1 s, {:.2e} within 2 s ({}); pelvis height {:.4} → {:.4} m; \
+         the ground carries {:.4} of the weight at 2 s",
+        stats.steps,
+        worst.1,
+        info.dofs[worst.0],
+        q[1],
+        ql[1],
+        (f[0][1] + f[1][1]) / weight
+    );
+    // quiet for a second; then a slow fall begins (constant excitations have no feedback)
+    assert!(at_one < 0.01, "{at_one}");
+    assert!(worst.1 < 0.1, "{worst:?}");
+    assert!((ql[1] - q[1]).abs() < 0.01);
+    assert!(((f[0][1] + f[1][1]) / weight - 1.0).abs() < 0.01);
+}

@@ -14,9 +14,10 @@
 //! - a muscle stretched beyond its fibre's range stops a run with a typed failure, the
 //!   trajectory kept;
 //! - standing on the muscles (mode 2): excitations from the statics of the held body and a
-//!   static optimisation (co-contraction about 0.5) keep it within 1 cm and 0.01 rad of its
-//!   equilibrium for a second; constant excitations have no feedback, and a slow fall starts
-//!   after about 1.5 s (printed).
+//!   static optimisation (co-contraction about 0.5), the equilibrium under them by statics
+//!   with the fibres at rest; the body stands 2 s on constant excitations within 1e-6 of it.
+//!   That equilibrium is unstable (no feedback): its linearisation has one growing pole, and
+//!   a pushed body departs at the rate that pole gives (within 20 %).
 
 use mbs::elements::Path;
 use mbs::muscle::{self, MuscleError, Musculotendon};
@@ -318,9 +319,9 @@ fn the_model_stands_on_its_muscles_with_constant_excitations() {
     let mut muscles = Muscles::new(info).unwrap();
     let mut kin = Kinematics::new::<Human>();
     model.kinematics(0.0, &q, &zero, &mut kin);
-    // co-contraction: the activations nearest 0.5 that produce the moments (the least
-    // Σ a² leaves the knees and ankles without stiffness: the body folds within 0.7 s)
-    muscles.excitation = muscles.excitations_for(&kin, &moments, 0.5).unwrap();
+    // co-contraction: the activations nearest 0.5 that produce the moments (with the least
+    // Σ a² the equilibrium has four growing poles, up to 15/s, where this one has one)
+    muscles.excitation = muscles.excitations_for(&kin, &moments, &[0.5; NM]).unwrap();
     for k in 0..2 {
         let arms_of =
             |dof: &str| moment_arms(&muscles, info, &kin, &format!("{dof}[{k}]")).unwrap();
@@ -343,58 +344,101 @@ fn the_model_stands_on_its_muscles_with_constant_excitations() {
     rest.release(info, &MUSCLE_JOINTS).unwrap();
     passive.tracking = Some(rest);
     let driven = MuscleDriven { passive, muscles };
+    // the equilibrium under these excitations, fibres at rest (the held body's differs a
+    // little: the muscles also pull about the joints they do not drive)
+    let at_rest = WithEfforts::new(Human::default(), MusclesAtRest(driven.clone()));
+    let eq = mbs::static_equilibrium(
+        &at_rest,
+        &mbs::StaticsOptions {
+            q0: Some(q.clone()),
+            locked: vec![0, 2, 4],
+            tolerance: 1e-8,
+            ..Default::default()
+        },
+    )
+    .expect("the body stands on its muscles at rest");
+    let moved = (0..n).map(|i| (eq.q[i] - q[i]).abs()).fold(0.0, f64::max);
+    let q = eq.q.clone();
+    model.kinematics(0.0, &q, &zero, &mut kin);
     let x = driven.initial_states(&kin, &zero).unwrap();
     let (mut qs, mut qds) = (q.clone(), zero.clone());
     qs.extend(vec![0.0; x.len()]);
     qds.extend(x);
-    let options = Options {
-        q0: Some(qs),
-        qd0: Some(qds),
-        output: Output::Every { dt: 0.01 },
-        ..Options::adaptive(2.0, 1e-5)
-    };
-    let clock = std::time::Instant::now();
-    let (tr, stats) = match mbs::simulate(
-        WithEfforts::new(Human::default(), driven),
-        Scheme::Radau5,
-        options,
-    ) {
-        Ok(r) => r,
-        Err(e) => panic!("standing on the muscles failed: {e}"),
-    };
-    let cpu = clock.elapsed().as_secs_f64();
-    let weight = (75.1646 + 2.0 * 0.0862) * 9.80665;
-    // the largest departure of any coordinate from the equilibrium up to each output
-    let mut worst = (0, 0.0);
-    let mut at_one = 0.0;
-    for s in 0..tr.len() {
-        for (i, (a, b)) in tr.q(s)[..n].iter().zip(&q).enumerate() {
-            let d = (a - b).abs();
-            if d > worst.1 {
-                worst = (i, d);
-            }
+    // its stability with the fibres' and activations' dynamics: the linearisation's poles
+    let lin = mbs::linearize(
+        &WithEfforts::new(Human::default(), driven.clone()),
+        0.0,
+        &qs,
+        &qds,
+        &[],
+        mbs::IterationMatrix::Auto,
+    )
+    .unwrap();
+    let poles = mbs::modes(&lin, None).unwrap();
+    let growing: Vec<f64> = poles
+        .modes
+        .iter()
+        .filter(|m| m.re > 0.1)
+        .map(|m| m.re)
+        .collect();
+    println!(
+        "equilibrium on the muscles: {:.2e} from the held body's, {} (stiffness eigenvalues from {:.1}); \
+         poles with Re > 0.1/s: {growing:.2?}",
+        moved,
+        format!("{:?}", eq.stability).to_lowercase(),
+        eq.stiffness_eigenvalues[0]
+    );
+    let wrapped = WithEfforts::new(Human::default(), driven);
+    let run = |push: f64, t_end: f64| {
+        let mut qd0 = qds.clone();
+        qd0[3] += push;
+        let options = Options {
+            q0: Some(qs.clone()),
+            qd0: Some(qd0),
+            output: Output::Every { dt: 0.01 },
+            ..Options::adaptive(t_end, 1e-6)
+        };
+        let clock = std::time::Instant::now();
+        match mbs::simulate(wrapped.clone(), Scheme::Radau5, options) {
+            Ok((tr, stats)) => (tr, stats, clock.elapsed().as_secs_f64()),
+            Err(e) => panic!("standing on the muscles failed: {e}"),
         }
-        if tr.t[s] <= 1.0 + 1e-9 {
-            at_one = worst.1;
-        }
-    }
+    };
+    // the largest departure of any body coordinate from the equilibrium at output s
+    let departure = |tr: &mbs::Trajectory, s: usize| {
+        tr.q(s)[..n]
+            .iter()
+            .zip(&q)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max)
+    };
+    let (tr, stats, cpu) = run(0.0, 2.0);
     let last = tr.len() - 1;
+    let still = (0..tr.len()).map(|s| departure(&tr, s)).fold(0.0, f64::max);
     let (ql, qdl) = (&tr.q(last)[..n], &tr.qd(last)[..n]);
     let f = ground_forces(&model, tr.t[last], ql, qdl, &mut kin);
+    let weight = (75.1646 + 2.0 * 0.0862) * 9.80665;
     println!(
-        "standing on 18 muscles at constant excitations, radau5 rtol 1e-5: {} steps, {cpu:.2} s CPU for 2 s; \
-         largest departure from the equilibrium {at_one:.2e} within 1 s, {:.2e} within 2 s ({}); pelvis height {:.4} → {:.4} m; \
-         the ground carries {:.4} of the weight at 2 s",
+        "standing on 18 muscles at constant excitations 2 s, radau5 rtol 1e-6: {} steps, {cpu:.3} s CPU; \
+         largest departure from the equilibrium {still:.1e}; the ground carries {:.6} of the weight",
         stats.steps,
-        worst.1,
-        info.dofs[worst.0],
-        q[1],
-        ql[1],
         (f[0][1] + f[1][1]) / weight
     );
-    // quiet for a second; then a slow fall begins (constant excitations have no feedback)
-    assert!(at_one < 0.01, "{at_one}");
-    assert!(worst.1 < 0.1, "{worst:?}");
-    assert!((ql[1] - q[1]).abs() < 0.01);
-    assert!(((f[0][1] + f[1][1]) / weight - 1.0).abs() < 0.01);
+    assert!(still < 1e-6, "{still}");
+    assert!(((f[0][1] + f[1][1]) / weight - 1.0).abs() < 1e-3);
+    // pushed (pelvis pitch rate 1e-4 rad/s), the body departs as the growing pole says
+    let (tr, pushed, cpu) = run(1e-4, 1.0);
+    let at = |t: f64| departure(&tr, (t / 0.01).round() as usize);
+    let lambda = growing.iter().copied().fold(0.0, f64::max);
+    let ratio = at(1.0) / at(0.5);
+    println!(
+        "pushed: departure {:.2e} at 0.5 s, {:.2e} at 1 s: × {ratio:.2} (the pole {lambda:.2}/s says × {:.2}); \
+         1 s in {} steps, {cpu:.3} s CPU",
+        at(0.5),
+        at(1.0),
+        (0.5 * lambda).exp(),
+        pushed.steps
+    );
+    assert_eq!(growing.len(), 1, "{growing:?}");
+    assert!((ratio / (0.5 * lambda).exp() - 1.0).abs() < 0.2, "{ratio}");
 }

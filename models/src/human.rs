@@ -157,7 +157,9 @@ mbs::multibody! {
 }
 
 mod muscles;
-pub use muscles::{MUSCLE_JOINTS, MUSCLES, MuscleData, MuscleDriven, Muscles, NM, moment_arms};
+pub use muscles::{
+    MUSCLE_JOINTS, MUSCLES, MuscleData, MuscleDriven, Muscles, MusclesAtRest, NM, moment_arms,
+};
 
 use mbs::{Effort, Efforts, Kinematics, Model};
 

@@ -194,15 +194,15 @@ impl Muscles {
     /// Constant excitations under which the muscles, at rest at the kinematics `kin`,
     /// produce the generalised forces `moments` ((coordinate, N·m)) on those coordinates:
     /// static optimisation, the least Σ (a − `baseline`)² with every activation in
-    /// [`MIN_ACTIVATION`, 1] (a baseline of 0 is the classical least Σ a²; a positive one
-    /// asks for co-contraction), by Newton on the moments (tendon forces linearised in the
+    /// [`MIN_ACTIVATION`, 1] (`baseline`: one per unit; zeros give the classical least Σ a²,
+    /// positive values ask for co-contraction), by Newton on the moments (tendon forces linearised in the
     /// activations by differences) with the least-change step and the units that reach a
     /// bound held there. In steady state the activation equals the excitation.
     pub fn excitations_for(
         &self,
         kin: &Kinematics,
         moments: &[(usize, f64)],
-        baseline: f64,
+        baseline: &[f64],
     ) -> Result<Vec<f64>, String> {
         let floor = MIN_ACTIVATION;
         let nq = kin.points.first().map_or(0, |p| p.jv.len() / 3);
@@ -216,7 +216,7 @@ impl Muscles {
             })
             .collect();
         let nj = moments.len();
-        let mut a = vec![baseline.max(floor); NM];
+        let mut a: Vec<f64> = baseline.iter().map(|b| b.clamp(floor, 1.0)).collect();
         let mut held = [false; NM];
         let err = |e: MuscleError| e.to_string();
         for _ in 0..50 {
@@ -240,7 +240,7 @@ impl Muscles {
             let mut aat = mbs::DMatrix::<f64>::zeros(nj, nj);
             for &m in &free {
                 for j in 0..nj {
-                    rhs[j] += col(m, j) * (a[m] - baseline);
+                    rhs[j] += col(m, j) * (a[m] - baseline[m]);
                     for k in 0..nj {
                         aat[(j, k)] += col(m, j) * col(m, k);
                     }
@@ -251,7 +251,7 @@ impl Muscles {
                 .solve(&mbs::DMatrix::from_column_slice(nj, 1, &rhs))
                 .ok_or("the muscles left free cannot produce the moments asked for")?;
             for &m in &free {
-                let v: f64 = baseline + (0..nj).map(|j| col(m, j) * y[j]).sum::<f64>();
+                let v: f64 = baseline[m] + (0..nj).map(|j| col(m, j) * y[j]).sum::<f64>();
                 if v < floor || v > 1.0 {
                     held[m] = true;
                 }
@@ -381,6 +381,34 @@ impl Efforts for MuscleDriven {
                 .0
                 .activation_rate(self.muscles.excitation[i], a);
             xd[PASSIVE_N + NM + i] = self.fibre(e, i)?.length_rate;
+        }
+        Ok(())
+    }
+}
+
+/// The muscles at rest, for statics: the passive joints' elastic moments, the tracking of
+/// the passive part (the joints the muscles do not span) and each muscle's tension with its
+/// fibre at rest (ṽ = 0) under its excitation, recomputed at every q; no extra states. The
+/// static equilibrium of a model wrapped with it is an equilibrium of the same model under
+/// [`MuscleDriven`] with activations equal to the excitations and the fibres at rest.
+#[derive(Clone, Debug)]
+pub struct MusclesAtRest(pub MuscleDriven);
+
+impl Efforts for MusclesAtRest {
+    fn efforts(&mut self, e: &mut Effort) -> Result<(), String> {
+        let MuscleDriven { passive, muscles } = &mut self.0;
+        passive.guard.check(e.q, e.kin)?;
+        for (i, law) in &passive.joints {
+            e.generalized_force(*i, law.elastic(e.q[*i]));
+        }
+        if let Some(t) = &mut passive.tracking {
+            t.efforts(e)?;
+        }
+        let forces = muscles
+            .forces_at_rest(e.kin, &muscles.excitation)
+            .map_err(|e| e.to_string())?;
+        for ((_, path), f) in muscles.units.iter().zip(forces) {
+            path.apply(e, f);
         }
         Ok(())
     }

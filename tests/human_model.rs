@@ -11,7 +11,9 @@
 //!   each foot, the pelvis stays within a centimetre;
 //! - passive joint moments: the law by hand, the viscous states' relaxation along a run,
 //!   and a collapsing body caught near its joints' ranges (without them its toes spin);
-//! - a knee beyond its splines' tables and a foot through the ground are typed failures.
+//! - a knee beyond its splines' tables and a foot through the ground are typed failures;
+//! - the grounded cycle levels the feet in double support and lifts the swinging foot;
+//! - residual torques hold the pelvis on its reference orientation.
 
 // the knots below are the sources' numbers (−1.0472 is a table value, not −π/3)
 #![allow(clippy::approx_constant)]
@@ -402,4 +404,98 @@ fn a_knee_beyond_its_tables_or_a_foot_through_the_ground_is_a_typed_failure() {
     assert!(matches!(e.kind, mbs::Failure::UserEffort { .. }), "{e}");
     assert!(e.to_string().contains("into the ground"), "{e}");
     let _ = n;
+}
+
+/// The lowest support point of each foot at `t` on `reference` (pelvis at the model's start).
+fn lowest_points(model: &Human, reference: &GaitReference, t: f64) -> [f64; 2] {
+    let (q, qd) = reference_state(model, reference, t);
+    let mut kin = Kinematics::new::<Human>();
+    model.kinematics(0.0, &q, &qd, &mut kin);
+    let sp = support_points(model, &kin);
+    [0, 1].map(|k| {
+        sp[k]
+            .iter()
+            .map(|(x, _)| x[1])
+            .fold(f64::INFINITY, f64::min)
+    })
+}
+
+#[test]
+fn the_grounded_cycle_levels_the_feet_in_double_support_and_lifts_the_swinging_one() {
+    let model = Human::default();
+    let info = model.info();
+    let fitted = GaitReference::fit(&GaitTable::normal(), info, 1.1, 8).unwrap();
+    let double = [[0.0, 0.13], [0.48, 0.62]];
+    let clearance = 0.01;
+    let (grounded, change) = fitted.grounded(&model, double, clearance, 100, 8).unwrap();
+    // (largest |level| in double support, least swing clearance in single support), before
+    // and after
+    let measure = |r: &GaitReference| {
+        let (mut level, mut lift) = (0.0f64, f64::INFINITY);
+        for s in 0..100 {
+            let phase = s as f64 / 100.0;
+            let [right, left] = lowest_points(&model, r, phase * r.period - r.offset);
+            if double.iter().any(|[a, b]| phase >= *a && phase < *b) {
+                level = level.max((right - left).abs());
+            } else if (0.13..0.48).contains(&phase) {
+                lift = lift.min(left - right);
+            } else {
+                lift = lift.min(right - left);
+            }
+        }
+        (level, lift)
+    };
+    let (before, after) = (measure(&fitted), measure(&grounded));
+    println!(
+        "grounded cycle: angles changed by up to {:.2}°; double support level within {:.1} mm (before {:.1} mm); \
+         least swing clearance {:.1} mm (before {:.1} mm)",
+        change.to_degrees(),
+        1e3 * after.0,
+        1e3 * before.0,
+        1e3 * after.1,
+        1e3 * before.1
+    );
+    assert!(change < 10f64.to_radians());
+    // the samples meet the targets; the refit with 8 harmonics rounds the switches between
+    // double and single support
+    assert!(after.0 < 0.5 * before.0, "{after:?}");
+    assert!(after.1 > 0.5 * clearance && before.1 < 0.0, "{after:?}");
+}
+
+#[test]
+fn residual_torques_hold_the_pelvis_on_its_reference_orientation() {
+    let model = Human::default();
+    let info = model.info();
+    let reference = GaitReference::still(info, 0.1).unwrap();
+    let (mut q0, qd0) = cycle_start(&model, &reference);
+    // in the air (no contact), tilted by 0.05 rad from the reference
+    q0[1] += 1.0;
+    q0[3] += 0.05;
+    let mut tracking = Tracking::new(reference.clone(), info, 3000.0, 30.0).unwrap();
+    let run = |tracking: Tracking| {
+        let options = Options {
+            q0: Some(q0.clone()),
+            qd0: Some(qd0.clone()),
+            output: Output::Every { dt: 0.01 },
+            ..Options::adaptive(0.4, 1e-6)
+        };
+        let (tr, _) = mbs::simulate(
+            mbs::WithEfforts::new(Human::default(), tracking),
+            Scheme::Radau5,
+            options,
+        )
+        .unwrap();
+        let last = tr.len() - 1;
+        tr.q(last)[3] - reference.pelvis[0].eval(0.4)[0]
+    };
+    let free = run(tracking.clone());
+    tracking.pelvis_kp = 3000.0;
+    tracking.pelvis_kd = 300.0;
+    let held = run(tracking);
+    println!(
+        "pelvis pitch error after 0.4 s in the air: free {free:+.4} rad, held {held:+.2e} rad"
+    );
+    // free, the tilt stays (no torque acts on the whole body in the air); held, it decays
+    assert!((free - 0.05).abs() < 0.01, "{free}");
+    assert!(held.abs() < 0.1 * 0.05, "{held}");
 }

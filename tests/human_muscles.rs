@@ -285,52 +285,38 @@ fn the_model_stands_on_its_muscles_with_constant_excitations() {
     let model = Human::default();
     let info = model.info();
     let n = Human::NQ;
-    // the posture: joints held on a still reference by stiff spring–dampers, the pelvis
-    // free; its static equilibrium on the feet (horizontal position and heading locked:
-    // at rest the ground's friction is zero, so they are neutral)
-    let reference = GaitReference::still(info, 0.1).unwrap();
-    let (q0, _) = cycle_start(&model, &reference);
-    let tracking = Tracking::new(reference, info, 3000.0, 30.0).unwrap();
-    let held = WithEfforts::new(Human::default(), tracking.clone());
-    let eq = mbs::static_equilibrium(
-        &held,
-        &mbs::StaticsOptions {
-            q0: Some(q0),
-            locked: vec![0, 2, 4],
-            tolerance: 1e-8,
-            ..Default::default()
-        },
-    )
-    .expect("the held body has a standing equilibrium");
-    let q = eq.q.clone();
-    let zero = vec![0.0; n];
-    // the moments the muscles must take over: the holding torque less the passive moment
-    let mut passive = PassiveJoints::new(info, 0.1, 0.01).unwrap();
-    let torques: Vec<(usize, f64)> = tracking.torques(0.0, &q, &zero).collect();
-    let moments: Vec<(usize, f64)> = MUSCLE_JOINTS
-        .iter()
-        .map(|name| {
-            let i = info.dofs.iter().position(|d| d == name).unwrap();
-            let tau = torques.iter().find(|(j, _)| *j == i).unwrap().1;
-            let (_, law) = passive.joints.iter().find(|(j, _)| *j == i).unwrap();
-            (i, tau - law.elastic(q[i]))
-        })
-        .collect();
-    let mut muscles = Muscles::new(info).unwrap();
-    let mut kin = Kinematics::new::<Human>();
-    model.kinematics(0.0, &q, &zero, &mut kin);
     // co-contraction: the activations nearest 0.5 that produce the moments (with the least
     // Σ a² the equilibrium has four growing poles, up to 15/s, where this one has one)
-    muscles.excitation = muscles.excitations_for(&kin, &moments, &[0.5; NM]).unwrap();
+    let stance = muscle_stance(&model, 0.1, &[0.5; NM]).unwrap();
+    let (driven, moments) = (&stance.driven, &stance.moments);
+    let muscles = &driven.muscles;
+    // the muscles produce the moments asked, at the held body's posture
+    let held = {
+        let reference = GaitReference::still(info, 0.1).unwrap();
+        let (q0, _) = cycle_start(&model, &reference);
+        let tracking = Tracking::new(reference, info, 3000.0, 30.0).unwrap();
+        mbs::static_equilibrium(
+            &WithEfforts::new(Human::default(), tracking),
+            &mbs::StaticsOptions {
+                q0: Some(q0),
+                locked: vec![0, 2, 4],
+                tolerance: 1e-8,
+                ..Default::default()
+            },
+        )
+        .unwrap()
+        .q
+    };
+    let mut kin = Kinematics::new::<Human>();
+    model.kinematics(0.0, &held, &vec![0.0; n], &mut kin);
+    let forces = muscles.forces_at_rest(&kin, &muscles.excitation).unwrap();
     for k in 0..2 {
-        let arms_of =
-            |dof: &str| moment_arms(&muscles, info, &kin, &format!("{dof}[{k}]")).unwrap();
         for (dof, (_, asked)) in ["hip_flexion", "knee", "ankle"]
             .iter()
             .zip(&moments[3 * k..])
         {
-            let forces = muscles.forces_at_rest(&kin, &muscles.excitation).unwrap();
-            let made: f64 = arms_of(dof).iter().zip(&forces).map(|(r, f)| r * f).sum();
+            let arms = moment_arms(muscles, info, &kin, &format!("{dof}[{k}]")).unwrap();
+            let made: f64 = arms.iter().zip(&forces).map(|(r, f)| r * f).sum();
             assert!(
                 (made - asked).abs() < 1e-6 * (1.0 + asked.abs()),
                 "{dof}[{k}]: {made} for {asked}"
@@ -339,31 +325,7 @@ fn the_model_stands_on_its_muscles_with_constant_excitations() {
     }
     println!("moments asked of the muscles (N·m): {moments:.2?}");
     println!("excitations: {:.3?}", muscles.excitation);
-    // the joints the muscles do not span stay held (gait10dof18musc locks them)
-    let mut rest = tracking.clone();
-    rest.release(info, &MUSCLE_JOINTS).unwrap();
-    passive.tracking = Some(rest);
-    let driven = MuscleDriven { passive, muscles };
-    // the equilibrium under these excitations, fibres at rest (the held body's differs a
-    // little: the muscles also pull about the joints they do not drive)
-    let at_rest = WithEfforts::new(Human::default(), MusclesAtRest(driven.clone()));
-    let eq = mbs::static_equilibrium(
-        &at_rest,
-        &mbs::StaticsOptions {
-            q0: Some(q.clone()),
-            locked: vec![0, 2, 4],
-            tolerance: 1e-8,
-            ..Default::default()
-        },
-    )
-    .expect("the body stands on its muscles at rest");
-    let moved = (0..n).map(|i| (eq.q[i] - q[i]).abs()).fold(0.0, f64::max);
-    let q = eq.q.clone();
-    model.kinematics(0.0, &q, &zero, &mut kin);
-    let x = driven.initial_states(&kin, &zero).unwrap();
-    let (mut qs, mut qds) = (q.clone(), zero.clone());
-    qs.extend(vec![0.0; x.len()]);
-    qds.extend(x);
+    let (q, qs, qds) = (stance.q[..n].to_vec(), stance.q.clone(), stance.qd.clone());
     // its stability with the fibres' and activations' dynamics: the linearisation's poles
     let lin = mbs::linearize(
         &WithEfforts::new(Human::default(), driven.clone()),
@@ -381,14 +343,15 @@ fn the_model_stands_on_its_muscles_with_constant_excitations() {
         .filter(|m| m.re > 0.1)
         .map(|m| m.re)
         .collect();
+    let eq = &stance.equilibrium;
     println!(
         "equilibrium on the muscles: {:.2e} from the held body's, {} (stiffness eigenvalues from {:.1}); \
          poles with Re > 0.1/s: {growing:.2?}",
-        moved,
+        stance.moved,
         format!("{:?}", eq.stability).to_lowercase(),
         eq.stiffness_eigenvalues[0]
     );
-    let wrapped = WithEfforts::new(Human::default(), driven);
+    let wrapped = WithEfforts::new(Human::default(), driven.clone());
     let run = |push: f64, t_end: f64| {
         let mut qd0 = qds.clone();
         qd0[3] += push;

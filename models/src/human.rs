@@ -29,9 +29,13 @@
 //! **Driving it** (Rust): [`GaitTable`] reads a cycle of joint angles (the stored one is
 //! OpenSim's tutorial normal gait, `models/data/normal_gait.tsv`), [`GaitReference`] fits
 //! each angle with a Fourier series, and [`Tracking`] (an [`Efforts`] part) holds the joints
-//! on the reference with stiff spring–dampers, the pelvis free. [`PassiveJoints`] adds passive joint moments (Anderson's laws, a viscous
-//! state per joint), with or without the tracking. [`ground_forces`] recomputes each foot's
-//! ground reaction from the kinematics for reports.
+//! on the reference with stiff spring–dampers, the pelvis free or its orientation held by
+//! residual torques ([`Tracking::pelvis_kp`]); [`GaitReference::grounded`] first makes the
+//! cycle consistent with flat ground. [`PassiveJoints`] adds passive joint moments
+//! (Anderson's laws, a viscous state per joint), with or without the tracking.
+//! [`ground_forces`] recomputes each foot's ground reaction from the kinematics for reports.
+//! The muscles are in [`muscles`]: [`MuscleDriven`] runs the model on them, [`muscle_stance`]
+//! stands it on them.
 
 mbs::multibody! {
     /// Human lower limbs (gait2392 segments, spline knee, patella), pelvis free, feet on
@@ -156,9 +160,10 @@ mbs::multibody! {
     }
 }
 
-mod muscles;
+pub mod muscles;
 pub use muscles::{
-    MUSCLE_JOINTS, MUSCLES, MuscleData, MuscleDriven, Muscles, MusclesAtRest, NM, moment_arms,
+    MUSCLE_JOINTS, MUSCLES, MuscleData, MuscleDriven, MuscleStance, Muscles, MusclesAtRest, NM,
+    moment_arms, muscle_stance,
 };
 
 use mbs::{Effort, Efforts, Kinematics, Model};
@@ -384,6 +389,118 @@ impl GaitReference {
         })
     }
 
+    /// The reference made consistent with flat ground (a kinematic pass before tracking, as
+    /// OpenSim's residual reduction adjusts a subject's kinematics to its model): at
+    /// `samples` instants of the cycle the legs' hip, knee and ankle angles are changed as
+    /// little as possible (weighted least squares, the hips' adduction and rotation four
+    /// times as costly as flexion, knees and ankles) so that in double support (`double`:
+    /// the cycle fractions [start, end) of each) the two feet's lowest points are level, and
+    /// in single support the swinging foot's lowest point is at least `clearance` above the
+    /// standing one's; the angles are then fitted again with `harmonics` harmonics. Lowest
+    /// points are those of the contact ellipsoids with the pelvis on its reference
+    /// orientation. Returns the reference and the largest change of an angle (rad).
+    pub fn grounded(
+        &self,
+        model: &Human,
+        double: [[f64; 2]; 2],
+        clearance: f64,
+        samples: usize,
+        harmonics: usize,
+    ) -> Result<(GaitReference, f64), String> {
+        let info = model.info();
+        let names = [
+            "hip_flexion",
+            "hip_adduction",
+            "hip_rotation",
+            "knee",
+            "ankle",
+        ];
+        let mut free = Vec::new();
+        for leg in 0..2 {
+            for (j, name) in names.iter().enumerate() {
+                let i = dof_index(info, &format!("{name}[{leg}]"))?;
+                let k = self
+                    .joints
+                    .iter()
+                    .position(|(c, _)| *c == i)
+                    .ok_or("not tracked")?;
+                free.push((k, i, if j == 1 || j == 2 { 4.0 } else { 1.0 }));
+            }
+        }
+        let feet = Feet::of(info);
+        let mut kin = Kinematics::new::<Human>();
+        let mut lows = |q: &[f64]| -> [f64; 2] {
+            model.kinematics(0.0, q, &vec![0.0; q.len()], &mut kin);
+            let sp = feet.support_points(&kin);
+            [0, 1].map(|k| {
+                sp[k]
+                    .iter()
+                    .map(|(x, _)| x[1])
+                    .fold(f64::INFINITY, f64::min)
+            })
+        };
+        let mut rows = Vec::with_capacity(samples);
+        let mut largest: f64 = 0.0;
+        for s in 0..samples {
+            let phase = s as f64 / samples as f64;
+            let t = phase * self.period - self.offset;
+            let (mut q, _) = reference_state(model, self, t);
+            let start: Vec<f64> = free.iter().map(|(_, i, _)| q[*i]).collect();
+            // the constraint g = low_right − low_left against its target: level in double
+            // support; otherwise the swinging foot above by the clearance (active when not)
+            let in_double = double.iter().any(|[a, b]| phase >= *a && phase < *b);
+            let right_stands = phase >= double[0][1] && phase < double[1][0];
+            for _ in 0..30 {
+                let [r, l] = lows(&q);
+                let g = r - l;
+                let target = if in_double {
+                    0.0
+                } else if right_stands {
+                    g.min(-clearance)
+                } else {
+                    g.max(clearance)
+                };
+                if (g - target).abs() < 1e-5 {
+                    break;
+                }
+                // ∂g/∂θ by central differences, then the weighted least-change step
+                let mut jac = vec![0.0; free.len()];
+                for (c, (_, i, _)) in free.iter().enumerate() {
+                    let h = 1e-6;
+                    let keep = q[*i];
+                    q[*i] = keep + h;
+                    let [rp, lp] = lows(&q);
+                    q[*i] = keep - h;
+                    let [rm, lm] = lows(&q);
+                    q[*i] = keep;
+                    jac[c] = ((rp - lp) - (rm - lm)) / (2.0 * h);
+                }
+                let norm: f64 = jac.iter().zip(&free).map(|(j, (_, _, w))| j * j / w).sum();
+                if norm < 1e-12 {
+                    return Err(format!(
+                        "at {:.0} % of the cycle the feet cannot be levelled",
+                        100.0 * phase
+                    ));
+                }
+                let lambda = (target - g) / norm;
+                for (c, (_, i, w)) in free.iter().enumerate() {
+                    q[*i] += lambda * jac[c] / w;
+                }
+            }
+            for (c, (_, i, _)) in free.iter().enumerate() {
+                largest = largest.max((q[*i] - start[c]).abs());
+            }
+            rows.push(free.iter().map(|(_, i, _)| q[*i]).collect::<Vec<f64>>());
+        }
+        // the samples are uniform in t + offset over a period, as `joint` reads them
+        let mut out = self.clone();
+        for (c, (k, _, _)) in free.iter().enumerate() {
+            let column: Vec<f64> = rows.iter().map(|r| r[c]).collect();
+            out.joints[*k].1 = Fourier::fit(&column, harmonics, self.period);
+        }
+        Ok((out, largest))
+    }
+
     /// Joint `k` of `joints` at `t`: angle, rate, acceleration.
     pub fn joint(&self, k: usize, t: f64) -> [f64; 3] {
         self.joints[k].1.eval(t + self.offset)
@@ -427,6 +544,12 @@ pub struct Tracking {
     pub toes_kd: f64,
     /// the toes' coordinates
     toes: [usize; 2],
+    /// residual torques on the pelvis' orientation (RRA's residual moments): stiffness
+    /// (N·m/rad) and damping (N·m·s/rad) toward the reference's orientation; zero (the
+    /// default) leaves the pelvis free
+    pub pelvis_kp: f64,
+    pub pelvis_kd: f64,
+    pelvis: usize,
     pub guard: Guard,
 }
 
@@ -446,6 +569,11 @@ impl Tracking {
             toes_kp: kp,
             toes_kd: kd,
             toes: [dof_index(info, "mtp[0]")?, dof_index(info, "mtp[1]")?],
+            pelvis_kp: 0.0,
+            pelvis_kd: 0.0,
+            pelvis: info
+                .frame_index("pelvis_o")
+                .ok_or("the model has no frame `pelvis_o`")?,
             guard: Guard::new(info)?,
         })
     }
@@ -483,12 +611,53 @@ impl Tracking {
     }
 }
 
+impl Tracking {
+    /// The residual torque on the pelvis (world axes) at `t` and the kinematics `kin`:
+    /// kp θ + kd (ω_ref − ω), θ the small rotation from the pelvis' orientation to the
+    /// reference's, ½ vee(E − Eᵀ) with E = R_ref Rᵀ; ω_ref by central differences.
+    pub fn pelvis_torque(&self, t: f64, kin: &Kinematics) -> [f64; 3] {
+        if self.pelvis_kp == 0.0 && self.pelvis_kd == 0.0 {
+            return [0.0; 3];
+        }
+        let k = &kin.frames[self.pelvis];
+        let r = k.pose.rotation;
+        let rr = self.reference.pelvis_rotation(t);
+        let e: [[f64; 3]; 3] = std::array::from_fn(|i| {
+            std::array::from_fn(|j| (0..3).map(|m| rr[i][m] * r[j][m]).sum())
+        });
+        let theta = [
+            0.5 * (e[2][1] - e[1][2]),
+            0.5 * (e[0][2] - e[2][0]),
+            0.5 * (e[1][0] - e[0][1]),
+        ];
+        let h = 1e-5;
+        let (rp, rm) = (
+            self.reference.pelvis_rotation(t + h),
+            self.reference.pelvis_rotation(t - h),
+        );
+        let d: [[f64; 3]; 3] = std::array::from_fn(|i| {
+            std::array::from_fn(|j| (0..3).map(|m| rp[i][m] * rm[j][m]).sum())
+        });
+        let w_ref = [
+            (d[2][1] - d[1][2]) / (4.0 * h),
+            (d[0][2] - d[2][0]) / (4.0 * h),
+            (d[1][0] - d[0][1]) / (4.0 * h),
+        ];
+        let w = k.angular_velocity;
+        std::array::from_fn(|i| self.pelvis_kp * theta[i] + self.pelvis_kd * (w_ref[i] - w[i]))
+    }
+}
+
 impl Efforts for Tracking {
     fn efforts(&mut self, e: &mut Effort) -> Result<(), String> {
         self.guard.check(e.q, e.kin)?;
         let (q, qd) = (e.q, e.qd);
         for (i, tau) in self.torques(e.t, q, qd) {
             e.generalized_force(i, tau);
+        }
+        let torque = self.pelvis_torque(e.t, e.kin);
+        if torque != [0.0; 3] {
+            e.torque_on_frame(self.pelvis, torque);
         }
         Ok(())
     }
@@ -700,7 +869,7 @@ pub fn walking_speed(model: &Human, reference: &GaitReference) -> f64 {
 /// The model's state on `reference` at `t`: every joint and the pelvis' orientation on
 /// their references (angles and rates; the pelvis' ZYX rates by central differences of its
 /// angles), the pelvis' translation at the model's start and at rest.
-fn reference_state(model: &Human, reference: &GaitReference, t: f64) -> (Vec<f64>, Vec<f64>) {
+pub fn reference_state(model: &Human, reference: &GaitReference, t: f64) -> (Vec<f64>, Vec<f64>) {
     let n = Human::NQ;
     let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
     model.initial_state(&mut q, &mut qd);

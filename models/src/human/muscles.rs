@@ -16,7 +16,10 @@
 //! this model's patella instead, which moves with the knee: the least-squares fit over knee
 //! angles −75°…3° follows OpenSim's points within 1.3 mm.
 
-use super::{Guard, PassiveJoints, TRACKED, dof_index};
+use super::{
+    GaitReference, Guard, Human, PassiveJoints, TRACKED, Tracking, cycle_start, dof_index,
+};
+use mbs::Model;
 use mbs::elements::Path;
 use mbs::muscle::{Fibre, MIN_ACTIVATION, MuscleError, Musculotendon};
 use mbs::{Effort, Efforts, Kinematics};
@@ -412,6 +415,96 @@ impl Efforts for MusclesAtRest {
         }
         Ok(())
     }
+}
+
+/// Standing on the muscles (mode 2's start), from [`muscle_stance`].
+#[derive(Clone, Debug)]
+pub struct MuscleStance {
+    /// the muscle-driven efforts, excitations set
+    pub driven: MuscleDriven,
+    /// the start: coordinates and velocities of the wrapped model (the body at rest, the
+    /// extra states' integrals zero, their values: relaxed passive moments, activations
+    /// equal to the excitations, fibres at rest)
+    pub q: Vec<f64>,
+    pub qd: Vec<f64>,
+    /// the moments asked of the muscles at [`MUSCLE_JOINTS`] (coordinate, N·m)
+    pub moments: Vec<(usize, f64)>,
+    /// the equilibrium under the muscles, from statics with the fibres at rest
+    pub equilibrium: mbs::Equilibrium,
+    /// how far it is from the held body's equilibrium (largest coordinate change)
+    pub moved: f64,
+}
+
+/// Standing on the muscles with constant excitations (mode 2): the body held by stiff
+/// spring–dampers on [`GaitReference::still`]`(ankle)` and its static equilibrium (pelvis
+/// free, horizontal position and heading locked: at rest the ground's friction is zero, so
+/// they are neutral); the moments the holding supplies at hip flexion, knee and ankle, less
+/// the passive moments, asked of the muscles by [`Muscles::excitations_for`] with
+/// `baseline`; the joints the muscles do not span stay held (gait10dof18musc locks them);
+/// then the equilibrium under those excitations by statics with the fibres at rest
+/// ([`MusclesAtRest`]).
+pub fn muscle_stance(model: &Human, ankle: f64, baseline: &[f64]) -> Result<MuscleStance, String> {
+    let info = model.info();
+    let n = Human::NQ;
+    let reference = GaitReference::still(info, ankle)?;
+    let (q0, _) = cycle_start(model, &reference);
+    let tracking = Tracking::new(reference, info, 3000.0, 30.0)?;
+    let statics = |q0: Vec<f64>| mbs::StaticsOptions {
+        q0: Some(q0),
+        locked: vec![0, 2, 4],
+        tolerance: 1e-8,
+        ..Default::default()
+    };
+    let held = mbs::static_equilibrium(
+        &mbs::WithEfforts::new(model.clone(), tracking.clone()),
+        &statics(q0),
+    )
+    .map_err(|e| format!("the held body: {e}"))?;
+    let q = held.q;
+    let zero = vec![0.0; n];
+    let mut passive = PassiveJoints::new(info, 0.1, 0.01)?;
+    let torques: Vec<(usize, f64)> = tracking.torques(0.0, &q, &zero).collect();
+    let mut moments = Vec::new();
+    for name in MUSCLE_JOINTS {
+        let i = dof_index(info, name)?;
+        let tau = torques.iter().find(|(j, _)| *j == i).ok_or("not held")?.1;
+        let (_, law) = passive
+            .joints
+            .iter()
+            .find(|(j, _)| *j == i)
+            .ok_or("no law")?;
+        moments.push((i, tau - law.elastic(q[i])));
+    }
+    let mut muscles = Muscles::new(info)?;
+    let mut kin = Kinematics::new::<Human>();
+    model.kinematics(0.0, &q, &zero, &mut kin);
+    muscles.excitation = muscles.excitations_for(&kin, &moments, baseline)?;
+    let mut rest = tracking;
+    rest.release(info, &MUSCLE_JOINTS)?;
+    passive.tracking = Some(rest);
+    let driven = MuscleDriven { passive, muscles };
+    let equilibrium = mbs::static_equilibrium(
+        &mbs::WithEfforts::new(model.clone(), MusclesAtRest(driven.clone())),
+        &statics(q.clone()),
+    )
+    .map_err(|e| format!("the body on its muscles: {e}"))?;
+    let moved = (0..n)
+        .map(|i| (equilibrium.q[i] - q[i]).abs())
+        .fold(0.0, f64::max);
+    model.kinematics(0.0, &equilibrium.q, &zero, &mut kin);
+    let x = driven.initial_states(&kin, &zero)?;
+    let mut qs = equilibrium.q.clone();
+    qs.resize(n + x.len(), 0.0);
+    let mut qds = zero;
+    qds.extend(x);
+    Ok(MuscleStance {
+        driven,
+        q: qs,
+        qd: qds,
+        moments,
+        equilibrium,
+        moved,
+    })
 }
 
 /// The moment arm −∂l/∂q of each unit about coordinate `dof` of the model `info` at `kin`.

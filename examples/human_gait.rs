@@ -1,0 +1,420 @@
+//! The human lower-limb model (`mbs_models::human`) in its two ways of running, with the
+//! figures the gait literature reads and the plots and animation to look at them.
+//!
+//! **Mode 1, prescribed gait** (`--period`, default 1.1 s): OpenSim's normal cycle fitted with
+//! Fourier series, made consistent with flat ground (`GaitReference::grounded`: feet level in
+//! double support, the swinging foot at least `--clearance` above the standing one), tracked
+//! by stiff joint spring–dampers (`--kp`), the pelvis' translation free on the contacts and
+//! its orientation held by residual torques (`--pelvis`, as OpenSim's residual reduction
+//! does; 0 leaves it free). Reported: the vertical and fore–aft ground reaction forces of the
+//! right foot in body weights (first peak, trough, second peak, braking, propulsion), the
+//! vertical impulse over the cycle against weight × time, the fraction of the cycle with no
+//! foot on the ground, the pelvis' height the reference implies and its acceleration, the
+//! residual torque, the joint moments (the tracking torques) and the time the run takes.
+//!
+//! **Mode 2, muscles** : the body standing on its 18 muscles with constant excitations
+//! (`muscle_stance`), then pushed (pelvis pitch rate 1e-4 rad/s): the muscle forces over 1 s.
+//!
+//! Writes `grf.svg`, `angles.svg`, `moments.svg`, `muscles.svg`, `walk.html` and
+//! `gait.csv` in `--out` (default `target/human_gait`).
+//!
+//! ```text
+//! cargo run --release --example human_gait [-- --period 1.1 --kp 3000 --pelvis 30000]
+//! ```
+
+use mbs::plot::{Chart, Series, line_chart};
+use mbs::{Kinematics, Model, Options, Output, Scheme, Trajectory, WithEfforts};
+use mbs_models::human::*;
+use std::path::PathBuf;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().collect();
+    let value = |name: &str| {
+        args.iter()
+            .position(|a| a == name)
+            .and_then(|i| args.get(i + 1))
+    };
+    let number = |name: &str, default: f64| -> Result<f64, String> {
+        match value(name) {
+            None => Ok(default),
+            Some(v) => v
+                .parse()
+                .map_err(|_| format!("{name} takes a number, not `{v}`")),
+        }
+    };
+    let period = number("--period", 1.1)?;
+    let kp = number("--kp", 3000.0)?;
+    let pelvis_kp = number("--pelvis", 30000.0)?;
+    let clearance = number("--clearance", 0.01)?;
+    let out = PathBuf::from(value("--out").map_or("target/human_gait", |s| s.as_str()));
+    std::fs::create_dir_all(&out)?;
+
+    let model = Human::default();
+    let info = model.info();
+    let weight = model_mass(&model) * 9.80665;
+
+    // ---- mode 1: the prescribed cycle
+    let table = GaitTable::normal();
+    let fitted = GaitReference::fit(&table, info, period, 8)?;
+    let double = [[0.0, 0.13], [0.48, 0.62]];
+    let (reference, change) = fitted.grounded(&model, double, clearance, 100, 8)?;
+    println!(
+        "mode 1: normal cycle of {period} s, 8 harmonics; made consistent with the ground by changing joint angles up to {:.2}°",
+        change.to_degrees()
+    );
+    let (range, acc) = implied_pelvis(&model, &reference);
+    println!(
+        "  the pelvis' height the reference implies: range {:.1} cm, acceleration from {:.2} g to {:.2} g (vertical force {:.2}–{:.2} body weights)",
+        100.0 * range,
+        acc[0],
+        acc[1],
+        1.0 + acc[0],
+        1.0 + acc[1]
+    );
+    let (q0, qd0) = cycle_start(&model, &reference);
+    let mut tracking = Tracking::new(reference.clone(), info, kp, kp / 100.0)?;
+    tracking.pelvis_kp = pelvis_kp;
+    tracking.pelvis_kd = pelvis_kp / 10.0;
+    let options = Options {
+        q0: Some(q0),
+        qd0: Some(qd0),
+        output: Output::Every { dt: 0.005 },
+        frames: true,
+        ..Options::adaptive(period, 1e-5)
+    };
+    let wrapped = WithEfforts::new(Human::default(), tracking.clone());
+    let clock = std::time::Instant::now();
+    let tr = match mbs::simulate(wrapped.clone(), Scheme::Radau5, options) {
+        Ok((tr, stats)) => {
+            println!(
+                "  one cycle: {} Radau5 steps, {:.2} s on one thread",
+                stats.steps,
+                clock.elapsed().as_secs_f64()
+            );
+            tr
+        }
+        Err(e) => {
+            println!("  the run stopped: {e}");
+            *e.trajectory
+        }
+    };
+    let report = Gait::of(&model, &tracking, &tr, period, weight);
+    report.print();
+    report.plots(&out, &tr, &tracking, info)?;
+    mbs::anim::write_html(&out.join("walk.html"), wrapped.info(), &tr)?;
+    tr.write_csv(std::fs::File::create(out.join("gait.csv"))?)?;
+
+    // ---- mode 2: standing on the muscles, then pushed
+    let stance = muscle_stance(&model, 0.1, &[0.5; NM])?;
+    println!(
+        "mode 2: standing on 18 muscles, excitations {:.2}–{:.2}; the equilibrium is {}",
+        stance
+            .driven
+            .muscles
+            .excitation
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min),
+        stance
+            .driven
+            .muscles
+            .excitation
+            .iter()
+            .copied()
+            .fold(0.0, f64::max),
+        format!("{:?}", stance.equilibrium.stability).to_lowercase()
+    );
+    let mut qd = stance.qd.clone();
+    qd[3] += 1e-4;
+    let options = Options {
+        q0: Some(stance.q.clone()),
+        qd0: Some(qd),
+        output: Output::Every { dt: 0.01 },
+        ..Options::adaptive(1.0, 1e-6)
+    };
+    let driven = WithEfforts::new(Human::default(), stance.driven.clone());
+    let clock = std::time::Instant::now();
+    let tr = match mbs::simulate(driven, Scheme::Radau5, options) {
+        Ok((tr, stats)) => {
+            println!(
+                "  pushed, 1 s: {} Radau5 steps, {:.3} s on one thread",
+                stats.steps,
+                clock.elapsed().as_secs_f64()
+            );
+            tr
+        }
+        Err(e) => {
+            println!("  the run stopped: {e}");
+            *e.trajectory
+        }
+    };
+    muscle_plot(&out, &stance, &tr)?;
+    println!("plots, animation and CSV in {}", out.display());
+    Ok(())
+}
+
+fn model_mass(model: &Human) -> f64 {
+    let n = Human::NQ;
+    let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
+    model.initial_state(&mut q, &mut qd);
+    let mut m = vec![0.0; n * n];
+    model.mass_matrix(0.0, &q, &mut m);
+    m[0]
+}
+
+/// The pelvis' height the reference implies with its lower foot on the ground, over a
+/// cycle: its range (m) and the least and largest of its acceleration in g (through a fit
+/// with 8 harmonics).
+fn implied_pelvis(model: &Human, reference: &GaitReference) -> (f64, [f64; 2]) {
+    let mut kin = Kinematics::new::<Human>();
+    let feet = Feet::of(model.info());
+    let samples = 200;
+    let at = |s: usize| reference.period * s as f64 / samples as f64 - reference.offset;
+    let heights: Vec<f64> = (0..samples)
+        .map(|s| {
+            let (q, qd) = reference_state(model, reference, at(s));
+            model.kinematics(0.0, &q, &qd, &mut kin);
+            let lowest = feet
+                .support_points(&kin)
+                .iter()
+                .flatten()
+                .map(|(x, _)| x[1])
+                .fold(f64::INFINITY, f64::min);
+            q[1] - lowest
+        })
+        .collect();
+    let fit = Fourier::fit(&heights, 8, reference.period);
+    let acc: Vec<f64> = (0..samples)
+        .map(|s| fit.eval(reference.period * s as f64 / samples as f64)[2] / 9.80665)
+        .collect();
+    let lo = |v: &[f64]| v.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = |v: &[f64]| v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    (hi(&heights) - lo(&heights), [lo(&acc), hi(&acc)])
+}
+
+/// What a gait laboratory reads from one cycle.
+struct Gait {
+    /// per output: cycle %, right and left foot's force (body weights), total vertical
+    grf: Vec<(f64, [f64; 3], [f64; 3])>,
+    impulse_ratio: f64,
+    airborne: f64,
+    residual_rms: f64,
+    residual_peak: f64,
+    body_weight: f64,
+}
+
+impl Gait {
+    fn of(model: &Human, tracking: &Tracking, tr: &Trajectory, period: f64, weight: f64) -> Gait {
+        let n = Human::NQ;
+        let mut kin = Kinematics::new::<Human>();
+        let (mut grf, mut impulse, mut airborne, mut r2, mut rmax) =
+            (Vec::new(), 0.0, 0.0, 0.0, 0.0f64);
+        for i in 0..tr.len() {
+            let (q, qd) = (&tr.q(i)[..n], &tr.qd(i)[..n]);
+            let f = ground_forces(model, tr.t[i], q, qd, &mut kin);
+            let torque = tracking.pelvis_torque(tr.t[i], &kin);
+            let r = torque.iter().map(|x| x * x).sum::<f64>().sqrt();
+            let bw = |v: [f64; 3]| v.map(|x| x / weight);
+            grf.push((100.0 * tr.t[i] / period, bw(f[0]), bw(f[1])));
+            if i > 0 {
+                let dt = tr.t[i] - tr.t[i - 1];
+                impulse += 0.5 * (f[0][1] + f[1][1] + grf_total(&grf[i - 1]) * weight) * dt;
+                if f[0][1] + f[1][1] < 0.01 * weight {
+                    airborne += dt;
+                }
+                r2 += r * r * dt;
+            }
+            rmax = rmax.max(r);
+        }
+        let t = tr.t.last().copied().unwrap_or(0.0);
+        Gait {
+            grf,
+            impulse_ratio: impulse / (weight * t.max(1e-12)),
+            airborne: airborne / t.max(1e-12),
+            residual_rms: (r2 / t.max(1e-12)).sqrt(),
+            residual_peak: rmax,
+            body_weight: weight,
+        }
+    }
+
+    fn print(&self) {
+        let right = |lo: f64, hi: f64, k: usize, max: bool| {
+            let v = self
+                .grf
+                .iter()
+                .filter(|(p, _, _)| *p >= lo && *p <= hi)
+                .map(|(_, r, _)| r[k]);
+            if max {
+                v.fold(f64::NEG_INFINITY, f64::max)
+            } else {
+                v.fold(f64::INFINITY, f64::min)
+            }
+        };
+        println!(
+            "  right foot, vertical: first peak {:.2} (0–30 %), trough {:.2} (20–45 %), second peak {:.2} (35–62 %) body weights [normal gait: peaks 1.0–1.3, trough 0.6–0.9]",
+            right(0.0, 30.0, 1, true),
+            right(20.0, 45.0, 1, false),
+            right(35.0, 62.0, 1, true)
+        );
+        println!(
+            "  right foot, fore–aft: braking {:+.2} (0–30 %), propulsion {:+.2} (35–62 %) body weights",
+            right(0.0, 30.0, 0, false),
+            right(35.0, 62.0, 0, true)
+        );
+        println!(
+            "  vertical impulse / (weight × time) = {:.3} [within 5 % of 1]; no foot on the ground during {:.0} % of the cycle",
+            self.impulse_ratio,
+            100.0 * self.airborne
+        );
+        println!(
+            "  residual torque on the pelvis: rms {:.0} N·m, peak {:.0} N·m ({:.2} and {:.2} N·m/kg)",
+            self.residual_rms,
+            self.residual_peak,
+            self.residual_rms / (self.body_weight / 9.80665),
+            self.residual_peak / (self.body_weight / 9.80665)
+        );
+    }
+
+    fn plots(
+        &self,
+        out: &std::path::Path,
+        tr: &Trajectory,
+        tracking: &Tracking,
+        info: &mbs::ModelInfo,
+    ) -> Result<(), Box<dyn std::error::Error>> {
+        let pick = |k: usize, c: usize| -> Vec<(f64, f64)> {
+            self.grf
+                .iter()
+                .map(|(p, r, l)| (*p, if k == 0 { r[c] } else { l[c] }))
+                .collect()
+        };
+        line_chart(
+            &out.join("grf.svg"),
+            &chart("Ground reaction forces", "force (body weights)"),
+            &[
+                series("right, vertical", pick(0, 1)),
+                series("right, fore-aft", pick(0, 0)),
+                series("left, vertical", pick(1, 1)),
+                series("left, fore-aft", pick(1, 0)),
+            ],
+        )?;
+        let n = Human::NQ;
+        let period = tracking.reference.period;
+        let joints = ["hip_flexion[0]", "knee[0]", "ankle[0]"];
+        let mut angles = Vec::new();
+        let mut moments = Vec::new();
+        let mass = self.body_weight / 9.80665;
+        for name in joints {
+            let i = info
+                .dofs
+                .iter()
+                .position(|d| *d == name)
+                .ok_or("no joint")?;
+            let k = tracking
+                .reference
+                .joints
+                .iter()
+                .position(|(c, _)| *c == i)
+                .ok_or("not tracked")?;
+            let cycle = |t: f64| 100.0 * t / period;
+            angles.push(series(
+                &format!("{name}, simulated"),
+                (0..tr.len())
+                    .map(|s| (cycle(tr.t[s]), tr.q(s)[i].to_degrees()))
+                    .collect(),
+            ));
+            angles.push(series(
+                &format!("{name}, reference"),
+                (0..tr.len())
+                    .map(|s| {
+                        (
+                            cycle(tr.t[s]),
+                            tracking.reference.joint(k, tr.t[s])[0].to_degrees(),
+                        )
+                    })
+                    .collect(),
+            ));
+            moments.push(series(
+                name,
+                (0..tr.len())
+                    .map(|s| {
+                        let tau = tracking
+                            .torques(tr.t[s], &tr.q(s)[..n], &tr.qd(s)[..n])
+                            .find(|(c, _)| *c == i)
+                            .map_or(0.0, |(_, v)| v);
+                        (cycle(tr.t[s]), tau / mass)
+                    })
+                    .collect(),
+            ));
+        }
+        line_chart(
+            &out.join("angles.svg"),
+            &chart("Joint angles, right leg", "angle (°)"),
+            &angles,
+        )?;
+        line_chart(
+            &out.join("moments.svg"),
+            &chart(
+                "Joint moments, right leg (tracking torques)",
+                "moment (N·m/kg)",
+            ),
+            &moments,
+        )?;
+        Ok(())
+    }
+}
+
+fn grf_total(g: &(f64, [f64; 3], [f64; 3])) -> f64 {
+    g.1[1] + g.2[1]
+}
+
+fn muscle_plot(
+    out: &std::path::Path,
+    stance: &MuscleStance,
+    tr: &Trajectory,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let model = Human::default();
+    let n = Human::NQ;
+    let muscles = &stance.driven.muscles;
+    let mut kin = Kinematics::new::<Human>();
+    let mut lines: Vec<Series> = muscles.units[..NM / 2]
+        .iter()
+        .map(|(u, _)| series(&u.name, Vec::new()))
+        .collect();
+    for s in 0..tr.len() {
+        model.kinematics(tr.t[s], &tr.q(s)[..n], &tr.qd(s)[..n], &mut kin);
+        let x = &tr.qd(s)[n..];
+        for (i, line) in lines.iter_mut().enumerate() {
+            let (unit, path) = &muscles.units[i];
+            let (a, lm) = (x[17 + i], x[17 + NM + i]);
+            if let Ok(f) = unit.fibre(path.length(&kin).0, a, lm) {
+                line.points.push((tr.t[s], f.tendon_force));
+            }
+        }
+    }
+    let mut c = chart(
+        "Muscle forces, right leg: standing, pushed",
+        "tendon force (N)",
+    );
+    c.x_label = "t (s)".into();
+    line_chart(&out.join("muscles.svg"), &c, &lines)?;
+    Ok(())
+}
+
+fn series(name: &str, points: Vec<(f64, f64)>) -> Series {
+    Series {
+        name: name.into(),
+        points,
+    }
+}
+
+fn chart(title: &str, y: &str) -> Chart {
+    Chart {
+        title: title.into(),
+        x_label: "gait cycle (%)".into(),
+        y_label: y.into(),
+        log_x: false,
+        log_y: false,
+        ..Chart::default()
+    }
+}

@@ -196,13 +196,13 @@ fn compare(
         let f = r.figures();
         let tr = &r.trajectory;
         let n = HexapodWalker::NQ;
-        energy.push(series(
+        energy.push(Series::new(
             name,
             (0..tr.len())
                 .map(|i| (tr.t[i], tr.qd(i)[n + ENERGY]))
                 .collect(),
         ));
-        height.push(series(
+        height.push(Series::new(
             name,
             (0..tr.len()).map(|i| (tr.t[i], tr.q(i)[2])).collect(),
         ));
@@ -244,22 +244,8 @@ fn compare(
     Ok(())
 }
 
-fn series(name: &str, points: Vec<(f64, f64)>) -> Series {
-    Series {
-        name: name.into(),
-        points,
-    }
-}
-
 fn chart(title: &str, y: &str) -> Chart {
-    Chart {
-        title: title.into(),
-        x_label: "t (s)".into(),
-        y_label: y.into(),
-        log_x: false,
-        log_y: false,
-        ..Chart::default()
-    }
+    Chart::linear(title, "t (s)", y)
 }
 
 fn write_outputs(out: &Path, w: &Walk, f: &Figures) -> Result<(), Box<dyn std::error::Error>> {
@@ -276,14 +262,14 @@ fn write_outputs(out: &Path, w: &Walk, f: &Figures) -> Result<(), Box<dyn std::e
         &out.join("base.svg"),
         &chart("base height (m) and pitch (deg/100)", "z (m), pitch"),
         &[
-            series("z", base(2, 1.0)),
-            series("pitch / 100", base(4, 180.0 / std::f64::consts::PI / 100.0)),
+            Series::new("z", base(2, 1.0)),
+            Series::new("pitch / 100", base(4, 180.0 / std::f64::consts::PI / 100.0)),
         ],
     )?;
     line_chart(
         &out.join("speed.svg"),
         &chart("forward speed", "ẋ (m/s)"),
-        &[series(
+        &[Series::new(
             "ẋ",
             (0..tr.len()).map(|i| (t[i], tr.qd(i)[0])).collect(),
         )],
@@ -305,19 +291,19 @@ fn write_outputs(out: &Path, w: &Walk, f: &Figures) -> Result<(), Box<dyn std::e
         &feet
             .into_iter()
             .enumerate()
-            .map(|(k, p)| series(names[k], p))
+            .map(|(k, p)| Series::new(names[k], p))
             .collect::<Vec<_>>(),
     )?;
     // the middle left leg's motors: currents, and the voltages the controller held
     let mut motors = Vec::new();
     for (j, joint) in ["a", "b", "c"].iter().enumerate() {
         let col = n + 3 * 2 + j;
-        motors.push(series(
-            &format!("i {joint}2 (A)"),
+        motors.push(Series::new(
+            format!("i {joint}2 (A)"),
             (0..tr.len()).map(|i| (t[i], tr.qd(i)[col])).collect(),
         ));
-        motors.push(series(
-            &format!("V {joint}2 (V)"),
+        motors.push(Series::new(
+            format!("V {joint}2 (V)"),
             w.log
                 .samples
                 .iter()

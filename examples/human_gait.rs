@@ -83,21 +83,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ..Options::adaptive(period, 1e-5)
     };
     let wrapped = WithEfforts::new(Human::default(), tracking.clone());
-    let clock = std::time::Instant::now();
-    let tr = match mbs::simulate(wrapped.clone(), Scheme::Radau5, options) {
-        Ok((tr, stats)) => {
-            println!(
-                "  one cycle: {} Radau5 steps, {:.2} s on one thread",
-                stats.steps,
-                clock.elapsed().as_secs_f64()
-            );
-            tr
-        }
-        Err(e) => {
-            println!("  the run stopped: {e}");
-            *e.trajectory
-        }
-    };
+    let tr = run(wrapped.clone(), options, "one cycle");
     let report = Gait::of(&model, &tracking, &tr, period, weight);
     report.print();
     report.plots(&out, &tr, &tracking, info)?;
@@ -133,24 +119,30 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ..Options::adaptive(1.0, 1e-6)
     };
     let driven = WithEfforts::new(Human::default(), stance.driven.clone());
+    let tr = run(driven, options, "pushed, 1 s");
+    muscle_plot(&out, &stance, &tr)?;
+    println!("plots, animation and CSV in {}", out.display());
+    Ok(())
+}
+
+/// Runs `model` with Radau5 and says how long it took; a run that stops is reported and its
+/// trajectory so far kept.
+fn run<M: Model + 'static>(model: M, options: Options, what: &str) -> Trajectory {
     let clock = std::time::Instant::now();
-    let tr = match mbs::simulate(driven, Scheme::Radau5, options) {
+    match mbs::simulate(model, Scheme::Radau5, options) {
         Ok((tr, stats)) => {
             println!(
-                "  pushed, 1 s: {} Radau5 steps, {:.3} s on one thread",
+                "  {what}: {} Radau5 steps, {:.3} s on one thread",
                 stats.steps,
                 clock.elapsed().as_secs_f64()
             );
             tr
         }
         Err(e) => {
-            println!("  the run stopped: {e}");
+            println!("  {what}: the run stopped: {e}");
             *e.trajectory
         }
-    };
-    muscle_plot(&out, &stance, &tr)?;
-    println!("plots, animation and CSV in {}", out.display());
-    Ok(())
+    }
 }
 
 fn model_mass(model: &Human) -> f64 {
@@ -292,10 +284,10 @@ impl Gait {
             &out.join("grf.svg"),
             &chart("Ground reaction forces", "force (body weights)"),
             &[
-                series("right, vertical", pick(0, 1)),
-                series("right, fore-aft", pick(0, 0)),
-                series("left, vertical", pick(1, 1)),
-                series("left, fore-aft", pick(1, 0)),
+                Series::new("right, vertical", pick(0, 1)),
+                Series::new("right, fore-aft", pick(0, 0)),
+                Series::new("left, vertical", pick(1, 1)),
+                Series::new("left, fore-aft", pick(1, 0)),
             ],
         )?;
         let n = Human::NQ;
@@ -317,14 +309,14 @@ impl Gait {
                 .position(|(c, _)| *c == i)
                 .ok_or("not tracked")?;
             let cycle = |t: f64| 100.0 * t / period;
-            angles.push(series(
-                &format!("{name}, simulated"),
+            angles.push(Series::new(
+                format!("{name}, simulated"),
                 (0..tr.len())
                     .map(|s| (cycle(tr.t[s]), tr.q(s)[i].to_degrees()))
                     .collect(),
             ));
-            angles.push(series(
-                &format!("{name}, reference"),
+            angles.push(Series::new(
+                format!("{name}, reference"),
                 (0..tr.len())
                     .map(|s| {
                         (
@@ -334,7 +326,7 @@ impl Gait {
                     })
                     .collect(),
             ));
-            moments.push(series(
+            moments.push(Series::new(
                 name,
                 (0..tr.len())
                     .map(|s| {
@@ -379,7 +371,7 @@ fn muscle_plot(
     let mut kin = Kinematics::new::<Human>();
     let mut lines: Vec<Series> = muscles.units[..NM / 2]
         .iter()
-        .map(|(u, _)| series(&u.name, Vec::new()))
+        .map(|(u, _)| Series::new(&u.name, Vec::new()))
         .collect();
     for s in 0..tr.len() {
         model.kinematics(tr.t[s], &tr.q(s)[..n], &tr.qd(s)[..n], &mut kin);
@@ -401,20 +393,6 @@ fn muscle_plot(
     Ok(())
 }
 
-fn series(name: &str, points: Vec<(f64, f64)>) -> Series {
-    Series {
-        name: name.into(),
-        points,
-    }
-}
-
 fn chart(title: &str, y: &str) -> Chart {
-    Chart {
-        title: title.into(),
-        x_label: "gait cycle (%)".into(),
-        y_label: y.into(),
-        log_x: false,
-        log_y: false,
-        ..Chart::default()
-    }
+    Chart::linear(title, "gait cycle (%)", y)
 }

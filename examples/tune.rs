@@ -225,13 +225,12 @@ fn main() -> Result<(), Error> {
     }
     let path = out.join("tune.svg");
     let chart = Chart {
-        title: "PD gains tuned for ∫ t e² dt + w ∫ τ² dt".into(),
-        x_label: "t (s)".into(),
-        y_label: "arm angle (rad)".into(),
-        log_x: false,
-        log_y: false,
         legend: mbs::plot::Legend::LowerRight,
-        ..Chart::default()
+        ..Chart::linear(
+            "PD gains tuned for ∫ t e² dt + w ∫ τ² dt",
+            "t (s)",
+            "arm angle (rad)",
+        )
     };
     line_chart(&path, &chart, &series).map_err(|e| Error::msg(e.to_string()))?;
     println!("\nresponses: {}", path.display());

@@ -817,14 +817,7 @@ impl RunArgs {
             // nothing to draw or play
             return Ok(written);
         }
-        let chart = |title: &str, y: &str| Chart {
-            title: title.to_string(),
-            x_label: "t (s)".into(),
-            y_label: y.into(),
-            log_x: false,
-            log_y: false,
-            ..Chart::default()
-        };
+        let chart = |title: &str, y: &str| Chart::linear(title, "t (s)", y);
         let coordinates: Vec<Series> = (0..tr.nq())
             .map(|k| Series {
                 name: tr.dof_names[k].clone(),

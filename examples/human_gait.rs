@@ -2,15 +2,17 @@
 //! figures the gait literature reads and the plots and animation to look at them.
 //!
 //! **Mode 1, prescribed gait** (`--period`, default 1.1 s): OpenSim's normal cycle fitted with
-//! Fourier series, made consistent with flat ground (`GaitReference::grounded`: feet level in
-//! double support, the swinging foot at least `--clearance` above the standing one), tracked
-//! by stiff joint spring–dampers (`--kp`), the pelvis' translation free on the contacts and
-//! its orientation held by residual torques (`--pelvis`, as OpenSim's residual reduction
-//! does; 0 leaves it free). Reported: the vertical and fore–aft ground reaction forces of the
-//! right foot in body weights (first peak, trough, second peak, braking, propulsion), the
-//! vertical impulse over the cycle against weight × time, the fraction of the cycle with no
-//! foot on the ground, the pelvis' height the reference implies and its acceleration, the
-//! residual torque, the joint moments (the tracking torques) and the time the run takes.
+//! Fourier series, made consistent with flat ground (`GaitReference::grounded`: periodic
+//! corrections of the leg angles so that the feet are level in double support, the swinging
+//! foot clears the standing one by up to `--clearance`, and the centre of mass accelerates
+//! within ± 0.3 g), tracked by stiff joint spring–dampers (`--kp`), the pelvis' translation
+//! free on the contacts and its orientation held by residual torques (`--pelvis`, as
+//! OpenSim's residual reduction does; 0 leaves it free), the feet's Hunt–Crossley
+//! dissipation `--dissipation`. The run lasts `--cycles` cycles (default 2) and the last one
+//! is reported: the vertical and fore–aft ground reaction forces of the right foot in body
+//! weights (first peak, trough, second peak, braking, propulsion), the vertical impulse
+//! against weight × time, the fraction of the cycle with no foot on the ground, the residual
+//! torque, the joint moments (the tracking torques) and the time the run takes.
 //!
 //! **Mode 2, muscles** : the body standing on its 18 muscles with constant excitations
 //! (`muscle_stance`), then pushed (pelvis pitch rate 1e-4 rad/s): the muscle forces over 1 s.
@@ -19,7 +21,7 @@
 //! `gait.csv` in `--out` (default `target/human_gait`).
 //!
 //! ```text
-//! cargo run --release --example human_gait [-- --period 1.1 --kp 3000 --pelvis 30000]
+//! cargo run --release --example human_gait [-- --period 1.1 --kp 3000 --pelvis 30000 --cycles 2]
 //! ```
 
 use mbs::plot::{Chart, Series, line_chart};
@@ -45,32 +47,49 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let period = number("--period", 1.1)?;
     let kp = number("--kp", 3000.0)?;
     let pelvis_kp = number("--pelvis", 30000.0)?;
-    let clearance = number("--clearance", 0.01)?;
+    let cycles = number("--cycles", 2.0)?.round().max(1.0);
+    let clearance = number("--clearance", 0.02)?;
+    let dissipation = number("--dissipation", Human::default().params().d_foot)?;
     let out = PathBuf::from(value("--out").map_or("target/human_gait", |s| s.as_str()));
     std::fs::create_dir_all(&out)?;
 
-    let model = Human::default();
+    let mut model = Human::default();
+    let mut params = model.params().clone();
+    params.d_foot = dissipation;
+    model.set_params(params)?;
     let info = model.info();
-    let weight = model_mass(&model) * 9.80665;
+    let weight = total_mass(&model) * 9.80665;
 
     // ---- mode 1: the prescribed cycle
     let table = GaitTable::normal();
     let fitted = GaitReference::fit(&table, info, period, 8)?;
-    let double = [[0.0, 0.13], [0.48, 0.62]];
-    let (reference, change) = fitted.grounded(&model, double, clearance, 100, 8)?;
+    let how = Grounding {
+        clearance,
+        ..Grounding::default()
+    };
+    let raw = fitted.grounded(
+        &model,
+        &Grounding {
+            iterations: 0,
+            ..how.clone()
+        },
+    )?;
+    let grounded = fitted.grounded(&model, &how)?;
     println!(
-        "mode 1: normal cycle of {period} s, 8 harmonics; made consistent with the ground by changing joint angles up to {:.2}°",
-        change.to_degrees()
+        "mode 1: normal cycle of {period} s, 8 harmonics, made consistent with the ground (angles corrected by up to {:.1}°):",
+        grounded.largest_change.to_degrees()
     );
-    let (range, acc) = implied_pelvis(&model, &reference);
-    println!(
-        "  the pelvis' height the reference implies: range {:.1} cm, acceleration from {:.2} g to {:.2} g (vertical force {:.2}–{:.2} body weights)",
-        100.0 * range,
-        acc[0],
-        acc[1],
-        1.0 + acc[0],
-        1.0 + acc[1]
-    );
+    for (what, g) in [("as published", &raw), ("grounded", &grounded)] {
+        println!(
+            "  {what:>12}: feet level within {:.1} mm in double support; swing clearance {:+.1} mm from the asked; \
+             centre of mass accelerating within [{:.2}, {:.2}] g",
+            1e3 * g.level,
+            1e3 * g.clearance,
+            g.acceleration[0],
+            g.acceleration[1]
+        );
+    }
+    let reference = grounded.reference;
     let (q0, qd0) = cycle_start(&model, &reference);
     let mut tracking = Tracking::new(reference.clone(), info, kp, kp / 100.0)?;
     tracking.pelvis_kp = pelvis_kp;
@@ -80,10 +99,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         qd0: Some(qd0),
         output: Output::Every { dt: 0.005 },
         frames: true,
-        ..Options::adaptive(period, 1e-5)
+        ..Options::adaptive(cycles * period, 1e-5)
     };
-    let wrapped = WithEfforts::new(Human::default(), tracking.clone());
-    let tr = run(wrapped.clone(), options, "one cycle");
+    let wrapped = WithEfforts::new(model.clone(), tracking.clone());
+    let tr = run(wrapped.clone(), options, &format!("{cycles} cycles"));
     let report = Gait::of(&model, &tracking, &tr, period, weight);
     report.print();
     report.plots(&out, &tr, &tracking, info)?;
@@ -145,45 +164,6 @@ fn run<M: Model + 'static>(model: M, options: Options, what: &str) -> Trajectory
     }
 }
 
-fn model_mass(model: &Human) -> f64 {
-    let n = Human::NQ;
-    let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
-    model.initial_state(&mut q, &mut qd);
-    let mut m = vec![0.0; n * n];
-    model.mass_matrix(0.0, &q, &mut m);
-    m[0]
-}
-
-/// The pelvis' height the reference implies with its lower foot on the ground, over a
-/// cycle: its range (m) and the least and largest of its acceleration in g (through a fit
-/// with 8 harmonics).
-fn implied_pelvis(model: &Human, reference: &GaitReference) -> (f64, [f64; 2]) {
-    let mut kin = Kinematics::new::<Human>();
-    let feet = Feet::of(model.info());
-    let samples = 200;
-    let at = |s: usize| reference.period * s as f64 / samples as f64 - reference.offset;
-    let heights: Vec<f64> = (0..samples)
-        .map(|s| {
-            let (q, qd) = reference_state(model, reference, at(s));
-            model.kinematics(0.0, &q, &qd, &mut kin);
-            let lowest = feet
-                .support_points(&kin)
-                .iter()
-                .flatten()
-                .map(|(x, _)| x[1])
-                .fold(f64::INFINITY, f64::min);
-            q[1] - lowest
-        })
-        .collect();
-    let fit = Fourier::fit(&heights, 8, reference.period);
-    let acc: Vec<f64> = (0..samples)
-        .map(|s| fit.eval(reference.period * s as f64 / samples as f64)[2] / 9.80665)
-        .collect();
-    let lo = |v: &[f64]| v.iter().copied().fold(f64::INFINITY, f64::min);
-    let hi = |v: &[f64]| v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    (hi(&heights) - lo(&heights), [lo(&acc), hi(&acc)])
-}
-
 /// What a gait laboratory reads from one cycle.
 struct Gait {
     /// per output: cycle %, right and left foot's force (body weights), total vertical
@@ -196,34 +176,40 @@ struct Gait {
 }
 
 impl Gait {
+    /// The figures of the last cycle of `tr` (the ones before are the start's transient).
     fn of(model: &Human, tracking: &Tracking, tr: &Trajectory, period: f64, weight: f64) -> Gait {
         let n = Human::NQ;
         let mut kin = Kinematics::new::<Human>();
+        let end = tr.t.last().copied().unwrap_or(0.0);
+        let start = ((end / period).round() - 1.0).max(0.0) * period;
         let (mut grf, mut impulse, mut airborne, mut r2, mut rmax) =
             (Vec::new(), 0.0, 0.0, 0.0, 0.0f64);
-        for i in 0..tr.len() {
+        let mut last: Option<(f64, f64)> = None;
+        for i in (0..tr.len()).filter(|i| tr.t[*i] >= start - 1e-9) {
             let (q, qd) = (&tr.q(i)[..n], &tr.qd(i)[..n]);
             let f = ground_forces(model, tr.t[i], q, qd, &mut kin);
             let torque = tracking.pelvis_torque(tr.t[i], &kin);
             let r = torque.iter().map(|x| x * x).sum::<f64>().sqrt();
             let bw = |v: [f64; 3]| v.map(|x| x / weight);
-            grf.push((100.0 * tr.t[i] / period, bw(f[0]), bw(f[1])));
-            if i > 0 {
-                let dt = tr.t[i] - tr.t[i - 1];
-                impulse += 0.5 * (f[0][1] + f[1][1] + grf_total(&grf[i - 1]) * weight) * dt;
-                if f[0][1] + f[1][1] < 0.01 * weight {
+            grf.push((100.0 * (tr.t[i] - start) / period, bw(f[0]), bw(f[1])));
+            let vertical = f[0][1] + f[1][1];
+            if let Some((t0, v0)) = last {
+                let dt = tr.t[i] - t0;
+                impulse += 0.5 * (vertical + v0) * dt;
+                if vertical < 0.01 * weight {
                     airborne += dt;
                 }
                 r2 += r * r * dt;
             }
+            last = Some((tr.t[i], vertical));
             rmax = rmax.max(r);
         }
-        let t = tr.t.last().copied().unwrap_or(0.0);
+        let t = (end - start).max(1e-12);
         Gait {
             grf,
-            impulse_ratio: impulse / (weight * t.max(1e-12)),
-            airborne: airborne / t.max(1e-12),
-            residual_rms: (r2 / t.max(1e-12)).sqrt(),
+            impulse_ratio: impulse / (weight * t),
+            airborne: airborne / t,
+            residual_rms: (r2 / t).sqrt(),
             residual_peak: rmax,
             body_weight: weight,
         }
@@ -354,10 +340,6 @@ impl Gait {
         )?;
         Ok(())
     }
-}
-
-fn grf_total(g: &(f64, [f64; 3], [f64; 3])) -> f64 {
-    g.1[1] + g.2[1]
 }
 
 fn muscle_plot(

@@ -389,24 +389,24 @@ impl GaitReference {
         })
     }
 
-    /// The reference made consistent with flat ground (a kinematic pass before tracking, as
-    /// OpenSim's residual reduction adjusts a subject's kinematics to its model): at
-    /// `samples` instants of the cycle the legs' hip, knee and ankle angles are changed as
-    /// little as possible (weighted least squares, the hips' adduction and rotation four
-    /// times as costly as flexion, knees and ankles) so that in double support (`double`:
-    /// the cycle fractions [start, end) of each) the two feet's lowest points are level, and
-    /// in single support the swinging foot's lowest point is at least `clearance` above the
-    /// standing one's; the angles are then fitted again with `harmonics` harmonics. Lowest
-    /// points are those of the contact ellipsoids with the pelvis on its reference
-    /// orientation. Returns the reference and the largest change of an angle (rad).
-    pub fn grounded(
-        &self,
-        model: &Human,
-        double: [[f64; 2]; 2],
-        clearance: f64,
-        samples: usize,
-        harmonics: usize,
-    ) -> Result<(GaitReference, f64), String> {
+    /// The reference made consistent with flat ground, a kinematic pass before tracking (as
+    /// OpenSim's residual reduction adjusts a subject's kinematics to its model): the legs'
+    /// hip, knee and ankle angles get periodic corrections (Fourier series of
+    /// `Grounding::harmonics`, the left leg's the right's half a cycle later) found by
+    /// Levenberg–Marquardt on least squares over `samples` instants of the cycle, so that
+    /// - in double support (`double`) the two feet's lowest points are level;
+    /// - in single support the swinging foot's lowest point is above the standing one's by
+    ///   `clearance` × sin(π u), u the fraction of the swing (no clearance asked at lift-off
+    ///   and touch-down, so the foot leaves and meets the ground without a jump);
+    /// - the centre of mass' height above the lower foot, which the ground's force must
+    ///   produce, accelerates within ± `max_acceleration` g (the vertical force within
+    ///   1 ± that in body weights, no flight);
+    /// - the corrections stay small (a penalty, the hips' adduction and rotation twice as
+    ///   costly).
+    ///
+    /// Lowest points are those of the contact ellipsoids with the pelvis on its reference
+    /// orientation; the centre of mass' height is the potential energy over the weight.
+    pub fn grounded(&self, model: &Human, how: &Grounding) -> Result<Grounded, String> {
         let info = model.info();
         let names = [
             "hip_flexion",
@@ -415,90 +415,111 @@ impl GaitReference {
             "knee",
             "ankle",
         ];
-        let mut free = Vec::new();
-        for leg in 0..2 {
+        let mut joints = [[(0usize, 0usize); 5]; 2];
+        for (leg, row) in joints.iter_mut().enumerate() {
             for (j, name) in names.iter().enumerate() {
                 let i = dof_index(info, &format!("{name}[{leg}]"))?;
                 let k = self
                     .joints
                     .iter()
                     .position(|(c, _)| *c == i)
-                    .ok_or("not tracked")?;
-                free.push((k, i, if j == 1 || j == 2 { 4.0 } else { 1.0 }));
+                    .ok_or_else(|| format!("`{name}[{leg}]` is not tracked"))?;
+                row[j] = (k, i);
             }
         }
-        let feet = Feet::of(info);
-        let mut kin = Kinematics::new::<Human>();
-        let mut lows = |q: &[f64]| -> [f64; 2] {
-            model.kinematics(0.0, q, &vec![0.0; q.len()], &mut kin);
-            let sp = feet.support_points(&kin);
-            [0, 1].map(|k| {
-                sp[k]
-                    .iter()
-                    .map(|(x, _)| x[1])
-                    .fold(f64::INFINITY, f64::min)
-            })
+        let pass = Pass {
+            model,
+            base: self,
+            joints,
+            how,
+            feet: Feet::of(info),
+            weight: total_mass(model) * G,
         };
-        let mut rows = Vec::with_capacity(samples);
-        let mut largest: f64 = 0.0;
-        for s in 0..samples {
-            let phase = s as f64 / samples as f64;
-            let t = phase * self.period - self.offset;
-            let (mut q, _) = reference_state(model, self, t);
-            let start: Vec<f64> = free.iter().map(|(_, i, _)| q[*i]).collect();
-            // the constraint g = low_right − low_left against its target: level in double
-            // support; otherwise the swinging foot above by the clearance (active when not)
-            let in_double = double.iter().any(|[a, b]| phase >= *a && phase < *b);
-            let right_stands = phase >= double[0][1] && phase < double[1][0];
-            for _ in 0..30 {
-                let [r, l] = lows(&q);
-                let g = r - l;
-                let target = if in_double {
-                    0.0
-                } else if right_stands {
-                    g.min(-clearance)
-                } else {
-                    g.max(clearance)
+        let nx = 5 * (2 * how.harmonics + 1);
+        let mut kin = Kinematics::new::<Human>();
+        let mut x = vec![0.0; nx];
+        let cost = |r: &[f64]| r.iter().map(|v| v * v).sum::<f64>();
+        let mut r = pass.residuals(&x, &mut kin);
+        let mut mu = 1e-3;
+        let mut iterations = 0;
+        while iterations < how.iterations {
+            iterations += 1;
+            let m = r.len();
+            let mut jac = mbs::DMatrix::<f64>::zeros(m, nx);
+            for c in 0..nx {
+                let mut xp = x.clone();
+                xp[c] += 1e-6;
+                let rp = pass.residuals(&xp, &mut kin);
+                for i in 0..m {
+                    jac[(i, c)] = (rp[i] - r[i]) / 1e-6;
+                }
+            }
+            let jtj = jac.transpose() * &jac;
+            let jtr = jac.transpose() * mbs::DMatrix::from_column_slice(m, 1, &r);
+            let mut improved = false;
+            for _ in 0..10 {
+                let mut a = jtj.clone();
+                for d in 0..nx {
+                    a[(d, d)] += mu * (1.0 + jtj[(d, d)]);
+                }
+                let Some(step) = a.lu().solve(&(-&jtr)) else {
+                    mu *= 10.0;
+                    continue;
                 };
-                if (g - target).abs() < 1e-5 {
+                let xn: Vec<f64> = (0..nx).map(|d| x[d] + step[d]).collect();
+                let rn = pass.residuals(&xn, &mut kin);
+                if cost(&rn) < cost(&r) {
+                    let gain = 1.0 - cost(&rn) / cost(&r);
+                    x = xn;
+                    r = rn;
+                    mu = (mu * 0.3).max(1e-9);
+                    improved = gain > 1e-6;
                     break;
                 }
-                // ∂g/∂θ by central differences, then the weighted least-change step
-                let mut jac = vec![0.0; free.len()];
-                for (c, (_, i, _)) in free.iter().enumerate() {
-                    let h = 1e-6;
-                    let keep = q[*i];
-                    q[*i] = keep + h;
-                    let [rp, lp] = lows(&q);
-                    q[*i] = keep - h;
-                    let [rm, lm] = lows(&q);
-                    q[*i] = keep;
-                    jac[c] = ((rp - lp) - (rm - lm)) / (2.0 * h);
+                mu *= 10.0;
+            }
+            if !improved {
+                break;
+            }
+        }
+        // the corrected reference: each joint's series plus its correction
+        let mut reference = self.clone();
+        let h = how.harmonics;
+        for (leg, row) in joints.iter().enumerate() {
+            for (j, (k, _)) in row.iter().enumerate() {
+                let c = &x[j * (2 * h + 1)..(j + 1) * (2 * h + 1)];
+                let f = &mut reference.joints[*k].1;
+                f.a0 += c[0];
+                if f.a.len() < h {
+                    f.a.resize(h, 0.0);
+                    f.b.resize(h, 0.0);
                 }
-                let norm: f64 = jac.iter().zip(&free).map(|(j, (_, _, w))| j * j / w).sum();
-                if norm < 1e-12 {
-                    return Err(format!(
-                        "at {:.0} % of the cycle the feet cannot be levelled",
-                        100.0 * phase
-                    ));
-                }
-                let lambda = (target - g) / norm;
-                for (c, (_, i, w)) in free.iter().enumerate() {
-                    q[*i] += lambda * jac[c] / w;
+                for m in 1..=h {
+                    // the left leg half a cycle later: odd harmonics change sign
+                    let sign = if leg == 1 && m % 2 == 1 { -1.0 } else { 1.0 };
+                    f.a[m - 1] += sign * c[m];
+                    f.b[m - 1] += sign * c[h + m];
                 }
             }
-            for (c, (_, i, _)) in free.iter().enumerate() {
-                largest = largest.max((q[*i] - start[c]).abs());
-            }
-            rows.push(free.iter().map(|(_, i, _)| q[*i]).collect::<Vec<f64>>());
         }
-        // the samples are uniform in t + offset over a period, as `joint` reads them
-        let mut out = self.clone();
-        for (c, (k, _, _)) in free.iter().enumerate() {
-            let column: Vec<f64> = rows.iter().map(|r| r[c]).collect();
-            out.joints[*k].1 = Fourier::fit(&column, harmonics, self.period);
-        }
-        Ok((out, largest))
+        let samples = pass.samples(&x, &mut kin);
+        let (level, clearance, acceleration) = pass.measure(&samples);
+        let largest_change = (0..how.samples)
+            .flat_map(|s| {
+                let phase = s as f64 / how.samples as f64;
+                (0..5).flat_map(move |j| [0, 1].map(move |leg| (phase, j, leg)))
+            })
+            .map(|(phase, j, leg)| pass.correction(&x, j, phase, leg).abs())
+            .fold(0.0, f64::max);
+
+        Ok(Grounded {
+            reference,
+            level,
+            clearance,
+            acceleration,
+            largest_change,
+            iterations,
+        })
     }
 
     /// Joint `k` of `joints` at `t`: angle, rate, acceleration.
@@ -510,6 +531,213 @@ impl GaitReference {
     pub fn pelvis_rotation(&self, t: f64) -> [[f64; 3]; 3] {
         let [a, b, c] = [0, 1, 2].map(|k| self.pelvis[k].eval(t + self.offset)[0]);
         mul(&mul(&rot(2, a), &rot(0, b)), &rot(1, c))
+    }
+}
+
+/// What [`GaitReference::grounded`] asks of a cycle.
+#[derive(Clone, Debug)]
+pub struct Grounding {
+    /// the cycle fractions [start, end) of the two double supports, the right foot in front
+    /// in the first
+    pub double: [[f64; 2]; 2],
+    /// the swinging foot's clearance at mid-swing (m)
+    pub clearance: f64,
+    /// the bound on the centre of mass' vertical acceleration (in g)
+    pub max_acceleration: f64,
+    /// harmonics of the corrections
+    pub harmonics: usize,
+    /// instants of the cycle
+    pub samples: usize,
+    /// Levenberg–Marquardt iterations at most
+    pub iterations: usize,
+    /// the weight of the corrections' coefficients (per radian) against the residuals
+    /// (centimetres of level or clearance, tenths of g beyond the bound)
+    pub penalty: f64,
+}
+
+impl Default for Grounding {
+    /// The normal cycle's events (right heel strike at 0, left toe-off at 13 %, left heel
+    /// strike at 50 %, right toe-off at 63 %), 2 cm of clearance, ± 0.3 g, five harmonics,
+    /// 100 instants, 60 iterations, a penalty of 3 (the problem is not convex: 1 and 10 end
+    /// in worse minima on the normal cycle).
+    fn default() -> Self {
+        Grounding {
+            double: [[0.0, 0.13], [0.5, 0.63]],
+            clearance: 0.02,
+            max_acceleration: 0.3,
+            harmonics: 5,
+            samples: 100,
+            iterations: 60,
+            penalty: 3.0,
+        }
+    }
+}
+
+/// A grounded reference and how well it meets [`Grounding`]'s asks.
+#[derive(Clone, Debug)]
+pub struct Grounded {
+    pub reference: GaitReference,
+    /// the largest height difference of the feet in double support (m)
+    pub level: f64,
+    /// the least margin of the swinging foot over the clearance asked (m; negative: short)
+    pub clearance: f64,
+    /// the least and largest vertical acceleration of the centre of mass (g)
+    pub acceleration: [f64; 2],
+    /// the largest correction of an angle (rad)
+    pub largest_change: f64,
+    pub iterations: usize,
+}
+
+const G: f64 = 9.80665;
+
+/// The model's mass (the translation block of its mass matrix).
+pub fn total_mass(model: &Human) -> f64 {
+    let n = Human::NQ;
+    let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
+    model.initial_state(&mut q, &mut qd);
+    let mut m = vec![0.0; n * n];
+    model.mass_matrix(0.0, &q, &mut m);
+    m[0]
+}
+
+/// The least-squares problem of [`GaitReference::grounded`].
+struct Pass<'a> {
+    model: &'a Human,
+    base: &'a GaitReference,
+    /// (index in the reference's joints, coordinate) per leg and joint
+    joints: [[(usize, usize); 5]; 2],
+    how: &'a Grounding,
+    feet: Feet,
+    weight: f64,
+}
+
+impl Pass<'_> {
+    /// Correction of joint `j` of leg `leg` at cycle fraction `phase`.
+    fn correction(&self, x: &[f64], j: usize, phase: f64, leg: usize) -> f64 {
+        let h = self.how.harmonics;
+        let c = &x[j * (2 * h + 1)..(j + 1) * (2 * h + 1)];
+        let phase = if leg == 0 { phase } else { phase - 0.5 };
+        let mut v = c[0];
+        for m in 1..=h {
+            let (s, co) = (std::f64::consts::TAU * m as f64 * phase).sin_cos();
+            v += c[m] * co + c[h + m] * s;
+        }
+        v
+    }
+
+    /// At each instant: the lowest point of each foot and the centre of mass' height above
+    /// the lower one.
+    fn samples(&self, x: &[f64], kin: &mut Kinematics) -> Vec<[f64; 3]> {
+        let n = self.how.samples;
+        (0..n)
+            .map(|s| {
+                let phase = s as f64 / n as f64;
+                let t = phase * self.base.period - self.base.offset;
+                let (mut q, qd) = reference_state(self.model, self.base, t);
+                for (leg, row) in self.joints.iter().enumerate() {
+                    for (j, (_, i)) in row.iter().enumerate() {
+                        q[*i] += self.correction(x, j, phase, leg);
+                    }
+                }
+                self.model.kinematics(0.0, &q, &qd, kin);
+                let sp = self.feet.support_points(kin);
+                let low = [0, 1].map(|k| {
+                    sp[k]
+                        .iter()
+                        .map(|(p, _)| p[1])
+                        .fold(f64::INFINITY, f64::min)
+                });
+                // the centre of mass from the potential, lifted clear of the ground
+                q[1] += 2.0;
+                let com = self.model.energy(0.0, &q, &qd).potential / self.weight - 2.0;
+                [low[0], low[1], com - low[0].min(low[1])]
+            })
+            .collect()
+    }
+
+    /// Whether `phase` is in double support; else whether the right foot stands, and the
+    /// fraction of the swing.
+    fn phase(&self, phase: f64) -> Option<(bool, f64)> {
+        let d = self.how.double;
+        if d.iter().any(|[a, b]| phase >= *a && phase < *b) {
+            return None;
+        }
+        let right = phase >= d[0][1] && phase < d[1][0];
+        let (a, b) = if right {
+            (d[0][1], d[1][0])
+        } else {
+            (d[1][1], 1.0 + d[0][0])
+        };
+        Some((right, (phase - a) / (b - a)))
+    }
+
+    /// (gap asked, gap) of the swinging foot at an instant in single support.
+    fn gap(&self, right: bool, u: f64, low: &[f64; 3]) -> (f64, f64) {
+        let asked = self.how.clearance * (std::f64::consts::PI * u).sin();
+        (
+            asked,
+            if right {
+                low[1] - low[0]
+            } else {
+                low[0] - low[1]
+            },
+        )
+    }
+
+    /// The centre of mass' vertical acceleration at each instant (g).
+    fn accelerations(&self, samples: &[[f64; 3]]) -> Vec<f64> {
+        let n = samples.len();
+        let dt = self.base.period / n as f64;
+        (0..n)
+            .map(|s| {
+                let (p, q) = ((s + n - 1) % n, (s + 1) % n);
+                (samples[q][2] - 2.0 * samples[s][2] + samples[p][2]) / (dt * dt) / G
+            })
+            .collect()
+    }
+
+    fn residuals(&self, x: &[f64], kin: &mut Kinematics) -> Vec<f64> {
+        let samples = self.samples(x, kin);
+        let acc = self.accelerations(&samples);
+        let n = samples.len();
+        let mut r = Vec::with_capacity(2 * n + x.len());
+        for (s, low) in samples.iter().enumerate() {
+            // centimetres, and tenths of g beyond the bound
+            match self.phase(s as f64 / n as f64) {
+                None => r.push(100.0 * (low[0] - low[1])),
+                Some((right, u)) => {
+                    let (asked, gap) = self.gap(right, u, low);
+                    r.push(100.0 * (asked - gap).max(0.0));
+                }
+            }
+            r.push(10.0 * (acc[s].abs() - self.how.max_acceleration).max(0.0));
+        }
+        let per = 2 * self.how.harmonics + 1;
+        for (c, v) in x.iter().enumerate() {
+            let j = c / per;
+            let w = self.how.penalty * if j == 1 || j == 2 { 2.0 } else { 1.0 };
+            r.push(w * v);
+        }
+        r
+    }
+
+    /// (largest level difference, least clearance margin, [least, largest] acceleration).
+    fn measure(&self, samples: &[[f64; 3]]) -> (f64, f64, [f64; 2]) {
+        let n = samples.len();
+        let (mut level, mut margin) = (0.0f64, f64::INFINITY);
+        for (s, low) in samples.iter().enumerate() {
+            match self.phase(s as f64 / n as f64) {
+                None => level = level.max((low[0] - low[1]).abs()),
+                Some((right, u)) => {
+                    let (asked, gap) = self.gap(right, u, low);
+                    margin = margin.min(gap - asked);
+                }
+            }
+        }
+        let acc = self.accelerations(samples);
+        let lo = acc.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = acc.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        (level, margin, [lo, hi])
     }
 }
 

@@ -111,22 +111,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     // ---- mode 2: standing on the muscles, then pushed
     let stance = muscle_stance(&model, 0.1, &[0.5; NM])?;
+    let e = &stance.driven.muscles.excitation;
     println!(
         "mode 2: standing on 18 muscles, excitations {:.2}–{:.2}; the equilibrium is {}",
-        stance
-            .driven
-            .muscles
-            .excitation
-            .iter()
-            .copied()
-            .fold(f64::INFINITY, f64::min),
-        stance
-            .driven
-            .muscles
-            .excitation
-            .iter()
-            .copied()
-            .fold(0.0, f64::max),
+        e.iter().copied().fold(f64::INFINITY, f64::min),
+        e.iter().copied().fold(0.0, f64::max),
         format!("{:?}", stance.equilibrium.stability).to_lowercase()
     );
     let mut qd = stance.qd.clone();

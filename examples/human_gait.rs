@@ -8,7 +8,7 @@
 //! within ± 0.3 g), tracked by stiff joint spring–dampers (`--kp`), the pelvis' translation
 //! free on the contacts and its orientation held by residual torques (`--pelvis`, as
 //! OpenSim's residual reduction does; 0 leaves it free), the feet's Hunt–Crossley
-//! dissipation `--dissipation`. The run lasts `--cycles` cycles (default 2) and the last one
+//! stiffness and dissipation `--stiffness`, `--dissipation` (default the model's). The run lasts `--cycles` cycles (default 2) and the last one
 //! is reported: the vertical and fore–aft ground reaction forces of the right foot in body
 //! weights (first peak, trough, second peak, braking, propulsion), the vertical impulse
 //! against weight × time, the fraction of the cycle with no foot on the ground, the residual
@@ -50,12 +50,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let cycles = number("--cycles", 2.0)?.round().max(1.0);
     let clearance = number("--clearance", 0.02)?;
     let dissipation = number("--dissipation", Human::default().params().d_foot)?;
+    let stiffness = number("--stiffness", Human::default().params().k_foot)?;
     let out = PathBuf::from(value("--out").map_or("target/human_gait", |s| s.as_str()));
     std::fs::create_dir_all(&out)?;
 
     let mut model = Human::default();
     let mut params = model.params().clone();
     params.d_foot = dissipation;
+    params.k_foot = stiffness;
     model.set_params(params)?;
     let info = model.info();
     let weight = total_mass(&model) * 9.80665;
@@ -205,26 +207,39 @@ impl Gait {
     }
 
     fn print(&self) {
+        let end = self.grf.last().map_or(0.0, |g| g.0);
+        if end < 99.0 {
+            println!(
+                "  (the run covers {end:.0} % of the cycle: the figures are of that part only)"
+            );
+        }
+        // the largest or least of the right foot's component k over [lo, hi] % ("—": the run
+        // did not reach it)
         let right = |lo: f64, hi: f64, k: usize, max: bool| {
             let v = self
                 .grf
                 .iter()
                 .filter(|(p, _, _)| *p >= lo && *p <= hi)
                 .map(|(_, r, _)| r[k]);
-            if max {
+            let x = if max {
                 v.fold(f64::NEG_INFINITY, f64::max)
             } else {
                 v.fold(f64::INFINITY, f64::min)
+            };
+            if x.is_finite() {
+                format!("{x:+.2}")
+            } else {
+                "—".to_string()
             }
         };
         println!(
-            "  right foot, vertical: first peak {:.2} (0–30 %), trough {:.2} (20–45 %), second peak {:.2} (35–62 %) body weights [normal gait: peaks 1.0–1.3, trough 0.6–0.9]",
+            "  right foot, vertical: first peak {} (0–30 %), trough {} (20–45 %), second peak {} (35–62 %) body weights [normal gait: peaks 1.0–1.3, trough 0.6–0.9]",
             right(0.0, 30.0, 1, true),
             right(20.0, 45.0, 1, false),
             right(35.0, 62.0, 1, true)
         );
         println!(
-            "  right foot, fore–aft: braking {:+.2} (0–30 %), propulsion {:+.2} (35–62 %) body weights",
+            "  right foot, fore–aft: braking {} (0–30 %), propulsion {} (35–62 %) body weights",
             right(0.0, 30.0, 0, false),
             right(35.0, 62.0, 0, true)
         );

@@ -5,6 +5,7 @@
 //!   `physics.biomechanics` (values below, computed with SymPy 1.14's
 //!   `MusculotendonDeGroote2016.with_defaults(…, FIBER_LENGTH_EXPLICIT)` and
 //!   `FirstOrderActivationDeGroote2016.with_defaults`, v_max = 10 l_opt);
+//! - the quadriceps' insertions on the patella follow OpenSim's moving points on the tibia;
 //! - the paths' ∂l/∂q from the generated point Jacobians equal central differences of the
 //!   length, and l̇ = ∂l/∂q · q̇;
 //! - the moment arms in the anatomical posture have each muscle's anatomical action (sign)
@@ -285,30 +286,15 @@ fn the_model_stands_on_its_muscles_with_constant_excitations() {
     let model = Human::default();
     let info = model.info();
     let n = Human::NQ;
-    // co-contraction: the activations nearest 0.5 that produce the moments (with the least
-    // Σ a² the equilibrium has four growing poles, up to 15/s, where this one has one)
+    // co-contraction: the activations nearest 0.5 that produce the moments (the least Σ a²
+    // leaves the knees and ankles with less stiffness, and more poles grow)
     let stance = muscle_stance(&model, 0.1, &[0.5; NM]).unwrap();
     let (driven, moments) = (&stance.driven, &stance.moments);
     let muscles = &driven.muscles;
     // the muscles produce the moments asked, at the held body's posture
-    let held = {
-        let reference = GaitReference::still(info, 0.1).unwrap();
-        let (q0, _) = cycle_start(&model, &reference);
-        let tracking = Tracking::new(reference, info, 3000.0, 30.0).unwrap();
-        mbs::static_equilibrium(
-            &WithEfforts::new(Human::default(), tracking),
-            &mbs::StaticsOptions {
-                q0: Some(q0),
-                locked: vec![0, 2, 4],
-                tolerance: 1e-8,
-                ..Default::default()
-            },
-        )
-        .unwrap()
-        .q
-    };
+    let held = &stance.held;
     let mut kin = Kinematics::new::<Human>();
-    model.kinematics(0.0, &held, &vec![0.0; n], &mut kin);
+    model.kinematics(0.0, held, &vec![0.0; n], &mut kin);
     let forces = muscles.forces_at_rest(&kin, &muscles.excitation).unwrap();
     for k in 0..2 {
         for (dof, (_, asked)) in ["hip_flexion", "knee", "ankle"]
@@ -347,7 +333,9 @@ fn the_model_stands_on_its_muscles_with_constant_excitations() {
     println!(
         "equilibrium on the muscles: {:.2e} from the held body's, {} (stiffness eigenvalues from {:.1}); \
          poles with Re > 0.1/s: {growing:.2?}",
-        stance.moved,
+        (0..n)
+            .map(|i| (eq.q[i] - held[i]).abs())
+            .fold(0.0, f64::max),
         format!("{:?}", eq.stability).to_lowercase(),
         eq.stiffness_eigenvalues[0]
     );
@@ -404,4 +392,84 @@ fn the_model_stands_on_its_muscles_with_constant_excitations() {
     );
     assert_eq!(growing.len(), 1, "{growing:?}");
     assert!((ratio / (0.5 * lambda).exp() - 1.0).abs() < 0.2, "{ratio}");
+}
+
+/// OpenSim's moving insertion points of the quadriceps in the tibia's axes (gait10dof18musc,
+/// `rect_fem_r-P3` and `vas_int_r-P4`): the knee angles and their x and y (m); the source's
+/// table values, not π fractions.
+#[allow(clippy::approx_constant)]
+const MOVING_KNEE: [f64; 17] = [
+    -2.0944, -1.99997, -1.5708, -1.45752, -1.39626, -1.0472, -0.698132, -0.526391, -0.349066,
+    -0.174533, 0.0, 0.00017453, 0.00034907, 0.0279253, 0.0872665, 0.174533, 2.0944,
+];
+const MOVING_POINTS: [(&str, [f64; 17], [f64; 17]); 2] = [
+    (
+        "rf_i[0]",
+        [
+            0.0155805, 0.0179938, 0.0275081, 0.0296564, 0.0307615, 0.0365695, 0.0422074, 0.0450902,
+            0.048391, 0.0534299, 0.0617576, 0.0617669, 0.0617762, 0.0633083, 0.066994, 0.0733035,
+            0.0573481,
+        ],
+        [
+            0.0234116, 0.0237613, 0.0251141, 0.0252795, 0.0253146, 0.0249184, 0.0242373, 0.0238447,
+            0.0234197, 0.0227644, 0.020984, 0.0209814, 0.0209788, 0.0205225, 0.0191754, 0.0159554,
+            -0.0673774,
+        ],
+    ),
+    (
+        "vas_i[0]",
+        [
+            0.0082733, 0.0106866, 0.0202042, 0.022353, 0.0234583, 0.0292715, 0.0349465, 0.037871,
+            0.0412569, 0.0465287, 0.0554632, 0.0554735, 0.0554837, 0.0571717, 0.061272, 0.0684368,
+            0.0648818,
+        ],
+        [
+            0.025599, 0.0259487, 0.0273124, 0.0274796, 0.0275151, 0.0271363, 0.0265737, 0.0263073,
+            0.0261187, 0.0260129, 0.0252923, 0.0252911, 0.0252898, 0.0250526, 0.0242191, 0.0218288,
+            -0.0685706,
+        ],
+    ),
+];
+
+#[test]
+fn the_quadriceps_insert_where_opensims_moving_points_are() {
+    use mbs::spline::{evaluate, natural_coefficients};
+    let model = Human::default();
+    let info = model.info();
+    let n = Human::NQ;
+    let knee = info.dofs.iter().position(|d| *d == "knee[0]").unwrap();
+    let tibia = info.frame_index("tibia_o[0]").unwrap();
+    let mut kin = Kinematics::new::<Human>();
+    let mut worst: f64 = 0.0;
+    for (point, xs, ys) in MOVING_POINTS {
+        let p = info.point_index(point).unwrap();
+        let table =
+            |v: [f64; 17]| -> Vec<(f64, f64)> { MOVING_KNEE.iter().copied().zip(v).collect() };
+        let (cx, cy) = (
+            natural_coefficients(&table(xs)).unwrap(),
+            natural_coefficients(&table(ys)).unwrap(),
+        );
+        // knee flexion from 3° of extension to 75°
+        for s in 0..=60 {
+            let a = 0.0524 - (0.0524 + 1.309) * s as f64 / 60.0;
+            let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
+            model.initial_state(&mut q, &mut qd);
+            q[knee] = a;
+            model.kinematics(0.0, &q, &qd, &mut kin);
+            // the point in the tibia's axes
+            let f = &kin.frames[tibia].pose;
+            let d = [0, 1, 2].map(|i| kin.points[p].position[i] - f.position[i]);
+            let local = [0, 1].map(|j| (0..3).map(|i| f.rotation[i][j] * d[i]).sum::<f64>());
+            let opensim = [
+                evaluate(&MOVING_KNEE, &cx, 0, a),
+                evaluate(&MOVING_KNEE, &cy, 0, a),
+            ];
+            worst = worst.max((local[0] - opensim[0]).hypot(local[1] - opensim[1]));
+        }
+    }
+    println!(
+        "quadriceps' insertions on the patella against OpenSim's moving points (natural cubic splines), knee −75°…3°: within {:.2} mm",
+        1e3 * worst
+    );
+    assert!(worst < 1.5e-3, "{worst}");
 }

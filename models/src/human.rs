@@ -427,9 +427,17 @@ impl GaitReference {
                 row[j] = (k, i);
             }
         }
+        // the reference's states at the instants, once
+        let states = (0..how.samples)
+            .map(|s| {
+                let t = s as f64 / how.samples as f64 * self.period - self.offset;
+                reference_state(model, self, t)
+            })
+            .collect();
         let pass = Pass {
             model,
-            base: self,
+            states,
+            period: self.period,
             joints,
             how,
             feet: Feet::of(info),
@@ -603,7 +611,9 @@ pub fn total_mass(model: &Human) -> f64 {
 /// The least-squares problem of [`GaitReference::grounded`].
 struct Pass<'a> {
     model: &'a Human,
-    base: &'a GaitReference,
+    /// the uncorrected reference's (q, q̇) at each instant
+    states: Vec<(Vec<f64>, Vec<f64>)>,
+    period: f64,
     /// (index in the reference's joints, coordinate) per leg and joint
     joints: [[(usize, usize); 5]; 2],
     how: &'a Grounding,
@@ -629,17 +639,18 @@ impl Pass<'_> {
     /// the lower one.
     fn samples(&self, x: &[f64], kin: &mut Kinematics) -> Vec<[f64; 3]> {
         let n = self.how.samples;
+        let mut q = vec![0.0; Human::NQ];
         (0..n)
             .map(|s| {
                 let phase = s as f64 / n as f64;
-                let t = phase * self.base.period - self.base.offset;
-                let (mut q, qd) = reference_state(self.model, self.base, t);
+                let (q0, qd) = &self.states[s];
+                q.copy_from_slice(q0);
                 for (leg, row) in self.joints.iter().enumerate() {
                     for (j, (_, i)) in row.iter().enumerate() {
                         q[*i] += self.correction(x, j, phase, leg);
                     }
                 }
-                self.model.kinematics(0.0, &q, &qd, kin);
+                self.model.kinematics(0.0, &q, qd, kin);
                 let sp = self.feet.support_points(kin);
                 let low = [0, 1].map(|k| {
                     sp[k]
@@ -649,7 +660,7 @@ impl Pass<'_> {
                 });
                 // the centre of mass from the potential, lifted clear of the ground
                 q[1] += 2.0;
-                let com = self.model.energy(0.0, &q, &qd).potential / self.weight - 2.0;
+                let com = self.model.energy(0.0, &q, qd).potential / self.weight - 2.0;
                 [low[0], low[1], com - low[0].min(low[1])]
             })
             .collect()
@@ -687,7 +698,7 @@ impl Pass<'_> {
     /// The centre of mass' vertical acceleration at each instant (g).
     fn accelerations(&self, samples: &[[f64; 3]]) -> Vec<f64> {
         let n = samples.len();
-        let dt = self.base.period / n as f64;
+        let dt = self.period / n as f64;
         (0..n)
             .map(|s| {
                 let (p, q) = ((s + n - 1) % n, (s + 1) % n);

@@ -14,7 +14,8 @@
 //! deep flexion (beyond 84°) are left out. The quadriceps' moving insertions on the tibia
 //! (OpenSim's splines of the knee angle, standing in for the patella) are fixed points on
 //! this model's patella instead, which moves with the knee: the least-squares fit over knee
-//! angles −75°…3° follows OpenSim's points within 1.3 mm.
+//! angles −75°…3° follows OpenSim's points within 1.4 mm
+//! (`tests/human_muscles.rs`).
 
 use super::{
     GaitReference, Guard, Human, PassiveJoints, TRACKED, Tracking, cycle_start, dof_index,
@@ -180,17 +181,18 @@ pub const MUSCLE_JOINTS: [&str; 6] = [
 ];
 
 impl Muscles {
-    /// Each unit's tendon force with its fibre at rest at the kinematics `kin` and
-    /// activations `a` (N).
+    /// Unit `i`'s tendon force with its fibre at rest at the kinematics `kin` and
+    /// activation `a` (N).
+    pub fn force_at_rest(&self, i: usize, kin: &Kinematics, a: f64) -> Result<f64, MuscleError> {
+        let (u, p) = &self.units[i];
+        let l = p.length(kin).0;
+        Ok(u.fibre(l, a, u.equilibrium(l, a)?)?.tendon_force)
+    }
+
+    /// Each unit's [`Muscles::force_at_rest`] with activations `a`.
     pub fn forces_at_rest(&self, kin: &Kinematics, a: &[f64]) -> Result<Vec<f64>, MuscleError> {
-        self.units
-            .iter()
-            .zip(a)
-            .map(|((u, p), a)| {
-                let l = p.length(kin).0;
-                let lm = u.equilibrium(l, *a)?;
-                Ok(u.fibre(l, *a, lm)?.tendon_force)
-            })
+        (0..self.units.len())
+            .map(|i| self.force_at_rest(i, kin, a[i]))
             .collect()
     }
 
@@ -407,10 +409,10 @@ impl Efforts for MusclesAtRest {
         if let Some(t) = &mut passive.tracking {
             t.efforts(e)?;
         }
-        let forces = muscles
-            .forces_at_rest(e.kin, &muscles.excitation)
-            .map_err(|e| e.to_string())?;
-        for ((_, path), f) in muscles.units.iter().zip(forces) {
+        for (i, (_, path)) in muscles.units.iter().enumerate() {
+            let f = muscles
+                .force_at_rest(i, e.kin, muscles.excitation[i])
+                .map_err(|e| e.to_string())?;
             path.apply(e, f);
         }
         Ok(())
@@ -431,8 +433,8 @@ pub struct MuscleStance {
     pub moments: Vec<(usize, f64)>,
     /// the equilibrium under the muscles, from statics with the fibres at rest
     pub equilibrium: mbs::Equilibrium,
-    /// how far it is from the held body's equilibrium (largest coordinate change)
-    pub moved: f64,
+    /// the held body's equilibrium (coordinates), where the moments were asked
+    pub held: Vec<f64>,
 }
 
 /// Standing on the muscles with constant excitations (mode 2): the body held by stiff
@@ -488,9 +490,6 @@ pub fn muscle_stance(model: &Human, ankle: f64, baseline: &[f64]) -> Result<Musc
         &statics(q.clone()),
     )
     .map_err(|e| format!("the body on its muscles: {e}"))?;
-    let moved = (0..n)
-        .map(|i| (equilibrium.q[i] - q[i]).abs())
-        .fold(0.0, f64::max);
     model.kinematics(0.0, &equilibrium.q, &zero, &mut kin);
     let x = driven.initial_states(&kin, &zero)?;
     let mut qs = equilibrium.q.clone();
@@ -503,7 +502,7 @@ pub fn muscle_stance(model: &Human, ankle: f64, baseline: &[f64]) -> Result<Musc
         qd: qds,
         moments,
         equilibrium,
-        moved,
+        held: q,
     })
 }
 

@@ -45,11 +45,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     };
     let period = number("--period", 1.1)?;
-    let kp = number("--kp", 3000.0)?;
+    let kp = number("--kp", GAIT_KP)?;
     let pelvis_kp = number("--pelvis", 30000.0)?;
     let cycles = number("--cycles", 2.0)?.round().max(1.0);
     let clearance = number("--clearance", 0.02)?;
-    let dissipation = number("--dissipation", Human::default().params().d_foot)?;
+    let dissipation = number("--dissipation", GAIT_DISSIPATION)?;
     let stiffness = number("--stiffness", Human::default().params().k_foot)?;
     let out = PathBuf::from(value("--out").map_or("target/human_gait", |s| s.as_str()));
     std::fs::create_dir_all(&out)?;
@@ -64,7 +64,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     // ---- mode 1: the prescribed cycle
     let table = GaitTable::normal();
-    let fitted = GaitReference::fit(&table, info, period, 8)?;
+    let fitted = GaitReference::fit(&table, info, period, FIT_HARMONICS)?;
     let how = Grounding {
         clearance,
         ..Grounding::default()
@@ -78,17 +78,25 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     )?;
     let grounded = fitted.grounded(&model, &how)?;
     println!(
-        "mode 1: normal cycle of {period} s, 8 harmonics, made consistent with the ground (angles corrected by up to {:.1}°):",
+        "mode 1: normal cycle of {period} s, {FIT_HARMONICS} harmonics, made consistent with the ground (angles corrected by up to {:.1}°):",
         grounded.largest_change.to_degrees()
     );
     for (what, g) in [("as published", &raw), ("grounded", &grounded)] {
+        let a = g.acceleration;
         println!(
-            "  {what:>12}: feet level within {:.1} mm in double support; swing clearance {:+.1} mm from the asked; \
-             centre of mass accelerating within [{:.2}, {:.2}] g",
+            "  {what:>12}: {:.2} m/s; in double support the feet level within {:.1} mm, sliding apart at up to {:.2} m/s; \
+             swing clearance {:+.1} mm from the asked; centre of mass accelerating within \
+             [{:.2}, {:.2}] g fore–aft, [{:.2}, {:.2}] g vertically, [{:.2}, {:.2}] g laterally",
+            g.speed,
             1e3 * g.level,
+            g.slip,
             1e3 * g.clearance,
-            g.acceleration[0],
-            g.acceleration[1]
+            a[0][0],
+            a[0][1],
+            a[1][0],
+            a[1][1],
+            a[2][0],
+            a[2][1]
         );
     }
     let reference = grounded.reference;
@@ -105,9 +113,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let wrapped = WithEfforts::new(model.clone(), tracking.clone());
     let tr = run(wrapped.clone(), options, &format!("{cycles} cycles"));
-    let report = Gait::of(&model, &tracking, &tr, period, weight);
-    report.print();
-    report.plots(&out, &tr, &tracking, info)?;
+    let forces = CycleForces::of(&model, &tracking, &tr, period, weight);
+    print(&forces, weight / 9.80665);
+    plots(&forces, weight / 9.80665, &out, &tr, &tracking, info)?;
     mbs::anim::write_html(&out.join("walk.html"), wrapped.info(), &tr)?;
     tr.write_csv(std::fs::File::create(out.join("gait.csv"))?)?;
 
@@ -155,195 +163,132 @@ fn run<M: Model + 'static>(model: M, options: Options, what: &str) -> Trajectory
     }
 }
 
-/// What a gait laboratory reads from one cycle.
-struct Gait {
-    /// per output: cycle %, right and left foot's force (body weights), total vertical
-    grf: Vec<(f64, [f64; 3], [f64; 3])>,
-    impulse_ratio: f64,
-    airborne: f64,
-    residual_rms: f64,
-    residual_peak: f64,
-    body_weight: f64,
+/// The printed report of a cycle's forces.
+fn print(c: &CycleForces, mass: f64) {
+    if c.covered < 0.99 {
+        println!(
+            "  (the run covers {:.0} % of the cycle: the figures are of that part only)",
+            100.0 * c.covered
+        );
+    }
+    let f = |x: Option<f64>| x.map_or("—".to_string(), |v| format!("{v:+.2}"));
+    for (k, foot) in ["right", "left"].iter().enumerate() {
+        let g = c.figures(k);
+        println!(
+            "  {foot:>5} foot, vertical: first peak {}, trough {}, second peak {}; fore–aft: braking {}, propulsion {}, \
+             mean {} over the stance's first half, {} over its second (body weights)",
+            f(g.first_peak),
+            f(g.trough),
+            f(g.second_peak),
+            f(g.braking),
+            f(g.propulsion),
+            f(g.first_half.map(|v| (v * 100.0).round() / 100.0)),
+            f(g.second_half.map(|v| (v * 100.0).round() / 100.0)),
+        );
+    }
+    println!(
+        "        [normal gait: peaks 1.0–1.3, trough 0.6–0.9; braking in the first half, propulsion in the second]"
+    );
+    println!(
+        "  vertical impulse / (weight × time) = {:.3} [within 5 % of 1]; no foot on the ground during {:.0} % of the cycle",
+        c.impulse_ratio,
+        100.0 * c.airborne
+    );
+    println!(
+        "  residual torque on the pelvis: rms {:.0} N·m, peak {:.0} N·m ({:.2} and {:.2} N·m/kg)",
+        c.residual_rms,
+        c.residual_peak,
+        c.residual_rms / mass,
+        c.residual_peak / mass
+    );
 }
 
-impl Gait {
-    /// The figures of the last cycle of `tr` (the ones before are the start's transient).
-    fn of(model: &Human, tracking: &Tracking, tr: &Trajectory, period: f64, weight: f64) -> Gait {
-        let n = Human::NQ;
-        let mut kin = Kinematics::new::<Human>();
-        let end = tr.t.last().copied().unwrap_or(0.0);
-        let start = ((end / period).round() - 1.0).max(0.0) * period;
-        let (mut grf, mut impulse, mut airborne, mut r2, mut rmax) =
-            (Vec::new(), 0.0, 0.0, 0.0, 0.0f64);
-        let mut last: Option<(f64, f64)> = None;
-        for i in (0..tr.len()).filter(|i| tr.t[*i] >= start - 1e-9) {
-            let (q, qd) = (&tr.q(i)[..n], &tr.qd(i)[..n]);
-            let f = ground_forces(model, tr.t[i], q, qd, &mut kin);
-            let torque = tracking.pelvis_torque(tr.t[i], &kin);
-            let r = torque.iter().map(|x| x * x).sum::<f64>().sqrt();
-            let bw = |v: [f64; 3]| v.map(|x| x / weight);
-            grf.push((100.0 * (tr.t[i] - start) / period, bw(f[0]), bw(f[1])));
-            let vertical = f[0][1] + f[1][1];
-            if let Some((t0, v0)) = last {
-                let dt = tr.t[i] - t0;
-                impulse += 0.5 * (vertical + v0) * dt;
-                if vertical < 0.01 * weight {
-                    airborne += dt;
-                }
-                r2 += r * r * dt;
-            }
-            last = Some((tr.t[i], vertical));
-            rmax = rmax.max(r);
-        }
-        let t = (end - start).max(1e-12);
-        Gait {
-            grf,
-            impulse_ratio: impulse / (weight * t),
-            airborne: airborne / t,
-            residual_rms: (r2 / t).sqrt(),
-            residual_peak: rmax,
-            body_weight: weight,
-        }
+fn plots(
+    c: &CycleForces,
+    mass: f64,
+    out: &std::path::Path,
+    tr: &Trajectory,
+    tracking: &Tracking,
+    info: &mbs::ModelInfo,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let pick = |k: usize, j: usize| -> Vec<(f64, f64)> {
+        c.grf
+            .iter()
+            .map(|(p, r, l)| (*p, if k == 0 { r[j] } else { l[j] }))
+            .collect()
+    };
+    line_chart(
+        &out.join("grf.svg"),
+        &chart("Ground reaction forces", "force (body weights)"),
+        &[
+            Series::new("right, vertical", pick(0, 1)),
+            Series::new("right, fore-aft", pick(0, 0)),
+            Series::new("left, vertical", pick(1, 1)),
+            Series::new("left, fore-aft", pick(1, 0)),
+        ],
+    )?;
+    let n = Human::NQ;
+    let period = tracking.reference.period;
+    let joints = ["hip_flexion[0]", "knee[0]", "ankle[0]"];
+    let mut angles = Vec::new();
+    let mut moments = Vec::new();
+    for name in joints {
+        let i = info
+            .dofs
+            .iter()
+            .position(|d| *d == name)
+            .ok_or("no joint")?;
+        let k = tracking
+            .reference
+            .joints
+            .iter()
+            .position(|(c, _)| *c == i)
+            .ok_or("not tracked")?;
+        let cycle = |t: f64| 100.0 * t / period;
+        angles.push(Series::new(
+            format!("{name}, simulated"),
+            (0..tr.len())
+                .map(|s| (cycle(tr.t[s]), tr.q(s)[i].to_degrees()))
+                .collect(),
+        ));
+        angles.push(Series::new(
+            format!("{name}, reference"),
+            (0..tr.len())
+                .map(|s| {
+                    (
+                        cycle(tr.t[s]),
+                        tracking.reference.joint(k, tr.t[s])[0].to_degrees(),
+                    )
+                })
+                .collect(),
+        ));
+        moments.push(Series::new(
+            name,
+            (0..tr.len())
+                .map(|s| {
+                    let tau = tracking
+                        .torques(tr.t[s], &tr.q(s)[..n], &tr.qd(s)[..n])
+                        .find(|(c, _)| *c == i)
+                        .map_or(0.0, |(_, v)| v);
+                    (cycle(tr.t[s]), tau / mass)
+                })
+                .collect(),
+        ));
     }
-
-    fn print(&self) {
-        let end = self.grf.last().map_or(0.0, |g| g.0);
-        if end < 99.0 {
-            println!(
-                "  (the run covers {end:.0} % of the cycle: the figures are of that part only)"
-            );
-        }
-        // the largest or least of the right foot's component k over [lo, hi] % ("—": the run
-        // did not reach it)
-        let right = |lo: f64, hi: f64, k: usize, max: bool| {
-            let v = self
-                .grf
-                .iter()
-                .filter(|(p, _, _)| *p >= lo && *p <= hi)
-                .map(|(_, r, _)| r[k]);
-            let x = if max {
-                v.fold(f64::NEG_INFINITY, f64::max)
-            } else {
-                v.fold(f64::INFINITY, f64::min)
-            };
-            if x.is_finite() {
-                format!("{x:+.2}")
-            } else {
-                "—".to_string()
-            }
-        };
-        println!(
-            "  right foot, vertical: first peak {} (0–30 %), trough {} (20–45 %), second peak {} (35–62 %) body weights [normal gait: peaks 1.0–1.3, trough 0.6–0.9]",
-            right(0.0, 30.0, 1, true),
-            right(20.0, 45.0, 1, false),
-            right(35.0, 62.0, 1, true)
-        );
-        println!(
-            "  right foot, fore–aft: braking {} (0–30 %), propulsion {} (35–62 %) body weights",
-            right(0.0, 30.0, 0, false),
-            right(35.0, 62.0, 0, true)
-        );
-        println!(
-            "  vertical impulse / (weight × time) = {:.3} [within 5 % of 1]; no foot on the ground during {:.0} % of the cycle",
-            self.impulse_ratio,
-            100.0 * self.airborne
-        );
-        println!(
-            "  residual torque on the pelvis: rms {:.0} N·m, peak {:.0} N·m ({:.2} and {:.2} N·m/kg)",
-            self.residual_rms,
-            self.residual_peak,
-            self.residual_rms / (self.body_weight / 9.80665),
-            self.residual_peak / (self.body_weight / 9.80665)
-        );
-    }
-
-    fn plots(
-        &self,
-        out: &std::path::Path,
-        tr: &Trajectory,
-        tracking: &Tracking,
-        info: &mbs::ModelInfo,
-    ) -> Result<(), Box<dyn std::error::Error>> {
-        let pick = |k: usize, c: usize| -> Vec<(f64, f64)> {
-            self.grf
-                .iter()
-                .map(|(p, r, l)| (*p, if k == 0 { r[c] } else { l[c] }))
-                .collect()
-        };
-        line_chart(
-            &out.join("grf.svg"),
-            &chart("Ground reaction forces", "force (body weights)"),
-            &[
-                Series::new("right, vertical", pick(0, 1)),
-                Series::new("right, fore-aft", pick(0, 0)),
-                Series::new("left, vertical", pick(1, 1)),
-                Series::new("left, fore-aft", pick(1, 0)),
-            ],
-        )?;
-        let n = Human::NQ;
-        let period = tracking.reference.period;
-        let joints = ["hip_flexion[0]", "knee[0]", "ankle[0]"];
-        let mut angles = Vec::new();
-        let mut moments = Vec::new();
-        let mass = self.body_weight / 9.80665;
-        for name in joints {
-            let i = info
-                .dofs
-                .iter()
-                .position(|d| *d == name)
-                .ok_or("no joint")?;
-            let k = tracking
-                .reference
-                .joints
-                .iter()
-                .position(|(c, _)| *c == i)
-                .ok_or("not tracked")?;
-            let cycle = |t: f64| 100.0 * t / period;
-            angles.push(Series::new(
-                format!("{name}, simulated"),
-                (0..tr.len())
-                    .map(|s| (cycle(tr.t[s]), tr.q(s)[i].to_degrees()))
-                    .collect(),
-            ));
-            angles.push(Series::new(
-                format!("{name}, reference"),
-                (0..tr.len())
-                    .map(|s| {
-                        (
-                            cycle(tr.t[s]),
-                            tracking.reference.joint(k, tr.t[s])[0].to_degrees(),
-                        )
-                    })
-                    .collect(),
-            ));
-            moments.push(Series::new(
-                name,
-                (0..tr.len())
-                    .map(|s| {
-                        let tau = tracking
-                            .torques(tr.t[s], &tr.q(s)[..n], &tr.qd(s)[..n])
-                            .find(|(c, _)| *c == i)
-                            .map_or(0.0, |(_, v)| v);
-                        (cycle(tr.t[s]), tau / mass)
-                    })
-                    .collect(),
-            ));
-        }
-        line_chart(
-            &out.join("angles.svg"),
-            &chart("Joint angles, right leg", "angle (°)"),
-            &angles,
-        )?;
-        line_chart(
-            &out.join("moments.svg"),
-            &chart(
-                "Joint moments, right leg (tracking torques)",
-                "moment (N·m/kg)",
-            ),
-            &moments,
-        )?;
-        Ok(())
-    }
+    line_chart(
+        &out.join("angles.svg"),
+        &chart("Joint angles, right leg", "angle (°)"),
+        &angles,
+    )?;
+    line_chart(
+        &out.join("moments.svg"),
+        &chart(
+            "Joint moments, right leg (tracking torques)",
+            "moment (N·m/kg)",
+        ),
+        &moments,
+    )?;
+    Ok(())
 }
 
 fn muscle_plot(

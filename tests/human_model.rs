@@ -12,8 +12,10 @@
 //! - passive joint moments: the law by hand, the viscous states' relaxation along a run,
 //!   and a collapsing body caught near its joints' ranges (without them its toes spin);
 //! - a knee beyond its splines' tables and a foot through the ground are typed failures;
-//! - the grounded cycle levels the feet in double support, lifts the swinging foot and keeps
-//!   the centre of mass' vertical acceleration near the bound asked;
+//! - the grounded cycle levels the feet in double support and keeps them from sliding apart,
+//!   lifts the swinging foot and keeps the centre of mass' acceleration near the bounds asked;
+//! - the prescribed cycle (mode 1, as the gait program runs it) gives the right foot a normal
+//!   double hump, braking then propulsion, and the weight's vertical impulse;
 //! - residual torques hold the pelvis on its reference orientation.
 
 // the knots below are the sources' numbers (−1.0472 is a table value, not −π/3)
@@ -422,10 +424,10 @@ fn lowest_points(model: &Human, reference: &GaitReference, t: f64) -> [f64; 2] {
 }
 
 #[test]
-fn the_grounded_cycle_levels_the_feet_lifts_the_swinging_one_and_bounds_the_vertical_force() {
+fn the_grounded_cycle_levels_the_feet_keeps_them_together_and_bounds_the_centre_of_mass() {
     let model = Human::default();
     let info = model.info();
-    let fitted = GaitReference::fit(&GaitTable::normal(), info, 1.1, 8).unwrap();
+    let fitted = GaitReference::fit(&GaitTable::normal(), info, 1.1, FIT_HARMONICS).unwrap();
     // no iteration: the measures of the fitted cycle itself
     let raw = fitted
         .grounded(
@@ -438,34 +440,98 @@ fn the_grounded_cycle_levels_the_feet_lifts_the_swinging_one_and_bounds_the_vert
         .unwrap();
     let how = Grounding::default();
     let g = fitted.grounded(&model, &how).unwrap();
-    println!(
-        "grounded cycle ({} iterations, angles corrected by up to {:.1}°): feet level within {:.1} mm in double \
-         support (before {:.1} mm), swing clearance at least {:+.1} mm from the asked (before {:+.1} mm), \
-         centre of mass accelerating within [{:.2}, {:.2}] g (before [{:.2}, {:.2}] g)",
-        g.iterations,
-        g.largest_change.to_degrees(),
-        1e3 * g.level,
-        1e3 * raw.level,
-        1e3 * g.clearance,
-        1e3 * raw.clearance,
-        g.acceleration[0],
-        g.acceleration[1],
-        raw.acceleration[0],
-        raw.acceleration[1]
-    );
-    assert!(raw.level > 0.02 && raw.clearance < -0.02, "{raw:?}");
-    assert!(g.level < 0.005 && g.clearance > -0.003, "{g:?}");
-    let bound = how.max_acceleration + 0.1;
+    for (what, g) in [("fitted", &raw), ("grounded", &g)] {
+        println!(
+            "{what} cycle ({} iterations, angles corrected by up to {:.1}°): {:.2} m/s; in double support feet \
+             level within {:.1} mm, sliding apart at up to {:.2} m/s; swing clearance at least {:+.1} mm from \
+             the asked; centre of mass accelerating within {:.2?} g (fore–aft, vertical, lateral)",
+            g.iterations,
+            g.largest_change.to_degrees(),
+            g.speed,
+            1e3 * g.level,
+            g.slip,
+            1e3 * g.clearance,
+            g.acceleration,
+        );
+    }
     assert!(
-        g.acceleration[0] > -bound && g.acceleration[1] < bound,
-        "{:?}",
-        g.acceleration
+        raw.level > 0.02 && raw.clearance < -0.02 && raw.slip > 0.5,
+        "{raw:?}"
     );
-    assert!(g.largest_change < 15f64.to_radians());
+    assert!(
+        g.level < 0.005 && g.clearance > -0.003 && g.slip < 0.15,
+        "{g:?}"
+    );
+    for (axis, (a, bound)) in g.acceleration.iter().zip(how.max_acceleration).enumerate() {
+        assert!(
+            a[0] > -bound - 0.1 && a[1] < bound + 0.1,
+            "axis {axis}: {a:?} against ± {bound}"
+        );
+    }
+    // the walking speed drifts, but not by half
+    assert!(g.speed > 0.75 * raw.speed, "{} {}", g.speed, raw.speed);
+    assert!(g.largest_change < 25f64.to_radians());
     // the corrected series are what the pass measured: the reference at an instant of
     // double support has its feet level
     let [right, left] = lowest_points(&model, &g.reference, 0.05 * 1.1);
     assert!((right - left).abs() < 0.005, "{right} {left}");
+}
+
+/// Mode 1 as the gait program runs it: the grounded normal cycle tracked, the pelvis held by
+/// residual torques, two cycles; the last one's forces.
+#[test]
+fn the_prescribed_cycle_gives_a_normal_double_hump_braking_then_propulsion() {
+    let mut model = Human::default();
+    let mut params = model.params().clone();
+    params.d_foot = GAIT_DISSIPATION;
+    model.set_params(params).unwrap();
+    let info = model.info();
+    let period = 1.1;
+    let fitted = GaitReference::fit(&GaitTable::normal(), info, period, FIT_HARMONICS).unwrap();
+    let reference = fitted
+        .grounded(&model, &Grounding::default())
+        .unwrap()
+        .reference;
+    let (q0, qd0) = cycle_start(&model, &reference);
+    let mut tracking = Tracking::new(reference, info, GAIT_KP, GAIT_KP / 100.0).unwrap();
+    tracking.pelvis_kp = 3e4;
+    tracking.pelvis_kd = 3e3;
+    let options = Options {
+        q0: Some(q0),
+        qd0: Some(qd0),
+        output: Output::Every { dt: 0.005 },
+        ..Options::adaptive(2.0 * period, 1e-5)
+    };
+    let (tr, stats) = mbs::simulate(
+        mbs::WithEfforts::new(model.clone(), tracking.clone()),
+        Scheme::Radau5,
+        options,
+    )
+    .unwrap();
+    let weight = total_mass(&model) * G;
+    let c = CycleForces::of(&model, &tracking, &tr, period, weight);
+    let (right, left) = (c.figures(0), c.figures(1));
+    println!(
+        "{} steps; right {right:.2?}; left {left:.2?}; impulse ratio {:.4}, airborne {:.3}, residual rms {:.0} N·m",
+        stats.steps, c.impulse_ratio, c.airborne, c.residual_rms
+    );
+    let within = |x: Option<f64>, lo: f64, hi: f64| x.is_some_and(|v| v >= lo && v <= hi);
+    // the right foot: the double hump in the normal ranges, braking then propulsion
+    assert!(within(right.first_peak, 1.0, 1.3), "{right:?}");
+    assert!(within(right.trough, 0.6, 0.9), "{right:?}");
+    assert!(within(right.second_peak, 1.0, 1.3), "{right:?}");
+    assert!(within(right.first_half, -1.0, -0.01), "{right:?}");
+    assert!(within(right.second_half, 0.01, 1.0), "{right:?}");
+    // the left foot: its trough and second peak normal, braking then propulsion; its first
+    // peak is the weight passing onto it at once when the right foot lifts off (1.5 body
+    // weights: not a normal cycle's)
+    assert!(within(left.trough, 0.6, 0.9), "{left:?}");
+    assert!(within(left.second_peak, 1.0, 1.3), "{left:?}");
+    assert!(within(left.first_half, -1.0, -0.01), "{left:?}");
+    assert!(within(left.second_half, 0.01, 1.0), "{left:?}");
+    // the vertical impulse is the weight's over the cycle, and a foot is always down
+    assert!((c.impulse_ratio - 1.0).abs() < 0.05, "{}", c.impulse_ratio);
+    assert!(c.airborne < 0.01, "{}", c.airborne);
 }
 
 #[test]

@@ -398,9 +398,15 @@ impl GaitReference {
     /// - in single support the swinging foot's lowest point is above the standing one's by
     ///   `clearance` × sin(π u), u the fraction of the swing (no clearance asked at lift-off
     ///   and touch-down, so the foot leaves and meets the ground without a jump);
-    /// - the centre of mass' height above the lower foot, which the ground's force must
-    ///   produce, accelerates within ± `max_acceleration` g (the vertical force within
-    ///   1 ± that in body weights, no flight);
+    /// - in double support the two feet's lowest points move together: their material
+    ///   points' horizontal velocities are equal (neither foot slides on the ground);
+    /// - the centre of mass accelerates within ± `max_acceleration` g along each world axis,
+    ///   so the ground's force stays within those bounds of weight (vertically: no flight).
+    ///   Vertically it is the centre's height above the lower foot; horizontally its
+    ///   velocity relative to the standing foot's contact (the mean of the two in double
+    ///   support), the momentum's rows of the mass matrix over the mass;
+    /// - the walking speed (the standing contact's mean backward speed) stays near the
+    ///   uncorrected reference's (a residual per 0.1 m/s, as light as the others);
     /// - the corrections stay small (a penalty, the hips' adduction and rotation twice as
     ///   costly).
     ///
@@ -434,7 +440,7 @@ impl GaitReference {
                 reference_state(model, self, t)
             })
             .collect();
-        let pass = Pass {
+        let mut pass = Pass {
             model,
             states,
             period: self.period,
@@ -442,10 +448,12 @@ impl GaitReference {
             how,
             feet: Feet::of(info),
             weight: total_mass(model) * G,
+            speed: 0.0,
         };
         let nx = 5 * (2 * how.harmonics + 1);
         let mut kin = Kinematics::new::<Human>();
         let mut x = vec![0.0; nx];
+        pass.speed = pass.speed(&pass.samples(&x, &mut kin));
         let cost = |r: &[f64]| r.iter().map(|v| v * v).sum::<f64>();
         let mut r = pass.residuals(&x, &mut kin);
         let mut mu = 1e-3;
@@ -511,13 +519,14 @@ impl GaitReference {
             }
         }
         let samples = pass.samples(&x, &mut kin);
-        let (level, clearance, acceleration) = pass.measure(&samples);
+        let (level, clearance, acceleration, slip) = pass.measure(&samples);
+        let speed = pass.speed(&samples);
         let largest_change = (0..how.samples)
             .flat_map(|s| {
                 let phase = s as f64 / how.samples as f64;
                 (0..5).flat_map(move |j| [0, 1].map(move |leg| (phase, j, leg)))
             })
-            .map(|(phase, j, leg)| pass.correction(&x, j, phase, leg).abs())
+            .map(|(phase, j, leg)| pass.correction(&x, j, phase, leg).0.abs())
             .fold(0.0, f64::max);
 
         Ok(Grounded {
@@ -525,6 +534,8 @@ impl GaitReference {
             level,
             clearance,
             acceleration,
+            slip,
+            speed,
             largest_change,
             iterations,
         })
@@ -542,6 +553,20 @@ impl GaitReference {
     }
 }
 
+/// Mode 1's settings, shared by the gait program and its test, chosen on the normal cycle
+/// of 1.1 s (the figures stay in the normal ranges for a tracking stiffness of 1e4–1e5
+/// N·m/rad and a dissipation of 5–20 s/m; not at 1 s/m, nor for a 1.2 s cycle, whose
+/// fore–aft force turns propulsive first):
+/// - the published cycle fitted with 5 harmonics: 8 follow the table's samples closer, but
+///   their 7 Hz content alone accelerates the centre of mass by about 1 g;
+pub const FIT_HARMONICS: usize = 5;
+/// - the joints tracked with 3·10⁴ N·m/rad (and a hundredth of it in N·m·s/rad): at
+///   3·10³ the legs lag the reference by centimetres at the foot, which lands hard;
+pub const GAIT_KP: f64 = 3e4;
+/// - the feet's Hunt–Crossley dissipation 10 s/m (the model's 1 s/m, a hard sole, lets the
+///   heel strike peak at 1.5 body weights: the tracked legs have no muscles' give).
+pub const GAIT_DISSIPATION: f64 = 10.0;
+
 /// What [`GaitReference::grounded`] asks of a cycle.
 #[derive(Clone, Debug)]
 pub struct Grounding {
@@ -550,8 +575,9 @@ pub struct Grounding {
     pub double: [[f64; 2]; 2],
     /// the swinging foot's clearance at mid-swing (m)
     pub clearance: f64,
-    /// the bound on the centre of mass' vertical acceleration (in g)
-    pub max_acceleration: f64,
+    /// the bounds on the centre of mass' acceleration along the world's axes: fore–aft,
+    /// vertical, lateral (in g)
+    pub max_acceleration: [f64; 3],
     /// harmonics of the corrections
     pub harmonics: usize,
     /// instants of the cycle
@@ -565,14 +591,15 @@ pub struct Grounding {
 
 impl Default for Grounding {
     /// The normal cycle's events (right heel strike at 0, left toe-off at 13 %, left heel
-    /// strike at 50 %, right toe-off at 63 %), 2 cm of clearance, ± 0.3 g, five harmonics,
+    /// strike at 50 %, right toe-off at 63 %), 2 cm of clearance, ± 0.25 g fore–aft and
+    /// vertically and ± 0.1 g laterally (a normal cycle's force ranges), five harmonics,
     /// 100 instants, 60 iterations, a penalty of 3 (the problem is not convex: 1 and 10 end
     /// in worse minima on the normal cycle).
     fn default() -> Self {
         Grounding {
             double: [[0.0, 0.13], [0.5, 0.63]],
             clearance: 0.02,
-            max_acceleration: 0.3,
+            max_acceleration: [0.25, 0.25, 0.1],
             harmonics: 5,
             samples: 100,
             iterations: 60,
@@ -589,8 +616,13 @@ pub struct Grounded {
     pub level: f64,
     /// the least margin of the swinging foot over the clearance asked (m; negative: short)
     pub clearance: f64,
-    /// the least and largest vertical acceleration of the centre of mass (g)
-    pub acceleration: [f64; 2],
+    /// the least and largest acceleration of the centre of mass along each world axis (g)
+    pub acceleration: [[f64; 2]; 3],
+    /// the largest difference of the feet's horizontal velocities in double support (m/s)
+    pub slip: f64,
+    /// the walking speed: the mean backward speed of the standing contact relative to the
+    /// pelvis' translation (m/s); the pass keeps the uncorrected reference's
+    pub speed: f64,
     /// the largest correction of an angle (rad)
     pub largest_change: f64,
     pub iterations: usize,
@@ -619,49 +651,69 @@ struct Pass<'a> {
     how: &'a Grounding,
     feet: Feet,
     weight: f64,
+    /// the uncorrected reference's walking speed (m/s), which the corrections keep
+    speed: f64,
 }
 
 impl Pass<'_> {
-    /// Correction of joint `j` of leg `leg` at cycle fraction `phase`.
-    fn correction(&self, x: &[f64], j: usize, phase: f64, leg: usize) -> f64 {
+    /// Correction of joint `j` of leg `leg` at cycle fraction `phase`: angle and rate.
+    fn correction(&self, x: &[f64], j: usize, phase: f64, leg: usize) -> (f64, f64) {
         let h = self.how.harmonics;
         let c = &x[j * (2 * h + 1)..(j + 1) * (2 * h + 1)];
         let phase = if leg == 0 { phase } else { phase - 0.5 };
-        let mut v = c[0];
+        let (mut v, mut rate) = (c[0], 0.0);
         for m in 1..=h {
-            let (s, co) = (std::f64::consts::TAU * m as f64 * phase).sin_cos();
+            let w = std::f64::consts::TAU * m as f64;
+            let (s, co) = (w * phase).sin_cos();
             v += c[m] * co + c[h + m] * s;
+            rate += w / self.period * (c[h + m] * co - c[m] * s);
         }
-        v
+        (v, rate)
     }
 
-    /// At each instant: the lowest point of each foot and the centre of mass' height above
-    /// the lower one.
-    fn samples(&self, x: &[f64], kin: &mut Kinematics) -> Vec<[f64; 3]> {
+    /// The corrected reference at each instant of the cycle.
+    fn samples(&self, x: &[f64], kin: &mut Kinematics) -> Vec<Sample> {
         let n = self.how.samples;
-        let mut q = vec![0.0; Human::NQ];
+        let nq = Human::NQ;
+        let (mut q, mut qd, mut m) = (vec![0.0; nq], vec![0.0; nq], vec![0.0; nq * nq]);
         (0..n)
             .map(|s| {
                 let phase = s as f64 / n as f64;
-                let (q0, qd) = &self.states[s];
+                let (q0, qd0) = &self.states[s];
                 q.copy_from_slice(q0);
+                qd.copy_from_slice(qd0);
                 for (leg, row) in self.joints.iter().enumerate() {
                     for (j, (_, i)) in row.iter().enumerate() {
-                        q[*i] += self.correction(x, j, phase, leg);
+                        let (v, rate) = self.correction(x, j, phase, leg);
+                        q[*i] += v;
+                        qd[*i] += rate;
                     }
                 }
-                self.model.kinematics(0.0, &q, qd, kin);
+                self.model.kinematics(0.0, &q, &qd, kin);
                 let sp = self.feet.support_points(kin);
-                let low = [0, 1].map(|k| {
+                let lowest = |k: usize| {
                     sp[k]
                         .iter()
-                        .map(|(p, _)| p[1])
-                        .fold(f64::INFINITY, f64::min)
+                        .min_by(|a, b| a.0[1].total_cmp(&b.0[1]))
+                        .map_or(([0.0; 3], [0.0; 3]), |p| *p)
+                };
+                let (low, contact) = ([lowest(0), lowest(1)].map(|p| p.0[1]), {
+                    let c = [lowest(0).1, lowest(1).1];
+                    c.map(|v| [v[0], v[2]])
                 });
-                // the centre of mass from the potential, lifted clear of the ground
+                // the centre of mass' height from the potential, lifted clear of the ground;
+                // its velocity from the momentum (the pelvis' translation at rest)
                 q[1] += 2.0;
-                let com = self.model.energy(0.0, &q, qd).potential / self.weight - 2.0;
-                [low[0], low[1], com - low[0].min(low[1])]
+                let com = self.model.energy(0.0, &q, &qd).potential / self.weight - 2.0;
+                self.model.mass_matrix(0.0, &q, &mut m);
+                let mass = self.weight / G;
+                let momentum = |r: usize| (0..nq).map(|j| m[r * nq + j] * qd[j]).sum::<f64>();
+                Sample {
+                    low,
+                    height: com - low[0].min(low[1]),
+                    contact,
+                    com_velocity: [momentum(0) / mass, momentum(2) / mass],
+                }
             })
             .collect()
     }
@@ -683,7 +735,7 @@ impl Pass<'_> {
     }
 
     /// (gap asked, gap) of the swinging foot at an instant in single support.
-    fn gap(&self, right: bool, u: f64, low: &[f64; 3]) -> (f64, f64) {
+    fn gap(&self, right: bool, u: f64, low: &[f64; 2]) -> (f64, f64) {
         let asked = self.how.clearance * (std::f64::consts::PI * u).sin();
         (
             asked,
@@ -695,14 +747,45 @@ impl Pass<'_> {
         )
     }
 
-    /// The centre of mass' vertical acceleration at each instant (g).
-    fn accelerations(&self, samples: &[[f64; 3]]) -> Vec<f64> {
+    /// The standing contact's horizontal velocity (x, z) at instant `s` of `samples` (the
+    /// mean of the two feet's in double support).
+    fn standing(&self, samples: &[Sample], s: usize) -> [f64; 2] {
+        let c = &samples[s].contact;
+        match self.phase(s as f64 / samples.len() as f64) {
+            None => [0, 1].map(|k| 0.5 * (c[0][k] + c[1][k])),
+            Some((true, _)) => c[0],
+            Some((false, _)) => c[1],
+        }
+    }
+
+    /// The walking speed: the mean backward speed of the standing contact.
+    fn speed(&self, samples: &[Sample]) -> f64 {
+        -(0..samples.len())
+            .map(|s| self.standing(samples, s)[0])
+            .sum::<f64>()
+            / samples.len() as f64
+    }
+
+    /// The centre of mass' acceleration along the world's axes at each instant (g): the
+    /// vertical from its height, the horizontal from its velocity relative to the ground
+    /// (its velocity relative to the pelvis' translation less the standing contact's).
+    fn accelerations(&self, samples: &[Sample]) -> Vec<[f64; 3]> {
         let n = samples.len();
         let dt = self.period / n as f64;
+        let ground = |s: usize| {
+            let stand = self.standing(samples, s);
+            [0, 1].map(|k| samples[s].com_velocity[k] - stand[k])
+        };
         (0..n)
             .map(|s| {
                 let (p, q) = ((s + n - 1) % n, (s + 1) % n);
-                (samples[q][2] - 2.0 * samples[s][2] + samples[p][2]) / (dt * dt) / G
+                let (vp, vq) = (ground(p), ground(q));
+                let h = |s: usize| samples[s].height;
+                [
+                    (vq[0] - vp[0]) / (2.0 * dt) / G,
+                    (h(q) - 2.0 * h(s) + h(p)) / (dt * dt) / G,
+                    (vq[1] - vp[1]) / (2.0 * dt) / G,
+                ]
             })
             .collect()
     }
@@ -711,18 +794,28 @@ impl Pass<'_> {
         let samples = self.samples(x, kin);
         let acc = self.accelerations(&samples);
         let n = samples.len();
-        let mut r = Vec::with_capacity(2 * n + x.len());
-        for (s, low) in samples.iter().enumerate() {
-            // centimetres, and tenths of g beyond the bound
+        let mut r = Vec::with_capacity(6 * n + 1 + x.len());
+        for (s, sample) in samples.iter().enumerate() {
+            // centimetres, tenths of a metre per second, and tenths of g beyond the bounds
+            let low = &sample.low;
             match self.phase(s as f64 / n as f64) {
-                None => r.push(100.0 * (low[0] - low[1])),
+                None => {
+                    r.push(100.0 * (low[0] - low[1]));
+                    let c = &sample.contact;
+                    r.extend([0, 1].map(|k| 10.0 * (c[0][k] - c[1][k])));
+                }
                 Some((right, u)) => {
                     let (asked, gap) = self.gap(right, u, low);
                     r.push(100.0 * (asked - gap).max(0.0));
+                    r.extend([0.0, 0.0]);
                 }
             }
-            r.push(10.0 * (acc[s].abs() - self.how.max_acceleration).max(0.0));
+            for (a, bound) in acc[s].iter().zip(self.how.max_acceleration) {
+                r.push(10.0 * (a.abs() - bound).max(0.0));
+            }
         }
+        // the walking speed kept (tenths of a metre per second)
+        r.push(10.0 * (self.speed(&samples) - self.speed));
         let per = 2 * self.how.harmonics + 1;
         for (c, v) in x.iter().enumerate() {
             let j = c / per;
@@ -732,13 +825,19 @@ impl Pass<'_> {
         r
     }
 
-    /// (largest level difference, least clearance margin, [least, largest] acceleration).
-    fn measure(&self, samples: &[[f64; 3]]) -> (f64, f64, [f64; 2]) {
+    /// (largest level difference, least clearance margin, [least, largest] acceleration per
+    /// axis, largest slip in double support).
+    fn measure(&self, samples: &[Sample]) -> (f64, f64, [[f64; 2]; 3], f64) {
         let n = samples.len();
-        let (mut level, mut margin) = (0.0f64, f64::INFINITY);
-        for (s, low) in samples.iter().enumerate() {
+        let (mut level, mut margin, mut slip) = (0.0f64, f64::INFINITY, 0.0f64);
+        for (s, sample) in samples.iter().enumerate() {
+            let low = &sample.low;
             match self.phase(s as f64 / n as f64) {
-                None => level = level.max((low[0] - low[1]).abs()),
+                None => {
+                    level = level.max((low[0] - low[1]).abs());
+                    let c = &sample.contact;
+                    slip = slip.max((c[0][0] - c[1][0]).hypot(c[0][1] - c[1][1]));
+                }
                 Some((right, u)) => {
                     let (asked, gap) = self.gap(right, u, low);
                     margin = margin.min(gap - asked);
@@ -746,10 +845,27 @@ impl Pass<'_> {
             }
         }
         let acc = self.accelerations(samples);
-        let lo = acc.iter().copied().fold(f64::INFINITY, f64::min);
-        let hi = acc.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        (level, margin, [lo, hi])
+        let range = |k: usize| {
+            acc.iter()
+                .fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], a| {
+                    [lo.min(a[k]), hi.max(a[k])]
+                })
+        };
+        (level, margin, [range(0), range(1), range(2)], slip)
     }
+}
+
+/// The corrected reference at one instant, as [`Pass`] reads it.
+struct Sample {
+    /// the lowest point's height of each foot (m)
+    low: [f64; 2],
+    /// the centre of mass' height above the lower foot (m)
+    height: f64,
+    /// the horizontal velocity (x, z) of each foot's lowest material point, relative to the
+    /// pelvis' translation (m/s)
+    contact: [[f64; 2]; 2],
+    /// the centre of mass' horizontal velocity (x, z) relative to the pelvis' translation
+    com_velocity: [f64; 2],
 }
 
 fn rot(axis: usize, a: f64) -> [[f64; 3]; 3] {
@@ -1051,6 +1167,139 @@ pub fn ground_forces(
         }
     }
     out
+}
+
+/// What a gait laboratory reads from the last cycle of a mode-1 run: the ground reaction
+/// forces of both feet over the cycle, the vertical impulse, the flight time and the
+/// residual torque on the pelvis.
+#[derive(Clone, Debug)]
+pub struct CycleForces {
+    /// per output instant of the cycle: cycle % (0 at the right heel strike), the right and
+    /// the left foot's force (world axes, body weights)
+    pub grf: Vec<(f64, [f64; 3], [f64; 3])>,
+    /// the vertical impulse over weight × time (1 when the body neither rises nor sinks)
+    pub impulse_ratio: f64,
+    /// the fraction of the cycle with no foot on the ground (less than 1 % of weight)
+    pub airborne: f64,
+    /// the residual torque on the pelvis: rms and peak (N·m)
+    pub residual_rms: f64,
+    pub residual_peak: f64,
+    /// the fraction of the cycle the trajectory covers (1 unless the run stopped)
+    pub covered: f64,
+}
+
+/// One foot's figures over its own cycle (0 % at its heel strike), in body weights: the
+/// vertical force's first peak (0–30 %), trough (20–45 %) and second peak (35–62 %); the
+/// fore–aft force's least over 0–30 % (braking) and largest over 35–62 % (propulsion), and
+/// its means over the stance's halves (0–31 %, 31–62 %: braking then propulsion when the
+/// first is negative and the second positive). `None` where the run did not reach.
+#[derive(Clone, Copy, Debug)]
+pub struct FootFigures {
+    pub first_peak: Option<f64>,
+    pub trough: Option<f64>,
+    pub second_peak: Option<f64>,
+    pub braking: Option<f64>,
+    pub propulsion: Option<f64>,
+    pub first_half: Option<f64>,
+    pub second_half: Option<f64>,
+}
+
+impl CycleForces {
+    /// The figures of the last whole cycle of `tr` (the cycles before are the start's
+    /// transient), `tr` a run of [`Tracking`] on `model` (its first `Human::NQ` coordinates),
+    /// `weight` the body's weight (N).
+    pub fn of(
+        model: &Human,
+        tracking: &Tracking,
+        tr: &mbs::Trajectory,
+        period: f64,
+        weight: f64,
+    ) -> CycleForces {
+        let n = Human::NQ;
+        let mut kin = Kinematics::new::<Human>();
+        let end = tr.t.last().copied().unwrap_or(0.0);
+        let start = ((end / period).round() - 1.0).max(0.0) * period;
+        let (mut grf, mut impulse, mut airborne, mut r2, mut rmax) =
+            (Vec::new(), 0.0, 0.0, 0.0, 0.0f64);
+        let mut last: Option<(f64, f64)> = None;
+        for i in (0..tr.len()).filter(|i| tr.t[*i] >= start - 1e-9) {
+            let (q, qd) = (&tr.q(i)[..n], &tr.qd(i)[..n]);
+            let f = ground_forces(model, tr.t[i], q, qd, &mut kin);
+            let torque = tracking.pelvis_torque(tr.t[i], &kin);
+            let r = torque.iter().map(|x| x * x).sum::<f64>().sqrt();
+            let bw = |v: [f64; 3]| v.map(|x| x / weight);
+            grf.push((100.0 * (tr.t[i] - start) / period, bw(f[0]), bw(f[1])));
+            let vertical = f[0][1] + f[1][1];
+            if let Some((t0, v0)) = last {
+                let dt = tr.t[i] - t0;
+                impulse += 0.5 * (vertical + v0) * dt;
+                if vertical < 0.01 * weight {
+                    airborne += dt;
+                }
+                r2 += r * r * dt;
+            }
+            last = Some((tr.t[i], vertical));
+            rmax = rmax.max(r);
+        }
+        let t = (end - start).max(1e-12);
+        CycleForces {
+            grf,
+            impulse_ratio: impulse / (weight * t),
+            airborne: airborne / t,
+            residual_rms: (r2 / t).sqrt(),
+            residual_peak: rmax,
+            covered: (t / period).min(1.0),
+        }
+    }
+
+    /// Foot `k`'s force over its own cycle: (its cycle %, force), in time order of the run.
+    fn foot(&self, k: usize) -> impl Iterator<Item = (f64, [f64; 3])> + '_ {
+        self.grf.iter().map(move |(p, r, l)| {
+            if k == 0 {
+                (*p, *r)
+            } else {
+                ((p + 50.0).rem_euclid(100.0), *l)
+            }
+        })
+    }
+
+    /// The figures of foot `k` (0 right, 1 left).
+    pub fn figures(&self, k: usize) -> FootFigures {
+        let extreme = |lo: f64, hi: f64, c: usize, max: bool| {
+            let v = self
+                .foot(k)
+                .filter(|(p, _)| *p >= lo && *p <= hi)
+                .map(|(_, f)| f[c]);
+            if max {
+                v.reduce(f64::max)
+            } else {
+                v.reduce(f64::min)
+            }
+        };
+        // the trapezoidal mean over [lo, hi] of the fore–aft force, on pairs of successive
+        // outputs inside the window
+        let mean = |lo: f64, hi: f64| {
+            let points: Vec<(f64, f64)> = self.foot(k).map(|(p, f)| (p, f[0])).collect();
+            let (mut sum, mut span) = (0.0, 0.0);
+            for w in points.windows(2) {
+                let ((p0, f0), (p1, f1)) = (w[0], w[1]);
+                if p0 >= lo && p1 <= hi && p1 > p0 {
+                    sum += 0.5 * (f0 + f1) * (p1 - p0);
+                    span += p1 - p0;
+                }
+            }
+            (span > 0.0).then(|| sum / span)
+        };
+        FootFigures {
+            first_peak: extreme(0.0, 30.0, 1, true),
+            trough: extreme(20.0, 45.0, 1, false),
+            second_peak: extreme(35.0, 62.0, 1, true),
+            braking: extreme(0.0, 30.0, 0, false),
+            propulsion: extreme(35.0, 62.0, 0, true),
+            first_half: mean(0.0, 31.0),
+            second_half: mean(31.0, 62.0),
+        }
+    }
 }
 
 /// ZYX angles (a, b, c) of a rotation R = Rz(a) Ry(b) Rx(c), the pelvis' `Tfree` angles.

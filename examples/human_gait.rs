@@ -2,17 +2,26 @@
 //! figures the gait literature reads and the plots and animation to look at them.
 //!
 //! **Mode 1, prescribed gait** (`--period`, default 1.1 s): OpenSim's normal cycle fitted with
-//! Fourier series, made consistent with flat ground (`GaitReference::grounded`: periodic
-//! corrections of the leg angles so that the feet are level in double support, the swinging
-//! foot clears the standing one by up to `--clearance`, and the centre of mass accelerates
-//! within ± 0.3 g), tracked by stiff joint spring–dampers (`--kp`), the pelvis' translation
-//! free on the contacts and its orientation held by residual torques (`--pelvis`, as
-//! OpenSim's residual reduction does; 0 leaves it free), the feet's Hunt–Crossley
-//! stiffness and dissipation `--stiffness`, `--dissipation` (default the model's). The run lasts `--cycles` cycles (default 2) and the last one
-//! is reported: the vertical and fore–aft ground reaction forces of the right foot in body
-//! weights (first peak, trough, second peak, braking, propulsion), the vertical impulse
-//! against weight × time, the fraction of the cycle with no foot on the ground, the residual
-//! torque, the joint moments (the tracking torques) and the time the run takes.
+//! 5 harmonics and made left–right symmetric (`GaitReference::symmetric`), then consistent
+//! with flat ground (`GaitReference::grounded`: periodic corrections of the leg angles so
+//! that the feet are level and move together in double support, the swinging foot clears
+//! the standing one by up to `--clearance`, the centre of mass accelerates within the
+//! normal cycle's bounds and the ground's force points at it in single support), tracked by
+//! stiff joint spring–dampers (`--kp`, default 3·10⁴ N·m/rad), the pelvis' translation free
+//! on the contacts and its orientation held by residual torques (`--pelvis`, as OpenSim's
+//! residual reduction does; 0 leaves it free), the feet's Hunt–Crossley stiffness and
+//! dissipation `--stiffness`, `--dissipation` (default the model's stiffness and 10 s/m).
+//! The run lasts `--cycles` cycles (default 2) and the last one is reported: each foot's
+//! vertical and fore–aft ground reaction forces in body weights (first peak, trough, second
+//! peak, braking, propulsion, the fore–aft means over the stance's halves), the vertical
+//! impulse against weight × time, the fraction of the cycle with no foot on the ground, the
+//! residual torque, the joint moments (the tracking torques) and the time the run takes.
+//!
+//! **Mode 1 on muscles**: the same cycle with the 18 muscles taking the sagittal moments
+//! over (`muscle_cycle`: excitations from static optimisation with reserves at each instant
+//! of the tracked cycle, fitted over it), the tracking left on as reserve actuators: the
+//! reserves' torques against the tracking's alone, the forces, and the time per cycle
+//! (Radau5 at `--muscle-rtol`, default 1e-4).
 //!
 //! **Mode 2, muscles** : the body standing on its 18 muscles with constant excitations
 //! (`muscle_stance`), then pushed (pelvis pitch rate 1e-4 rad/s): the muscle forces over 1 s.
@@ -21,7 +30,7 @@
 //! `gait.csv` in `--out` (default `target/human_gait`).
 //!
 //! ```text
-//! cargo run --release --example human_gait [-- --period 1.1 --kp 3000 --pelvis 30000 --cycles 2]
+//! cargo run --release --example human_gait [-- --period 1.1 --kp 30000 --pelvis 30000 --cycles 2]
 //! ```
 
 use mbs::plot::{Chart, Series, line_chart};
@@ -51,6 +60,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let clearance = number("--clearance", 0.02)?;
     let dissipation = number("--dissipation", GAIT_DISSIPATION)?;
     let stiffness = number("--stiffness", Human::default().params().k_foot)?;
+    let muscle_rtol = number("--muscle-rtol", 1e-4)?;
     let out = PathBuf::from(value("--out").map_or("target/human_gait", |s| s.as_str()));
     std::fs::create_dir_all(&out)?;
 
@@ -65,6 +75,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // ---- mode 1: the prescribed cycle
     let table = GaitTable::normal();
     let fitted = GaitReference::fit(&table, info, period, FIT_HARMONICS)?;
+    let fitted = fitted.symmetric(info)?;
     let how = Grounding {
         clearance,
         ..Grounding::default()
@@ -112,12 +123,51 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ..Options::adaptive(cycles * period, 1e-5)
     };
     let wrapped = WithEfforts::new(model.clone(), tracking.clone());
-    let tr = run(wrapped.clone(), options, &format!("{cycles} cycles"));
+    let tr = run(
+        wrapped.clone(),
+        options,
+        &format!("{cycles} cycles"),
+        cycles,
+    );
     let forces = CycleForces::of(&model, &tracking, &tr, period, weight);
     print(&forces, weight / 9.80665);
     plots(&forces, weight / 9.80665, &out, &tr, &tracking, info)?;
     mbs::anim::write_html(&out.join("walk.html"), wrapped.info(), &tr)?;
     tr.write_csv(std::fs::File::create(out.join("gait.csv"))?)?;
+
+    // ---- mode 1 on muscles: the muscles take the sagittal moments over, the tracking
+    // stays as reserves
+    let cycle = muscle_cycle(&model, &tracking, &tr, &[0.0; NM], 8)?;
+    let (q0, qd0) = cycle_start(&model, &tracking.reference);
+    let mut kin = Kinematics::new::<Human>();
+    model.kinematics(0.0, &q0, &qd0, &mut kin);
+    let x0 = cycle.driven.initial_states(0.0, &kin, &qd0)?;
+    let (mut q0m, mut qd0m) = (q0.clone(), qd0.clone());
+    q0m.resize(q0.len() + x0.len(), 0.0);
+    qd0m.extend(x0);
+    let options = Options {
+        q0: Some(q0m),
+        qd0: Some(qd0m),
+        output: Output::Every { dt: 0.005 },
+        ..Options::adaptive(cycles * period, muscle_rtol)
+    };
+    let on_muscles = WithEfforts::new(model.clone(), cycle.driven.clone());
+    let shares = &cycle.shares;
+    println!(
+        "mode 1 on 18 muscles (excitations from static optimisation of the cycle's moments, the tracking as reserves): \
+         at rest, the muscles would supply {:.0} % of the moments on average over the cycle, {:.0} % at least",
+        100.0 * shares.iter().sum::<f64>() / shares.len().max(1) as f64,
+        100.0 * shares.iter().copied().fold(1.0, f64::min)
+    );
+    let tr_m = run(on_muscles, options, &format!("{cycles} cycles"), cycles);
+    let reserve = |tr: &Trajectory| tracking.rms_over_last_cycle(info, tr, &MUSCLE_JOINTS);
+    println!(
+        "  reserve torques at hip flexion, knee and ankle: rms {:.1} N·m, against {:.1} N·m with no muscles",
+        reserve(&tr_m)?,
+        reserve(&tr)?
+    );
+    let forces_m = CycleForces::of(&model, &tracking, &tr_m, period, weight);
+    print(&forces_m, weight / 9.80665);
 
     // ---- mode 2: standing on the muscles, then pushed
     let stance = muscle_stance(&model, 0.1, &[0.5; NM])?;
@@ -137,7 +187,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ..Options::adaptive(1.0, 1e-6)
     };
     let driven = WithEfforts::new(Human::default(), stance.driven.clone());
-    let tr = run(driven, options, "pushed, 1 s");
+    let tr = run(driven, options, "pushed, 1 s", 0.0);
     muscle_plot(&out, &stance, &tr)?;
     println!("plots, animation and CSV in {}", out.display());
     Ok(())
@@ -145,14 +195,23 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
 /// Runs `model` with Radau5 and says how long it took; a run that stops is reported and its
 /// trajectory so far kept.
-fn run<M: Model + 'static>(model: M, options: Options, what: &str) -> Trajectory {
+fn run<M: Model + 'static>(model: M, options: Options, what: &str, cycles: f64) -> Trajectory {
     let clock = std::time::Instant::now();
+    let tolerance = match options.step {
+        mbs::StepControl::Adaptive { rtol, .. } => format!(" at rtol {rtol:.0e}"),
+        _ => String::new(),
+    };
     match mbs::simulate(model, Scheme::Radau5, options) {
         Ok((tr, stats)) => {
+            let time = clock.elapsed().as_secs_f64();
+            let per = if cycles > 0.0 {
+                format!(", {:.3} s per cycle", time / cycles)
+            } else {
+                String::new()
+            };
             println!(
-                "  {what}: {} Radau5 steps, {:.3} s on one thread",
+                "  {what}: {} Radau5 steps{tolerance}, {time:.3} s on one thread{per}",
                 stats.steps,
-                clock.elapsed().as_secs_f64()
             );
             tr
         }

@@ -184,7 +184,7 @@ fn a_fibre_at_rest_has_no_length_rate_and_its_tension_is_the_generalised_force()
     driven.muscles.excitation = (0..NM).map(|i| 0.05 + 0.05 * i as f64).collect();
     let mut kin = Kinematics::new::<Human>();
     model.kinematics(0.0, &q, &qd, &mut kin);
-    let x = driven.initial_states(&kin, &qd).unwrap();
+    let x = driven.initial_states(0.0, &kin, &qd).unwrap();
     for (i, (unit, path)) in driven.muscles.units.iter().enumerate() {
         let f = unit
             .fibre(path.length(&kin).0, x[17 + i], x[17 + NM + i])
@@ -249,7 +249,7 @@ fn a_fibre_beyond_its_range_is_a_typed_failure() {
     qd[knee] = -6.0;
     let mut kin = Kinematics::new::<Human>();
     model.kinematics(0.0, &q, &qd, &mut kin);
-    let x = driven.initial_states(&kin, &qd).unwrap();
+    let x = driven.initial_states(0.0, &kin, &qd).unwrap();
     // the vasti may lengthen by a tenth of their optimal length
     let vasti = driven.muscles.index("vasti[0]").unwrap();
     driven.muscles.units[vasti].0.fibre_range = [0.4, x[17 + NM + vasti] + 0.1];

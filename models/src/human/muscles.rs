@@ -18,7 +18,7 @@
 //! (`tests/human_muscles.rs`).
 
 use super::{
-    GaitReference, Guard, Human, PassiveJoints, TRACKED, Tracking, cycle_start, dof_index,
+    Fourier, GaitReference, Guard, Human, PassiveJoints, TRACKED, Tracking, cycle_start, dof_index,
 };
 use mbs::Model;
 use mbs::elements::Path;
@@ -104,12 +104,15 @@ pub const MUSCLES: [MuscleData; 9] = [
 pub const NM: usize = 18;
 
 /// The model's 18 muscles (right leg's nine, then the left's, in [`MUSCLES`]' order), each
-/// a unit and its path, and their excitations (constant over a run).
+/// a unit and its path, and their excitations: constant, or periodic functions of time.
 #[derive(Clone, Debug)]
 pub struct Muscles {
     pub units: Vec<(Musculotendon, Path)>,
-    /// excitation of each unit, in [0, 1]
+    /// excitation of each unit, in [0, 1], when `pattern` is empty
     pub excitation: Vec<f64>,
+    /// each unit's excitation over time (clamped to [`MIN_ACTIVATION`], 1]); empty: the
+    /// constant `excitation`
+    pub pattern: Vec<Fourier>,
 }
 
 impl Muscles {
@@ -141,7 +144,16 @@ impl Muscles {
         Ok(Muscles {
             units,
             excitation: vec![0.0; NM],
+            pattern: Vec::new(),
         })
+    }
+
+    /// Unit `i`'s excitation at `t`.
+    pub fn excitation_at(&self, i: usize, t: f64) -> f64 {
+        match self.pattern.get(i) {
+            Some(f) => f.eval(t)[0].clamp(MIN_ACTIVATION, 1.0),
+            None => self.excitation[i],
+        }
     }
 
     /// The index of unit `name` (`"soleus[0]"`).
@@ -265,6 +277,80 @@ impl Muscles {
         }
         Err("static optimisation of the excitations did not converge in 50 iterations".into())
     }
+
+    /// Static optimisation with reserves: the activations in [`MIN_ACTIVATION`, 1] that
+    /// minimise Σ (a − `baseline`)² + Σ (r / `reserve`)², r the part of each moment the
+    /// muscles (at rest at `kin`) leave to a reserve actuator (N·m; `reserve` in N·m: a
+    /// reserve of that size costs as much as a unit activated fully beyond its baseline).
+    /// Always has a solution, unlike [`Muscles::excitations_for`]: where the muscles cannot
+    /// produce the moments, the reserves do. Projected Gauss–Newton, each unit's tension
+    /// linearised in its activation by differences. Returns (activations, reserves).
+    pub fn excitations_with_reserves(
+        &self,
+        kin: &Kinematics,
+        moments: &[(usize, f64)],
+        baseline: &[f64],
+        reserve: f64,
+    ) -> Result<(Vec<f64>, Vec<f64>), String> {
+        let floor = MIN_ACTIVATION;
+        let nq = kin.points.first().map_or(0, |p| p.jv.len() / 3);
+        // moment arms: arms[m][j]
+        let arms: Vec<Vec<f64>> = self
+            .units
+            .iter()
+            .map(|(_, p)| {
+                let mut g = vec![0.0; nq];
+                p.gradient(kin, &mut g);
+                moments.iter().map(|(i, _)| -g[*i]).collect()
+            })
+            .collect();
+        let err = |e: MuscleError| e.to_string();
+        let w = 1.0 / reserve;
+        let mut a: Vec<f64> = baseline.iter().map(|b| b.clamp(floor, 1.0)).collect();
+        let residual = |f: &[f64]| -> Vec<f64> {
+            moments
+                .iter()
+                .enumerate()
+                .map(|(j, (_, tau))| tau - (0..NM).map(|m| arms[m][j] * f[m]).sum::<f64>())
+                .collect()
+        };
+        for _ in 0..100 {
+            let f = self.forces_at_rest(kin, &a).map_err(err)?;
+            let delta = 1e-6;
+            let up: Vec<f64> = a.iter().map(|x| x + delta).collect();
+            let fu = self.forces_at_rest(kin, &up).map_err(err)?;
+            let r = residual(&f);
+            // J[j][m] = ∂(moment j)/∂a_m; normal equations of
+            // w² |r − J Δ|² + |a + Δ − b|²: (w² JᵀJ + I) Δ = w² Jᵀ r − (a − b)
+            let jac = |j: usize, m: usize| arms[m][j] * (fu[m] - f[m]) / delta;
+            let mut lhs = mbs::DMatrix::<f64>::identity(NM, NM);
+            let mut rhs = mbs::DMatrix::<f64>::zeros(NM, 1);
+            for m in 0..NM {
+                rhs[m] = -(a[m] - baseline[m]);
+                for (j, rj) in r.iter().enumerate() {
+                    rhs[m] += w * w * jac(j, m) * rj;
+                    for k in 0..NM {
+                        lhs[(m, k)] += w * w * jac(j, m) * jac(j, k);
+                    }
+                }
+            }
+            let step = lhs
+                .cholesky()
+                .ok_or("static optimisation with reserves: singular normal equations")?
+                .solve(&rhs);
+            let mut moved = 0.0f64;
+            for m in 0..NM {
+                let v = (a[m] + step[m]).clamp(floor, 1.0);
+                moved = moved.max((v - a[m]).abs());
+                a[m] = v;
+            }
+            if moved < 1e-10 {
+                break;
+            }
+        }
+        let f = self.forces_at_rest(kin, &a).map_err(err)?;
+        Ok((a, residual(&f)))
+    }
 }
 
 /// Names of the extra states of [`MuscleDriven`] after the passive joints' 17: the 18
@@ -327,7 +413,7 @@ const STATES: [&str; PASSIVE_N + 2 * NM] = {
 
 /// The model driven by its muscles: passive joint moments ([`PassiveJoints`], 17 states)
 /// and the 18 muscles with their activations and fibre lengths (36 states), excitations as
-/// inputs (constant: [`Muscles::excitation`]), optionally a [`super::Tracking`] of the
+/// inputs ([`Muscles::excitation_at`]), optionally a [`super::Tracking`] of the
 /// joints the muscles do not span (through the passive part's `tracking`). A fibre beyond
 /// its range stops the run with a typed failure naming the muscle, as the [`Guard`] does for
 /// the knee and the feet.
@@ -338,14 +424,15 @@ pub struct MuscleDriven {
 }
 
 impl MuscleDriven {
-    /// The extra states of a start at the kinematics `kin` with velocities `qd`: relaxed
-    /// passive moments, activations equal to the excitations and fibres at rest.
-    pub fn initial_states(&self, kin: &Kinematics, qd: &[f64]) -> Result<Vec<f64>, String> {
+    /// The extra states of a start at `t`, the kinematics `kin` and velocities `qd`:
+    /// relaxed passive moments, activations equal to the excitations and fibres at rest.
+    pub fn initial_states(&self, t: f64, kin: &Kinematics, qd: &[f64]) -> Result<Vec<f64>, String> {
         let mut x = self.passive.relaxed(qd);
-        x.extend_from_slice(&self.muscles.excitation);
+        let e: Vec<f64> = (0..NM).map(|i| self.muscles.excitation_at(i, t)).collect();
+        x.extend_from_slice(&e);
         let fibres = self
             .muscles
-            .equilibrium(kin, &self.muscles.excitation)
+            .equilibrium(kin, &e)
             .map_err(|e| e.to_string())?;
         x.extend(fibres);
         Ok(x)
@@ -384,7 +471,7 @@ impl Efforts for MuscleDriven {
             let a = e.x[PASSIVE_N + i];
             xd[PASSIVE_N + i] = self.muscles.units[i]
                 .0
-                .activation_rate(self.muscles.excitation[i], a);
+                .activation_rate(self.muscles.excitation_at(i, e.t), a);
             xd[PASSIVE_N + NM + i] = self.fibre(e, i)?.length_rate;
         }
         Ok(())
@@ -491,7 +578,7 @@ pub fn muscle_stance(model: &Human, ankle: f64, baseline: &[f64]) -> Result<Musc
     )
     .map_err(|e| format!("the body on its muscles: {e}"))?;
     model.kinematics(0.0, &equilibrium.q, &zero, &mut kin);
-    let x = driven.initial_states(&kin, &zero)?;
+    let x = driven.initial_states(0.0, &kin, &zero)?;
     let mut qs = equilibrium.q.clone();
     qs.resize(n + x.len(), 0.0);
     let mut qds = zero;
@@ -503,6 +590,113 @@ pub fn muscle_stance(model: &Human, ankle: f64, baseline: &[f64]) -> Result<Musc
         moments,
         equilibrium,
         held: q,
+    })
+}
+
+/// The moment (N·m) a reserve actuator supplies at the cost of a unit fully activated, in
+/// [`muscle_cycle`]'s static optimisation: small, so the muscles supply what they can.
+pub const RESERVE: f64 = 1.0;
+
+/// Mode 1 with muscles: the muscles take over the sagittal joint moments of a tracked
+/// cycle, the tracking staying on as reserve actuators (as OpenSim's computed muscle
+/// control keeps reserves).
+#[derive(Clone, Debug)]
+pub struct MuscleCycle {
+    /// the muscles with periodic excitations, the passive joints and the tracking
+    pub driven: MuscleDriven,
+    /// the activations static optimisation found at each instant of the cycle (one row
+    /// per instant, [`NM`] columns)
+    pub activations: Vec<Vec<f64>>,
+    /// the share of the moments asked that the muscles produce at each instant: 1 − |r| /
+    /// |τ|, r the reserves' part
+    pub shares: Vec<f64>,
+}
+
+/// The excitations that let the muscles produce the joint moments of the last cycle of
+/// `tr`, a run of `tracking` on `model` sampled uniformly (`Output::Every`): at each output
+/// instant the tracking torques at [`MUSCLE_JOINTS`] less the passive elastic moments,
+/// asked of the muscles by [`Muscles::excitations_with_reserves`] with `baseline` and
+/// reserves costing as much per [`RESERVE`] as a full activation (the fibres at rest: the
+/// speed of lengthening and the activation's lag are left to the reserves); each
+/// unit's activations over the cycle fitted with `harmonics` harmonics, its excitation.
+/// The tracking stays on every joint.
+pub fn muscle_cycle(
+    model: &Human,
+    tracking: &Tracking,
+    tr: &mbs::Trajectory,
+    baseline: &[f64],
+    harmonics: usize,
+) -> Result<MuscleCycle, String> {
+    let info = model.info();
+    let n = Human::NQ;
+    let period = tracking.reference.period;
+    let end = tr.t.last().copied().unwrap_or(0.0);
+    let start = ((end / period).round() - 1.0).max(0.0) * period;
+    let instants: Vec<usize> = (0..tr.len())
+        .filter(|i| tr.t[*i] >= start - 1e-9 && tr.t[*i] < start + period - 1e-9)
+        .collect();
+    let dt = period / instants.len().max(1) as f64;
+    let uniform = instants.len() > 2 * harmonics
+        && instants
+            .iter()
+            .enumerate()
+            .all(|(k, i)| (tr.t[*i] - start - k as f64 * dt).abs() < 1e-6);
+    if !uniform {
+        return Err(format!(
+            "the run must cover a whole cycle of {period} s sampled uniformly (Output::Every), \
+             more than {} outputs over it",
+            2 * harmonics
+        ));
+    }
+    let mut passive = PassiveJoints::new(info, 0.1, 0.01)?;
+    let mut muscles = Muscles::new(info)?;
+    let mut kin = Kinematics::new::<Human>();
+    let joints = MUSCLE_JOINTS
+        .iter()
+        .map(|name| {
+            let i = dof_index(info, name)?;
+            let law = passive
+                .joints
+                .iter()
+                .find(|(j, _)| *j == i)
+                .map(|(_, l)| *l)
+                .ok_or_else(|| format!("no passive law for `{name}`"))?;
+            Ok((i, law))
+        })
+        .collect::<Result<Vec<_>, String>>()?;
+    let mut activations = Vec::with_capacity(instants.len());
+    let mut shares = Vec::with_capacity(instants.len());
+    for &s in &instants {
+        let (t, q, qd) = (tr.t[s], &tr.q(s)[..n], &tr.qd(s)[..n]);
+        model.kinematics(t, q, qd, &mut kin);
+        let torques: Vec<(usize, f64)> = tracking.torques(t, q, qd).collect();
+        let moments: Vec<(usize, f64)> = joints
+            .iter()
+            .map(|(i, law)| {
+                let tau = torques.iter().find(|(j, _)| j == i).map_or(0.0, |p| p.1);
+                (*i, tau - law.elastic(q[*i]))
+            })
+            .collect();
+        let (a, reserves) = muscles.excitations_with_reserves(&kin, &moments, baseline, RESERVE)?;
+        let asked = moments.iter().map(|(_, v)| v * v).sum::<f64>().sqrt();
+        let left = reserves.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let share = if asked > 0.0 { 1.0 - left / asked } else { 1.0 };
+        activations.push(a);
+        shares.push(share);
+    }
+    muscles.pattern = (0..NM)
+        .map(|m| {
+            let column: Vec<f64> = activations.iter().map(|a| a[m]).collect();
+            // the samples begin at `start`, a whole number of periods: the series is in
+            // the run's time as it is
+            Fourier::fit(&column, harmonics, period)
+        })
+        .collect();
+    passive.tracking = Some(tracking.clone());
+    Ok(MuscleCycle {
+        driven: MuscleDriven { passive, muscles },
+        activations,
+        shares,
     })
 }
 

@@ -138,16 +138,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // ---- mode 1 on muscles: the muscles take the sagittal moments over, the tracking
     // stays as reserves
     let cycle = muscle_cycle(&model, &tracking, &tr, &[0.0; NM], 8)?;
-    let (q0, qd0) = cycle_start(&model, &tracking.reference);
-    let mut kin = Kinematics::new::<Human>();
-    model.kinematics(0.0, &q0, &qd0, &mut kin);
-    let x0 = cycle.driven.initial_states(0.0, &kin, &qd0)?;
-    let (mut q0m, mut qd0m) = (q0.clone(), qd0.clone());
-    q0m.resize(q0.len() + x0.len(), 0.0);
-    qd0m.extend(x0);
+    let (q0, qd0) = cycle.start(&model)?;
     let options = Options {
-        q0: Some(q0m),
-        qd0: Some(qd0m),
+        q0: Some(q0),
+        qd0: Some(qd0),
         output: Output::Every { dt: 0.005 },
         ..Options::adaptive(cycles * period, muscle_rtol)
     };

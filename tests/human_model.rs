@@ -556,16 +556,10 @@ fn the_prescribed_cycle_gives_a_normal_double_hump_braking_then_propulsion_also_
     // muscles' 36 states and the passive moments' 17 integrated with the body for two
     // cycles, which must end without a muscle leaving its fibre's range
     let cycle = muscle_cycle(&model, &tracking, &tr, &[0.0; NM], 8).unwrap();
-    let (q0, qd0) = cycle_start(&model, &tracking.reference);
-    let mut kin = mbs::Kinematics::new::<Human>();
-    model.kinematics(0.0, &q0, &qd0, &mut kin);
-    let x0 = cycle.driven.initial_states(0.0, &kin, &qd0).unwrap();
-    let (mut q0m, mut qd0m) = (q0.clone(), qd0);
-    q0m.resize(q0.len() + x0.len(), 0.0);
-    qd0m.extend(x0);
+    let (q0, qd0) = cycle.start(&model).unwrap();
     let options = Options {
-        q0: Some(q0m),
-        qd0: Some(qd0m),
+        q0: Some(q0),
+        qd0: Some(qd0),
         output: Output::Every { dt: 0.005 },
         ..Options::adaptive(2.0 * period, 1e-4)
     };

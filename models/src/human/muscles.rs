@@ -208,6 +208,20 @@ impl Muscles {
             .collect()
     }
 
+    /// Each unit's moment arms −∂l/∂q at `kin` about the coordinates of `moments`:
+    /// `arms[unit][k]`.
+    fn arms(&self, kin: &Kinematics, moments: &[(usize, f64)]) -> Vec<Vec<f64>> {
+        let nq = kin.points.first().map_or(0, |p| p.jv.len() / 3);
+        self.units
+            .iter()
+            .map(|(_, p)| {
+                let mut g = vec![0.0; nq];
+                p.gradient(kin, &mut g);
+                moments.iter().map(|(i, _)| -g[*i]).collect()
+            })
+            .collect()
+    }
+
     /// Constant excitations under which the muscles, at rest at the kinematics `kin`,
     /// produce the generalised forces `moments` ((coordinate, N·m)) on those coordinates:
     /// static optimisation, the least Σ (a − `baseline`)² with every activation in
@@ -222,16 +236,7 @@ impl Muscles {
         baseline: &[f64],
     ) -> Result<Vec<f64>, String> {
         let floor = MIN_ACTIVATION;
-        let nq = kin.points.first().map_or(0, |p| p.jv.len() / 3);
-        let arms: Vec<Vec<f64>> = self
-            .units
-            .iter()
-            .map(|(_, p)| {
-                let mut g = vec![0.0; nq];
-                p.gradient(kin, &mut g);
-                moments.iter().map(|(i, _)| -g[*i]).collect()
-            })
-            .collect();
+        let arms = self.arms(kin, moments);
         let nj = moments.len();
         let mut a: Vec<f64> = baseline.iter().map(|b| b.clamp(floor, 1.0)).collect();
         let mut held = [false; NM];
@@ -293,17 +298,7 @@ impl Muscles {
         reserve: f64,
     ) -> Result<(Vec<f64>, Vec<f64>), String> {
         let floor = MIN_ACTIVATION;
-        let nq = kin.points.first().map_or(0, |p| p.jv.len() / 3);
-        // moment arms: arms[m][j]
-        let arms: Vec<Vec<f64>> = self
-            .units
-            .iter()
-            .map(|(_, p)| {
-                let mut g = vec![0.0; nq];
-                p.gradient(kin, &mut g);
-                moments.iter().map(|(i, _)| -g[*i]).collect()
-            })
-            .collect();
+        let arms = self.arms(kin, moments);
         let err = |e: MuscleError| e.to_string();
         let w = 1.0 / reserve;
         let mut a: Vec<f64> = baseline.iter().map(|b| b.clamp(floor, 1.0)).collect();
@@ -610,6 +605,28 @@ pub struct MuscleCycle {
     /// the share of the moments asked that the muscles produce at each instant: 1 − |r| /
     /// |τ|, r the reserves' part
     pub shares: Vec<f64>,
+}
+
+impl MuscleCycle {
+    /// The start of a run on the muscles: the tracked cycle's start ([`cycle_start`]) with
+    /// the extra states of [`MuscleDriven::initial_states`] (the coordinates' part of them
+    /// zero, their values after the velocities).
+    pub fn start(&self, model: &Human) -> Result<(Vec<f64>, Vec<f64>), String> {
+        let reference = &self
+            .driven
+            .passive
+            .tracking
+            .as_ref()
+            .ok_or("the cycle's efforts have no tracking")?
+            .reference;
+        let (mut q, mut qd) = cycle_start(model, reference);
+        let mut kin = Kinematics::new::<Human>();
+        model.kinematics(0.0, &q, &qd, &mut kin);
+        let x = self.driven.initial_states(0.0, &kin, &qd)?;
+        q.resize(q.len() + x.len(), 0.0);
+        qd.extend(x);
+        Ok((q, qd))
+    }
 }
 
 /// The excitations that let the muscles produce the joint moments of the last cycle of

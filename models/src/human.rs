@@ -678,7 +678,8 @@ impl GaitReference {
 /// of 10 or 20 s/m and a cycle of 1.0 s; the first peak reaches 1.32 body weights at 5 s/m
 /// and 1.84 at the model's 1 s/m, the second 1.31 for a cycle of 1.2 s):
 /// - the published cycle fitted with 5 harmonics: 8 follow the table's samples closer, but
-///   left a 7 Hz ripple of about ± 0.4 g in the corrected cycle's fore–aft acceleration;
+///   with them an earlier version of the pass left a 7 Hz ripple of about ± 0.4 g in the
+///   corrected cycle's fore–aft acceleration;
 pub const FIT_HARMONICS: usize = 5;
 /// - the joints tracked with 3·10⁴ N·m/rad (and a hundredth of it in N·m·s/rad): at
 ///   3·10³ the legs lagged the reference enough for the feet to land at 2.8 body weights;

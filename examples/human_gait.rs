@@ -55,7 +55,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let period = number("--period", 1.1)?;
     let kp = number("--kp", GAIT_KP)?;
-    let pelvis_kp = number("--pelvis", 30000.0)?;
+    let pelvis_kp = number("--pelvis", GAIT_PELVIS_KP)?;
     let cycles = number("--cycles", 2.0)?.round().max(1.0);
     let clearance = number("--clearance", 0.02)?;
     let dissipation = number("--dissipation", GAIT_DISSIPATION)?;
@@ -70,7 +70,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     params.k_foot = stiffness;
     model.set_params(params)?;
     let info = model.info();
-    let weight = total_mass(&model) * 9.80665;
+    let mass = total_mass(&model);
+    let weight = mass * 9.80665;
 
     // ---- mode 1: the prescribed cycle
     let table = GaitTable::normal();
@@ -129,9 +130,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         &format!("{cycles} cycles"),
         cycles,
     );
-    let forces = CycleForces::of(&model, &tracking, &tr, period, weight);
-    print(&forces, weight / 9.80665);
-    plots(&forces, weight / 9.80665, &out, &tr, &tracking, info)?;
+    let forces = CycleForces::of(&model, &tracking, &tr, weight);
+    print(&forces, mass);
+    plots(&forces, mass, &out, &tr, &tracking, info)?;
     mbs::anim::write_html(&out.join("walk.html"), wrapped.info(), &tr)?;
     tr.write_csv(std::fs::File::create(out.join("gait.csv"))?)?;
 
@@ -160,8 +161,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         reserve(&tr_m)?,
         reserve(&tr)?
     );
-    let forces_m = CycleForces::of(&model, &tracking, &tr_m, period, weight);
-    print(&forces_m, weight / 9.80665);
+    let forces_m = CycleForces::of(&model, &tracking, &tr_m, weight);
+    print(&forces_m, mass);
 
     // ---- mode 2: standing on the muscles, then pushed
     let stance = muscle_stance(&model, 0.1, &[0.5; NM])?;
@@ -182,7 +183,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let driven = WithEfforts::new(Human::default(), stance.driven.clone());
     let tr = run(driven, options, "pushed, 1 s", 0.0);
-    muscle_plot(&out, &stance, &tr)?;
+    muscle_plot(&Human::default(), &out, &stance, &tr)?;
     println!("plots, animation and CSV in {}", out.display());
     Ok(())
 }
@@ -345,11 +346,11 @@ fn plots(
 }
 
 fn muscle_plot(
+    model: &Human,
     out: &std::path::Path,
     stance: &MuscleStance,
     tr: &Trajectory,
 ) -> Result<(), Box<dyn std::error::Error>> {
-    let model = Human::default();
     let n = Human::NQ;
     let muscles = &stance.driven.muscles;
     let mut kin = Kinematics::new::<Human>();

@@ -510,8 +510,8 @@ fn the_prescribed_cycle_gives_a_normal_double_hump_braking_then_propulsion_also_
         .reference;
     let (q0, qd0) = cycle_start(&model, &reference);
     let mut tracking = Tracking::new(reference, info, GAIT_KP, GAIT_KP / 100.0).unwrap();
-    tracking.pelvis_kp = 3e4;
-    tracking.pelvis_kd = 3e3;
+    tracking.pelvis_kp = GAIT_PELVIS_KP;
+    tracking.pelvis_kd = GAIT_PELVIS_KP / 10.0;
     let options = Options {
         q0: Some(q0),
         qd0: Some(qd0),
@@ -525,7 +525,7 @@ fn the_prescribed_cycle_gives_a_normal_double_hump_braking_then_propulsion_also_
     )
     .unwrap();
     let weight = total_mass(&model) * G;
-    let c = CycleForces::of(&model, &tracking, &tr, period, weight);
+    let c = CycleForces::of(&model, &tracking, &tr, weight);
     let (right, left) = (c.figures(0), c.figures(1));
     println!(
         "{} steps; right {right:.2?}; left {left:.2?}; impulse ratio {:.4}, airborne {:.3}, residual rms {:.0} N·m",
@@ -576,7 +576,7 @@ fn the_prescribed_cycle_gives_a_normal_double_hump_braking_then_propulsion_also_
         .rms_over_last_cycle(info, &tr, &MUSCLE_JOINTS)
         .unwrap();
     let share = cycle.shares.iter().sum::<f64>() / cycle.shares.len() as f64;
-    let m = CycleForces::of(&model, &tracking, &tr_m, period, weight);
+    let m = CycleForces::of(&model, &tracking, &tr_m, weight);
     let g = m.figures(0);
     println!(
         "on muscles: {} steps; reserves rms {reserves:.1} N·m against {alone:.1} N·m tracked alone; \

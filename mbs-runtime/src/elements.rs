@@ -314,21 +314,13 @@ impl Path {
         }
     }
 
-    /// Applies the tension `tension` (N) along the path.
+    /// Applies the tension `tension` (N) along the path: each segment pulls its two ends
+    /// toward each other.
     pub fn apply(&self, e: &mut Effort, tension: f64) {
-        let n = self.points.len();
-        for k in 0..n {
-            let p = e.point(self.points[k]).position;
-            let mut f = [0.0; 3];
-            if k > 0 {
-                let d = sub(e.point(self.points[k - 1]).position, p);
-                f = add(f, scale(tension / dot(d, d).sqrt(), d));
-            }
-            if k + 1 < n {
-                let d = sub(e.point(self.points[k + 1]).position, p);
-                f = add(f, scale(tension / dot(d, d).sqrt(), d));
-            }
-            e.force_at_point(self.points[k], f);
+        let kin = e.kin;
+        for (w, (u, _, _)) in self.points.windows(2).zip(self.segments(kin)) {
+            e.force_at_point(w[0], scale(tension, u));
+            e.force_at_point(w[1], scale(-tension, u));
         }
     }
 }

@@ -317,6 +317,17 @@ const TRACKED: [(&str, Option<&str>); 17] = [
     ("mtp[1]", None),
 ];
 
+/// The leg joints a gait cycle drives (each leg's coordinates are these with `[0]` or
+/// `[1]`): those [`GaitReference::symmetric`] mirrors and [`GaitReference::grounded`]
+/// corrects.
+const LEG_JOINTS: [&str; 5] = [
+    "hip_flexion",
+    "hip_adduction",
+    "hip_rotation",
+    "knee",
+    "ankle",
+];
+
 /// The joint angles of a gait cycle as smooth periodic functions of time: for each of the
 /// model's 17 joint coordinates, a Fourier series fitted to a [`GaitTable`] (degrees
 /// converted to radians), the pelvis' orientation likewise.
@@ -418,13 +429,7 @@ impl GaitReference {
                 .ok_or_else(|| format!("`{name}` is not in the reference"))
         };
         let mut out = self.clone();
-        for joint in [
-            "hip_flexion",
-            "hip_adduction",
-            "hip_rotation",
-            "knee",
-            "ankle",
-        ] {
+        for joint in LEG_JOINTS {
             let r = position(&format!("{joint}[0]"))?;
             let l = position(&format!("{joint}[1]"))?;
             let right = mean(&self.joints[r].1, &later(&self.joints[l].1));
@@ -501,16 +506,9 @@ impl GaitReference {
     /// normal cycle: 10–15 s on two cores).
     pub fn grounded(&self, model: &Human, how: &Grounding) -> Result<Grounded, String> {
         let info = model.info();
-        let names = [
-            "hip_flexion",
-            "hip_adduction",
-            "hip_rotation",
-            "knee",
-            "ankle",
-        ];
         let mut joints = [[(0usize, 0usize); 5]; 2];
         for (leg, row) in joints.iter_mut().enumerate() {
-            for (j, name) in names.iter().enumerate() {
+            for (j, name) in LEG_JOINTS.iter().enumerate() {
                 let i = dof_index(info, &format!("{name}[{leg}]"))?;
                 let k = self
                     .joints
@@ -553,10 +551,9 @@ impl GaitReference {
         while iterations < how.iterations {
             iterations += 1;
             let m = r.len();
-            let mut jac = mbs::DMatrix::<f64>::zeros(m, nx);
             // the columns by forward differences, shared among the cores
             let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
-            let columns: Vec<Vec<f64>> = std::thread::scope(|scope| {
+            let columns: Vec<Vec<Vec<f64>>> = std::thread::scope(|scope| {
                 let chunks: Vec<_> = (0..threads)
                     .map(|t| {
                         let (pass, x, r) = (&pass, &x, &r);
@@ -574,19 +571,13 @@ impl GaitReference {
                         })
                     })
                     .collect();
-                let parts: Vec<Vec<Vec<f64>>> = chunks
+                chunks
                     .into_iter()
                     .map(|h| h.join().expect("a column's thread"))
-                    .collect();
-                (0..nx)
-                    .map(|c| parts[c % threads][c / threads].clone())
                     .collect()
             });
-            for (c, column) in columns.iter().enumerate() {
-                for i in 0..m {
-                    jac[(i, c)] = column[i];
-                }
-            }
+            // column c is the (c / threads)-th of thread c % threads
+            let jac = mbs::DMatrix::from_fn(m, nx, |i, c| columns[c % threads][c / threads][i]);
             let jtj = jac.transpose() * &jac;
             let jtr = jac.transpose() * mbs::DMatrix::from_column_slice(m, 1, &r);
             let mut improved = false;
@@ -602,11 +593,10 @@ impl GaitReference {
                 let xn: Vec<f64> = (0..nx).map(|d| x[d] + step[d]).collect();
                 let rn = pass.residuals(&xn, &mut kin);
                 if cost(&rn) < cost(&r) {
-                    let gain = 1.0 - cost(&rn) / cost(&r);
                     x = xn;
                     r = rn;
                     mu = (mu * 0.3).max(1e-9);
-                    improved = gain > 0.0;
+                    improved = true;
                     break;
                 }
                 mu *= 10.0;
@@ -685,8 +675,11 @@ pub const FIT_HARMONICS: usize = 5;
 ///   3·10³ the legs lagged the reference enough for the feet to land at 2.8 body weights;
 pub const GAIT_KP: f64 = 3e4;
 /// - the feet's Hunt–Crossley dissipation 10 s/m (the model's 1 s/m, a hard sole, lets the
-///   heel strike peak at 1.8 body weights: the tracked legs have no muscles' give).
+///   heel strike peak at 1.8 body weights: the tracked legs have no muscles' give);
 pub const GAIT_DISSIPATION: f64 = 10.0;
+/// - the pelvis' orientation held by residual torques of 3·10⁴ N·m/rad (and a tenth of it
+///   in N·m·s/rad).
+pub const GAIT_PELVIS_KP: f64 = 3e4;
 
 /// What [`GaitReference::grounded`] asks of a cycle.
 #[derive(Clone, Debug)]
@@ -1118,9 +1111,7 @@ impl Tracking {
             .iter()
             .map(|name| dof_index(info, name))
             .collect::<Result<Vec<usize>, String>>()?;
-        let period = self.reference.period;
-        let end = tr.t.last().copied().unwrap_or(0.0);
-        let start = ((end / period).round() - 1.0).max(0.0) * period;
+        let start = last_cycle_start(tr, self.reference.period);
         let (mut sum, mut count) = (0.0, 0usize);
         for s in (0..tr.len()).filter(|s| tr.t[*s] >= start - 1e-9) {
             for (i, tau) in self.torques(tr.t[s], &tr.q(s)[..n], &tr.qd(s)[..n]) {
@@ -1347,6 +1338,13 @@ pub fn ground_forces(
     out
 }
 
+/// The start of the last whole cycle of `tr` (cycles of `period` from t = 0; the cycles
+/// before it are the start's transient).
+pub fn last_cycle_start(tr: &mbs::Trajectory, period: f64) -> f64 {
+    let end = tr.t.last().copied().unwrap_or(0.0);
+    ((end / period).round() - 1.0).max(0.0) * period
+}
+
 /// What a gait laboratory reads from the last cycle of a mode-1 run: the ground reaction
 /// forces of both feet over the cycle, the vertical impulse, the flight time and the
 /// residual torque on the pelvis.
@@ -1383,20 +1381,20 @@ pub struct FootFigures {
 }
 
 impl CycleForces {
-    /// The figures of the last whole cycle of `tr` (the cycles before are the start's
-    /// transient), `tr` a run of [`Tracking`] on `model` (its first `Human::NQ` coordinates),
-    /// `weight` the body's weight (N).
+    /// The figures of the last whole cycle of `tr` ([`last_cycle_start`]), `tr` a run of
+    /// [`Tracking`] on `model` (its first `Human::NQ` coordinates), `weight` the body's
+    /// weight (N).
     pub fn of(
         model: &Human,
         tracking: &Tracking,
         tr: &mbs::Trajectory,
-        period: f64,
         weight: f64,
     ) -> CycleForces {
         let n = Human::NQ;
         let mut kin = Kinematics::new::<Human>();
+        let period = tracking.reference.period;
         let end = tr.t.last().copied().unwrap_or(0.0);
-        let start = ((end / period).round() - 1.0).max(0.0) * period;
+        let start = last_cycle_start(tr, period);
         let (mut grf, mut impulse, mut airborne, mut r2, mut rmax) =
             (Vec::new(), 0.0, 0.0, 0.0, 0.0f64);
         let mut last: Option<(f64, f64)> = None;

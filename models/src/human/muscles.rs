@@ -19,6 +19,7 @@
 
 use super::{
     Fourier, GaitReference, Guard, Human, PassiveJoints, TRACKED, Tracking, cycle_start, dof_index,
+    last_cycle_start,
 };
 use mbs::Model;
 use mbs::elements::Path;
@@ -208,16 +209,16 @@ impl Muscles {
             .collect()
     }
 
-    /// Each unit's moment arms −∂l/∂q at `kin` about the coordinates of `moments`:
+    /// Each unit's moment arms −∂l/∂q at `kin` about the coordinates `dofs`:
     /// `arms[unit][k]`.
-    fn arms(&self, kin: &Kinematics, moments: &[(usize, f64)]) -> Vec<Vec<f64>> {
+    fn arms(&self, kin: &Kinematics, dofs: impl Iterator<Item = usize> + Clone) -> Vec<Vec<f64>> {
         let nq = kin.points.first().map_or(0, |p| p.jv.len() / 3);
+        let mut g = vec![0.0; nq];
         self.units
             .iter()
             .map(|(_, p)| {
-                let mut g = vec![0.0; nq];
                 p.gradient(kin, &mut g);
-                moments.iter().map(|(i, _)| -g[*i]).collect()
+                dofs.clone().map(|i| -g[i]).collect()
             })
             .collect()
     }
@@ -236,7 +237,7 @@ impl Muscles {
         baseline: &[f64],
     ) -> Result<Vec<f64>, String> {
         let floor = MIN_ACTIVATION;
-        let arms = self.arms(kin, moments);
+        let arms = self.arms(kin, moments.iter().map(|(i, _)| *i));
         let nj = moments.len();
         let mut a: Vec<f64> = baseline.iter().map(|b| b.clamp(floor, 1.0)).collect();
         let mut held = [false; NM];
@@ -298,7 +299,7 @@ impl Muscles {
         reserve: f64,
     ) -> Result<(Vec<f64>, Vec<f64>), String> {
         let floor = MIN_ACTIVATION;
-        let arms = self.arms(kin, moments);
+        let arms = self.arms(kin, moments.iter().map(|(i, _)| *i));
         let err = |e: MuscleError| e.to_string();
         let w = 1.0 / reserve;
         let mut a: Vec<f64> = baseline.iter().map(|b| b.clamp(floor, 1.0)).collect();
@@ -433,6 +434,53 @@ impl MuscleDriven {
         Ok(x)
     }
 
+    /// The state of a run on the muscles from the body's (`q`, `qd`) at `t`: the extra
+    /// states of [`MuscleDriven::initial_states`] after the velocities, their coordinates'
+    /// part zero.
+    pub fn start(
+        &self,
+        model: &Human,
+        t: f64,
+        mut q: Vec<f64>,
+        mut qd: Vec<f64>,
+    ) -> Result<(Vec<f64>, Vec<f64>), String> {
+        let mut kin = Kinematics::new::<Human>();
+        model.kinematics(t, &q, &qd, &mut kin);
+        let x = self.initial_states(t, &kin, &qd)?;
+        q.resize(q.len() + x.len(), 0.0);
+        qd.extend(x);
+        Ok((q, qd))
+    }
+
+    /// The moments asked of the muscles at [`MUSCLE_JOINTS`] when `torques` ((coordinate,
+    /// N·m), a tracking's) hold the body at `q`: each joint's torque less its passive elastic
+    /// moment.
+    fn moments_asked(
+        &self,
+        info: &mbs::ModelInfo,
+        torques: &[(usize, f64)],
+        q: &[f64],
+    ) -> Result<Vec<(usize, f64)>, String> {
+        MUSCLE_JOINTS
+            .iter()
+            .map(|name| {
+                let i = dof_index(info, name)?;
+                let tau = torques
+                    .iter()
+                    .find(|(j, _)| *j == i)
+                    .ok_or_else(|| format!("`{name}` is not held"))?
+                    .1;
+                let (_, law) = self
+                    .passive
+                    .joints
+                    .iter()
+                    .find(|(j, _)| *j == i)
+                    .ok_or_else(|| format!("no passive law for `{name}`"))?;
+                Ok((i, tau - law.elastic(q[i])))
+            })
+            .collect()
+    }
+
     /// The guard of the passive part.
     pub fn guard(&self) -> &Guard {
         &self.passive.guard
@@ -546,38 +594,24 @@ pub fn muscle_stance(model: &Human, ankle: f64, baseline: &[f64]) -> Result<Musc
     .map_err(|e| format!("the held body: {e}"))?;
     let q = held.q;
     let zero = vec![0.0; n];
-    let mut passive = PassiveJoints::new(info, 0.1, 0.01)?;
     let torques: Vec<(usize, f64)> = tracking.torques(0.0, &q, &zero).collect();
-    let mut moments = Vec::new();
-    for name in MUSCLE_JOINTS {
-        let i = dof_index(info, name)?;
-        let tau = torques.iter().find(|(j, _)| *j == i).ok_or("not held")?.1;
-        let (_, law) = passive
-            .joints
-            .iter()
-            .find(|(j, _)| *j == i)
-            .ok_or("no law")?;
-        moments.push((i, tau - law.elastic(q[i])));
-    }
-    let mut muscles = Muscles::new(info)?;
+    let mut driven = MuscleDriven {
+        passive: PassiveJoints::new(info, 0.1, 0.01)?,
+        muscles: Muscles::new(info)?,
+    };
+    let moments = driven.moments_asked(info, &torques, &q)?;
     let mut kin = Kinematics::new::<Human>();
     model.kinematics(0.0, &q, &zero, &mut kin);
-    muscles.excitation = muscles.excitations_for(&kin, &moments, baseline)?;
+    driven.muscles.excitation = driven.muscles.excitations_for(&kin, &moments, baseline)?;
     let mut rest = tracking;
     rest.release(info, &MUSCLE_JOINTS)?;
-    passive.tracking = Some(rest);
-    let driven = MuscleDriven { passive, muscles };
+    driven.passive.tracking = Some(rest);
     let equilibrium = mbs::static_equilibrium(
         &mbs::WithEfforts::new(model.clone(), MusclesAtRest(driven.clone())),
         &statics(q.clone()),
     )
     .map_err(|e| format!("the body on its muscles: {e}"))?;
-    model.kinematics(0.0, &equilibrium.q, &zero, &mut kin);
-    let x = driven.initial_states(0.0, &kin, &zero)?;
-    let mut qs = equilibrium.q.clone();
-    qs.resize(n + x.len(), 0.0);
-    let mut qds = zero;
-    qds.extend(x);
+    let (qs, qds) = driven.start(model, 0.0, equilibrium.q.clone(), zero)?;
     Ok(MuscleStance {
         driven,
         q: qs,
@@ -619,13 +653,8 @@ impl MuscleCycle {
             .as_ref()
             .ok_or("the cycle's efforts have no tracking")?
             .reference;
-        let (mut q, mut qd) = cycle_start(model, reference);
-        let mut kin = Kinematics::new::<Human>();
-        model.kinematics(0.0, &q, &qd, &mut kin);
-        let x = self.driven.initial_states(0.0, &kin, &qd)?;
-        q.resize(q.len() + x.len(), 0.0);
-        qd.extend(x);
-        Ok((q, qd))
+        let (q, qd) = cycle_start(model, reference);
+        self.driven.start(model, 0.0, q, qd)
     }
 }
 
@@ -647,8 +676,7 @@ pub fn muscle_cycle(
     let info = model.info();
     let n = Human::NQ;
     let period = tracking.reference.period;
-    let end = tr.t.last().copied().unwrap_or(0.0);
-    let start = ((end / period).round() - 1.0).max(0.0) * period;
+    let start = last_cycle_start(tr, period);
     let instants: Vec<usize> = (0..tr.len())
         .filter(|i| tr.t[*i] >= start - 1e-9 && tr.t[*i] < start + period - 1e-9)
         .collect();
@@ -665,43 +693,28 @@ pub fn muscle_cycle(
             2 * harmonics
         ));
     }
-    let mut passive = PassiveJoints::new(info, 0.1, 0.01)?;
-    let mut muscles = Muscles::new(info)?;
+    let mut driven = MuscleDriven {
+        passive: PassiveJoints::new(info, 0.1, 0.01)?,
+        muscles: Muscles::new(info)?,
+    };
     let mut kin = Kinematics::new::<Human>();
-    let joints = MUSCLE_JOINTS
-        .iter()
-        .map(|name| {
-            let i = dof_index(info, name)?;
-            let law = passive
-                .joints
-                .iter()
-                .find(|(j, _)| *j == i)
-                .map(|(_, l)| *l)
-                .ok_or_else(|| format!("no passive law for `{name}`"))?;
-            Ok((i, law))
-        })
-        .collect::<Result<Vec<_>, String>>()?;
     let mut activations = Vec::with_capacity(instants.len());
     let mut shares = Vec::with_capacity(instants.len());
     for &s in &instants {
         let (t, q, qd) = (tr.t[s], &tr.q(s)[..n], &tr.qd(s)[..n]);
         model.kinematics(t, q, qd, &mut kin);
         let torques: Vec<(usize, f64)> = tracking.torques(t, q, qd).collect();
-        let moments: Vec<(usize, f64)> = joints
-            .iter()
-            .map(|(i, law)| {
-                let tau = torques.iter().find(|(j, _)| j == i).map_or(0.0, |p| p.1);
-                (*i, tau - law.elastic(q[*i]))
-            })
-            .collect();
-        let (a, reserves) = muscles.excitations_with_reserves(&kin, &moments, baseline, RESERVE)?;
+        let moments = driven.moments_asked(info, &torques, q)?;
+        let (a, reserves) = driven
+            .muscles
+            .excitations_with_reserves(&kin, &moments, baseline, RESERVE)?;
         let asked = moments.iter().map(|(_, v)| v * v).sum::<f64>().sqrt();
         let left = reserves.iter().map(|v| v * v).sum::<f64>().sqrt();
         let share = if asked > 0.0 { 1.0 - left / asked } else { 1.0 };
         activations.push(a);
         shares.push(share);
     }
-    muscles.pattern = (0..NM)
+    driven.muscles.pattern = (0..NM)
         .map(|m| {
             let column: Vec<f64> = activations.iter().map(|a| a[m]).collect();
             // the samples begin at `start`, a whole number of periods: the series is in
@@ -709,9 +722,9 @@ pub fn muscle_cycle(
             Fourier::fit(&column, harmonics, period)
         })
         .collect();
-    passive.tracking = Some(tracking.clone());
+    driven.passive.tracking = Some(tracking.clone());
     Ok(MuscleCycle {
-        driven: MuscleDriven { passive, muscles },
+        driven,
         activations,
         shares,
     })
@@ -725,13 +738,9 @@ pub fn moment_arms(
     dof: &str,
 ) -> Result<Vec<f64>, String> {
     let i = dof_index(info, dof)?;
-    let mut g = vec![0.0; info.dofs.len()];
     Ok(muscles
-        .units
-        .iter()
-        .map(|(_, p)| {
-            p.gradient(kin, &mut g);
-            -g[i]
-        })
+        .arms(kin, std::iter::once(i))
+        .into_iter()
+        .map(|a| a[0])
         .collect())
 }

@@ -88,15 +88,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             ..how.clone()
         },
     )?;
+    let clock = std::time::Instant::now();
     let grounded = fitted.grounded(&model, &how)?;
     println!(
-        "mode 1: normal cycle of {period} s, {FIT_HARMONICS} harmonics, made consistent with the ground (angles corrected by up to {:.1}°):",
-        grounded.largest_change.to_degrees()
+        "mode 1: normal cycle of {period} s, {FIT_HARMONICS} harmonics, symmetric, made consistent with the ground \
+         (angles corrected by up to {:.1}°, {} iterations, {:.1} s):",
+        grounded.largest_change.to_degrees(),
+        grounded.iterations,
+        clock.elapsed().as_secs_f64()
     );
-    for (what, g) in [("as published", &raw), ("grounded", &grounded)] {
+    for (what, g) in [("published", &raw), ("grounded", &grounded)] {
         let a = g.acceleration;
         println!(
-            "  {what:>12}: {:.2} m/s; in double support the feet level within {:.1} mm, sliding apart at up to {:.2} m/s; \
+            "  {what:>9}: {:.2} m/s; in double support the feet level within {:.1} mm, sliding apart at up to {:.2} m/s; \
              swing clearance {:+.1} mm from the asked; centre of mass accelerating within \
              [{:.2}, {:.2}] g fore–aft, [{:.2}, {:.2}] g vertically, [{:.2}, {:.2}] g laterally",
             g.speed,
@@ -181,9 +185,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         output: Output::Every { dt: 0.01 },
         ..Options::adaptive(1.0, 1e-6)
     };
-    let driven = WithEfforts::new(Human::default(), stance.driven.clone());
+    let driven = WithEfforts::new(model.clone(), stance.driven.clone());
     let tr = run(driven, options, "pushed, 1 s", 0.0);
-    muscle_plot(&Human::default(), &out, &stance, &tr)?;
+    muscle_plot(&model, &out, &stance, &tr)?;
     println!("plots, animation and CSV in {}", out.display());
     Ok(())
 }

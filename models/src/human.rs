@@ -384,8 +384,8 @@ impl GaitReference {
     }
 
     /// The cycle made left–right symmetric, as a normal cycle is and one subject's measured
-    /// cycle is not quite (the tutorial's legs differ by up to 2.8° half a cycle apart, its
-    /// pelvis is rotated by −0.7° on average): each leg joint of the right leg the mean of
+    /// cycle is not quite (the tutorial's legs differ by degrees half a cycle apart, its
+    /// pelvis turns a little more one way than the other): each leg joint of the right leg the mean of
     /// the right one and the left one half a cycle later, the left leg's the right's half a
     /// cycle later; the pelvis' tilt and the lumbar extension of even harmonics only (the
     /// same at each step), the pelvis' list and rotation and the lumbar bending and rotation
@@ -497,13 +497,13 @@ impl GaitReference {
     ///
     /// A foot's lowest point and its contact are its ellipsoids' support points blended by
     /// a soft minimum over 0.5 mm of height (the hard minimum jumps from ellipsoid to
-    /// ellipsoid as the foot rolls, and made the pass end in a different minimum for a
-    /// change of 1e-10 in the period), with the pelvis on its reference orientation; the
+    /// ellipsoid as the foot rolls, and the pass's result then depended on rounding), with
+    /// the pelvis on its reference orientation; the
     /// centre of mass' height is the potential energy over the weight, its fore–aft
     /// position from the mass matrix (the column of the pelvis' rotation about the vertical).
     /// Levenberg–Marquardt, the Jacobian by forward differences shared among the cores,
-    /// until ten iterations lower the cost by less than 1e-4 of it (about 200–400 on the
-    /// normal cycle: 10–15 s on two cores).
+    /// until ten iterations lower the cost by less than 1e-4 of it (`human_gait` prints the
+    /// iterations and the time: 396 and about 10 s on two cores for the normal cycle).
     pub fn grounded(&self, model: &Human, how: &Grounding) -> Result<Grounded, String> {
         let info = model.info();
         let mut joints = [[(0usize, 0usize); 5]; 2];
@@ -667,12 +667,11 @@ impl GaitReference {
 /// stays in the normal ranges for a tracking stiffness of 1e4 or 1e5 N·m/rad, a dissipation
 /// of 10 or 20 s/m and a cycle of 1.0 s; the first peak reaches 1.32 body weights at 5 s/m
 /// and 1.84 at the model's 1 s/m, the second 1.31 for a cycle of 1.2 s):
-/// - the published cycle fitted with 5 harmonics: 8 follow the table's samples closer, but
-///   with them an earlier version of the pass left a 7 Hz ripple of about ± 0.4 g in the
-///   corrected cycle's fore–aft acceleration;
+/// - the published cycle fitted with 5 harmonics (8 follow the table's samples closer; the
+///   figures were worked out with 5);
 pub const FIT_HARMONICS: usize = 5;
 /// - the joints tracked with 3·10⁴ N·m/rad (and a hundredth of it in N·m·s/rad): at
-///   3·10³ the legs lagged the reference enough for the feet to land at 2.8 body weights;
+///   3·10³ the legs lag the reference and the fore–aft force propels first, then brakes;
 pub const GAIT_KP: f64 = 3e4;
 /// - the feet's Hunt–Crossley dissipation 10 s/m (the model's 1 s/m, a hard sole, lets the
 ///   heel strike peak at 1.8 body weights: the tracked legs have no muscles' give);

@@ -57,8 +57,8 @@
 
 use crate::plot::{Chart, PlotError, Series};
 use crate::{
-    ConstraintMethod, Failure, Model, Options, Output, RotationJoint, Scheme, SimError, Stats,
-    StepControl, Trajectory, simulate,
+    ConstraintMethod, Failure, GlobalControl, Model, Options, Output, RotationJoint, Scheme,
+    SimError, Stats, StepControl, Trajectory, simulate, simulate_global,
 };
 use std::fmt::{self, Write as _};
 use std::path::Path;
@@ -172,6 +172,9 @@ pub struct Sweep {
     pub constraints: Option<ConstraintMethod>,
     /// the legend of its line: the scheme's name, with the constraint method if given
     pub label: String,
+    /// adaptive runs under global error control ([`mbs_runtime::simulate_global`]): the
+    /// row's time and work are those of all its runs (default `None`: one run, local control)
+    pub global: Option<GlobalControl>,
 }
 
 impl Sweep {
@@ -182,6 +185,7 @@ impl Sweep {
             settings: rtols.iter().map(|&r| Setting::Rtol(r)).collect(),
             constraints: None,
             label: scheme.name().to_string(),
+            global: None,
         }
     }
 
@@ -192,6 +196,7 @@ impl Sweep {
             settings: steps.iter().map(|&h| Setting::Step(h)).collect(),
             constraints: None,
             label: scheme.name().to_string(),
+            global: None,
         }
     }
 
@@ -199,6 +204,14 @@ impl Sweep {
     pub fn with_constraints(mut self, method: ConstraintMethod) -> Sweep {
         self.constraints = Some(method);
         self.label = format!("{} ({})", self.scheme.name(), method.name());
+        self
+    }
+
+    /// The same sweep under global error control with the default limits (the label says
+    /// so): rtol bounds the error of the trajectory, not of a step.
+    pub fn global(mut self) -> Sweep {
+        self.global = Some(GlobalControl::default());
+        self.label = format!("{} global", self.label);
         self
     }
 
@@ -335,7 +348,7 @@ impl Reference {
         let check_states = match check {
             Some((scheme, setting)) => {
                 let (tc, _) = simulate(model.clone(), scheme, opts(setting)).map_err(Box::new)?;
-                Some(states_of(&tc, model.info().rotation_joints))
+                Some(tc.measured_states(model.info().rotation_joints))
             }
             None => None,
         };
@@ -348,7 +361,7 @@ impl Reference {
                 check,
                 note: String::new(),
             },
-            states: states_of(&tr, model.info().rotation_joints),
+            states: tr.measured_states(model.info().rotation_joints),
             times,
             check: check_states,
         })
@@ -399,61 +412,7 @@ impl Reference {
     }
 }
 
-/// The state a run is measured by at every output of a trajectory: (q, qd), each rotation
-/// joint's three angles replaced by the nine entries of its rotation (row-major) and its
-/// three rates by its angular velocity in its own axes, which do not depend on the chart the
-/// angles are read in ([`state_size`] numbers).
-fn states_of(tr: &Trajectory, joints: &[RotationJoint]) -> Vec<Vec<f64>> {
-    (0..tr.len())
-        .map(|i| {
-            let (q, qd) = (tr.q(i), tr.qd(i));
-            if joints.is_empty() {
-                return q.iter().chain(qd).copied().collect();
-            }
-            let mut y = Vec::with_capacity(state_size(q.len(), joints.len()));
-            let angle = |k: usize| joints.iter().position(|j| j.angles.contains(&k));
-            for k in 0..q.len() {
-                match angle(k) {
-                    Some(j) if joints[j].angles[0] == k => {
-                        // Euler angles of a model without charts: the identity
-                        let chart = if j < tr.joint_names.len() {
-                            tr.chart(i, j)
-                        } else {
-                            crate::IDENTITY3
-                        };
-                        let r = crate::charts::joint_rotation(&chart, &joints[j], q);
-                        let m = r.to_rotation_matrix();
-                        y.extend((0..9).map(|e| m[(e / 3, e % 3)]));
-                    }
-                    Some(_) => {}
-                    None => y.push(q[k]),
-                }
-            }
-            for k in 0..q.len() {
-                match angle(k) {
-                    Some(j) if joints[j].angles[0] == k => {
-                        let [a, b, c] = joints[j].angles;
-                        y.extend(crate::charts::body_rates(
-                            [q[a], q[b], q[c]],
-                            [qd[a], qd[b], qd[c]],
-                        ));
-                    }
-                    Some(_) => {}
-                    None => y.push(qd[k]),
-                }
-            }
-            y
-        })
-        .collect()
-}
-
-/// The length of a measured state ([`Reference`]'s states) of a model with `nq` coordinates
-/// and `joints` rotation joints (`Tball`, `Tfree`): q then qd, each joint's angles as the 9
-/// entries of its rotation and its rates as its angular velocity in its own axes, in place
-/// of its first angle and first rate.
-pub fn state_size(nq: usize, joints: usize) -> usize {
-    2 * nq + 6 * joints
-}
+pub use mbs_runtime::state_size;
 
 /// max_i |y_i − r_i| / (a + |r_i|): the Test Set's mixed error with absolute floor `a`.
 pub fn mixed_error(y: &[f64], reference: &[f64], floor: f64) -> f64 {
@@ -654,9 +613,14 @@ impl Study {
         let mut last = None;
         while repeats < self.repeats && (repeats == 0 || spent < self.repeat_budget) {
             let (m, o) = (model.clone(), options.clone());
-            let (result, cpu, wall) = self
-                .clock
-                .time(|| simulate(m, sweep.scheme, o).map_err(Box::new));
+            let (result, cpu, wall) = self.clock.time(|| match &sweep.global {
+                Some(g) if matches!(setting, Setting::Rtol(_)) => {
+                    simulate_global(&m, sweep.scheme, &o, g)
+                        .map(|(tr, _, report)| (tr, report.work))
+                        .map_err(Box::new)
+                }
+                _ => simulate(m, sweep.scheme, o).map_err(Box::new),
+            });
             repeats += 1;
             spent += wall;
             best = best.min(cpu);
@@ -704,7 +668,7 @@ impl Study {
 
     fn measure<M: Model>(&self, model: &M, tr: &Trajectory) -> Result<Accuracy, RunFailure> {
         let r = &self.reference;
-        let y = states_of(tr, &self.joints(model));
+        let y = tr.measured_states(&self.joints(model));
         let times_match = y.len() == r.times.len()
             && tr
                 .t

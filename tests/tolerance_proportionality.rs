@@ -31,8 +31,16 @@
 //! rtol, half a digit per decade: 5.4 digits at rtol 1e-4 and 8.0 at 1e-10 on the Cartesian
 //! double pendulum, and it loses 0.5 digits from rtol 1e-5 to 1e-6 on the four-bar).
 //!
-//! `cargo test --release --test tolerance_proportionality -- --nocapture` prints the tables
-//! and the digits of q and qd apart at rtol 1e-8.
+//! Global error control (`mbs::simulate_global`) is what makes rtol a bound on these errors:
+//! every sweep runs again under it at rtol 1e-4, 1e-6 and 1e-8, and it is asserted that
+//! no run it returns is more than half a digit short of rtol (the slack of an estimate made
+//! against a run ten times tighter), that every run it does not return ends in the typed
+//! `GlobalToleranceNotMet`, and that DOPRI5 and Radau5 with their default constraint method
+//! return a run at each of these tolerances on every model (BDF does too except on fastlink
+//! at 1e-8, where its local tolerance reaches its floor of 100ε).
+//!
+//! `cargo test --release --test tolerance_proportionality -- --nocapture` prints the tables,
+//! the digits of q and qd apart at rtol 1e-8, and the global-control runs.
 
 use mbs::work_precision::{Reference, Setting, Study, Sweep, WorkPrecision, decades, mixed_error};
 use mbs::{ConstraintMethod, GenAlphaParams, HhtParams, Model, Options, Scheme};
@@ -216,7 +224,8 @@ fn study(title: &str, reference: Reference, constrained: bool) -> Study {
 /// proportionality.
 fn measure<M: Model + Clone + 'static>(s: Study, model: &M) -> Vec<String> {
     let wp = s.run(model).expect("study");
-    let bad = judge(&wp, M::NC > 0);
+    let mut bad = judge(&wp, M::NC > 0);
+    bad.extend(measure_global(&s, model));
     let n = M::NQ;
     println!(
         "digits over q alone and qd alone at rtol 1e-8 (largest mixed error over the samples):"
@@ -238,6 +247,78 @@ fn measure<M: Model + Clone + 'static>(s: Study, model: &M) -> Vec<String> {
             -ev.log10()
         );
     }
+    bad
+}
+
+/// The tolerances of the global-control sweeps.
+const GLOBAL_RTOLS: [f64; 3] = [1e-4, 1e-6, 1e-8];
+/// Digits a run under global control may fall short of rtol: the slack of an estimate made
+/// against a run only ten times tighter.
+const GLOBAL_SLACK: f64 = 0.5;
+
+/// The study's sweeps again under global error control (`mbs::simulate_global`) at
+/// [`GLOBAL_RTOLS`]: prints, per run, the digits beyond −log10 rtol (or the failure) and the
+/// steps of all its runs; returns the runs that mislead: a result more than
+/// [`GLOBAL_SLACK`] digits short of rtol, or a failure other than the typed
+/// `GlobalToleranceNotMet` (and `ConstraintsUnsupported`, a method not offered), or a
+/// failure of DOPRI5 or Radau5 with the default constraint method.
+fn measure_global<M: Model + Clone + 'static>(s: &Study, model: &M) -> Vec<String> {
+    let g = Study {
+        sweeps: s
+            .sweeps
+            .iter()
+            .map(|w| {
+                Sweep {
+                    settings: GLOBAL_RTOLS.iter().map(|&r| Setting::Rtol(r)).collect(),
+                    ..w.clone()
+                }
+                .global()
+            })
+            .collect(),
+        ..s.clone()
+    };
+    let wp = g.run(model).expect("study");
+    println!(
+        "\nglobal error control: {} (digits − (−log10 rtol), steps of all runs)",
+        wp.title
+    );
+    let mut bad = Vec::new();
+    let mut line = String::new();
+    for (k, row) in wp.rows.iter().enumerate() {
+        let Setting::Rtol(rtol) = row.setting else {
+            continue;
+        };
+        if k % GLOBAL_RTOLS.len() == 0 {
+            println!("{line}");
+            line = format!("{:<32}", row.label);
+        }
+        let at = format!("{}: {} at rtol {rtol:e}", wp.title, row.label);
+        match &row.outcome {
+            Ok(a) => {
+                let over = -a.error_max.log10() + rtol.log10();
+                line += &format!("  {over:+6.2} {:>7}", row.stats.steps);
+                if over < -GLOBAL_SLACK {
+                    bad.push(format!("{at}: {over:.2} digits beyond rtol"));
+                }
+            }
+            Err(f) => {
+                line += &format!("  {:>14}", f.name());
+                let typed = matches!(
+                    f.kind,
+                    mbs::Failure::GlobalToleranceNotMet { .. }
+                        | mbs::Failure::ConstraintsUnsupported { .. }
+                );
+                // BDF reaches its floor (local rtol' 100ε) at rtol 1e-8 on fastlink
+                let expected = ["dopri5 auto", "radau5 auto"]
+                    .iter()
+                    .any(|l| row.label.starts_with(l));
+                if !typed || expected {
+                    bad.push(format!("{at}: {}", f.kind));
+                }
+            }
+        }
+    }
+    println!("{line}");
     bad
 }
 

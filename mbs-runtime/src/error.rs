@@ -198,6 +198,34 @@ pub enum Failure {
         t: f64,
         max_steps: usize,
     },
+    #[error(
+        "global error control: {} after {runs} runs, the most accurate at local rtol {rtol:.1e}{}{}; loosen rtol, or use a scheme of higher order (radau5, dopri5, bdf) or another constraint method",
+        estimated(*estimate),
+        if *floor { " (the last run took no more steps at a tenth of the tolerance: rtol does not set this scheme's step here, and the runs' difference says nothing of the error)" } else { "" }, cause.as_ref().map(|c| format!(" (the next run failed: {c})")).unwrap_or_default()
+    )]
+    GlobalToleranceNotMet {
+        /// the last estimate, in the user's tolerance (1 = met)
+        estimate: f64,
+        /// the local rtol of the most accurate complete run (the trajectory kept)
+        rtol: f64,
+        runs: usize,
+        /// the last, tighter run took at most 5 % more steps than the run before: rtol does not
+        /// set the scheme's step (its local tolerance is at a floor), and the error cannot be
+        /// estimated
+        floor: bool,
+        /// why the next, tighter run stopped, when it did (`None`: the limits of
+        /// [`GlobalControl`](crate::GlobalControl) were reached)
+        cause: Option<Box<Failure>>,
+    },
+}
+
+/// The estimate of a [`Failure::GlobalToleranceNotMet`], in words.
+fn estimated(estimate: f64) -> String {
+    if estimate.is_finite() {
+        format!("the estimated error of the trajectory is still {estimate:.3} of the tolerance")
+    } else {
+        "the error of the trajectory could not be estimated".to_string()
+    }
 }
 
 impl Failure {

@@ -36,8 +36,8 @@ pub use analysis::{
 pub use efforts::{Effort, Efforts, WithEfforts};
 pub use error::{Failure, ModelError, ParamError, check_inertia};
 pub use integrators::{
-    Assembly, Controller, Inputs, Integrator, SimError, Simulation, State, assemble, simulate,
-    simulate_with,
+    Assembly, Controller, GlobalControl, GlobalReport, GlobalRun, Inputs, Integrator, SimError,
+    Simulation, State, assemble, simulate, simulate_global, simulate_with,
 };
 pub use lanes::{F64x4, LANES};
 pub use model::{
@@ -53,4 +53,4 @@ pub use options::{
 pub use sensitivity::Sensitivities;
 pub use spline::Spline;
 pub use stats::{ErrorTest, Stats};
-pub use trajectory::{CsvWriter, Observer, Trajectory};
+pub use trajectory::{CsvWriter, Observer, Trajectory, state_size};

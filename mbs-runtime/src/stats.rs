@@ -109,6 +109,54 @@ impl Stats {
             + self.tangents
     }
 
+    /// Adds the work of `other`: counters summed, the range of steps widened, the order
+    /// histories summed (the work of several runs, as in global error control).
+    pub fn add_work(&mut self, other: &Stats) {
+        if other.steps > 0 {
+            if self.steps == 0 {
+                (self.h_min, self.h_max) = (other.h_min, other.h_max);
+            } else {
+                self.h_min = self.h_min.min(other.h_min);
+                self.h_max = self.h_max.max(other.h_max);
+            }
+        }
+        let sums = [
+            (&mut self.steps, other.steps),
+            (&mut self.rejected_error, other.rejected_error),
+            (&mut self.rejected_newton, other.rejected_newton),
+            (&mut self.dynamics, other.dynamics),
+            (&mut self.forward_dynamics, other.forward_dynamics),
+            (&mut self.mass_matrix, other.mass_matrix),
+            (&mut self.inverse_dynamics, other.inverse_dynamics),
+            (&mut self.tangents, other.tangents),
+            (&mut self.constraints, other.constraints),
+            (&mut self.projections, other.projections),
+            (&mut self.repartitions, other.repartitions),
+            (&mut self.samples, other.samples),
+            (&mut self.chart_switches, other.chart_switches),
+            (&mut self.user_efforts, other.user_efforts),
+            (&mut self.energy, other.energy),
+            (&mut self.factorizations, other.factorizations),
+            (&mut self.solves, other.solves),
+            (&mut self.condition_checks, other.condition_checks),
+            (&mut self.newton_iterations, other.newton_iterations),
+            (&mut self.stiff_detections, other.stiff_detections),
+        ];
+        for (a, b) in sums {
+            *a += b;
+        }
+        if self.order_steps.len() < other.order_steps.len() {
+            self.order_steps.resize(other.order_steps.len(), 0);
+        }
+        for (a, b) in self.order_steps.iter_mut().zip(&other.order_steps) {
+            *a += b;
+        }
+        self.stiff_from = match (self.stiff_from, other.stiff_from) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        };
+    }
+
     pub(crate) fn record_step(&mut self, h: f64) {
         if self.steps == 0 {
             self.h_min = h;

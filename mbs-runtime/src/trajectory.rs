@@ -1,7 +1,7 @@
 //! The sampled motion: t, q, qd, qdd (and energy, body poses on request) at the output times,
 //! with CSV and JSON writers, and observers that see every output as it is produced.
 
-use crate::model::{Energy, Pose};
+use crate::model::{Energy, Pose, RotationJoint};
 use serde::{Deserialize, Serialize};
 use std::io::{self, Write};
 
@@ -58,7 +58,65 @@ impl<F: FnMut(f64, &[f64], &[f64], &[f64])> Observer for F {
     }
 }
 
+/// The length of a measured state ([`Trajectory::measured_states`]) of a model with `nq`
+/// coordinates and `joints` rotation joints (`Tball`, `Tfree`): q then qd, each joint's
+/// angles as the 9 entries of its rotation and its rates as its angular velocity in its own
+/// axes, in place of its first angle and first rate.
+pub fn state_size(nq: usize, joints: usize) -> usize {
+    2 * nq + 6 * joints
+}
+
 impl Trajectory {
+    /// The state a run is measured by at every output (work–precision studies, global error
+    /// control): (q, qd), each rotation joint's three angles replaced by the nine entries of
+    /// its rotation (row-major) and its three rates by its angular velocity in its own axes,
+    /// which do not depend on the chart the angles are read in ([`state_size`] numbers).
+    /// `joints` beyond the trajectory's own rotation joints are Euler angles read with the
+    /// identity chart.
+    pub fn measured_states(&self, joints: &[RotationJoint]) -> Vec<Vec<f64>> {
+        (0..self.len())
+            .map(|i| {
+                let (q, qd) = (self.q(i), self.qd(i));
+                if joints.is_empty() {
+                    return q.iter().chain(qd).copied().collect();
+                }
+                let mut y = Vec::with_capacity(state_size(q.len(), joints.len()));
+                let angle = |k: usize| joints.iter().position(|j| j.angles.contains(&k));
+                for k in 0..q.len() {
+                    match angle(k) {
+                        Some(j) if joints[j].angles[0] == k => {
+                            // Euler angles of a model without charts: the identity
+                            let chart = if j < self.joint_names.len() {
+                                self.chart(i, j)
+                            } else {
+                                crate::IDENTITY3
+                            };
+                            let r = crate::charts::joint_rotation(&chart, &joints[j], q);
+                            let m = r.to_rotation_matrix();
+                            y.extend((0..9).map(|e| m[(e / 3, e % 3)]));
+                        }
+                        Some(_) => {}
+                        None => y.push(q[k]),
+                    }
+                }
+                for k in 0..q.len() {
+                    match angle(k) {
+                        Some(j) if joints[j].angles[0] == k => {
+                            let [a, b, c] = joints[j].angles;
+                            y.extend(crate::charts::body_rates(
+                                [q[a], q[b], q[c]],
+                                [qd[a], qd[b], qd[c]],
+                            ));
+                        }
+                        Some(_) => {}
+                        None => y.push(qd[k]),
+                    }
+                }
+                y
+            })
+            .collect()
+    }
+
     pub(crate) fn new(
         dof_names: Vec<String>,
         frame_names: Vec<String>,

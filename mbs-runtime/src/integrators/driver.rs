@@ -560,6 +560,12 @@ impl<M: Model + 'static> Integrator for Simulation<M> {
 }
 
 /// The names a trajectory carries: coordinates, frames, constraints.
+/// A request refused before any work: `kind` at t₀, with an empty trajectory of the model's
+/// names.
+pub(crate) fn refused<M: Model>(model: &M, kind: Failure, t0: f64) -> SimError {
+    Names::of(model).failure_at_start(kind, t0, Stats::default())
+}
+
 struct Names {
     dofs: Vec<String>,
     frames: Vec<String>,

@@ -29,6 +29,7 @@ mod dispatch;
 mod dopri5;
 mod driver;
 mod explicit;
+mod global;
 mod inputs;
 mod midpoint;
 mod newmark;
@@ -41,6 +42,7 @@ mod stepper;
 
 pub use constrained::{Assembly, assemble};
 pub use driver::{Simulation, simulate, simulate_with};
+pub use global::{GlobalControl, GlobalReport, GlobalRun, simulate_global};
 pub use inputs::{Controller, Inputs};
 pub use newmark::index3_iteration_matrix;
 pub use sim_error::SimError;

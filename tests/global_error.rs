@@ -1,0 +1,143 @@
+//! Global error control (`mbs::simulate_global`): rtol as a bound on the error of the whole
+//! trajectory. Local error control leaves the four-bar two digits short of rtol; global control
+//! brings it within rtol and its estimate says how far the returned run is from the truth; a
+//! tolerance a scheme cannot reach is a typed failure that keeps the most accurate trajectory;
+//! rotation joints are compared without their charts.
+//!
+//! `cargo test --release --test global_error -- --nocapture` prints the reports.
+
+use mbs::{
+    ConstraintMethod, Failure, GenAlphaParams, GlobalControl, Model, Options, Output, Scheme,
+    Trajectory, simulate, simulate_global,
+};
+use mbs_models::{fastlink, fourbar, tumble};
+
+/// Largest |y − r| / (atol + rtol·|r|) over the outputs and measured components (a rotation
+/// joint by its rotation and angular velocity): the error in the user's tolerance (1 = at
+/// the tolerance).
+fn error_in_tolerance(
+    model: &impl Model,
+    tr: &Trajectory,
+    reference: &Trajectory,
+    rtol: f64,
+    atol: f64,
+) -> f64 {
+    let joints = model.info().rotation_joints;
+    let (a, b) = (
+        tr.measured_states(joints),
+        reference.measured_states(joints),
+    );
+    assert_eq!(a.len(), b.len(), "outputs at the same times");
+    a.iter()
+        .zip(&b)
+        .flat_map(|(ya, yb)| ya.iter().zip(yb))
+        .map(|(y, r)| (y - r).abs() / (atol + rtol * r.abs()))
+        .fold(0.0, f64::max)
+}
+
+fn times(t_end: f64, n: usize) -> Vec<f64> {
+    (1..=n).map(|k| t_end * k as f64 / n as f64).collect()
+}
+
+fn options(t_end: f64, rtol: f64, n: usize) -> Options {
+    Options {
+        output: Output::Times(times(t_end, n)),
+        energy: false,
+        ..Options::adaptive(t_end, rtol)
+    }
+}
+
+/// The four-bar over 2 s (its crank's fast turns amplify every step's error): DOPRI5 with
+/// local control at rtol 1e-6 is more than a digit short; under global control the returned
+/// run is within rtol, and the estimate is within a factor 3 of its true error (against
+/// DOPRI5 at rtol 1e-13, whose own error is below 1e-10).
+#[test]
+fn global_control_brings_the_four_bar_within_rtol_where_local_control_falls_short() {
+    let model = fourbar::FourBar::default();
+    let rtol = 1e-6;
+    let (reference, _) =
+        simulate(model.clone(), Scheme::Dopri5, options(2.0, 1e-13, 20)).expect("reference");
+    let (local, _) =
+        simulate(model.clone(), Scheme::Dopri5, options(2.0, rtol, 20)).expect("local");
+    let e_local = error_in_tolerance(&model, &local, &reference, rtol, rtol / 100.0);
+    let o = options(2.0, rtol, 20);
+    let (tr, stats, report) =
+        simulate_global(&model, Scheme::Dopri5, &o, &GlobalControl::default()).expect("global");
+    let e = error_in_tolerance(&model, &tr, &reference, rtol, rtol / 100.0);
+    println!("local: {e_local:.3e} of the tolerance; global: {e:.3e}, {report}");
+    assert!(
+        e_local > 10.0,
+        "local control is more than a digit short: {e_local}"
+    );
+    assert!(e <= 1.0, "global control meets rtol: {e}");
+    assert!(report.estimate <= 1.0);
+    assert!(
+        e / report.estimate < 3.0 && report.estimate / e < 3.0,
+        "the estimate {} is within a factor 3 of the true error {e}",
+        report.estimate
+    );
+    // work: every run counted, the returned run's own stats among them
+    let steps: usize = report.runs.iter().map(|r| r.steps).sum();
+    assert_eq!(report.work.steps, steps);
+    assert!(report.runs.iter().any(|r| r.steps == stats.steps));
+    assert!(report.runs.len() <= 4, "{report}");
+    assert!(report.runs.windows(2).all(|w| w[1].rtol < w[0].rtol));
+}
+
+/// A tolerance the scheme cannot reach: generalized-α at index 3 tests positions only and
+/// is 4–5 digits short of rtol on fastlink, so rtol 1e-8 would take a local rtol below 1e-13.
+/// The control stops with the typed failure and keeps its most accurate complete run.
+#[test]
+fn an_unreachable_tolerance_is_a_typed_failure_that_keeps_the_trajectory() {
+    let model = fastlink::FastLink::default();
+    let mut o = options(0.03, 1e-8, 30);
+    o.constraints.method = ConstraintMethod::Index3;
+    let scheme = Scheme::GenAlpha(GenAlphaParams::from_rho_inf(0.8));
+    let err = simulate_global(&model, scheme, &o, &GlobalControl::default())
+        .expect_err("1e-8 is out of gen-α index 3's reach on fastlink");
+    println!("{}", err.kind);
+    let Failure::GlobalToleranceNotMet { estimate, runs, .. } = err.kind else {
+        panic!("a typed failure: {}", err.kind);
+    };
+    assert!(estimate > 1.0 && runs >= 2);
+    assert_eq!(err.trajectory.len(), 30, "the whole trajectory is kept");
+    assert!((err.t - 0.03).abs() < 1e-12);
+}
+
+/// Fixed steps have no tolerance to meet: refused before any work, by name.
+#[test]
+fn fixed_steps_are_refused() {
+    let o = Options::fixed(1.0, 1e-3);
+    let err = simulate_global(
+        &fourbar::FourBar::default(),
+        Scheme::Rk4,
+        &o,
+        &GlobalControl::default(),
+    )
+    .expect_err("fixed steps");
+    assert!(
+        matches!(err.kind, Failure::InvalidOption { name: "step", .. }),
+        "{}",
+        err.kind
+    );
+    assert_eq!(err.stats.steps, 0);
+}
+
+/// A body on a spherical joint tumbling through its flips: each run re-centres its chart at
+/// its own times, so the runs are compared by rotation and angular velocity, not angles. The
+/// control converges over 10 s (the first flip), and the result is within rtol of a run at rtol
+/// 1e-12.
+#[test]
+fn rotation_joints_are_compared_without_their_charts() {
+    let model = tumble::TumbleBall::default();
+    let rtol = 1e-5;
+    let (reference, _) =
+        simulate(model.clone(), Scheme::Dopri5, options(10.0, 1e-12, 50)).expect("reference");
+    let o = options(10.0, rtol, 50);
+    let (tr, stats, report) =
+        simulate_global(&model, Scheme::Dopri5, &o, &GlobalControl::default()).expect("global");
+    let e = error_in_tolerance(&model, &tr, &reference, rtol, rtol / 100.0);
+    println!("tumble on Tball: {e:.3e} of the tolerance, {report}");
+    assert!(stats.chart_switches > 0, "the charts were re-centred");
+    assert!(e <= 1.0, "{e}");
+}

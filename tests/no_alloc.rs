@@ -81,7 +81,7 @@ fn recentring_allocates_nothing() {
         if scheme.is_adaptive() {
             modes.push(Options {
                 h_max: 5e-3,
-                ..Options::adaptive(100.0, 1e-7)
+                ..Options::adaptive(100.0, 1e-5)
             });
         }
         for base in modes {

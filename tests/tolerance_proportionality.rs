@@ -7,9 +7,10 @@
 //!
 //! Asserted for the methods whose error test covers positions and velocities and whose
 //! tolerance is mapped so that the error follows rtol (DOPRI5 and BDF with projection or
-//! partitioning, Radau5 with projection or partitioning, the Newmark family at index 2
+//! partitioning, Radau5 with projection or partitioning, Radau3 with projection, partitioning
+//! or at index 2, the Newmark family at index 2
 //! from rtol 1e-4 to 1e-7 — below that its local tolerance reaches the
-//! rounding floor; DOPRI5 from 1e-5), over their range:
+//! rounding floor; DOPRI5 from 1e-6), over their range:
 //!
 //! - every run reaches t_end;
 //! - no run loses more than 0.2 digits when rtol tightens by a decade;
@@ -25,14 +26,14 @@
 //!
 //! Printed, not asserted: index 3, the Newmark family's default (Radau weights velocity
 //! errors by h, the Newmark family tests positions only: 2–5 digits short, ⅔ of a digit per
-//! decade), the Newmark family with projection or partitioning (positions only), Radau3, which
-//! keeps RADAU5's tolerance transformation (2–4 digits short:
-//! `mbs-runtime/src/integrators/radau/mod.rs`), and Radau5 at index 2 (over-accurate at loose
+//! decade), the Newmark family with projection or partitioning (positions only), and Radau5 at
+//! index 2 (over-accurate at loose
 //! rtol, half a digit per decade: 5.4 digits at rtol 1e-4 and 8.0 at 1e-10 on the Cartesian
 //! double pendulum, and it loses 0.5 digits from rtol 1e-5 to 1e-6 on the four-bar).
 //!
 //! Global error control (`mbs::simulate_global`) is what makes rtol a bound on these errors:
-//! every sweep runs again under it at rtol 1e-4, 1e-6 and 1e-8, and it is asserted that
+//! every sweep runs again under it at rtol 1e-4, 1e-6 and 1e-8 (the schemes of order 2 and 3
+//! to 1e-6), and it is asserted that
 //! no run it returns is more than half a digit short of rtol (the slack of an estimate made
 //! against a run ten times tighter), that every run it does not return ends in the typed
 //! `GlobalToleranceNotMet`, and that DOPRI5 and Radau5 with their default constraint method
@@ -54,15 +55,17 @@ const WITHIN: f64 = 1.5;
 const LOSS: f64 = 0.2;
 
 /// The loosest and tightest rtol at which a sweep is asserted, or `None` when it is only
-/// printed. DOPRI5 from 1e-5: at 1e-4 it loses the four-bar's phase over its fast crank turns
-/// (0.43 digits where the median of the others is 2.29).
+/// printed. DOPRI5 from 1e-6: at 1e-4 it loses the four-bar's phase over its fast crank turns
+/// (0.43 digits where the median of the others is 2.29), and at 1e-5 it dips on slider-crank
+/// (b) (3.20 digits, 1.7 below the median since Radau3's tolerance is mapped) and, with
+/// partitioning, on the Cartesian double pendulum (3.22, 1.6 below).
 fn claimed(label: &str) -> Option<(f64, f64)> {
     let (scheme, method) = label.split_once(' ').unwrap_or((label, ""));
     match (scheme, method) {
-        (_, "index3") | ("radau3", _) | ("radau5", "index2") => None,
+        (_, "index3") | ("radau5", "index2") => None,
         ("gen-alpha" | "hht", "index2") => Some((1e-4, 1e-7)),
         ("gen-alpha" | "hht", _) => None,
-        ("dopri5", _) => Some((1e-5, 1e-10)),
+        ("dopri5", _) => Some((1e-6, 1e-10)),
         _ => Some((1e-4, 1e-10)),
     }
 }
@@ -250,8 +253,20 @@ fn measure<M: Model + Clone + 'static>(s: Study, model: &M) -> Vec<String> {
     bad
 }
 
-/// The tolerances of the global-control sweeps.
+/// The tolerances of the global-control sweeps; the schemes of order 2 and 3 stop at 1e-6
+/// (Radau3 takes up to 1.1 million steps in all at 1e-8 on fastlink, the Newmark family fails
+/// there after runs down to its floor).
 const GLOBAL_RTOLS: [f64; 3] = [1e-4, 1e-6, 1e-8];
+
+/// The global-control tolerances of the sweep `label`.
+fn global_rtols(label: &str) -> &'static [f64] {
+    let low_order = ["radau3", "gen-alpha", "hht"];
+    if low_order.iter().any(|s| label.starts_with(s)) {
+        &GLOBAL_RTOLS[..2]
+    } else {
+        &GLOBAL_RTOLS
+    }
+}
 /// Digits a run under global control may fall short of rtol: the slack of an estimate made
 /// against a run only ten times tighter.
 const GLOBAL_SLACK: f64 = 0.5;
@@ -269,7 +284,10 @@ fn measure_global<M: Model + Clone + 'static>(s: &Study, model: &M) -> Vec<Strin
             .iter()
             .map(|w| {
                 Sweep {
-                    settings: GLOBAL_RTOLS.iter().map(|&r| Setting::Rtol(r)).collect(),
+                    settings: global_rtols(&w.label)
+                        .iter()
+                        .map(|&r| Setting::Rtol(r))
+                        .collect(),
                     ..w.clone()
                 }
                 .global()
@@ -288,7 +306,7 @@ fn measure_global<M: Model + Clone + 'static>(s: &Study, model: &M) -> Vec<Strin
         let Setting::Rtol(rtol) = row.setting else {
             continue;
         };
-        if k % GLOBAL_RTOLS.len() == 0 {
+        if k == 0 || wp.rows[k - 1].label != row.label {
             println!("{line}");
             line = format!("{:<32}", row.label);
         }

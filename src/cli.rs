@@ -9,6 +9,8 @@
 //! --dt DT         output every DT seconds (default: every step)
 //! --constraints M auto, index3, index2, projection, partitioning, baumgarte:ALPHA,BETA
 //!                 (constrained models; default auto)
+//! --global-error  rtol bounds the error of the trajectory, not of a step: the run is
+//!                 repeated at tighter tolerances until the estimate is within it
 //! --scene NAME    the scene to run (programs whose model has several)
 //! --out DIR       write DIR/trajectory.csv (every output, written as the run goes),
 //!                 coordinates.svg, energy.svg, animation.html (offline, in any browser),
@@ -41,8 +43,9 @@
 
 use crate::plot::{Chart, Series, line_chart};
 use crate::{
-    ConstraintMethod, ConstraintOptions, CsvWriter, Failure, Inputs, Model, Options, Output,
-    Scheme, SimError, Simulation, Stats, StepControl, Trajectory, error::short,
+    ConstraintMethod, ConstraintOptions, CsvWriter, Failure, GlobalControl, GlobalReport, Inputs,
+    Model, Options, Output, Scheme, SimError, Simulation, Stats, StepControl, Trajectory,
+    error::short, simulate_global,
 };
 /// `RunArgs::parse()` needs this trait in scope: programs can name it without depending on
 /// clap themselves (`use mbs::cli::Parser;`).
@@ -95,6 +98,11 @@ pub struct RunArgs {
     /// baumgarte:ALPHA,BETA (1/s)
     #[arg(long, default_value = "auto", value_parser = parse_constraint_method)]
     pub constraints: ConstraintMethod,
+    /// make --rtol/--atol bound the error of the whole trajectory: run again at tighter local
+    /// tolerances until the estimated global error is within them (`mbs::simulate_global`;
+    /// adaptive steps, models without inputs)
+    #[arg(long, conflicts_with = "h")]
+    pub global_error: bool,
     /// print nothing but errors
     #[arg(long)]
     pub quiet: bool,
@@ -120,6 +128,16 @@ pub struct RunArgs {
     /// with --sweep: threads (default: every core, or RAYON_NUM_THREADS)
     #[arg(long, requires = "sweep")]
     pub threads: Option<usize>,
+}
+
+/// The globally controlled runs of a model `--global-error` asks for.
+type GlobalRunner<'a> =
+    dyn Fn(Scheme, &Options) -> Result<(Trajectory, Stats, GlobalReport), SimError> + 'a;
+
+/// How `execute` runs: the globally controlled runs, or one simulation step by step.
+enum Runner<'a, M: Model> {
+    Global(&'a GlobalRunner<'a>),
+    Steps(Box<Simulation<M>>),
 }
 
 /// What `--sweep` did.
@@ -157,6 +175,9 @@ pub struct RunReport {
     pub conservative: bool,
     /// max |E(t) − E(0)| and the scale of energies over every output (not the thinned ones)
     energy: Option<(f64, f64)>,
+    /// with `--global-error`: the runs made and the estimate of the returned one (`stats` is
+    /// then the work of every run)
+    pub global: Option<GlobalReport>,
 }
 
 impl RunReport {
@@ -186,6 +207,10 @@ pub enum RunError {
     },
     #[error("unknown scene `{given}`: this program has {known}")]
     UnknownScene { given: String, known: String },
+    #[error(
+        "--global-error repeats the run from the same start, which a model with inputs driven by Rust code cannot: run it without --global-error"
+    )]
+    GlobalWithInputs,
     #[error("{0}")]
     Sweep(#[from] crate::sweep::SweepError),
     #[error("this program makes one run at a time: it does not offer --sweep")]
@@ -498,7 +523,7 @@ impl RunArgs {
     /// Runs `model` as asked, prints a summary unless `--quiet`, writes the outputs if
     /// `--out`. A run that fails or is stopped by Ctrl-C writes what it computed until then
     /// and returns [`RunError::Stopped`] with it.
-    pub fn run<M: Model + 'static>(
+    pub fn run<M: Model + Clone + 'static>(
         &self,
         model: M,
         default_t_end: f64,
@@ -506,7 +531,14 @@ impl RunArgs {
         if self.sweep.is_some() {
             return Err(RunError::SweepNotOffered);
         }
-        self.run_with(model, default_t_end, Inputs::new())
+        if self.global_error {
+            let copy = model.clone();
+            let global = move |scheme: Scheme, options: &Options| {
+                simulate_global(&copy, scheme, options, &GlobalControl::default())
+            };
+            return self.execute(model, default_t_end, Inputs::new(), Some(&global));
+        }
+        self.execute(model, default_t_end, Inputs::new(), None)
     }
 
     /// `--sweep PLAN.toml --out DIR`: the sweep of the plan over copies of `model`
@@ -618,6 +650,20 @@ impl RunArgs {
         if self.sweep.is_some() {
             return Err(RunError::SweepWithInputs);
         }
+        if self.global_error {
+            return Err(RunError::GlobalWithInputs);
+        }
+        self.execute(model, default_t_end, inputs, None)
+    }
+
+    /// One run, streamed step by step, or with `global` the globally controlled runs.
+    fn execute<M: Model + 'static>(
+        &self,
+        model: M,
+        default_t_end: f64,
+        inputs: Inputs,
+        global: Option<&GlobalRunner<'_>>,
+    ) -> Result<RunReport, RunError> {
         let scheme = Scheme::from_name(&self.scheme)
             .ok_or_else(|| RunError::UnknownScheme(self.scheme.clone()))?;
         let info = model.info();
@@ -638,11 +684,17 @@ impl RunArgs {
         let cpu0 = cpu_time::ThreadTime::try_now().ok();
         let options = self.options(default_t_end);
         let (t0, t_end) = (options.t0, options.t_end);
-        let mut sim = Simulation::with_inputs(model, scheme, options, inputs)
-            .map_err(|e| RunError::Simulation(Box::new(e)))?;
-        if let (Some(a), false) = (sim.assembly(), self.quiet) {
-            println!("{a}");
-        }
+        let runner = match global {
+            Some(run) => Runner::Global(run),
+            None => {
+                let sim = Simulation::with_inputs(model, scheme, options.clone(), inputs)
+                    .map_err(|e| RunError::Simulation(Box::new(e)))?;
+                if let (Some(a), false) = (sim.assembly(), self.quiet) {
+                    println!("{a}");
+                }
+                Runner::Steps(Box::new(sim))
+            }
+        };
         let csv = match &self.out {
             None => None,
             Some(dir) => {
@@ -657,63 +709,98 @@ impl RunArgs {
             }
         };
         let mut recorder = Recorder::new(csv, t0, t_end);
-        sim.drain_outputs(|tr| recorder.take(tr));
-        if !self.quiet {
-            println!(
-                "running {name} with {} to t = {t_end} s (Ctrl-C stops it and keeps what was computed)",
-                scheme.name()
-            );
-        }
-        // step by step (no artificial stops), with a progress bar once the run passes a second
-        let bar = ProgressBar::hidden();
-        bar.set_length(100);
-        bar.set_style(
-            ProgressStyle::with_template("{prefix} [{bar:40}] {percent:>3}% {msg}")
-                .unwrap_or_else(|_| ProgressStyle::default_bar())
-                .progress_chars("=> "),
-        );
-        bar.set_prefix(format!("{name} ({})", scheme.name()));
-        let mut shown = 0;
-        let mut failure = None;
-        let mut interrupted = false;
-        while crate::Integrator::state(&sim).t < t_end {
-            if INTERRUPTED.load(Ordering::SeqCst) {
-                interrupted = true;
-                break;
-            }
-            if let Err(e) = crate::Integrator::step(&mut sim) {
-                failure = Some(Box::new(e));
-                break;
-            }
-            sim.drain_outputs(|tr| recorder.take(tr));
-            let t = crate::Integrator::state(&sim).t;
-            let done = (100.0 * (t - t0) / (t_end - t0)).floor() as u64;
-            if done > shown {
-                shown = done;
-                if bar.is_hidden() && !self.quiet && start.elapsed() > Duration::from_secs(1) {
-                    bar.set_draw_target(ProgressDrawTarget::stderr());
+        let mut global_report = None;
+        let (stats, failure, interrupted) = match runner {
+            Runner::Global(run) => {
+                if !self.quiet {
+                    println!(
+                        "running {name} with {} to t = {t_end} s under global error control",
+                        scheme.name()
+                    );
                 }
-                bar.set_position(done);
-                bar.set_message(format!("t = {t:.3} s"));
+                drop(running);
+                match run(scheme, &options) {
+                    Ok((tr, _, report)) => {
+                        recorder.take(&tr);
+                        let work = report.work.clone();
+                        if !self.quiet {
+                            println!("{report}");
+                        }
+                        global_report = Some(report);
+                        (work, None, false)
+                    }
+                    Err(mut e) => {
+                        recorder.take(&e.trajectory);
+                        e.trajectory.clear_outputs();
+                        ((*e.stats).clone(), Some(Box::new(e)), false)
+                    }
+                }
             }
-        }
-        drop(running);
-        if failure.is_some() || interrupted {
-            bar.abandon();
-        } else {
-            bar.finish_and_clear();
-        }
-        let stats = match &mut failure {
-            Some(e) => {
-                // the outputs recorded in the failing call, and the work until the failure
-                recorder.take(&e.trajectory);
-                e.trajectory.clear_outputs();
-                (*e.stats).clone()
-            }
-            None => {
-                let (rest, stats) = sim.finish();
-                recorder.take(&rest);
-                stats
+            Runner::Steps(sim) => {
+                let mut sim = *sim;
+                sim.drain_outputs(|tr| recorder.take(tr));
+                if !self.quiet {
+                    println!(
+                        "running {name} with {} to t = {t_end} s (Ctrl-C stops it and keeps what was computed)",
+                        scheme.name()
+                    );
+                }
+                // step by step (no artificial stops), with a progress bar once the run passes a second
+                let bar = ProgressBar::hidden();
+                bar.set_length(100);
+                bar.set_style(
+                    ProgressStyle::with_template("{prefix} [{bar:40}] {percent:>3}% {msg}")
+                        .unwrap_or_else(|_| ProgressStyle::default_bar())
+                        .progress_chars("=> "),
+                );
+                bar.set_prefix(format!("{name} ({})", scheme.name()));
+                let mut shown = 0;
+                let mut failure = None;
+                let mut interrupted = false;
+                while crate::Integrator::state(&sim).t < t_end {
+                    if INTERRUPTED.load(Ordering::SeqCst) {
+                        interrupted = true;
+                        break;
+                    }
+                    if let Err(e) = crate::Integrator::step(&mut sim) {
+                        failure = Some(Box::new(e));
+                        break;
+                    }
+                    sim.drain_outputs(|tr| recorder.take(tr));
+                    let t = crate::Integrator::state(&sim).t;
+                    let done = (100.0 * (t - t0) / (t_end - t0)).floor() as u64;
+                    if done > shown {
+                        shown = done;
+                        if bar.is_hidden()
+                            && !self.quiet
+                            && start.elapsed() > Duration::from_secs(1)
+                        {
+                            bar.set_draw_target(ProgressDrawTarget::stderr());
+                        }
+                        bar.set_position(done);
+                        bar.set_message(format!("t = {t:.3} s"));
+                    }
+                }
+                drop(running);
+                if failure.is_some() || interrupted {
+                    bar.abandon();
+                } else {
+                    bar.finish_and_clear();
+                }
+                let stats = match &mut failure {
+                    Some(e) => {
+                        // the outputs recorded in the failing call, and the work until the failure
+                        recorder.take(&e.trajectory);
+                        e.trajectory.clear_outputs();
+                        (*e.stats).clone()
+                    }
+                    None => {
+                        let (rest, stats) = sim.finish();
+                        recorder.take(&rest);
+                        stats
+                    }
+                };
+                (stats, failure, interrupted)
             }
         };
         let (outputs, peak_held) = (recorder.outputs, recorder.peak_held);
@@ -735,6 +822,7 @@ impl RunArgs {
                 .unwrap_or_else(|| start.elapsed()),
             conservative,
             energy,
+            global: global_report,
         };
         let stopped = failure.is_some() || interrupted;
         let status = match &failure {

@@ -420,3 +420,57 @@ fn a_model_with_inputs_runs_with_the_programs_defaults() {
     let k: &mbs::DMatrix<f64> = &lin.k;
     assert!((k[(0, 0)] - 9.81).abs() < 1e-9, "{k}");
 }
+
+/// `--global-error`: the run is repeated at tighter tolerances until the estimated error of
+/// the trajectory is within --rtol; the outputs are those asked (--dt), the report holds the
+/// runs and its stats their work, and the result is within rtol of a run at rtol 1e-12.
+/// A fixed step conflicts with it; a model with inputs driven by Rust code is refused.
+#[test]
+fn global_error_control_from_the_command_line() {
+    let dir = scratch("global");
+    let out = dir.to_string_lossy().to_string();
+    let rtol = 1e-6;
+    let a = args(&[
+        "--rtol",
+        "1e-6",
+        "--t-end",
+        "5",
+        "--dt",
+        "0.1",
+        "--global-error",
+        "--out",
+        &out,
+    ]);
+    let report = a.run(SwingFree::default(), 10.0).unwrap();
+    let g = report
+        .global
+        .as_ref()
+        .expect("the runs of the global control");
+    assert!(g.estimate <= 1.0 && g.runs.len() >= 2, "{g}");
+    assert_eq!(
+        report.stats.steps,
+        g.runs.iter().map(|r| r.steps).sum::<usize>()
+    );
+    assert_eq!(report.trajectory.len(), 51);
+    let csv = std::fs::read_to_string(dir.join("trajectory.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 52);
+    let tight = args(&["--rtol", "1e-12", "--t-end", "5", "--dt", "0.1"])
+        .run(SwingFree::default(), 10.0)
+        .unwrap();
+    for i in 0..51 {
+        let (q, r) = (report.trajectory.q(i)[0], tight.trajectory.q(i)[0]);
+        let (qd, rd) = (report.trajectory.qd(i)[0], tight.trajectory.qd(i)[0]);
+        let bound = |r: f64| rtol * (0.01 + r.abs());
+        assert!(
+            (q - r).abs() <= bound(r) && (qd - rd).abs() <= bound(rd),
+            "at {i}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(RunArgs::try_parse_from(["program", "--global-error", "--h", "0.01"]).is_err());
+    let e = args(&["--global-error"])
+        .run_with(SwingFree::default(), 1.0, mbs::Inputs::new())
+        .err()
+        .unwrap();
+    assert!(matches!(e, RunError::GlobalWithInputs), "{e}");
+}

@@ -57,7 +57,7 @@ const LOSS: f64 = 0.2;
 /// The loosest and tightest rtol at which a sweep is asserted, or `None` when it is only
 /// printed. DOPRI5 from 1e-6: at 1e-4 it loses the four-bar's phase over its fast crank turns
 /// (0.43 digits where the median of the others is 2.29), and at 1e-5 it dips on slider-crank
-/// (b) (3.20 digits, 1.7 below the median since Radau3's tolerance is mapped) and, with
+/// (b) (3.20 digits, 2.0 below the median since Radau3's tolerance is mapped) and, with
 /// partitioning, on the Cartesian double pendulum (3.22, 1.6 below).
 fn claimed(label: &str) -> Option<(f64, f64)> {
     let (scheme, method) = label.split_once(' ').unwrap_or((label, ""));

@@ -134,12 +134,6 @@ pub struct RunArgs {
 type GlobalRunner<'a> =
     dyn Fn(Scheme, &Options) -> Result<(Trajectory, Stats, GlobalReport), SimError> + 'a;
 
-/// How `execute` runs: the globally controlled runs, or one simulation step by step.
-enum Runner<'a, M: Model> {
-    Global(&'a GlobalRunner<'a>),
-    Steps(Box<Simulation<M>>),
-}
-
 /// What `--sweep` did.
 #[derive(Debug)]
 pub enum SweepReport {
@@ -684,17 +678,13 @@ impl RunArgs {
         let cpu0 = cpu_time::ThreadTime::try_now().ok();
         let options = self.options(default_t_end);
         let (t0, t_end) = (options.t0, options.t_end);
-        let runner = match global {
-            Some(run) => Runner::Global(run),
-            None => {
-                let sim = Simulation::with_inputs(model, scheme, options.clone(), inputs)
-                    .map_err(|e| RunError::Simulation(Box::new(e)))?;
-                if let (Some(a), false) = (sim.assembly(), self.quiet) {
-                    println!("{a}");
-                }
-                Runner::Steps(Box::new(sim))
-            }
-        };
+        // the options and the start are checked (and a loop's assembly shown) before any file
+        // is written, also for the globally controlled runs, which start the same way
+        let mut sim = Simulation::with_inputs(model, scheme, options.clone(), inputs)
+            .map_err(|e| RunError::Simulation(Box::new(e)))?;
+        if let (Some(a), false) = (sim.assembly(), self.quiet) {
+            println!("{a}");
+        }
         let csv = match &self.out {
             None => None,
             Some(dir) => {
@@ -710,8 +700,8 @@ impl RunArgs {
         };
         let mut recorder = Recorder::new(csv, t0, t_end);
         let mut global_report = None;
-        let (stats, failure, interrupted) = match runner {
-            Runner::Global(run) => {
+        let (stats, failure, interrupted) = match global {
+            Some(run) => {
                 if !self.quiet {
                     println!(
                         "running {name} with {} to t = {t_end} s under global error control",
@@ -736,8 +726,7 @@ impl RunArgs {
                     }
                 }
             }
-            Runner::Steps(sim) => {
-                let mut sim = *sim;
+            None => {
                 sim.drain_outputs(|tr| recorder.take(tr));
                 if !self.quiet {
                     println!(

@@ -424,7 +424,8 @@ fn a_model_with_inputs_runs_with_the_programs_defaults() {
 /// `--global-error`: the run is repeated at tighter tolerances until the estimated error of
 /// the trajectory is within --rtol; the outputs are those asked (--dt), the report holds the
 /// runs and its stats their work, and the result is within rtol of a run at rtol 1e-12.
-/// A fixed step conflicts with it; a model with inputs driven by Rust code is refused.
+/// A fixed step conflicts with it; a model with inputs driven by Rust code is refused; a bad
+/// option is refused before any file is written.
 #[test]
 fn global_error_control_from_the_command_line() {
     let dir = scratch("global");
@@ -473,4 +474,13 @@ fn global_error_control_from_the_command_line() {
         .err()
         .unwrap();
     assert!(matches!(e, RunError::GlobalWithInputs), "{e}");
+    // a bad option is refused before anything is run or written, as without the flag
+    let dir = scratch("global-refused");
+    let out = dir.to_string_lossy().to_string();
+    let e = args(&["--global-error", "--rtol", "-1e-6", "--out", &out])
+        .run(SwingFree::default(), 1.0)
+        .err()
+        .unwrap();
+    assert!(matches!(e, RunError::Simulation(_)), "{e}");
+    assert!(!dir.exists());
 }

@@ -55,10 +55,10 @@ const WITHIN: f64 = 1.5;
 const LOSS: f64 = 0.2;
 
 /// The loosest and tightest rtol at which a sweep is asserted, or `None` when it is only
-/// printed. DOPRI5 from 1e-6: at 1e-4 it loses the four-bar's phase over its fast crank turns
-/// (0.43 digits where the median of the others is 2.29), and at 1e-5 it dips on slider-crank
-/// (b) (3.20 digits, 2.0 below the median since Radau3's tolerance is mapped) and, with
-/// partitioning, on the Cartesian double pendulum (3.22, 1.6 below).
+/// printed. DOPRI5 from 1e-6: at 1e-4 and 1e-5 it falls 1.5–2.1 digits below the median of
+/// the others on three loops (the four-bar at 1e-4, 0.43 digits against 2.54: it loses the
+/// phase of the fast crank turns; the Cartesian double pendulum at 1e-4 and, with
+/// partitioning, 1e-5; slider-crank (b) at 1e-5, 3.20 against 5.20).
 fn claimed(label: &str) -> Option<(f64, f64)> {
     let (scheme, method) = label.split_once(' ').unwrap_or((label, ""));
     match (scheme, method) {

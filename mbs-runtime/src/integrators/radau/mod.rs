@@ -284,7 +284,7 @@
 //! control and no mapping removes it (global error control does: `simulate_global`).
 //!
 //! **Chosen:** Radau3 takes the mapping with c = 0.1, RADAU5's factor (5× looser than the
-//! table above, ⅔ of a digit less accurate and 40 % fewer steps). In the
+//! table above: by its order, about ⅔ of a digit less accurate for 40 % fewer steps). In the
 //! tolerance-proportionality sweeps (`tests/tolerance_proportionality.rs`, rtol 1e-4…1e-10 on
 //! six loops) its digits now gain 0.93–1.02 per decade with projection, partitioning or at
 //! index 2 (0.58–0.76 before), and its mean offset from rtol with projection is −2.2 to +1.3

@@ -3,8 +3,9 @@
 //! of the repository, at states drawn about each model's start: qdd and the product of its
 //! pivots (against det M) agree to 1e-12 relative, or to 4 ε κ₁(M) when M is so
 //! ill-conditioned that no two backward-stable solves need agree closer (the long chains);
-//! the backward error ‖M qdd − h‖ / (‖M‖ ‖qdd‖ + ‖h‖) is at most 1e-15. Also prints the op
-//! counts of both paths per model.
+//! the backward error ‖M qdd − h‖ / (‖M‖ ‖qdd‖ + ‖h‖) is at most 1e-15. The same for
+//! `forward_dynamics_forced` (M qdd = h + f, the path of efforts written in Rust) with a drawn
+//! generalised force f of the size of h. Also prints the op counts of both paths per model.
 
 use mbs::Model;
 use mbs::linalg::{cholesky, cholesky_solve};
@@ -46,6 +47,8 @@ fn check<M: Model>(name: &str, model: &M) -> (f64, f64) {
     let mut worst_kappa = 0.0f64;
     let (mut m, mut h) = (vec![0.0; n * n], vec![0.0; n]);
     let (mut qdd, mut pivots) = (vec![0.0; n], vec![0.0; n]);
+    let (mut forced, mut forced_pivots) = (vec![0.0; n], vec![0.0; n]);
+    let mut worst_forced = 0.0f64;
     for _ in 0..STATES {
         let q: Vec<f64> = q0.iter().map(|x| x + 0.3 * draw.next()).collect();
         let qd: Vec<f64> = qd0.iter().map(|x| x + draw.next()).collect();
@@ -53,6 +56,12 @@ fn check<M: Model>(name: &str, model: &M) -> (f64, f64) {
         model.dynamics(t, &q, &qd, &u, &mut m, &mut h);
         let (m0, h0) = (m.clone(), h.clone());
         cholesky(&mut m, n).unwrap_or_else(|e| panic!("{name}: M singular at {q:?}: {e:?}"));
+        // h + f, f drawn of the size of h
+        let h_scale = h.iter().fold(1.0f64, |a, v| a.max(v.abs()));
+        let f: Vec<f64> = (0..n).map(|_| h_scale * draw.next()).collect();
+        let mut hf: Vec<f64> = h.iter().zip(&f).map(|(a, b)| a + b).collect();
+        cholesky_solve(&m, n, &mut hf);
+        model.forward_dynamics_forced(t, &q, &qd, &u, &f, &mut forced, &mut forced_pivots);
         cholesky_solve(&m, n, &mut h);
         model.forward_dynamics(t, &q, &qd, &u, &mut qdd, &mut pivots);
         let scale = h.iter().fold(0.0f64, |a, v| a.max(v.abs()));
@@ -94,7 +103,19 @@ fn check<M: Model>(name: &str, model: &M) -> (f64, f64) {
         let log_det: f64 = (0..n).map(|i| 2.0 * m[i + n * i].ln()).sum();
         let log_prod: f64 = pivots.iter().map(|p| p.ln()).sum();
         worst_det = worst_det.max((log_prod - log_det).abs() / bound);
+        let scale = hf.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let diff = forced
+            .iter()
+            .zip(&hf)
+            .fold(0.0f64, |a, (x, r)| a.max((x - r).abs()));
+        worst_forced = worst_forced.max(diff / scale.max(f64::MIN_POSITIVE) / bound);
+        assert_eq!(
+            forced_pivots, pivots,
+            "{name}: the pivots do not depend on f"
+        );
     }
+    // the forced path is the same solve: its qdd counts with the others
+    worst_qdd = worst_qdd.max(worst_forced);
     let (label, fwd) = flops(model, "forward_dynamics");
     let (_, dynamics) = flops(model, "dynamics");
     println!(
@@ -169,6 +190,10 @@ fn forward_dynamics_equal_the_dense_solve_on_every_model() {
         &spherical_pendulum::SphericalPendulumZyx::default(),
     ));
     see(check("sine slider", &structural::SineSlider::default()));
+    see(check(
+        "hexapod walker",
+        &hexapod_walker::HexapodWalker::default(),
+    ));
     println!(
         "worst: qdd {:.2}, log det {:.2} of max(1e-12, 4 ε κ₁(M))",
         worst.0, worst.1

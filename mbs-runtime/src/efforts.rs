@@ -134,8 +134,6 @@ struct Scratch {
     qp: Vec<f64>,
     vp: Vec<f64>,
     up: Vec<f64>,
-    /// Cholesky factor of the wrapped M (forward dynamics)
-    l: Vec<f64>,
 }
 
 /// A generated model with efforts and extra states written in Rust: a [`Model`] with
@@ -176,7 +174,6 @@ impl<M: Model + 'static, E: Efforts> WithEfforts<M, E> {
             qp: z(big),
             vp: z(big),
             up: z(M::NU),
-            l: z(n * n),
         };
         let info = extended_info::<M, E>(model.info());
         WithEfforts {
@@ -307,16 +304,18 @@ impl<M: Model, E: Efforts> Model for WithEfforts<M, E> {
     const NFRAMES: usize = M::NFRAMES;
     const NPOINTS: usize = M::NPOINTS;
     const NC: usize = M::NC;
-    /// one Cholesky factorisation of the wrapped M; the extra states have unit mass
+    /// the wrapped model's forward dynamics with the user's efforts added to h
+    /// ([`Model::forward_dynamics_forced`]); the extra states have unit mass
     const FORWARD_DYNAMICS_GENERATED: bool = true;
 
     fn info(&self) -> &'static ModelInfo {
         self.info
     }
 
-    /// qdd from the wrapped M (NQ_M × NQ_M, dense Cholesky) and h plus the user's efforts;
-    /// the extra states' derivatives as they are. Pivots: L_jj² of the wrapped M (0 where it
-    /// is not positive definite), 1 for the extra states.
+    /// qdd of the wrapped model with the user's efforts added to its h, by its
+    /// [`Model::forward_dynamics_forced`] (generated: articulated bodies or sparse LᵀDL, no
+    /// dense factorisation; the default: dense Cholesky); the extra states' derivatives as
+    /// they are. Pivots: the wrapped model's, 1 for the extra states.
     fn forward_dynamics(
         &self,
         t: f64,
@@ -328,19 +327,20 @@ impl<M: Model, E: Efforts> Model for WithEfforts<M, E> {
     ) {
         let n = M::NQ;
         let s = &mut *self.scratch.borrow_mut();
-        self.model
-            .dynamics(t, &q[..n], &qd[..n], u, &mut s.m, &mut s.h);
         if !self.user(s, t, q, qd, u, false) {
             qdd.fill(f64::NAN);
             pivots.fill(0.0);
             return;
         }
-        s.l.copy_from_slice(&s.m);
-        let ok = crate::linalg::cholesky(&mut s.l, n).is_ok();
-        for i in 0..n {
-            qdd[i] = s.h[i] + s.qg[i];
-        }
-        crate::linalg::solve_with_pivots(&s.l, n, ok, &mut qdd[..n], &mut pivots[..n]);
+        self.model.forward_dynamics_forced(
+            t,
+            &q[..n],
+            &qd[..n],
+            u,
+            &s.qg,
+            &mut qdd[..n],
+            &mut pivots[..n],
+        );
         qdd[n..].copy_from_slice(&s.xd);
         pivots[n..].fill(1.0);
     }

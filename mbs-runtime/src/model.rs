@@ -397,6 +397,31 @@ pub trait Model {
         crate::linalg::solve_with_pivots(&m, n, ok, qdd, pivots);
     }
 
+    /// [`Model::forward_dynamics`] with a generalised force `f` (NQ) added to h: qdd of
+    /// M qdd = h + f, for efforts computed outside the model ([`crate::WithEfforts`]).
+    /// Generated models solve it by the same function as `forward_dynamics` (which is this one
+    /// at f = 0); the default solves densely, allocating.
+    #[allow(clippy::too_many_arguments)]
+    fn forward_dynamics_forced(
+        &self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        u: &[f64],
+        f: &[f64],
+        qdd: &mut [f64],
+        pivots: &mut [f64],
+    ) {
+        let n = Self::NQ;
+        let mut m = vec![0.0; n * n];
+        self.dynamics(t, q, qd, u, &mut m, qdd);
+        for (a, f) in qdd.iter_mut().zip(f) {
+            *a += f;
+        }
+        let ok = crate::linalg::cholesky(&mut m, n).is_ok();
+        crate::linalg::solve_with_pivots(&m, n, ok, qdd, pivots);
+    }
+
     /// [`Model::dynamics`] at four states at once (`t`, `q`, `qd`, `u`, `m`, `h` hold one
     /// state per lane, see [`crate::lanes`]). Generated with SIMD arithmetic when the model
     /// asks for it (`option batch;`, [`Model::BATCH_GENERATED`]); the default calls

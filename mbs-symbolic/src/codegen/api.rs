@@ -99,6 +99,15 @@ pub const FORWARD_DYNAMICS: Method = method(
     "",
 );
 
+/// `forward_dynamics_forced`: forward dynamics with a generalised force `f` added to h
+/// (efforts computed at run time, `mbs::WithEfforts`); the generated `forward_dynamics` is the
+/// same function at f = 0. The trait's default solves densely.
+pub const FORWARD_DYNAMICS_FORCED: Method = method(
+    "forward_dynamics_forced",
+    "t: f64, q: &[f64], qd: &[f64], u: &[f64], f: &[f64], qdd: &mut [f64], pivots: &mut [f64]",
+    "",
+);
+
 /// `point_kinematics`, which has a default in the trait (all of `kinematics`) that every
 /// generated model overrides with the points' part alone.
 pub const POINT_KINEMATICS: Method = method(
@@ -189,7 +198,7 @@ pub struct Sizes {
 }
 
 /// `impl ::mbs::Model for {ty}` with parameter struct `pty`: the constants, then every method
-/// of [`METHODS`] and [`FORWARD_DYNAMICS`] (and [`BATCH`] with `sizes.batch`,
+/// of [`METHODS`], [`FORWARD_DYNAMICS`] and [`FORWARD_DYNAMICS_FORCED`] (and [`BATCH`] with `sizes.batch`,
 /// [`PARAMETER_TANGENTS`] with sensitive parameters) with the body `body(method)`.
 pub fn model_impl(
     ty: &str,
@@ -235,7 +244,11 @@ const BATCH_GENERATED: bool = {batch};
     };
     for m in METHODS
         .iter()
-        .chain([&FORWARD_DYNAMICS, &POINT_KINEMATICS])
+        .chain([
+            &FORWARD_DYNAMICS,
+            &FORWARD_DYNAMICS_FORCED,
+            &POINT_KINEMATICS,
+        ])
         .chain(batch_methods)
         .chain(sensitivity_methods)
     {

@@ -31,6 +31,7 @@ impl Naming for RustNames<'_> {
             Var::Input(i) => format!("u_{i}"),
             Var::Lambda(i) => format!("lambda_{i}"),
             Var::Chart(i) => format!("r_{i}"),
+            Var::Force(i) => format!("f_{i}"),
         }
     }
 
@@ -46,6 +47,7 @@ impl Naming for RustNames<'_> {
             }
             Var::Input(i) => format!("let u_{i} = u[{i}];"),
             Var::Lambda(i) => format!("let lambda_{i} = lambda[{i}];"),
+            Var::Force(i) => format!("let f_{i} = f[{i}];"),
             Var::Chart(i) => {
                 let (j, r, c) = (i / 9, i % 9 / 3, i % 3);
                 format!("let r_{i} = {}[{j}][{r}][{c}];", self.charts_path)

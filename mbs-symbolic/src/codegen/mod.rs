@@ -438,7 +438,7 @@ fn emit_scene(
     f.matrix(a, "m", &mb.m);
     f.vector("h", &mb.h);
     specs.push((f, Some("dynamics (M, h)")));
-    let mut f = FnSpec::new("__forward_dynamics", api::FORWARD_DYNAMICS.args);
+    let mut f = FnSpec::new("__forward_dynamics", api::FORWARD_DYNAMICS_FORCED.args);
     f.vector("qdd", &eq.forward.qdd);
     f.vector("pivots", &eq.forward.pivots);
     let forward_label = format!("forward_dynamics ({})", eq.forward.method.name());
@@ -449,7 +449,7 @@ fn emit_scene(
         f.matrix(a, "m", &mb.m);
         f.vector("h", &mb.h);
         specs.push((f, None));
-        let mut f = FnSpec::lanes("__forward_dynamics_x4", api::FORWARD_DYNAMICS.args);
+        let mut f = FnSpec::lanes("__forward_dynamics_x4", api::FORWARD_DYNAMICS_FORCED.args);
         f.vector("qdd", &eq.forward.qdd);
         f.vector("pivots", &eq.forward.pivots);
         specs.push((f, None));
@@ -765,18 +765,25 @@ fn emit_scene(
             format!("self.params.__{name}(&self.charts, {})", m.call())
         }
         // SIMD code where the processor runs it, else the one-state function lane by lane
+        // one function with the added generalised force f, at f = 0 or given
+        "forward_dynamics" => format!("self.__forward_dynamics(t, q, qd, u, &[0.0; {n}], qdd, pivots)"),
+        "forward_dynamics_forced" => format!("self.__forward_dynamics({})", m.call()),
         name @ ("dynamics_x4" | "forward_dynamics_x4") => {
             let one = name.trim_end_matches("_x4");
             let (a, b) = if one == "dynamics" { ("m", "h") } else { ("qdd", "pivots") };
+            let call = if one == "dynamics" {
+                m.call()
+            } else {
+                format!("t, q, qd, u, &[::mbs::F64x4::ZERO; {n}], qdd, pivots")
+            };
             format!(
                 "if ::mbs::lanes::simd_available() {{
 #[allow(unused_unsafe)]
 // SAFETY: the processor has the features the batch code is compiled for
-unsafe {{ self.__{name}({}) }}
+unsafe {{ self.__{name}({call}) }}
 }} else {{
 ::mbs::lanes::lane_by_lane(t, [q, qd, u], [{a}, {b}], |t, [q, qd, u], [{a}, {b}]| ::mbs::Model::{one}(self, t, q, qd, u, {a}, {b}))
-}}",
-                m.call()
+}}"
             )
         }
         name => format!("self.__{name}({})", m.call()),

@@ -51,6 +51,7 @@ fn var_code(v: Var) -> u64 {
         Var::Input(i) => 5 << 16 | i as u64,
         Var::Lambda(i) => 6 << 16 | i as u64,
         Var::Chart(i) => 7 << 16 | i as u64,
+        Var::Force(i) => 8 << 16 | i as u64,
     }
 }
 

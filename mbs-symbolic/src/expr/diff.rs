@@ -91,7 +91,8 @@ impl Arena {
                     | Var::Param(_)
                     | Var::Input(_)
                     | Var::Lambda(_)
-                    | Var::Chart(_) => self.zero(),
+                    | Var::Chart(_)
+                    | Var::Force(_) => self.zero(),
                 },
             },
             Node::Add(a, b) => {

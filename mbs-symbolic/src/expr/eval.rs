@@ -44,6 +44,8 @@ impl Env for SliceEnv<'_> {
                 // the identity: entries 0, 4 and 8 of each 3 × 3 block are 1
                 None => f64::from(u8::from(i % 9 % 4 == 0)),
             },
+            // no generalised force added from outside the model
+            Var::Force(_) => 0.0,
         }
     }
 }

@@ -54,6 +54,9 @@ pub enum Var {
     /// reference rotation the joint's angles are measured from, held by the model at run time
     /// and constant in time between re-centrings
     Chart(u16),
+    /// generalised force `f[i]` added to h at run time (the argument of the generated
+    /// forward dynamics that carries efforts computed outside the model)
+    Force(u16),
 }
 
 impl Var {
@@ -66,7 +69,7 @@ impl Var {
             Var::Qdd(i) => 80 + i as u32 % 40,
             Var::T => 120,
             Var::Param(i) => 121 + i as u32 % 4,
-            Var::Input(i) | Var::Lambda(i) | Var::Chart(i) => 125 + i as u32 % 3,
+            Var::Input(i) | Var::Lambda(i) | Var::Chart(i) | Var::Force(i) => 125 + i as u32 % 3,
         };
         1u128 << bit
     }
@@ -83,6 +86,7 @@ impl fmt::Display for Var {
             Var::Input(i) => write!(f, "u{i}"),
             Var::Lambda(i) => write!(f, "l{i}"),
             Var::Chart(i) => write!(f, "r{i}"),
+            Var::Force(i) => write!(f, "f{i}"),
         }
     }
 }

@@ -158,6 +158,8 @@ impl Arena {
             Var::Lambda(idx(r)?)
         } else if let Some(r) = tok.strip_prefix('r') {
             Var::Chart(idx(r)?)
+        } else if let Some(r) = tok.strip_prefix('f') {
+            Var::Force(idx(r)?)
         } else {
             return Err(format!("unknown atom `{tok}`"));
         };

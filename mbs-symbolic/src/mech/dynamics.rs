@@ -244,10 +244,19 @@ impl SceneEquations {
 }
 
 /// The cheaper, by flops, of articulated bodies (when the tree allows it) and sparse LᵀDL,
-/// applied to `mb`'s h.
+/// applied to `mb`'s h plus a generalised force given at run time (`Var::Force`, zero in the
+/// generated `forward_dynamics`, the efforts of `mbs::WithEfforts` in
+/// `forward_dynamics_forced`).
 fn forward_dynamics(sys: &mut System, tree: &Tree, mb: &MassBias) -> Forward {
-    let Some(aba) = articulated(sys, tree, &mb.h) else {
-        return ltdl(&mut sys.arena, &mb.m, &mb.h);
+    let a = &mut sys.arena;
+    let h: Vec<ExprId> = (0..mb.h.len())
+        .map(|i| {
+            let f = a.var(Var::Force(i as u16));
+            a.add(mb.h[i], f)
+        })
+        .collect();
+    let Some(aba) = articulated(sys, tree, &h) else {
+        return ltdl(&mut sys.arena, &mb.m, &h);
     };
     let cost = |a: &Arena, f: &Forward| crate::expr::ops(a, &f.roots()).flops();
     let aba_cost = cost(&sys.arena, &aba);
@@ -255,7 +264,7 @@ fn forward_dynamics(sys: &mut System, tree: &Tree, mb: &MassBias) -> Forward {
     if 2 * ltdl_estimate(&sys.arena, &mb.m) > 4 * aba_cost {
         return aba;
     }
-    let sparse = ltdl(&mut sys.arena, &mb.m, &mb.h);
+    let sparse = ltdl(&mut sys.arena, &mb.m, &h);
     if aba_cost < cost(&sys.arena, &sparse) {
         aba
     } else {

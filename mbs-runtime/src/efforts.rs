@@ -37,8 +37,9 @@ pub trait Efforts: 'static {
     /// their names (NX of them)
     const STATE_NAMES: &'static [&'static str] = &[];
     /// whether [`Efforts::efforts`] reads frames ([`Effort::frame`]); when false only the
-    /// points' kinematics are computed at each evaluation ([`Model::point_kinematics`], a
-    /// fraction of the cost on a model of many bodies) and the frames' are left unset
+    /// points' positions, velocities and Jacobians are computed at each evaluation
+    /// ([`Model::point_kinematics`], a fraction of the cost on a model of many bodies), and
+    /// the frames and the points' bias accelerations are left unset
     const FRAMES: bool = true;
     /// x(0) (NX)
     fn initial_states(&self, _x: &mut [f64]) {}
@@ -72,7 +73,8 @@ impl Effort<'_> {
         &self.kin.frames[i]
     }
 
-    /// Kinematics of declared point `i` (`ModelInfo::point_index`).
+    /// Kinematics of declared point `i` (`ModelInfo::point_index`); its bias acceleration is
+    /// set only when the user part reads frames ([`Efforts::FRAMES`]).
     pub fn point(&self, i: usize) -> &PointKinematics {
         &self.kin.points[i]
     }

@@ -557,8 +557,11 @@ pub trait Model {
     /// Poses, velocities, Jacobians and bias accelerations of every frame and point.
     fn kinematics(&self, t: f64, q: &[f64], qd: &[f64], out: &mut Kinematics);
 
-    /// The points' part of [`Model::kinematics`] alone (`out.points`; `out.frames` is left
-    /// as it was): generated models compute nothing else, the default all of it.
+    /// The points' positions, velocities and Jacobians of [`Model::kinematics`] alone (in
+    /// `out.points`; their bias accelerations and `out.frames` are left as they were): what
+    /// efforts at points need ([`crate::Efforts::FRAMES`]). Generated models compute nothing
+    /// else (the bias accelerations were a quarter of the walking hexapod's flops here), the
+    /// default all of [`Model::kinematics`].
     fn point_kinematics(&self, t: f64, q: &[f64], qd: &[f64], out: &mut Kinematics) {
         self.kinematics(t, q, qd, out);
     }

@@ -466,7 +466,8 @@ impl Motor {
     /// the joint drives it), P₀ = 1 W.
     pub fn torque(&self, i: f64, w: f64) -> f64 {
         let tau = self.gear * self.k * i;
-        tau * self.eta.powf((tau * w).tanh())
+        // η^x as exp(x ln η): one exponential where `powf` costs about two
+        tau * ((tau * w).tanh() * self.eta.ln()).exp()
     }
 
     /// di/dt at voltage `v`, current `i`, joint speed `w`.

@@ -526,19 +526,22 @@ fn emit_scene(
         fk.matrix(a, &format!("out.frames[{i}].jw"), &dense3(a, &k.jw, n));
     }
     specs.push((f, Some("frames")));
-    // the points' part again alone, for efforts that read only points
+    // the points' positions, velocities and Jacobians again alone, for efforts that read
+    // only points (their bias accelerations only in `kinematics`)
     let mut fp = FnSpec::new("__point_kinematics", args("kinematics"));
     for (i, pk) in model.points.iter().enumerate() {
+        for r in 0..3 {
+            fk.outputs.push((
+                format!("out.points[{i}].bias_acceleration[{r}]"),
+                pk.bias[r],
+            ));
+        }
         for g in [&mut fk, &mut fp] {
             for r in 0..3 {
                 g.outputs
                     .push((format!("out.points[{i}].position[{r}]"), pk.position[r]));
                 g.outputs
                     .push((format!("out.points[{i}].velocity[{r}]"), pk.velocity[r]));
-                g.outputs.push((
-                    format!("out.points[{i}].bias_acceleration[{r}]"),
-                    pk.bias[r],
-                ));
             }
             g.matrix(
                 a,

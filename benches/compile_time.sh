@@ -7,11 +7,22 @@
 #   benches/compile_time.sh            # all cases
 #   benches/compile_time.sh chain32    # one case (arm24, chain32, hexapod, chain200, arm24-dev,
 #                                      # arm24-batch: the arm with `option batch;`)
+#   benches/compile_time.sh --generator-unoptimised [cases]
+#
+# The model crate's Cargo.toml has the profile lines the README recommends: the generator
+# (`mbs-symbolic`, which the proc-macro runs) optimised. `--generator-unoptimised` leaves them
+# out and measures Cargo's default, which builds proc-macros and their dependencies at
+# opt-level 0.
 #
 # Each timed build compiles the model crate from scratch (its artifacts cleaned, no
 # incremental cache); the peak memory is the largest resident set of the build's processes
 # (GNU time's %M, which covers the compiler and the proc-macro it runs).
 set -euo pipefail
+optimised=1
+if [ "${1:-}" = --generator-unoptimised ]; then
+    optimised=0
+    shift
+fi
 root="$(cd "$(dirname "$0")/.." && pwd)"
 dir="$(mktemp -d)"
 trap 'rm -rf "$dir"' EXIT
@@ -25,6 +36,14 @@ edition = "2024"
 mbs = { path = "$root" }
 [workspace]
 TOML
+if [ "$optimised" = 1 ]; then
+    cat >> "$dir/Cargo.toml" <<TOML
+[profile.release.package.mbs-symbolic]
+opt-level = 3
+[profile.dev.package.mbs-symbolic]
+opt-level = 3
+TOML
+fi
 
 # the shapes of the scaling benchmark (`chain!`, `arm!`), one model named `Model`
 shapes="$root/benches/scaling/shapes.rs"

@@ -129,7 +129,10 @@ fn a_40_link_chain_in_a_loop_is_the_chain_written_out() {
         };
         let eq = &reference.scenes[0];
         let a = &reference.sys.arena;
-        for mb in [&eq.vp, &eq.rec] {
+        // 40 bars are beyond the size at which virtual power is built: the recursive one only
+        assert!(eq.vp.is_none());
+        {
+            let mb = &eq.rec;
             let scale_m = m.iter().fold(0.0f64, |s, v| s.max(v.abs()));
             let scale_h = h.iter().fold(0.0f64, |s, v| s.max(v.abs()));
             for i in 0..N {

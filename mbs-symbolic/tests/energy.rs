@@ -374,7 +374,7 @@ fn balance(
             let dt_kin = a.dt(eq.kinetic);
             let dt_pot = a.dt(eq.potential);
             let mut roots = vec![de, dt_kin, dt_pot, eq.power];
-            for mb in [&eq.vp, &eq.rec] {
+            for mb in [eq.vp.as_ref().expect("small model"), &eq.rec] {
                 roots.extend(mb.m.iter().flatten());
                 roots.extend(&mb.h);
             }

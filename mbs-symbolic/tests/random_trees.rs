@@ -229,12 +229,16 @@ impl Checks {
         }
         let eq = &model.scenes[0];
         let mut roots = Vec::new();
-        roots.extend(flat(&eq.vp.m));
-        roots.extend(&eq.vp.h);
+        let vp = eq
+            .vp
+            .as_ref()
+            .expect("random trees are small enough for virtual power");
+        roots.extend(flat(&vp.m));
+        roots.extend(&vp.h);
         roots.extend(flat(&eq.rec.m));
         roots.extend(&eq.rec.h);
         roots.extend(&eq.tau_rec);
-        roots.extend(&eq.tau_vp);
+        roots.extend(eq.tau_vp.as_ref().expect("built with vp"));
         roots.extend(&eq.static_h);
         roots.extend([eq.kinetic, eq.potential]);
         for &b in &bodies {

@@ -39,16 +39,17 @@ pub struct SceneEquations {
     /// scene index (`None`: the model without scenes)
     pub scene: Option<usize>,
     pub effects: Vec<usize>,
-    /// virtual power M, h
-    pub vp: MassBias,
+    /// virtual power M, h; not built for large models ([`VP_PAIRS_LIMIT`]) or when the
+    /// recursive formulation is forced
+    pub vp: Option<MassBias>,
     /// recursive M (composite inertia), h (Newton–Euler)
     pub rec: MassBias,
     /// the formulation used for M and h
     pub formulation: Formulation,
     /// τ = M qdd − h by Newton–Euler
     pub tau_rec: Vec<ExprId>,
-    /// τ = M qdd − h from the virtual-power M and h
-    pub tau_vp: Vec<ExprId>,
+    /// τ = M qdd − h from the virtual-power M and h (when built)
+    pub tau_vp: Option<Vec<ExprId>>,
     /// the formulation used for τ
     pub tau_formulation: Formulation,
     /// h with qd = 0
@@ -76,17 +77,17 @@ pub struct SceneEquations {
 impl SceneEquations {
     /// M and h of the chosen formulation.
     pub fn chosen(&self) -> &MassBias {
-        match self.formulation {
-            Formulation::VirtualPower => &self.vp,
-            Formulation::Recursive => &self.rec,
+        match (self.formulation, &self.vp) {
+            (Formulation::VirtualPower, Some(vp)) => vp,
+            _ => &self.rec,
         }
     }
 
     /// τ of the chosen formulation.
     pub fn tau(&self) -> &[ExprId] {
-        match self.tau_formulation {
-            Formulation::VirtualPower => &self.tau_vp,
-            Formulation::Recursive => &self.tau_rec,
+        match (self.tau_formulation, &self.tau_vp) {
+            (Formulation::VirtualPower, Some(t)) => t,
+            _ => &self.tau_rec,
         }
     }
 
@@ -99,8 +100,10 @@ impl SceneEquations {
         let nd = sys.ndof();
         let effects = sys.scene_effects(scene);
         let loads = Loads::build(sys, tree, world, &effects);
-        let (m_vp, h_vp) = virtual_power(sys, tree, world, &loads);
-        let vp = MassBias { m: m_vp, h: h_vp };
+        let vp = build_virtual_power(sys, tree, world).then(|| {
+            let (m, h) = virtual_power(sys, tree, world, &loads);
+            MassBias { m, h }
+        });
         let m_rec = crba(sys, tree);
         let minus_h = newton_euler(sys, tree, world, &loads, false);
         let h_rec: Vec<ExprId> = minus_h.iter().map(|&x| sys.arena.neg(x)).collect();
@@ -108,31 +111,32 @@ impl SceneEquations {
         let tau_rec = newton_euler(sys, tree, world, &loads, true);
         let a = &mut sys.arena;
         let qdd: Vec<ExprId> = (0..nd).map(|k| a.var(Var::Qdd(k as u16))).collect();
-        let tau_vp: Vec<ExprId> = (0..nd)
-            .map(|i| {
-                let mq = a.dot(&vp.m[i], &qdd);
-                a.sub(mq, vp.h[i])
-            })
-            .collect();
+        let tau_vp: Option<Vec<ExprId>> = vp.as_ref().map(|vp| {
+            (0..nd)
+                .map(|i| {
+                    let mq = a.dot(&vp.m[i], &qdd);
+                    a.sub(mq, vp.h[i])
+                })
+                .collect()
+        });
         let cost = |a: &Arena, r: &[ExprId]| crate::expr::ops(a, r).flops();
-        let formulation = sys.options.formulation.unwrap_or_else(|| {
-            if cost(a, &vp.roots()) < cost(a, &rec.roots()) {
+        let formulation = match (sys.options.formulation, &vp) {
+            (Some(f), _) => f,
+            (None, Some(vp)) if cost(a, &vp.roots()) < cost(a, &rec.roots()) => {
                 Formulation::VirtualPower
-            } else {
-                Formulation::Recursive
             }
-        });
-        let tau_formulation = sys.options.formulation.unwrap_or_else(|| {
-            if cost(a, &tau_vp) < cost(a, &tau_rec) {
-                Formulation::VirtualPower
-            } else {
-                Formulation::Recursive
-            }
-        });
-        let chosen_h = match formulation {
-            Formulation::VirtualPower => vp.h.clone(),
-            Formulation::Recursive => rec.h.clone(),
+            _ => Formulation::Recursive,
         };
+        let tau_formulation = match (sys.options.formulation, &tau_vp) {
+            (Some(f), _) => f,
+            (None, Some(t)) if cost(a, t) < cost(a, &tau_rec) => Formulation::VirtualPower,
+            _ => Formulation::Recursive,
+        };
+        let chosen = match (formulation, &vp) {
+            (Formulation::VirtualPower, Some(vp)) => vp,
+            _ => &rec,
+        };
+        let chosen_h = chosen.h.clone();
         let mut zero_qd = FxHashMap::default();
         for k in 0..nd {
             zero_qd.insert(Var::Qd(k as u16), a.zero());
@@ -143,9 +147,9 @@ impl SceneEquations {
             .iter()
             .map(|&e| (0..nu).map(|k| a.diff(e, Var::Input(k as u16))).collect())
             .collect();
-        let tau: Vec<ExprId> = match tau_formulation {
-            Formulation::VirtualPower => tau_vp.clone(),
-            Formulation::Recursive => tau_rec.clone(),
+        let tau: Vec<ExprId> = match (tau_formulation, &tau_vp) {
+            (Formulation::VirtualPower, Some(t)) => t.clone(),
+            _ => tau_rec.clone(),
         };
         let tangents = sys.options.tangents.then(|| {
             let k: Vec<Vec<ExprId>> = tau
@@ -215,9 +219,9 @@ impl SceneEquations {
             }
             _ => None,
         };
-        let forward = match formulation {
-            Formulation::VirtualPower => forward_dynamics(sys, tree, &vp),
-            Formulation::Recursive => forward_dynamics(sys, tree, &rec),
+        let forward = match (formulation, &vp) {
+            (Formulation::VirtualPower, Some(vp)) => forward_dynamics(sys, tree, vp),
+            _ => forward_dynamics(sys, tree, &rec),
         };
         let (kinetic, potential) = energies(sys, tree, world, &loads);
         let power = loads.power.unwrap_or(sys.arena.zero());
@@ -241,6 +245,35 @@ impl SceneEquations {
             forward,
         }
     }
+}
+
+/// Above this many products of Jacobian columns (Σ over bodies of k(k+1)/2 for the k columns
+/// of J_G and of J_ω), the virtual-power formulation is not built: its M grows as the square
+/// of each body's number of coordinates, the recursive one's as that number, and building it
+/// is then most of the generator's time for nothing (a 200-bar chain: about 1.3 million
+/// products; it was chosen only on models far below, e.g. a Cartesian double pendulum).
+pub const VP_PAIRS_LIMIT: usize = 20_000;
+
+/// Whether to build the virtual-power formulation: unless the recursive one is forced, or
+/// the model is beyond [`VP_PAIRS_LIMIT`] without virtual power forced.
+fn build_virtual_power(sys: &System, tree: &Tree, world: &World) -> bool {
+    match sys.options.formulation {
+        Some(Formulation::VirtualPower) => return true,
+        Some(Formulation::Recursive) => return false,
+        None => {}
+    }
+    let pairs = |k: usize| k * (k + 1) / 2;
+    let mut total = 0;
+    for (n, node) in tree.nodes.iter().enumerate().skip(1) {
+        let bodies = node
+            .frames
+            .iter()
+            .filter(|&&f| sys.frames[f].inertia.is_some())
+            .count();
+        let k = &world.nodes[n];
+        total += bodies * (pairs(k.jv.len()) + pairs(k.jw.len()));
+    }
+    total <= VP_PAIRS_LIMIT
 }
 
 /// The cheaper, by flops, of articulated bodies (when the tree allows it) and sparse LᵀDL,

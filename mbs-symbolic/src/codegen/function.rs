@@ -1,7 +1,7 @@
 //! One generated method: outputs scheduled, emitted, and split into chunk methods when there
 //! are more than [`MAX_LETS`](crate::expr::cse::MAX_LETS) temporaries.
 
-use crate::expr::cse::Schedule;
+use crate::expr::cse::{MAX_LETS, Schedule};
 use crate::expr::emit::{LANES_TYPE, MissingDerivative, Naming, Numbers, emit};
 use crate::expr::{Arena, ExprId, OpCount, Var};
 use crate::mech::system::ParamDef;
@@ -71,6 +71,22 @@ pub struct FnSpec {
     pub outputs: Vec<(String, ExprId)>,
     /// `f64`, or lanes of several states (the batch functions of `option batch;`)
     pub numbers: Numbers,
+    /// a second method made of this one's first chunks, when it has several
+    pub prefix: Option<Prefix>,
+}
+
+/// A method computing the outputs before `outputs[split]` of a chunked [`FnSpec`] by calling
+/// the chunks that compute them (scheduled first): `mass_matrix` as the first chunks of
+/// `dynamics`, whose code then exists once.
+pub struct Prefix {
+    pub name: String,
+    /// its parameter list
+    pub args: String,
+    pub split: usize,
+    /// statements binding the arguments of the whole method it lacks (unused by its chunks)
+    pub bind: Vec<String>,
+    /// statements before the computation (buffer resets of its outputs)
+    pub prelude: Vec<String>,
 }
 
 impl FnSpec {
@@ -83,6 +99,7 @@ impl FnSpec {
             prelude: Vec::new(),
             outputs: Vec::new(),
             numbers: Numbers::Scalar,
+            prefix: None,
         }
     }
 
@@ -119,15 +136,29 @@ impl FnSpec {
     }
 }
 
-/// Emits the method(s) of `spec`; returns their text and op count.
+/// What [`emit_fn`] made: the text of the method(s), the op count of the method and, when
+/// its [`Prefix`] was emitted, the op count of the prefix method.
+pub struct EmittedFn {
+    pub text: String,
+    pub count: OpCount,
+    pub prefix: Option<OpCount>,
+}
+
+/// Emits the method(s) of `spec`. A [`Prefix`] is emitted only when the method has several
+/// chunks anyway (a small method stays one function, and its prefix is the caller's to
+/// emit on its own).
 pub fn emit_fn(
     arena: &Arena,
     spec: &FnSpec,
     names: &RustNames,
-) -> Result<(String, OpCount), Vec<MissingDerivative>> {
+) -> Result<EmittedFn, Vec<MissingDerivative>> {
     let roots: Vec<ExprId> = spec.outputs.iter().map(|o| o.1).collect();
     let targets: Vec<String> = spec.outputs.iter().map(|o| o.0.clone()).collect();
-    let sch = Schedule::new(arena, &roots);
+    let mut sch = Schedule::new(arena, &roots);
+    let prefix = spec.prefix.as_ref().filter(|_| sch.chunks.len() > 1);
+    if let Some(p) = prefix {
+        sch = Schedule::with_segments(arena, &roots, &[p.split], MAX_LETS);
+    }
     let em = emit(arena, &sch, &targets, names, spec.numbers)?;
     let number = spec.numbers.type_name();
     // batch code is compiled for 256-bit registers on x86-64 whatever the build's target CPU
@@ -167,5 +198,44 @@ pub fn emit_fn(
             );
         }
     }
-    Ok((s, em.count))
+    let prefix_count = prefix.map(|p| {
+        let chunks = sch.segments[0].clone();
+        let lets = sch.chunks[chunks.end - 1].end;
+        let _ = write!(
+            s,
+            "#[inline]\n{simd}fn {}(&self, {}) {{\n{}{}let mut w = [{}; {}];\n",
+            p.name,
+            p.args,
+            p.bind.iter().map(|b| format!("{b}\n")).collect::<String>(),
+            p.prelude
+                .iter()
+                .map(|b| format!("{b}\n"))
+                .collect::<String>(),
+            spec.numbers.zero(),
+            em.workspace
+        );
+        for k in chunks {
+            let _ = writeln!(s, "self.{}_part{k}({}, &mut w);", spec.name, spec.call);
+        }
+        s.push_str("}\n");
+        // the work of the first segment: its nodes come first in the order
+        let mut needed = vec![false; sch.order.last().map_or(0, |n| n.index() + 1)];
+        for n in arena.reachable(&roots[..p.split]) {
+            needed[n.index()] = true;
+        }
+        let nodes: Vec<ExprId> = sch
+            .order
+            .iter()
+            .copied()
+            .filter(|n| needed[n.index()])
+            .collect();
+        let mut c = crate::expr::ops_of_nodes(arena, &nodes);
+        c.lets = lets;
+        c
+    });
+    Ok(EmittedFn {
+        text: s,
+        count: em.count,
+        prefix: prefix_count,
+    })
 }

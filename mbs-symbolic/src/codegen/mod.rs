@@ -12,7 +12,7 @@ use crate::mech::dynamics::SceneEquations;
 use crate::mech::system::{Formulation, Load, System};
 use crate::mech::{SymbolicModel, world};
 use api::{Sizes, args};
-use function::{FnSpec, RustNames, emit_fn};
+use function::{EmittedFn, FnSpec, Prefix, RustNames, emit_fn};
 use std::fmt::Write;
 use std::time::{Duration, Instant};
 
@@ -140,12 +140,12 @@ pub fn generate(sys: System, vis: &str) -> Result<Generated, Vec<MissingDerivati
 }
 
 fn collect<T>(
-    r: Result<(String, OpCount), Vec<MissingDerivative>>,
+    r: Result<EmittedFn, Vec<MissingDerivative>>,
     missing: &mut Vec<MissingDerivative>,
-    f: impl FnOnce(String, OpCount) -> T,
+    f: impl FnOnce(EmittedFn) -> T,
 ) -> Option<T> {
     match r {
-        Ok((s, c)) => Some(f(s, c)),
+        Ok(e) => Some(f(e)),
         Err(m) => {
             missing.extend(m);
             None
@@ -153,8 +153,9 @@ fn collect<T>(
     }
 }
 
-/// The parameter struct with its derived values and the constraint functions (shared by
-/// every scene); returns the op counts of the constraint functions when there are any.
+/// The parameter struct with its derived values, the poses and kinematics of frames and
+/// points and the constraint functions (shared by every scene); returns the op counts of the
+/// kinematics, and of the constraint functions when there are any.
 fn emit_params(
     model: &SymbolicModel,
     vis: &str,
@@ -325,7 +326,7 @@ fn emit_params(
         charts_path: "charts",
         splines_path: &splines,
     };
-    let mut derived = collect(emit_fn(a, &spec, &names), missing, |s, _| s).unwrap_or_default();
+    let mut derived = collect(emit_fn(a, &spec, &names), missing, |e| e.text).unwrap_or_default();
     // the constraints are the same in every scene: emitted once, here
     // ... and read the charts of rotation joints, which the models hold, as an argument
     let c = &model.constraints;
@@ -352,8 +353,16 @@ fn emit_params(
         "constraint_tangent",
     ];
     let mut ops = Vec::new();
+    for (spec, label) in kinematics_specs(model, with_charts) {
+        if let Some((s, count)) = collect(emit_fn(a, &spec, &names), missing, |e| (e.text, e.count))
+        {
+            derived.push_str(&s);
+            ops.push((label.to_string(), count));
+        }
+    }
     for (spec, label) in specs.iter().zip(labels) {
-        if let Some((s, count)) = collect(emit_fn(a, spec, &names), missing, |s, c| (s, c)) {
+        if let Some((s, count)) = collect(emit_fn(a, spec, &names), missing, |e| (e.text, e.count))
+        {
             derived.push_str(&s);
             if !c.phi.is_empty() {
                 ops.push((label.to_string(), count));
@@ -405,6 +414,77 @@ Ok(())
     ops
 }
 
+/// The poses and kinematics of frames and points, the same in every scene: emitted once on
+/// the parameter struct, the charts of rotation joints an argument (`with_charts` makes the
+/// parameter lists).
+fn kinematics_specs(
+    model: &SymbolicModel,
+    with_charts: impl Fn(&str) -> String,
+) -> Vec<(FnSpec, &'static str)> {
+    let a = &model.sys.arena;
+    let n = model.sys.ndof();
+    let mut f = FnSpec::new("__frames", &with_charts("frames"));
+    let mut fk = FnSpec::new("__kinematics", &with_charts("kinematics"));
+    for (i, &node) in model.tree.frame_node.iter().enumerate() {
+        let k = &model.world.nodes[node];
+        for r in 0..3 {
+            for c in 0..3 {
+                f.outputs
+                    .push((format!("out[{i}].rotation[{r}][{c}]"), k.r[r][c]));
+                fk.outputs.push((
+                    format!("out.frames[{i}].pose.rotation[{r}][{c}]"),
+                    k.r[r][c],
+                ));
+            }
+            f.outputs.push((format!("out[{i}].position[{r}]"), k.p[r]));
+            fk.outputs
+                .push((format!("out.frames[{i}].pose.position[{r}]"), k.p[r]));
+            fk.outputs
+                .push((format!("out.frames[{i}].velocity[{r}]"), k.v[r]));
+            fk.outputs
+                .push((format!("out.frames[{i}].angular_velocity[{r}]"), k.w[r]));
+            fk.outputs
+                .push((format!("out.frames[{i}].bias_acceleration[{r}]"), k.ab[r]));
+            fk.outputs.push((
+                format!("out.frames[{i}].bias_angular_acceleration[{r}]"),
+                k.alb[r],
+            ));
+        }
+        fk.matrix(a, &format!("out.frames[{i}].jv"), &dense3(a, &k.jv, n));
+        fk.matrix(a, &format!("out.frames[{i}].jw"), &dense3(a, &k.jw, n));
+    }
+    let frames = f;
+    // the points' positions, velocities and Jacobians again alone, for efforts that read
+    // only points (their bias accelerations only in `kinematics`)
+    let mut fp = FnSpec::new("__point_kinematics", &with_charts("kinematics"));
+    for (i, pk) in model.points.iter().enumerate() {
+        for r in 0..3 {
+            fk.outputs.push((
+                format!("out.points[{i}].bias_acceleration[{r}]"),
+                pk.bias[r],
+            ));
+        }
+        for g in [&mut fk, &mut fp] {
+            for r in 0..3 {
+                g.outputs
+                    .push((format!("out.points[{i}].position[{r}]"), pk.position[r]));
+                g.outputs
+                    .push((format!("out.points[{i}].velocity[{r}]"), pk.velocity[r]));
+            }
+            g.matrix(
+                a,
+                &format!("out.points[{i}].jv"),
+                &dense3(a, &pk.jacobian, n),
+            );
+        }
+    }
+    vec![
+        (frames, "frames"),
+        (fk, "kinematics"),
+        (fp, "point_kinematics"),
+    ]
+}
+
 fn dense3(a: &crate::expr::Arena, cols: &world::Cols, n: usize) -> Vec<Vec<ExprId>> {
     // rows i = 0..3 of a 3 × n matrix
     let d = world::dense(a, cols, n);
@@ -436,7 +516,25 @@ fn emit_scene(
     let mb = eq.chosen();
     let mut f = FnSpec::new("__dynamics", args("dynamics"));
     f.matrix(a, "m", &mb.m);
+    let split = f.outputs.len();
     f.vector("h", &mb.h);
+    // mass_matrix as the first chunks of dynamics when dynamics is split into chunks anyway:
+    // the code of M then exists once (a long chain's M is most of its code, and compile time
+    // grows with the code); a small model keeps two functions of one chunk each
+    let chunked = {
+        let roots: Vec<ExprId> = f.outputs.iter().map(|o| o.1).collect();
+        crate::expr::cse::Schedule::new(a, &roots).chunks.len() > 1
+    };
+    f.prefix = chunked.then(|| Prefix {
+        name: "__mass_matrix".into(),
+        args: args("mass_matrix").into(),
+        split,
+        bind: vec![format!(
+            "let (qd, u, h) = (&[0.0f64; {n}], &[0.0f64; {}], &mut [0.0f64; {n}]);",
+            sys.inputs.len()
+        )],
+        prelude: f.prelude.clone(),
+    });
     specs.push((f, Some("dynamics (M, h)")));
     let mut f = FnSpec::new("__forward_dynamics", api::FORWARD_DYNAMICS_FORCED.args);
     f.vector("qdd", &eq.forward.qdd);
@@ -457,6 +555,7 @@ fn emit_scene(
     let mut f = FnSpec::new("__mass_matrix", args("mass_matrix"));
     f.matrix(a, "m", &mb.m);
     specs.push((f, Some("mass_matrix")));
+    let mass_matrix_spec = specs.len() - 1;
     let mut f = FnSpec::new("__inverse_dynamics", args("inverse_dynamics"));
     f.vector("tau", eq.tau());
     specs.push((f, Some("inverse_dynamics")));
@@ -494,64 +593,6 @@ fn emit_scene(
     let mut f = FnSpec::new("__power", &format!("{}, e: &mut [f64]", args("power")));
     f.vector("e", &[eq.power]);
     specs.push((f, Some("power")));
-    // poses and kinematics of frames and points
-    let mut f = FnSpec::new("__frames", args("frames"));
-    let mut fk = FnSpec::new("__kinematics", args("kinematics"));
-    for (i, &node) in model.tree.frame_node.iter().enumerate() {
-        let k = &model.world.nodes[node];
-        for r in 0..3 {
-            for c in 0..3 {
-                f.outputs
-                    .push((format!("out[{i}].rotation[{r}][{c}]"), k.r[r][c]));
-                fk.outputs.push((
-                    format!("out.frames[{i}].pose.rotation[{r}][{c}]"),
-                    k.r[r][c],
-                ));
-            }
-            f.outputs.push((format!("out[{i}].position[{r}]"), k.p[r]));
-            fk.outputs
-                .push((format!("out.frames[{i}].pose.position[{r}]"), k.p[r]));
-            fk.outputs
-                .push((format!("out.frames[{i}].velocity[{r}]"), k.v[r]));
-            fk.outputs
-                .push((format!("out.frames[{i}].angular_velocity[{r}]"), k.w[r]));
-            fk.outputs
-                .push((format!("out.frames[{i}].bias_acceleration[{r}]"), k.ab[r]));
-            fk.outputs.push((
-                format!("out.frames[{i}].bias_angular_acceleration[{r}]"),
-                k.alb[r],
-            ));
-        }
-        fk.matrix(a, &format!("out.frames[{i}].jv"), &dense3(a, &k.jv, n));
-        fk.matrix(a, &format!("out.frames[{i}].jw"), &dense3(a, &k.jw, n));
-    }
-    specs.push((f, Some("frames")));
-    // the points' positions, velocities and Jacobians again alone, for efforts that read
-    // only points (their bias accelerations only in `kinematics`)
-    let mut fp = FnSpec::new("__point_kinematics", args("kinematics"));
-    for (i, pk) in model.points.iter().enumerate() {
-        for r in 0..3 {
-            fk.outputs.push((
-                format!("out.points[{i}].bias_acceleration[{r}]"),
-                pk.bias[r],
-            ));
-        }
-        for g in [&mut fk, &mut fp] {
-            for r in 0..3 {
-                g.outputs
-                    .push((format!("out.points[{i}].position[{r}]"), pk.position[r]));
-                g.outputs
-                    .push((format!("out.points[{i}].velocity[{r}]"), pk.velocity[r]));
-            }
-            g.matrix(
-                a,
-                &format!("out.points[{i}].jv"),
-                &dense3(a, &pk.jacobian, n),
-            );
-        }
-    }
-    specs.push((fk, Some("kinematics")));
-    specs.push((fp, Some("point_kinematics")));
     let mut f = FnSpec::new("__initial_state", args("initial_state"));
     let q0: Vec<ExprId> = sys.dofs.iter().map(|d| d.q0).collect();
     let qd0: Vec<ExprId> = sys.dofs.iter().map(|d| d.qd0).collect();
@@ -561,10 +602,16 @@ fn emit_scene(
 
     // the methods are independent and the arena is read-only: emit them in parallel, then
     // assemble in order so that the text does not depend on scheduling
+    // (mass_matrix is not emitted on its own when dynamics emits it as its first chunks)
+    let names = &names;
     let emitted: Vec<_> = std::thread::scope(|scope| {
         let handles: Vec<_> = specs
             .iter()
-            .map(|(spec, _)| scope.spawn(|| emit_fn(a, spec, &names)))
+            .enumerate()
+            .map(|(i, (spec, _))| {
+                let own = !(chunked && i == mass_matrix_spec);
+                scope.spawn(move || own.then(|| emit_fn(a, spec, names)))
+            })
             .collect();
         handles
             .into_iter()
@@ -573,10 +620,26 @@ fn emit_scene(
     });
     let mut methods = String::new();
     let mut ops: Vec<(String, OpCount)> = Vec::new();
+    let mut prefix_count = None;
     for ((_, label), result) in specs.iter().zip(emitted) {
-        if let Some(c) = collect(result, missing, |s, c| {
-            methods.push_str(&s);
-            c
+        let Some(result) = result else {
+            // mass_matrix, counted as the first chunks of dynamics
+            if let (Some(label), Some(c)) = (label, prefix_count) {
+                ops.push((label.to_string(), c));
+                reports.push(FunctionReport {
+                    model: ty.clone(),
+                    function: label.to_string(),
+                    ops: c,
+                });
+            }
+            continue;
+        };
+        if let Some(c) = collect(result, missing, |e| {
+            methods.push_str(&e.text);
+            if e.prefix.is_some() {
+                prefix_count = e.prefix;
+            }
+            e.count
         }) {
             if let Some(label) = label {
                 ops.push((label.to_string(), c));
@@ -588,7 +651,8 @@ fn emit_scene(
             }
         }
     }
-    // the constraint functions, emitted once on the parameters, serve every scene
+    // the kinematics and constraint functions, emitted once on the parameters, serve every
+    // scene
     for (label, c) in shared {
         ops.push((label.clone(), *c));
         reports.push(FunctionReport {
@@ -765,6 +829,10 @@ fn emit_scene(
         "power" => "let mut e = [0.0f64; 1];\nself.__power(t, q, qd, u, &mut e);\ne[0]".into(),
         // the constraint functions live on the parameter struct, shared by every scene
         name if name.starts_with("constraint") => {
+            format!("self.params.__{name}(&self.charts, {})", m.call())
+        }
+        // ... and so do the poses and kinematics of frames and points
+        name @ ("frames" | "kinematics" | "point_kinematics") => {
             format!("self.params.__{name}(&self.charts, {})", m.call())
         }
         // SIMD code where the processor runs it, else the one-state function lane by lane

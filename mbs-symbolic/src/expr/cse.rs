@@ -23,6 +23,8 @@ pub struct Schedule {
     pub lets: Vec<ExprId>,
     /// for each chunk, the range of `lets` it defines
     pub chunks: Vec<std::ops::Range<usize>>,
+    /// for each segment of the outputs (see [`Schedule::with_segments`]), its chunks
+    pub segments: Vec<std::ops::Range<usize>>,
     /// per node index: `Some(chunk)` when the node has a `let` in that chunk
     pub(crate) let_chunk: Vec<Option<u32>>,
     /// per output: the chunk that assigns it
@@ -36,8 +38,41 @@ impl Schedule {
 
     /// As [`Schedule::new`] with another chunk size (tests use small ones).
     pub fn with_max_lets(arena: &Arena, outputs: &[ExprId], max_lets: usize) -> Schedule {
-        let order = arena.reachable(outputs);
-        let top = order.last().map_or(0, |n| n.index() + 1);
+        Self::with_segments(arena, outputs, &[], max_lets)
+    }
+
+    /// As [`Schedule::with_max_lets`], the outputs cut into segments that start at the
+    /// output indices `starts` (increasing): every node the outputs of a segment need and no
+    /// earlier segment computed comes after those of the earlier segments, and no chunk
+    /// spans two segments, so that the chunks of the first segments alone compute their
+    /// outputs (a function whose first chunks are another function).
+    pub fn with_segments(
+        arena: &Arena,
+        outputs: &[ExprId],
+        starts: &[usize],
+        max_lets: usize,
+    ) -> Schedule {
+        let bounds: Vec<usize> = std::iter::once(0)
+            .chain(starts.iter().copied())
+            .chain(std::iter::once(outputs.len()))
+            .collect();
+        let all = arena.reachable(outputs);
+        let top = all.last().map_or(0, |n| n.index() + 1);
+        // the order: each segment's new nodes, by index (children are older than parents)
+        let mut segment_of = vec![u32::MAX; top];
+        let mut order = Vec::with_capacity(all.len());
+        for (s, w) in bounds.windows(2).enumerate() {
+            for n in arena.reachable(&outputs[..w[1]]) {
+                if segment_of[n.index()] == u32::MAX {
+                    segment_of[n.index()] = s as u32;
+                    order.push(n);
+                }
+            }
+        }
+        let mut position = vec![0u32; top];
+        for (i, n) in order.iter().enumerate() {
+            position[n.index()] = i as u32;
+        }
         let mut uses = vec![0u32; top];
         for &n in &order {
             let (ch, k) = arena.node(n).children();
@@ -86,30 +121,49 @@ impl Schedule {
             }
         }
         let max_lets = max_lets.max(1);
-        let chunks: Vec<_> = if lets.is_empty() {
-            std::iter::once(0..0).collect()
-        } else {
-            (0..lets.len())
-                .step_by(max_lets)
-                .map(|s| s..(s + max_lets).min(lets.len()))
-                .collect()
-        };
+        // chunks of at most max_lets within each segment, one (maybe empty) at least
+        let mut chunks = Vec::new();
+        let mut segments = Vec::new();
+        let mut first = 0;
+        for s in 0..bounds.len() - 1 {
+            let end = first + lets[first..].partition_point(|l| segment_of[l.index()] == s as u32);
+            let start_chunk = chunks.len();
+            let mut c = first;
+            loop {
+                chunks.push(c..(c + max_lets).min(end));
+                c += max_lets;
+                if c >= end {
+                    break;
+                }
+            }
+            segments.push(start_chunk..chunks.len());
+            first = end;
+        }
         let mut let_chunk = vec![None; top];
         for (ci, r) in chunks.iter().enumerate() {
             for &n in &lets[r.clone()] {
                 let_chunk[n.index()] = Some(ci as u32);
             }
         }
-        // an output goes in the chunk that holds the last `let` created before its root
-        let output_chunk = outputs
-            .iter()
-            .map(|o| (lets.partition_point(|l| l <= o).saturating_sub(1) / max_lets) as u32)
-            .collect();
+        // an output goes in the chunk that holds the last `let` scheduled before its root,
+        // within its segment
+        let mut output_chunk = Vec::with_capacity(outputs.len());
+        for (s, w) in bounds.windows(2).enumerate() {
+            for o in &outputs[w[0]..w[1]] {
+                let before = lets.partition_point(|l| position[l.index()] <= position[o.index()]);
+                let c = match before.checked_sub(1) {
+                    Some(i) => let_chunk[lets[i].index()].unwrap_or(0),
+                    None => 0,
+                };
+                output_chunk.push(c.max(segments[s].start as u32));
+            }
+        }
         Schedule {
             outputs: outputs.to_vec(),
             order,
             lets,
             chunks,
+            segments,
             let_chunk,
             output_chunk,
         }
@@ -137,5 +191,49 @@ mod tests {
         let sch = Schedule::new(&a, &[m, n]);
         assert!(sch.is_let(s));
         assert!(!sch.is_let(m) && !sch.is_let(n));
+    }
+
+    #[test]
+    fn the_first_segment_is_computed_by_its_own_chunks() {
+        // outputs 0..4 need sin(q_i) shared with outputs 4..8, which also need their own
+        // nodes created before some of the first segment's
+        let mut a = Arena::new();
+        let mut first = Vec::new();
+        let mut second = Vec::new();
+        for i in 0..4 {
+            let q = a.var(Var::Q(i));
+            let own = a.mul(q, q); // a node of the second segment, created early
+            let own2 = a.add(own, q);
+            let s = a.sin(q);
+            let c = a.cos(q);
+            let f = a.mul(s, c);
+            first.push(a.add(f, s));
+            let g = a.mul(own2, s);
+            second.push(a.add(g, own2));
+        }
+        let mut outs = first.clone();
+        outs.extend(&second);
+        let sch = Schedule::with_segments(&a, &outs, &[4], 2);
+        assert_eq!(sch.segments.len(), 2);
+        let (s0, s1) = (sch.segments[0].clone(), sch.segments[1].clone());
+        assert_eq!(s0.end, s1.start);
+        assert!(s1.end == sch.chunks.len() && s0.start == 0);
+        // the first segment's outputs are assigned in its chunks, the second's in theirs
+        assert!(sch.output_chunk[..4].iter().all(|&c| (c as usize) < s0.end));
+        assert!(
+            sch.output_chunk[4..]
+                .iter()
+                .all(|&c| (c as usize) >= s1.start)
+        );
+        // the lets of the first segment's chunks are all needed by its outputs, and every
+        // node its outputs need comes before the second segment's nodes
+        let needed = a.reachable(&first);
+        let first_lets = sch.chunks[s0.end - 1].end;
+        assert!(sch.lets[..first_lets].iter().all(|l| needed.contains(l)));
+        assert!(sch.lets[first_lets..].iter().all(|l| !needed.contains(l)));
+        assert!(sch.order[..needed.len()].iter().all(|n| needed.contains(n)));
+        // one segment: the plain schedule
+        let plain = Schedule::with_max_lets(&a, &outs, 2);
+        assert_eq!(plain.segments, vec![0..plain.chunks.len()]);
     }
 }

@@ -144,9 +144,9 @@ pub struct EmittedFn {
     pub prefix: Option<OpCount>,
 }
 
-/// Emits the method(s) of `spec`. A [`Prefix`] is emitted only when the method has several
-/// chunks anyway (a small method stays one function, and its prefix is the caller's to
-/// emit on its own).
+/// Emits the method(s) of `spec`; with a [`Prefix`], the outputs are scheduled in two
+/// segments (so in two chunks at least: the caller gives one only to a method that has
+/// several chunks anyway) and the prefix method is emitted too.
 pub fn emit_fn(
     arena: &Arena,
     spec: &FnSpec,
@@ -154,11 +154,11 @@ pub fn emit_fn(
 ) -> Result<EmittedFn, Vec<MissingDerivative>> {
     let roots: Vec<ExprId> = spec.outputs.iter().map(|o| o.1).collect();
     let targets: Vec<String> = spec.outputs.iter().map(|o| o.0.clone()).collect();
-    let mut sch = Schedule::new(arena, &roots);
-    let prefix = spec.prefix.as_ref().filter(|_| sch.chunks.len() > 1);
-    if let Some(p) = prefix {
-        sch = Schedule::with_segments(arena, &roots, &[p.split], MAX_LETS);
-    }
+    let prefix = spec.prefix.as_ref();
+    let sch = match prefix {
+        Some(p) => Schedule::with_segments(arena, &roots, &[p.split], MAX_LETS),
+        None => Schedule::new(arena, &roots),
+    };
     let em = emit(arena, &sch, &targets, names, spec.numbers)?;
     let number = spec.numbers.type_name();
     // batch code is compiled for 256-bit registers on x86-64 whatever the build's target CPU
@@ -218,18 +218,8 @@ pub fn emit_fn(
             let _ = writeln!(s, "self.{}_part{k}({}, &mut w);", spec.name, spec.call);
         }
         s.push_str("}\n");
-        // the work of the first segment: its nodes come first in the order
-        let mut needed = vec![false; sch.order.last().map_or(0, |n| n.index() + 1)];
-        for n in arena.reachable(&roots[..p.split]) {
-            needed[n.index()] = true;
-        }
-        let nodes: Vec<ExprId> = sch
-            .order
-            .iter()
-            .copied()
-            .filter(|n| needed[n.index()])
-            .collect();
-        let mut c = crate::expr::ops_of_nodes(arena, &nodes);
+        // the work of the first segment: the nodes its outputs need
+        let mut c = crate::expr::ops(arena, &roots[..p.split]);
         c.lets = lets;
         c
     });

@@ -423,20 +423,23 @@ fn kinematics_specs(
 ) -> Vec<(FnSpec, &'static str)> {
     let a = &model.sys.arena;
     let n = model.sys.ndof();
-    let mut f = FnSpec::new("__frames", &with_charts("frames"));
+    let mut frames = FnSpec::new("__frames", &with_charts("frames"));
     let mut fk = FnSpec::new("__kinematics", &with_charts("kinematics"));
     for (i, &node) in model.tree.frame_node.iter().enumerate() {
         let k = &model.world.nodes[node];
         for r in 0..3 {
             for c in 0..3 {
-                f.outputs
+                frames
+                    .outputs
                     .push((format!("out[{i}].rotation[{r}][{c}]"), k.r[r][c]));
                 fk.outputs.push((
                     format!("out.frames[{i}].pose.rotation[{r}][{c}]"),
                     k.r[r][c],
                 ));
             }
-            f.outputs.push((format!("out[{i}].position[{r}]"), k.p[r]));
+            frames
+                .outputs
+                .push((format!("out[{i}].position[{r}]"), k.p[r]));
             fk.outputs
                 .push((format!("out.frames[{i}].pose.position[{r}]"), k.p[r]));
             fk.outputs
@@ -453,7 +456,6 @@ fn kinematics_specs(
         fk.matrix(a, &format!("out.frames[{i}].jv"), &dense3(a, &k.jv, n));
         fk.matrix(a, &format!("out.frames[{i}].jw"), &dense3(a, &k.jw, n));
     }
-    let frames = f;
     // the points' positions, velocities and Jacobians again alone, for efforts that read
     // only points (their bias accelerations only in `kinematics`)
     let mut fp = FnSpec::new("__point_kinematics", &with_charts("kinematics"));
@@ -552,8 +554,11 @@ fn emit_scene(
         f.vector("pivots", &eq.forward.pivots);
         specs.push((f, None));
     }
+    // (its outputs only when it is a function of its own: see the emission below)
     let mut f = FnSpec::new("__mass_matrix", args("mass_matrix"));
-    f.matrix(a, "m", &mb.m);
+    if !chunked {
+        f.matrix(a, "m", &mb.m);
+    }
     specs.push((f, Some("mass_matrix")));
     let mass_matrix_spec = specs.len() - 1;
     let mut f = FnSpec::new("__inverse_dynamics", args("inverse_dynamics"));
@@ -622,25 +627,16 @@ fn emit_scene(
     let mut ops: Vec<(String, OpCount)> = Vec::new();
     let mut prefix_count = None;
     for ((_, label), result) in specs.iter().zip(emitted) {
-        let Some(result) = result else {
+        let count = match result {
             // mass_matrix, counted as the first chunks of dynamics
-            if let (Some(label), Some(c)) = (label, prefix_count) {
-                ops.push((label.to_string(), c));
-                reports.push(FunctionReport {
-                    model: ty.clone(),
-                    function: label.to_string(),
-                    ops: c,
-                });
-            }
-            continue;
+            None => prefix_count,
+            Some(result) => collect(result, missing, |e| {
+                methods.push_str(&e.text);
+                prefix_count = prefix_count.or(e.prefix);
+                e.count
+            }),
         };
-        if let Some(c) = collect(result, missing, |e| {
-            methods.push_str(&e.text);
-            if e.prefix.is_some() {
-                prefix_count = e.prefix;
-            }
-            e.count
-        }) {
+        if let Some(c) = count {
             if let Some(label) = label {
                 ops.push((label.to_string(), c));
                 reports.push(FunctionReport {

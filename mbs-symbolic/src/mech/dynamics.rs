@@ -77,18 +77,12 @@ pub struct SceneEquations {
 impl SceneEquations {
     /// M and h of the chosen formulation.
     pub fn chosen(&self) -> &MassBias {
-        match (self.formulation, &self.vp) {
-            (Formulation::VirtualPower, Some(vp)) => vp,
-            _ => &self.rec,
-        }
+        pick(self.formulation, self.vp.as_ref(), &self.rec)
     }
 
     /// τ of the chosen formulation.
     pub fn tau(&self) -> &[ExprId] {
-        match (self.tau_formulation, &self.tau_vp) {
-            (Formulation::VirtualPower, Some(t)) => t,
-            _ => &self.tau_rec,
-        }
+        pick(self.tau_formulation, self.tau_vp.as_ref(), &self.tau_rec).as_slice()
     }
 
     pub fn build(
@@ -132,11 +126,7 @@ impl SceneEquations {
             (None, Some(t)) if cost(a, t) < cost(a, &tau_rec) => Formulation::VirtualPower,
             _ => Formulation::Recursive,
         };
-        let chosen = match (formulation, &vp) {
-            (Formulation::VirtualPower, Some(vp)) => vp,
-            _ => &rec,
-        };
-        let chosen_h = chosen.h.clone();
+        let chosen_h = pick(formulation, vp.as_ref(), &rec).h.clone();
         let mut zero_qd = FxHashMap::default();
         for k in 0..nd {
             zero_qd.insert(Var::Qd(k as u16), a.zero());
@@ -147,10 +137,7 @@ impl SceneEquations {
             .iter()
             .map(|&e| (0..nu).map(|k| a.diff(e, Var::Input(k as u16))).collect())
             .collect();
-        let tau: Vec<ExprId> = match (tau_formulation, &tau_vp) {
-            (Formulation::VirtualPower, Some(t)) => t.clone(),
-            _ => tau_rec.clone(),
-        };
+        let tau: Vec<ExprId> = pick(tau_formulation, tau_vp.as_ref(), &tau_rec).clone();
         let tangents = sys.options.tangents.then(|| {
             let k: Vec<Vec<ExprId>> = tau
                 .iter()
@@ -219,10 +206,7 @@ impl SceneEquations {
             }
             _ => None,
         };
-        let forward = match (formulation, &vp) {
-            (Formulation::VirtualPower, Some(vp)) => forward_dynamics(sys, tree, vp),
-            _ => forward_dynamics(sys, tree, &rec),
-        };
+        let forward = forward_dynamics(sys, tree, pick(formulation, vp.as_ref(), &rec));
         let (kinetic, potential) = energies(sys, tree, world, &loads);
         let power = loads.power.unwrap_or(sys.arena.zero());
         SceneEquations {
@@ -244,6 +228,15 @@ impl SceneEquations {
             power,
             forward,
         }
+    }
+}
+
+/// The virtual-power form of something when it is the formulation and was built, else the
+/// recursive one.
+fn pick<'a, T>(formulation: Formulation, vp: Option<&'a T>, rec: &'a T) -> &'a T {
+    match (formulation, vp) {
+        (Formulation::VirtualPower, Some(vp)) => vp,
+        _ => rec,
     }
 }
 

@@ -3,7 +3,9 @@
 //! poles (`pole_sensitivity`), then
 //! dq(t)/dp integrated with the motion (`mbs::Sensitivities`) by three schemes, against
 //! central differences of plain runs, and what they cost: steps, evaluations and CPU time
-//! with and without (best of 5 runs each).
+//! with and without (best of 5 runs each). Then the same for a closed loop, the four-bar of
+//! `models/src/fourbar.rs` with four sensitive parameters: its equilibrium and multipliers,
+//! and its motion's sensitivities with their drift from the constraints' derivatives.
 //!
 //! ```text
 //! cargo run --release --example sensitivity
@@ -13,12 +15,13 @@ use mbs::analysis::{StaticsOptions, pole_sensitivity, static_equilibrium, static
 use mbs::{
     Model, Options, Output, Parameters, Scheme, Sensitivities, StepControl, Trajectory, simulate,
 };
+use mbs_models::fourbar::SensitiveFourBar;
 use mbs_models::sprung_arm::SprungArm;
 use std::time::{Duration, Instant};
 
-fn options(rtol: f64) -> Options {
+fn options(t_end: f64, rtol: f64) -> Options {
     Options {
-        t_end: 2.0,
+        t_end,
         step: StepControl::Adaptive {
             rtol,
             atol: rtol * 1e-2,
@@ -29,18 +32,29 @@ fn options(rtol: f64) -> Options {
     }
 }
 
-fn with(name: &str, value: f64) -> SprungArm {
-    let mut model = SprungArm::default();
+/// The default model with parameter `name` set to `value`.
+fn with<M: Model + Default>(name: &str, value: f64) -> M {
+    let mut model = M::default();
     let mut p = model.params().clone();
     p.set(name, value).expect("a parameter");
     model.set_params(p).expect("valid");
     model
 }
 
+/// The default value of parameter `name`.
+fn param<M: Model + Default>(name: &str) -> f64 {
+    let i = <M::Params as Parameters>::NAMES
+        .iter()
+        .position(|n| *n == name)
+        .expect("a parameter");
+    M::default().params().values()[i]
+}
+
 /// The best wall time of 5 runs, and the last run's outputs and work.
 fn timed<M: Model + 'static>(
     make: impl Fn() -> M,
     scheme: Scheme,
+    t_end: f64,
     rtol: f64,
 ) -> (Duration, Trajectory, mbs::Stats) {
     let mut best = Duration::MAX;
@@ -48,7 +62,7 @@ fn timed<M: Model + 'static>(
     for _ in 0..5 {
         let model = make();
         let start = Instant::now();
-        let r = simulate(model, scheme, options(rtol)).expect("run");
+        let r = simulate(model, scheme, options(t_end, rtol)).expect("run");
         best = best.min(start.elapsed());
         last = Some(r);
     }
@@ -92,60 +106,103 @@ fn main() {
         }
     }
 
-    // dq(2 s)/dp by central differences of plain runs at rtol 1e-12
-    let base = model.params().values();
+    motion::<SprungArm>(2.0);
+
+    // a closed loop: the equilibrium moves on the constraints, and the multipliers with it
+    let model = SensitiveFourBar::default();
+    let eq = static_equilibrium(&model, &statics).expect("equilibrium");
+    let s = static_sensitivity(&model, &eq, &statics).expect("sensitivity");
+    println!(
+        "\nfour-bar with a crank spring: equilibrium q = [{:.6}, {:.6}, {:.6}], λ = [{:.6}, {:.6}]; dq/dp and dλ/dp (exact, from ∂τ/∂p, ∂Φ/∂p and ∂(Bᵀλ)/∂p):",
+        eq.q[0], eq.q[1], eq.q[2], eq.lambda[0], eq.lambda[1]
+    );
+    for (j, p) in s.params.iter().enumerate() {
+        println!(
+            "  ∂q/∂{p:<3} = [{:>12.8}, {:>12.8}, {:>12.8}]   ∂λ/∂{p:<3} = [{:>12.6}, {:>12.6}]",
+            s.get(0, p).unwrap_or(f64::NAN),
+            s.get(1, p).unwrap_or(f64::NAN),
+            s.get(2, p).unwrap_or(f64::NAN),
+            s.dlambda_dp[2 * j],
+            s.dlambda_dp[2 * j + 1]
+        );
+    }
+    motion::<SensitiveFourBar>(1.0);
+}
+
+/// dq(t_end)/dp of `M`'s default motion by three schemes at rtol 1e-8 against central
+/// differences of plain runs at rtol 1e-12, with the work and CPU time of each (best of 5);
+/// on closed loops also the largest drift of the sensitivities from B s + ∂Φ/∂p = 0.
+fn motion<M: Model + Default + 'static>(t_end: f64) {
     let mut reference = Vec::new();
-    for (j, name) in SprungArm::SENSITIVE.iter().enumerate() {
-        let e = 1e-5 * base[j];
-        let end = |m: SprungArm| {
-            let (tr, _) = simulate(m, Scheme::Dopri5, options(1e-12)).expect("run");
+    for name in M::SENSITIVE {
+        let p0 = param::<M>(name);
+        let e = 1e-5 * p0;
+        let end = |m: M| {
+            let (tr, _) = simulate(m, Scheme::Dopri5, options(t_end, 1e-12)).expect("run");
             tr.q(tr.len() - 1).to_vec()
         };
-        let (qp, qm) = (end(with(name, base[j] + e)), end(with(name, base[j] - e)));
-        reference.push([(qp[0] - qm[0]) / (2.0 * e), (qp[1] - qm[1]) / (2.0 * e)]);
+        let (qp, qm) = (end(with(name, p0 + e)), end(with(name, p0 - e)));
+        let d: Vec<f64> = qp
+            .iter()
+            .zip(&qm)
+            .map(|(a, b)| (a - b) / (2.0 * e))
+            .collect();
+        reference.push(d);
     }
     println!(
-        "\ndq(t = 2 s)/dp for {} at rtol 1e-8 (motion and sensitivities under one error control), best of 5:",
-        SprungArm::SENSITIVE.join(", ")
+        "\n{}: dq(t = {t_end} s)/dp for {} at rtol 1e-8 (motion and sensitivities under one error control), best of 5:",
+        M::default().info().name,
+        M::SENSITIVE.join(", ")
+    );
+    let drift = if M::NC > 0 { "drift" } else { "" };
+    println!(
+        "{:>8} {:>12} {:>8} {:>8} {:>11} {:>11} {:>10} {:>9}",
+        "scheme", "max error", "steps", "steps", "evals", "evals", "CPU", drift
     );
     println!(
-        "{:>8} {:>12} {:>8} {:>8} {:>11} {:>11} {:>10}",
-        "scheme", "max error", "steps", "steps", "evals", "evals", "CPU"
-    );
-    println!(
-        "{:>8} {:>12} {:>8} {:>8} {:>11} {:>11} {:>10}",
-        "", "vs diffs", "plain", "+sens", "plain", "+sens", "ratio"
+        "{:>8} {:>12} {:>8} {:>8} {:>11} {:>11} {:>10} {:>9}",
+        "",
+        "vs diffs",
+        "plain",
+        "+sens",
+        "plain",
+        "+sens",
+        "ratio",
+        if M::NC > 0 { "|Bs+Φp|" } else { "" }
     );
     for scheme in [
         Scheme::Dopri5,
         Scheme::Radau5,
         Scheme::Bdf(Default::default()),
     ] {
-        let (t_plain, _, plain) = timed(SprungArm::default, scheme, 1e-8);
-        let (t_sens, tr, sens) = timed(
-            || Sensitivities::new(SprungArm::default()).expect("sensitive parameters"),
-            scheme,
-            1e-8,
-        );
+        let (t_plain, _, plain) = timed(M::default, scheme, t_end, 1e-8);
+        let wrap = || Sensitivities::new(M::default()).expect("sensitive parameters");
+        let (t_sens, tr, sens) = timed(wrap, scheme, t_end, 1e-8);
         let last = tr.len() - 1;
         let mut worst: f64 = 0.0;
         for (j, r) in reference.iter().enumerate() {
-            let sq = Sensitivities::<SprungArm>::dq_dp(&tr, last, j);
+            let sq = Sensitivities::<M>::dq_dp(&tr, last, j);
             let scale = r.iter().fold(0.0f64, |m, x| m.max(x.abs()));
             for (a, b) in sq.iter().zip(r) {
                 worst = worst.max((a - b).abs() / scale);
             }
         }
         let evals = |s: &mbs::Stats| s.dynamics + s.forward_dynamics + s.inverse_dynamics;
+        let drift = if M::NC > 0 {
+            format!("{:.1e}", wrap().residuals(&tr, last).0)
+        } else {
+            String::new()
+        };
         println!(
-            "{:>8} {:>12.1e} {:>8} {:>8} {:>11} {:>11} {:>9.1}x",
+            "{:>8} {:>12.1e} {:>8} {:>8} {:>11} {:>11} {:>9.1}x {:>9}",
             scheme.name(),
             worst,
             plain.steps,
             sens.steps,
             evals(&plain),
             evals(&sens),
-            t_sens.as_secs_f64() / t_plain.as_secs_f64()
+            t_sens.as_secs_f64() / t_plain.as_secs_f64(),
+            drift
         );
     }
 }

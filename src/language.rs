@@ -32,7 +32,7 @@
 //! | statement | meaning |
 //! |---|---|
 //! | `param l = 1.0;` | a parameter: a field of the generated `…Params` struct, changeable at run time; its default is a constant expression |
-//! | `param k = 1e4 sensitive;` | a parameter whose derivatives are generated: `Model::parameter_tangents` gives ∂τ/∂p of every sensitive parameter (through every `let` that uses it), `Model::SENSITIVE` names them; for statics (`analysis::static_sensitivity`), poles (`analysis::pole_sensitivity`, from `Model::rest_tangent_derivatives`: M, C, K's derivatives at rest, generated with `option tangents;`) and motions (`mbs::Sensitivities`, with `option tangents;`). Parameters not marked cost nothing |
+//! | `param k = 1e4 sensitive;` | a parameter whose derivatives are generated: `Model::parameter_tangents` gives ∂τ/∂p of every sensitive parameter (through every `let` that uses it), `Model::SENSITIVE` names them; for statics (`analysis::static_sensitivity`), poles (`analysis::pole_sensitivity`, from `Model::rest_tangent_derivatives`: M, C, K's derivatives at rest, generated with `option tangents;`) and motions (`mbs::Sensitivities`, with `option tangents;`); with constraints, also `Model::constraint_parameter_tangents` (∂Φ/∂p, the derivatives of Φ̇ and Φ̈, ∂(Bᵀλ)/∂p) for closed loops. Parameters not marked cost nothing |
 //! | `let I = m*l*l/12;` | a named expression, substituted where used |
 //! | `dof q[0] = PI/2;` | the next coordinate, with its initial value (default 0) |
 //! | `dof knee = 0.2, qd = 1.0;` | a named coordinate with initial position and velocity; `knee`, `q[knee]`, `qd[knee]` refer to it |

@@ -3,6 +3,7 @@
 
 use mbs::analysis::{StaticsOptions, static_equilibrium, static_sensitivity};
 use mbs::{Model, ModelError, Parameters};
+use mbs_models::fourbar::{SensitiveFourBar, SensitiveFourBarParams};
 use mbs_models::sprung_arm::SprungArm;
 
 mbs::multibody! {
@@ -53,6 +54,35 @@ fn generated_parameter_tangents_match_central_differences() {
             "{name}"
         );
     }
+    // ∂M/∂p and ∂h/∂p apart, against differences of M and h
+    let (mut dm, mut dh) = ([0.0; 12], [0.0; 6]);
+    model
+        .parameter_derivatives(t, &q, &qd, &[], &mut dm, &mut dh)
+        .unwrap();
+    for (j, name) in SprungArm::SENSITIVE.iter().enumerate() {
+        let p0 = model.params().values()[j];
+        let e = 1e-5 * p0;
+        let (mut mp, mut hp, mut mm, mut hm) = ([0.0; 4], [0.0; 2], [0.0; 4], [0.0; 2]);
+        with(name, p0 + e).dynamics(t, &q, &qd, &[], &mut mp, &mut hp);
+        with(name, p0 - e).dynamics(t, &q, &qd, &[], &mut mm, &mut hm);
+        for i in 0..4 {
+            let diff = (mp[i] - mm[i]) / (2.0 * e);
+            let exact = dm[i + 4 * j];
+            assert!(
+                (exact - diff).abs() <= 1e-7 * exact.abs().max(1.0),
+                "∂M/∂{name}: {exact} vs {diff}"
+            );
+        }
+        for i in 0..2 {
+            let diff = (hp[i] - hm[i]) / (2.0 * e);
+            let exact = dh[i + 2 * j];
+            assert!(
+                (exact - diff).abs() <= 1e-7 * exact.abs().max(1.0),
+                "∂h/∂{name}: {exact} vs {diff}"
+            );
+        }
+    }
+    assert!(dm.iter().any(|x| x.abs() > 1e-2) && dh.iter().any(|x| x.abs() > 1e-2));
     // without sensitive parameters: a typed error that says what to write
     let e = PlainArm::default()
         .parameter_tangents(t, &q[..1], &qd[..1], &qdd[..1], &[], &mut [0.0; 1])
@@ -319,4 +349,271 @@ fn sensitivities_refuse_models_they_cannot_differentiate() {
         panic!("accepted")
     };
     assert!(matches!(e, ModelError::NoSensitiveParameters { .. }), "{e}");
+}
+
+// ---- closed loops ----
+
+fn fourbar_with(name: &str, value: f64) -> SensitiveFourBar {
+    let mut model = SensitiveFourBar::default();
+    let mut p = model.params().clone();
+    p.set(name, value).unwrap();
+    model.set_params(p).unwrap();
+    model
+}
+
+/// The value of sensitive parameter `j` of the four-bar.
+fn fourbar_param(j: usize) -> f64 {
+    let name = SensitiveFourBar::SENSITIVE[j];
+    let i = <SensitiveFourBarParams as Parameters>::NAMES
+        .iter()
+        .position(|n| *n == name)
+        .unwrap();
+    SensitiveFourBar::default().params().values()[i]
+}
+
+/// Φ, Φ̇ = B qd + Φ_t, Φ̈ = B qdd − γ and Bᵀλ of the four-bar, concatenated.
+fn loop_terms(
+    model: &SensitiveFourBar,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    lam: &[f64],
+) -> Vec<f64> {
+    let (n, nc, t) = (3, 2, 0.3);
+    let (mut phi, mut b, mut phi_t, mut gamma) = (
+        vec![0.0; nc],
+        vec![0.0; nc * n],
+        vec![0.0; nc],
+        vec![0.0; nc],
+    );
+    model.constraints(t, q, &mut phi);
+    model.constraint_jacobian(t, q, &mut b);
+    model.constraint_rate(t, q, &mut phi_t);
+    model.constraint_bias(t, q, qd, &mut gamma);
+    let bv = |i: usize, v: &[f64]| (0..n).map(|k| b[i + nc * k] * v[k]).sum::<f64>();
+    let mut out = phi.clone();
+    out.extend((0..nc).map(|i| bv(i, qd) + phi_t[i]));
+    out.extend((0..nc).map(|i| bv(i, qdd) - gamma[i]));
+    out.extend((0..n).map(|k| (0..nc).map(|i| b[i + nc * k] * lam[i]).sum::<f64>()));
+    out
+}
+
+#[test]
+fn generated_constraint_derivatives_match_central_differences() {
+    use mbs::ConstraintTangents;
+    let (n, nc) = (3, 2);
+    let (q, qd, qdd, lam) = (
+        [1.0, 0.6, 1.8],
+        [5.0, -1.2, 0.7],
+        [3.0, -20.0, 8.0],
+        [1.5, -0.7],
+    );
+    let model = SensitiveFourBar::default();
+    let mut ct = ConstraintTangents::new::<SensitiveFourBar>();
+    model
+        .constraint_parameter_tangents(0.3, &q, &qd, &qdd, &lam, &mut ct)
+        .unwrap();
+    let close = |what: &str, exact: f64, diff: f64| {
+        assert!(
+            (exact - diff).abs() <= 1e-7 * exact.abs().max(1.0),
+            "{what}: generated {exact}, differences {diff}"
+        );
+    };
+    // by the parameters: rows Φ, Φ̇, Φ̈ (nc each), then Bᵀλ (n)
+    for j in 0..4 {
+        let (name, p0) = (SensitiveFourBar::SENSITIVE[j], fourbar_param(j));
+        let e = 1e-6 * p0;
+        let plus = loop_terms(&fourbar_with(name, p0 + e), &q, &qd, &qdd, &lam);
+        let minus = loop_terms(&fourbar_with(name, p0 - e), &q, &qd, &qdd, &lam);
+        let d = |r: usize| (plus[r] - minus[r]) / (2.0 * e);
+        for i in 0..nc {
+            close(&format!("∂Φ{i}/∂{name}"), ct.dphi_dp[i + nc * j], d(i));
+            close(
+                &format!("∂Φ̇{i}/∂{name}"),
+                ct.drate_dp[i + nc * j],
+                d(nc + i),
+            );
+            close(
+                &format!("∂Φ̈{i}/∂{name}"),
+                ct.dacc_dp[i + nc * j],
+                d(2 * nc + i),
+            );
+        }
+        for k in 0..n {
+            close(
+                &format!("∂(Bᵀλ){k}/∂{name}"),
+                ct.dforce_dp[k + n * j],
+                d(3 * nc + k),
+            );
+        }
+    }
+    // by the coordinates and their rates
+    let e = 1e-6;
+    for k in 0..n {
+        let (mut qp, mut qm, mut vp, mut vm) = (q, q, qd, qd);
+        qp[k] += e;
+        qm[k] -= e;
+        vp[k] += e;
+        vm[k] -= e;
+        let by_q = (
+            loop_terms(&model, &qp, &qd, &qdd, &lam),
+            loop_terms(&model, &qm, &qd, &qdd, &lam),
+        );
+        let by_v = (
+            loop_terms(&model, &q, &vp, &qdd, &lam),
+            loop_terms(&model, &q, &vm, &qdd, &lam),
+        );
+        for i in 0..nc {
+            let dq = |r: usize| (by_q.0[r] - by_q.1[r]) / (2.0 * e);
+            let dv = |r: usize| (by_v.0[r] - by_v.1[r]) / (2.0 * e);
+            close(&format!("∂Φ̇{i}/∂q{k}"), ct.drate_dq[i + nc * k], dq(nc + i));
+            close(
+                &format!("∂Φ̈{i}/∂q{k}"),
+                ct.dacc_dq[i + nc * k],
+                dq(2 * nc + i),
+            );
+            close(
+                &format!("∂Φ̈{i}/∂qd{k}"),
+                ct.dacc_dqd[i + nc * k],
+                dv(2 * nc + i),
+            );
+        }
+    }
+    assert!(ct.dphi_dp.iter().any(|x| x.abs() > 1e-2));
+    assert!(ct.dforce_dp.iter().any(|x| x.abs() > 1e-2));
+    // models without constraints or sensitive parameters have none
+    let e = SprungArm::default()
+        .constraint_parameter_tangents(0.0, &[0.0; 2], &[0.0; 2], &[0.0; 2], &[], &mut ct)
+        .unwrap_err();
+    assert!(matches!(e, ModelError::NoSensitiveParameters { .. }), "{e}");
+}
+
+#[test]
+fn closed_loop_equilibria_move_with_the_parameters_as_differences_say() {
+    let options = StaticsOptions {
+        tolerance: 1e-13,
+        ..StaticsOptions::default()
+    };
+    let model = SensitiveFourBar::default();
+    let eq = static_equilibrium(&model, &options).unwrap();
+    assert!(eq.constraint_residual < 1e-12, "{eq}");
+    let s = static_sensitivity(&model, &eq, &options).unwrap();
+    assert_eq!(s.params, ["l1", "l2", "rho", "k1"]);
+    assert_eq!(s.dlambda_dp.len(), 2 * 4);
+    for (j, name) in s.params.iter().enumerate() {
+        let p0 = fourbar_param(j);
+        let e = 1e-5 * p0;
+        let start = StaticsOptions {
+            q0: Some(eq.q.clone()),
+            ..options.clone()
+        };
+        let plus = static_equilibrium(&fourbar_with(name, p0 + e), &start).unwrap();
+        let minus = static_equilibrium(&fourbar_with(name, p0 - e), &start).unwrap();
+        for i in 0..3 {
+            let diff = (plus.q[i] - minus.q[i]) / (2.0 * e);
+            let exact = s.get(i, name).unwrap();
+            println!("∂q{i}/∂{name}: {exact:.10} (differences {diff:.10})");
+            assert!(
+                (exact - diff).abs() <= 1e-6 * exact.abs().max(1e-3),
+                "∂q{i}/∂{name}: {exact} vs {diff}"
+            );
+        }
+        for i in 0..2 {
+            let diff = (plus.lambda[i] - minus.lambda[i]) / (2.0 * e);
+            let exact = s.dlambda_dp[i + 2 * j];
+            println!("∂λ{i}/∂{name}: {exact:.10} (differences {diff:.10})");
+            assert!(
+                (exact - diff).abs() <= 1e-6 * exact.abs().max(1e-3),
+                "∂λ{i}/∂{name}: {exact} vs {diff}"
+            );
+        }
+    }
+    // the poles of a closed loop are refused, with what is available instead
+    let err = mbs::analysis::pole_sensitivity(&model, &eq, &options).unwrap_err();
+    assert!(err.to_string().contains("static_sensitivity"), "{err}");
+}
+
+/// The four-bar's q(t_end), qd(t_end) at tight tolerances.
+fn fourbar_end(model: SensitiveFourBar, t_end: f64) -> (Vec<f64>, Vec<f64>) {
+    let options = mbs::Options {
+        t_end,
+        step: mbs::StepControl::Adaptive {
+            rtol: 1e-12,
+            atol: 1e-14,
+            h0: None,
+        },
+        output: mbs::Output::Last,
+        ..mbs::Options::default()
+    };
+    let (tr, _) = mbs::simulate(model, mbs::Scheme::Dopri5, options).unwrap();
+    let last = tr.len() - 1;
+    (tr.q(last).to_vec(), tr.qd(last).to_vec())
+}
+
+#[test]
+fn closed_loop_sensitivities_match_central_differences() {
+    use mbs::{Options, Scheme, Sensitivities, StepControl, simulate};
+    type S = Sensitivities<SensitiveFourBar>;
+    let t_end = 1.0;
+    let ns = SensitiveFourBar::SENSITIVE.len();
+    let mut reference = Vec::new();
+    for j in 0..ns {
+        let (name, p0) = (SensitiveFourBar::SENSITIVE[j], fourbar_param(j));
+        let e = 1e-5 * p0;
+        let (qp, vp) = fourbar_end(fourbar_with(name, p0 + e), t_end);
+        let (qm, vm) = fourbar_end(fourbar_with(name, p0 - e), t_end);
+        let d = |a: &[f64], b: &[f64]| -> Vec<f64> {
+            a.iter().zip(b).map(|(x, y)| (x - y) / (2.0 * e)).collect()
+        };
+        reference.push((d(&qp, &qm), d(&vp, &vm)));
+    }
+    let options = Options {
+        t_end,
+        step: StepControl::Adaptive {
+            rtol: 1e-10,
+            atol: 1e-12,
+            h0: None,
+        },
+        ..Options::default()
+    };
+    for scheme in [
+        Scheme::Dopri5,
+        Scheme::Radau5,
+        Scheme::Bdf(Default::default()),
+    ] {
+        let model = S::new(SensitiveFourBar::default()).unwrap();
+        let (tr, stats) = simulate(model, scheme, options.clone()).unwrap();
+        let (_, plain) = simulate(SensitiveFourBar::default(), scheme, options.clone()).unwrap();
+        let last = tr.len() - 1;
+        // the start's sensitivities are the assembly's: the crank's (independent) stays 0,
+        // the coupler's and rocker's close the loop for a longer crank
+        let s0 = S::dq_dp(&tr, 0, 0);
+        assert!(
+            s0[0] == 0.0 && s0[1].abs() > 0.1 && s0[2].abs() > 0.1,
+            "{s0:?}"
+        );
+        let mut worst: f64 = 0.0;
+        for (j, (dq, dv)) in reference.iter().enumerate() {
+            let (sq, sv) = (S::dq_dp(&tr, last, j), S::dqd_dp(&tr, last, j));
+            let scale = dq.iter().chain(dv).fold(0.0f64, |m, x| m.max(x.abs()));
+            for (exact, diff) in sq.iter().zip(dq).chain(sv.iter().zip(dv)) {
+                worst = worst.max((exact - diff).abs() / scale);
+            }
+        }
+        let wrapper = S::new(SensitiveFourBar::default()).unwrap();
+        let drift = (0..tr.len()).fold((0.0f64, 0.0f64), |m, i| {
+            let (p, v) = wrapper.residuals(&tr, i);
+            (m.0.max(p), m.1.max(v))
+        });
+        println!(
+            "{}: worst |s − differences| / max|s| = {worst:.1e}; drift |B s + Φ_p| ≤ {:.1e}, rate ≤ {:.1e}; {} steps with sensitivities, {} without",
+            scheme.name(),
+            drift.0,
+            drift.1,
+            stats.steps,
+            plain.steps
+        );
+        assert!(worst < 1e-6, "{}: {worst:e}", scheme.name());
+        assert!(drift.0 < 1e-7 && drift.1 < 1e-6, "{drift:?}");
+    }
 }

@@ -41,8 +41,8 @@ pub use integrators::{
 };
 pub use lanes::{F64x4, LANES};
 pub use model::{
-    Energy, FrameKinematics, IDENTITY3, Kinematics, Model, ModelInfo, OpCount, OpsTable,
-    Parameters, PointKinematics, Pose, RotationJoint, ShapeInfo, ShapeKind,
+    ConstraintTangents, Energy, FrameKinematics, IDENTITY3, Kinematics, Model, ModelInfo, OpCount,
+    OpsTable, Parameters, PointKinematics, Pose, RotationJoint, ShapeInfo, ShapeKind,
 };
 /// The matrices of [`Linearization`] (nalgebra's), named without a dependency of one's own.
 pub use nalgebra::DMatrix;

@@ -319,6 +319,43 @@ impl Kinematics {
 }
 
 /// Parameters of a generated model: a plain struct with `Default` = the DSL's values.
+/// The derivatives [`Model::constraint_parameter_tangents`] writes, column-major, NS columns
+/// by sensitive parameter in the order of [`Model::SENSITIVE`]. With Φ̇ = B qd + Φ_t and
+/// Φ̈ = B qdd − γ:
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ConstraintTangents {
+    /// ∂Φ/∂p (NC × NS)
+    pub dphi_dp: Vec<f64>,
+    /// ∂Φ̇/∂q (NC × NQ)
+    pub drate_dq: Vec<f64>,
+    /// ∂Φ̇/∂p (NC × NS)
+    pub drate_dp: Vec<f64>,
+    /// ∂Φ̈/∂q (NC × NQ)
+    pub dacc_dq: Vec<f64>,
+    /// ∂Φ̈/∂qd (NC × NQ)
+    pub dacc_dqd: Vec<f64>,
+    /// ∂Φ̈/∂p (NC × NS)
+    pub dacc_dp: Vec<f64>,
+    /// ∂(Bᵀλ)/∂p (NQ × NS)
+    pub dforce_dp: Vec<f64>,
+}
+
+impl ConstraintTangents {
+    /// Buffers of the sizes of model `M`.
+    pub fn new<M: Model>() -> ConstraintTangents {
+        let (n, nc, ns) = (M::NQ, M::NC, M::SENSITIVE.len());
+        ConstraintTangents {
+            dphi_dp: vec![0.0; nc * ns],
+            drate_dq: vec![0.0; nc * n],
+            drate_dp: vec![0.0; nc * ns],
+            dacc_dq: vec![0.0; nc * n],
+            dacc_dqd: vec![0.0; nc * n],
+            dacc_dp: vec![0.0; nc * ns],
+            dforce_dp: vec![0.0; n * ns],
+        }
+    }
+}
+
 pub trait Parameters:
     Clone + fmt::Debug + Default + PartialEq + Serialize + DeserializeOwned
 {
@@ -501,6 +538,40 @@ pub trait Model {
         })
     }
 
+    /// ∂M/∂p (NQ × NQ × NS: block j, column-major, is ∂M/∂pⱼ) and ∂h/∂p (NQ × NS,
+    /// column-major) at (t, q, qd, u), exact: τ = M qdd − h is affine in qdd, so ∂h/∂p is
+    /// −∂τ/∂p at qdd = 0 and column k of ∂M/∂pⱼ is ∂τ/∂pⱼ at qdd = e_k less that. NQ + 1
+    /// evaluations of [`Model::parameter_tangents`], which is what the sensitivities use
+    /// directly; an error for models without sensitive parameters.
+    fn parameter_derivatives(
+        &self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        u: &[f64],
+        dm: &mut [f64],
+        dh: &mut [f64],
+    ) -> Result<(), crate::error::ModelError> {
+        let (n, ns) = (Self::NQ, Self::SENSITIVE.len());
+        let mut qdd = vec![0.0; n];
+        self.parameter_tangents(t, q, qd, &qdd, u, dh)?;
+        let mut col = vec![0.0; n * ns];
+        for k in 0..n {
+            qdd[k] = 1.0;
+            self.parameter_tangents(t, q, qd, &qdd, u, &mut col)?;
+            qdd[k] = 0.0;
+            for j in 0..ns {
+                for i in 0..n {
+                    dm[i + n * k + n * n * j] = col[i + n * j] - dh[i + n * j];
+                }
+            }
+        }
+        for x in dh.iter_mut() {
+            *x = -*x;
+        }
+        Ok(())
+    }
+
     /// How the matrices of the motion about a state at rest (qd = qdd = 0) change: M,
     /// C = ∂τ/∂qd and K = ∂τ/∂q, each NQ × NQ·(1 + NS) column-major in blocks of NQ × NQ.
     /// Block 0 is the derivative along the coordinates' direction `dq` (Σₖ ∂X/∂qₖ dqₖ),
@@ -523,6 +594,38 @@ pub trait Model {
         Err(crate::error::ModelError::NoSensitiveParameters {
             model: self.info().name,
         })
+    }
+
+    /// With constraints and parameters marked `sensitive`: the derivatives of Φ, Φ̇ and Φ̈ and
+    /// of the constraint forces Bᵀλ that the sensitivities of a closed loop need, at (t, q,
+    /// qd, qdd, λ) ([`ConstraintTangents`]). Generated exactly; an error for other models.
+    #[allow(clippy::too_many_arguments)]
+    fn constraint_parameter_tangents(
+        &self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        lambda: &[f64],
+        out: &mut ConstraintTangents,
+    ) -> Result<(), crate::error::ModelError> {
+        let _ = (t, q, qd, qdd, lambda, out);
+        Err(crate::error::ModelError::NoSensitiveParameters {
+            model: self.info().name,
+        })
+    }
+
+    /// Called once the start of a closed loop is assembled (q and qd consistent with Φ = 0 and
+    /// Φ̇ = 0), so that a wrapper can make the coordinates it adds consistent too (the
+    /// sensitivities of the assembled start, [`crate::Sensitivities`]). Does nothing by default.
+    fn complete_start(
+        &self,
+        t: f64,
+        q: &mut [f64],
+        qd: &mut [f64],
+    ) -> Result<(), crate::error::Failure> {
+        let _ = (t, q, qd);
+        Ok(())
     }
 
     /// h(q, 0, t, u): forces at rest, for statics (NQ).

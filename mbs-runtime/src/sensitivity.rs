@@ -14,13 +14,30 @@
 //! every scheme integrates the motion and its sensitivities together, with its error control
 //! over both (as CVODES's "full" error control); its forward dynamics solves every block with
 //! one Cholesky factorisation of M. Starts at s = ṡ = 0 (initial conditions that
-//! do not depend on the parameters). Open-loop models without rotation joints; the wrapped
+//! do not depend on the parameters). Models without rotation joints; the wrapped
 //! model's iteration matrices come from finite differences (its tangents would need second
 //! derivatives).
+//!
+//! **Closed loops** (M qdd = h + Bᵀλ, Φ(q, p) = 0). Differentiating both along the motion,
+//! with μ = ∂λ/∂p and K_λ = ∂(Bᵀλ)/∂q:
+//!
+//! ```text
+//! M s̈ − Bᵀμ = −(K_t − K_λ) s − C_t ṡ − ∂τ/∂p + ∂(Bᵀλ)/∂p
+//! B s̈       = −∂Φ̈/∂q s − ∂Φ̈/∂qd ṡ − ∂Φ̈/∂p          (Φ̈ = B qdd − γ)
+//! ```
+//!
+//! at the qdd and λ of the motion (the index-1 system of the wrapped model at (q, qd)). The
+//! wrapper keeps the wrapped model's constraints on q, which the scheme enforces with the
+//! chosen constraint method, and gives each sᵢ the forces M s̈ᵢ of this system: the
+//! sensitivities follow Φ̈'s derivative (index 1), and B s + ∂Φ/∂p = 0 and its rate hold to
+//! the accuracy of the integration (`Sensitivities::residuals` measures them). The start's
+//! sensitivities are those of the assembly: the coordinates marked `independent` keep theirs
+//! (0), the others take the least change, in the metric of M, that satisfies
+//! B s + ∂Φ/∂p = 0 and B ṡ + ∂Φ̇/∂q s + ∂Φ̇/∂p = 0 ([`Model::complete_start`]).
 
-use crate::error::{ModelError, ParamError};
-use crate::linalg::{cholesky, cholesky_solve};
-use crate::model::{Energy, Kinematics, Model, ModelInfo, Pose};
+use crate::error::{Failure, ModelError, ParamError};
+use crate::linalg::{Lu, cholesky, cholesky_solve};
+use crate::model::{ConstraintTangents, Energy, Kinematics, Model, ModelInfo, Pose};
 use crate::trajectory::Trajectory;
 use std::any::TypeId;
 use std::cell::RefCell;
@@ -45,11 +62,59 @@ struct Scratch {
     dtau: Vec<f64>,
     zero: Vec<f64>,
     haug: Vec<f64>,
+    /// closed loops only (empty otherwise)
+    loops: Loops,
+}
+
+/// What a closed loop adds: B, γ, the index-1 system [M −Bᵀ; B 0] factorised, λ, K_λ, the
+/// constraints' derivatives and a right-hand side.
+struct Loops {
+    b: Vec<f64>,
+    gamma: Vec<f64>,
+    kkt: Lu<f64>,
+    lambda: Vec<f64>,
+    k_lambda: Vec<f64>,
+    tangents: ConstraintTangents,
+    rhs: Vec<f64>,
+}
+
+impl Loops {
+    fn new<M: Model>() -> Loops {
+        let (n, nc) = (M::NQ, M::NC);
+        Loops {
+            b: vec![0.0; nc * n],
+            gamma: vec![0.0; nc],
+            kkt: Lu::new(n + nc),
+            lambda: vec![0.0; nc],
+            k_lambda: vec![0.0; n * n],
+            tangents: ConstraintTangents::new::<M>(),
+            rhs: vec![0.0; n + nc],
+        }
+    }
+
+    /// Factorises [M −Bᵀ; B 0] from `m` and `self.b`; whether it is regular.
+    fn factor(&mut self, m: &[f64], n: usize) -> bool {
+        let nc = self.gamma.len();
+        let na = n + nc;
+        let a = self.kkt.matrix_mut();
+        a.fill(0.0);
+        for c in 0..n {
+            for r in 0..n {
+                a[r + na * c] = m[r + n * c];
+            }
+            for i in 0..nc {
+                let bij = self.b[i + nc * c];
+                a[(n + i) + na * c] = bij;
+                a[c + na * (n + i)] = -bij;
+            }
+        }
+        self.kkt.factor().is_ok()
+    }
 }
 
 impl<M: Model + 'static> Sensitivities<M> {
-    /// Wraps `model`; refused without sensitive parameters, without tangents, with
-    /// constraints or rotation joints.
+    /// Wraps `model`; refused without sensitive parameters, without tangents, or with
+    /// rotation joints.
     pub fn new(model: M) -> Result<Sensitivities<M>, ModelError> {
         let info = model.info();
         let unsupported = |reason: &'static str| ModelError::SensitivitiesUnsupported {
@@ -61,11 +126,6 @@ impl<M: Model + 'static> Sensitivities<M> {
         }
         if !info.has_tangents {
             return Err(ModelError::TangentsNotGenerated { model: info.name });
-        }
-        if M::NC > 0 {
-            return Err(unsupported(
-                "it has constraints (∂Φ/∂p and the multipliers' sensitivities are not generated yet)",
-            ));
         }
         if !info.rotation_joints.is_empty() {
             return Err(unsupported(
@@ -86,6 +146,7 @@ impl<M: Model + 'static> Sensitivities<M> {
                 dtau: z(n * M::SENSITIVE.len()),
                 zero: z(n * (1 + M::SENSITIVE.len())),
                 haug: z(n * (1 + M::SENSITIVE.len())),
+                loops: Loops::new::<M>(),
             }),
             model,
         })
@@ -119,6 +180,7 @@ impl<M: Model + 'static> Sensitivities<M> {
             // the runtime's checks of the pivots and of the accelerations report it
             s.qdd.fill(f64::NAN);
         }
+        let closed = M::NC > 0 && self.closed_loop_state(s, t, q, qd);
         // checked at construction: both are generated
         let _ = self.model.tangents(t, q, qd, &s.qdd, u, &mut s.k, &mut s.c);
         let _ = self
@@ -127,15 +189,120 @@ impl<M: Model + 'static> Sensitivities<M> {
         s.haug[..n].copy_from_slice(&s.h);
         for j in 0..M::SENSITIVE.len() {
             let (sq, sv) = (&x[n * (1 + j)..n * (2 + j)], &xd[n * (1 + j)..n * (2 + j)]);
+            let out = &mut s.haug[n * (1 + j)..n * (2 + j)];
             for i in 0..n {
                 let mut f = -s.dtau[i + n * j];
                 for k in 0..n {
                     f -= s.k[i + n * k] * sq[k] + s.c[i + n * k] * sv[k];
                 }
-                s.haug[n * (1 + j) + i] = f;
+                out[i] = f;
+            }
+            if M::NC > 0 {
+                Self::closed_loop_forces(&mut s.loops, &s.m, closed, j, sq, sv, out);
             }
         }
         factorised
+    }
+
+    /// qdd and λ of the wrapped closed loop at (q, qd) into `s.qdd` and `s.loops.lambda` (the
+    /// index-1 system), then K_λ and the constraints' derivatives there; whether the system
+    /// was regular (NaN accelerations otherwise, which the runtime's checks report).
+    fn closed_loop_state(&self, s: &mut Scratch, t: f64, q: &[f64], qd: &[f64]) -> bool {
+        let (n, nc) = (M::NQ, M::NC);
+        let l = &mut s.loops;
+        self.model.constraint_jacobian(t, q, &mut l.b);
+        self.model.constraint_bias(t, q, qd, &mut l.gamma);
+        let regular = l.factor(&s.m, n);
+        l.rhs[..n].copy_from_slice(&s.h);
+        l.rhs[n..].copy_from_slice(&l.gamma);
+        if regular {
+            l.kkt.solve(&mut l.rhs);
+        } else {
+            l.rhs.fill(f64::NAN);
+        }
+        s.qdd.copy_from_slice(&l.rhs[..n]);
+        l.lambda.copy_from_slice(&l.rhs[n..n + nc]);
+        self.model
+            .constraint_tangent(t, q, &l.lambda, &mut l.k_lambda);
+        // checked at construction: generated for constraints with sensitive parameters
+        let _ =
+            self.model
+                .constraint_parameter_tangents(t, q, qd, &s.qdd, &l.lambda, &mut l.tangents);
+        regular
+    }
+
+    /// Block j's forces M s̈ⱼ of a closed loop from `f` = −K_t s − C_t ṡ − ∂τ/∂p (in `out`):
+    /// adds K_λ s + ∂(Bᵀλ)/∂p, solves the index-1 system with B s̈ = −∂Φ̈/∂q s − ∂Φ̈/∂qd ṡ −
+    /// ∂Φ̈/∂p, and writes M s̈ = f + Bᵀμ.
+    fn closed_loop_forces(
+        l: &mut Loops,
+        m: &[f64],
+        regular: bool,
+        j: usize,
+        sq: &[f64],
+        sv: &[f64],
+        out: &mut [f64],
+    ) {
+        let (n, nc) = (M::NQ, M::NC);
+        let ct = &l.tangents;
+        for i in 0..n {
+            let mut f = out[i] + ct.dforce_dp[i + n * j];
+            for k in 0..n {
+                f += l.k_lambda[i + n * k] * sq[k];
+            }
+            l.rhs[i] = f;
+        }
+        for i in 0..nc {
+            let mut g = -ct.dacc_dp[i + nc * j];
+            for k in 0..n {
+                g -= ct.dacc_dq[i + nc * k] * sq[k] + ct.dacc_dqd[i + nc * k] * sv[k];
+            }
+            l.rhs[n + i] = g;
+        }
+        if !regular {
+            out.fill(f64::NAN);
+            return;
+        }
+        l.kkt.solve(&mut l.rhs);
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = (0..n).map(|k| m[i + n * k] * l.rhs[k]).sum();
+        }
+    }
+
+    /// The largest |B sⱼ + ∂Φ/∂pⱼ| and |B ṡⱼ + ∂Φ̇/∂q sⱼ + ∂Φ̇/∂pⱼ| at output `i` of a
+    /// trajectory of this model: how far its sensitivities have drifted from the constraints'
+    /// derivatives (zero for models without constraints).
+    pub fn residuals(&self, tr: &Trajectory, i: usize) -> (f64, f64) {
+        let (n, nc) = (M::NQ, M::NC);
+        if nc == 0 {
+            return (0.0, 0.0);
+        }
+        let (t, x, xd) = (tr.t[i], tr.q(i), tr.qd(i));
+        let mut b = vec![0.0; nc * n];
+        let mut ct = ConstraintTangents::new::<M>();
+        self.model.constraint_jacobian(t, &x[..n], &mut b);
+        let zero = vec![0.0; n.max(nc)];
+        let _ = self.model.constraint_parameter_tangents(
+            t,
+            &x[..n],
+            &xd[..n],
+            &zero[..n],
+            &zero[..nc],
+            &mut ct,
+        );
+        let mut worst = (0.0f64, 0.0f64);
+        for j in 0..M::SENSITIVE.len() {
+            let (sq, sv) = (&x[n * (1 + j)..n * (2 + j)], &xd[n * (1 + j)..n * (2 + j)]);
+            for r in 0..nc {
+                let (mut p, mut v) = (ct.dphi_dp[r + nc * j], ct.drate_dp[r + nc * j]);
+                for k in 0..n {
+                    p += b[r + nc * k] * sq[k];
+                    v += b[r + nc * k] * sv[k] + ct.drate_dq[r + nc * k] * sq[k];
+                }
+                worst = (worst.0.max(p.abs()), worst.1.max(v.abs()));
+            }
+        }
+        worst
     }
 
     /// diag(M, …, M) from `s.m`.
@@ -185,7 +352,7 @@ impl<M: Model + 'static> Model for Sensitivities<M> {
     const NU: usize = M::NU;
     const NFRAMES: usize = M::NFRAMES;
     const NPOINTS: usize = M::NPOINTS;
-    const NC: usize = 0;
+    const NC: usize = M::NC;
     /// block by block with one Cholesky factorisation of the wrapped M
     const FORWARD_DYNAMICS_GENERATED: bool = true;
 
@@ -310,11 +477,104 @@ impl<M: Model + 'static> Model for Sensitivities<M> {
         self.model.power(t, &q[..M::NQ], &qd[..M::NQ], u)
     }
 
-    fn constraints(&self, _: f64, _: &[f64], _: &mut [f64]) {}
-    fn constraint_jacobian(&self, _: f64, _: &[f64], _: &mut [f64]) {}
-    fn constraint_rate(&self, _: f64, _: &[f64], _: &mut [f64]) {}
-    fn constraint_bias(&self, _: f64, _: &[f64], _: &[f64], _: &mut [f64]) {}
-    fn constraint_tangent(&self, _: f64, _: &[f64], _: &[f64], _: &mut [f64]) {}
+    // the wrapped model's constraints on q; the sensitivities follow them through their forces
+    fn constraints(&self, t: f64, q: &[f64], phi: &mut [f64]) {
+        self.model.constraints(t, &q[..M::NQ], phi)
+    }
+
+    /// B of the wrapped model in the first NQ columns, zero over the sensitivities
+    fn constraint_jacobian(&self, t: f64, q: &[f64], b: &mut [f64]) {
+        b.fill(0.0);
+        self.model
+            .constraint_jacobian(t, &q[..M::NQ], &mut b[..M::NC * M::NQ]);
+    }
+
+    fn constraint_rate(&self, t: f64, q: &[f64], phi_t: &mut [f64]) {
+        self.model.constraint_rate(t, &q[..M::NQ], phi_t)
+    }
+
+    fn constraint_bias(&self, t: f64, q: &[f64], qd: &[f64], gamma: &mut [f64]) {
+        self.model
+            .constraint_bias(t, &q[..M::NQ], &qd[..M::NQ], gamma)
+    }
+
+    /// the wrapped model's ∂(Bᵀλ)/∂q in the top-left block
+    fn constraint_tangent(&self, t: f64, q: &[f64], lambda: &[f64], k: &mut [f64]) {
+        let (n, na) = (M::NQ, Self::NQ);
+        k.fill(0.0);
+        if n == 0 || M::NC == 0 {
+            return;
+        }
+        let s = &mut *self.scratch.borrow_mut();
+        self.model.constraint_tangent(t, &q[..n], lambda, &mut s.k);
+        for c in 0..n {
+            k[na * c..na * c + n].copy_from_slice(&s.k[n * c..n * (c + 1)]);
+        }
+    }
+
+    /// The sensitivities of the assembled start (see the module's documentation).
+    fn complete_start(&self, t: f64, q: &mut [f64], qd: &mut [f64]) -> Result<(), Failure> {
+        let (n, nc) = (M::NQ, M::NC);
+        if nc == 0 {
+            return Ok(());
+        }
+        let inner = self.model.info();
+        let free: Vec<usize> = (0..n)
+            .filter(|&i| inner.independent.get(i) != Some(&true))
+            .collect();
+        let (mut b, mut mm) = (vec![0.0; nc * n], vec![0.0; n * n]);
+        let mut ct = ConstraintTangents::new::<M>();
+        self.model.constraint_jacobian(t, &q[..n], &mut b);
+        self.model.mass_matrix(t, &q[..n], &mut mm);
+        let zero = vec![0.0; n];
+        self.model
+            .constraint_parameter_tangents(t, &q[..n], &qd[..n], &zero, &zero[..nc], &mut ct)
+            .map_err(|e| Failure::InvalidOption {
+                name: "model",
+                value: inner.name.to_string(),
+                reason: crate::integrators::model_error_reason(&e),
+            })?;
+        let singular = || {
+            Failure::InconsistentStart {
+            reason: "the sensitivities of the start cannot be made consistent: B over the coordinates not marked independent is rank-deficient".into(),
+            constraint: String::new(),
+            residual: f64::NAN,
+            iterations: 0,
+        }
+        };
+        let mut r = vec![0.0; nc];
+        for j in 0..M::SENSITIVE.len() {
+            let block = n * (1 + j)..n * (2 + j);
+            // positions: B s + ∂Φ/∂p = 0
+            for (i, ri) in r.iter_mut().enumerate() {
+                *ri = ct.dphi_dp[i + nc * j]
+                    + (0..n)
+                        .map(|k| b[i + nc * k] * q[block.start + k])
+                        .sum::<f64>();
+            }
+            let dx =
+                crate::integrators::least_correction(&b, &mm, &free, &r).ok_or_else(singular)?;
+            for (a, &k) in free.iter().enumerate() {
+                q[block.start + k] -= dx[a];
+            }
+            // velocities: B ṡ + ∂Φ̇/∂q s + ∂Φ̇/∂p = 0
+            let sq = &q[block.clone()];
+            for (i, ri) in r.iter_mut().enumerate() {
+                *ri = ct.drate_dp[i + nc * j]
+                    + (0..n)
+                        .map(|k| {
+                            b[i + nc * k] * qd[block.start + k] + ct.drate_dq[i + nc * k] * sq[k]
+                        })
+                        .sum::<f64>();
+            }
+            let dv =
+                crate::integrators::least_correction(&b, &mm, &free, &r).ok_or_else(singular)?;
+            for (a, &k) in free.iter().enumerate() {
+                qd[block.start + k] -= dv[a];
+            }
+        }
+        Ok(())
+    }
 
     fn frames(&self, t: f64, q: &[f64], out: &mut [Pose]) {
         self.model.frames(t, &q[..M::NQ], out)

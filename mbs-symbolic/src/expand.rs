@@ -248,6 +248,7 @@ fn validate(&self) -> ::core::result::Result<(), ::mbs::ParamError> {{ {never} }
         batch: false,
         sensitive: Vec::new(),
         rest_derivatives: false,
+        constraint_sensitivity: false,
     };
     for ty in scenes {
         code.push_str(&format!(

@@ -7,6 +7,10 @@
 //! closed where the coupler meets the rocker's tip. Crank angle π/3 at t = 0 (kept: marked
 //! `independent`), crank speed 5 rad/s; `b` and `c` are given roughly, on the branch with the
 //! coupler above the x axis, and the assembly closes the loop from them.
+//!
+//! [`SensitiveFourBar`] is the same mechanism with a rotational spring at the crank (a stable
+//! equilibrium) and four parameters marked `sensitive`: the sensitivities of a closed loop
+//! (`tests/sensitivity.rs`, `examples/sensitivity.rs`).
 
 mbs::multibody! {
     /// Four-bar crank-rocker: crank `a` at the origin, coupler `b` hinged at the crank tip,
@@ -35,6 +39,32 @@ mbs::multibody! {
         TOG[rocker] = Tdisp(l0, 0, 0) * Trotz(c) * Tdisp(l3 / 2, 0, 0);
         gravity(0, -g, 0);
         constraint close: coincide(coupler_end, rocker_tip, along = [x, y]);
+    }
+}
+
+mbs::multibody! {
+    /// [`FourBar`] with a rotational spring at the
+    /// crank, so that it has a stable equilibrium, and its link lengths, density and spring
+    /// rate marked `sensitive`.
+    pub model SensitiveFourBar {
+        param l0 = 0.4; param l1 = 0.1 sensitive; param l2 = 0.35 sensitive; param l3 = 0.3;
+        param rho = 1.0 sensitive; param k1 = 2.0 sensitive; param g = 9.81;
+        dof a = PI / 3, qd = 5.0, independent;
+        dof b = 0.6;
+        dof c = 1.8;
+        let m1 = rho * l1; let m2 = rho * l2; let m3 = rho * l3;
+        body crank { mass = m1; inertia = (0, m1 * l1 * l1 / 12, m1 * l1 * l1 / 12); }
+        body coupler { mass = m2; inertia = (0, m2 * l2 * l2 / 12, m2 * l2 * l2 / 12); }
+        body rocker { mass = m3; inertia = (0, m3 * l3 * l3 / 12, m3 * l3 * l3 / 12); }
+        point coupler_end on coupler at (l2 / 2, 0, 0);
+        point rocker_tip on rocker at (l3 / 2, 0, 0);
+        TOG[crank] = Trotz(a) * Tdisp(l1 / 2, 0, 0);
+        TOG[coupler] = TOG[crank] * Tdisp(l1 / 2, 0, 0) * Trotz(b - a) * Tdisp(l2 / 2, 0, 0);
+        TOG[rocker] = Tdisp(l0, 0, 0) * Trotz(c) * Tdisp(l3 / 2, 0, 0);
+        gravity(0, -g, 0);
+        rotational_spring(ground, crank, axis = z, k = k1, angle0 = 1.0);
+        constraint close: coincide(coupler_end, rocker_tip, along = [x, y]);
+        option tangents;
     }
 }
 

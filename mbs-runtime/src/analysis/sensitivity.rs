@@ -6,6 +6,14 @@
 //! dq/dp = −K⁻¹ ∂τ/∂p over the free coordinates (locked ones stay where they are). One
 //! factorisation of K and one evaluation of ∂τ/∂p give every column, exact when K is (a model
 //! with `option tangents;`), else to the accuracy of K's central differences.
+//!
+//! On a closed loop the equilibrium is τ = Bᵀλ with Φ(q, p) = 0, and along the equilibria
+//!
+//! ```text
+//! (K − K_λ) dq/dp − Bᵀ dλ/dp = −∂τ/∂p + ∂(Bᵀλ)/∂p,    B dq/dp = −∂Φ/∂p
+//! ```
+//!
+//! (K_λ = ∂(Bᵀλ)/∂q; rows and columns of the free coordinates), which gives dλ/dp as well.
 
 use super::statics::{Equilibrium, StaticsOptions, stiffness};
 use super::{AnalysisError, check};
@@ -32,6 +40,9 @@ pub struct StaticSensitivity {
     pub dofs: Vec<String>,
     /// ∂q_eq/∂p, NQ × NS column-major (0 on locked coordinates)
     pub dq_dp: Vec<f64>,
+    /// ∂λ_eq/∂p of the constraints' multipliers, NC × NS column-major (empty without
+    /// constraints)
+    pub dlambda_dp: Vec<f64>,
 }
 
 impl StaticSensitivity {
@@ -43,9 +54,8 @@ impl StaticSensitivity {
 }
 
 /// How the equilibrium `eq` (found with `options`, whose time, inputs, locked coordinates
-/// and stiffness setting it reuses) moves with each sensitive parameter of `model`.
-/// Models with constraints are refused (their equilibria move on the constraint manifold,
-/// not handled yet).
+/// and stiffness setting it reuses) moves with each sensitive parameter of `model`; on closed
+/// loops, along the constraint manifold, with the multipliers' sensitivities.
 pub fn static_sensitivity<M: Model + Clone>(
     model: &M,
     eq: &Equilibrium,
@@ -57,11 +67,6 @@ pub fn static_sensitivity<M: Model + Clone>(
     if ns == 0 {
         return Err(refuse(
             "it has no sensitive parameters: mark them, `param k = 1e4 sensitive;`",
-        ));
-    }
-    if M::NC > 0 {
-        return Err(refuse(
-            "its equilibria move on its constraints: static sensitivities of closed loops are not available yet",
         ));
     }
     // q is read in the equilibrium's charts
@@ -78,36 +83,71 @@ pub fn static_sensitivity<M: Model + Clone>(
     let mut k = vec![0.0; n * n];
     stiffness(&m, options.t, &eq.q, &u, options.stiffness, &mut k)?;
     let free: Vec<usize> = (0..n).filter(|i| !options.locked.contains(i)).collect();
-    let nf = free.len();
-    let mut lu = Lu::<f64>::new(nf);
+    let (nf, nc) = (free.len(), M::NC);
+    // closed loops: B, K − K_λ and the right-hand side's ∂(Bᵀλ)/∂p − ∂τ/∂p, −∂Φ/∂p
+    let mut b = vec![0.0; nc * n];
+    let mut ct = crate::model::ConstraintTangents::new::<M>();
+    if nc > 0 {
+        m.constraint_jacobian(options.t, &eq.q, &mut b);
+        let mut k_lambda = vec![0.0; n * n];
+        m.constraint_tangent(options.t, &eq.q, &eq.lambda, &mut k_lambda);
+        m.constraint_parameter_tangents(options.t, &eq.q, &zero, &zero, &eq.lambda, &mut ct)
+            .map_err(|e| refuse(crate::integrators::model_error_reason(&e)))?;
+        check(&m, "∂Φ/∂p", &ct.dphi_dp)?;
+        check(&m, "∂(Bᵀλ)/∂p", &ct.dforce_dp)?;
+        for (x, g) in k.iter_mut().zip(&k_lambda) {
+            *x -= g;
+        }
+        for (x, g) in dtau.iter_mut().zip(&ct.dforce_dp) {
+            *x -= g;
+        }
+    }
+    let na = nf + nc;
+    let mut lu = Lu::<f64>::new(na);
     {
         let a = lu.matrix_mut();
+        a.fill(0.0);
         for (c, &j) in free.iter().enumerate() {
             for (r, &i) in free.iter().enumerate() {
-                a[r + nf * c] = k[i + n * j];
+                a[r + na * c] = k[i + n * j];
+            }
+            for i in 0..nc {
+                a[(nf + i) + na * c] = b[i + nc * j];
+                a[c + na * (nf + i)] = -b[i + nc * j];
             }
         }
     }
     lu.factor().map_err(|_| {
-        refuse("its stiffness is singular at the equilibrium over the free coordinates (a neutral direction): lock the coordinates without stiffness")
+        refuse(if nc == 0 {
+            "its stiffness is singular at the equilibrium over the free coordinates (a neutral direction): lock the coordinates without stiffness"
+        } else {
+            "its stiffness on the constraint manifold is singular at the equilibrium over the free coordinates (a neutral direction, or constraints that lock coordinates already locked): lock the coordinates without stiffness"
+        })
     })?;
     let mut dq_dp = vec![0.0; n * ns];
-    let mut b = vec![0.0; nf];
+    let mut dlambda_dp = vec![0.0; nc * ns];
+    let mut x = vec![0.0; na];
     for p in 0..ns {
         for (r, &i) in free.iter().enumerate() {
-            b[r] = -dtau[i + n * p];
+            x[r] = -dtau[i + n * p];
         }
-        lu.solve(&mut b);
+        for i in 0..nc {
+            x[nf + i] = -ct.dphi_dp[i + nc * p];
+        }
+        lu.solve(&mut x);
         for (r, &i) in free.iter().enumerate() {
-            dq_dp[i + n * p] = b[r];
+            dq_dp[i + n * p] = x[r];
         }
+        dlambda_dp[nc * p..nc * (p + 1)].copy_from_slice(&x[nf..]);
     }
     check(&m, "∂q/∂p", &dq_dp)?;
+    check(&m, "∂λ/∂p", &dlambda_dp)?;
     let info = m.info();
     Ok(StaticSensitivity {
         params: M::SENSITIVE.to_vec(),
         dofs: (0..n).map(|i| info.dof_label(i).to_string()).collect(),
         dq_dp,
+        dlambda_dp,
     })
 }
 
@@ -169,6 +209,11 @@ pub fn pole_sensitivity<M: Model + Clone>(
     let n = M::NQ;
     let ns = M::SENSITIVE.len();
     let refuse = |reason| refusal(model, reason);
+    if M::NC > 0 {
+        return Err(refuse(
+            "it has constraints: the poles of a closed loop are those of its motion on the constraint manifold, whose derivatives by the parameters are not available yet (static_sensitivity and Sensitivities are)",
+        ));
+    }
     if !options.locked.is_empty() {
         return Err(Failure::InvalidOption {
             name: "locked",

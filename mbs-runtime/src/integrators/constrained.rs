@@ -639,6 +639,26 @@ impl fmt::Display for Assembly {
     }
 }
 
+/// The change of the coordinates `free` (the others kept) that B (NC × NQ) maps to `r`, the
+/// least in the metric of M (NQ × NQ): W⁻¹B_fᵀ(B_f W⁻¹B_fᵀ)⁻¹r with W = M_ff; subtracted, it
+/// removes a residual r of Φ (or Φ̇) to first order. None when W or B_f W⁻¹B_fᵀ is singular.
+pub(crate) fn least_correction(
+    b: &[f64],
+    mm: &[f64],
+    free: &[usize],
+    r: &[f64],
+) -> Option<nalgebra::DVector<f64>> {
+    use nalgebra::{DMatrix, DVector};
+    let (nc, nf) = (r.len(), free.len());
+    let n = b.len() / nc.max(1);
+    let bf = DMatrix::from_fn(nc, nf, |i, k| b[i + nc * free[k]]);
+    let w = DMatrix::from_fn(nf, nf, |a, c| mm[free[a] + n * free[c]]);
+    let winv_bt = w.cholesky()?.solve(&bf.transpose());
+    let s = &bf * &winv_bt;
+    let x = s.cholesky()?.solve(&DVector::from_column_slice(r));
+    Some(winv_bt * x)
+}
+
 /// Makes (q, qd) consistent with Φ(q, t) = 0 and Φ̇ = 0: Newton on the coordinates not
 /// marked `independent` (minimal correction in the metric of M, no coordinate moved by more
 /// than 0.5 per step, step halved until max |Φ| decreases), refusing a result on another
@@ -652,7 +672,7 @@ pub fn assemble<M: Model>(
     qd: &mut [f64],
     o: &ConstraintOptions,
 ) -> Result<Assembly, Failure> {
-    use nalgebra::{DMatrix, DVector};
+    use nalgebra::DMatrix;
     let (n, nc) = (M::NQ, M::NC);
     let info = model.info();
     let names: Vec<String> = info.constraints.iter().map(|s| s.to_string()).collect();
@@ -703,16 +723,8 @@ pub fn assemble<M: Model>(
             0,
         ));
     }
-    // B over the free coordinates, the metric M_ff and the correction −W⁻¹B_fᵀ(B_f W⁻¹B_fᵀ)⁻¹r
+    // B over the free coordinates
     let restricted = |b: &[f64]| DMatrix::from_fn(nc, free.len(), |i, k| b[i + nc * free[k]]);
-    let metric =
-        |mm: &[f64]| DMatrix::from_fn(free.len(), free.len(), |a, c| mm[free[a] + n * free[c]]);
-    let correction = |bf: &DMatrix<f64>, w: &DMatrix<f64>, r: &[f64]| -> Option<DVector<f64>> {
-        let winv_bt = w.clone().cholesky()?.solve(&bf.transpose());
-        let s = bf * &winv_bt;
-        let x = s.cholesky()?.solve(&DVector::from_column_slice(r));
-        Some(winv_bt * x)
-    };
     let deficient = |b: &[f64], phi: &[f64], it: usize| -> Failure {
         let (rank, _, _) = rank_of(b, nc, n);
         if rank < nc {
@@ -790,8 +802,7 @@ pub fn assemble<M: Model>(
         }
         model.constraint_jacobian(t, q, &mut b);
         model.mass_matrix(t, q, &mut mm);
-        let bf = restricted(&b);
-        let Some(dx) = correction(&bf, &metric(&mm), &phi) else {
+        let Some(dx) = least_correction(&b, &mm, &free, &phi) else {
             return Err(deficient(&b, &phi, it));
         };
         // at most MAX_MOVE per coordinate and step, so that a far start does not wander off
@@ -847,8 +858,7 @@ pub fn assemble<M: Model>(
     let r0 = rate(qd);
     let (rate_before, _) = worst(&r0);
     model.mass_matrix(t, q, &mut mm);
-    let bf = restricted(&b);
-    let Some(dv) = correction(&bf, &metric(&mm), &r0) else {
+    let Some(dv) = least_correction(&b, &mm, &free, &r0) else {
         return Err(deficient(&b, &phi, it));
     };
     for (k, &j) in free.iter().enumerate() {

@@ -697,6 +697,9 @@ fn consistent_start<M: Model>(
     let adaptive = matches!(options.step, StepControl::Adaptive { .. });
     let mode = constraint_mode(oc.method, scheme, adaptive)?;
     let a = assemble(&problem.model, cur.t, &mut cur.q, &mut cur.qd, oc)?;
+    problem
+        .model
+        .complete_start(cur.t, &mut cur.q, &mut cur.qd)?;
     let mut c = Constrained::new(&problem.model, mode, oc);
     if mode == Mode::Partitioning {
         c.eval_b(&problem.model, &mut problem.stats, cur.t, &cur.q);

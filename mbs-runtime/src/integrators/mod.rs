@@ -47,6 +47,7 @@ pub use inputs::{Controller, Inputs};
 pub use newmark::index3_iteration_matrix;
 pub use sim_error::SimError;
 
+pub(crate) use constrained::least_correction;
 pub(crate) use dense::lerp_lambda;
 pub(crate) use inputs::InputFn;
 pub(crate) use problem::model_error_reason;

@@ -132,6 +132,18 @@ pub const REST_TANGENT_DERIVATIVES: Method = method(
     "::core::result::Result<(), ::mbs::ModelError>",
 );
 
+/// `constraint_parameter_tangents`, which has a default in the trait (an error) that models
+/// with constraints and parameters marked `sensitive` override.
+pub const CONSTRAINT_PARAMETER_TANGENTS: Method = method(
+    "constraint_parameter_tangents",
+    "t: f64, q: &[f64], qd: &[f64], qdd: &[f64], lambda: &[f64], out: &mut ::mbs::ConstraintTangents",
+    "::core::result::Result<(), ::mbs::ModelError>",
+);
+
+/// The arguments of the inner function behind [`CONSTRAINT_PARAMETER_TANGENTS`], one slice per
+/// field of `ConstraintTangents`.
+pub const CONSTRAINT_PARAMETER_TANGENTS_INNER: &str = "t: f64, q: &[f64], qd: &[f64], qdd: &[f64], lambda: &[f64], dphi_dp: &mut [f64], drate_dq: &mut [f64], drate_dp: &mut [f64], dacc_dq: &mut [f64], dacc_dqd: &mut [f64], dacc_dp: &mut [f64], dforce_dp: &mut [f64]";
+
 /// The batch methods (four states at once on `::mbs::F64x4` lanes), which have defaults in
 /// the trait (lane by lane) that models with `option batch;` override; the arguments are
 /// those of `dynamics` and `forward_dynamics` with lanes for `f64`.
@@ -195,6 +207,9 @@ pub struct Sizes {
     pub sensitive: Vec<String>,
     /// the model overrides [`REST_TANGENT_DERIVATIVES`] (sensitive parameters and tangents)
     pub rest_derivatives: bool,
+    /// the model overrides [`CONSTRAINT_PARAMETER_TANGENTS`] (sensitive parameters and
+    /// constraints)
+    pub constraint_sensitivity: bool,
 }
 
 /// `impl ::mbs::Model for {ty}` with parameter struct `pty`: the constants, then every method
@@ -216,6 +231,7 @@ pub fn model_impl(
         batch,
         sensitive,
         rest_derivatives,
+        constraint_sensitivity,
     } = sizes;
     let mut s = format!(
         "impl ::mbs::Model for {ty} {{
@@ -242,6 +258,11 @@ const BATCH_GENERATED: bool = {batch};
         (false, false) => std::slice::from_ref(&PARAMETER_TANGENTS),
         (false, true) => &[PARAMETER_TANGENTS, REST_TANGENT_DERIVATIVES][..],
     };
+    let constraint_methods = if *constraint_sensitivity {
+        std::slice::from_ref(&CONSTRAINT_PARAMETER_TANGENTS)
+    } else {
+        &[]
+    };
     for m in METHODS
         .iter()
         .chain([
@@ -251,6 +272,7 @@ const BATCH_GENERATED: bool = {batch};
         ])
         .chain(batch_methods)
         .chain(sensitivity_methods)
+        .chain(constraint_methods)
     {
         let args = m.args.replace("{P}", pty);
         let ret = if m.ret.is_empty() {

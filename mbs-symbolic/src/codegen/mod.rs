@@ -345,13 +345,31 @@ fn emit_params(
     let mut f = FnSpec::new("__constraint_tangent", &with_charts("constraint_tangent"));
     f.matrix(a, "k", &c.tangent);
     specs.push(f);
-    let labels = [
+    let mut labels = vec![
         "constraints Φ",
         "constraint_jacobian B",
         "constraint_rate Φ_t",
         "constraint_bias γ",
         "constraint_tangent",
     ];
+    if let Some(cs) = &c.sensitivity {
+        let mut f = FnSpec::new(
+            "__constraint_parameter_tangents",
+            &format!(
+                "charts: &[[[f64; 3]; 3]], {}",
+                api::CONSTRAINT_PARAMETER_TANGENTS_INNER
+            ),
+        );
+        f.matrix(a, "dphi_dp", &cs.dphi_dp);
+        f.matrix(a, "drate_dq", &cs.drate_dq);
+        f.matrix(a, "drate_dp", &cs.drate_dp);
+        f.matrix(a, "dacc_dq", &cs.dacc_dq);
+        f.matrix(a, "dacc_dqd", &cs.dacc_dqd);
+        f.matrix(a, "dacc_dp", &cs.dacc_dp);
+        f.matrix(a, "dforce_dp", &cs.dforce_dp);
+        specs.push(f);
+        labels.push("constraint_parameter_tangents (∂Φ/∂p, …)");
+    }
     let mut ops = Vec::new();
     for (spec, label) in kinematics_specs(model, with_charts) {
         if let Some((s, count)) = collect(emit_fn(a, &spec, &names), missing, |e| (e.text, e.count))
@@ -808,6 +826,7 @@ fn emit_scene(
             .map(|p| p.name.clone())
             .collect(),
         rest_derivatives: sys.options.tangents && sys.params.iter().any(|p| p.sensitive),
+        constraint_sensitivity: model.constraints.sensitivity.is_some(),
     };
     let model_impl = api::model_impl(&ty, &pty, &sizes, |m| {
         match m.name {
@@ -821,6 +840,12 @@ fn emit_scene(
         "rest_tangent_derivatives" => {
             format!("self.__rest_tangent_derivatives({})", m.call()) + ";\nOk(())"
         }
+        "constraint_parameter_tangents" => format!(
+            "self.params.__constraint_parameter_tangents(&self.charts, t, q, qd, qdd, lambda, {})",
+            ["dphi_dp", "drate_dq", "drate_dp", "dacc_dq", "dacc_dqd", "dacc_dp", "dforce_dp"]
+                .map(|f| format!("&mut out.{f}"))
+                .join(", ")
+        ) + ";\nOk(())",
         "energy" => "let mut e = [0.0f64; 2];\nself.__energy(t, q, qd, &mut e);\n::mbs::Energy { kinetic: e[0], potential: e[1] }".into(),
         "power" => "let mut e = [0.0f64; 1];\nself.__power(t, q, qd, u, &mut e);\ne[0]".into(),
         // the constraint functions live on the parameter struct, shared by every scene

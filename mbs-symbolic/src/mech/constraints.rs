@@ -1,7 +1,8 @@
 //! Holonomic constraints Φ(q, t) = 0 on the DAG: Φ from the constraint descriptions (world
 //! kinematics for closures), B = ∂Φ/∂q, Φ_t = ∂Φ/∂t, γ with B qdd = γ (γ = −Φ̈ at qdd = 0:
 //! the total time derivative of Φ̇ = B qd + Φ_t with the accelerations set to zero), and
-//! ∂(Bᵀλ)/∂q for Newton, with λ as symbols.
+//! ∂(Bᵀλ)/∂q for Newton, with λ as symbols; with parameters marked `sensitive`, the
+//! derivatives the sensitivities of a closed loop need ([`ConstraintSensitivity`]).
 
 use super::spatial::{self as s, Matrix};
 use super::system::{Attach, ConstraintKind, System};
@@ -19,6 +20,76 @@ pub struct ConstraintEquations {
     pub gamma: Vec<ExprId>,
     /// ∂(Bᵀλ)/∂q (n × n, row-major), λ as `Var::Lambda`
     pub tangent: Matrix,
+    /// with parameters marked `sensitive` (and constraints)
+    pub sensitivity: Option<ConstraintSensitivity>,
+}
+
+/// What forward and static sensitivities of a closed loop need besides ∂τ/∂p: the
+/// derivatives of Φ, of Φ̇ = B qd + Φ_t and of Φ̈ = B qdd − γ by the coordinates and by the
+/// sensitive parameters, and ∂(Bᵀλ)/∂p (row-major; NS columns in declaration order).
+#[derive(Clone, Debug, Default)]
+pub struct ConstraintSensitivity {
+    /// ∂Φ/∂p (nc × ns)
+    pub dphi_dp: Matrix,
+    /// ∂Φ̇/∂q (nc × n)
+    pub drate_dq: Matrix,
+    /// ∂Φ̇/∂p (nc × ns)
+    pub drate_dp: Matrix,
+    /// ∂Φ̈/∂q (nc × n), qdd and λ as symbols
+    pub dacc_dq: Matrix,
+    /// ∂Φ̈/∂qd (nc × n)
+    pub dacc_dqd: Matrix,
+    /// ∂Φ̈/∂p (nc × ns)
+    pub dacc_dp: Matrix,
+    /// ∂(Bᵀλ)/∂p (n × ns)
+    pub dforce_dp: Matrix,
+}
+
+impl ConstraintSensitivity {
+    fn build(
+        a: &mut Arena,
+        c: &ConstraintEquations,
+        btl: &[ExprId],
+        sensitive: &[u16],
+    ) -> ConstraintSensitivity {
+        let n = c.tangent.len();
+        let rate: Vec<ExprId> =
+            c.b.iter()
+                .zip(&c.phi_t)
+                .map(|(row, &pt)| {
+                    let qd: Vec<ExprId> = (0..n).map(|j| a.var(Var::Qd(j as u16))).collect();
+                    let bqd = a.dot(row, &qd);
+                    a.add(bqd, pt)
+                })
+                .collect();
+        let acc: Vec<ExprId> =
+            c.b.iter()
+                .zip(&c.gamma)
+                .map(|(row, &g)| {
+                    let qdd: Vec<ExprId> = (0..n).map(|j| a.var(Var::Qdd(j as u16))).collect();
+                    let bqdd = a.dot(row, &qdd);
+                    a.sub(bqdd, g)
+                })
+                .collect();
+        let mut by = |x: &[ExprId], var: &dyn Fn(usize) -> Var, count: usize| -> Matrix {
+            x.iter()
+                .map(|&e| (0..count).map(|j| a.diff(e, var(j))).collect())
+                .collect()
+        };
+        let param = |j: usize| Var::Param(sensitive[j]);
+        let q = |j: usize| Var::Q(j as u16);
+        let qd = |j: usize| Var::Qd(j as u16);
+        let ns = sensitive.len();
+        ConstraintSensitivity {
+            dphi_dp: by(&c.phi, &param, ns),
+            drate_dq: by(&rate, &q, n),
+            drate_dp: by(&rate, &param, ns),
+            dacc_dq: by(&acc, &q, n),
+            dacc_dqd: by(&acc, &qd, n),
+            dacc_dp: by(&acc, &param, ns),
+            dforce_dp: by(btl, &param, ns),
+        }
+    }
 }
 
 fn position(a: &mut Arena, w: &World, tree: &Tree, p: &Attach) -> s::V3 {
@@ -106,12 +177,21 @@ impl ConstraintEquations {
             .iter()
             .map(|&f| (0..n).map(|k| a.diff(f, Var::Q(k as u16))).collect())
             .collect();
-        ConstraintEquations {
+        let sensitive: Vec<u16> = (0..sys.params.len())
+            .filter(|&i| sys.params[i].sensitive)
+            .map(|i| i as u16)
+            .collect();
+        let mut c = ConstraintEquations {
             phi,
             b,
             phi_t,
             gamma,
             tangent,
+            sensitivity: None,
+        };
+        if !c.phi.is_empty() && !sensitive.is_empty() {
+            c.sensitivity = Some(ConstraintSensitivity::build(a, &c, &btl, &sensitive));
         }
+        c
     }
 }

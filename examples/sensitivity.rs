@@ -90,21 +90,7 @@ fn main() {
     // how the poles move along the equilibria: dλ/dp from the left and right eigenvectors
     let poles = pole_sensitivity(&model, &eq, &statics).expect("pole sensitivity");
     println!("poles at the equilibrium and their sensitivities (exact, generated M', C', K'):");
-    for (i, mode) in poles.modes.modes.iter().enumerate() {
-        println!(
-            "  mode {i}: f = {:.4} Hz, ζ = {:.4}",
-            mode.frequency_hz, mode.damping_ratio
-        );
-        for p in &poles.params {
-            let (dre, dim) = poles.dpole(i, p).unwrap_or((f64::NAN, f64::NAN));
-            println!(
-                "    d/d{p:<3}: dλ = {dre:>11.6} {:+.6}i 1/s,  df = {:>10.6} Hz,  dζ = {:>10.6}",
-                dim,
-                poles.dfrequency(i, p).unwrap_or(f64::NAN),
-                poles.ddamping(i, p).unwrap_or(f64::NAN)
-            );
-        }
-    }
+    print_poles(&poles);
 
     motion::<SprungArm>(2.0);
 
@@ -126,7 +112,31 @@ fn main() {
             s.dlambda_dp[2 * j + 1]
         );
     }
+    let poles = pole_sensitivity(&model, &eq, &statics).expect("pole sensitivity");
+    println!(
+        "its poles on the constraint manifold and their sensitivities (exact, generated B', K_λ' too):"
+    );
+    print_poles(&poles);
     motion::<SensitiveFourBar>(1.0);
+}
+
+/// Each mode and its dλ/dp, df/dp and dζ/dp.
+fn print_poles(poles: &mbs::analysis::PoleSensitivity) {
+    for (i, mode) in poles.modes.modes.iter().enumerate() {
+        println!(
+            "  mode {i}: f = {:.4} Hz, ζ = {:.4}",
+            mode.frequency_hz, mode.damping_ratio
+        );
+        for p in &poles.params {
+            let (dre, dim) = poles.dpole(i, p).unwrap_or((f64::NAN, f64::NAN));
+            println!(
+                "    d/d{p:<3}: dλ = {dre:>11.6} {:+.6}i 1/s,  df = {:>10.6} Hz,  dζ = {:>10.6}",
+                dim,
+                poles.dfrequency(i, p).unwrap_or(f64::NAN),
+                poles.ddamping(i, p).unwrap_or(f64::NAN)
+            );
+        }
+    }
 }
 
 /// dq(t_end)/dp of `M`'s default motion by three schemes at rtol 1e-8 against central

@@ -481,6 +481,53 @@ fn generated_constraint_derivatives_match_central_differences() {
     }
     assert!(ct.dphi_dp.iter().any(|x| x.abs() > 1e-2));
     assert!(ct.dforce_dp.iter().any(|x| x.abs() > 1e-2));
+    // B' and K_λ' (pole sensitivities): along a direction in q, then by each parameter
+    let dir = [0.3, -1.1, 0.6];
+    let (mut db, mut dk) = (vec![0.0; nc * n * 5], vec![0.0; n * n * 5]);
+    model
+        .constraint_rest_derivatives(0.3, &q, &dir, &lam, &mut db, &mut dk)
+        .unwrap();
+    let b_and_k = |m: &SensitiveFourBar, q: &[f64]| {
+        let (mut b, mut k) = (vec![0.0; nc * n], vec![0.0; n * n]);
+        m.constraint_jacobian(0.3, q, &mut b);
+        m.constraint_tangent(0.3, q, &lam, &mut k);
+        (b, k)
+    };
+    let compare = |what: &str,
+                   block: usize,
+                   plus: (Vec<f64>, Vec<f64>),
+                   minus: (Vec<f64>, Vec<f64>),
+                   e: f64| {
+        for i in 0..nc * n {
+            close(
+                &format!("B' {what} [{i}]"),
+                db[nc * n * block + i],
+                (plus.0[i] - minus.0[i]) / (2.0 * e),
+            );
+        }
+        for i in 0..n * n {
+            close(
+                &format!("K_λ' {what} [{i}]"),
+                dk[n * n * block + i],
+                (plus.1[i] - minus.1[i]) / (2.0 * e),
+            );
+        }
+    };
+    let qp: Vec<f64> = (0..n).map(|i| q[i] + e * dir[i]).collect();
+    let qm: Vec<f64> = (0..n).map(|i| q[i] - e * dir[i]).collect();
+    compare("along dq", 0, b_and_k(&model, &qp), b_and_k(&model, &qm), e);
+    for j in 0..4 {
+        let (name, p0) = (SensitiveFourBar::SENSITIVE[j], fourbar_param(j));
+        let e = 1e-6 * p0;
+        compare(
+            name,
+            1 + j,
+            b_and_k(&fourbar_with(name, p0 + e), &q),
+            b_and_k(&fourbar_with(name, p0 - e), &q),
+            e,
+        );
+    }
+    assert!(db.iter().any(|x| x.abs() > 1e-2) && dk.iter().any(|x| x.abs() > 1e-2));
     // models without constraints or sensitive parameters have none
     let e = SprungArm::default()
         .constraint_parameter_tangents(0.0, &[0.0; 2], &[0.0; 2], &[0.0; 2], &[], &mut ct)
@@ -528,9 +575,58 @@ fn closed_loop_equilibria_move_with_the_parameters_as_differences_say() {
             );
         }
     }
-    // the poles of a closed loop are refused, with what is available instead
-    let err = mbs::analysis::pole_sensitivity(&model, &eq, &options).unwrap_err();
-    assert!(err.to_string().contains("static_sensitivity"), "{err}");
+}
+
+#[test]
+fn closed_loop_poles_move_with_the_parameters_as_differences_say() {
+    use mbs::analysis::{linearize, modes, pole_sensitivity};
+    let options = StaticsOptions {
+        tolerance: 1e-13,
+        ..StaticsOptions::default()
+    };
+    let poles_of = |model: &SensitiveFourBar, start: &[f64]| {
+        let start = StaticsOptions {
+            q0: Some(start.to_vec()),
+            ..options.clone()
+        };
+        let eq = static_equilibrium(model, &start).unwrap();
+        let lin = linearize(
+            model,
+            0.0,
+            &eq.q,
+            &[0.0; 3],
+            &[],
+            mbs::IterationMatrix::Exact,
+        )
+        .unwrap();
+        modes(&lin, None).unwrap()
+    };
+    let model = SensitiveFourBar::default();
+    let eq = static_equilibrium(&model, &options).unwrap();
+    let s = pole_sensitivity(&model, &eq, &options).unwrap();
+    // one degree of freedom: one oscillating mode (no damping)
+    assert_eq!(s.modes.modes.len(), 1);
+    let mode = &s.modes.modes[0];
+    assert!(mode.im > 0.0, "{mode:?}");
+    for (j, name) in s.params.iter().enumerate() {
+        let p0 = fourbar_param(j);
+        let e = 1e-5 * p0;
+        let plus = poles_of(&fourbar_with(name, p0 + e), &eq.q);
+        let minus = poles_of(&fourbar_with(name, p0 - e), &eq.q);
+        let (dre, dim) = s.dpole(0, name).unwrap();
+        let diff_re = (plus.modes[0].re - minus.modes[0].re) / (2.0 * e);
+        let diff_im = (plus.modes[0].im - minus.modes[0].im) / (2.0 * e);
+        println!(
+            "mode 0 ({:.4} Hz) d/d{name}: λ' = {dre:.8} + {dim:.8}i (differences {diff_re:.8} + {diff_im:.8}i)",
+            mode.frequency_hz
+        );
+        let size = dre.hypot(dim).max(1e-3);
+        assert!(
+            (dre - diff_re).abs() <= 1e-6 * size && (dim - diff_im).abs() <= 1e-6 * size,
+            "{name}: ({dre}, {dim}) vs ({diff_re}, {diff_im})"
+        );
+        assert!(dim.abs() > 1e-2, "{name} moves the pole");
+    }
 }
 
 /// The four-bar's q(t_end), qd(t_end) at tight tolerances.

@@ -615,6 +615,26 @@ pub trait Model {
         })
     }
 
+    /// With constraints, parameters marked `sensitive` and `option tangents;` (pole
+    /// sensitivities of closed loops): how B (NC × NQ) and K_λ = ∂(Bᵀλ)/∂q (NQ × NQ) change,
+    /// each NQ·(1 + NS) columns in blocks as [`Model::rest_tangent_derivatives`]: block 0
+    /// along the coordinates' direction `dq`, block 1 + j by sensitive parameter j (λ held).
+    /// Generated exactly; an error for other models.
+    fn constraint_rest_derivatives(
+        &self,
+        t: f64,
+        q: &[f64],
+        dq: &[f64],
+        lambda: &[f64],
+        db: &mut [f64],
+        dk: &mut [f64],
+    ) -> Result<(), crate::error::ModelError> {
+        let _ = (t, q, dq, lambda, db, dk);
+        Err(crate::error::ModelError::NoSensitiveParameters {
+            model: self.info().name,
+        })
+    }
+
     /// Called once the start of a closed loop is assembled (q and qd consistent with Φ = 0 and
     /// Φ̇ = 0), so that a wrapper can make the coordinates it adds consistent too (the
     /// sensitivities of the assembled start, [`crate::Sensitivities`]). Does nothing by default.

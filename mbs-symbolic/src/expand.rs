@@ -249,6 +249,7 @@ fn validate(&self) -> ::core::result::Result<(), ::mbs::ParamError> {{ {never} }
         sensitive: Vec::new(),
         rest_derivatives: false,
         constraint_sensitivity: false,
+        constraint_rest_derivatives: false,
     };
     for ty in scenes {
         code.push_str(&format!(

@@ -8,8 +8,8 @@
 //! `independent`), crank speed 5 rad/s; `b` and `c` are given roughly, on the branch with the
 //! coupler above the x axis, and the assembly closes the loop from them.
 //!
-//! [`SensitiveFourBar`] is the same mechanism with a rotational spring at the crank (a stable
-//! equilibrium) and four parameters marked `sensitive`: the sensitivities of a closed loop
+//! [`SensitiveFourBar`] is the same mechanism with a rotational spring and damper at the crank
+//! (a stable equilibrium) and four parameters marked `sensitive`: the sensitivities of a closed loop
 //! (`tests/sensitivity.rs`, `examples/sensitivity.rs`).
 
 mbs::multibody! {
@@ -43,9 +43,9 @@ mbs::multibody! {
 }
 
 mbs::multibody! {
-    /// [`FourBar`] with a rotational spring at the
-    /// crank, so that it has a stable equilibrium, and its link lengths, density and spring
-    /// rate marked `sensitive`.
+    /// [`FourBar`] with a rotational spring and a light damper at the crank, so that it has a
+    /// stable, damped equilibrium, and its link lengths, density and spring rate marked
+    /// `sensitive`.
     pub model SensitiveFourBar {
         param l0 = 0.4; param l1 = 0.1 sensitive; param l2 = 0.35 sensitive; param l3 = 0.3;
         param rho = 1.0 sensitive; param k1 = 2.0 sensitive; param g = 9.81;
@@ -62,7 +62,7 @@ mbs::multibody! {
         TOG[coupler] = TOG[crank] * Tdisp(l1 / 2, 0, 0) * Trotz(b - a) * Tdisp(l2 / 2, 0, 0);
         TOG[rocker] = Tdisp(l0, 0, 0) * Trotz(c) * Tdisp(l3 / 2, 0, 0);
         gravity(0, -g, 0);
-        rotational_spring(ground, crank, axis = z, k = k1, angle0 = 1.0);
+        rotational_spring(ground, crank, axis = z, k = k1, angle0 = 1.0, c = 0.01);
         constraint close: coincide(coupler_end, rocker_tip, along = [x, y]);
         option tangents;
     }

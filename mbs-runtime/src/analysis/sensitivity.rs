@@ -196,10 +196,17 @@ impl PoleSensitivity {
 /// With Q(λ) = λ²M + λC + K (C = ∂τ/∂qd, K = ∂τ/∂q at rest), a simple pole λ with right
 /// and left eigenvectors Q(λ)x = 0, yᴴQ(λ) = 0 moves by
 /// dλ/dp = −yᴴ(λ²M' + λC' + K')x / yᴴ(2λM + C)x, where X' = dX/dp along the equilibria comes
-/// from the generated second derivatives ([`Model::rest_tangent_derivatives`]). Exact to
-/// rounding for simple poles; a repeated pole has no derivative and is reported as an error.
-/// Needs `option tangents;`; models with constraints and equilibria with locked coordinates
-/// (not at rest on them) are refused.
+/// from the generated second derivatives ([`Model::rest_tangent_derivatives`]).
+///
+/// On a closed loop the motion about the equilibrium is M δq̈ + C δq̇ + (K − K_λ) δq = Bᵀ δλ,
+/// B δq = 0 (K_λ = ∂(Bᵀλ)/∂q), whose poles are the finite eigenvalues of
+/// A(λ) = [Q(λ) − K_λ, −Bᵀ; B, 0]: with right and left eigenvectors (x, ℓ) and (y, m),
+/// dλ/dp = −(yᴴ(λ²M' + λC' + K' − K_λ')x − yᴴB'ᵀℓ + mᴴB'x) / yᴴ(2λM + C)x, B' and K_λ' along
+/// the equilibria from [`Model::constraint_rest_derivatives`] and dλ_eq/dp.
+///
+/// Exact to rounding for simple poles; a repeated pole has no derivative and is reported as
+/// an error. Needs `option tangents;`; equilibria with locked coordinates (not at rest on
+/// them) are refused.
 pub fn pole_sensitivity<M: Model + Clone>(
     model: &M,
     eq: &Equilibrium,
@@ -209,11 +216,6 @@ pub fn pole_sensitivity<M: Model + Clone>(
     let n = M::NQ;
     let ns = M::SENSITIVE.len();
     let refuse = |reason| refusal(model, reason);
-    if M::NC > 0 {
-        return Err(refuse(
-            "it has constraints: the poles of a closed loop are those of its motion on the constraint manifold, whose derivatives by the parameters are not available yet (static_sensitivity and Sensitivities are)",
-        ));
-    }
     if !options.locked.is_empty() {
         return Err(Failure::InvalidOption {
             name: "locked",
@@ -238,26 +240,56 @@ pub fn pole_sensitivity<M: Model + Clone>(
     check(&m, "M", &mass)?;
     check(&m, "K", &k)?;
     check(&m, "C", &c)?;
-    // M', C', K' along the equilibria, one n × n block per parameter
+    // closed loops: B, and K − K_λ in place of K
+    let nc = M::NC;
+    let mut b = vec![0.0; nc * n];
+    let mut k_lambda = vec![0.0; n * n];
+    if nc > 0 {
+        m.constraint_jacobian(options.t, &eq.q, &mut b);
+        m.constraint_tangent(options.t, &eq.q, &eq.lambda, &mut k_lambda);
+        check(&m, "B", &b)?;
+        check(&m, "∂(Bᵀλ)/∂q", &k_lambda)?;
+        for (x, g) in k.iter_mut().zip(&k_lambda) {
+            *x -= g;
+        }
+    }
+    // M', C', K' (less K_λ') and B' along the equilibria, one block per parameter
     let nb = n * n;
     let (mut dm, mut dc, mut dk) = (
         vec![0.0; nb * (1 + ns)],
         vec![0.0; nb * (1 + ns)],
         vec![0.0; nb * (1 + ns)],
     );
-    let mut along: Vec<Vec<f64>> = Vec::with_capacity(3 * ns);
+    let (mut db, mut dkl) = (vec![0.0; nc * n * (1 + ns)], vec![0.0; nb * (1 + ns)]);
+    let mut kl_of_dlambda = vec![0.0; nb];
+    let mut along: Vec<Vec<f64>> = Vec::with_capacity(4 * ns);
     for p in 0..ns {
         let dir = &dq.dq_dp[n * p..n * (p + 1)];
         m.rest_tangent_derivatives(options.t, &eq.q, dir, &u, &mut dm, &mut dc, &mut dk)
             .map_err(|e| refuse(crate::integrators::model_error_reason(&e)))?;
         for x in [&dm, &dc, &dk] {
             check(&m, "∂(M, C, K)/∂p", x)?;
-            along.push(
-                (0..nb)
-                    .map(|i| x[i] + x[nb * (1 + p) + i])
-                    .collect::<Vec<f64>>(),
-            );
         }
+        let total = |x: &[f64], size: usize| -> Vec<f64> {
+            (0..size).map(|i| x[i] + x[size * (1 + p) + i]).collect()
+        };
+        let (mp, cp, mut kp) = (total(&dm, nb), total(&dc, nb), total(&dk, nb));
+        let mut bp = Vec::new();
+        if nc > 0 {
+            m.constraint_rest_derivatives(options.t, &eq.q, dir, &eq.lambda, &mut db, &mut dkl)
+                .map_err(|e| refuse(crate::integrators::model_error_reason(&e)))?;
+            check(&m, "∂(B, K_λ)/∂p", &db)?;
+            check(&m, "∂(B, K_λ)/∂p", &dkl)?;
+            // K_λ is linear in λ, which moves by dλ_eq/dp
+            let dlambda = &dq.dlambda_dp[nc * p..nc * (p + 1)];
+            m.constraint_tangent(options.t, &eq.q, dlambda, &mut kl_of_dlambda);
+            let klp = total(&dkl, nb);
+            for i in 0..nb {
+                kp[i] -= klp[i] + kl_of_dlambda[i];
+            }
+            bp = total(&db, nc * n);
+        }
+        along.extend([mp, cp, kp, bp]);
     }
     let lin = super::linearize(
         &m,
@@ -274,23 +306,33 @@ pub fn pole_sensitivity<M: Model + Clone>(
         .iter()
         .flat_map(|x| x.iter())
         .fold(1.0f64, |s, x| s.max(x.abs()));
+    let na = n + nc;
     let mut dpole_dp = Vec::with_capacity(modes.modes.len() * ns);
-    let mut q_right = Lu::<C64>::new(n);
-    let mut q_left = Lu::<C64>::new(n);
+    let mut a_right = Lu::<C64>::new(na);
+    let mut a_left = Lu::<C64>::new(na);
     for mode in &modes.modes {
         let lambda = C64::new(mode.re, mode.im);
-        // Q(μ) and Q(μ)ᴴ with μ a hair off λ, for inverse iteration
+        // A(μ) and A(μ)ᴴ with μ a hair off λ, for inverse iteration
         let mag = mode.re.hypot(mode.im);
         let mu = lambda + C64::new(1e-9 * mag.max(1.0), 1e-9 * mag.max(1.0));
         {
-            let (a, b) = (q_right.matrix_mut(), q_left.matrix_mut());
+            let (ar, al) = (a_right.matrix_mut(), a_left.matrix_mut());
+            ar.fill(C64::default());
             for j in 0..n {
                 for i in 0..n {
-                    let e = mu * mu * real(mass[i + n * j])
+                    ar[i + na * j] = mu * mu * real(mass[i + n * j])
                         + mu * real(c[i + n * j])
                         + real(k[i + n * j]);
-                    a[i + n * j] = e;
-                    b[j + n * i] = conj(e);
+                }
+                for i in 0..nc {
+                    let bij = b[i + nc * j];
+                    ar[(n + i) + na * j] = real(bij);
+                    ar[j + na * (n + i)] = real(-bij);
+                }
+            }
+            for j in 0..na {
+                for i in 0..na {
+                    al[j + na * i] = conj(ar[i + na * j]);
                 }
             }
         }
@@ -302,14 +344,14 @@ pub fn pole_sensitivity<M: Model + Clone>(
             }
             .into()
         };
-        q_right.factor().map_err(|_| singular())?;
-        q_left.factor().map_err(|_| singular())?;
+        a_right.factor().map_err(|_| singular())?;
+        a_left.factor().map_err(|_| singular())?;
         let start = |i: usize| C64::new(1.0 + 0.1 * i as f64, 0.05 * i as f64);
         let (mut x, mut y): (Vec<C64>, Vec<C64>) =
-            ((0..n).map(start).collect(), (0..n).map(start).collect());
+            ((0..na).map(start).collect(), (0..na).map(start).collect());
         for _ in 0..3 {
-            q_right.solve(&mut x);
-            q_left.solve(&mut y);
+            a_right.solve(&mut x);
+            a_left.solve(&mut y);
             for v in [&mut x, &mut y] {
                 let nv = v.iter().map(|z| z.abs()).fold(0.0, f64::max);
                 for z in v.iter_mut() {
@@ -317,7 +359,7 @@ pub fn pole_sensitivity<M: Model + Clone>(
                 }
             }
         }
-        // yᴴ A x for a real n × n matrix A
+        // yᴴ A x for a real n × n matrix A, over the coordinates' parts
         let form = |a: &dyn Fn(usize) -> C64| -> C64 {
             let mut s = C64::default();
             for j in 0..n {
@@ -334,10 +376,17 @@ pub fn pole_sensitivity<M: Model + Clone>(
             ));
         }
         for p in 0..ns {
-            let (dmp, dcp, dkp) = (&along[3 * p], &along[3 * p + 1], &along[3 * p + 2]);
-            let num = form(&|ij| {
+            let [dmp, dcp, dkp, dbp] = [0, 1, 2, 3].map(|i| &along[4 * p + i]);
+            let mut num = form(&|ij| {
                 lambda * lambda * real(dmp[ij]) + lambda * real(dcp[ij]) + real(dkp[ij])
             });
+            // − yᴴB'ᵀℓ + mᴴB'x
+            for i in 0..nc {
+                for j in 0..n {
+                    let bij = real(dbp[i + nc * j]);
+                    num = num - conj(y[j]) * bij * x[n + i] + conj(y[n + i]) * bij * x[j];
+                }
+            }
             let d = C64::default() - num / denom;
             // a real pole moves along the real axis
             let im = if mode.im == 0.0 { 0.0 } else { d.im };

@@ -140,6 +140,14 @@ pub const CONSTRAINT_PARAMETER_TANGENTS: Method = method(
     "::core::result::Result<(), ::mbs::ModelError>",
 );
 
+/// `constraint_rest_derivatives`, which has a default in the trait (an error) that models with
+/// constraints, parameters marked `sensitive` and `option tangents;` override.
+pub const CONSTRAINT_REST_DERIVATIVES: Method = method(
+    "constraint_rest_derivatives",
+    "t: f64, q: &[f64], dq: &[f64], lambda: &[f64], db: &mut [f64], dk: &mut [f64]",
+    "::core::result::Result<(), ::mbs::ModelError>",
+);
+
 /// The arguments of the inner function behind [`CONSTRAINT_PARAMETER_TANGENTS`], one slice per
 /// field of `ConstraintTangents`.
 pub const CONSTRAINT_PARAMETER_TANGENTS_INNER: &str = "t: f64, q: &[f64], qd: &[f64], qdd: &[f64], lambda: &[f64], dphi_dp: &mut [f64], drate_dq: &mut [f64], drate_dp: &mut [f64], dacc_dq: &mut [f64], dacc_dqd: &mut [f64], dacc_dp: &mut [f64], dforce_dp: &mut [f64]";
@@ -210,6 +218,9 @@ pub struct Sizes {
     /// the model overrides [`CONSTRAINT_PARAMETER_TANGENTS`] (sensitive parameters and
     /// constraints)
     pub constraint_sensitivity: bool,
+    /// the model overrides [`CONSTRAINT_REST_DERIVATIVES`] (sensitive parameters,
+    /// constraints and tangents)
+    pub constraint_rest_derivatives: bool,
 }
 
 /// `impl ::mbs::Model for {ty}` with parameter struct `pty`: the constants, then every method
@@ -232,6 +243,7 @@ pub fn model_impl(
         sensitive,
         rest_derivatives,
         constraint_sensitivity,
+        constraint_rest_derivatives,
     } = sizes;
     let mut s = format!(
         "impl ::mbs::Model for {ty} {{
@@ -258,10 +270,10 @@ const BATCH_GENERATED: bool = {batch};
         (false, false) => std::slice::from_ref(&PARAMETER_TANGENTS),
         (false, true) => &[PARAMETER_TANGENTS, REST_TANGENT_DERIVATIVES][..],
     };
-    let constraint_methods = if *constraint_sensitivity {
-        std::slice::from_ref(&CONSTRAINT_PARAMETER_TANGENTS)
-    } else {
-        &[]
+    let constraint_methods = match (constraint_sensitivity, constraint_rest_derivatives) {
+        (false, _) => &[][..],
+        (true, false) => std::slice::from_ref(&CONSTRAINT_PARAMETER_TANGENTS),
+        (true, true) => &[CONSTRAINT_PARAMETER_TANGENTS, CONSTRAINT_REST_DERIVATIVES][..],
     };
     for m in METHODS
         .iter()

@@ -369,6 +369,17 @@ fn emit_params(
         f.matrix(a, "dforce_dp", &cs.dforce_dp);
         specs.push(f);
         labels.push("constraint_parameter_tangents (∂Φ/∂p, …)");
+        if let Some([db, dk]) = &cs.rest {
+            // the direction δq is passed as `qd`, which B and K_λ do not depend on
+            let mut f = FnSpec::new(
+                "__constraint_rest_derivatives",
+                "charts: &[[[f64; 3]; 3]], t: f64, q: &[f64], qd: &[f64], lambda: &[f64], db: &mut [f64], dk: &mut [f64]",
+            );
+            f.matrix(a, "db", db);
+            f.matrix(a, "dk", dk);
+            specs.push(f);
+            labels.push("constraint_rest_derivatives (B', K_λ')");
+        }
     }
     let mut ops = Vec::new();
     for (spec, label) in kinematics_specs(model, with_charts) {
@@ -827,6 +838,11 @@ fn emit_scene(
             .collect(),
         rest_derivatives: sys.options.tangents && sys.params.iter().any(|p| p.sensitive),
         constraint_sensitivity: model.constraints.sensitivity.is_some(),
+        constraint_rest_derivatives: model
+            .constraints
+            .sensitivity
+            .as_ref()
+            .is_some_and(|c| c.rest.is_some()),
     };
     let model_impl = api::model_impl(&ty, &pty, &sizes, |m| {
         match m.name {
@@ -846,6 +862,9 @@ fn emit_scene(
                 .map(|f| format!("&mut out.{f}"))
                 .join(", ")
         ) + ";\nOk(())",
+        "constraint_rest_derivatives" => {
+            format!("self.params.__constraint_rest_derivatives(&self.charts, {})", m.call()) + ";\nOk(())"
+        }
         "energy" => "let mut e = [0.0f64; 2];\nself.__energy(t, q, qd, &mut e);\n::mbs::Energy { kinetic: e[0], potential: e[1] }".into(),
         "power" => "let mut e = [0.0f64; 1];\nself.__power(t, q, qd, u, &mut e);\ne[0]".into(),
         // the constraint functions live on the parameter struct, shared by every scene

@@ -43,6 +43,11 @@ pub struct ConstraintSensitivity {
     pub dacc_dp: Matrix,
     /// ∂(Bᵀλ)/∂p (n × ns)
     pub dforce_dp: Matrix,
+    /// with `option tangents;` (pole sensitivities): the derivatives of B (nc × n) and of
+    /// K_λ = ∂(Bᵀλ)/∂q (n × n), each as n·(1 + ns) columns in blocks: block 0 along the
+    /// direction given as `Var::Qd` (Σₖ ∂X/∂qₖ qdₖ: B and K_λ do not depend on qd), block
+    /// 1 + j by sensitive parameter j
+    pub rest: Option<[Matrix; 2]>,
 }
 
 impl ConstraintSensitivity {
@@ -51,6 +56,7 @@ impl ConstraintSensitivity {
         c: &ConstraintEquations,
         btl: &[ExprId],
         sensitive: &[u16],
+        rest: bool,
     ) -> ConstraintSensitivity {
         let n = c.tangent.len();
         let rate: Vec<ExprId> =
@@ -71,6 +77,8 @@ impl ConstraintSensitivity {
                     a.sub(bqdd, g)
                 })
                 .collect();
+        let rest = rest
+            .then(|| [&c.b, &c.tangent].map(|x| super::dynamics::along_and_by(a, x, n, sensitive)));
         let mut by = |x: &[ExprId], var: &dyn Fn(usize) -> Var, count: usize| -> Matrix {
             x.iter()
                 .map(|&e| (0..count).map(|j| a.diff(e, var(j))).collect())
@@ -81,6 +89,7 @@ impl ConstraintSensitivity {
         let qd = |j: usize| Var::Qd(j as u16);
         let ns = sensitive.len();
         ConstraintSensitivity {
+            rest,
             dphi_dp: by(&c.phi, &param, ns),
             drate_dq: by(&rate, &q, n),
             drate_dp: by(&rate, &param, ns),
@@ -190,7 +199,8 @@ impl ConstraintEquations {
             sensitivity: None,
         };
         if !c.phi.is_empty() && !sensitive.is_empty() {
-            c.sensitivity = Some(ConstraintSensitivity::build(a, &c, &btl, &sensitive));
+            let rest = sys.options.tangents;
+            c.sensitivity = Some(ConstraintSensitivity::build(a, &c, &btl, &sensitive, rest));
         }
         c
     }

@@ -180,29 +180,7 @@ impl SceneEquations {
                     x.iter().map(|row| a.substitute(row, &rest)).collect()
                 };
                 let rested = [at_rest(&m), at_rest(c), at_rest(k)];
-                Some(rested.map(|x| {
-                    x.iter()
-                        .map(|row| {
-                            let mut out = Vec::with_capacity(nd * (1 + sensitive.len()));
-                            for &e in row {
-                                let terms: Vec<ExprId> = (0..nd)
-                                    .map(|k| {
-                                        let d = a.diff(e, Var::Q(k as u16));
-                                        let v = a.var(Var::Qd(k as u16));
-                                        a.mul(d, v)
-                                    })
-                                    .collect();
-                                out.push(a.sum(terms));
-                            }
-                            for &p in &sensitive {
-                                for &e in row {
-                                    out.push(a.diff(e, Var::Param(p)));
-                                }
-                            }
-                            out
-                        })
-                        .collect()
-                }))
+                Some(rested.map(|x| along_and_by(a, &x, nd, &sensitive)))
             }
             _ => None,
         };
@@ -338,4 +316,31 @@ fn energies(sys: &mut System, tree: &Tree, world: &World, loads: &Loads) -> (Exp
         }
     }
     (t, v)
+}
+
+/// Each row of `x` (functions of q free of qd) followed by its derivatives, in blocks of its
+/// width: block 0 along the direction given as `Var::Qd` (Σₖ ∂x/∂qₖ qdₖ, for n coordinates),
+/// block 1 + j by sensitive parameter j.
+pub(super) fn along_and_by(a: &mut Arena, x: &Matrix, n: usize, sensitive: &[u16]) -> Matrix {
+    x.iter()
+        .map(|row| {
+            let mut out = Vec::with_capacity(row.len() * (1 + sensitive.len()));
+            for &e in row {
+                let terms: Vec<ExprId> = (0..n)
+                    .map(|k| {
+                        let d = a.diff(e, Var::Q(k as u16));
+                        let v = a.var(Var::Qd(k as u16));
+                        a.mul(d, v)
+                    })
+                    .collect();
+                out.push(a.sum(terms));
+            }
+            for &p in sensitive {
+                for &e in row {
+                    out.push(a.diff(e, Var::Param(p)));
+                }
+            }
+            out
+        })
+        .collect()
 }

@@ -3,7 +3,7 @@
 
 use mbs::analysis::{StaticsOptions, static_equilibrium, static_sensitivity};
 use mbs::{Model, ModelError, Parameters};
-use mbs_models::fourbar::{SensitiveFourBar, SensitiveFourBarParams};
+use mbs_models::fourbar::SensitiveFourBar;
 use mbs_models::sprung_arm::SprungArm;
 
 mbs::multibody! {
@@ -353,22 +353,27 @@ fn sensitivities_refuse_models_they_cannot_differentiate() {
 
 // ---- closed loops ----
 
-fn fourbar_with(name: &str, value: f64) -> SensitiveFourBar {
-    let mut model = SensitiveFourBar::default();
+/// The default model with parameter `name` set to `value`.
+fn with_value<M: Model + Default>(name: &str, value: f64) -> M {
+    let mut model = M::default();
     let mut p = model.params().clone();
     p.set(name, value).unwrap();
     model.set_params(p).unwrap();
     model
 }
 
-/// The value of sensitive parameter `j` of the four-bar.
-fn fourbar_param(j: usize) -> f64 {
-    let name = SensitiveFourBar::SENSITIVE[j];
-    let i = <SensitiveFourBarParams as Parameters>::NAMES
+/// The default value of parameter `name`.
+fn default_value<M: Model + Default>(name: &str) -> f64 {
+    let i = <M::Params as Parameters>::NAMES
         .iter()
         .position(|n| *n == name)
         .unwrap();
-    SensitiveFourBar::default().params().values()[i]
+    M::default().params().values()[i]
+}
+
+/// The value of sensitive parameter `j` of the four-bar.
+fn fourbar_param(j: usize) -> f64 {
+    default_value::<SensitiveFourBar>(SensitiveFourBar::SENSITIVE[j])
 }
 
 /// Φ, Φ̇ = B qd + Φ_t, Φ̈ = B qdd − γ and Bᵀλ of the four-bar, concatenated.
@@ -423,8 +428,20 @@ fn generated_constraint_derivatives_match_central_differences() {
     for j in 0..4 {
         let (name, p0) = (SensitiveFourBar::SENSITIVE[j], fourbar_param(j));
         let e = 1e-6 * p0;
-        let plus = loop_terms(&fourbar_with(name, p0 + e), &q, &qd, &qdd, &lam);
-        let minus = loop_terms(&fourbar_with(name, p0 - e), &q, &qd, &qdd, &lam);
+        let plus = loop_terms(
+            &with_value::<SensitiveFourBar>(name, p0 + e),
+            &q,
+            &qd,
+            &qdd,
+            &lam,
+        );
+        let minus = loop_terms(
+            &with_value::<SensitiveFourBar>(name, p0 - e),
+            &q,
+            &qd,
+            &qdd,
+            &lam,
+        );
         let d = |r: usize| (plus[r] - minus[r]) / (2.0 * e);
         for i in 0..nc {
             close(&format!("∂Φ{i}/∂{name}"), ct.dphi_dp[i + nc * j], d(i));
@@ -522,8 +539,8 @@ fn generated_constraint_derivatives_match_central_differences() {
         compare(
             name,
             1 + j,
-            b_and_k(&fourbar_with(name, p0 + e), &q),
-            b_and_k(&fourbar_with(name, p0 - e), &q),
+            b_and_k(&with_value::<SensitiveFourBar>(name, p0 + e), &q),
+            b_and_k(&with_value::<SensitiveFourBar>(name, p0 - e), &q),
             e,
         );
     }
@@ -554,8 +571,10 @@ fn closed_loop_equilibria_move_with_the_parameters_as_differences_say() {
             q0: Some(eq.q.clone()),
             ..options.clone()
         };
-        let plus = static_equilibrium(&fourbar_with(name, p0 + e), &start).unwrap();
-        let minus = static_equilibrium(&fourbar_with(name, p0 - e), &start).unwrap();
+        let plus =
+            static_equilibrium(&with_value::<SensitiveFourBar>(name, p0 + e), &start).unwrap();
+        let minus =
+            static_equilibrium(&with_value::<SensitiveFourBar>(name, p0 - e), &start).unwrap();
         for i in 0..3 {
             let diff = (plus.q[i] - minus.q[i]) / (2.0 * e);
             let exact = s.get(i, name).unwrap();
@@ -611,8 +630,8 @@ fn closed_loop_poles_move_with_the_parameters_as_differences_say() {
     for (j, name) in s.params.iter().enumerate() {
         let p0 = fourbar_param(j);
         let e = 1e-5 * p0;
-        let plus = poles_of(&fourbar_with(name, p0 + e), &eq.q);
-        let minus = poles_of(&fourbar_with(name, p0 - e), &eq.q);
+        let plus = poles_of(&with_value::<SensitiveFourBar>(name, p0 + e), &eq.q);
+        let minus = poles_of(&with_value::<SensitiveFourBar>(name, p0 - e), &eq.q);
         let (dre, dim) = s.dpole(0, name).unwrap();
         let diff_re = (plus.modes[0].re - minus.modes[0].re) / (2.0 * e);
         let diff_im = (plus.modes[0].im - minus.modes[0].im) / (2.0 * e);
@@ -656,8 +675,8 @@ fn closed_loop_sensitivities_match_central_differences() {
     for j in 0..ns {
         let (name, p0) = (SensitiveFourBar::SENSITIVE[j], fourbar_param(j));
         let e = 1e-5 * p0;
-        let (qp, vp) = fourbar_end(fourbar_with(name, p0 + e), t_end);
-        let (qm, vm) = fourbar_end(fourbar_with(name, p0 - e), t_end);
+        let (qp, vp) = fourbar_end(with_value::<SensitiveFourBar>(name, p0 + e), t_end);
+        let (qm, vm) = fourbar_end(with_value::<SensitiveFourBar>(name, p0 - e), t_end);
         let d = |a: &[f64], b: &[f64]| -> Vec<f64> {
             a.iter().zip(b).map(|(x, y)| (x - y) / (2.0 * e)).collect()
         };
@@ -711,5 +730,146 @@ fn closed_loop_sensitivities_match_central_differences() {
         );
         assert!(worst < 1e-6, "{}: {worst:e}", scheme.name());
         assert!(drift.0 < 1e-7 && drift.1 < 1e-6, "{drift:?}");
+    }
+}
+
+// ---- rotation joints ----
+
+mbs::multibody! {
+    /// The ball on a rod of `mbs_models::spherical_pendulum` (a `Tball` joint whose ZYX chart
+    /// locks at the bottom of the swing) with a sideways start rate that does not depend on
+    /// the parameters, and its length, radius and gravity marked `sensitive`.
+    pub model SensitiveBall {
+        param m = 1.0;
+        param l = 1.0 sensitive;
+        param r = 0.05 sensitive;
+        param g = 9.81 sensitive;
+        dof a = 0.0, qd = 0.6;
+        dof b = PI / 6;
+        dof c = 0.0;
+        option tangents;
+        body ball { mass = m; inertia = (0.4 * m * r * r, 0.4 * m * r * r, 0.4 * m * r * r); }
+        point centre on ball at (0, 0, 0);
+        TOG[ball] = Tball(a, b, c) * Tdisp(l, 0, 0);
+        gravity(0, 0, -g);
+    }
+}
+
+/// The ball's position and velocity at output `i` of a trajectory of `model` (read in that
+/// output's charts).
+fn ball_state<M: Model>(
+    model: &mut M,
+    tr: &mbs::Trajectory,
+    i: usize,
+    q: &[f64],
+    qd: &[f64],
+) -> [f64; 6] {
+    mbs::charts::use_charts_of(model, tr, i);
+    let mut k = mbs::Kinematics::new::<M>();
+    model.kinematics(tr.t[i], q, qd, &mut k);
+    let p = &k.points[0];
+    [
+        p.position[0],
+        p.position[1],
+        p.position[2],
+        p.velocity[0],
+        p.velocity[1],
+        p.velocity[2],
+    ]
+}
+
+#[test]
+fn sensitivities_cross_chart_switches_as_differences_say() {
+    use mbs::{Options, Scheme, Sensitivities, StepControl, simulate};
+    type S = Sensitivities<SensitiveBall>;
+    let t_end = 3.0;
+    let options = |rtol: f64| Options {
+        t_end,
+        step: StepControl::Adaptive {
+            rtol,
+            atol: rtol * 1e-2,
+            h0: None,
+        },
+        output: mbs::Output::Last,
+        ..Options::default()
+    };
+    // the ball's position and velocity at the end by central differences of plain runs
+    let end = |model: SensitiveBall| {
+        let (tr, stats) = simulate(model.clone(), Scheme::Dopri5, options(1e-12)).unwrap();
+        let last = tr.len() - 1;
+        (
+            ball_state(&mut model.clone(), &tr, last, tr.q(last), tr.qd(last)),
+            stats.chart_switches,
+        )
+    };
+    let mut reference = Vec::new();
+    for name in SensitiveBall::SENSITIVE {
+        let p0 = default_value::<SensitiveBall>(name);
+        let e = 1e-5 * p0;
+        let ((plus, switches), (minus, _)) = (
+            end(with_value::<SensitiveBall>(name, p0 + e)),
+            end(with_value::<SensitiveBall>(name, p0 - e)),
+        );
+        assert!(switches >= 2, "the swing re-centres the chart: {switches}");
+        reference.push(
+            (0..6)
+                .map(|i| (plus[i] - minus[i]) / (2.0 * e))
+                .collect::<Vec<f64>>(),
+        );
+    }
+    for scheme in [
+        Scheme::Dopri5,
+        Scheme::Radau5,
+        Scheme::Bdf(Default::default()),
+    ] {
+        let (tr, stats) = simulate(
+            S::new(SensitiveBall::default()).unwrap(),
+            scheme,
+            options(1e-10),
+        )
+        .unwrap();
+        assert!(stats.chart_switches >= 2, "{}", stats.chart_switches);
+        let last = tr.len() - 1;
+        let (x, xd) = (tr.q(last), tr.qd(last));
+        let mut model = SensitiveBall::default();
+        let mut worst: f64 = 0.0;
+        for (j, r) in reference.iter().enumerate() {
+            // the ball's state along (s, ṡ), in the run's last charts
+            let (sq, sv) = (S::dq_dp(&tr, last, j), S::dqd_dp(&tr, last, j));
+            let h = 1e-6;
+            let at = |sign: f64, model: &mut SensitiveBall| {
+                let q: Vec<f64> = (0..3).map(|i| x[i] + sign * h * sq[i]).collect();
+                let qd: Vec<f64> = (0..3).map(|i| xd[i] + sign * h * sv[i]).collect();
+                ball_state(model, &tr, last, &q, &qd)
+            };
+            let (plus, minus) = (at(1.0, &mut model), at(-1.0, &mut model));
+            // ... plus the parameter's own effect at fixed (q, qd) (the rod's length)
+            let (name, p0) = (
+                SensitiveBall::SENSITIVE[j],
+                default_value::<SensitiveBall>(SensitiveBall::SENSITIVE[j]),
+            );
+            let e = 1e-6 * p0;
+            let direct = |v: f64| {
+                ball_state(
+                    &mut with_value::<SensitiveBall>(name, v),
+                    &tr,
+                    last,
+                    &x[..3],
+                    &xd[..3],
+                )
+            };
+            let (dplus, dminus) = (direct(p0 + e), direct(p0 - e));
+            let scale = r.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            for i in 0..6 {
+                let exact = (plus[i] - minus[i]) / (2.0 * h) + (dplus[i] - dminus[i]) / (2.0 * e);
+                worst = worst.max((exact - r[i]).abs() / scale);
+            }
+        }
+        println!(
+            "{}: {} chart switches; worst |d(ball position, velocity)/dp − differences| / max = {worst:.1e}",
+            scheme.name(),
+            stats.chart_switches
+        );
+        assert!(worst < 1e-5, "{}: {worst:e}", scheme.name());
     }
 }

@@ -55,6 +55,20 @@ fn body_bias(angles: [f64; 3], rates: [f64; 3]) -> [f64; 3] {
     ]
 }
 
+/// `(∂J/∂q · s) · v`: how the angular velocity J(b, c)·v changes when the angles move by `s`
+/// (`body_bias` is its value at s = v = q̇).
+fn body_bias_along(angles: [f64; 3], s: [f64; 3], v: [f64; 3]) -> [f64; 3] {
+    let (sb, cb) = angles[1].sin_cos();
+    let (sc, cc) = angles[2].sin_cos();
+    let [va, vb, _] = v;
+    let [_, s_b, s_c] = s;
+    [
+        -s_b * cb * va,
+        -s_b * sb * sc * va + s_c * (cb * cc * va - sc * vb),
+        -s_b * sb * cc * va - s_c * (cb * sc * va + cc * vb),
+    ]
+}
+
 /// The rates at zero angles that give the angular velocity `w` (joint axes): at (0, 0, 0),
 /// ω = (ċ, ḃ, ȧ).
 fn rates_at_zero(w: [f64; 3]) -> [f64; 3] {
@@ -159,6 +173,30 @@ impl Recentring {
     }
 }
 
+impl Recentring {
+    /// Maps the derivatives of the joint's angles and rates by a parameter, `s` = ∂q/∂p and
+    /// `sd` = ∂q̇/∂p (whole coordinate vectors: the joint's entries are read and written),
+    /// from the old chart into the new one, the new chart held fixed: the same perturbation
+    /// of the joint's orientation, δθ = J s (so s maps as the rates do), and of its angular
+    /// velocity, δω = J ṡ + (∂J/∂q·s) q̇, read at zero angles.
+    pub fn map_sensitivity(&self, s: &mut [f64], sd: &mut [f64]) {
+        let (s_old, sd_old) = (self.angles.map(|k| s[k]), self.angles.map(|k| sd[k]));
+        let s_new = rates_at_zero(body_rates(self.q, s_old));
+        let j = body_rates(self.q, sd_old);
+        let b = body_bias_along(self.q, s_old, self.qd);
+        let b_new = body_bias_along([0.0; 3], s_new, self.qd_new);
+        let sd_new = rates_at_zero([
+            j[0] + b[0] - b_new[0],
+            j[1] + b[1] - b_new[1],
+            j[2] + b[2] - b_new[2],
+        ]);
+        for (i, &k) in self.angles.iter().enumerate() {
+            s[k] = s_new[i];
+            sd[k] = sd_new[i];
+        }
+    }
+}
+
 /// Re-centres every rotation joint of `model` at (q, qd) (its angles become zero, its
 /// chart its orientation: the best-conditioned chart, whose angles are the small rotation
 /// in the joint's own axes, δ(a, b, c) ≈ (δθz, δθy, δθx)), except the joints with a
@@ -201,7 +239,9 @@ pub fn below<M: Model>(model: &M, q: &[f64], threshold: f64) -> bool {
 }
 
 /// Re-centres every joint of `model` whose chart quality at `q` is below `threshold`:
-/// sets the model's charts, maps q, qd (and qdd) in place, and returns what moved.
+/// sets the model's charts, maps q, qd (and qdd) in place, and returns what moved in `moved`;
+/// then lets the model map coordinates of its own ([`Model::recentred`]) and returns whether
+/// it asks for the accelerations to be evaluated again.
 pub fn recentre_below<M: Model>(
     model: &mut M,
     threshold: f64,
@@ -209,7 +249,7 @@ pub fn recentre_below<M: Model>(
     qd: &mut [f64],
     qdd: Option<&mut [f64]>,
     moved: &mut Vec<Recentring>,
-) {
+) -> bool {
     moved.clear();
     let joints = model.info().rotation_joints;
     for (j, joint) in joints.iter().enumerate() {
@@ -224,6 +264,7 @@ pub fn recentre_below<M: Model>(
             r.map_acceleration(a);
         }
     }
+    !moved.is_empty() && model.recentred(moved, q, qd)
 }
 
 #[cfg(test)]

@@ -39,11 +39,6 @@ pub enum ModelError {
         "model `{model}` has no sensitive parameters: mark those you want derivatives for, `param k = 1e4 sensitive;`"
     )]
     NoSensitiveParameters { model: &'static str },
-    #[error("sensitivities of model `{model}` are not available: {reason}")]
-    SensitivitiesUnsupported {
-        model: &'static str,
-        reason: &'static str,
-    },
 }
 
 /// `x` with at most 10 significant digits and no trailing zeros (`0.2394270743`, `2.5`,

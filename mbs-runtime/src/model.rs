@@ -708,6 +708,21 @@ pub trait Model {
         IDENTITY3
     }
 
+    /// Called after the runtime re-centred the charts of the rotation joints in `moved` and
+    /// mapped the joints' angles and rates in q and qd (and their accelerations), so that a
+    /// wrapper can map the coordinates it adds ([`crate::Sensitivities`]); returns whether
+    /// the accelerations must be evaluated again at the mapped state (the runtime's map covers
+    /// the joints' own). Does nothing by default.
+    fn recentred(
+        &self,
+        moved: &[crate::charts::Recentring],
+        q: &mut [f64],
+        qd: &mut [f64],
+    ) -> bool {
+        let _ = (moved, q, qd);
+        false
+    }
+
     /// Moves the chart of rotation joint `joint` to `r` (a rotation matrix; the caller maps
     /// the joint's angles and rates so the motion does not change). Models without rotation
     /// joints ignore it.

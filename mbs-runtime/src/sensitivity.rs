@@ -14,9 +14,14 @@
 //! every scheme integrates the motion and its sensitivities together, with its error control
 //! over both (as CVODES's "full" error control); its forward dynamics solves every block with
 //! one Cholesky factorisation of M. Starts at s = ṡ = 0 (initial conditions that
-//! do not depend on the parameters). Models without rotation joints; the wrapped
-//! model's iteration matrices come from finite differences (its tangents would need second
-//! derivatives).
+//! do not depend on the parameters). The wrapped model's iteration matrices come from finite
+//! differences (its tangents would need second derivatives).
+//!
+//! **Rotation joints.** When the runtime re-centres a joint's chart, the sensitivities of its
+//! angles and rates are mapped into the new chart, the new chart held fixed (it is a number
+//! of the nominal motion): the same perturbation of the joint's orientation and angular
+//! velocity ([`crate::charts::Recentring::map_sensitivity`]). A joint's sensitivities are
+//! thus read in the chart of the output they belong to, as its angles are.
 //!
 //! **Closed loops** (M qdd = h + Bᵀλ, Φ(q, p) = 0). Differentiating both along the motion,
 //! with μ = ∂λ/∂p and K_λ = ∂(Bᵀλ)/∂q:
@@ -113,24 +118,14 @@ impl Loops {
 }
 
 impl<M: Model + 'static> Sensitivities<M> {
-    /// Wraps `model`; refused without sensitive parameters, without tangents, or with
-    /// rotation joints.
+    /// Wraps `model`; refused without sensitive parameters or without tangents.
     pub fn new(model: M) -> Result<Sensitivities<M>, ModelError> {
         let info = model.info();
-        let unsupported = |reason: &'static str| ModelError::SensitivitiesUnsupported {
-            model: info.name,
-            reason,
-        };
         if M::SENSITIVE.is_empty() {
             return Err(ModelError::NoSensitiveParameters { model: info.name });
         }
         if !info.has_tangents {
             return Err(ModelError::TangentsNotGenerated { model: info.name });
-        }
-        if !info.rotation_joints.is_empty() {
-            return Err(unsupported(
-                "it has rotation joints (a re-centred chart would need its sensitivities mapped too)",
-            ));
         }
         let n = M::NQ;
         let z = |len: usize| vec![0.0; len];
@@ -574,6 +569,33 @@ impl<M: Model + 'static> Model for Sensitivities<M> {
             }
         }
         Ok(())
+    }
+
+    fn chart(&self, joint: usize) -> [[f64; 3]; 3] {
+        self.model.chart(joint)
+    }
+
+    fn set_chart(&mut self, joint: usize, r: [[f64; 3]; 3]) {
+        self.model.set_chart(joint, r)
+    }
+
+    /// Maps each sensitivity block as the re-centred charts ask (the new charts held fixed:
+    /// the same perturbation of each joint's orientation and angular velocity), then asks for
+    /// the accelerations again, which the sensitivities' need at the mapped state.
+    fn recentred(
+        &self,
+        moved: &[crate::charts::Recentring],
+        q: &mut [f64],
+        qd: &mut [f64],
+    ) -> bool {
+        let n = M::NQ;
+        for j in 0..M::SENSITIVE.len() {
+            let block = n * (1 + j)..n * (2 + j);
+            for r in moved {
+                r.map_sensitivity(&mut q[block.clone()], &mut qd[block.clone()]);
+            }
+        }
+        true
     }
 
     fn frames(&self, t: f64, q: &[f64], out: &mut [Pose]) {

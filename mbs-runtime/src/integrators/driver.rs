@@ -331,7 +331,7 @@ impl<M: Model + 'static> Simulation<M> {
             return Ok(());
         }
         let cur = &mut self.cur;
-        charts::recentre_below(
+        let evaluate = charts::recentre_below(
             &mut self.problem.model,
             threshold,
             &mut cur.q,
@@ -341,6 +341,15 @@ impl<M: Model + 'static> Simulation<M> {
         );
         if self.moved.is_empty() {
             return Ok(());
+        }
+        if evaluate {
+            // the model's own coordinates (a wrapper's) need their accelerations anew
+            self.problem.chart_changed();
+            let (q, qd) = (cur.q.clone(), cur.qd.clone());
+            self.problem.accel(cur.t, &q, &qd, &mut cur.qdd)?;
+            if let Some(c) = self.problem.loops.closed() {
+                cur.lambda.copy_from_slice(&c.lambda);
+            }
         }
         for r in &self.moved {
             self.traj.charts[r.joint].push(chart_quaternion(&r.chart));

@@ -201,6 +201,5 @@ pub(crate) fn model_error_reason(e: &crate::error::ModelError) -> &'static str {
         crate::error::ModelError::NoSensitiveParameters { .. } => {
             "the model has no sensitive parameters: mark them, `param k = 1e4 sensitive;`"
         }
-        crate::error::ModelError::SensitivitiesUnsupported { reason, .. } => reason,
     }
 }

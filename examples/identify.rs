@@ -309,7 +309,7 @@ from {start:?} ({label}):"
             );
             series.push(Series {
                 name: format!("{} ({label} start)", o.name),
-                points: cumulative_best(&o.log),
+                points: mbs::plot::best_so_far(&o.log),
             });
         }
     }
@@ -329,16 +329,4 @@ convergence plot: {}",
         path.display()
     );
     Ok(())
-}
-
-/// The best cost after each simulation.
-fn cumulative_best(log: &[f64]) -> Vec<(f64, f64)> {
-    let mut best = f64::INFINITY;
-    log.iter()
-        .enumerate()
-        .map(|(i, &c)| {
-            best = best.min(c);
-            ((i + 1) as f64, best)
-        })
-        .collect()
 }

@@ -10,7 +10,8 @@
 //! `sensitive` and `mbs::Sensitivities` (dJ/dp from ∂q/∂p and ∂q̇/∂p along the motion), and
 //! Nelder–Mead without derivatives. Prints iterations, simulations, time, the gains and the
 //! settling time (last exit from ±2 % of the step) before and after, and writes
-//! `tune.svg` (the responses) in `--out DIR` (default the current folder).
+//! `tune.svg` (the responses) and `tune_convergence.svg` (the best J against simulations) in
+//! `--out DIR` (default the current folder).
 //!
 //! ```text
 //! cargo run --release --example tune -- [--out DIR]
@@ -24,7 +25,7 @@ use mbs::plot::{Chart, Series, line_chart};
 use mbs::{
     Model, Options, Output, Parameters, Scheme, Sensitivities, StepControl, Trajectory, simulate,
 };
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
 use std::time::Instant;
 
 mbs::multibody! {
@@ -109,6 +110,8 @@ fn settling(tr: &Trajectory) -> f64 {
 
 struct Tuning {
     runs: Cell<usize>,
+    /// J of every simulation, for the convergence plot
+    log: RefCell<Vec<f64>>,
 }
 
 impl CostFunction for Tuning {
@@ -117,7 +120,9 @@ impl CostFunction for Tuning {
     fn cost(&self, p: &Vec<f64>) -> Result<f64, Error> {
         self.runs.set(self.runs.get() + 1);
         let (tr, _) = simulate(arm(p)?, Scheme::Dopri5, options())?;
-        Ok(criterion(&tr, p, false).0)
+        let j = criterion(&tr, p, false).0;
+        self.log.borrow_mut().push(j);
+        Ok(j)
     }
 }
 
@@ -127,7 +132,9 @@ impl Gradient for Tuning {
     fn gradient(&self, p: &Vec<f64>) -> Result<Vec<f64>, Error> {
         self.runs.set(self.runs.get() + 1);
         let (tr, _) = simulate(Sensitivities::new(arm(p)?)?, Scheme::Dopri5, options())?;
-        Ok(criterion(&tr, p, true).1.to_vec())
+        let (j, gradient) = criterion(&tr, p, true);
+        self.log.borrow_mut().push(j);
+        Ok(gradient.to_vec())
     }
 }
 
@@ -176,14 +183,18 @@ fn main() -> Result<(), Error> {
             .map(|i| (before.t[i], before.q(i)[0]))
             .collect(),
     }];
+    let mut convergence = Vec::new();
     let solvers: [(&str, bool); 2] = [
         ("L-BFGS, exact gradients", true),
         ("Nelder-Mead, no derivatives", false),
     ];
     for (name, gradient) in solvers {
-        let problem = Tuning { runs: Cell::new(0) };
+        let problem = Tuning {
+            runs: Cell::new(0),
+            log: RefCell::new(Vec::new()),
+        };
         let clock = Instant::now();
-        let (best, iterations, runs) = if gradient {
+        let (best, iterations, runs, log) = if gradient {
             let solver = LBFGS::new(MoreThuenteLineSearch::new(), 5)
                 .with_tolerance_grad(1e-9)?
                 .with_tolerance_cost(1e-12)?;
@@ -191,8 +202,9 @@ fn main() -> Result<(), Error> {
                 .configure(|s| s.param(START.to_vec()).max_iters(100))
                 .run()?;
             let runs = run.problem.problem.as_ref().map_or(0, |p| p.runs.get());
+            let log = run.problem.problem.as_ref().map(|p| p.log.take());
             let best = run.state().get_best_param().cloned().unwrap_or_default();
-            (best, run.state().get_iter(), runs)
+            (best, run.state().get_iter(), runs, log.unwrap_or_default())
         } else {
             let simplex = vec![START.to_vec(), vec![24.0, 2.0], vec![20.0, 2.4]];
             let solver = NelderMead::new(simplex).with_sd_tolerance(1e-10)?;
@@ -200,8 +212,9 @@ fn main() -> Result<(), Error> {
                 .configure(|s| s.max_iters(1000))
                 .run()?;
             let runs = run.problem.problem.as_ref().map_or(0, |p| p.runs.get());
+            let log = run.problem.problem.as_ref().map(|p| p.log.take());
             let best = run.state().get_best_param().cloned().unwrap_or_default();
-            (best, run.state().get_iter(), runs)
+            (best, run.state().get_iter(), runs, log.unwrap_or_default())
         };
         let seconds = clock.elapsed().as_secs_f64();
         let (after, _) = simulate(arm(&best)?, Scheme::Dopri5, options())?;
@@ -216,6 +229,10 @@ fn main() -> Result<(), Error> {
             criterion(&after, &best, false).0,
             settling(&after)
         );
+        convergence.push(Series {
+            name: name.to_string(),
+            points: mbs::plot::best_so_far(&log),
+        });
         series.push(Series {
             name: format!("{name}: kp = {:.1}, kd = {:.2}", best[0], best[1]),
             points: (0..after.len())
@@ -234,5 +251,9 @@ fn main() -> Result<(), Error> {
     };
     line_chart(&path, &chart, &series).map_err(|e| Error::msg(e.to_string()))?;
     println!("\nresponses: {}", path.display());
+    let path = out.join("tune_convergence.svg");
+    let chart = Chart::linear("PD gains: best J so far", "simulations", "J");
+    line_chart(&path, &chart, &convergence).map_err(|e| Error::msg(e.to_string()))?;
+    println!("convergence plot: {}", path.display());
     Ok(())
 }

@@ -109,6 +109,19 @@ fn range(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
     }
 }
 
+/// A convergence curve: after each evaluation (x = 1, 2, …), the best of the costs in `log` so
+/// far.
+pub fn best_so_far(log: &[f64]) -> Vec<(f64, f64)> {
+    let mut best = f64::INFINITY;
+    log.iter()
+        .enumerate()
+        .map(|(i, &c)| {
+            best = best.min(c);
+            ((i + 1) as f64, best)
+        })
+        .collect()
+}
+
 /// Draws `series` as lines with markers into an SVG file at `path`.
 pub fn line_chart(path: &Path, chart: &Chart, series: &[Series]) -> Result<(), PlotError> {
     let svg = line_chart_svg(chart, series)?;

@@ -189,29 +189,25 @@ fn generated_second_derivatives_at_rest_match_central_differences() {
     assert!(matches!(e, ModelError::NoSensitiveParameters { .. }), "{e}");
 }
 
+/// The modes about the equilibrium of `model` found from `start`.
+fn poles_at<M: Model + Clone>(model: &M, start: &[f64], options: &StaticsOptions) -> mbs::Modes {
+    use mbs::analysis::{linearize, modes};
+    let start = StaticsOptions {
+        q0: Some(start.to_vec()),
+        ..options.clone()
+    };
+    let eq = static_equilibrium(model, &start).unwrap();
+    let zero = vec![0.0; M::NQ];
+    let lin = linearize(model, 0.0, &eq.q, &zero, &[], mbs::IterationMatrix::Exact).unwrap();
+    modes(&lin, None).unwrap()
+}
+
 #[test]
 fn poles_move_with_the_parameters_as_differences_say() {
-    use mbs::analysis::{linearize, modes, pole_sensitivity};
+    use mbs::analysis::pole_sensitivity;
     let options = StaticsOptions {
         tolerance: 1e-13,
         ..StaticsOptions::default()
-    };
-    let poles_of = |model: &SprungArm, start: &[f64]| {
-        let start = StaticsOptions {
-            q0: Some(start.to_vec()),
-            ..options.clone()
-        };
-        let eq = static_equilibrium(model, &start).unwrap();
-        let lin = linearize(
-            model,
-            0.0,
-            &eq.q,
-            &[0.0; 2],
-            &[],
-            mbs::IterationMatrix::Exact,
-        )
-        .unwrap();
-        modes(&lin, None).unwrap()
     };
     let model = SprungArm::default();
     let eq = static_equilibrium(&model, &options).unwrap();
@@ -225,8 +221,8 @@ fn poles_move_with_the_parameters_as_differences_say() {
     for (j, name) in s.params.iter().enumerate() {
         let p0 = model.params().values()[j];
         let e = 1e-5 * p0;
-        let plus = poles_of(&with(name, p0 + e), &eq.q);
-        let minus = poles_of(&with(name, p0 - e), &eq.q);
+        let plus = poles_at(&with(name, p0 + e), &eq.q, &options);
+        let minus = poles_at(&with(name, p0 - e), &eq.q, &options);
         for (i, mode) in s.modes.modes.iter().enumerate() {
             let (dre, dim) = s.dpole(i, name).unwrap();
             let diff_re = (plus.modes[i].re - minus.modes[i].re) / (2.0 * e);
@@ -271,7 +267,7 @@ fn poles_move_with_the_parameters_as_differences_say() {
 }
 
 /// q(t_end), qd(t_end) of a plain run at tight tolerances.
-fn end_state(model: SprungArm, t_end: f64) -> (Vec<f64>, Vec<f64>) {
+fn end_state<M: Model + 'static>(model: M, t_end: f64) -> (Vec<f64>, Vec<f64>) {
     let options = mbs::Options {
         t_end,
         step: mbs::StepControl::Adaptive {
@@ -287,23 +283,29 @@ fn end_state(model: SprungArm, t_end: f64) -> (Vec<f64>, Vec<f64>) {
     (tr.q(last).to_vec(), tr.qd(last).to_vec())
 }
 
+/// (dq/dp, dqd/dp) at t_end for each sensitive parameter of `M`, by central differences of
+/// plain runs.
+fn end_state_differences<M: Model + Default + 'static>(t_end: f64) -> Vec<(Vec<f64>, Vec<f64>)> {
+    M::SENSITIVE
+        .iter()
+        .map(|name| {
+            let p0 = default_value::<M>(name);
+            let e = 1e-5 * p0;
+            let (qp, vp) = end_state(with_value::<M>(name, p0 + e), t_end);
+            let (qm, vm) = end_state(with_value::<M>(name, p0 - e), t_end);
+            let d = |a: &[f64], b: &[f64]| -> Vec<f64> {
+                a.iter().zip(b).map(|(x, y)| (x - y) / (2.0 * e)).collect()
+            };
+            (d(&qp, &qm), d(&vp, &vm))
+        })
+        .collect()
+}
+
 #[test]
 fn sensitivities_integrated_with_the_motion_match_central_differences() {
     use mbs::{Options, Output, Scheme, Sensitivities, StepControl, simulate};
     let t_end = 2.0;
-    // the reference: central differences of plain runs
-    let base = SprungArm::default();
-    let mut reference = Vec::new();
-    for (j, name) in SprungArm::SENSITIVE.iter().enumerate() {
-        let p0 = base.params().values()[j];
-        let e = 1e-5 * p0;
-        let (qp, vp) = end_state(with(name, p0 + e), t_end);
-        let (qm, vm) = end_state(with(name, p0 - e), t_end);
-        let d = |a: &[f64], b: &[f64]| -> Vec<f64> {
-            a.iter().zip(b).map(|(x, y)| (x - y) / (2.0 * e)).collect()
-        };
-        reference.push((d(&qp, &qm), d(&vp, &vm)));
-    }
+    let reference = end_state_differences::<SprungArm>(t_end);
     let options = Options {
         t_end,
         step: StepControl::Adaptive {
@@ -598,40 +600,31 @@ fn closed_loop_equilibria_move_with_the_parameters_as_differences_say() {
 
 #[test]
 fn closed_loop_poles_move_with_the_parameters_as_differences_say() {
-    use mbs::analysis::{linearize, modes, pole_sensitivity};
+    use mbs::analysis::pole_sensitivity;
     let options = StaticsOptions {
         tolerance: 1e-13,
         ..StaticsOptions::default()
     };
-    let poles_of = |model: &SensitiveFourBar, start: &[f64]| {
-        let start = StaticsOptions {
-            q0: Some(start.to_vec()),
-            ..options.clone()
-        };
-        let eq = static_equilibrium(model, &start).unwrap();
-        let lin = linearize(
-            model,
-            0.0,
-            &eq.q,
-            &[0.0; 3],
-            &[],
-            mbs::IterationMatrix::Exact,
-        )
-        .unwrap();
-        modes(&lin, None).unwrap()
-    };
     let model = SensitiveFourBar::default();
     let eq = static_equilibrium(&model, &options).unwrap();
     let s = pole_sensitivity(&model, &eq, &options).unwrap();
-    // one degree of freedom: one oscillating mode (no damping)
+    // one degree of freedom: one lightly damped mode
     assert_eq!(s.modes.modes.len(), 1);
     let mode = &s.modes.modes[0];
     assert!(mode.im > 0.0, "{mode:?}");
     for (j, name) in s.params.iter().enumerate() {
         let p0 = fourbar_param(j);
         let e = 1e-5 * p0;
-        let plus = poles_of(&with_value::<SensitiveFourBar>(name, p0 + e), &eq.q);
-        let minus = poles_of(&with_value::<SensitiveFourBar>(name, p0 - e), &eq.q);
+        let plus = poles_at(
+            &with_value::<SensitiveFourBar>(name, p0 + e),
+            &eq.q,
+            &options,
+        );
+        let minus = poles_at(
+            &with_value::<SensitiveFourBar>(name, p0 - e),
+            &eq.q,
+            &options,
+        );
         let (dre, dim) = s.dpole(0, name).unwrap();
         let diff_re = (plus.modes[0].re - minus.modes[0].re) / (2.0 * e);
         let diff_im = (plus.modes[0].im - minus.modes[0].im) / (2.0 * e);
@@ -648,40 +641,12 @@ fn closed_loop_poles_move_with_the_parameters_as_differences_say() {
     }
 }
 
-/// The four-bar's q(t_end), qd(t_end) at tight tolerances.
-fn fourbar_end(model: SensitiveFourBar, t_end: f64) -> (Vec<f64>, Vec<f64>) {
-    let options = mbs::Options {
-        t_end,
-        step: mbs::StepControl::Adaptive {
-            rtol: 1e-12,
-            atol: 1e-14,
-            h0: None,
-        },
-        output: mbs::Output::Last,
-        ..mbs::Options::default()
-    };
-    let (tr, _) = mbs::simulate(model, mbs::Scheme::Dopri5, options).unwrap();
-    let last = tr.len() - 1;
-    (tr.q(last).to_vec(), tr.qd(last).to_vec())
-}
-
 #[test]
 fn closed_loop_sensitivities_match_central_differences() {
     use mbs::{Options, Scheme, Sensitivities, StepControl, simulate};
     type S = Sensitivities<SensitiveFourBar>;
     let t_end = 1.0;
-    let ns = SensitiveFourBar::SENSITIVE.len();
-    let mut reference = Vec::new();
-    for j in 0..ns {
-        let (name, p0) = (SensitiveFourBar::SENSITIVE[j], fourbar_param(j));
-        let e = 1e-5 * p0;
-        let (qp, vp) = fourbar_end(with_value::<SensitiveFourBar>(name, p0 + e), t_end);
-        let (qm, vm) = fourbar_end(with_value::<SensitiveFourBar>(name, p0 - e), t_end);
-        let d = |a: &[f64], b: &[f64]| -> Vec<f64> {
-            a.iter().zip(b).map(|(x, y)| (x - y) / (2.0 * e)).collect()
-        };
-        reference.push((d(&qp, &qm), d(&vp, &vm)));
-    }
+    let reference = end_state_differences::<SensitiveFourBar>(t_end);
     let options = Options {
         t_end,
         step: StepControl::Adaptive {

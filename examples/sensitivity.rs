@@ -199,7 +199,8 @@ fn motion<M: Model + Default + 'static>(t_end: f64) {
         }
         let evals = |s: &mbs::Stats| s.dynamics + s.forward_dynamics + s.inverse_dynamics;
         let drift = if M::NC > 0 {
-            format!("{:.1e}", wrap().residuals(&tr, last).0)
+            let drift = wrap().residuals(&tr, last).map_or(f64::NAN, |r| r.0);
+            format!("{drift:.1e}")
         } else {
             String::new()
         };

@@ -565,6 +565,10 @@ fn closed_loop_equilibria_move_with_the_parameters_as_differences_say() {
     assert!(eq.constraint_residual < 1e-12, "{eq}");
     let s = static_sensitivity(&model, &eq, &options).unwrap();
     assert_eq!(s.params, ["l1", "l2", "rho", "k1"]);
+    // an equilibrium of another model is refused, not indexed out of bounds
+    let other = static_equilibrium(&SprungArm::default(), &options).unwrap();
+    let err = static_sensitivity(&model, &other, &options).unwrap_err();
+    assert!(err.to_string().contains("not one of this model"), "{err}");
     assert_eq!(s.dlambda_dp.len(), 2 * 4);
     for (j, name) in s.params.iter().enumerate() {
         let p0 = fourbar_param(j);
@@ -680,9 +684,9 @@ fn closed_loop_sensitivities_match_central_differences() {
                 worst = worst.max((exact - diff).abs() / scale);
             }
         }
-        let wrapper = S::new(SensitiveFourBar::default()).unwrap();
+        let mut wrapper = S::new(SensitiveFourBar::default()).unwrap();
         let drift = (0..tr.len()).fold((0.0f64, 0.0f64), |m, i| {
-            let (p, v) = wrapper.residuals(&tr, i);
+            let (p, v) = wrapper.residuals(&tr, i).unwrap();
             (m.0.max(p), m.1.max(v))
         });
         println!(
@@ -786,6 +790,7 @@ fn sensitivities_cross_chart_switches_as_differences_say() {
         Scheme::Dopri5,
         Scheme::Radau5,
         Scheme::Bdf(Default::default()),
+        Scheme::GenAlpha(Default::default()),
     ] {
         let (tr, stats) = simulate(
             S::new(SensitiveBall::default()).unwrap(),

@@ -7,7 +7,8 @@
 //! translation comes before the chart and is left as it is.
 //!
 //! Here: the ZYX rotation and its angular-velocity Jacobian, the quaternion of a joint, and
-//! [`Recentring`], the map of one re-centring applied to a state and to any acceleration.
+//! [`Recentring`], the map of one re-centring applied to a state, to any acceleration and to
+//! the derivatives of a state by a parameter (`map_sensitivity`).
 
 use crate::model::{Model, RotationJoint};
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion};

@@ -318,11 +318,10 @@ impl Kinematics {
     }
 }
 
-/// Parameters of a generated model: a plain struct with `Default` = the DSL's values.
 /// The derivatives [`Model::constraint_parameter_tangents`] writes, column-major, NS columns
 /// by sensitive parameter in the order of [`Model::SENSITIVE`]. With Φ̇ = B qd + Φ_t and
-/// Φ̈ = B qdd − γ:
-#[derive(Clone, Debug, Default, PartialEq)]
+/// Φ̈ = B qdd − γ (buffers sized for one model by [`ConstraintTangents::new`]):
+#[derive(Clone, Debug, PartialEq)]
 pub struct ConstraintTangents {
     /// ∂Φ/∂p (NC × NS)
     pub dphi_dp: Vec<f64>,
@@ -356,6 +355,7 @@ impl ConstraintTangents {
     }
 }
 
+/// Parameters of a generated model: a plain struct with `Default` = the DSL's values.
 pub trait Parameters:
     Clone + fmt::Debug + Default + PartialEq + Serialize + DeserializeOwned
 {

@@ -14,8 +14,9 @@
 //! every scheme integrates the motion and its sensitivities together, with its error control
 //! over both (as CVODES's "full" error control); its forward dynamics solves every block with
 //! one Cholesky factorisation of M. Starts at s = ṡ = 0 (initial conditions that
-//! do not depend on the parameters). The wrapped model's iteration matrices come from finite
-//! differences (its tangents would need second derivatives).
+//! do not depend on the parameters), except on closed loops (below). The wrapped model's
+//! iteration matrices come from finite differences (its tangents would need second
+//! derivatives).
 //!
 //! **Rotation joints.** When the runtime re-centres a joint's chart, the sensitivities of its
 //! angles and rates are mapped into the new chart, the new chart held fixed (it is a number
@@ -37,8 +38,12 @@
 //! sensitivities follow Φ̈'s derivative (index 1), and B s + ∂Φ/∂p = 0 and its rate hold to
 //! the accuracy of the integration (`Sensitivities::residuals` measures them). The start's
 //! sensitivities are those of the assembly: the coordinates marked `independent` keep theirs
-//! (0), the others take the least change, in the metric of M, that satisfies
-//! B s + ∂Φ/∂p = 0 and B ṡ + ∂Φ̇/∂q s + ∂Φ̇/∂p = 0 ([`Model::complete_start`]).
+//! (0 unless a start says otherwise), the others take the least change, in the metric of M,
+//! that satisfies B s + ∂Φ/∂p = 0 and B ṡ + ∂Φ̇/∂q s + ∂Φ̇/∂p = 0
+//! ([`Model::complete_start`]). That is the derivative of the assembly when the coordinates
+//! not marked number the constraints (the loop then closes in one way); with more of them,
+//! the assembly's result also depends on Newton's path from the start and on M(p), which
+//! this first-order choice does not follow.
 
 use crate::error::{Failure, ModelError, ParamError};
 use crate::linalg::{Lu, cholesky, cholesky_solve};
@@ -128,6 +133,19 @@ impl<M: Model + 'static> Sensitivities<M> {
             return Err(ModelError::TangentsNotGenerated { model: info.name });
         }
         let n = M::NQ;
+        if M::NC > 0 {
+            // generated for models with constraints and sensitive parameters; a model written
+            // by hand may lack it
+            let z = vec![0.0; n.max(M::NC)];
+            model.constraint_parameter_tangents(
+                0.0,
+                &z[..n],
+                &z[..n],
+                &z[..n],
+                &z[..M::NC],
+                &mut ConstraintTangents::new::<M>(),
+            )?;
+        }
         let z = |len: usize| vec![0.0; len];
         Ok(Sensitivities {
             info: extended_info::<M>(info),
@@ -219,7 +237,7 @@ impl<M: Model + 'static> Sensitivities<M> {
         l.lambda.copy_from_slice(&l.rhs[n..n + nc]);
         self.model
             .constraint_tangent(t, q, &l.lambda, &mut l.k_lambda);
-        // checked at construction: generated for constraints with sensitive parameters
+        // checked at construction: it answers for this model
         let _ =
             self.model
                 .constraint_parameter_tangents(t, q, qd, &s.qdd, &l.lambda, &mut l.tangents);
@@ -266,12 +284,17 @@ impl<M: Model + 'static> Sensitivities<M> {
 
     /// The largest |B sⱼ + ∂Φ/∂pⱼ| and |B ṡⱼ + ∂Φ̇/∂q sⱼ + ∂Φ̇/∂pⱼ| at output `i` of a
     /// trajectory of this model: how far its sensitivities have drifted from the constraints'
-    /// derivatives (zero for models without constraints).
-    pub fn residuals(&self, tr: &Trajectory, i: usize) -> (f64, f64) {
+    /// derivatives (zero for models without constraints). Reads the output in its charts (and
+    /// leaves the wrapper in them); None when `tr` has no output `i` of this model's size.
+    pub fn residuals(&mut self, tr: &Trajectory, i: usize) -> Option<(f64, f64)> {
         let (n, nc) = (M::NQ, M::NC);
-        if nc == 0 {
-            return (0.0, 0.0);
+        if i >= tr.len() || tr.q(i).len() != <Self as Model>::NQ {
+            return None;
         }
+        if nc == 0 {
+            return Some((0.0, 0.0));
+        }
+        crate::charts::use_charts_of(&mut self.model, tr, i);
         let (t, x, xd) = (tr.t[i], tr.q(i), tr.qd(i));
         let mut b = vec![0.0; nc * n];
         let mut ct = ConstraintTangents::new::<M>();
@@ -297,7 +320,7 @@ impl<M: Model + 'static> Sensitivities<M> {
                 worst = (worst.0.max(p.abs()), worst.1.max(v.abs()));
             }
         }
-        worst
+        Some(worst)
     }
 
     /// diag(M, …, M) from `s.m`.
@@ -521,9 +544,9 @@ impl<M: Model + 'static> Model for Sensitivities<M> {
         let mut ct = ConstraintTangents::new::<M>();
         self.model.constraint_jacobian(t, &q[..n], &mut b);
         self.model.mass_matrix(t, &q[..n], &mut mm);
-        let zero = vec![0.0; n];
+        let zero = vec![0.0; n.max(nc)];
         self.model
-            .constraint_parameter_tangents(t, &q[..n], &qd[..n], &zero, &zero[..nc], &mut ct)
+            .constraint_parameter_tangents(t, &q[..n], &qd[..n], &zero[..n], &zero[..nc], &mut ct)
             .map_err(|e| Failure::InvalidOption {
                 name: "model",
                 value: inner.name.to_string(),

@@ -69,6 +69,11 @@ pub fn static_sensitivity<M: Model + Clone>(
             "it has no sensitive parameters: mark them, `param k = 1e4 sensitive;`",
         ));
     }
+    if eq.q.len() != n || eq.lambda.len() != M::NC {
+        return Err(refuse(
+            "the equilibrium is not one of this model (its coordinates or multipliers have other sizes): find it with static_equilibrium on this model",
+        ));
+    }
     // q is read in the equilibrium's charts
     let mut m = model.clone();
     for (j, r) in eq.charts.iter().enumerate() {

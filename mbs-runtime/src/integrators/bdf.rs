@@ -380,6 +380,7 @@ impl<M: Model> Stepper<M> for Bdf {
         s: &State,
         ctl: &Control,
         _moved: &[Recentring],
+        _evaluated: bool,
     ) -> Result<(), Failure> {
         self.newton.forget();
         self.start(p, s, ctl)

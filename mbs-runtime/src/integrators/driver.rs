@@ -345,8 +345,10 @@ impl<M: Model + 'static> Simulation<M> {
         if evaluate {
             // the model's own coordinates (a wrapper's) need their accelerations anew
             self.problem.chart_changed();
-            let (q, qd) = (cur.q.clone(), cur.qd.clone());
-            self.problem.accel(cur.t, &q, &qd, &mut cur.qdd)?;
+            let (q, qd) = (std::mem::take(&mut cur.q), std::mem::take(&mut cur.qd));
+            let r = self.problem.accel(cur.t, &q, &qd, &mut cur.qdd);
+            (cur.q, cur.qd) = (q, qd);
+            r?;
             if let Some(c) = self.problem.loops.closed() {
                 cur.lambda.copy_from_slice(&c.lambda);
             }
@@ -357,8 +359,13 @@ impl<M: Model + 'static> Simulation<M> {
         }
         self.problem.stats.chart_switches += self.moved.len();
         self.problem.chart_changed();
-        self.stepper
-            .rechart(&mut self.problem, &self.cur, &self.ctl, &self.moved)
+        self.stepper.rechart(
+            &mut self.problem,
+            &self.cur,
+            &self.ctl,
+            &self.moved,
+            evaluate,
+        )
     }
 
     /// The next sample instant of any controller (infinite without).

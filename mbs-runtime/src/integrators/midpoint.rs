@@ -47,6 +47,7 @@ impl<M: Model> Stepper<M> for Midpoint {
         s: &State,
         ctl: &Control,
         _moved: &[Recentring],
+        _evaluated: bool,
     ) -> Result<(), Failure> {
         self.newton.forget();
         self.start(p, s, ctl)

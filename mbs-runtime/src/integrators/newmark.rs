@@ -238,12 +238,19 @@ impl<M: Model> Stepper<M> for AlphaFamily {
     fn rechart(
         &mut self,
         _p: &mut Problem<M>,
-        _s: &State,
+        s: &State,
         _ctl: &Control,
         moved: &[Recentring],
+        evaluated: bool,
     ) -> Result<(), Failure> {
-        for r in moved {
-            r.map_acceleration(&mut self.a);
+        if evaluated {
+            // coordinates of the model's own that the map does not cover (a wrapper's): the
+            // acceleration-like variable starts again from the accelerations, as at t₀
+            self.a.copy_from_slice(&s.qdd);
+        } else {
+            for r in moved {
+                r.map_acceleration(&mut self.a);
+            }
         }
         self.h_prev = None;
         self.newton.forget();

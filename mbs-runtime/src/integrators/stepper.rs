@@ -60,16 +60,19 @@ pub(crate) trait Stepper<M: Model> {
     }
     /// Called after the driver re-centred the charts of rotation joints at the accepted
     /// state `s` (`moved` says which, and maps accelerations of the old charts into the new
-    /// ones). The step size stays the driver's; by default the scheme starts again from `s`.
-    /// A scheme that keeps matrices or history in the coordinates drops or maps them.
+    /// ones; `evaluated`: the model asked for its accelerations anew, so `s.qdd` was
+    /// evaluated in the new charts, and the map covers only the joints' own coordinates). The
+    /// step size stays the driver's; by default the scheme starts again from `s`. A scheme
+    /// that keeps matrices or history in the coordinates drops or maps them.
     fn rechart(
         &mut self,
         p: &mut Problem<M>,
         s: &State,
         ctl: &Control,
         moved: &[Recentring],
+        evaluated: bool,
     ) -> Result<(), Failure> {
-        let _ = moved;
+        let _ = (moved, evaluated);
         self.start(p, s, ctl)
     }
     /// Called once the driver has accepted the step from `prev` to `cur`.

@@ -35,7 +35,7 @@ pub struct ConstraintSensitivity {
     pub drate_dq: Matrix,
     /// ∂Φ̇/∂p (nc × ns)
     pub drate_dp: Matrix,
-    /// ∂Φ̈/∂q (nc × n), qdd and λ as symbols
+    /// ∂Φ̈/∂q (nc × n), qdd as symbols
     pub dacc_dq: Matrix,
     /// ∂Φ̈/∂qd (nc × n)
     pub dacc_dqd: Matrix,

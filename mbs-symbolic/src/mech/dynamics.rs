@@ -318,7 +318,7 @@ fn energies(sys: &mut System, tree: &Tree, world: &World, loads: &Loads) -> (Exp
     (t, v)
 }
 
-/// Each row of `x` (functions of q free of qd) followed by its derivatives, in blocks of its
+/// The derivatives of each row of `x` (functions of q free of qd), in blocks of the row's
 /// width: block 0 along the direction given as `Var::Qd` (Σₖ ∂x/∂qₖ qdₖ, for n coordinates),
 /// block 1 + j by sensitive parameter j.
 pub(super) fn along_and_by(a: &mut Arena, x: &Matrix, n: usize, sensitive: &[u16]) -> Matrix {

@@ -611,6 +611,7 @@ impl<M: Model> Stepper<M> for Radau {
         _s: &State,
         _ctl: &Control,
         _moved: &[Recentring],
+        _evaluated: bool,
     ) -> Result<(), Failure> {
         self.jac_valid = false;
         self.need_jac = true;

@@ -1,7 +1,8 @@
 //! Efforts written in Rust and extra first-order states ([`mbs::WithEfforts`]): the same
 //! force through the hook and in the DSL gives the same motion; extra states follow their
 //! exact solution with every scheme; the wrapper's tangents match differences of its τ; a
-//! failing user effort stops every scheme with its typed error and a trajectory free of NaN.
+//! failing user effort stops every scheme with its typed error and a trajectory free of NaN; a
+//! rejected trial state is retried with a smaller step.
 
 use mbs::{Effort, Efforts, Failure, Model, Options, Output, Scheme, Stats, WithEfforts, simulate};
 
@@ -282,4 +283,88 @@ fn failing_user_efforts_stop_every_scheme_with_a_typed_error() {
             assert!(tr.t.last().is_some_and(|&t| t <= 0.5));
         }
     }
+}
+
+/// A guard on the first bar's angle a little above the largest the motion reaches: the
+/// trial states of large steps can overshoot it where the motion never goes.
+struct Guard {
+    limit: f64,
+    reject: bool,
+}
+
+impl Efforts for Guard {
+    const FRAMES: bool = false;
+    fn efforts(&mut self, e: &mut Effort) -> Result<(), String> {
+        if e.q[0].abs() > self.limit {
+            let m = format!("|q[0]| = {:.6} beyond {:.6}", e.q[0].abs(), self.limit);
+            return Err(if self.reject { e.reject(m) } else { m });
+        }
+        Ok(())
+    }
+}
+
+#[test]
+fn rejected_trial_states_are_retried_smaller() {
+    // the largest |q[0]| of the motion, sampled finely at tight tolerances
+    let t_end = 3.0;
+    let fine = Options {
+        output: Output::Every { dt: 1e-3 },
+        ..Options::adaptive(t_end, 1e-12)
+    };
+    let (tr, _) = simulate(DpBare::default(), Scheme::Dopri5, fine).unwrap();
+    let reach = (0..tr.len()).map(|i| tr.q(i)[0].abs()).fold(0.0, f64::max);
+    let guarded = |limit, reject| WithEfforts::new(DpBare::default(), Guard { limit, reject });
+    // a guard 1e-6 above it: large steps' trial states overshoot it; a plain Err stops the
+    // run there, a rejection retries the step smaller and the run goes on
+    let limit = reach + 1e-6;
+    for (scheme, rtol) in [
+        (Scheme::Dopri5, 1e-2),
+        (Scheme::Dopri5, 1e-3),
+        (Scheme::Radau5, 1e-3),
+    ] {
+        let name = format!("{} at rtol {rtol:e}", scheme.name());
+        let hard = simulate(
+            guarded(limit, false),
+            scheme,
+            Options::adaptive(t_end, rtol),
+        )
+        .expect_err("a trial state overshoots");
+        assert!(
+            matches!(hard.kind, Failure::UserEffort { .. }),
+            "{name}: {hard}"
+        );
+        let (tr, stats) = simulate(guarded(limit, true), scheme, Options::adaptive(t_end, rtol))
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        println!(
+            "{name}: the Err guard stops at t = {:.4}; the rejecting guard runs to {t_end} s in {} steps, {} retried smaller",
+            hard.t, stats.steps, stats.rejected_effort
+        );
+        assert!(stats.rejected_effort >= 1, "{name}");
+        assert_eq!(tr.t.last(), Some(&t_end), "{name}");
+        assert!((0..tr.len()).all(|i| tr.q(i)[0].abs() <= limit), "{name}");
+    }
+    // a guard the motion itself crosses: the run stops with the typed failure where smaller
+    // steps cannot avoid it, the trajectory until then kept
+    let e = simulate(
+        guarded(reach - 0.005, true),
+        Scheme::Dopri5,
+        Options::adaptive(t_end, 1e-6),
+    )
+    .expect_err("the motion crosses the guard");
+    println!(
+        "crossed, adaptive: {e}; {} retried smaller",
+        e.stats.rejected_effort
+    );
+    assert!(matches!(e.kind, Failure::EffortRejected { .. }), "{e}");
+    assert!(e.h < 1e-9 && e.t > 0.5 && e.t < t_end, "{e} (h {})", e.h);
+    assert_eq!(e.trajectory.t.last(), Some(&e.t));
+    // ... and at a fixed step at once
+    let e = simulate(
+        guarded(reach - 0.005, true),
+        Scheme::Rk4,
+        Options::fixed(t_end, 1e-3),
+    )
+    .expect_err("the motion crosses the guard");
+    assert!(matches!(e.kind, Failure::EffortRejected { .. }), "{e}");
+    assert_eq!(e.stats.rejected_effort, 0);
 }

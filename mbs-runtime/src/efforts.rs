@@ -21,7 +21,10 @@
 //! The user part must be a function of (t, q, qd, x, u): it is called at trial states, for
 //! differences and several times per step. Memory belongs in extra states or in sampled
 //! controllers ([`crate::Inputs`]). A user error (`Err`) or a non-finite effort stops the run
-//! with [`Failure::UserEffort`] or [`Failure::NonFinite`] naming the coordinate or state.
+//! with [`Failure::UserEffort`] or [`Failure::NonFinite`] naming the coordinate or state. A
+//! state the efforts are not defined at, which a smaller step may avoid (an overshooting
+//! trial state), is rejected with `Err(e.reject(…))` instead ([`Effort::reject`]): the step
+//! is retried smaller, as SUNDIALS does with a right-hand side's recoverable error.
 
 use crate::error::{Failure, ModelError, ParamError};
 use crate::model::{Energy, FrameKinematics, Kinematics, Model, ModelInfo, PointKinematics, Pose};
@@ -43,7 +46,8 @@ pub trait Efforts: 'static {
     const FRAMES: bool = true;
     /// x(0) (NX)
     fn initial_states(&self, _x: &mut [f64]) {}
-    /// Adds the efforts at the state in `e` (world axes). An `Err` stops the run.
+    /// Adds the efforts at the state in `e` (world axes). An `Err` stops the run;
+    /// `Err(e.reject(…))` has the step retried smaller ([`Effort::reject`]).
     fn efforts(&mut self, e: &mut Effort) -> Result<(), String>;
     /// ẋ (NX) at the state in `e`.
     fn state_derivatives(&mut self, _e: &Effort, _xd: &mut [f64]) -> Result<(), String> {
@@ -64,9 +68,22 @@ pub struct Effort<'a> {
     /// kinematics of the wrapped model's frames and points at (t, q, qd)
     pub kin: &'a Kinematics,
     qg: &'a mut [f64],
+    rejected: bool,
 }
 
 impl Effort<'_> {
+    /// Rejects this state as one the efforts are not defined at (a table's range, a guard)
+    /// but which a smaller step may avoid: a trial state of a Newton iteration or an explicit
+    /// stage can overshoot where the motion itself never goes. Return it as the error,
+    /// `return Err(e.reject("knee beyond its table"))`: an adaptive step is then retried at a
+    /// quarter of its size (counted in `Stats::rejected_effort`), and the run stops with
+    /// [`Failure::EffortRejected`] only at a fixed step or when the step reaches its floor,
+    /// keeping the trajectory. A plain `Err` stops the run at once.
+    pub fn reject(&mut self, message: impl Into<String>) -> String {
+        self.rejected = true;
+        message.into()
+    }
+
     /// Kinematics of frame (or body) `i` (`ModelInfo::frame_index`); unset when the user
     /// part says it reads no frames ([`Efforts::FRAMES`]).
     pub fn frame(&self, i: usize) -> &FrameKinematics {
@@ -264,12 +281,17 @@ impl<M: Model, E: Efforts> WithEfforts<M, E> {
             u,
             kin: &s.kin,
             qg,
+            rejected: false,
         };
         let r = user
             .efforts(&mut e)
             .and_then(|_| user.state_derivatives(&e, xd));
         if let Err(message) = r {
-            self.fail(Failure::UserEffort { t, message });
+            self.fail(if e.rejected {
+                Failure::EffortRejected { t, message }
+            } else {
+                Failure::UserEffort { t, message }
+            });
             return false;
         }
         let bad = qg

@@ -177,6 +177,12 @@ pub enum Failure {
     },
     #[error("user effort failed at t = {t}: {message}")]
     UserEffort { t: f64, message: String },
+    /// A user effort rejected a state ([`crate::Effort::reject`]) and smaller steps did not
+    /// avoid it: at a fixed step, or with the step at its floor.
+    #[error(
+        "user effort rejected the state at t = {t} and smaller steps did not avoid it: {message}"
+    )]
+    EffortRejected { t: f64, message: String },
     #[error("{scheme} cannot integrate constraints by {method}: {supported}")]
     ConstraintsUnsupported {
         scheme: &'static str,

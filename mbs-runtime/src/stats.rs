@@ -14,6 +14,9 @@ pub struct Stats {
     pub rejected_error: usize,
     /// steps rejected because Newton did not converge
     pub rejected_newton: usize,
+    /// steps retried smaller because a user effort rejected a trial state
+    /// ([`crate::Effort::reject`]; with Newton, also counted in `rejected_newton`)
+    pub rejected_effort: usize,
     /// evaluations of M and h together (`Model::dynamics`)
     pub dynamics: usize,
     /// evaluations of qdd by the generated forward dynamics (`Model::forward_dynamics`:

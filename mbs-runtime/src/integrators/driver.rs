@@ -453,6 +453,12 @@ impl<M: Model + 'static> Simulation<M> {
             let step = Step(&mut self.problem, &self.cur, h, &self.ctl, &mut self.next);
             let result = self.stepper.attempt(step);
             match result {
+                // a trial state the user's efforts rejected: retried smaller while it can be
+                Err(kind @ Failure::EffortRejected { .. }) if !fixed && h > h_min => {
+                    self.problem.stats.rejected_effort += 1;
+                    self.last_cause = Some(kind);
+                    self.h = (0.25 * h).max(h_min);
+                }
                 Err(kind) => return Err(self.fail(kind, h)),
                 Ok(Attempt::Accepted { h_next }) => {
                     self.next.t = if last {
@@ -507,9 +513,13 @@ impl<M: Model + 'static> Simulation<M> {
                     cause,
                 }) => {
                     self.problem.stats.rejected_newton += 1;
+                    if matches!(cause, Some(Failure::EffortRejected { .. })) {
+                        self.problem.stats.rejected_effort += 1;
+                    }
                     // a user effort's own error does not go away with a smaller step (a
-                    // singular configuration met by a trial iterate may: the step shrinks,
-                    // and the failure is reported if it collapses)
+                    // singular configuration met by a trial iterate may, and so may a state
+                    // the efforts rejected: the step shrinks, and the failure is reported if
+                    // it collapses)
                     let fatal = matches!(
                         cause,
                         Some(Failure::UserEffort { .. })

@@ -395,7 +395,7 @@ fn a_knee_beyond_its_tables_or_a_foot_through_the_ground_is_a_typed_failure() {
     up[1] += 0.3;
     let e = run(held(bent), up, qd0.clone());
     println!("{e}");
-    assert!(matches!(e.kind, mbs::Failure::UserEffort { .. }), "{e}");
+    assert!(matches!(e.kind, mbs::Failure::EffortRejected { .. }), "{e}");
     assert!(e.to_string().contains("knee[0]"), "{e}");
     assert!(
         e.t > 0.0 && e.trajectory.len() > 1,
@@ -407,7 +407,7 @@ fn a_knee_beyond_its_tables_or_a_foot_through_the_ground_is_a_typed_failure() {
     q[1] -= 0.03;
     let e = run(held(reference), q, qd0);
     println!("{e}");
-    assert!(matches!(e.kind, mbs::Failure::UserEffort { .. }), "{e}");
+    assert!(matches!(e.kind, mbs::Failure::EffortRejected { .. }), "{e}");
     assert!(e.to_string().contains("into the ground"), "{e}");
     let _ = n;
 }

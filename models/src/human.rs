@@ -1173,7 +1173,7 @@ impl Tracking {
 
 impl Efforts for Tracking {
     fn efforts(&mut self, e: &mut Effort) -> Result<(), String> {
-        self.guard.check(e.q, e.kin)?;
+        self.guard.apply(e)?;
         let (q, qd) = (e.q, e.qd);
         for (i, tau) in self.torques(e.t, q, qd) {
             e.generalized_force(i, tau);
@@ -1264,7 +1264,10 @@ pub const KNEE_TABLE: f64 = 2.0944;
 /// that drive it ([`Tracking`], [`PassiveJoints`]): a knee beyond its splines' tables (the
 /// tibia's translation would be extrapolated) and an ellipsoid deeper in the ground than its
 /// smallest semi-axis (the foot has passed through the ground). Each is an `Err` naming the
-/// coordinate or the ellipsoid, which stops the run with a typed failure, trajectory kept.
+/// coordinate or the ellipsoid. In a run ([`Guard::apply`]) it rejects the state
+/// ([`mbs::Effort::reject`]): an overshooting trial state of a large step is retried smaller,
+/// and a motion that really goes there stops with `Failure::EffortRejected`, trajectory
+/// kept.
 #[derive(Clone, Copy, Debug)]
 pub struct Guard {
     feet: Feet,
@@ -1277,6 +1280,14 @@ impl Guard {
             feet: Feet::of(info),
             knees: [dof_index(info, "knee[0]")?, dof_index(info, "knee[1]")?],
         })
+    }
+
+    /// [`Guard::check`] at the state of `e`, a failure rejecting that state.
+    pub fn apply(&self, e: &mut Effort) -> Result<(), String> {
+        match self.check(e.q, e.kin) {
+            Ok(()) => Ok(()),
+            Err(m) => Err(e.reject(m)),
+        }
     }
 
     /// `Err` with what went wrong, at (q, kin).
@@ -1711,7 +1722,7 @@ impl Efforts for PassiveJoints {
 
     fn efforts(&mut self, e: &mut Effort) -> Result<(), String> {
         if self.tracking.is_none() {
-            self.guard.check(e.q, e.kin)?;
+            self.guard.apply(e)?;
         }
         for (k, (i, l)) in self.joints.iter().enumerate() {
             let m = l.elastic(e.q[*i]) + e.x[k];

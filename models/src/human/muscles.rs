@@ -532,7 +532,7 @@ pub struct MusclesAtRest(pub MuscleDriven);
 impl Efforts for MusclesAtRest {
     fn efforts(&mut self, e: &mut Effort) -> Result<(), String> {
         let MuscleDriven { passive, muscles } = &mut self.0;
-        passive.guard.check(e.q, e.kin)?;
+        passive.guard.apply(e)?;
         for (i, law) in &passive.joints {
             e.generalized_force(*i, law.elastic(e.q[*i]));
         }

@@ -185,15 +185,18 @@ impl<M: Model + 'static> Sensitivities<M> {
         let (q, qd) = (&x[..n], &xd[..n]);
         self.model.dynamics(t, q, qd, u, &mut s.m, &mut s.h);
         s.l.copy_from_slice(&s.m);
-        s.qdd.copy_from_slice(&s.h);
         let factorised = cholesky(&mut s.l, n).is_ok();
-        if factorised {
-            cholesky_solve(&s.l, n, &mut s.qdd);
-        } else {
-            // the runtime's checks of the pivots and of the accelerations report it
-            s.qdd.fill(f64::NAN);
-        }
+        // qdd of an open loop from the factor; a closed loop's from its index-1 system
         let closed = M::NC > 0 && self.closed_loop_state(s, t, q, qd);
+        if M::NC == 0 {
+            s.qdd.copy_from_slice(&s.h);
+            if factorised {
+                cholesky_solve(&s.l, n, &mut s.qdd);
+            } else {
+                // the runtime's checks of the pivots and of the accelerations report it
+                s.qdd.fill(f64::NAN);
+            }
+        }
         // checked at construction: both are generated
         let _ = self.model.tangents(t, q, qd, &s.qdd, u, &mut s.k, &mut s.c);
         let _ = self

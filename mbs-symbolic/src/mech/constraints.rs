@@ -59,24 +59,22 @@ impl ConstraintSensitivity {
         rest: bool,
     ) -> ConstraintSensitivity {
         let n = c.tangent.len();
-        let rate: Vec<ExprId> =
+        // B v ∘ e row by row: Φ̇ = B qd + Φ_t, Φ̈ = B qdd − γ
+        let mut b_times = |var: fn(u16) -> Var,
+                           with: fn(&mut Arena, ExprId, ExprId) -> ExprId,
+                           e: &[ExprId]|
+         -> Vec<ExprId> {
+            let v: Vec<ExprId> = (0..n).map(|j| a.var(var(j as u16))).collect();
             c.b.iter()
-                .zip(&c.phi_t)
-                .map(|(row, &pt)| {
-                    let qd: Vec<ExprId> = (0..n).map(|j| a.var(Var::Qd(j as u16))).collect();
-                    let bqd = a.dot(row, &qd);
-                    a.add(bqd, pt)
+                .zip(e)
+                .map(|(row, &e)| {
+                    let bv = a.dot(row, &v);
+                    with(a, bv, e)
                 })
-                .collect();
-        let acc: Vec<ExprId> =
-            c.b.iter()
-                .zip(&c.gamma)
-                .map(|(row, &g)| {
-                    let qdd: Vec<ExprId> = (0..n).map(|j| a.var(Var::Qdd(j as u16))).collect();
-                    let bqdd = a.dot(row, &qdd);
-                    a.sub(bqdd, g)
-                })
-                .collect();
+                .collect()
+        };
+        let rate = b_times(Var::Qd, Arena::add, &c.phi_t);
+        let acc = b_times(Var::Qdd, Arena::sub, &c.gamma);
         let rest = rest
             .then(|| [&c.b, &c.tangent].map(|x| super::dynamics::along_and_by(a, x, n, sensitive)));
         let mut by = |x: &[ExprId], var: &dyn Fn(usize) -> Var, count: usize| -> Matrix {

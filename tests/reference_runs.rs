@@ -70,17 +70,18 @@ fn order_two_schemes_converge_to_the_references() {
         // within 1e-6 over the first second, before the chaos amplifies order-2 errors
         check::<dpend::DoublePendulum>("dpend", scheme, 1.0, 1e-12);
         check::<arm3d_6::Arm3d6>("arm3d_6", scheme, 1.0, 1e-12);
-        // and converging at t = 2 s as rtol^(2/3): 100× tighter, ≈ 21× closer
+        // and converging at t = 2 s as rtol (their local tolerance is mapped to
+        // 0.3·rtol^1.5): 100× tighter, 160–200× closer (about 1.1 digits per decade)
         let (coarse, fine) = (
-            error::<arm3d_6::Arm3d6>("arm3d_6", scheme, 2.0, 1e-9),
-            error::<arm3d_6::Arm3d6>("arm3d_6", scheme, 2.0, 1e-11),
+            error::<arm3d_6::Arm3d6>("arm3d_6", scheme, 2.0, 1e-5),
+            error::<arm3d_6::Arm3d6>("arm3d_6", scheme, 2.0, 1e-7),
         );
         println!(
-            "arm3d_6  t =    2: {:<9} error {coarse:.2e} at rtol 1e-9, {fine:.2e} at rtol 1e-11",
+            "arm3d_6  t =    2: {:<9} error {coarse:.2e} at rtol 1e-5, {fine:.2e} at rtol 1e-7",
             scheme.name()
         );
         assert!(
-            (10.0..50.0).contains(&(coarse / fine)),
+            (30.0..300.0).contains(&(coarse / fine)),
             "{}: {coarse:e} → {fine:e}",
             scheme.name()
         );

@@ -51,20 +51,21 @@ fn work_counters_of_reference_runs() {
         (Scheme::Rk4, [1000, 0, 0, 0, 4131, 0, 0, 0, 0, 0]),
         // 93 attempts × 6 evaluations (first same as last) + the start + the initial-step probe
         (Scheme::Dopri5, [80, 13, 0, 0, 560, 0, 0, 0, 0, 0]),
-        // about 2.4 Newton iterations per step; a factorisation every 4–5 steps; one M per
-        // accepted step, the singular-configuration watch (finite-difference iteration
-        // matrices do not evaluate M), and one at the start, its reference
+        // local tolerance 0.3·rtol^1.5 (their global error follows rtol): 15× the steps of a
+        // per-step rtol; about 3.2 Newton iterations per step; a factorisation every 45–55
+        // steps; one M per accepted step, the singular-configuration watch (finite-difference
+        // iteration matrices do not evaluate M), and one at the start, its reference
         (
             Scheme::Newmark(NewmarkParams::default()),
-            [839, 22, 0, 0, 2, 840, 2625, 192, 2049, 2049],
+            [12523, 13, 0, 0, 2, 12524, 40968, 273, 40149, 40149],
         ),
         (
             Scheme::Hht(HhtParams::default()),
-            [917, 21, 0, 0, 2, 918, 2828, 187, 2267, 2267],
+            [13694, 12, 0, 0, 2, 13695, 44567, 274, 43745, 43745],
         ),
         (
             Scheme::GenAlpha(GenAlphaParams::default()),
-            [1001, 19, 0, 0, 2, 1002, 3035, 191, 2462, 2462],
+            [14957, 12, 0, 0, 2, 14958, 48233, 276, 47405, 47405],
         ),
         // fixed step, Newton to 1e-10 (5 iterations per step) and one forward-dynamics solve
         // per step for qdd

@@ -4,12 +4,14 @@
 //! - MODELS.md's r = 1 + 9.81/k is not the static stretch at θ = 0.5 (9.81 cos 0.5/k): the
 //!   radial mode starts with an amplitude 1.2/k m and a velocity amplitude 1.2/√k m/s, far
 //!   above atol. That oscillation is part of the solution asked for, and every scheme that
-//!   honours the tolerance resolves it: the work of all of them grows with k, 19 (gen-α) to
-//!   45 (DOPRI5) times the steps at k = 1e8 as at 1e4.
+//!   honours the tolerance resolves it: the work of all of them grows with k, 28 (BDF) to
+//!   45 (DOPRI5) times the steps at k = 1e8 as at 1e4, 3 times for gen-α, whose order 2
+//!   already takes 3,609 steps at k = 1e4 (its local tolerance is 0.3·rtol^1.5, so that its
+//!   global error follows rtol).
 //! - on the slow manifold, r = 1 + 9.81 cos 0.5/k, the radial mode is hardly excited: the
 //!   implicit schemes (Radau5, BDF, gen-α with adaptive steps) take no more steps at
-//!   k = 1e8 than at 1e6 (Radau5 17 against 19, BDF 853 against 850, gen-α 183 against
-//!   180; BDF keeps to order 2 while h·ω of the radial mode is past BDF5's stable 0.7, which
+//!   k = 1e8 than at 1e6 (Radau5 17 against 19, BDF 853 against 850, gen-α 2,628 against
+//!   2,628; BDF keeps to order 2 while h·ω of the radial mode is past BDF5's stable 0.7, which
 //!   at its rtol' = 0.1·rtol^1.25 costs it more steps than order 5 took at k = 1e4: 853
 //!   against 326), and θ(1) tends to the rigid pendulum's as k grows;
 //!   DOPRI5 is held by its stability bound h ≲ 3.3/√k: 67 times the steps for 10⁴ times k.
@@ -95,15 +97,27 @@ fn springpend_stiffness_sweep() {
             let growth = steps[3] / steps[1];
             println!("    steps at k = 1e8 / at k = 1e4: {growth:.2} (√(1e8/1e4) = 100)");
             if stretch == 1.0 {
-                // the radial oscillation is resolved by every scheme (19 to 45 times the steps)
-                assert!(growth > 15.0, "{}: {growth}", scheme.name());
+                // the radial oscillation is resolved by every scheme: the work grows with k,
+                // 28 to 45 times from k = 1e4 to 1e8 for the schemes of order 3 to 5, 3 times
+                // for gen-α, whose order 2 already takes 3,609 steps at k = 1e4
+                assert!(
+                    steps.windows(2).all(|w| w[1] > w[0]),
+                    "{}: {steps:?}",
+                    scheme.name()
+                );
+                let least = if scheme.name() == "gen-alpha" {
+                    2.5
+                } else {
+                    15.0
+                };
+                assert!(growth > least, "{}: {growth}", scheme.name());
             } else if scheme.name() == "bdf" {
                 // BDF keeps to order 2 while h·ω of the radial mode is past BDF5's 0.7, and
                 // order 2 at its rtol' = 0.1·rtol^1.25 takes more steps than order 5 did at
                 // k = 1e4 (326 → 853), but no more as k grows (853 at k = 1e6 and 1e8)
                 assert!(growth < 3.0, "{}: {growth}", scheme.name());
             } else if scheme.is_implicit() {
-                // no more steps (gen-α: 183 against 180)
+                // no more steps (gen-α: 2,628 against 2,630)
                 assert!(growth < 1.1, "{}: {growth}", scheme.name());
             } else {
                 // DOPRI5 held by its stability bound: 67 times the steps
@@ -132,11 +146,13 @@ fn springpend_stiffness_sweep() {
             [
                 21196, 1845, 0, 0, 2, 2782, 28732, 2781, 2781, 28732, 28732, 2782,
             ], // MODELS.md start r = 1 + 9.81/k, bdf k 1e8
-            [180, 2, 0, 0, 2, 28, 381, 27, 27, 381, 381, 28], // MODELS.md start r = 1 + 9.81/k, gen-alpha k 1e2
-            [250, 37, 0, 0, 2, 103, 645, 102, 102, 645, 645, 103], // MODELS.md start r = 1 + 9.81/k, gen-alpha k 1e4
-            [423, 232, 0, 0, 2, 387, 1929, 386, 386, 1929, 1929, 387], // MODELS.md start r = 1 + 9.81/k, gen-alpha k 1e6
+            [2642, 2, 0, 0, 2, 36, 7002, 35, 35, 7002, 7002, 36], // MODELS.md start r = 1 + 9.81/k, gen-alpha k 1e2
+            [3609, 12, 0, 0, 2, 210, 7016, 209, 209, 7016, 7016, 210], // MODELS.md start r = 1 + 9.81/k, gen-alpha k 1e4
             [
-                4836, 4554, 0, 0, 2, 6974, 15122, 6973, 6973, 15122, 15122, 6974,
+                6999, 760, 0, 0, 2, 2447, 18597, 2446, 2446, 18597, 18597, 2447,
+            ], // MODELS.md start r = 1 + 9.81/k, gen-alpha k 1e6
+            [
+                10686, 3902, 0, 0, 2, 7392, 45846, 7391, 7391, 45846, 45846, 7392,
             ], // MODELS.md start r = 1 + 9.81/k, gen-alpha k 1e8
             [42, 7, 0, 0, 296, 0, 0, 0, 0, 0, 0, 0], // MODELS.md start r = 1 + 9.81/k, dopri5 k 1e2
             [321, 32, 0, 0, 2120, 0, 0, 0, 0, 0, 0, 0], // MODELS.md start r = 1 + 9.81/k, dopri5 k 1e4
@@ -150,10 +166,10 @@ fn springpend_stiffness_sweep() {
             [326, 54, 0, 0, 2, 78, 482, 77, 77, 482, 482, 78], // slow-manifold start r = 1 + 9.81 cos 0.5/k, bdf k 1e4
             [850, 6, 0, 0, 2, 16, 906, 15, 15, 906, 906, 16], // slow-manifold start r = 1 + 9.81 cos 0.5/k, bdf k 1e6
             [853, 6, 0, 0, 2, 16, 961, 15, 15, 961, 961, 16], // slow-manifold start r = 1 + 9.81 cos 0.5/k, bdf k 1e8
-            [177, 2, 0, 0, 2, 34, 329, 33, 33, 329, 329, 34], // slow-manifold start r = 1 + 9.81 cos 0.5/k, gen-alpha k 1e2
-            [180, 2, 0, 0, 2, 41, 398, 40, 40, 398, 398, 41], // slow-manifold start r = 1 + 9.81 cos 0.5/k, gen-alpha k 1e4
-            [180, 2, 0, 0, 2, 42, 317, 41, 41, 317, 317, 42], // slow-manifold start r = 1 + 9.81 cos 0.5/k, gen-alpha k 1e6
-            [183, 2, 0, 0, 2, 48, 645, 47, 47, 645, 645, 48], // slow-manifold start r = 1 + 9.81 cos 0.5/k, gen-alpha k 1e8
+            [2595, 2, 0, 0, 2, 42, 5920, 41, 41, 5920, 5920, 42], // slow-manifold start r = 1 + 9.81 cos 0.5/k, gen-alpha k 1e2
+            [2630, 2, 0, 0, 2, 50, 5195, 49, 49, 5195, 5195, 50], // slow-manifold start r = 1 + 9.81 cos 0.5/k, gen-alpha k 1e4
+            [2628, 2, 0, 0, 2, 49, 5623, 48, 48, 5623, 5623, 49], // slow-manifold start r = 1 + 9.81 cos 0.5/k, gen-alpha k 1e6
+            [2628, 2, 0, 0, 2, 49, 5245, 48, 48, 5245, 5245, 49], // slow-manifold start r = 1 + 9.81 cos 0.5/k, gen-alpha k 1e8
             [38, 4, 0, 0, 254, 0, 0, 0, 0, 0, 0, 0], // slow-manifold start r = 1 + 9.81 cos 0.5/k, dopri5 k 1e2
             [133, 29, 0, 0, 974, 0, 0, 0, 0, 0, 0, 0], // slow-manifold start r = 1 + 9.81 cos 0.5/k, dopri5 k 1e4
             [684, 173, 0, 0, 5144, 0, 0, 0, 0, 0, 0, 0], // slow-manifold start r = 1 + 9.81 cos 0.5/k, dopri5 k 1e6

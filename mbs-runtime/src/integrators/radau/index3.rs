@@ -59,6 +59,10 @@ impl Radau {
             self.phit = z(nc);
             self.kbt = z(n * nc);
             self.bbt = z(nc * nc);
+            self.zm = z(nc * n);
+            self.zbt = z(nc * nc);
+            self.qp = z(n);
+            self.rate0 = z(nc);
             self.psix = z(nc);
         }
     }
@@ -86,6 +90,10 @@ impl Radau {
         }
         Failure::non_finite("B = ∂Φ/∂q", &self.bm, |i| p.label((i / nc).min(n - 1)))?;
         if self.index2 {
+            self.rate_jacobian(p, cur);
+            Failure::non_finite("∂(B qd + Φ_t)/∂q", &self.zm, |i| {
+                p.label((i / nc).min(n - 1))
+            })?;
             self.index2_matrices();
         }
         Ok(())

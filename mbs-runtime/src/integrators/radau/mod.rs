@@ -197,21 +197,28 @@
 //! τ(t_i, Q_i, V_i, A_i) − B(Q_i)ᵀΛ_i = 0,   Φ(Q_i, t_i) = 0,   B(Q_i)V_i + Φ_t(Q_i, t_i) = 0.
 //! ```
 //!
-//! Simplified Newton freezes M, C_t, K̃, B as at index 3 and leaves out ∂(B qd)/∂q in the rows
-//! of Φ̇; with the eigen-blocks of A the unknowns of block μ are (W_μ, U_μ, Z_μ/(hμ)) and the
-//! (n + 2nc)-square system is
+//! Simplified Newton freezes M, C_t, K̃, B as at index 3 and Z = ∂(B qd + Φ_t)/∂q (forward
+//! differences at (q₀, qd₀): n more evaluations of B and Φ_t with each new Jacobian); with the
+//! eigen-blocks of A the unknowns of block μ are (W_μ, U_μ, Z_μ/(hμ)) and the (n + 2nc)-square
+//! system is
 //!
 //! ```text
 //! [ M + hμC_t + h²μ²K̃   −Bᵀ   h²μ²K̃Bᵀ ]   [ −[(T⁻¹ ⊗ I) r]_μ          ]
 //! [ B                    0     BBᵀ      ] = [ −[(T⁻¹ ⊗ I) Φ]_μ / (h²μ²) ]
-//! [ B                    0     0        ]   [ −[(T⁻¹ ⊗ I) Φ̇]_μ / (hμ)   ]
+//! [ B + hμZ              0     hμZBᵀ    ]   [ −[(T⁻¹ ⊗ I) Φ̇]_μ / (hμ)   ]
 //! ```
 //!
 //! bounded as h → 0 like the index-3 blocks. Newton's norm adds the position corrections
 //! h Σ a_ij B₀ᵀδM_j to the positions' and weights λ by h, as RADAU5 weights index-2 components;
 //! it also requires the predicted |Φ_i| and the |Φ̇_i| before the update below
-//! `ConstraintOptions::tolerance`, and |Φ̇| of the new state too (the left-out ∂(B qd)/∂q can
-//! leave it above: 4e-11 on the pendulum at rtol 1e-4 otherwise). Rounding floors: velocities
+//! `ConstraintOptions::tolerance`, and |Φ̇| of the new state too (4e-11 on the pendulum at rtol
+//! 1e-4 otherwise, before Z was in the matrix). These absolute tolerances do not follow rtol:
+//! when the corrections have converged and only they are unmet, Newton goes on for up to
+//! `max_iterations` more iterations (at index 3 too) instead of rejecting the step. Without
+//! that and Z, Radau5 at index 2 was limited by Newton at loose rtol (the four-bar at rtol
+//! 1e-4: 352 steps with 222 Newton rejections, 6.4 digits; fastlink 829 steps with 531; now
+//! 149 with 5, 3.7 digits, and 273 with 34; `cargo run --release --example work_precision --
+//! --model fourbar`). Rounding floors: velocities
 //! and λ (times 1/h) not below 4ε max|qd|/κ, measured on the four-bar, where without it the
 //! step collapsed at rtol 1e-9 when the rocker's velocity passed through zero.
 //!
@@ -221,17 +228,19 @@
 //! are both differential components, so the norm runs over (e_q, e_v) unscaled; λ, index 2, is
 //! in it weighted by h (RADAU5's scaling); μ (zero on the exact solution) is left out. The
 //! error test is `ErrorTest::PositionsVelocities`. λ is reported at its attainable accuracy,
-//! of order s: on the pendulum at rtol 1e-8, 1e-5 (Radau3) and 2e-7 (Radau5); q and qd within
-//! 5e-9 and 8e-11.
+//! of order s: on the pendulum at rtol 1e-8, 1.2e-8 (Radau3) and 1.0e-7 (Radau5), where q and
+//! qd are within 4.8e-11 and 3.0e-11 (Radau3), 9.6e-11 and 4.2e-11 (Radau5).
 //!
 //! Against projection (the default for Radau, `ConstraintMethod::Auto`): at equal rtol, index 2
 //! gives about the same mixed error over (q, qd) with Radau3 (within 0.3 digits on the
-//! slider-crank and the four-bar, 0.6 better at rtol 1e-4 on the four-bar) and a smaller one
-//! with Radau5 at loose tolerances (0.4–2.7 digits at rtol 1e-4…1e-7, within 0.4 at
-//! 1e-9…1e-10; table under "What rtol means"), with more steps (pendulum, Radau5, rtol 1e-6: 18 against 13) and more work per
-//! step ((n + 2nc)-square blocks, the constraints at every stage), and λ of order s where
-//! projection gives λ of the index-1 form at the accuracy of q and qd. Not measurably better
-//! at equal work, it is not the default.
+//! slider-crank and the four-bar, 0.6 better at rtol 1e-4 on the four-bar) and with Radau5
+//! from 1.3 digits better (rtol 1e-4 on Cash's pendulum) to 1.3 short (rtol 1e-10 on Cash's
+//! pendulum: its velocities trail its positions by about 2 digits there in adaptive runs,
+//! though both converge with order 5 at fixed steps), with more steps (pendulum, Radau5, rtol
+//! 1e-6: 16 against 13) and more work per step ((n + 2nc)-square blocks, the constraints at
+//! every stage), and λ of order s where projection gives λ of the index-1 form at the accuracy
+//! of q and qd. Not better at equal work (the four-bar at 3.7 digits: 2.0 ms against 1.2 ms
+//! with projection at 3.9), it is not the default.
 //!
 //! ## What rtol means
 //! The mixed error over (q, qd) (Test Set for IVP Solvers, floor 0.01, largest over 10 sampled
@@ -482,6 +491,13 @@ pub(crate) struct Radau {
     phit: Vec<f64>,
     kbt: Vec<f64>,
     bbt: Vec<f64>,
+    /// index 2: Z = ∂(B v + Φ_t)/∂q at the start of the step (nc × n), and Z B₀ᵀ (nc × nc),
+    /// frozen with the other matrices
+    zm: Vec<f64>,
+    zbt: Vec<f64>,
+    /// index 2: scratch of Z's differences (q perturbed, Φ̇ at q₀)
+    qp: Vec<f64>,
+    rate0: Vec<f64>,
     psix: Vec<f64>,
 }
 
@@ -553,6 +569,10 @@ impl Radau {
             phit: Vec::new(),
             kbt: Vec::new(),
             bbt: Vec::new(),
+            zm: Vec::new(),
+            zbt: Vec::new(),
+            qp: Vec::new(),
+            rate0: Vec::new(),
             psix: Vec::new(),
         }
     }

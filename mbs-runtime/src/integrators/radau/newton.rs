@@ -3,7 +3,7 @@
 
 use super::super::State;
 use super::super::problem::Problem;
-use super::index2::border2;
+use super::index2::{Border, border2};
 use super::index3::border;
 use super::tableau::re;
 use super::{
@@ -41,7 +41,14 @@ impl Radau {
                 }
             }
             if self.index2 {
-                border2(a, &self.bm, &self.kbt, &self.bbt, g2, n, nc);
+                let m = Border {
+                    b: &self.bm,
+                    kbt: &self.kbt,
+                    bbt: &self.bbt,
+                    z: &self.zm,
+                    zbt: &self.zbt,
+                };
+                border2(a, &m, g1, g2, n, nc);
             } else {
                 border(a, &self.bm, n, nc);
             }
@@ -62,7 +69,14 @@ impl Radau {
                 }
             }
             if self.index2 {
-                border2(a, &self.bm, &self.kbt, &self.bbt, g * g, n, nc);
+                let m = Border {
+                    b: &self.bm,
+                    kbt: &self.kbt,
+                    bbt: &self.bbt,
+                    z: &self.zm,
+                    zbt: &self.zbt,
+                };
+                border2(a, &m, g, g * g, n, nc);
             } else {
                 border(a, &self.bm, n, nc);
             }
@@ -288,6 +302,7 @@ impl Radau {
         let (mut newt, mut dynold, mut thqold) = (0usize, 1.0, 1.0);
         let mut last = f64::INFINITY;
         let mut dyn1 = f64::INFINITY;
+        let mut residual_only = false;
         let fail = |h_next: f64, newt: usize, last: f64, cause: Option<Failure>| NewtonFail {
             h_next,
             iterations: newt,
@@ -295,7 +310,9 @@ impl Radau {
             cause,
         };
         loop {
-            if newt >= nit {
+            // the corrections have converged and only the constraints' residuals are still
+            // above their tolerance: up to `nit` more iterations for them
+            if newt >= nit && !(residual_only && newt < 2 * nit) {
                 return Err(fail(0.5 * h, newt, last, None));
             }
             self.stages(cur, h);
@@ -375,10 +392,11 @@ impl Radau {
             let phi_ok = self.nc == 0
                 || (self.phi_max * self.faccon.min(1.0) <= self.tol_phi
                     && self.psi_max <= self.tol_phi);
-            if self.faccon * dyno <= tol.kappa && phi_ok {
+            residual_only = self.faccon * dyno <= tol.kappa;
+            if residual_only && phi_ok {
                 self.stages(cur, h);
-                // index 2: the new state's |Φ̇| too (the simplified Newton leaves out
-                // ∂(B qd)/∂q, so an update may leave Φ̇ above what it was before it)
+                // index 2: the new state's |Φ̇| too (the simplified Newton's Z is frozen at
+                // the start of the step, so an update may leave Φ̇ above what it was before)
                 if !self.index2 || self.final_rate(p, cur.t + h) <= self.tol_phi {
                     return Ok(newt);
                 }

@@ -109,35 +109,35 @@ fn within(p: f64, theory: f64) -> bool {
     (p - theory).abs() <= 0.3
 }
 
-/// Radau3 at index 2: q and qd of order 2s − 1 = 3, λ of order s = 2.
+/// Radau3 at index 2: q and qd of order 2s − 1 = 3, and λ too: the state's λ comes from the
+/// index-1 equations at (q, qd) (the last stage's Λ is of order s = 2).
 #[test]
-fn radau3_fixed_step_orders_are_three_three_two() {
+fn radau3_fixed_step_orders_are_three() {
     let p = orders(Scheme::Radau3, &[20, 40, 80, 160, 320]);
     for o in &p {
         assert!(
-            within(o[0], 3.0) && within(o[1], 3.0) && within(o[2], 2.0),
+            within(o[0], 3.0) && within(o[1], 3.0) && within(o[2], 3.0),
             "{p:?}"
         );
     }
 }
 
-/// Radau5 at index 2: q and qd of order 5, λ of order 3; q and qd measured at the larger
+/// Radau5 at index 2: q, qd and λ of order 5 (the stage Λ of order 3), measured at the larger
 /// steps, where their errors stay well above the reference's (~1e-13).
 #[test]
-fn radau5_fixed_step_orders_are_five_five_three() {
-    let p = orders(Scheme::Radau5, &[5, 10, 20]);
+fn radau5_fixed_step_orders_are_five() {
+    let p = orders(Scheme::Radau5, &[5, 10, 20, 40]);
     for o in &p {
-        assert!(within(o[0], 5.0) && within(o[1], 5.0), "{p:?}");
-    }
-    let p = orders(Scheme::Radau5, &[20, 40, 80, 160]);
-    for o in &p {
-        assert!(within(o[2], 3.0), "{p:?}");
+        assert!(
+            within(o[0], 5.0) && within(o[1], 5.0) && within(o[2], 5.0),
+            "{p:?}"
+        );
     }
 }
 
-/// Adaptive runs on the pendulum: q and qd at t = 1 within a few rtol, λ at its attainable
-/// accuracy (order s, weighted by h in the error test as RADAU5 weights index-2 components):
-/// within √rtol (Radau3's at rtol 1e-8 is 1.2e-5).
+/// Adaptive runs on the pendulum: q, qd and λ at t = 1 within a few rtol (λ from the index-1
+/// equations at the step's (q, qd); the last stage's Λ, of order s, was only within √rtol:
+/// Radau3's at rtol 1e-8 was 1.2e-5).
 #[test]
 fn adaptive_runs_reach_the_pendulum_reference() {
     let (rq, rv, rl) = pendulum_reference();
@@ -155,8 +155,7 @@ fn adaptive_runs_reach_the_pendulum_reference() {
                 e[2],
                 st.steps
             );
-            assert!(e[0] < 3.0 * rtol && e[1] < 3.0 * rtol, "{e:?}");
-            assert!(e[2] < rtol.sqrt(), "{e:?}");
+            assert!(e.iter().all(|&x| x < 3.0 * rtol), "{e:?}");
             // projection (the default) for comparison
             let o = with_method(Options::adaptive(1.0, rtol), ConstraintMethod::Projection);
             let (tr, st) = run(Pendulum3::default(), scheme, o);
@@ -280,10 +279,11 @@ fn work_counters_of_an_index2_run() {
     println!("{got:?}");
     // steps, rejected by the error test, by Newton, M, τ, constraint evaluations (B and Φ at
     // every stage of every iteration, Φ_t, B and Φ_t of the new state, the drift check, and
-    // n + 1 evaluations of B and Φ_t for ∂(B qd + Φ_t)/∂q with each new Jacobian),
-    // factorisations (a complex and a real block at every new h), solves, Newton iterations
-    // (4.9 per attempt, with the 2 rejected ones)
-    assert_eq!(got, [16, 0, 2, 16, 347, 981, 40, 198, 89]);
+    // n + 1 evaluations of B and Φ_t for ∂(B qd + Φ_t)/∂q with each new Jacobian, B and γ
+    // for the state's qdd and λ), factorisations (a complex and a real block at every new h;
+    // M and the bordered system for the state's qdd and λ at every step), solves, Newton
+    // iterations (4.9 per attempt, with the 2 rejected ones)
+    assert_eq!(got, [16, 0, 2, 16, 347, 1013, 72, 230, 89]);
     assert_eq!(s.error_test, mbs::ErrorTest::PositionsVelocities);
 }
 

@@ -37,7 +37,12 @@ impl Radau {
                 y += self.k.db[j] * self.acc[j * n + r];
             }
             self.rq[r] = h * h * x;
-            self.rv[r] = h * (g0 * cur.qdd[r] + y);
+            let qdd0 = if self.own_valid {
+                self.own_end[r]
+            } else {
+                cur.qdd[r]
+            };
+            self.rv[r] = h * (g0 * qdd0 + y);
         }
     }
 
@@ -180,7 +185,12 @@ impl Radau {
     /// evaluation fails or is not finite.
     pub(super) fn residual_at<M: Model>(&mut self, p: &mut Problem<M>, cur: &State) -> bool {
         let (n, nc) = (self.n, self.nc);
-        if p.residual(cur.t, &self.qx, &self.vx, &cur.qdd, &mut self.ax)
+        let qdd0: &[f64] = if self.own_valid {
+            &self.own_end[..n]
+        } else {
+            &cur.qdd
+        };
+        if p.residual(cur.t, &self.qx, &self.vx, qdd0, &mut self.ax)
             .is_err()
         {
             return false;

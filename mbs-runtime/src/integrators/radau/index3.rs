@@ -60,6 +60,7 @@ impl Radau {
             self.kbt = z(n * nc);
             self.bbt = z(nc * nc);
             self.zm = z(nc * n);
+            self.own_end = z(n + nc);
             self.zbt = z(nc * nc);
             self.qp = z(n);
             self.rate0 = z(nc);

@@ -227,16 +227,21 @@
 //! g(e_v + B₀ᵀe_μ), where r_q has the embedded formula's μ part h Σ (b̂ − b)_j B₀ᵀM_j. q and qd
 //! are both differential components, so the norm runs over (e_q, e_v) unscaled; λ, index 2, is
 //! in it weighted by h (RADAU5's scaling); μ (zero on the exact solution) is left out. The
-//! error test is `ErrorTest::PositionsVelocities`. λ is reported at its attainable accuracy,
-//! of order s: on the pendulum at rtol 1e-8, 1.2e-8 (Radau3) and 1.0e-7 (Radau5), where q and
-//! qd are within 4.8e-11 and 3.0e-11 (Radau3), 9.6e-11 and 4.2e-11 (Radau5).
+//! error test is `ErrorTest::PositionsVelocities`. The estimate's f(y₀) takes the scheme's own
+//! end values (the last stage's A_s and Λ_s); the state an accepted step hands on has qdd and λ
+//! from the index-1 equations at its (q, qd) instead (`consistent_end`: one evaluation of M and
+//! h and one bordered solve per step). The stage Λ_s is of order s only, and the interpolant
+//! between outputs, which uses qdd at both ends, carried its error into the velocities between
+//! steps: on Cash's pendulum at rtol 1e-8, 2e-9 between steps against 4e-11 at them (Radau5),
+//! now 3e-10. λ so has the order of q and qd, 2s − 1, at fixed steps, and on the pendulum at
+//! rtol 1e-8 q, qd and λ are within 4.8e-11, 3.0e-11, 4.3e-11 (Radau3) and 9.6e-11, 4.2e-11,
+//! 8.9e-11 (Radau5), where the stage Λ_s was within 1.2e-8 and 1.0e-7.
 //!
 //! Against projection (the default for Radau, `ConstraintMethod::Auto`): at equal rtol, index 2
 //! gives about the same mixed error over (q, qd) with Radau3 (within 0.3 digits on the
 //! slider-crank and the four-bar, 0.6 better at rtol 1e-4 on the four-bar) and with Radau5
-//! from 1.3 digits better (rtol 1e-4 on Cash's pendulum) to 1.3 short (rtol 1e-10 on Cash's
-//! pendulum: its velocities trail its positions by about 2 digits there in adaptive runs,
-//! though both converge with order 5 at fixed steps), with more steps (pendulum, Radau5, rtol
+//! from 0.4 digits short (fastlink at rtol 1e-10) to 1.9 better (the four-bar at rtol 1e-10)
+//! in `tests/tolerance_proportionality.rs`, with more steps (pendulum, Radau5, rtol
 //! 1e-6: 16 against 13) and more work per step ((n + 2nc)-square blocks, the constraints at
 //! every stage), and λ of order s where projection gives λ of the index-1 form at the accuracy
 //! of q and qd. Not better at equal work (the four-bar at 3.7 digits: 2.0 ms against 1.2 ms
@@ -495,6 +500,10 @@ pub(crate) struct Radau {
     /// frozen with the other matrices
     zm: Vec<f64>,
     zbt: Vec<f64>,
+    /// index 2: the scheme's own qdd and λ at the end of the last accepted step (its last
+    /// stage), which the error estimate's f(y₀) needs; the state holds the index-1 ones
+    own_end: Vec<f64>,
+    own_valid: bool,
     /// index 2: scratch of Z's differences (q perturbed, Φ̇ at q₀)
     qp: Vec<f64>,
     rate0: Vec<f64>,
@@ -571,6 +580,8 @@ impl Radau {
             bbt: Vec::new(),
             zm: Vec::new(),
             zbt: Vec::new(),
+            own_end: Vec::new(),
+            own_valid: false,
             qp: Vec::new(),
             rate0: Vec::new(),
             psix: Vec::new(),
@@ -615,6 +626,7 @@ impl<M: Model> Stepper<M> for Radau {
         self.jac_valid = false;
         self.need_jac = true;
         self.h_prev = 0.0;
+        self.own_valid = false;
         self.first = true;
         self.reject = false;
         self.control.restart();
@@ -636,6 +648,7 @@ impl<M: Model> Stepper<M> for Radau {
         self.jac_valid = false;
         self.need_jac = true;
         self.h_prev = 0.0;
+        self.own_valid = false;
         Ok(())
     }
 
@@ -748,6 +761,7 @@ impl<M: Model> Stepper<M> for Radau {
         next.lambda[..nc].copy_from_slice(&self.lam[(s - 1) * nc..]);
         let keep_matrices = ctl.newton.reuse && self.theta <= THET;
         if !tol.adaptive {
+            self.consistent_end(p, cur.t + h, next)?;
             self.first = false;
             self.jac_fresh = false;
             self.need_jac = !keep_matrices;
@@ -777,6 +791,7 @@ impl<M: Model> Stepper<M> for Radau {
             if keep_matrices && (QUOT1..=QUOT2).contains(&(h_new / h)) {
                 h_new = h;
             }
+            self.consistent_end(p, cur.t + h, next)?;
             self.jac_fresh = false;
             self.need_jac = !keep_matrices;
             Ok(Attempt::Accepted { h_next: h_new })
@@ -792,5 +807,12 @@ impl<M: Model> Stepper<M> for Radau {
         std::mem::swap(&mut self.acc, &mut self.acc_prev);
         std::mem::swap(&mut self.lam, &mut self.lam_prev);
         self.h_prev = self.h_try;
+        if self.index2 {
+            // the accepted step's last stage: the scheme's own end values
+            let (s, n, nc) = (self.k.s, self.n, self.nc);
+            self.own_end[..n].copy_from_slice(&self.acc_prev[(s - 1) * n..]);
+            self.own_end[n..].copy_from_slice(&self.lam_prev[(s - 1) * nc..]);
+            self.own_valid = true;
+        }
     }
 }

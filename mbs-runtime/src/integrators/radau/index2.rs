@@ -17,16 +17,16 @@ impl Radau {
         let (n, nc) = (self.n, self.nc);
         for k in 0..nc {
             for i in 0..n {
-                self.kbt[i + n * k] = (0..n)
+                self.i2.kbt[i + n * k] = (0..n)
                     .map(|j| self.km[i + n * j] * self.bm[k + nc * j])
                     .sum();
             }
             for l in 0..nc {
-                self.bbt[k + nc * l] = (0..n)
+                self.i2.bbt[k + nc * l] = (0..n)
                     .map(|j| self.bm[k + nc * j] * self.bm[l + nc * j])
                     .sum();
-                self.zbt[k + nc * l] = (0..n)
-                    .map(|j| self.zm[k + nc * j] * self.bm[l + nc * j])
+                self.i2.zbt[k + nc * l] = (0..n)
+                    .map(|j| self.i2.z[k + nc * j] * self.bm[l + nc * j])
                     .sum();
             }
         }
@@ -40,7 +40,7 @@ impl Radau {
     pub(super) fn rate_jacobian<M: Model>(&mut self, p: &mut Problem<M>, cur: &State) {
         let (n, nc) = (self.n, self.nc);
         if p.iteration == IterationMatrix::MassOnly {
-            self.zm.fill(0.0);
+            self.i2.z.fill(0.0);
             return;
         }
         let Some(c) = p.loops.closed_mut() else {
@@ -62,7 +62,7 @@ impl Radau {
             p.model.constraint_rate(cur.t, &self.qp, &mut self.phit);
             p.stats.constraints += 1;
             for k in 0..nc {
-                self.zm[k + nc * j] = (rate(&c.b, &self.phit, k) - self.rate0[k]) / d;
+                self.i2.z[k + nc * j] = (rate(&c.b, &self.phit, k) - self.rate0[k]) / d;
             }
             self.qp[j] = cur.q[j];
         }
@@ -241,27 +241,29 @@ impl Radau {
     }
 }
 
-/// The frozen matrices that border an index-2 block: B (nc × n), K̃Bᵀ (n × nc), BBᵀ, Z and
-/// ZBᵀ (Z = ∂(B v + Φ_t)/∂q, nc × n).
-pub(super) struct Border<'a> {
-    pub b: &'a [f64],
-    pub kbt: &'a [f64],
-    pub bbt: &'a [f64],
-    pub z: &'a [f64],
-    pub zbt: &'a [f64],
+/// The frozen matrices that border an index-2 block besides B: K̃Bᵀ (n × nc), BBᵀ,
+/// Z = ∂(B v + Φ_t)/∂q at the start of the step (nc × n) and ZBᵀ (nc × nc).
+#[derive(Default)]
+pub(super) struct Blocks {
+    pub kbt: Vec<f64>,
+    pub bbt: Vec<f64>,
+    pub z: Vec<f64>,
+    pub zbt: Vec<f64>,
 }
 
 /// Borders the n × n block of the (n + 2nc) × (n + 2nc) column-major matrix `a` for the
 /// stabilized index-2 form: columns of Λ (−Bᵀ), of μ (g2·K̃Bᵀ over BBᵀ), rows of Φ (B, 0,
 /// BBᵀ) and of Φ̇ (B + g1·Z, 0, g1·ZBᵀ); `g1` = hμ and `g2` = h²μ² of the block.
-pub(super) fn border2<T: Field>(a: &mut [T], m: &Border<'_>, g1: T, g2: T, n: usize, nc: usize) {
-    let Border {
-        b,
-        kbt,
-        bbt,
-        z,
-        zbt,
-    } = *m;
+pub(super) fn border2<T: Field>(
+    a: &mut [T],
+    b: &[f64],
+    m: &Blocks,
+    g1: T,
+    g2: T,
+    n: usize,
+    nc: usize,
+) {
+    let Blocks { kbt, bbt, z, zbt } = m;
     let big = n + 2 * nc;
     for j in n..big {
         for i in 0..big {

@@ -57,11 +57,11 @@ impl Radau {
             self.bmu = z(s * n);
             self.psis = z(s * nc);
             self.phit = z(nc);
-            self.kbt = z(n * nc);
-            self.bbt = z(nc * nc);
-            self.zm = z(nc * n);
+            self.i2.kbt = z(n * nc);
+            self.i2.bbt = z(nc * nc);
+            self.i2.z = z(nc * n);
             self.own_end = z(n + nc);
-            self.zbt = z(nc * nc);
+            self.i2.zbt = z(nc * nc);
             self.qp = z(n);
             self.rate0 = z(nc);
             self.psix = z(nc);
@@ -92,7 +92,7 @@ impl Radau {
         Failure::non_finite("B = ∂Φ/∂q", &self.bm, |i| p.label((i / nc).min(n - 1)))?;
         if self.index2 {
             self.rate_jacobian(p, cur);
-            Failure::non_finite("∂(B qd + Φ_t)/∂q", &self.zm, |i| {
+            Failure::non_finite("∂(B qd + Φ_t)/∂q", &self.i2.z, |i| {
                 p.label((i / nc).min(n - 1))
             })?;
             self.index2_matrices();

@@ -494,12 +494,8 @@ pub(crate) struct Radau {
     psis: Vec<f64>,
     psi_max: f64,
     phit: Vec<f64>,
-    kbt: Vec<f64>,
-    bbt: Vec<f64>,
-    /// index 2: Z = ∂(B v + Φ_t)/∂q at the start of the step (nc × n), and Z B₀ᵀ (nc × nc),
-    /// frozen with the other matrices
-    zm: Vec<f64>,
-    zbt: Vec<f64>,
+    /// index 2: the frozen blocks that border the iteration matrix
+    i2: index2::Blocks,
     /// index 2: the scheme's own qdd and λ at the end of the last accepted step (its last
     /// stage), which the error estimate's f(y₀) needs; the state holds the index-1 ones
     own_end: Vec<f64>,
@@ -576,10 +572,7 @@ impl Radau {
             psis: Vec::new(),
             psi_max: 0.0,
             phit: Vec::new(),
-            kbt: Vec::new(),
-            bbt: Vec::new(),
-            zm: Vec::new(),
-            zbt: Vec::new(),
+            i2: index2::Blocks::default(),
             own_end: Vec::new(),
             own_valid: false,
             qp: Vec::new(),

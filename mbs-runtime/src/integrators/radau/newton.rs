@@ -3,7 +3,7 @@
 
 use super::super::State;
 use super::super::problem::Problem;
-use super::index2::{Border, border2};
+use super::index2::border2;
 use super::index3::border;
 use super::tableau::re;
 use super::{
@@ -41,14 +41,7 @@ impl Radau {
                 }
             }
             if self.index2 {
-                let m = Border {
-                    b: &self.bm,
-                    kbt: &self.kbt,
-                    bbt: &self.bbt,
-                    z: &self.zm,
-                    zbt: &self.zbt,
-                };
-                border2(a, &m, g1, g2, n, nc);
+                border2(a, &self.bm, &self.i2, g1, g2, n, nc);
             } else {
                 border(a, &self.bm, n, nc);
             }
@@ -69,14 +62,7 @@ impl Radau {
                 }
             }
             if self.index2 {
-                let m = Border {
-                    b: &self.bm,
-                    kbt: &self.kbt,
-                    bbt: &self.bbt,
-                    z: &self.zm,
-                    zbt: &self.zbt,
-                };
-                border2(a, &m, g, g * g, n, nc);
+                border2(a, &self.bm, &self.i2, g, g * g, n, nc);
             } else {
                 border(a, &self.bm, n, nc);
             }

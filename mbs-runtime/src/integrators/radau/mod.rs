@@ -188,9 +188,11 @@
 //! the index 2; Bᵀ needs no solve with M in the stage positions, and frozen it makes the
 //! linearisation in μ exact. It is a DAE of index 2 in Hessenberg form with (q, qd)
 //! differential and (λ, μ) algebraic, on which Radau IIA converges with order 2s − 1 in q and
-//! qd and order s in λ (Hairer, Lubich & Roche 1989; Hairer & Wanner §VII.4): Radau3 3, 3, 2,
-//! Radau5 5, 5, 3, as measured with fixed steps on the pendulum (`tests/radau_index2.rs`).
-//! The stage unknowns are (A_i, Λ_i, M_i), with
+//! qd and order s in the stage λ (Hairer, Lubich & Roche 1989; Hairer & Wanner §VII.4); the
+//! state's λ, taken from the index-1 equations at (q, qd) (below), has the order of q and qd:
+//! Radau3 3, 3, 3, Radau5 5, 5, 5, as measured with fixed steps on the pendulum
+//! (`tests/radau_index2.rs`; the stage λ gave 2 and 3). The stage unknowns are (A_i, Λ_i,
+//! M_i), with
 //!
 //! ```text
 //! Q_i = q₀ + h c_i qd₀ + h² Σ_j (A²)_ij A_j + h Σ_j a_ij B₀ᵀM_j,   V_i as above,
@@ -243,9 +245,9 @@
 //! from 0.4 digits short (fastlink at rtol 1e-10) to 1.9 better (the four-bar at rtol 1e-10)
 //! in `tests/tolerance_proportionality.rs`, with more steps (pendulum, Radau5, rtol
 //! 1e-6: 16 against 13) and more work per step ((n + 2nc)-square blocks, the constraints at
-//! every stage), and λ of order s where projection gives λ of the index-1 form at the accuracy
-//! of q and qd. Not better at equal work (the four-bar at 3.7 digits: 2.0 ms against 1.2 ms
-//! with projection at 3.9), it is not the default.
+//! every stage, the index-1 qdd and λ of the new state). Not better at equal work (the
+//! four-bar at 3.7 digits: 2.0 ms against 1.2 ms with projection at 3.9), it is not the
+//! default.
 //!
 //! ## What rtol means
 //! The mixed error over (q, qd) (Test Set for IVP Solvers, floor 0.01, largest over 10 sampled

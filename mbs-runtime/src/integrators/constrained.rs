@@ -82,6 +82,10 @@ pub(crate) struct Constrained {
     best: Vec<usize>,
     pub qc: Vec<f64>,
     pub vc: Vec<f64>,
+    /// scratch of `rate_jacobian`: q perturbed, B v + Φ_t at q, Φ_t at q perturbed
+    qp: Vec<f64>,
+    rate0: Vec<f64>,
+    phi_tp: Vec<f64>,
 }
 
 impl Constrained {
@@ -116,6 +120,9 @@ impl Constrained {
             best: Vec::with_capacity(nc),
             qc: z(n),
             vc: z(n),
+            qp: z(n),
+            rate0: z(nc),
+            phi_tp: z(nc),
         }
     }
 
@@ -130,6 +137,45 @@ impl Constrained {
     pub fn eval_phi<M: Model>(&mut self, m: &M, st: &mut Stats, t: f64, q: &[f64]) {
         m.constraints(t, q, &mut self.phi);
         st.constraints += 1;
+    }
+
+    /// Z = ∂(B v + Φ_t)/∂q at (t, q, v) (nc × n, column-major) into `z`, by forward
+    /// differences: n + 1 evaluations of Φ_t and n of B. `b` is B(q), which `self.b` holds
+    /// again afterwards. The Φ̇ rows of the stabilized index-2 iteration matrices need it
+    /// (the Newmark family's and Radau's).
+    #[allow(clippy::too_many_arguments)]
+    pub fn rate_jacobian<M: Model>(
+        &mut self,
+        m: &M,
+        st: &mut Stats,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        b: &[f64],
+        z: &mut [f64],
+    ) {
+        let (n, nc) = (self.n, self.nc);
+        let rate = |b: &[f64], phi_t: &[f64], k: usize| {
+            phi_t[k] + (0..n).map(|j| b[k + nc * j] * v[j]).sum::<f64>()
+        };
+        m.constraint_rate(t, q, &mut self.phi_tp);
+        st.constraints += 1;
+        for k in 0..nc {
+            self.rate0[k] = rate(b, &self.phi_tp, k);
+        }
+        self.qp.copy_from_slice(q);
+        for j in 0..n {
+            let d = f64::EPSILON.sqrt() * q[j].abs().max(1.0);
+            self.qp[j] = q[j] + d;
+            m.constraint_jacobian(t, &self.qp, &mut self.b);
+            m.constraint_rate(t, &self.qp, &mut self.phi_tp);
+            st.constraints += 2;
+            for k in 0..nc {
+                z[k + nc * j] = (rate(&self.b, &self.phi_tp, k) - self.rate0[k]) / d;
+            }
+            self.qp[j] = q[j];
+        }
+        self.b.copy_from_slice(b);
     }
 
     pub fn eval_b<M: Model>(&mut self, m: &M, st: &mut Stats, t: f64, q: &[f64]) {

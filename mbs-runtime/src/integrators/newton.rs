@@ -99,11 +99,9 @@ pub(crate) struct AccelNewton {
     nu: Vec<f64>,
     b0: Vec<f64>,
     phi_t: Vec<f64>,
-    /// index 2: B at the matrix's q, Z = ∂(B v + Φ_t)/∂q there (nc × n), and work vectors
+    /// index 2: B at the matrix's q and Z = ∂(B v + Φ_t)/∂q there (nc × n)
     bq: Vec<f64>,
     z: Vec<f64>,
-    qp: Vec<f64>,
-    rate0: Vec<f64>,
     mm: Vec<f64>,
     kc: Vec<f64>,
     valid: bool,
@@ -133,8 +131,6 @@ impl AccelNewton {
             phi_t: Vec::new(),
             bq: Vec::new(),
             z: Vec::new(),
-            qp: Vec::new(),
-            rate0: Vec::new(),
             mm: Vec::new(),
             kc: Vec::new(),
             valid: false,
@@ -185,7 +181,7 @@ impl AccelNewton {
         (self.mm, self.kc) = (z(n * n), z(n * n));
         if index2 {
             (self.nu, self.b0, self.phi_t) = (z(nc), z(nc * n), z(nc));
-            (self.bq, self.z, self.qp, self.rate0) = (z(nc * n), z(nc * n), z(n), z(nc));
+            (self.bq, self.z) = (z(nc * n), z(nc * n));
         }
         self.valid = false;
     }
@@ -492,33 +488,19 @@ impl AccelNewton {
         Failure::non_finite("iteration matrix", m, |i| p.label((i % big).min(n - 1)))
     }
 
-    /// Index 2: Z = ∂(B v + Φ_t)/∂q at the current (q, v) by forward differences, with B(q)
-    /// in `self.bq`; leaves B(q) in the constraints' buffer.
+    /// Index 2: Z = ∂(B v + Φ_t)/∂q at the current (q, v), with B(q) in `self.bq`.
     fn rate_jacobian<M: Model>(&mut self, p: &mut Problem<M>, t: f64) {
-        let (n, nc) = (self.n, self.nc);
-        let Some(c) = p.loops.closed_mut() else {
-            return;
-        };
-        p.model.constraint_rate(t, &self.q, &mut self.phi_t);
-        p.stats.constraints += 1;
-        for k in 0..nc {
-            self.rate0[k] =
-                self.phi_t[k] + (0..n).map(|j| self.bq[k + nc * j] * self.v[j]).sum::<f64>();
+        if let Some(c) = p.loops.closed_mut() {
+            c.rate_jacobian(
+                &p.model,
+                &mut p.stats,
+                t,
+                &self.q,
+                &self.v,
+                &self.bq,
+                &mut self.z,
+            );
         }
-        self.qp.copy_from_slice(&self.q);
-        for j in 0..n {
-            let d = f64::EPSILON.sqrt() * self.q[j].abs().max(1.0);
-            self.qp[j] = self.q[j] + d;
-            c.eval_b(&p.model, &mut p.stats, t, &self.qp);
-            p.model.constraint_rate(t, &self.qp, &mut self.phi_t);
-            p.stats.constraints += 1;
-            for k in 0..nc {
-                let rate = self.phi_t[k] + (0..n).map(|i| c.b[k + nc * i] * self.v[i]).sum::<f64>();
-                self.z[k + nc * j] = (rate - self.rate0[k]) / d;
-            }
-            self.qp[j] = self.q[j];
-        }
-        c.b.copy_from_slice(&self.bq);
     }
 
     /// The index-3 iteration matrix (N × N, N = n + nc, column-major) at (t, q̂ + β'a,

@@ -30,6 +30,7 @@ impl Radau {
     /// (r_q, r_v): r_q = h² Σ d̂_q,j a_j, r_v = h (γ₀ qdd₀ + Σ d̂_b,j a_j).
     pub(super) fn embedded_difference(&mut self, cur: &State, h: f64) {
         let (s, n, g0) = (self.k.s, self.n, self.k.gamma0);
+        let own = self.own_end_valid();
         for r in 0..n {
             let (mut x, mut y) = (0.0, 0.0);
             for j in 0..s {
@@ -37,11 +38,7 @@ impl Radau {
                 y += self.k.db[j] * self.acc[j * n + r];
             }
             self.rq[r] = h * h * x;
-            let qdd0 = if self.own_valid {
-                self.own_end[r]
-            } else {
-                cur.qdd[r]
-            };
+            let qdd0 = if own { self.own_end[r] } else { cur.qdd[r] };
             self.rv[r] = h * (g0 * qdd0 + y);
         }
     }
@@ -185,7 +182,7 @@ impl Radau {
     /// evaluation fails or is not finite.
     pub(super) fn residual_at<M: Model>(&mut self, p: &mut Problem<M>, cur: &State) -> bool {
         let (n, nc) = (self.n, self.nc);
-        let qdd0: &[f64] = if self.own_valid {
+        let qdd0: &[f64] = if self.own_end_valid() {
             &self.own_end[..n]
         } else {
             &cur.qdd

@@ -11,6 +11,12 @@ use crate::model::Model;
 use crate::options::IterationMatrix;
 
 impl Radau {
+    /// Index 2: whether `own_end` holds the last accepted step's own end values (none since a
+    /// start or a re-centring).
+    pub(super) fn own_end_valid(&self) -> bool {
+        self.index2 && self.h_prev > 0.0
+    }
+
     /// Index 2: K̃Bᵀ (n × nc), BBᵀ and ZBᵀ (nc × nc) of the frozen K̃ = K_t − ∂(Bᵀλ)/∂q, B and
     /// Z = ∂(B v + Φ_t)/∂q, the blocks of μ in the iteration matrix.
     pub(super) fn index2_matrices(&mut self) {
@@ -32,42 +38,25 @@ impl Radau {
         }
     }
 
-    /// Index 2: Z = ∂(B v + Φ_t)/∂q at the start of the step (q₀, qd₀) by forward
-    /// differences, n evaluations of B and Φ_t (zero with `MassOnly`). The Φ̇ rows of the
-    /// iteration matrix need it: the stage positions move with the accelerations as h²μ²
-    /// against hμ for the velocities, so leaving it out costs Newton a contraction of about
-    /// h·‖Z‖/‖B‖ per iteration, which limited the steps of fast loops.
+    /// Index 2: Z = ∂(B v + Φ_t)/∂q at the start of the step (q₀, qd₀), B(q₀) in `bm` (zero
+    /// with `MassOnly`). The Φ̇ rows of the iteration matrix need it: the stage positions move
+    /// with the accelerations as h²μ² against hμ for the velocities, so leaving it out costs
+    /// Newton a contraction of about h·‖Z‖/‖B‖ per iteration, which limited the steps of fast
+    /// loops.
     pub(super) fn rate_jacobian<M: Model>(&mut self, p: &mut Problem<M>, cur: &State) {
-        let (n, nc) = (self.n, self.nc);
         if p.iteration == IterationMatrix::MassOnly {
             self.i2.z.fill(0.0);
-            return;
+        } else if let Some(c) = p.loops.closed_mut() {
+            c.rate_jacobian(
+                &p.model,
+                &mut p.stats,
+                cur.t,
+                &cur.q,
+                &cur.qd,
+                &self.bm,
+                &mut self.i2.z,
+            );
         }
-        let Some(c) = p.loops.closed_mut() else {
-            return;
-        };
-        let rate = |b: &[f64], phit: &[f64], k: usize| {
-            phit[k] + (0..n).map(|j| b[k + nc * j] * cur.qd[j]).sum::<f64>()
-        };
-        p.model.constraint_rate(cur.t, &cur.q, &mut self.phit);
-        p.stats.constraints += 1;
-        for k in 0..nc {
-            self.rate0[k] = rate(&self.bm, &self.phit, k);
-        }
-        self.qp.copy_from_slice(&cur.q);
-        for j in 0..n {
-            let d = f64::EPSILON.sqrt() * cur.q[j].abs().max(1.0);
-            self.qp[j] = cur.q[j] + d;
-            c.eval_b(&p.model, &mut p.stats, cur.t, &self.qp);
-            p.model.constraint_rate(cur.t, &self.qp, &mut self.phit);
-            p.stats.constraints += 1;
-            for k in 0..nc {
-                self.i2.z[k + nc * j] = (rate(&c.b, &self.phit, k) - self.rate0[k]) / d;
-            }
-            self.qp[j] = cur.q[j];
-        }
-        // B(q₀) back in the constraints' buffer
-        c.eval_b(&p.model, &mut p.stats, cur.t, &cur.q);
     }
 
     /// Index 2: the stage position corrections B₀ᵀM_j of the current stage multipliers μ
@@ -212,7 +201,7 @@ impl Radau {
                 self.vx[r] = cur.qd[r] + self.err[n + r];
             }
             for k in 0..nc {
-                let lambda0 = if self.own_valid {
+                let lambda0 = if self.own_end_valid() {
                     self.own_end[n + k]
                 } else {
                     cur.lambda[k]

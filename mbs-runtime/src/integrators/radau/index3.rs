@@ -62,8 +62,6 @@ impl Radau {
             self.i2.z = z(nc * n);
             self.own_end = z(n + nc);
             self.i2.zbt = z(nc * nc);
-            self.qp = z(n);
-            self.rate0 = z(nc);
             self.psix = z(nc);
         }
     }

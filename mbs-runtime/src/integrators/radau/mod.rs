@@ -501,10 +501,6 @@ pub(crate) struct Radau {
     /// index 2: the scheme's own qdd and λ at the end of the last accepted step (its last
     /// stage), which the error estimate's f(y₀) needs; the state holds the index-1 ones
     own_end: Vec<f64>,
-    own_valid: bool,
-    /// index 2: scratch of Z's differences (q perturbed, Φ̇ at q₀)
-    qp: Vec<f64>,
-    rate0: Vec<f64>,
     psix: Vec<f64>,
 }
 
@@ -576,9 +572,6 @@ impl Radau {
             phit: Vec::new(),
             i2: index2::Blocks::default(),
             own_end: Vec::new(),
-            own_valid: false,
-            qp: Vec::new(),
-            rate0: Vec::new(),
             psix: Vec::new(),
         }
     }
@@ -621,7 +614,6 @@ impl<M: Model> Stepper<M> for Radau {
         self.jac_valid = false;
         self.need_jac = true;
         self.h_prev = 0.0;
-        self.own_valid = false;
         self.first = true;
         self.reject = false;
         self.control.restart();
@@ -643,7 +635,6 @@ impl<M: Model> Stepper<M> for Radau {
         self.jac_valid = false;
         self.need_jac = true;
         self.h_prev = 0.0;
-        self.own_valid = false;
         Ok(())
     }
 
@@ -807,7 +798,6 @@ impl<M: Model> Stepper<M> for Radau {
             let (s, n, nc) = (self.k.s, self.n, self.nc);
             self.own_end[..n].copy_from_slice(&self.acc_prev[(s - 1) * n..]);
             self.own_end[n..].copy_from_slice(&self.lam_prev[(s - 1) * nc..]);
-            self.own_valid = true;
         }
     }
 }

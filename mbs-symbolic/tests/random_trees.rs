@@ -8,7 +8,7 @@ mod common;
 use common::*;
 use mbs_symbolic::SymbolicModel;
 use mbs_symbolic::expr::ExprId;
-use mbs_symbolic::mech::forward::{articulated, ltdl};
+use mbs_symbolic::mech::forward::{Elimination, articulated, ltdl};
 use mbs_symbolic::mech::tree::canonical;
 
 const TREES: u64 = 100;
@@ -220,9 +220,13 @@ impl Checks {
             let mb = model.scenes[0].chosen();
             (mb.m.clone(), mb.h.clone())
         };
-        let aba = articulated(&mut model.sys, &model.tree, &h_sym);
+        // articulated bodies in both places of elimination
+        let aba: Vec<_> = [Elimination::ParentAxes, Elimination::ChildAxes]
+            .into_iter()
+            .filter_map(|e| articulated(&mut model.sys, &model.tree, &h_sym, e))
+            .collect();
         let sparse = ltdl(&mut model.sys.arena, &m_sym, &h_sym);
-        self.articulated += aba.is_some() as usize;
+        self.articulated += !aba.is_empty() as usize;
         let mut forward = Vec::new();
         for f in aba.iter().chain([&sparse]) {
             forward.extend(f.roots());
@@ -260,7 +264,7 @@ impl Checks {
             let static_h = take(n);
             let energy = take(2);
             let pos = take(3 * bodies.len());
-            let aba_v = aba.as_ref().map(|_| (take(n), take(n)));
+            let aba_v: Vec<_> = aba.iter().map(|_| (take(n), take(n))).collect();
             let ltdl_v = (take(n), take(n));
             let at = || format!("seed {seed}, state {s}, {n} dof");
             let m_ref = oracle.crba(&q, t);
@@ -307,9 +311,8 @@ impl Checks {
             let qdd_ref = solve_spd(&m_ref, &h_ref);
             let l = cholesky(&m_ref).expect("M positive definite");
             let log_det: f64 = (0..n).map(|i| 2.0 * l[i][i].ln()).sum();
-            let forms = [(aba_v.as_ref(), 0), (Some(&ltdl_v), 1)];
-            for (v, form) in forms {
-                let Some((qdd_f, pivots)) = v else { continue };
+            let forms = aba_v.iter().map(|v| (v, 0)).chain([(&ltdl_v, 1)]);
+            for ((qdd_f, pivots), form) in forms {
                 let w = if form == 0 {
                     &mut self.fwd_aba
                 } else {

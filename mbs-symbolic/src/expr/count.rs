@@ -36,3 +36,54 @@ pub fn ops_of_nodes(arena: &Arena, nodes: &[ExprId]) -> OpCount {
     }
     c
 }
+
+/// Latency of the longest chain of dependent operations from the inputs to any of `roots`,
+/// in cycles of a typical out-of-order core (add 3, multiply 4, divide 13, square root 15,
+/// other functions 40): what bounds straight-line code whose work is a recursion, as the
+/// articulated-body algorithm's, rather than its operation count.
+pub fn critical_path(arena: &Arena, roots: &[ExprId]) -> u32 {
+    let nodes = arena.reachable(roots);
+    let Some(top) = nodes.last() else {
+        return 0;
+    };
+    // children come before their parents in the arena, and `reachable` is sorted
+    let mut depth = vec![0u32; top.index() + 1];
+    for &n in &nodes {
+        let node = arena.node(n);
+        let own = match node {
+            Node::Num(_) | Node::Var(_) => 0,
+            Node::Add(..) | Node::Sub(..) | Node::Neg(..) => 3,
+            Node::Mul(..) => 4,
+            Node::Powi(_, k) => 4 * (k.unsigned_abs()).saturating_sub(1),
+            Node::Div(..) => 13,
+            Node::Func(super::Func::Sqrt, _) => 15,
+            _ => 40,
+        };
+        let (ch, k) = node.children();
+        let before = ch[..k].iter().map(|c| depth[c.index()]).max().unwrap_or(0);
+        depth[n.index()] = before + own;
+    }
+    roots.iter().map(|r| depth[r.index()]).max().unwrap_or(0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::expr::Var;
+
+    #[test]
+    fn the_critical_path_is_the_longest_chain_of_latencies() {
+        let mut a = crate::expr::Arena::new();
+        let (x, y, z) = (a.var(Var::Q(0)), a.var(Var::Q(1)), a.var(Var::Q(2)));
+        // (x·y + z) / x: multiply, add, divide in a row
+        let p = a.mul(x, y);
+        let s = a.add(p, z);
+        let d = a.div(s, x);
+        assert_eq!(critical_path(&a, &[d]), 4 + 3 + 13);
+        // a side branch shorter than the chain does not lengthen it, a root alone counts
+        let short = a.add(x, z);
+        assert_eq!(critical_path(&a, &[d, short]), 20);
+        assert_eq!(critical_path(&a, &[short]), 3);
+        assert_eq!(critical_path(&a, &[]), 0);
+    }
+}

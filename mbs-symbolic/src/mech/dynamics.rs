@@ -2,7 +2,7 @@
 //! (or the one the model forces), tangents when asked for, energies, power, static forces.
 
 use super::effects::Loads;
-use super::forward::{Forward, articulated, ltdl, ltdl_estimate};
+use super::forward::{Elimination, Forward, articulated, ltdl, ltdl_estimate};
 use super::recursive::{body_kinematics, crba, newton_euler, spinning_body_motion};
 use super::spin::spinning_frames;
 
@@ -247,10 +247,14 @@ fn build_virtual_power(sys: &System, tree: &Tree, world: &World) -> bool {
     total <= VP_PAIRS_LIMIT
 }
 
-/// The cheaper, by flops, of articulated bodies (when the tree allows it) and sparse LᵀDL,
-/// applied to `mb`'s h plus a generalised force given at run time (`Var::Force`, zero in the
-/// generated `forward_dynamics`, the efforts of `mbs::WithEfforts` in
-/// `forward_dynamics_forced`).
+/// The quickest of articulated bodies (when the tree allows it, with a rotation's coordinates
+/// eliminated in the parent's or the child's axes) and sparse LᵀDL, applied to `mb`'s h plus
+/// a generalised force given at run time (`Var::Force`, zero in the generated
+/// `forward_dynamics`, the efforts of `mbs::WithEfforts` in `forward_dynamics_forced`).
+///
+/// Quickest by [`time_estimate`]: the articulated-body recursion is a chain of dependent
+/// steps through a division per coordinate, so on a planar chain its latency, not its
+/// operation count, sets its time; on a spatial arm its operations do.
 fn forward_dynamics(sys: &mut System, tree: &Tree, mb: &MassBias) -> Forward {
     let a = &mut sys.arena;
     let h: Vec<ExprId> = (0..mb.h.len())
@@ -259,21 +263,35 @@ fn forward_dynamics(sys: &mut System, tree: &Tree, mb: &MassBias) -> Forward {
             a.add(mb.h[i], f)
         })
         .collect();
-    let Some(aba) = articulated(sys, tree, &h) else {
+    let Some(parent) = articulated(sys, tree, &h, Elimination::ParentAxes) else {
         return ltdl(&mut sys.arena, &mb.m, &h);
     };
-    let cost = |a: &Arena, f: &Forward| crate::expr::ops(a, &f.roots()).flops();
-    let aba_cost = cost(&sys.arena, &aba);
+    let child = articulated(sys, tree, &h, Elimination::ChildAxes).expect("the same tree");
+    let time = |a: &Arena, f: &Forward| time_estimate(a, &f.roots());
+    let aba = if time(&sys.arena, &child) < time(&sys.arena, &parent) {
+        child
+    } else {
+        parent
+    };
+    let aba_flops = crate::expr::ops(&sys.arena, &aba.roots()).flops();
     // two flops per multiply–subtract: far above, LᵀDL is not worth building (long chains)
-    if 2 * ltdl_estimate(&sys.arena, &mb.m) > 4 * aba_cost {
+    if 2 * ltdl_estimate(&sys.arena, &mb.m) > 4 * aba_flops {
         return aba;
     }
     let sparse = ltdl(&mut sys.arena, &mb.m, &h);
-    if aba_cost < cost(&sys.arena, &sparse) {
+    if time(&sys.arena, &aba) < time(&sys.arena, &sparse) {
         aba
     } else {
         sparse
     }
+}
+
+/// Cycles straight-line code of `roots` may take on a core that retires two floating-point
+/// operations per cycle: its operations' throughput or its critical path, whichever is
+/// longer (a rough model, enough to choose between forms of one computation).
+fn time_estimate(a: &Arena, roots: &[ExprId]) -> u32 {
+    let flops = crate::expr::ops(a, roots).flops() as u32;
+    (flops / 2).max(crate::expr::critical_path(a, roots))
 }
 
 /// Kinetic energy Σ ½ m v_G² + ½ ωᵀ Φ ω, and potential energy of gravity, springs, contacts

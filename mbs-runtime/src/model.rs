@@ -415,8 +415,9 @@ pub trait Model {
     /// qdd = M⁻¹ h at (t, q, qd, u) (NQ), with the pivot of every coordinate in the
     /// factorisation used (NQ): their product is det M, and a pivot that is not positive
     /// means M is singular there (qdd is then not finite). Generated models solve without a
-    /// dense factorisation, by articulated bodies or by sparse LᵀDL, whichever costs fewer
-    /// flops (the op-count row `forward_dynamics (…)` names it); the default evaluates M and h
+    /// dense factorisation, by articulated bodies or by sparse LᵀDL, whichever the generator
+    /// estimates quicker from its operations and its critical path (the op-count row
+    /// `forward_dynamics (…)` names it); the default evaluates M and h
     /// and factorises M by dense Cholesky, allocating (models written by hand).
     fn forward_dynamics(
         &self,

@@ -268,10 +268,11 @@ fn forward_dynamics(sys: &mut System, tree: &Tree, mb: &MassBias) -> Forward {
     };
     let child = articulated(sys, tree, &h, Elimination::ChildAxes).expect("the same tree");
     let time = |a: &Arena, f: &Forward| time_estimate(a, &f.roots());
-    let aba = if time(&sys.arena, &child) < time(&sys.arena, &parent) {
-        child
+    let (t_parent, t_child) = (time(&sys.arena, &parent), time(&sys.arena, &child));
+    let (aba, aba_time) = if t_child < t_parent {
+        (child, t_child)
     } else {
-        parent
+        (parent, t_parent)
     };
     let aba_flops = crate::expr::ops(&sys.arena, &aba.roots()).flops();
     // two flops per multiply–subtract: far above, LᵀDL is not worth building (long chains)
@@ -279,7 +280,7 @@ fn forward_dynamics(sys: &mut System, tree: &Tree, mb: &MassBias) -> Forward {
         return aba;
     }
     let sparse = ltdl(&mut sys.arena, &mb.m, &h);
-    if time(&sys.arena, &aba) < time(&sys.arena, &sparse) {
+    if aba_time < time(&sys.arena, &sparse) {
         aba
     } else {
         sparse

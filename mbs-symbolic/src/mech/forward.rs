@@ -245,24 +245,18 @@ impl Art {
     /// rotation or of translation), the row and column of that axis are zero, and so set,
     /// which the arena cannot see from the expressions (D − U D⁻¹ U).
     fn clear_along(&mut self, ar: &Arena, (w, v): Sv) {
-        let nonzero = |x: &V3| {
-            let mut it = (0..3).filter(|&i| !ar.is_num(x[i], 0.0));
-            match (it.next(), it.next()) {
-                (Some(i), None) => Some(Some(i)),
-                (None, _) => Some(None),
-                _ => None,
-            }
-        };
+        let nonzero =
+            |x: &V3| -> Vec<usize> { (0..3).filter(|&i| !ar.is_num(x[i], 0.0)).collect() };
         let z = ar.zero();
-        match (nonzero(&w), nonzero(&v)) {
-            (Some(Some(i)), Some(None)) => {
+        match (nonzero(&w).as_slice(), nonzero(&v).as_slice()) {
+            (&[i], []) => {
                 for j in 0..3 {
                     self.a[i][j] = z;
                     self.a[j][i] = z;
                     self.b[i][j] = z;
                 }
             }
-            (Some(None), Some(Some(i))) => {
+            ([], &[i]) => {
                 for j in 0..3 {
                     self.c[i][j] = z;
                     self.c[j][i] = z;
@@ -317,11 +311,9 @@ struct Turn {
     k: usize,
     c: ExprId,
     s: ExprId,
-    /// cos 2θ, sin 2θ, and their halves
+    /// cos 2θ and sin 2θ
     c2: ExprId,
     s2: ExprId,
-    half_c2: ExprId,
-    half_s2: ExprId,
 }
 
 impl Turn {
@@ -343,19 +335,9 @@ impl Turn {
         let cc = a.mul(c, c);
         let ss = a.mul(s, s);
         let c2 = a.sub(cc, ss);
-        let half = a.num(0.5);
-        let half_c2 = a.mul(half, c2);
-        let half_s2 = a.mul(c, s);
-        let s2 = a.add(half_s2, half_s2);
-        Some(Turn {
-            k,
-            c,
-            s,
-            c2,
-            s2,
-            half_c2,
-            half_s2,
-        })
+        let cs = a.mul(c, s);
+        let s2 = a.add(cs, cs);
+        Some(Turn { k, c, s, c2, s2 })
     }
 
     fn plane(&self) -> (usize, usize) {
@@ -369,17 +351,18 @@ impl Turn {
         (a.sub(cx, sy), a.add(sx, cy))
     }
 
-    /// R [[p, m], [m, q]] Rᵀ = [[μ + t, m'], [m', μ − t]] with μ = (p + q)/2,
-    /// t = (p − q) cos 2θ / 2 − m sin 2θ, m' = (p − q) sin 2θ / 2 + m cos 2θ.
+    /// R [[p, m], [m, q]] Rᵀ = [[μ + t, m'], [m', μ − t]] with μ = (p + q)/2, δ = (p − q)/2,
+    /// t = δ cos 2θ − m sin 2θ, m' = δ sin 2θ + m cos 2θ.
     fn block(&self, a: &mut Arena, p: ExprId, q: ExprId, m: ExprId) -> [ExprId; 3] {
         let half = a.num(0.5);
         let sum = a.add(p, q);
         let mu = a.mul(half, sum);
         let diff = a.sub(p, q);
-        let dc = a.mul(diff, self.half_c2);
+        let delta = a.mul(half, diff);
+        let dc = a.mul(delta, self.c2);
         let ms = a.mul(m, self.s2);
         let t = a.sub(dc, ms);
-        let ds = a.mul(diff, self.half_s2);
+        let ds = a.mul(delta, self.s2);
         let mc = a.mul(m, self.c2);
         [a.add(mu, t), a.add(ds, mc), a.sub(mu, t)]
     }
@@ -492,10 +475,10 @@ pub fn articulated(
         _ => None,
     };
     // A translation no coordinate moves, whose node has one child, itself a translation no
-    // coordinate moves, is taken together with that child's: the child's articulated inertia (full matrices) is
-    // moved once by the sum, and the skipped node's bodies (rigid: a few terms) are moved to
-    // the child's origin. On an arm, whose links are Tdisp·Trot·Tdisp, this is one
-    // translation per link where there were two.
+    // coordinate moves, is taken together with that child's: the child's articulated inertia
+    // (full matrices) is moved once by the sum, and the skipped node's bodies (rigid: a few
+    // terms) are moved to the child's origin. On an arm, whose links are Tdisp·Trot·Tdisp,
+    // this is one translation per link where there were two.
     let skip: Vec<bool> = (0..nn)
         .map(|n| {
             let node = &tree.nodes[n];
@@ -552,8 +535,20 @@ pub fn articulated(
             }
         }
     }
+    // A displacement's coordinates are eliminated in the child's axes (the same as the
+    // parent's); a rotation's in the axes `order` says, its axis being the same vector in
+    // both. With a spinning body they are eliminated in the parent's axes, where that body's
+    // inertia is the same expression.
+    let in_child: Vec<bool> = spin
+        .iter()
+        .map(|sp| order == Elimination::ChildAxes && sp.is_zero(a))
+        .collect();
+    let to_parent = |a: &mut Arena, (ia, p): (Art, Sv), r: &M3| {
+        let ia = ia.rotate(a, r);
+        (ia, (s::mul_mv(a, r, p.0), s::mul_mv(a, r, p.1)))
+    };
+    let to_child = |a: &mut Arena, x: Sv, r: &M3| (s::mul_mtv(a, r, x.0), s::mul_mtv(a, r, x.1));
     let mut joints: Vec<Vec<Joint>> = (0..nn).map(|_| Vec::new()).collect();
-    let mut child_axes = vec![false; nn];
     let mut pivots = vec![a.zero(); nd];
     for n in (1..nn).rev() {
         if skip[n] {
@@ -563,17 +558,8 @@ pub fn articulated(
             .factor
             .expect("a node below the ground has a factor");
         let (mut ia, mut p) = (inertia[n], force[n]);
-        // A displacement's coordinates are eliminated in the child's axes (the same as the
-        // parent's); a rotation's in the axes `order` says, its axis being the same vector
-        // in both. With a spinning body they are eliminated in the parent's axes, where
-        // that body's inertia is the same expression.
-        let in_child = order == Elimination::ChildAxes && spin[n].is_zero(a);
-        let turn = |a: &mut Arena, (ia, p): (Art, Sv), r: &M3| {
-            let ia = ia.rotate(a, r);
-            (ia, (s::mul_mv(a, r, p.0), s::mul_mv(a, r, p.1)))
-        };
-        if let Some(r) = rots[n].filter(|_| !in_child) {
-            (ia, p) = turn(a, (ia, p), &r);
+        if let Some(r) = rots[n].filter(|_| !in_child[n]) {
+            (ia, p) = to_parent(a, (ia, p), &r);
             ia = ia.add(a, &spin[n]);
         }
         for &k in dofs[n].iter().rev() {
@@ -605,10 +591,9 @@ pub fn articulated(
             });
         }
         joints[n].reverse();
-        if let Some(r) = rots[n].filter(|_| in_child) {
-            (ia, p) = turn(a, (ia, p), &r);
+        if let Some(r) = rots[n].filter(|_| in_child[n]) {
+            (ia, p) = to_parent(a, (ia, p), &r);
         }
-        child_axes[n] = in_child;
         if let Some(d) = disp[n] {
             ia = ia.translate(a, d);
             let dxf = s::cross(a, d, p.1);
@@ -635,9 +620,7 @@ pub fn articulated(
             let axd = s::cross(a, x.0, d);
             x = (x.0, s::add(a, x.1, axd));
         }
-        let to_child =
-            |a: &mut Arena, x: Sv, r: &M3| (s::mul_mtv(a, r, x.0), s::mul_mtv(a, r, x.1));
-        if let Some(r) = rots[n].filter(|_| child_axes[n]) {
+        if let Some(r) = rots[n].filter(|_| in_child[n]) {
             x = to_child(a, x, &r);
         }
         for j in &joints[n] {
@@ -647,7 +630,7 @@ pub fn articulated(
             qdd[j.k as usize] = qk;
             x = sv_axpy(a, x, qk, j.s);
         }
-        if let Some(r) = rots[n].filter(|_| !child_axes[n]) {
+        if let Some(r) = rots[n].filter(|_| !in_child[n]) {
             x = to_child(a, x, &r);
         }
         acc[n] = x;

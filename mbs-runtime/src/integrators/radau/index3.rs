@@ -57,11 +57,13 @@ impl Radau {
             self.bmu = z(s * n);
             self.psis = z(s * nc);
             self.phit = z(nc);
-            self.i2.kbt = z(n * nc);
-            self.i2.bbt = z(nc * nc);
-            self.i2.z = z(nc * n);
+            self.i2 = super::index2::Blocks {
+                kbt: z(n * nc),
+                bbt: z(nc * nc),
+                z: z(nc * n),
+                zbt: z(nc * nc),
+            };
             self.own_end = z(n + nc);
-            self.i2.zbt = z(nc * nc);
             self.psix = z(nc);
         }
     }

@@ -82,6 +82,14 @@ pub use mbs_runtime::*;
 #[doc(hidden)]
 pub mod __private {
     pub use serde;
+
+    /// The `N` elements of `s` as an array, for the generated code's stores of runs of
+    /// consecutive outputs (`*array_mut(&mut m[4..8]) = [a, b, c, d];`: one statement for
+    /// the compiler's front end, written in place).
+    #[inline(always)]
+    pub fn array_mut<T, const N: usize>(s: &mut [T]) -> &mut [T; N] {
+        s.try_into().expect("a range of N elements")
+    }
 }
 
 /// The README's code blocks run as doc-tests, so the front page cannot rot.

@@ -12,6 +12,8 @@
 use clap::{Parser, Subcommand};
 use mbs_symbolic::codegen::Generated;
 use mbs_symbolic::expand::{Expansion, expand_models, sources};
+use std::fmt::Write as _;
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -262,21 +264,24 @@ fn print_model(
         .into_iter()
         .filter(|it| scene.is_none_or(|s| item_belongs(it, name, s)))
         .collect();
+    let mut out = String::new();
     if !counts_only {
         let shown = syn::File {
             shebang: None,
             attrs: Vec::new(),
             items,
         };
-        println!("{}", prettyplease::unparse(&shown));
+        let _ = writeln!(out, "{}", prettyplease::unparse(&shown));
     }
-    println!(
+    let _ = writeln!(
+        out,
         "// model {name}: generation {:.1} ms (symbolic {:.1} ms, emission {:.1} ms)",
         (generated.build_time + generated.emit_time).as_secs_f64() * 1e3,
         generated.build_time.as_secs_f64() * 1e3,
         generated.emit_time.as_secs_f64() * 1e3
     );
-    println!(
+    let _ = writeln!(
+        out,
         "// {:<28} {:<22} {:>8} {:>8} {:>8} {:>6} {:>6} {:>6}",
         "type", "function", "flops", "adds", "muls", "divs", "funcs", "lets"
     );
@@ -286,11 +291,18 @@ fn print_model(
         }
         let (model, function) = (&r.model, &r.function);
         let [flops, adds, muls, divs, funcs, lets] = r.ops.columns();
-        println!(
+        let _ = writeln!(
+            out,
             "// {model:<28} {function:<22} {flops:>8} {adds:>8} {muls:>8} {divs:>6} {funcs:>6} {lets:>6}"
         );
     }
-    Ok(())
+    // a reader that stops early (`mbs expand … | head`) is not an error
+    match std::io::stdout().lock().write_all(out.as_bytes()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            Err(format!("cannot write the code: {e}"))
+        }
+        _ => Ok(()),
+    }
 }
 
 /// Whether a generated item is part of scene `scene` of model `name` (the parameter struct is

@@ -68,6 +68,8 @@ pub struct FnSpec {
     pub call: String,
     /// statements before the computation (buffer resets)
     pub prelude: Vec<String>,
+    /// the outputs' buffers the prelude fills with zeros
+    pub zeroed: Vec<String>,
     pub outputs: Vec<(String, ExprId)>,
     /// `f64`, or lanes of several states (the batch functions of `option batch;`)
     pub numbers: Numbers,
@@ -97,6 +99,7 @@ impl FnSpec {
             args: args.into(),
             call,
             prelude: Vec::new(),
+            zeroed: Vec::new(),
             outputs: Vec::new(),
             numbers: Numbers::Scalar,
             prefix: None,
@@ -118,6 +121,7 @@ impl FnSpec {
         if rows.iter().flatten().any(|&e| a.is_num(e, 0.0)) {
             self.prelude
                 .push(format!("{target}.fill({});", self.numbers.zero()));
+            self.zeroed.push(target.into());
         }
         for (i, row) in rows.iter().enumerate() {
             for (j, &e) in row.iter().enumerate() {
@@ -159,7 +163,7 @@ pub fn emit_fn(
         Some(p) => Schedule::with_segments(arena, &roots, &[p.split], MAX_LETS),
         None => Schedule::new(arena, &roots),
     };
-    let em = emit(arena, &sch, &targets, names, spec.numbers)?;
+    let em = emit(arena, &sch, &targets, &spec.zeroed, names, spec.numbers)?;
     let number = spec.numbers.type_name();
     // batch code is compiled for 256-bit registers on x86-64 whatever the build's target CPU
     // (the trait method checks the processor before calling it)

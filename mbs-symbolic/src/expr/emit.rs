@@ -394,11 +394,164 @@ impl Plan {
     }
 }
 
-/// Emits the statements of `sch`, output `i` assigned as `targets[i] = …;`.
+/// In functions split into chunks, stores to consecutive elements of one slice are one
+/// statement (`*array_mut(&mut m[4..9]) = […];`), and so are reads of the workspace, from
+/// this many elements: rustc's front end (type and borrow checking) takes far longer over one
+/// statement per element.
+const MIN_RUN: usize = 3;
+/// At most this many elements per statement.
+const MAX_RUN: usize = 32;
+/// At most this many zeros written inside a run, where the buffer was filled with zeros
+/// before (the zero entries of a Jacobian's columns).
+const MAX_GAP: usize = 2;
+
+/// Where the outputs go: targets of the form `base[index]` by base, for runs of stores.
+struct Stores<'t> {
+    targets: &'t [String],
+    /// per target, `(base, index)` when it has that form
+    split: Vec<Option<(&'t str, usize)>>,
+    /// every indexed target
+    all: rustc_hash::FxHashSet<(&'t str, usize)>,
+    /// the bases filled with zeros before the computation
+    zeroed: rustc_hash::FxHashSet<&'t str>,
+}
+
+impl<'t> Stores<'t> {
+    fn new(targets: &'t [String], zeroed: &'t [String]) -> Stores<'t> {
+        let split: Vec<_> = targets.iter().map(|t| split_index(t)).collect();
+        Stores {
+            targets,
+            all: split.iter().flatten().copied().collect(),
+            split,
+            zeroed: zeroed.iter().map(|z| z.as_str()).collect(),
+        }
+    }
+
+    /// Writes `targets[i] = value` for each `(i, value)`: runs of one base's consecutive
+    /// indices as one statement each (zeros filling short gaps of a zeroed base that no
+    /// output writes), the other targets one by one.
+    fn write(&self, s: &mut String, outs: Vec<(usize, String)>, numbers: Numbers) {
+        let mut indexed: Vec<(&str, usize, String)> = Vec::new();
+        for (i, v) in outs {
+            match self.split[i] {
+                Some((b, k)) => indexed.push((b, k, v)),
+                None => {
+                    let _ = writeln!(s, "{} = {v};", self.targets[i]);
+                }
+            }
+        }
+        indexed.sort_by(|a, b| (a.0, a.1).cmp(&(b.0, b.1)));
+        let mut run: Vec<(usize, Option<String>)> = Vec::new();
+        let mut base = "";
+        for (b, k, v) in indexed {
+            if let Some(&(last, _)) = run.last() {
+                let gap = if b == base { k - last - 1 } else { usize::MAX };
+                let fills = gap > 0
+                    && gap <= MAX_GAP
+                    && self.zeroed.contains(base)
+                    && (last + 1..k).all(|g| !self.all.contains(&(base, g)));
+                if gap == 0 || fills {
+                    run.extend((last + 1..k).map(|g| (g, None)));
+                } else {
+                    write_runs(s, base, &run, numbers);
+                    run.clear();
+                }
+            }
+            base = b;
+            run.push((k, Some(v)));
+        }
+        write_runs(s, base, &run, numbers);
+    }
+}
+
+/// Writes `let name = w[k];` for the `(k, name)` of `loads` (increasing `k`): stretches
+/// with at most [`MAX_GAP`] slots skipped between reads, from [`MIN_RUN`] reads, as one
+/// statement of at most [`MAX_RUN`] slots (`let [x3, _, x8] = w[4..7] else { … };`).
+fn write_loads(s: &mut String, loads: &[(usize, String)]) {
+    let mut i = 0;
+    while i < loads.len() {
+        let mut j = i + 1;
+        while j < loads.len()
+            && loads[j].0 - loads[j - 1].0 <= MAX_GAP + 1
+            && loads[j].0 - loads[i].0 < MAX_RUN
+        {
+            j += 1;
+        }
+        if j - i >= MIN_RUN {
+            let (a, b) = (loads[i].0, loads[j - 1].0 + 1);
+            let mut names = vec!["_"; b - a];
+            for (k, name) in &loads[i..j] {
+                names[k - a] = name;
+            }
+            let _ = writeln!(
+                s,
+                "let [{}] = w[{a}..{b}] else {{ unreachable!() }};",
+                names.join(", ")
+            );
+        } else {
+            for (k, name) in &loads[i..j] {
+                let _ = writeln!(s, "let {name} = w[{k}];");
+            }
+        }
+        i = j;
+    }
+}
+
+/// `"a.b[3]"` → `("a.b", 3)`.
+fn split_index(t: &str) -> Option<(&str, usize)> {
+    let inner = t.strip_suffix(']')?;
+    let open = inner.rfind('[')?;
+    let k = inner[open + 1..].parse().ok()?;
+    Some((&inner[..open], k))
+}
+
+/// Writes `base[k] = v` for the `(k, v)` of `run`, whose indices are consecutive (`None`: a
+/// zero where the buffer holds one already): from [`MIN_RUN`] elements as one assignment
+/// of at most [`MAX_RUN`], the others one by one.
+fn write_runs(s: &mut String, base: &str, run: &[(usize, Option<String>)], numbers: Numbers) {
+    let zero = numbers.zero();
+    for part in run.chunks(MAX_RUN) {
+        // no statement starts or ends with a zero the buffer holds already
+        let a = part
+            .iter()
+            .position(|e| e.1.is_some())
+            .unwrap_or(part.len());
+        let b = part
+            .iter()
+            .rposition(|e| e.1.is_some())
+            .map_or(a, |b| b + 1);
+        let part = &part[a..b];
+        if part.len() >= MIN_RUN {
+            let _ = write!(
+                s,
+                "*::mbs::__private::array_mut(&mut {base}[{}..{}]) = [",
+                part[0].0,
+                part[0].0 + part.len()
+            );
+            for (k, (_, v)) in part.iter().enumerate() {
+                if k > 0 {
+                    s.push_str(", ");
+                }
+                s.push_str(v.as_deref().unwrap_or(&zero));
+            }
+            s.push_str("];\n");
+        } else {
+            for (k, v) in part {
+                if let Some(v) = v {
+                    let _ = writeln!(s, "{base}[{k}] = {v};");
+                }
+            }
+        }
+    }
+}
+
+/// Emits the statements of `sch`, output `i` assigned as `targets[i] = …;`; `zeroed` names
+/// the targets' bases that were filled with zeros before (their other elements are zero).
 pub fn emit(
     arena: &Arena,
     sch: &Schedule,
     targets: &[String],
+    zeroed: &[String],
     naming: &dyn Naming,
     numbers: Numbers,
 ) -> Result<Emitted, Vec<MissingDerivative>> {
@@ -427,9 +580,19 @@ pub fn emit(
     let Plan {
         vars: mut chunk_vars,
         loads: mut chunk_loads,
-        slot,
+        mut slot,
         workspace,
     } = plan;
+    // slots numbered in the order of the lets: what a chunk reads of an earlier one lies in
+    // stretches of consecutive slots
+    let mut next = 0;
+    for &n in &sch.lets {
+        if let Some(k) = slot[n.index()].as_mut() {
+            *k = next;
+            next += 1;
+        }
+    }
+    let stores = (nchunks > 1).then(|| Stores::new(targets, zeroed));
     // pass 2: text
     let mut w = Writer {
         arena,
@@ -453,15 +616,18 @@ pub fn emit(
             }
         }
         let loads = &mut chunk_loads[c];
-        loads.sort_unstable();
+        loads.sort_unstable_by_key(|l| slot[l.index()]);
         loads.dedup();
-        for &l in loads.iter() {
-            let (name, k) = (w.name_string(l), slot[l.index()].unwrap());
-            if numbers == Numbers::Lanes {
+        let loads: Vec<(usize, String)> = loads
+            .iter()
+            .map(|&l| (slot[l.index()].unwrap(), w.name_string(l)))
+            .collect();
+        if numbers == Numbers::Lanes {
+            for (k, name) in &loads {
                 let _ = writeln!(s, "let {name} = {SIMD_TYPE}::new(w[{k}]);");
-            } else {
-                let _ = writeln!(s, "let {name} = w[{k}];");
             }
+        } else {
+            write_loads(&mut s, &loads);
         }
         for &n in &sch.lets[r.clone()] {
             s.push_str("let ");
@@ -469,18 +635,26 @@ pub fn emit(
             s.push_str(" = ");
             w.body(n, &mut s);
             s.push_str(";\n");
+            // stored at once: held to the end of the chunk, the values spill
             if let Some(k) = slot[n.index()] {
                 let _ = write!(s, "w[{k}] = ");
                 w.stored(n, &mut s);
                 s.push_str(";\n");
             }
         }
+        let mut outs = Vec::new();
         for (i, &o) in sch.outputs.iter().enumerate() {
             if sch.output_chunk[i] as usize == c {
-                s.push_str(&targets[i]);
-                s.push_str(" = ");
-                w.stored(o, &mut s);
-                s.push_str(";\n");
+                let mut v = String::new();
+                w.stored(o, &mut v);
+                outs.push((i, v));
+            }
+        }
+        if let Some(stores) = &stores {
+            stores.write(&mut s, outs, numbers);
+        } else {
+            for (i, v) in outs {
+                let _ = writeln!(s, "{} = {v};", targets[i]);
             }
         }
         chunks.push(s);
@@ -530,6 +704,7 @@ mod tests {
             &a,
             &sch,
             &["out[0]".into(), "out[1]".into()],
+            &[],
             &N,
             Numbers::Scalar,
         )
@@ -557,6 +732,7 @@ mod tests {
             &a,
             &sch,
             &["out[0]".into(), "out[1]".into()],
+            &[],
             &N,
             Numbers::Scalar,
         )
@@ -582,7 +758,7 @@ mod tests {
         let sch = Schedule::with_max_lets(&a, &outs, 3);
         assert!(sch.chunks.len() > 1);
         let targets: Vec<String> = (0..outs.len()).map(|i| format!("out[{i}]")).collect();
-        let e = emit(&a, &sch, &targets, &N, Numbers::Scalar).unwrap();
+        let e = emit(&a, &sch, &targets, &[], &N, Numbers::Scalar).unwrap();
         assert!(e.workspace > 0);
         assert!(e.chunks[1].contains("= w["), "{}", e.chunks[1]);
         assert!(
@@ -609,7 +785,7 @@ mod tests {
         }
         let sch = Schedule::with_max_lets(&a, &outs, 3);
         let targets: Vec<String> = (0..outs.len()).map(|i| format!("out[{i}]")).collect();
-        let e = emit(&a, &sch, &targets, &N, Numbers::Lanes).unwrap();
+        let e = emit(&a, &sch, &targets, &[], &N, Numbers::Lanes).unwrap();
         let all = e.chunks.concat();
         // the state in a register, the parameter as it is; functions through Math; outputs
         // and the workspace as F64x4
@@ -623,5 +799,80 @@ mod tests {
         assert!(all.contains("out[0] = ::mbs::F64x4::from("), "{all}");
         assert!(all.contains("= ::mbs::lanes::Simd::new(w["), "{all}");
         assert!(all.contains("] = ::mbs::F64x4::from("), "{all}");
+    }
+    #[test]
+    fn consecutive_stores_are_one_statement() {
+        // m: four consecutive, given out of order; v (filled with zeros): gaps of one and two
+        // zeros filled, not one of three; u (not filled): no gap filled; z alone (runs start
+        // at three elements)
+        let targets: Vec<String> = [
+            "m[2]", "m[0]", "m[1]", "m[3]", "v[0]", "v[2]", "v[5]", "v[9]", "u[0]", "u[2]", "z",
+        ]
+        .iter()
+        .map(|t| t.to_string())
+        .collect();
+        let zeroed = ["v".to_string()];
+        let stores = super::Stores::new(&targets, &zeroed);
+        let outs = (0..targets.len()).map(|i| (i, format!("a{i}"))).collect();
+        let mut code = String::new();
+        stores.write(&mut code, outs, Numbers::Scalar);
+        let has = |s: &str| assert!(code.contains(s), "{s} in\n{code}");
+        has("*::mbs::__private::array_mut(&mut m[0..4]) = [a1, a2, a0, a3];\n");
+        has("*::mbs::__private::array_mut(&mut v[0..6]) = [a4, 0.0, a5, 0.0, 0.0, a6];\n");
+        has("v[9] = a7;\n");
+        has("u[0] = a8;\n");
+        has("u[2] = a9;\n");
+        has("z = a10;\n");
+        assert_eq!(code.lines().count(), 6, "{code}");
+    }
+
+    #[test]
+    fn a_function_of_one_chunk_stores_element_by_element() {
+        let mut a = Arena::new();
+        let x = a.var(Var::Q(0));
+        let outs: Vec<_> = (0..6)
+            .map(|i| {
+                let c = a.num(i as f64 + 2.0);
+                a.mul(c, x)
+            })
+            .collect();
+        let sch = Schedule::new(&a, &outs);
+        let targets: Vec<String> = (0..outs.len()).map(|i| format!("out[{i}]")).collect();
+        let e = emit(&a, &sch, &targets, &[], &N, Numbers::Scalar).unwrap();
+        assert!(
+            e.chunks[0].contains("out[5] = 7.0 * q0;"),
+            "{}",
+            e.chunks[0]
+        );
+    }
+
+    #[test]
+    fn workspace_slots_are_loaded_in_runs() {
+        // chunk 0 computes six values that chunk 1 reads
+        let mut a = Arena::new();
+        let x = a.var(Var::Q(0));
+        let mut vals = Vec::new();
+        for i in 0..6 {
+            let c = a.num(i as f64 + 2.0);
+            let cx = a.mul(c, x);
+            vals.push(a.sin(cx));
+        }
+        let mut outs = vals.clone();
+        let mut acc = vals[0];
+        for &v in &vals[1..] {
+            acc = a.mul(acc, v);
+            let s = a.sin(acc);
+            acc = a.add(s, v);
+        }
+        outs.push(acc);
+        let sch = Schedule::with_max_lets(&a, &outs, 6);
+        assert!(sch.chunks.len() > 1);
+        let targets: Vec<String> = (0..outs.len()).map(|i| format!("out[{i}]")).collect();
+        let e = emit(&a, &sch, &targets, &[], &N, Numbers::Scalar).unwrap();
+        let later = e.chunks[1..].concat();
+        assert!(
+            later.contains("] = w[0..6] else { unreachable!() };"),
+            "{later}"
+        );
     }
 }

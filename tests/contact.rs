@@ -69,6 +69,37 @@ mbs::multibody! {
 }
 
 mbs::multibody! {
+    /// The box of `Block` in three scenes (free, on the floor, on the floor and hung from a
+    /// spring): with tangents and several scenes, the tangents of the bodies and gravity are
+    /// generated once and each scene adds those of its own effects.
+    pub model Crate {
+        param k = 2e4; param c = 100.0; param mu = 0.5; param eps = 1e-4;
+        dof x = 0.0; dof y = 0.0; dof z = 0.3; dof a = 0.3; dof b = 0.2; dof r = -0.15;
+        body box1 { mass = 1.0; inertia = (0.2 * 0.2 / 6, 0.2 * 0.2 / 6, 0.2 * 0.2 / 6); }
+        point c0 on box1 at (-0.1, -0.1, -0.1);
+        point c1 on box1 at (0.1, -0.1, -0.1);
+        point c2 on box1 at (0.1, 0.1, -0.1);
+        point c3 on box1 at (-0.1, 0.1, -0.1);
+        point hook on ground at (0.3, 0.2, 1.0);
+        TOG[box1] = Tdisp(x, y, z) * Trotz(a) * Troty(b) * Trotx(r);
+        gravity(0, 0, -9.81);
+        effect floor {
+            contact(c0, k = k, c = c, mu = mu, eps = eps);
+            contact(c1, k = k, c = c, mu = mu, eps = eps);
+            contact(c2, k = k, c = c, mu = mu, eps = eps);
+            contact(c3, k = k, c = c, mu = mu, eps = eps);
+        }
+        effect hung {
+            spring(hook, c2, k = 50, l0 = 0.5, c = 0.7);
+        }
+        scene Free = [];
+        scene Floor = [floor];
+        scene Hung = [floor, hung];
+        option tangents;
+    }
+}
+
+mbs::multibody! {
     /// A body on a bushing to the ground: translation x and rotation a about z.
     pub model Mount {
         param m = 2.0; param izz = 0.05;
@@ -171,6 +202,23 @@ fn exact_tangents_in_contact_match_central_differences() {
         "tip in the wall: {tip:?}"
     );
     check_tangents(&rig, &q, &qd, &qdd, "rig: sphere, tip, bushing, spring");
+}
+
+#[test]
+fn tangents_shared_by_scenes_match_central_differences() {
+    // three corners in the floor, sliding, the spring stretched
+    let q = [0.1, -0.2, 0.0985, 0.4, 0.05, -0.03];
+    let qd = [0.7, -0.4, -0.05, 1.5, 0.3, -0.6];
+    let qdd = [0.3, -1.0, 2.0, 0.5, -0.2, 0.1];
+    check_tangents(&CrateFree::default(), &q, &qd, &qdd, "crate, free");
+    check_tangents(&CrateFloor::default(), &q, &qd, &qdd, "crate on the floor");
+    check_tangents(
+        &CrateHung::default(),
+        &q,
+        &qd,
+        &qdd,
+        "crate on the floor, hung",
+    );
 }
 
 #[test]

@@ -70,6 +70,8 @@ pub struct FnSpec {
     pub prelude: Vec<String>,
     /// the outputs' buffers the prelude fills with zeros
     pub zeroed: Vec<String>,
+    /// outputs added to their targets (`k[3] += …;`) rather than assigned
+    pub accumulate: bool,
     pub outputs: Vec<(String, ExprId)>,
     /// `f64`, or lanes of several states (the batch functions of `option batch;`)
     pub numbers: Numbers,
@@ -100,6 +102,7 @@ impl FnSpec {
             call,
             prelude: Vec::new(),
             zeroed: Vec::new(),
+            accumulate: false,
             outputs: Vec::new(),
             numbers: Numbers::Scalar,
             prefix: None,
@@ -123,6 +126,21 @@ impl FnSpec {
                 .push(format!("{target}.fill({});", self.numbers.zero()));
             self.zeroed.push(target.into());
         }
+        for (i, row) in rows.iter().enumerate() {
+            for (j, &e) in row.iter().enumerate() {
+                if !a.is_num(e, 0.0) {
+                    self.outputs.push((format!("{target}[{}]", i + n * j), e));
+                }
+            }
+        }
+    }
+
+    /// Adds a dense matrix given by rows to `target` (column-major, as [`FnSpec::matrix`]),
+    /// which holds a matrix already: its nonzero entries are added; the method adds all its
+    /// outputs so.
+    pub fn matrix_added(&mut self, a: &Arena, target: &str, rows: &[Vec<ExprId>]) {
+        let n = rows.len();
+        self.accumulate = true;
         for (i, row) in rows.iter().enumerate() {
             for (j, &e) in row.iter().enumerate() {
                 if !a.is_num(e, 0.0) {
@@ -163,7 +181,15 @@ pub fn emit_fn(
         Some(p) => Schedule::with_segments(arena, &roots, &[p.split], MAX_LETS),
         None => Schedule::new(arena, &roots),
     };
-    let em = emit(arena, &sch, &targets, &spec.zeroed, names, spec.numbers)?;
+    let em = emit(
+        arena,
+        &sch,
+        &targets,
+        &spec.zeroed,
+        spec.accumulate,
+        names,
+        spec.numbers,
+    )?;
     let number = spec.numbers.type_name();
     // batch code is compiled for 256-bit registers on x86-64 whatever the build's target CPU
     // (the trait method checks the processor before calling it)

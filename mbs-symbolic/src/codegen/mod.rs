@@ -381,6 +381,14 @@ fn emit_params(
             labels.push("constraint_rest_derivatives (B', K_λ')");
         }
     }
+    // the tangents of the bodies and of the effects every scene has, when shared
+    if let Some((k, c)) = &model.common_tangents {
+        let mut f = FnSpec::new("__tangents_common", &with_charts("tangents"));
+        f.matrix(a, "k", k);
+        f.matrix(a, "c", c);
+        specs.push(f);
+        labels.push("tangents (K, C), common part");
+    }
     let mut ops = Vec::new();
     for (spec, label) in kinematics_specs(model, with_charts) {
         if let Some((s, count)) = collect(emit_fn(a, &spec, &names), missing, |e| (e.text, e.count))
@@ -393,7 +401,7 @@ fn emit_params(
         if let Some((s, count)) = collect(emit_fn(a, spec, &names), missing, |e| (e.text, e.count))
         {
             derived.push_str(&s);
-            if !c.phi.is_empty() {
+            if !c.phi.is_empty() || spec.name == "__tangents_common" {
                 ops.push((label.to_string(), count));
             }
         }
@@ -595,9 +603,16 @@ fn emit_scene(
     specs.push((f, Some("inverse_dynamics")));
     if let Some((kt, ct)) = &eq.tangents {
         let mut f = FnSpec::new("__tangents", args("tangents"));
-        f.matrix(a, "k", kt);
-        f.matrix(a, "c", ct);
-        specs.push((f, Some("tangents (K, C)")));
+        if eq.tangents_common {
+            // added to the tangents common to the scenes
+            f.matrix_added(a, "k", kt);
+            f.matrix_added(a, "c", ct);
+            specs.push((f, Some("tangents (K, C), own effects")));
+        } else {
+            f.matrix(a, "k", kt);
+            f.matrix(a, "c", ct);
+            specs.push((f, Some("tangents (K, C)")));
+        }
     }
     if let Some(dp) = &eq.param_tangents {
         let mut f = FnSpec::new("__parameter_tangents", api::PARAMETER_TANGENTS.args);
@@ -815,7 +830,9 @@ fn emit_scene(
             .collect::<Vec<_>>()
             .join(", "),
     );
-    let tangents_body = if eq.tangents.is_some() {
+    let tangents_body = if eq.tangents_common {
+        "self.params.__tangents_common(&self.charts, t, q, qd, qdd, u, k, c);\nself.__tangents(t, q, qd, qdd, u, k, c);\nOk(())".to_string()
+    } else if eq.tangents.is_some() {
         "self.__tangents(t, q, qd, qdd, u, k, c);\nOk(())".to_string()
     } else {
         format!(

@@ -545,13 +545,15 @@ fn write_runs(s: &mut String, base: &str, run: &[(usize, Option<String>)], numbe
     }
 }
 
-/// Emits the statements of `sch`, output `i` assigned as `targets[i] = …;`; `zeroed` names
-/// the targets' bases that were filled with zeros before (their other elements are zero).
+/// Emits the statements of `sch`, output `i` assigned as `targets[i] = …;` (added, `+=`, with
+/// `accumulate`); `zeroed` names the targets' bases that were filled with zeros before
+/// (their other elements are zero).
 pub fn emit(
     arena: &Arena,
     sch: &Schedule,
     targets: &[String],
     zeroed: &[String],
+    accumulate: bool,
     naming: &dyn Naming,
     numbers: Numbers,
 ) -> Result<Emitted, Vec<MissingDerivative>> {
@@ -592,7 +594,8 @@ pub fn emit(
             next += 1;
         }
     }
-    let stores = (nchunks > 1).then(|| Stores::new(targets, zeroed));
+    let stores = (nchunks > 1 && !accumulate).then(|| Stores::new(targets, zeroed));
+    let op = if accumulate { "+=" } else { "=" };
     // pass 2: text
     let mut w = Writer {
         arena,
@@ -654,7 +657,7 @@ pub fn emit(
             stores.write(&mut s, outs, numbers);
         } else {
             for (i, v) in outs {
-                let _ = writeln!(s, "{} = {v};", targets[i]);
+                let _ = writeln!(s, "{} {op} {v};", targets[i]);
             }
         }
         chunks.push(s);
@@ -705,6 +708,7 @@ mod tests {
             &sch,
             &["out[0]".into(), "out[1]".into()],
             &[],
+            false,
             &N,
             Numbers::Scalar,
         )
@@ -733,6 +737,7 @@ mod tests {
             &sch,
             &["out[0]".into(), "out[1]".into()],
             &[],
+            false,
             &N,
             Numbers::Scalar,
         )
@@ -758,7 +763,7 @@ mod tests {
         let sch = Schedule::with_max_lets(&a, &outs, 3);
         assert!(sch.chunks.len() > 1);
         let targets: Vec<String> = (0..outs.len()).map(|i| format!("out[{i}]")).collect();
-        let e = emit(&a, &sch, &targets, &[], &N, Numbers::Scalar).unwrap();
+        let e = emit(&a, &sch, &targets, &[], false, &N, Numbers::Scalar).unwrap();
         assert!(e.workspace > 0);
         assert!(e.chunks[1].contains("= w["), "{}", e.chunks[1]);
         assert!(
@@ -785,7 +790,7 @@ mod tests {
         }
         let sch = Schedule::with_max_lets(&a, &outs, 3);
         let targets: Vec<String> = (0..outs.len()).map(|i| format!("out[{i}]")).collect();
-        let e = emit(&a, &sch, &targets, &[], &N, Numbers::Lanes).unwrap();
+        let e = emit(&a, &sch, &targets, &[], false, &N, Numbers::Lanes).unwrap();
         let all = e.chunks.concat();
         // the state in a register, the parameter as it is; functions through Math; outputs
         // and the workspace as F64x4
@@ -838,7 +843,7 @@ mod tests {
             .collect();
         let sch = Schedule::new(&a, &outs);
         let targets: Vec<String> = (0..outs.len()).map(|i| format!("out[{i}]")).collect();
-        let e = emit(&a, &sch, &targets, &[], &N, Numbers::Scalar).unwrap();
+        let e = emit(&a, &sch, &targets, &[], false, &N, Numbers::Scalar).unwrap();
         assert!(
             e.chunks[0].contains("out[5] = 7.0 * q0;"),
             "{}",
@@ -868,7 +873,7 @@ mod tests {
         let sch = Schedule::with_max_lets(&a, &outs, 6);
         assert!(sch.chunks.len() > 1);
         let targets: Vec<String> = (0..outs.len()).map(|i| format!("out[{i}]")).collect();
-        let e = emit(&a, &sch, &targets, &[], &N, Numbers::Scalar).unwrap();
+        let e = emit(&a, &sch, &targets, &[], false, &N, Numbers::Scalar).unwrap();
         let later = e.chunks[1..].concat();
         assert!(
             later.contains("] = w[0..6] else { unreachable!() };"),

@@ -3,7 +3,7 @@
 
 use super::effects::Loads;
 use super::forward::{Elimination, Forward, articulated, ltdl, ltdl_estimate};
-use super::recursive::{body_kinematics, crba, newton_euler, spinning_body_motion};
+use super::recursive::{body_kinematics, crba, load_tau, newton_euler, spinning_body_motion};
 use super::spin::spinning_frames;
 
 use super::spatial::{self as s, Matrix};
@@ -56,8 +56,11 @@ pub struct SceneEquations {
     pub static_h: Vec<ExprId>,
     /// ∂h/∂u (dense, row-major, NQ × NU): how inputs enter the equations
     pub input_matrix: Matrix,
-    /// K_t = ∂τ/∂q and C_t = ∂τ/∂qd (dense, row-major), when the model asks for them
+    /// K_t = ∂τ/∂q and C_t = ∂τ/∂qd (dense, row-major), when the model asks for them; with
+    /// `tangents_common`, only the part of the scene's own effects
     pub tangents: Option<(Matrix, Matrix)>,
+    /// whether `tangents` add to the model's (`SymbolicModel::common_tangents`)
+    pub tangents_common: bool,
     /// ∂τ/∂p (NQ × NS) for the parameters marked `sensitive`, in declaration order
     pub param_tangents: Option<Matrix>,
     /// With sensitive parameters and tangents: how M, C = ∂τ/∂qd and K = ∂τ/∂q at rest
@@ -90,9 +93,21 @@ impl SceneEquations {
         tree: &Tree,
         world: &World,
         scene: Option<usize>,
+        common: Option<&[usize]>,
     ) -> SceneEquations {
         let nd = sys.ndof();
         let effects = sys.scene_effects(scene);
+        // the loads of the scene's own effects, when the model's common tangents are built and
+        // these act on the coordinates without gravity (which acts through the bodies)
+        let own_loads = common.and_then(|common| {
+            let own: Vec<usize> = effects
+                .iter()
+                .copied()
+                .filter(|e| !common.contains(e))
+                .collect();
+            let loads = Loads::build(sys, tree, world, &own);
+            loads.gravity.is_none().then_some(loads)
+        });
         let loads = Loads::build(sys, tree, world, &effects);
         let vp = build_virtual_power(sys, tree, world).then(|| {
             let (m, h) = virtual_power(sys, tree, world, &loads);
@@ -138,17 +153,11 @@ impl SceneEquations {
             .map(|&e| (0..nu).map(|k| a.diff(e, Var::Input(k as u16))).collect())
             .collect();
         let tau: Vec<ExprId> = pick(tau_formulation, tau_vp.as_ref(), &tau_rec).clone();
-        let tangents = sys.options.tangents.then(|| {
-            let k: Vec<Vec<ExprId>> = tau
-                .iter()
-                .map(|&t| (0..nd).map(|j| a.diff(t, Var::Q(j as u16))).collect())
-                .collect();
-            let c: Vec<Vec<ExprId>> = tau
-                .iter()
-                .map(|&t| (0..nd).map(|j| a.diff(t, Var::Qd(j as u16))).collect())
-                .collect();
-            (k, c)
-        });
+        let own_tau = own_loads.map(|l| load_tau(sys, tree, world, &l));
+        let tangents_common = own_tau.is_some();
+        let a = &mut sys.arena;
+        let tau_t = own_tau.as_ref().unwrap_or(&tau);
+        let tangents = sys.options.tangents.then(|| tangent_matrices(a, tau_t));
         // ∂τ/∂p of the parameters marked `sensitive` (NQ × NS), the derivatives flowing
         // through every `let` and derived value since those are expressions of the parameters
         let sensitive: Vec<u16> = (0..sys.params.len())
@@ -199,6 +208,7 @@ impl SceneEquations {
             static_h,
             input_matrix,
             tangents,
+            tangents_common,
             param_tangents,
             rest_tangent_derivatives,
             kinetic,
@@ -227,6 +237,20 @@ pub const VP_PAIRS_LIMIT: usize = 20_000;
 
 /// Whether to build the virtual-power formulation: unless the recursive one is forced, or
 /// the model is beyond [`VP_PAIRS_LIMIT`] without virtual power forced.
+/// K = ∂τ/∂q and C = ∂τ/∂qd, rows of τ.
+pub fn tangent_matrices(a: &mut Arena, tau: &[ExprId]) -> (Matrix, Matrix) {
+    let nd = tau.len();
+    let k: Matrix = tau
+        .iter()
+        .map(|&t| (0..nd).map(|j| a.diff(t, Var::Q(j as u16))).collect())
+        .collect();
+    let c: Matrix = tau
+        .iter()
+        .map(|&t| (0..nd).map(|j| a.diff(t, Var::Qd(j as u16))).collect())
+        .collect();
+    (k, c)
+}
+
 fn build_virtual_power(sys: &System, tree: &Tree, world: &World) -> bool {
     match sys.options.formulation {
         Some(Formulation::VirtualPower) => return true,

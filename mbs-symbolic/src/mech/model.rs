@@ -3,8 +3,10 @@
 //! depend on the kinematics and not on each other.
 
 use super::constraints::ConstraintEquations;
-use super::dynamics::SceneEquations;
-use super::spatial as s;
+use super::dynamics::{SceneEquations, tangent_matrices};
+use super::effects::Loads;
+use super::recursive::newton_euler;
+use super::spatial::{self as s, Matrix};
 use super::system::System;
 use super::tree::Tree;
 use super::world::{Cols, World};
@@ -26,6 +28,9 @@ pub struct SymbolicModel {
     pub world: World,
     pub points: Vec<PointKin>,
     pub scenes: Vec<SceneEquations>,
+    /// With tangents and several scenes: K and C of the bodies and the effects every scene
+    /// has, emitted once; the scenes whose `tangents_common` is set add their own effects'
+    pub common_tangents: Option<(Matrix, Matrix)>,
     /// Φ, B, Φ_t, γ, ∂(Bᵀλ)/∂q of the constraints (empty without constraints)
     pub constraints: ConstraintEquations,
 }
@@ -39,10 +44,31 @@ impl SymbolicModel {
         } else {
             (0..sys.scenes.len()).map(Some).collect()
         };
-        let scenes = scenes
+        // τ is linear in the loads: the tangents of the bodies and of the effects every
+        // scene has are built once (not with sensitive parameters, whose derivatives at rest
+        // are built from each scene's whole tangents)
+        let common: Option<Vec<usize>> = (sys.options.tangents
+            && scenes.len() > 1
+            && !sys.params.iter().any(|p| p.sensitive))
+        .then(|| {
+            let all: Vec<Vec<usize>> = scenes.iter().map(|&s| sys.scene_effects(s)).collect();
+            all[0]
+                .iter()
+                .copied()
+                .filter(|e| all.iter().all(|v| v.contains(e)))
+                .collect()
+        });
+        let scenes: Vec<SceneEquations> = scenes
             .into_iter()
-            .map(|s| SceneEquations::build(&mut sys, &tree, &world, s))
+            .map(|s| SceneEquations::build(&mut sys, &tree, &world, s, common.as_deref()))
             .collect();
+        let common_tangents = common
+            .filter(|_| scenes.iter().any(|e| e.tangents_common))
+            .map(|common| {
+                let loads = Loads::build(&mut sys, &tree, &world, &common);
+                let tau = newton_euler(&mut sys, &tree, &world, &loads, true);
+                tangent_matrices(&mut sys.arena, &tau)
+            });
         let points = sys
             .points
             .clone()
@@ -75,6 +101,7 @@ impl SymbolicModel {
             world,
             points,
             scenes,
+            common_tangents,
             constraints,
         }
     }

@@ -120,27 +120,25 @@ impl FnSpec {
     /// Adds a dense matrix output given by rows, stored column-major (`target[i + rows*j]`);
     /// zeros are written by one `fill`.
     pub fn matrix(&mut self, a: &Arena, target: &str, rows: &[Vec<ExprId>]) {
-        let n = rows.len();
         if rows.iter().flatten().any(|&e| a.is_num(e, 0.0)) {
             self.prelude
                 .push(format!("{target}.fill({});", self.numbers.zero()));
             self.zeroed.push(target.into());
         }
-        for (i, row) in rows.iter().enumerate() {
-            for (j, &e) in row.iter().enumerate() {
-                if !a.is_num(e, 0.0) {
-                    self.outputs.push((format!("{target}[{}]", i + n * j), e));
-                }
-            }
-        }
+        self.nonzero_entries(a, target, rows);
     }
 
     /// Adds a dense matrix given by rows to `target` (column-major, as [`FnSpec::matrix`]),
     /// which holds a matrix already: its nonzero entries are added; the method adds all its
     /// outputs so.
     pub fn matrix_added(&mut self, a: &Arena, target: &str, rows: &[Vec<ExprId>]) {
-        let n = rows.len();
         self.accumulate = true;
+        self.nonzero_entries(a, target, rows);
+    }
+
+    /// The nonzero entries of a matrix given by rows as outputs `target[i + rows*j]`.
+    fn nonzero_entries(&mut self, a: &Arena, target: &str, rows: &[Vec<ExprId>]) {
+        let n = rows.len();
         for (i, row) in rows.iter().enumerate() {
             for (j, &e) in row.iter().enumerate() {
                 if !a.is_num(e, 0.0) {

@@ -381,16 +381,16 @@ fn emit_params(
             labels.push("constraint_rest_derivatives (B', K_λ')");
         }
     }
+    let mut shared = kinematics_specs(model, with_charts);
     // the tangents of the bodies and of the effects every scene has, when shared
     if let Some((k, c)) = &model.common_tangents {
         let mut f = FnSpec::new("__tangents_common", &with_charts("tangents"));
         f.matrix(a, "k", k);
         f.matrix(a, "c", c);
-        specs.push(f);
-        labels.push("tangents (K, C), common part");
+        shared.push((f, "tangents (K, C), common part"));
     }
     let mut ops = Vec::new();
-    for (spec, label) in kinematics_specs(model, with_charts) {
+    for (spec, label) in shared {
         if let Some((s, count)) = collect(emit_fn(a, &spec, &names), missing, |e| (e.text, e.count))
         {
             derived.push_str(&s);
@@ -401,7 +401,7 @@ fn emit_params(
         if let Some((s, count)) = collect(emit_fn(a, spec, &names), missing, |e| (e.text, e.count))
         {
             derived.push_str(&s);
-            if !c.phi.is_empty() || spec.name == "__tangents_common" {
+            if !c.phi.is_empty() {
                 ops.push((label.to_string(), count));
             }
         }

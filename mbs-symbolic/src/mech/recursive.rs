@@ -119,27 +119,8 @@ pub fn newton_euler(
     loads: &Loads,
     with_qdd: bool,
 ) -> Vec<ExprId> {
-    newton_euler_of(sys, tree, world, loads, Some(with_qdd))
-}
-
-/// The part of τ that `loads` make, without the bodies' inertia: τ is linear in the loads,
-/// so a scene's τ is that of the loads every scene has plus this of its own (which must not
-/// include gravity, which acts through the bodies).
-pub fn load_tau(sys: &mut System, tree: &Tree, world: &World, loads: &Loads) -> Vec<ExprId> {
-    debug_assert!(loads.gravity.is_none(), "gravity acts through the bodies");
-    newton_euler_of(sys, tree, world, loads, None)
-}
-
-/// Newton–Euler with the bodies (`Some(with_qdd)`) or with the loads alone (`None`).
-fn newton_euler_of(
-    sys: &mut System,
-    tree: &Tree,
-    world: &World,
-    loads: &Loads,
-    bodies: Option<bool>,
-) -> Vec<ExprId> {
     let nd = sys.ndof();
-    let bk = bodies.map(|with_qdd| body_kinematics(&mut sys.arena, tree, loads.gravity, with_qdd));
+    let bk = body_kinematics(&mut sys.arena, tree, loads.gravity, with_qdd);
     let spinning = spinning_frames(sys, tree);
     let a = &mut sys.arena;
     let rots = rotations(a, tree);
@@ -147,9 +128,6 @@ fn newton_euler_of(
     let mut force = vec![z; tree.nodes.len()];
     let mut moment = vec![z; tree.nodes.len()];
     let mut tau = vec![a.zero(); nd];
-    let (Some(bk), Some(with_qdd)) = (bk, bodies) else {
-        return backward(a, tree, world, &rots, loads, force, moment, tau);
-    };
     for (n, node) in tree.nodes.iter().enumerate().skip(1) {
         for &f in &node.frames {
             let Some(inr) = sys.frames[f].inertia else {
@@ -185,6 +163,28 @@ fn newton_euler_of(
         }
     }
     backward(a, tree, world, &rots, loads, force, moment, tau)
+}
+
+/// The part of τ that `loads` make, without the bodies' inertia: τ is linear in the loads,
+/// so a scene's τ is that of the loads every scene has plus this of its own (which must not
+/// include gravity, which acts through the bodies).
+pub fn load_tau(sys: &mut System, tree: &Tree, world: &World, loads: &Loads) -> Vec<ExprId> {
+    debug_assert!(loads.gravity.is_none(), "gravity acts through the bodies");
+    let nd = sys.ndof();
+    let a = &mut sys.arena;
+    let rots = rotations(a, tree);
+    let (z, zero) = (s::zero3(a), a.zero());
+    let nn = tree.nodes.len();
+    backward(
+        a,
+        tree,
+        world,
+        &rots,
+        loads,
+        vec![z; nn],
+        vec![z; nn],
+        vec![zero; nd],
+    )
 }
 
 /// The loads added to the bodies' forces and moments, then everything carried to the root

@@ -11,6 +11,8 @@ mod common;
 use common::*;
 use mbs_symbolic::SymbolicModel;
 use mbs_symbolic::expr::ExprId;
+use mbs_symbolic::mech::effects::Loads;
+use mbs_symbolic::mech::forward::{Elimination, articulated, bias_wrenches};
 use mbs_symbolic::mech::system::{Attach, Load};
 
 const TREES: u64 = 40;
@@ -306,6 +308,11 @@ struct Balance {
     regimes: [usize; 3],
     /// largest power of contacts and damped bushings alone, relative to the other terms
     max_power: f64,
+    /// qdd of the articulated bodies applied to the bodies' wrenches of Newton–Euler, the
+    /// loads taken off, against the dense solve of M qdd = h (recursive)
+    forward: Worst,
+    /// scenes (of trees whose coordinates each move one node) where that applies
+    articulated: usize,
 }
 
 /// Builds `TREES` random trees from `seed0` with the loads of `add_loads` (and the force
@@ -378,6 +385,14 @@ fn balance(
                 roots.extend(mb.m.iter().flatten());
                 roots.extend(&mb.h);
             }
+            let loads = Loads::build(&mut model.sys, &model.tree, &model.world, &eq.effects);
+            let (direct, bias) = bias_wrenches(&mut model.sys, &model.tree, &model.world, &loads);
+            let mut aba = Vec::new();
+            for e in [Elimination::ParentAxes, Elimination::ChildAxes] {
+                let f = articulated(&mut model.sys, &model.tree, &direct, Some(&bias), e);
+                aba.extend(f.map(|f| f.qdd).unwrap_or_default());
+            }
+            out.articulated += !aba.is_empty() as usize;
             for s in 0..STATES {
                 let (t, q, qd, _) = random_state(&mut rng, n);
                 let z = vec![0.0; n];
@@ -404,6 +419,11 @@ fn balance(
                 );
                 out.oracle
                     .see(rel_err(&h_vp, &h_ref).max(rel_err(&h_rec, &h_ref)), at);
+                let qdd_ref = solve_spd(&m_rec, &h_rec);
+                let v = eval_charts(&model, &aba, (t, &q, &qd, &z), &charts);
+                for qdd in v.chunks(n) {
+                    out.forward.see(rel_err(qdd, &qdd_ref), at);
+                }
                 for (m, h) in [(&m_vp, &h_vp), (&m_rec, &h_rec)] {
                     let qdd = solve_spd(m, h);
                     let v = eval_charts(&model, &roots[..4], (t, &q, &qd, &qdd), &charts);
@@ -437,6 +457,11 @@ fn energy_balance_with_loads() {
     b.vp_rec
         .check("M, h with loads: virtual power vs recursive", 1e-10);
     b.oracle.check("h with loads vs oracle", 1e-10);
+    b.forward.check(
+        "forward dynamics with loads, articulated bodies on the bodies' wrenches, vs dense solve",
+        1e-10,
+    );
+    assert!(b.articulated >= 10, "{} scenes", b.articulated);
     b.cons.check("gravity + springs: d(T+V)/dt = 0", 1e-9);
     b.full.check("all loads: d(T+V)/dt = power", 1e-9);
     assert!(tally.iter().all(|&c| c >= 5), "{tally:?}");
@@ -474,6 +499,12 @@ fn energy_balance_with_contacts_and_bushings() {
         1e-10,
     );
     b.oracle.check("h with force elements vs oracle", 1e-10);
+    b.forward.check(
+        "forward dynamics with force elements, articulated bodies on the bodies' wrenches, \
+         vs dense solve",
+        1e-10,
+    );
+    assert!(b.articulated >= 10, "{} scenes", b.articulated);
     b.cons
         .check("gravity + springs + bushings: d(T+V)/dt = 0", 1e-9);
     b.full.check("with contacts: d(T+V)/dt = power", 1e-9);

@@ -8,7 +8,8 @@ mod common;
 use common::*;
 use mbs_symbolic::SymbolicModel;
 use mbs_symbolic::expr::ExprId;
-use mbs_symbolic::mech::forward::{Elimination, articulated, ltdl};
+use mbs_symbolic::mech::effects::Loads;
+use mbs_symbolic::mech::forward::{Elimination, articulated, bias_wrenches, ltdl};
 use mbs_symbolic::mech::tree::canonical;
 
 const TREES: u64 = 100;
@@ -220,11 +221,17 @@ impl Checks {
             let mb = model.scenes[0].chosen();
             (mb.m.clone(), mb.h.clone())
         };
-        // articulated bodies in both places of elimination
-        let aba: Vec<_> = [Elimination::ParentAxes, Elimination::ChildAxes]
-            .into_iter()
-            .filter_map(|e| articulated(&mut model.sys, &model.tree, &h_sym, e))
-            .collect();
+        // articulated bodies in both places of elimination, applied to h and to the bodies'
+        // wrenches of Newton–Euler
+        let effects = model.scenes[0].effects.clone();
+        let loads = Loads::build(&mut model.sys, &model.tree, &model.world, &effects);
+        let (direct, bias) = bias_wrenches(&mut model.sys, &model.tree, &model.world, &loads);
+        let mut aba = Vec::new();
+        for (rhs, bias) in [(&h_sym, None), (&direct, Some(&bias[..]))] {
+            for e in [Elimination::ParentAxes, Elimination::ChildAxes] {
+                aba.extend(articulated(&mut model.sys, &model.tree, rhs, bias, e));
+            }
+        }
         let sparse = ltdl(&mut model.sys.arena, &m_sym, &h_sym);
         self.articulated += !aba.is_empty() as usize;
         let mut forward = Vec::new();

@@ -119,11 +119,28 @@ pub fn newton_euler(
     loads: &Loads,
     with_qdd: bool,
 ) -> Vec<ExprId> {
+    let w = body_wrenches(sys, tree, loads, with_qdd);
+    let a = &mut sys.arena;
+    let rots = rotations(a, tree);
+    backward(a, tree, world, &rots, loads, w.force, w.moment, w.tau)
+}
+
+/// What the bodies' motion asks of each node before anything is carried inwards: the force
+/// and the moment about its origin, in its axes (the bodies' m a and Φ α + ω × Φ ω at the
+/// accelerations `with_qdd` says, gravity included; a spinning body's in its parent's), and
+/// the spinning bodies' axial moments on their coordinates (`tau`).
+pub struct BodyWrenches {
+    pub force: Vec<V3>,
+    pub moment: Vec<V3>,
+    pub tau: Vec<ExprId>,
+}
+
+/// The bodies' wrenches of Newton–Euler's outward pass (see [`BodyWrenches`]).
+pub fn body_wrenches(sys: &mut System, tree: &Tree, loads: &Loads, with_qdd: bool) -> BodyWrenches {
     let nd = sys.ndof();
     let bk = body_kinematics(&mut sys.arena, tree, loads.gravity, with_qdd);
     let spinning = spinning_frames(sys, tree);
     let a = &mut sys.arena;
-    let rots = rotations(a, tree);
     let z = s::zero3(a);
     let mut force = vec![z; tree.nodes.len()];
     let mut moment = vec![z; tree.nodes.len()];
@@ -162,7 +179,7 @@ pub fn newton_euler(
             moment[n] = s::add(a, moment[n], m);
         }
     }
-    backward(a, tree, world, &rots, loads, force, moment, tau)
+    BodyWrenches { force, moment, tau }
 }
 
 /// The part of τ that `loads` make, without the bodies' inertia: τ is linear in the loads,
@@ -187,6 +204,27 @@ pub fn load_tau(sys: &mut System, tree: &Tree, world: &World, loads: &Loads) -> 
     )
 }
 
+/// The loads' forces and moments on the nodes (in their axes, about their origins) taken from
+/// what the bodies ask of them.
+pub fn subtract_loads(
+    a: &mut Arena,
+    world: &World,
+    loads: &Loads,
+    force: &mut [V3],
+    moment: &mut [V3],
+) {
+    for &(n, r, fw) in &loads.forces {
+        let f = s::mul_mtv(a, &world.nodes[n].r, fw);
+        force[n] = s::sub(a, force[n], f);
+        let rxf = s::cross(a, r, f);
+        moment[n] = s::sub(a, moment[n], rxf);
+    }
+    for &(n, tw) in &loads.torques {
+        let t = s::mul_mtv(a, &world.nodes[n].r, tw);
+        moment[n] = s::sub(a, moment[n], t);
+    }
+}
+
 /// The loads added to the bodies' forces and moments, then everything carried to the root
 /// and projected on the coordinates.
 #[allow(clippy::too_many_arguments)]
@@ -200,16 +238,7 @@ fn backward(
     mut moment: Vec<V3>,
     mut tau: Vec<ExprId>,
 ) -> Vec<ExprId> {
-    for &(n, r, fw) in &loads.forces {
-        let f = s::mul_mtv(a, &world.nodes[n].r, fw);
-        force[n] = s::sub(a, force[n], f);
-        let rxf = s::cross(a, r, f);
-        moment[n] = s::sub(a, moment[n], rxf);
-    }
-    for &(n, tw) in &loads.torques {
-        let t = s::mul_mtv(a, &world.nodes[n].r, tw);
-        moment[n] = s::sub(a, moment[n], t);
-    }
+    subtract_loads(a, world, loads, &mut force, &mut moment);
     for n in (1..tree.nodes.len()).rev() {
         let fac = tree.nodes[n].factor.unwrap();
         let (f, m) = (force[n], moment[n]);

@@ -71,7 +71,8 @@ mbs::multibody! {
 mbs::multibody! {
     /// The box of `Block` in three scenes (free, on the floor, on the floor and hung from a
     /// spring): with tangents and several scenes, the tangents of the bodies and gravity are
-    /// generated once and each scene adds those of its own effects.
+    /// generated once, those of `floor` (which two scenes have) once, and `Hung` adds those of
+    /// `hung`.
     pub model Crate {
         param k = 2e4; param c = 100.0; param mu = 0.5; param eps = 1e-4;
         dof x = 0.0; dof y = 0.0; dof z = 0.3; dof a = 0.3; dof b = 0.2; dof r = -0.15;
@@ -219,6 +220,17 @@ fn tangents_shared_by_scenes_match_central_differences() {
         &qdd,
         "crate on the floor, hung",
     );
+    // each part generated once: the floor's tangents serve two scenes
+    fn parts<M: Model>(m: &M) -> Vec<&'static str> {
+        let rows = m.info().ops.iter().map(|(label, _)| *label);
+        rows.filter(|l| l.starts_with("tangents")).collect()
+    }
+    let common = "tangents (K, C), common part";
+    let floor = "tangents (K, C), effects floor";
+    assert_eq!(parts(&CrateFree::default()), [common]);
+    assert_eq!(parts(&CrateFloor::default()), [common, floor]);
+    let hung = "tangents (K, C), effects hung";
+    assert_eq!(parts(&CrateHung::default()), [common, floor, hung]);
 }
 
 #[test]

@@ -161,7 +161,7 @@ fn emit_params(
     vis: &str,
     code: &mut String,
     missing: &mut Vec<MissingDerivative>,
-) -> Vec<(String, OpCount)> {
+) -> Vec<(String, OpCount, Option<usize>)> {
     let sys = &model.sys;
     let a = &sys.arena;
     let ty = format!("{}Params", sys.name);
@@ -381,20 +381,36 @@ fn emit_params(
             labels.push("constraint_rest_derivatives (B', K_λ')");
         }
     }
-    let mut shared = kinematics_specs(model, with_charts);
-    // the tangents of the bodies and of the effects every scene has, when shared
-    if let Some((k, c)) = &model.common_tangents {
-        let mut f = FnSpec::new("__tangents_common", &with_charts("tangents"));
-        f.matrix(a, "k", k);
-        f.matrix(a, "c", c);
-        shared.push((f, "tangents (K, C), common part"));
+    let mut shared: Vec<(FnSpec, String, Option<usize>)> = kinematics_specs(model, with_charts)
+        .into_iter()
+        .map(|(f, label)| (f, label.to_string(), None))
+        .collect();
+    // the tangents shared by the scenes: of the bodies and the effects every scene has
+    // (written), then of each group of other effects (added)
+    for (i, part) in model.shared_tangents.iter().enumerate() {
+        let mut f = FnSpec::new(&tangent_part_fn(i), &with_charts("tangents"));
+        let label = if i == 0 {
+            f.matrix(a, "k", &part.k);
+            f.matrix(a, "c", &part.c);
+            "tangents (K, C), common part".to_string()
+        } else {
+            f.matrix_added(a, "k", &part.k);
+            f.matrix_added(a, "c", &part.c);
+            let names: Vec<&str> = part
+                .effects
+                .iter()
+                .filter_map(|&e| sys.effects[e].name.as_deref())
+                .collect();
+            format!("tangents (K, C), effects {}", names.join(", "))
+        };
+        shared.push((f, label, Some(i)));
     }
     let mut ops = Vec::new();
-    for (spec, label) in shared {
+    for (spec, label, part) in shared {
         if let Some((s, count)) = collect(emit_fn(a, &spec, &names), missing, |e| (e.text, e.count))
         {
             derived.push_str(&s);
-            ops.push((label.to_string(), count));
+            ops.push((label, count, part));
         }
     }
     for (spec, label) in specs.iter().zip(labels) {
@@ -402,7 +418,7 @@ fn emit_params(
         {
             derived.push_str(&s);
             if !c.phi.is_empty() {
-                ops.push((label.to_string(), count));
+                ops.push((label.to_string(), count, None));
             }
         }
     }
@@ -449,6 +465,14 @@ Ok(())
         checks = checks.join("\n"),
     );
     ops
+}
+
+/// The name of the function of part `i` of the tangents the scenes share.
+fn tangent_part_fn(i: usize) -> String {
+    match i {
+        0 => "__tangents_common".to_string(),
+        _ => format!("__tangents_effects{i}"),
+    }
 }
 
 /// The poses and kinematics of frames and points, the same in every scene: emitted once on
@@ -534,7 +558,7 @@ fn emit_scene(
     model: &SymbolicModel,
     eq: &SceneEquations,
     vis: &str,
-    shared: &[(String, OpCount)],
+    shared: &[(String, OpCount, Option<usize>)],
     code: &mut String,
     reports: &mut Vec<FunctionReport>,
     missing: &mut Vec<MissingDerivative>,
@@ -603,16 +627,9 @@ fn emit_scene(
     specs.push((f, Some("inverse_dynamics")));
     if let Some((kt, ct)) = &eq.tangents {
         let mut f = FnSpec::new("__tangents", args("tangents"));
-        if eq.tangents_common {
-            // added to the tangents common to the scenes
-            f.matrix_added(a, "k", kt);
-            f.matrix_added(a, "c", ct);
-            specs.push((f, Some("tangents (K, C), own effects")));
-        } else {
-            f.matrix(a, "k", kt);
-            f.matrix(a, "c", ct);
-            specs.push((f, Some("tangents (K, C)")));
-        }
+        f.matrix(a, "k", kt);
+        f.matrix(a, "c", ct);
+        specs.push((f, Some("tangents (K, C)")));
     }
     if let Some(dp) = &eq.param_tangents {
         let mut f = FnSpec::new("__parameter_tangents", api::PARAMETER_TANGENTS.args);
@@ -692,8 +709,11 @@ fn emit_scene(
         }
     }
     // the kinematics and constraint functions, emitted once on the parameters, serve every
-    // scene
-    for (label, c) in shared {
+    // scene; the shared tangents' parts those that add them
+    for (label, c, part) in shared {
+        if part.is_some_and(|p| !eq.tangent_parts.contains(&p)) {
+            continue;
+        }
         ops.push((label.clone(), *c));
         reports.push(FunctionReport {
             model: ty.clone(),
@@ -813,7 +833,7 @@ fn emit_scene(
             .map(|d| d.independent.to_string())
             .collect::<Vec<_>>()
             .join(", "),
-        tan = eq.tangents.is_some(),
+        tan = eq.tangents.is_some() || !eq.tangent_parts.is_empty(),
         shapes = shapes::literal(&shapes::shapes(sys)),
         joints = sys
             .rotation_joints
@@ -830,8 +850,18 @@ fn emit_scene(
             .collect::<Vec<_>>()
             .join(", "),
     );
-    let tangents_body = if eq.tangents_common {
-        "self.params.__tangents_common(&self.charts, t, q, qd, qdd, u, k, c);\nself.__tangents(t, q, qd, qdd, u, k, c);\nOk(())".to_string()
+    let tangents_body = if !eq.tangent_parts.is_empty() {
+        let calls: String = eq
+            .tangent_parts
+            .iter()
+            .map(|&i| {
+                format!(
+                    "self.params.{}(&self.charts, t, q, qd, qdd, u, k, c);\n",
+                    tangent_part_fn(i)
+                )
+            })
+            .collect();
+        calls + "Ok(())"
     } else if eq.tangents.is_some() {
         "self.__tangents(t, q, qd, qdd, u, k, c);\nOk(())".to_string()
     } else {

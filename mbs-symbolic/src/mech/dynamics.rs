@@ -3,7 +3,7 @@
 
 use super::effects::Loads;
 use super::forward::{Elimination, Forward, articulated, bias_wrenches, ltdl, ltdl_estimate};
-use super::recursive::{body_kinematics, crba, load_tau, newton_euler, spinning_body_motion};
+use super::recursive::{body_kinematics, crba, newton_euler, spinning_body_motion};
 use super::spin::spinning_frames;
 
 use super::spatial::{self as s, Matrix};
@@ -56,11 +56,13 @@ pub struct SceneEquations {
     pub static_h: Vec<ExprId>,
     /// ∂h/∂u (dense, row-major, NQ × NU): how inputs enter the equations
     pub input_matrix: Matrix,
-    /// K_t = ∂τ/∂q and C_t = ∂τ/∂qd (dense, row-major), when the model asks for them; with
-    /// `tangents_common`, only the part of the scene's own effects
+    /// K_t = ∂τ/∂q and C_t = ∂τ/∂qd (dense, row-major), when the model asks for them and the
+    /// scene does not take them from the model's shared parts (`tangent_parts`)
     pub tangents: Option<(Matrix, Matrix)>,
-    /// whether `tangents` add to the model's (`SymbolicModel::common_tangents`)
-    pub tangents_common: bool,
+    /// With tangents shared by the scenes: the parts of `SymbolicModel::shared_tangents` whose
+    /// sum is this scene's K_t and C_t (the bodies' and the common effects' first, then the
+    /// groups of its other effects); empty when the scene builds its own (`tangents`)
+    pub tangent_parts: Vec<usize>,
     /// ∂τ/∂p (NQ × NS) for the parameters marked `sensitive`, in declaration order
     pub param_tangents: Option<Matrix>,
     /// With sensitive parameters and tangents: how M, C = ∂τ/∂qd and K = ∂τ/∂q at rest
@@ -97,16 +99,16 @@ impl SceneEquations {
     ) -> SceneEquations {
         let nd = sys.ndof();
         let effects = sys.scene_effects(scene);
-        // the loads of the scene's own effects, when the model's common tangents are built and
-        // these act on the coordinates without gravity (which acts through the bodies)
-        let own_loads = common.and_then(|common| {
+        // the scene takes its tangents from the model's shared parts when its own effects (the
+        // ones not every scene has) act on the coordinates without gravity, which acts through
+        // the bodies
+        let shares = common.is_some_and(|common| {
             let own: Vec<usize> = effects
                 .iter()
                 .copied()
                 .filter(|e| !common.contains(e))
                 .collect();
-            let loads = Loads::build(sys, tree, world, &own);
-            loads.gravity.is_none().then_some(loads)
+            Loads::build(sys, tree, world, &own).gravity.is_none()
         });
         let loads = Loads::build(sys, tree, world, &effects);
         let vp = build_virtual_power(sys, tree, world).then(|| {
@@ -153,11 +155,8 @@ impl SceneEquations {
             .map(|&e| (0..nu).map(|k| a.diff(e, Var::Input(k as u16))).collect())
             .collect();
         let tau: Vec<ExprId> = pick(tau_formulation, tau_vp.as_ref(), &tau_rec).clone();
-        let own_tau = own_loads.map(|l| load_tau(sys, tree, world, &l));
-        let tangents_common = own_tau.is_some();
         let a = &mut sys.arena;
-        let tau_t = own_tau.as_ref().unwrap_or(&tau);
-        let tangents = sys.options.tangents.then(|| tangent_matrices(a, tau_t));
+        let tangents = (sys.options.tangents && !shares).then(|| tangent_matrices(a, &tau));
         // ∂τ/∂p of the parameters marked `sensitive` (NQ × NS), the derivatives flowing
         // through every `let` and derived value since those are expressions of the parameters
         let sensitive: Vec<u16> = (0..sys.params.len())
@@ -214,7 +213,7 @@ impl SceneEquations {
             static_h,
             input_matrix,
             tangents,
-            tangents_common,
+            tangent_parts: if shares { vec![0] } else { Vec::new() },
             param_tangents,
             rest_tangent_derivatives,
             kinetic,

@@ -5,7 +5,7 @@
 use super::constraints::ConstraintEquations;
 use super::dynamics::{SceneEquations, tangent_matrices};
 use super::effects::Loads;
-use super::recursive::newton_euler;
+use super::recursive::{load_tau, newton_euler};
 use super::spatial::{self as s, Matrix};
 use super::system::System;
 use super::tree::Tree;
@@ -21,6 +21,14 @@ pub struct PointKin {
     pub bias: s::V3,
 }
 
+/// K_t and C_t of some loads, emitted once for the scenes that add them.
+pub struct SharedTangents {
+    /// the effects whose loads these are (and the bodies', for the first part)
+    pub effects: Vec<usize>,
+    pub k: Matrix,
+    pub c: Matrix,
+}
+
 /// The symbolic model: system, tree, world kinematics and the equations of every scene.
 pub struct SymbolicModel {
     pub sys: System,
@@ -28,9 +36,10 @@ pub struct SymbolicModel {
     pub world: World,
     pub points: Vec<PointKin>,
     pub scenes: Vec<SceneEquations>,
-    /// With tangents and several scenes: K and C of the bodies and the effects every scene
-    /// has, emitted once; the scenes whose `tangents_common` is set add their own effects'
-    pub common_tangents: Option<(Matrix, Matrix)>,
+    /// With tangents and several scenes, emitted once each: K and C of the bodies and the
+    /// effects every scene has (the first part), then of each group of the other effects that
+    /// the same scenes have; a scene's K and C are the sum of its `tangent_parts`
+    pub shared_tangents: Vec<SharedTangents>,
     /// Φ, B, Φ_t, γ, ∂(Bᵀλ)/∂q of the constraints (empty without constraints)
     pub constraints: ConstraintEquations,
 }
@@ -58,17 +67,49 @@ impl SymbolicModel {
                 .filter(|e| all.iter().all(|v| v.contains(e)))
                 .collect()
         });
-        let scenes: Vec<SceneEquations> = scenes
+        let mut scenes: Vec<SceneEquations> = scenes
             .into_iter()
             .map(|s| SceneEquations::build(&mut sys, &tree, &world, s, common.as_deref()))
             .collect();
-        let common_tangents = common
-            .filter(|_| scenes.iter().any(|e| e.tangents_common))
-            .map(|common| {
-                let loads = Loads::build(&mut sys, &tree, &world, &common);
-                let tau = newton_euler(&mut sys, &tree, &world, &loads, true);
-                tangent_matrices(&mut sys.arena, &tau)
+        let sharing: Vec<usize> = (0..scenes.len())
+            .filter(|&i| !scenes[i].tangent_parts.is_empty())
+            .collect();
+        let mut shared_tangents = Vec::new();
+        if let Some(common) = common.filter(|_| !sharing.is_empty()) {
+            let loads = Loads::build(&mut sys, &tree, &world, &common);
+            let tau = newton_euler(&mut sys, &tree, &world, &loads, true);
+            let (k, c) = tangent_matrices(&mut sys.arena, &tau);
+            shared_tangents.push(SharedTangents {
+                effects: common.clone(),
+                k,
+                c,
             });
+            // the other effects of those scenes, grouped by the scenes that have them: τ is
+            // linear in the loads, so each group's part is carried to the coordinates
+            // without the bodies, once
+            let mut groups: Vec<(Vec<usize>, Vec<usize>)> = Vec::new();
+            for e in (0..sys.effects.len()).filter(|e| !common.contains(e)) {
+                let users: Vec<usize> = sharing
+                    .iter()
+                    .copied()
+                    .filter(|&i| scenes[i].effects.contains(&e))
+                    .collect();
+                match groups.iter_mut().find(|g| g.0 == users) {
+                    _ if users.is_empty() => {}
+                    Some(g) => g.1.push(e),
+                    None => groups.push((users, vec![e])),
+                }
+            }
+            for (users, effects) in groups {
+                let loads = Loads::build(&mut sys, &tree, &world, &effects);
+                let tau = load_tau(&mut sys, &tree, &world, &loads);
+                let (k, c) = tangent_matrices(&mut sys.arena, &tau);
+                for i in users {
+                    scenes[i].tangent_parts.push(shared_tangents.len());
+                }
+                shared_tangents.push(SharedTangents { effects, k, c });
+            }
+        }
         let points = sys
             .points
             .clone()
@@ -101,7 +142,7 @@ impl SymbolicModel {
             world,
             points,
             scenes,
-            common_tangents,
+            shared_tangents,
             constraints,
         }
     }

@@ -12,10 +12,10 @@
 //!   pass), 6 % fewer operations on spatial arms (9–10 % on planar chains, where
 //!   `mech::dynamics` keeps h: the same latency, measured no faster). It needs every
 //!   coordinate to move exactly one node of the tree (a coordinate shared by two factors
-//!   couples them outside the tree). Three things keep a spatial arm's joint near 220 flops,
-//!   where a full spatial transform per elementary factor cost about 300: translations that
-//!   no coordinate moves and no branch separates are taken in one step; a rotation about a
-//!   coordinate axis turns a 3×3 block by the double angle (`Turn`); and the zeros an
+//!   couples them outside the tree). Three things keep a spatial arm's joint at 220–250
+//!   flops, where a full spatial transform per elementary factor cost about 300: translations
+//!   that no coordinate moves and no branch separates are taken in one step; a rotation about
+//!   a coordinate axis turns a 3×3 block by the double angle (`Turn`); and the zeros an
 //!   elimination leaves are set (`Art::clear_along`). The recursion is a chain of dependent
 //!   steps through a division per coordinate, so its time on a planar chain is its latency,
 //!   not its operation count: `Elimination` says where a rotation's coordinate is

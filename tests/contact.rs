@@ -101,6 +101,31 @@ mbs::multibody! {
 }
 
 mbs::multibody! {
+    /// The box with gravity as an effect of its own: a scene whose effects beyond the common
+    /// ones hold gravity (which acts through the bodies) builds its tangents whole; the others
+    /// share theirs.
+    pub model Weighed {
+        param k = 2e4; param c = 100.0; param mu = 0.5; param eps = 1e-4;
+        dof x = 0.0; dof y = 0.0; dof z = 0.3; dof a = 0.3; dof b = 0.2; dof r = -0.15;
+        body box1 { mass = 1.0; inertia = (0.2 * 0.2 / 6, 0.2 * 0.2 / 6, 0.2 * 0.2 / 6); }
+        point c0 on box1 at (-0.1, -0.1, -0.1);
+        point c1 on box1 at (0.1, -0.1, -0.1);
+        point c2 on box1 at (0.1, 0.1, -0.1);
+        TOG[box1] = Tdisp(x, y, z) * Trotz(a) * Troty(b) * Trotx(r);
+        effect weight { gravity(0, 0, -9.81); }
+        effect floor {
+            contact(c0, k = k, c = c, mu = mu, eps = eps);
+            contact(c1, k = k, c = c, mu = mu, eps = eps);
+            contact(c2, k = k, c = c, mu = mu, eps = eps);
+        }
+        scene Free = [];
+        scene Floor = [floor];
+        scene Heavy = [weight, floor];
+        option tangents;
+    }
+}
+
+mbs::multibody! {
     /// A body on a bushing to the ground: translation x and rotation a about z.
     pub model Mount {
         param m = 2.0; param izz = 0.05;
@@ -231,6 +256,14 @@ fn tangents_shared_by_scenes_match_central_differences() {
     assert_eq!(parts(&CrateFloor::default()), [common, floor]);
     let hung = "tangents (K, C), effects hung";
     assert_eq!(parts(&CrateHung::default()), [common, floor, hung]);
+    // gravity as an effect: the scene that has it builds its own; the floor's part then
+    // serves one scene
+    check_tangents(&WeighedFree::default(), &q, &qd, &qdd, "weighed, free");
+    check_tangents(&WeighedFloor::default(), &q, &qd, &qdd, "weighed, floor");
+    check_tangents(&WeighedHeavy::default(), &q, &qd, &qdd, "weighed, heavy");
+    assert_eq!(parts(&WeighedFree::default()), [common]);
+    assert_eq!(parts(&WeighedFloor::default()), [common, floor]);
+    assert_eq!(parts(&WeighedHeavy::default()), ["tangents (K, C)"]);
 }
 
 #[test]

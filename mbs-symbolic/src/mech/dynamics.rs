@@ -7,7 +7,7 @@ use super::recursive::{body_kinematics, crba, newton_euler, spinning_body_motion
 use super::spin::spinning_frames;
 
 use super::spatial::{self as s, Matrix};
-use super::system::{Factor, Formulation, System};
+use super::system::{Factor, Formulation, Load, System};
 use super::tree::Tree;
 use super::virtual_power::virtual_power;
 use super::world::World;
@@ -103,12 +103,9 @@ impl SceneEquations {
         // ones not every scene has) act on the coordinates without gravity, which acts through
         // the bodies
         let shares = common.is_some_and(|common| {
-            let own: Vec<usize> = effects
-                .iter()
-                .copied()
-                .filter(|e| !common.contains(e))
-                .collect();
-            Loads::build(sys, tree, world, &own).gravity.is_none()
+            let own = effects.iter().filter(|e| !common.contains(e));
+            let loads = own.flat_map(|&e| &sys.effects[e].loads);
+            !loads.into_iter().any(|l| matches!(l, Load::Gravity(_)))
         });
         let loads = Loads::build(sys, tree, world, &effects);
         let vp = build_virtual_power(sys, tree, world).then(|| {
@@ -240,8 +237,6 @@ fn pick<'a, T>(formulation: Formulation, vp: Option<&'a T>, rec: &'a T) -> &'a T
 /// products; it was chosen only on models far below, e.g. a Cartesian double pendulum).
 pub const VP_PAIRS_LIMIT: usize = 20_000;
 
-/// Whether to build the virtual-power formulation: unless the recursive one is forced, or
-/// the model is beyond [`VP_PAIRS_LIMIT`] without virtual power forced.
 /// K = ∂τ/∂q and C = ∂τ/∂qd, rows of τ.
 pub fn tangent_matrices(a: &mut Arena, tau: &[ExprId]) -> (Matrix, Matrix) {
     let nd = tau.len();
@@ -256,6 +251,8 @@ pub fn tangent_matrices(a: &mut Arena, tau: &[ExprId]) -> (Matrix, Matrix) {
     (k, c)
 }
 
+/// Whether to build the virtual-power formulation: unless the recursive one is forced, or
+/// the model is beyond [`VP_PAIRS_LIMIT`] without virtual power forced.
 fn build_virtual_power(sys: &System, tree: &Tree, world: &World) -> bool {
     match sys.options.formulation {
         Some(Formulation::VirtualPower) => return true,

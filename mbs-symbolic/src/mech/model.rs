@@ -94,8 +94,10 @@ impl SymbolicModel {
                     .copied()
                     .filter(|&i| scenes[i].effects.contains(&e))
                     .collect();
+                if users.is_empty() {
+                    continue;
+                }
                 match groups.iter_mut().find(|g| g.0 == users) {
-                    _ if users.is_empty() => {}
                     Some(g) => g.1.push(e),
                     None => groups.push((users, vec![e])),
                 }

@@ -120,9 +120,7 @@ pub fn newton_euler(
     with_qdd: bool,
 ) -> Vec<ExprId> {
     let w = body_wrenches(sys, tree, loads, with_qdd);
-    let a = &mut sys.arena;
-    let rots = rotations(a, tree);
-    backward(a, tree, world, &rots, loads, w.force, w.moment, w.tau)
+    backward(&mut sys.arena, tree, world, loads, w)
 }
 
 /// What the bodies' motion asks of each node before anything is carried inwards: the force
@@ -189,19 +187,14 @@ pub fn load_tau(sys: &mut System, tree: &Tree, world: &World, loads: &Loads) -> 
     debug_assert!(loads.gravity.is_none(), "gravity acts through the bodies");
     let nd = sys.ndof();
     let a = &mut sys.arena;
-    let rots = rotations(a, tree);
     let (z, zero) = (s::zero3(a), a.zero());
     let nn = tree.nodes.len();
-    backward(
-        a,
-        tree,
-        world,
-        &rots,
-        loads,
-        vec![z; nn],
-        vec![z; nn],
-        vec![zero; nd],
-    )
+    let none = BodyWrenches {
+        force: vec![z; nn],
+        moment: vec![z; nn],
+        tau: vec![zero; nd],
+    };
+    backward(a, tree, world, loads, none)
 }
 
 /// The loads' forces and moments on the nodes (in their axes, about their origins) taken from
@@ -227,17 +220,19 @@ pub fn subtract_loads(
 
 /// The loads added to the bodies' forces and moments, then everything carried to the root
 /// and projected on the coordinates.
-#[allow(clippy::too_many_arguments)]
 fn backward(
     a: &mut Arena,
     tree: &Tree,
     world: &World,
-    rots: &[Option<M3>],
     loads: &Loads,
-    mut force: Vec<V3>,
-    mut moment: Vec<V3>,
-    mut tau: Vec<ExprId>,
+    wrenches: BodyWrenches,
 ) -> Vec<ExprId> {
+    let BodyWrenches {
+        mut force,
+        mut moment,
+        mut tau,
+    } = wrenches;
+    let rots = rotations(a, tree);
     subtract_loads(a, world, loads, &mut force, &mut moment);
     for n in (1..tree.nodes.len()).rev() {
         let fac = tree.nodes[n].factor.unwrap();

@@ -6,10 +6,10 @@
 //   previous link's frame, 0.3 m boxes of 1 kg along x, q(0) = 0.2 rad, gravity along −z (as
 //   `arm3d_6`); `pairs` = n/2 − 1, `last` = n − 1, `before_last` = n − 2 (the language's
 //   loop ranges and indices outside loops are written numbers).
-// Options of the language follow as identifiers: `chain!(Name, 16, batch)`.
+// Options of the language follow: `chain!(Name, 16, batch)`, `chain!(Name, 32, jacobians = assembled)`.
 
 macro_rules! chain {
-    ($name:ident, $n:tt $(, $option:ident)*) => {
+    ($name:ident, $n:tt $(, $option:ident $(= $value:ident)?)*) => {
         mbs::multibody! {
             /// Planar chain of uniform bars.
             pub model $name {
@@ -23,14 +23,14 @@ macro_rules! chain {
                     TOG[bar[i]] = TOG[bar[i-1]] * Tdisp(0, -l/2, 0) * Trotz(q[i]) * Tdisp(0, -l/2, 0);
                 }
                 gravity(0, -g, 0);
-                $(option $option;)*
+                $(option $option $(= $value)?;)*
             }
         }
     };
 }
 
 macro_rules! arm {
-    ($name:ident, $n:tt, $pairs:tt, $last:tt, $before:tt $(, $option:ident)*) => {
+    ($name:ident, $n:tt, $pairs:tt, $last:tt, $before:tt $(, $option:ident $(= $value:ident)?)*) => {
         mbs::multibody! {
             /// Spatial arm of revolute joints, axes z, y alternating.
             pub model $name {
@@ -48,7 +48,7 @@ macro_rules! arm {
                 }
                 TOG[link[$last]] = TOG[link[$before]] * Tdisp(len / 2, 0, 0) * Troty(q[$last]) * Tdisp(len / 2, 0, 0);
                 gravity(0, 0, -g);
-                $(option $option;)*
+                $(option $option $(= $value)?;)*
             }
         }
     };

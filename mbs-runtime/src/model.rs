@@ -318,6 +318,75 @@ impl Kinematics {
     }
 }
 
+/// The tree of a generated model's twists, from which `kinematics` and `point_kinematics`
+/// assemble the Jacobians of frames and points when the model generates the twists rather
+/// than every column (`option jacobians = assembled;`, the default for large models): each
+/// node of the tree moves with a twist per coordinate of its factor, (ω, v₀) in world axes
+/// with v₀ the velocity at the world origin, and the column of coordinate j of a point p's
+/// Jacobian is the sum over the nodes on p's path to the root of v₀ + ω × p (and of ω for a
+/// frame's J_ω). Used by generated code only.
+#[doc(hidden)]
+#[derive(Clone, Copy, Debug)]
+pub struct TwistTree {
+    /// parent of each node (the root, node 0, its own)
+    pub parent: &'static [u32],
+    /// the twists of node k are `first[k]..first[k + 1]`
+    pub first: &'static [u32],
+    /// the coordinate of each twist
+    pub coordinate: &'static [u16],
+    /// the node of each frame and each declared point (0 for a point fixed in the world)
+    pub frame_node: &'static [u32],
+    pub point_node: &'static [u32],
+}
+
+impl TwistTree {
+    /// The Jacobians of the points, and of the frames when `frames`, from the twists `tw`
+    /// (6 per twist: ω, then v₀) and the positions already in `out`.
+    pub fn assemble(&self, tw: &[f64], out: &mut Kinematics, frames: bool) {
+        if frames {
+            for (f, &node) in out.frames.iter_mut().zip(self.frame_node) {
+                f.jv.fill(0.0);
+                f.jw.fill(0.0);
+                let p = f.pose.position;
+                let mut k = node as usize;
+                while k != 0 {
+                    for t in self.first[k] as usize..self.first[k + 1] as usize {
+                        let x: &[f64; 6] = tw[6 * t..6 * t + 6].try_into().expect("6 values");
+                        let j = 3 * self.coordinate[t] as usize;
+                        add_column(&mut f.jv[j..j + 3], x, p);
+                        let jw = &mut f.jw[j..j + 3];
+                        jw[0] += x[0];
+                        jw[1] += x[1];
+                        jw[2] += x[2];
+                    }
+                    k = self.parent[k] as usize;
+                }
+            }
+        }
+        for (pk, &node) in out.points.iter_mut().zip(self.point_node) {
+            pk.jv.fill(0.0);
+            let p = pk.position;
+            let mut k = node as usize;
+            while k != 0 {
+                for t in self.first[k] as usize..self.first[k + 1] as usize {
+                    let x: &[f64; 6] = tw[6 * t..6 * t + 6].try_into().expect("6 values");
+                    let j = 3 * self.coordinate[t] as usize;
+                    add_column(&mut pk.jv[j..j + 3], x, p);
+                }
+                k = self.parent[k] as usize;
+            }
+        }
+    }
+}
+
+/// A column of a Jacobian += v₀ + ω × p, for the twist x = (ω, v₀).
+#[inline(always)]
+fn add_column(col: &mut [f64], x: &[f64; 6], p: [f64; 3]) {
+    col[0] += x[3] + x[1] * p[2] - x[2] * p[1];
+    col[1] += x[4] + x[2] * p[0] - x[0] * p[2];
+    col[2] += x[5] + x[0] * p[1] - x[1] * p[0];
+}
+
 /// The derivatives [`Model::constraint_parameter_tangents`] writes, column-major, NS columns
 /// by sensitive parameter in the order of [`Model::SENSITIVE`]. With Φ̇ = B qd + Φ_t and
 /// Φ̈ = B qdd − γ (buffers sized for one model by [`ConstraintTangents::new`]):

@@ -34,6 +34,7 @@ mbs::multibody! {
     }
     pub model Tree3 {
         option tangents;
+        option jacobians = assembled;
         dof q[0] = 0.0;
         dof q[1] = 0.0;
         dof q[2] = 0.0;
@@ -178,6 +179,7 @@ mbs::multibody! {
         gravity(6.625108293572719, (-3.610873190784128), 4.859244738804457);
     }
     pub model Tree9 {
+        option jacobians = assembled;
         dof q[0] = 0.0;
         dof q[1] = 0.0;
         dof q[2] = 0.0;

@@ -8,9 +8,10 @@ pub mod shapes;
 
 use crate::expr::emit::MissingDerivative;
 use crate::expr::{ExprId, OpCount};
+use crate::mech::SymbolicModel;
 use crate::mech::dynamics::SceneEquations;
-use crate::mech::system::{Formulation, Load, System};
-use crate::mech::{SymbolicModel, world};
+use crate::mech::system::{Formulation, Jacobians, Load, System};
+use crate::mech::world::{self, Twist};
 use api::{Sizes, args};
 use function::{EmittedFn, FnSpec, Prefix, RustNames, emit_fn};
 use std::fmt::Write;
@@ -217,6 +218,13 @@ fn emit_params(
             "#[allow(clippy::all)]\nimpl {ty} {{\n/// The natural cubic splines of the model's `spline(x, [(x0, y0), …])`: knots, and the coefficients c0 + c1 s + c2 s² + c3 s³ of each interval.\npub const SPLINES: [::mbs::Spline; {}] = [{}];\n}}",
             tables.len(),
             tables.join(",\n")
+        );
+    }
+    if jacobians_assembled(model) {
+        let _ = writeln!(
+            code,
+            "#[allow(clippy::all)]\nimpl {ty} {{\n{}\n}}",
+            twist_tree(model)
         );
     }
     // validation: masses, inertias, spring stiffnesses as functions of the parameters
@@ -475,17 +483,89 @@ fn tangent_part_fn(i: usize) -> String {
     }
 }
 
+/// Whether `kinematics` and `point_kinematics` assemble their Jacobians at run time from the
+/// coordinates' twists (O(n) code) rather than generating every column (O(n²) code on a
+/// chain): as the model asks (`option jacobians = …;`), or when the generated columns would
+/// be many ([`ASSEMBLED_COLUMNS`]).
+pub fn jacobians_assembled(model: &SymbolicModel) -> bool {
+    match model.sys.options.jacobians {
+        Some(j) => j == Jacobians::Assembled,
+        None => {
+            let frames: usize = model
+                .tree
+                .frame_node
+                .iter()
+                .map(|&n| model.world.nodes[n].jv.len() + model.world.nodes[n].jw.len())
+                .sum();
+            let points: usize = model.points.iter().map(|p| p.jacobian.len()).sum();
+            frames + points > ASSEMBLED_COLUMNS
+        }
+    }
+}
+
+/// Nonzero columns of the frames' and points' Jacobians above which they are assembled at run
+/// time by default.
+pub const ASSEMBLED_COLUMNS: usize = 2048;
+
+/// The twists of every node in tree order, with the node each belongs to.
+fn twist_list(model: &SymbolicModel) -> Vec<(usize, Twist)> {
+    model
+        .world
+        .twists
+        .iter()
+        .enumerate()
+        .flat_map(|(n, t)| t.iter().map(move |&t| (n, t)))
+        .collect()
+}
+
+/// The associated constant `TWISTS` of the parameter struct: the tree and the coordinate of
+/// each twist, which `::mbs::__private::TwistTree::assemble` sums into the Jacobians.
+fn twist_tree(model: &SymbolicModel) -> String {
+    let sys = &model.sys;
+    let list = |v: Vec<String>| format!("&[{}]", v.join(", "));
+    let tree = &model.tree;
+    let mut first = vec![0usize];
+    for t in &model.world.twists {
+        first.push(first.last().unwrap() + t.len());
+    }
+    let point_node: Vec<String> = sys
+        .points
+        .iter()
+        .map(|p| p.frame.map_or(0, |f| tree.frame_node[f]).to_string())
+        .collect();
+    format!(
+        "/// The tree of the twists the Jacobians of `kinematics` are assembled from.\npub const TWISTS: ::mbs::__private::TwistTree = ::mbs::__private::TwistTree {{ parent: {}, first: {}, coordinate: {}, frame_node: {}, point_node: {} }};",
+        list(tree.nodes.iter().map(|n| n.parent.to_string()).collect()),
+        list(first.iter().map(|f| f.to_string()).collect()),
+        list(
+            twist_list(model)
+                .iter()
+                .map(|(_, t)| t.coordinate.to_string())
+                .collect()
+        ),
+        list(tree.frame_node.iter().map(|n| n.to_string()).collect()),
+        list(point_node),
+    )
+}
+
 /// The poses and kinematics of frames and points, the same in every scene: emitted once on
 /// the parameter struct, the charts of rotation joints an argument (`with_charts` makes the
-/// parameter lists).
+/// parameter lists). With the Jacobians assembled, the two kinematics functions write the
+/// coordinates' twists into `tw` (6 per twist: ω, then v₀) in place of the Jacobians' columns.
 fn kinematics_specs(
     model: &SymbolicModel,
     with_charts: impl Fn(&str) -> String,
 ) -> Vec<(FnSpec, &'static str)> {
     let a = &model.sys.arena;
     let n = model.sys.ndof();
+    let assembled = jacobians_assembled(model);
+    let kin_args = if assembled {
+        format!("{}, tw: &mut [f64]", with_charts("kinematics"))
+    } else {
+        with_charts("kinematics")
+    };
     let mut frames = FnSpec::new("__frames", &with_charts("frames"));
-    let mut fk = FnSpec::new("__kinematics", &with_charts("kinematics"));
+    let mut fk = FnSpec::new("__kinematics", &kin_args);
     for (i, &node) in model.tree.frame_node.iter().enumerate() {
         let k = &model.world.nodes[node];
         for r in 0..3 {
@@ -514,12 +594,14 @@ fn kinematics_specs(
                 k.alb[r],
             ));
         }
-        fk.matrix(a, &format!("out.frames[{i}].jv"), &dense3(a, &k.jv, n));
-        fk.matrix(a, &format!("out.frames[{i}].jw"), &dense3(a, &k.jw, n));
+        if !assembled {
+            fk.matrix(a, &format!("out.frames[{i}].jv"), &dense3(a, &k.jv, n));
+            fk.matrix(a, &format!("out.frames[{i}].jw"), &dense3(a, &k.jw, n));
+        }
     }
     // the points' positions, velocities and Jacobians again alone, for efforts that read
     // only points (their bias accelerations only in `kinematics`)
-    let mut fp = FnSpec::new("__point_kinematics", &with_charts("kinematics"));
+    let mut fp = FnSpec::new("__point_kinematics", &kin_args);
     for (i, pk) in model.points.iter().enumerate() {
         for r in 0..3 {
             fk.outputs.push((
@@ -534,11 +616,33 @@ fn kinematics_specs(
                 g.outputs
                     .push((format!("out.points[{i}].velocity[{r}]"), pk.velocity[r]));
             }
-            g.matrix(
-                a,
-                &format!("out.points[{i}].jv"),
-                &dense3(a, &pk.jacobian, n),
-            );
+            if !assembled {
+                g.matrix(
+                    a,
+                    &format!("out.points[{i}].jv"),
+                    &dense3(a, &pk.jacobian, n),
+                );
+            }
+        }
+    }
+    if assembled {
+        // every twist in `kinematics`; in `point_kinematics` those on the points' paths
+        let mut on_points = vec![false; model.tree.nodes.len()];
+        for p in &model.sys.points {
+            let mut node = p.frame.map_or(0, |f| model.tree.frame_node[f]);
+            while node != 0 && !on_points[node] {
+                on_points[node] = true;
+                node = model.tree.nodes[node].parent;
+            }
+        }
+        for (t, (node, tw)) in twist_list(model).into_iter().enumerate() {
+            let values = [tw.w[0], tw.w[1], tw.w[2], tw.v0[0], tw.v0[1], tw.v0[2]];
+            for (c, v) in values.into_iter().enumerate() {
+                fk.outputs.push((format!("tw[{}]", 6 * t + c), v));
+                if on_points[node] {
+                    fp.outputs.push((format!("tw[{}]", 6 * t + c), v));
+                }
+            }
         }
     }
     vec![
@@ -891,6 +995,8 @@ fn emit_scene(
             .as_ref()
             .is_some_and(|c| c.rest.is_some()),
     };
+    let assembled = jacobians_assembled(model);
+    let twists: usize = model.world.twists.iter().map(Vec::len).sum();
     let model_impl = api::model_impl(&ty, &pty, &sizes, |m| {
         match m.name {
         "info" => format!("{info}\n&INFO"),
@@ -918,7 +1024,14 @@ fn emit_scene(
         name if name.starts_with("constraint") => {
             format!("self.params.__{name}(&self.charts, {})", m.call())
         }
-        // ... and so do the poses and kinematics of frames and points
+        // ... and so do the poses and kinematics of frames and points, whose Jacobians may be
+        // assembled from the twists the generated code writes
+        name @ ("kinematics" | "point_kinematics") if assembled => format!(
+            "let mut tw = [0.0f64; {}];\nself.params.__{name}(&self.charts, {}, &mut tw);\n{pty}::TWISTS.assemble(&tw, out, {});",
+            6 * twists,
+            m.call(),
+            name == "kinematics"
+        ),
         name @ ("frames" | "kinematics" | "point_kinematics") => {
             format!("self.params.__{name}(&self.charts, {})", m.call())
         }

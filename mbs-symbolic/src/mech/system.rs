@@ -308,6 +308,19 @@ pub struct Options {
     pub batch: bool,
     /// force a formulation; `None` picks the cheaper by op count
     pub formulation: Option<Formulation>,
+    /// force the form of the Jacobians of `kinematics` and `point_kinematics`; `None` picks
+    /// by the size of the model (`codegen::jacobians_assembled`)
+    pub jacobians: Option<Jacobians>,
+}
+
+/// How `kinematics` and `point_kinematics` give the Jacobians of frames and points.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Jacobians {
+    /// every column as generated code (O(n²) code on a chain)
+    Generated,
+    /// the twists of the coordinates generated (O(n) code), the columns summed from them at
+    /// run time (`mbs::__private::TwistTree`)
+    Assembled,
 }
 
 impl System {

@@ -33,9 +33,24 @@ pub struct NodeKin {
     pub ab: V3,
 }
 
+/// The motion one coordinate gives a node's factor alone, per unit of its velocity: a twist
+/// in world axes, (ω, v₀) with v₀ the velocity of the point of the moving body at the world
+/// origin. A point p carried by the node or its descendants then moves at v₀ + ω × p, and its
+/// Jacobian's column of that coordinate is the sum of the twists of that coordinate along its
+/// path to the root: O(n) twists describe the O(n²) columns of a tree's Jacobians, which the
+/// runtime assembles (`Jacobians::Assembled`).
+#[derive(Clone, Copy, Debug)]
+pub struct Twist {
+    pub coordinate: u16,
+    pub w: V3,
+    pub v0: V3,
+}
+
 /// World kinematics of every node of a tree.
 pub struct World {
     pub nodes: Vec<NodeKin>,
+    /// the twists of each node's own factor (none for the root, constant factors and charts)
+    pub twists: Vec<Vec<Twist>>,
 }
 
 fn add_cols(a: &mut Arena, x: &Cols, y: &Cols) -> Cols {
@@ -82,8 +97,10 @@ impl World {
             ab: z,
         };
         let mut nodes = vec![ground];
+        let mut twists = vec![Vec::new()];
         for n in 1..tree.nodes.len() {
             let par = nodes[tree.nodes[n].parent].clone();
+            let mut own_twists = Vec::new();
             let k = match tree.nodes[n].factor.expect("non-root nodes have a factor") {
                 Factor::Rot { axis, angle } => {
                     let rel = s::rotation(a, axis, angle);
@@ -96,6 +113,11 @@ impl World {
                             (k, s::scale(a, d, nw))
                         })
                         .collect();
+                    // about an axis through the origin p: v₀ = ω × (0 − p) = p × ω
+                    for &(coordinate, w) in &cols {
+                        let v0 = s::cross(a, par.p, w);
+                        own_twists.push(Twist { coordinate, w, v0 });
+                    }
                     let jw = add_cols(a, &par.jw, &cols);
                     let th_d = a.dt(angle);
                     let th_dd0 = a.dt_bias(th_d);
@@ -145,6 +167,13 @@ impl World {
                             (k, s::mul_mv(a, &par.r, dd))
                         })
                         .collect();
+                    for &(coordinate, v0) in &own {
+                        own_twists.push(Twist {
+                            coordinate,
+                            w: z,
+                            v0,
+                        });
+                    }
                     jv_extra = add_cols(a, &jv_extra, &own);
                     let jv = add_cols(a, &par.jv, &jv_extra);
                     let ddot = [a.dt(d[0]), a.dt(d[1]), a.dt(d[2])];
@@ -166,8 +195,9 @@ impl World {
                 }
             };
             nodes.push(k);
+            twists.push(own_twists);
         }
-        World { nodes }
+        World { nodes, twists }
     }
 
     /// World position of a point at `r` (node axes) on node `n`.

@@ -6,6 +6,8 @@ mbs::multibody! {
         option tangent;
         option formulation = lagrange;
         option batch = 4;
+        option jacobians = sparse;
+        option jacobians;
     }
 }
 

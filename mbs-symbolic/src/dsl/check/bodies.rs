@@ -20,8 +20,20 @@ impl Checker {
                 }
             }
             ("formulation", _) => self.error(key.span(), "write `option formulation = recursive;` or `option formulation = virtual_power;`"),
+            ("jacobians", Some(Expr::Path(p))) if p.path.get_ident().is_some() => {
+                let v = p.path.get_ident().unwrap();
+                self.sys.options.jacobians = match v.to_string().as_str() {
+                    "generated" => Some(Jacobians::Generated),
+                    "assembled" => Some(Jacobians::Assembled),
+                    other => {
+                        self.error(v.span(), format!("unknown form of Jacobians `{other}`: write `option jacobians = generated;` or `option jacobians = assembled;`"));
+                        None
+                    }
+                }
+            }
+            ("jacobians", _) => self.error(key.span(), "write `option jacobians = generated;` or `option jacobians = assembled;`"),
             (name @ ("tangents" | "batch"), Some(v)) => self.error(v.span(), format!("write `option {name};` (it takes no value)")),
-            (other, _) => self.error(key.span(), format!("unknown option `{other}`: the options are `tangents`, `batch` and `formulation = recursive | virtual_power`")),
+            (other, _) => self.error(key.span(), format!("unknown option `{other}`: the options are `tangents`, `batch`, `formulation = recursive | virtual_power` and `jacobians = generated | assembled`")),
         }
     }
 

@@ -1,15 +1,15 @@
-//! The two forms of the Jacobians of `kinematics` and `point_kinematics` (`option jacobians
-//! = generated | assembled;`) at run time: a 32-bar planar chain and a 24-joint spatial arm,
-//! each compiled both ways, and the walking hexapod's feet (assembled) (criterion).
+//! The two forms of the Jacobians of `kinematics` and `point_kinematics`, and of M in
+//! `dynamics` (`option jacobians = generated | assembled;`) at run time: a 32-bar planar chain
+//! and a 24-joint spatial arm, each compiled both ways (criterion).
 //!
 //! ```text
 //! cargo bench -p mbs-benches --bench kinematics
 //! ```
 //!
 //! Prints the generated op counts of both forms, criterion's figures, then a table of medians
-//! in ns per call. The assembled form generates O(n) code (the coordinates' twists) and sums
-//! the O(n²) columns at run time in a generic loop, where the generated form writes each
-//! column with the model's zeros folded.
+//! in ns per call. The assembled form generates O(n) code (the coordinates' twists, the
+//! composite inertias) and sums the O(n²) columns and entries of M at run time in a generic
+//! loop, where the generated form writes each with the model's zeros folded.
 
 mod common;
 
@@ -24,32 +24,40 @@ mod models {
 use common::{median_ns, test_state};
 use criterion::Criterion;
 use mbs::{Kinematics, Model};
-use mbs_models::hexapod_walker::HexapodWalker;
 use models::*;
 use std::hint::black_box;
 
-fn flops<M: Model>(model: &M) -> usize {
+fn flops<M: Model>(model: &M, function: &str) -> usize {
     let row = model
         .info()
         .ops
         .iter()
-        .find(|(name, _)| *name == "kinematics");
-    row.expect("generated models count kinematics").1.flops()
+        .find(|(name, _)| name.starts_with(function));
+    row.expect("generated models count their functions")
+        .1
+        .flops()
 }
 
-/// Measures `kinematics` (and `point_kinematics` when the model has points) of `model` in
-/// the group `name`, under the id `form`.
+/// Measures `kinematics` (and `point_kinematics` when the model has points) and `dynamics`
+/// of `model` in the group `name`, under the id `form` (`{form}_points`, `{form}_dynamics`).
 fn bench<M: Model + Default>(c: &mut Criterion, name: &str, form: &str) {
     let model = M::default();
     println!(
-        "{name:<9} {form:<9} kinematics: {:>6} flops generated",
-        flops(&model)
+        "{name:<9} {form:<9} kinematics: {:>6} flops generated, dynamics: {:>6}",
+        flops(&model, "kinematics"),
+        flops(&model, "dynamics")
     );
     let (q, qd) = test_state(M::NQ);
     let mut out = Kinematics::new::<M>();
     let mut g = c.benchmark_group(format!("kinematics_{name}"));
     g.bench_function(form, |b| {
         b.iter(|| model.kinematics(0.0, black_box(&q), black_box(&qd), &mut out))
+    });
+    let n = M::NQ;
+    let u = vec![0.0; M::NU];
+    let (mut m, mut h) = (vec![0.0; n * n], vec![0.0; n]);
+    g.bench_function(format!("{form}_dynamics"), |b| {
+        b.iter(|| model.dynamics(0.0, black_box(&q), black_box(&qd), &u, &mut m, &mut h))
     });
     if M::NPOINTS > 0 {
         g.bench_function(format!("{form}_points"), |b| {
@@ -65,15 +73,16 @@ fn main() {
     bench::<Chain32Assembled>(&mut c, "chain32", "assembled");
     bench::<Arm24Generated>(&mut c, "arm3d_24", "generated");
     bench::<Arm24Assembled>(&mut c, "arm3d_24", "assembled");
-    bench::<HexapodWalker>(&mut c, "walker", "assembled");
     c.final_summary();
     let rows = [
         ("chain32", "generated"),
         ("chain32", "assembled"),
+        ("chain32", "generated_dynamics"),
+        ("chain32", "assembled_dynamics"),
         ("arm3d_24", "generated"),
         ("arm3d_24", "assembled"),
-        ("walker", "assembled"),
-        ("walker", "assembled_points"),
+        ("arm3d_24", "generated_dynamics"),
+        ("arm3d_24", "assembled_dynamics"),
     ];
     // criterion's medians exist after a measuring run (`cargo bench`), not in test mode
     if median_ns("kinematics_chain32", "generated").is_none() {
@@ -82,7 +91,7 @@ fn main() {
     println!("\nmedians (ns per call)");
     for (name, id) in rows {
         if let Some(t) = median_ns(&format!("kinematics_{name}"), id) {
-            println!("{name:<9} {id:<17} {t:>9.1}");
+            println!("{name:<9} {id:<19} {t:>9.1}");
         }
     }
 }

@@ -113,6 +113,41 @@ fn both_forms_agree() {
     println!("largest difference between the two forms: {worst:e}");
 }
 
+/// M assembled from the twists and composite inertias equals the generated M, and
+/// `mass_matrix` equals `dynamics`' M.
+#[test]
+fn assembled_mass_matrix_equals_generated() {
+    let n = Generated::NQ;
+    let (c, s) = (0.6f64.cos(), 0.6f64.sin());
+    let moved = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]];
+    let mut worst = 0.0f64;
+    for chart in [mbs::IDENTITY3, moved] {
+        let mut g = Generated::default();
+        let mut a = Assembled::default();
+        g.set_chart(0, chart);
+        a.set_chart(0, chart);
+        for k in 0..8 {
+            let (t, q, qd) = state(k);
+            let (mut mg, mut hg) = (vec![0.0; n * n], vec![0.0; n]);
+            let (mut ma, mut ha) = (vec![7.0; n * n], vec![0.0; n]);
+            g.dynamics(t, &q, &qd, &[], &mut mg, &mut hg);
+            a.dynamics(t, &q, &qd, &[], &mut ma, &mut ha);
+            let scale = mg.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            let d = max_diff(&mg, &ma) / scale;
+            assert!(
+                d < 1e-14,
+                "state {k}: M differs by {d:e} of its largest entry"
+            );
+            assert!(max_diff(&hg, &ha) < 1e-12, "state {k}: h");
+            let mut mm = vec![0.0; n * n];
+            a.mass_matrix(t, &q, &mut mm);
+            assert_eq!(mm, ma, "state {k}: mass_matrix and dynamics' M");
+            worst = worst.max(d);
+        }
+    }
+    println!("largest difference of M between the two forms: {worst:e} of its largest entry");
+}
+
 /// Central differences of the poses and points' positions against the assembled Jacobians.
 #[test]
 fn assembled_jacobians_are_derivatives() {

@@ -324,12 +324,14 @@ impl Kinematics {
 /// node of the tree moves with a twist per coordinate of its factor, (ω, v₀) in world axes
 /// with v₀ the velocity at the world origin, and the column of coordinate j of a point p's
 /// Jacobian is the sum over the nodes on p's path to the root of v₀ + ω × p (and of ω for a
-/// frame's J_ω). Used by generated code only.
+/// frame's J_ω). `dynamics` and `mass_matrix` assemble M from the same twists and the
+/// composite inertias of the nodes ([`TwistTree::mass_matrix`]). Used by generated code only.
 #[doc(hidden)]
 #[derive(Clone, Copy, Debug)]
 pub struct TwistTree {
-    /// parent of each node (the root, node 0, its own)
-    pub parent: &'static [u32],
+    /// of each node, the nearest of its ancestors that has twists (0, the root, when none
+    /// has): the walks to the root skip the nodes of constant factors
+    pub up: &'static [u32],
     /// the twists of node k are `first[k]..first[k + 1]`
     pub first: &'static [u32],
     /// the coordinate of each twist
@@ -337,6 +339,10 @@ pub struct TwistTree {
     /// the node of each frame and each declared point (0 for a point fixed in the world)
     pub frame_node: &'static [u32],
     pub point_node: &'static [u32],
+    /// per node, its place among the nodes with twists (`u32::MAX` for the others), whose
+    /// origins and composite inertias follow the twists in the buffer of
+    /// [`TwistTree::mass_matrix`]
+    pub mass_node: &'static [u32],
 }
 
 impl TwistTree {
@@ -359,7 +365,7 @@ impl TwistTree {
                         jw[1] += x[1];
                         jw[2] += x[2];
                     }
-                    k = self.parent[k] as usize;
+                    k = self.up[k] as usize;
                 }
             }
         }
@@ -373,10 +379,90 @@ impl TwistTree {
                     let j = 3 * self.coordinate[t] as usize;
                     add_column(&mut pk.jv[j..j + 3], x, p);
                 }
-                k = self.parent[k] as usize;
+                k = self.up[k] as usize;
             }
         }
     }
+}
+
+impl TwistTree {
+    /// M (NQ × NQ, column-major) by composite rigid bodies in world axes, from `mw`: the
+    /// twists (6 each: ω, v₀), then per node with twists its origin o and the composite
+    /// inertia of its subtree about o (mass, first moment, inertia xx yy zz xy xz yz). For a
+    /// twist t of node a, F = I_a ξ_t (linear m v + ω × h, angular I ω + h × v, with the
+    /// velocities at o), and M gains ξ_s · F for every twist s of a and of its ancestors.
+    pub fn mass_matrix(&self, mw: &[f64], n: usize, m: &mut [f64]) {
+        m.fill(0.0);
+        let nt = self.coordinate.len();
+        let (tw, nodes) = mw.split_at(6 * nt);
+        for a in 1..self.up.len() {
+            let (t0, t1) = (self.first[a] as usize, self.first[a + 1] as usize);
+            if t0 == t1 {
+                continue;
+            }
+            let c = &nodes[13 * self.mass_node[a] as usize..][..13];
+            let o = [c[0], c[1], c[2]];
+            let (mass, h) = (c[3], [c[4], c[5], c[6]]);
+            let i = [
+                [c[7], c[10], c[11]],
+                [c[10], c[8], c[12]],
+                [c[11], c[12], c[9]],
+            ];
+            for t in t0..t1 {
+                let x: &[f64; 6] = tw[6 * t..6 * t + 6].try_into().expect("6 values");
+                let w = [x[0], x[1], x[2]];
+                // the twist's velocity at o, then F = I_a ξ_t about o
+                let wo = cross(w, o);
+                let v = [x[3] + wo[0], x[4] + wo[1], x[5] + wo[2]];
+                let (wh, hv) = (cross(w, h), cross(h, v));
+                let lin = [0, 1, 2].map(|r| mass * v[r] + wh[r]);
+                let ang =
+                    [0, 1, 2].map(|r| i[r][0] * w[0] + i[r][1] * w[1] + i[r][2] * w[2] + hv[r]);
+                // ... its moment about the world origin, where the twists' v₀ are: then
+                // ξ_s · F = ω_s · (ang + o × lin) + v₀_s · lin
+                let olin = cross(o, lin);
+                let ang = [ang[0] + olin[0], ang[1] + olin[1], ang[2] + olin[2]];
+                let ct = self.coordinate[t] as usize;
+                let mut k = a;
+                while k != 0 {
+                    let last = if k == a {
+                        t + 1
+                    } else {
+                        self.first[k + 1] as usize
+                    };
+                    for s in self.first[k] as usize..last {
+                        let y: &[f64; 6] = tw[6 * s..6 * s + 6].try_into().expect("6 values");
+                        let value = y[0] * ang[0]
+                            + y[1] * ang[1]
+                            + y[2] * ang[2]
+                            + y[3] * lin[0]
+                            + y[4] * lin[1]
+                            + y[5] * lin[2];
+                        // into the upper triangle (row ≤ column, down a column for the
+                        // ancestors of a chain), mirrored at the end
+                        let cs = self.coordinate[s] as usize;
+                        let (r, c) = (cs.min(ct), cs.max(ct));
+                        let twice = s != t && cs == ct;
+                        m[r + n * c] += if twice { 2.0 * value } else { value };
+                    }
+                    k = self.up[k] as usize;
+                }
+            }
+        }
+        for c in 0..n {
+            for r in 0..c {
+                m[c + n * r] = m[r + n * c];
+            }
+        }
+    }
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 
 /// A column of a Jacobian += v₀ + ω × p, for the twist x = (ω, v₀).

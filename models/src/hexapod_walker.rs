@@ -34,9 +34,6 @@ mbs::multibody! {
     /// The hexapod with outward legs and motor voltages as inputs (no contact, no control:
     /// those are Rust, [`Drive`]).
     pub model HexapodWalker {
-        // the Jacobians summed at run time from the coordinates' twists (less code; the
-        // efforts read only the feet, through `point_kinematics`)
-        option jacobians = assembled;
         param g = 9.81;
         param m_base = 20.0;
         param m_support = 0.5;

@@ -10,7 +10,7 @@ use crate::expr::emit::MissingDerivative;
 use crate::expr::{ExprId, OpCount};
 use crate::mech::SymbolicModel;
 use crate::mech::dynamics::SceneEquations;
-use crate::mech::system::{Formulation, Jacobians, Load, System};
+use crate::mech::system::{Formulation, Load, System};
 use crate::mech::world::{self, Twist};
 use api::{Sizes, args};
 use function::{EmittedFn, FnSpec, Prefix, RustNames, emit_fn};
@@ -483,29 +483,11 @@ fn tangent_part_fn(i: usize) -> String {
     }
 }
 
-/// Whether `kinematics` and `point_kinematics` assemble their Jacobians at run time from the
-/// coordinates' twists (O(n) code) rather than generating every column (O(n²) code on a
-/// chain): as the model asks (`option jacobians = …;`), or when the generated columns would
-/// be many ([`ASSEMBLED_COLUMNS`]).
+/// Whether the Jacobians of `kinematics` and `point_kinematics`, and M, are assembled at run
+/// time from the coordinates' twists (`SymbolicModel::assembled`).
 pub fn jacobians_assembled(model: &SymbolicModel) -> bool {
-    match model.sys.options.jacobians {
-        Some(j) => j == Jacobians::Assembled,
-        None => {
-            let frames: usize = model
-                .tree
-                .frame_node
-                .iter()
-                .map(|&n| model.world.nodes[n].jv.len() + model.world.nodes[n].jw.len())
-                .sum();
-            let points: usize = model.points.iter().map(|p| p.jacobian.len()).sum();
-            frames + points > ASSEMBLED_COLUMNS
-        }
-    }
+    model.assembled
 }
-
-/// Nonzero columns of the frames' and points' Jacobians above which they are assembled at run
-/// time by default.
-pub const ASSEMBLED_COLUMNS: usize = 2048;
 
 /// The twists of every node in tree order, with the node each belongs to.
 fn twist_list(model: &SymbolicModel) -> Vec<(usize, Twist)> {
@@ -533,9 +515,32 @@ fn twist_tree(model: &SymbolicModel) -> String {
         .iter()
         .map(|p| p.frame.map_or(0, |f| tree.frame_node[f]).to_string())
         .collect();
+    // the nearest ancestor with twists (parents come before their children)
+    let mut up = vec![0usize; tree.nodes.len()];
+    for n in 1..tree.nodes.len() {
+        let p = tree.nodes[n].parent;
+        up[n] = if p == 0 || !model.world.twists[p].is_empty() {
+            p
+        } else {
+            up[p]
+        };
+    }
+    let mut with_twists = 0;
+    let mass_node: Vec<String> = model
+        .world
+        .twists
+        .iter()
+        .map(|t| {
+            if t.is_empty() {
+                return u32::MAX.to_string();
+            }
+            with_twists += 1;
+            (with_twists - 1).to_string()
+        })
+        .collect();
     format!(
-        "/// The tree of the twists the Jacobians of `kinematics` are assembled from.\npub const TWISTS: ::mbs::__private::TwistTree = ::mbs::__private::TwistTree {{ parent: {}, first: {}, coordinate: {}, frame_node: {}, point_node: {} }};",
-        list(tree.nodes.iter().map(|n| n.parent.to_string()).collect()),
+        "/// The tree of the twists the Jacobians of `kinematics`, and M, are assembled from.\npub const TWISTS: ::mbs::__private::TwistTree = ::mbs::__private::TwistTree {{ up: {}, first: {}, coordinate: {}, frame_node: {}, point_node: {}, mass_node: {} }};",
+        list(up.iter().map(|n| n.to_string()).collect()),
         list(first.iter().map(|f| f.to_string()).collect()),
         list(
             twist_list(model)
@@ -545,7 +550,33 @@ fn twist_tree(model: &SymbolicModel) -> String {
         ),
         list(tree.frame_node.iter().map(|n| n.to_string()).collect()),
         list(point_node),
+        list(mass_node),
     )
+}
+
+/// The outputs M is assembled from at run time (`TwistTree::mass_matrix`), into `mw`: the
+/// twists (6 each, as in `kinematics`), then 13 numbers per node with twists (its origin and
+/// composite inertia, `world::composite_inertias`).
+fn mass_outputs(model: &SymbolicModel, f: &mut FnSpec) {
+    let mut k = 0;
+    for (_, tw) in twist_list(model) {
+        for v in [tw.w[0], tw.w[1], tw.w[2], tw.v0[0], tw.v0[1], tw.v0[2]] {
+            f.outputs.push((format!("mw[{k}]"), v));
+            k += 1;
+        }
+    }
+    for c in &model.composites {
+        for &v in c {
+            f.outputs.push((format!("mw[{k}]"), v));
+            k += 1;
+        }
+    }
+}
+
+/// Numbers `mw` holds for the assembly of M: 6 per twist, 13 per node with twists.
+fn mass_workspace(model: &SymbolicModel) -> usize {
+    let twists: usize = model.world.twists.iter().map(Vec::len).sum();
+    6 * twists + 13 * model.composites.len()
 }
 
 /// The poses and kinematics of frames and points, the same in every scene: emitted once on
@@ -681,8 +712,24 @@ fn emit_scene(
     // the methods to emit, with the label of their op-count row (none for initial_state)
     let mut specs: Vec<(FnSpec, Option<&str>)> = Vec::new();
     let mb = eq.chosen();
-    let mut f = FnSpec::new("__dynamics", args("dynamics"));
-    f.matrix(a, "m", &mb.m);
+    // M whole, or what the runtime assembles it from: the twists and the composite inertias
+    // (`mw`, see `mass_outputs`)
+    let with_mw = |name: &str| {
+        if model.assembled {
+            format!("{}, mw: &mut [f64]", args(name))
+        } else {
+            args(name).to_string()
+        }
+    };
+    let mass_of = |f: &mut FnSpec| {
+        if model.assembled {
+            mass_outputs(model, f)
+        } else {
+            f.matrix(a, "m", &mb.m)
+        }
+    };
+    let mut f = FnSpec::new("__dynamics", &with_mw("dynamics"));
+    mass_of(&mut f);
     let split = f.outputs.len();
     f.vector("h", &mb.h);
     // mass_matrix as the first chunks of dynamics when dynamics is split into chunks anyway:
@@ -694,7 +741,7 @@ fn emit_scene(
     };
     f.prefix = chunked.then(|| Prefix {
         name: "__mass_matrix".into(),
-        args: args("mass_matrix").into(),
+        args: with_mw("mass_matrix"),
         split,
         bind: vec![format!(
             "let (qd, u, h) = (&[0.0f64; {n}], &[0.0f64; {}], &mut [0.0f64; {n}]);",
@@ -720,9 +767,9 @@ fn emit_scene(
         specs.push((f, None));
     }
     // (its outputs only when it is a function of its own: see the emission below)
-    let mut f = FnSpec::new("__mass_matrix", args("mass_matrix"));
+    let mut f = FnSpec::new("__mass_matrix", &with_mw("mass_matrix"));
     if !chunked {
-        f.matrix(a, "m", &mb.m);
+        mass_of(&mut f);
     }
     specs.push((f, Some("mass_matrix")));
     let mass_matrix_spec = specs.len() - 1;
@@ -1035,6 +1082,12 @@ fn emit_scene(
         name @ ("frames" | "kinematics" | "point_kinematics") => {
             format!("self.params.__{name}(&self.charts, {})", m.call())
         }
+        // M assembled from the twists and composite inertias the generated code writes
+        name @ ("dynamics" | "mass_matrix") if assembled => format!(
+            "let mut mw = [0.0f64; {}];\nself.__{name}({}, &mut mw);\n{pty}::TWISTS.mass_matrix(&mw, {n}, m);",
+            mass_workspace(model),
+            m.call()
+        ),
         // SIMD code where the processor runs it, else the one-state function lane by lane
         // one function with the added generalised force f, at f = 0 or given
         "forward_dynamics" => format!("self.__forward_dynamics(t, q, qd, u, &[0.0; {n}], qdd, pivots)"),

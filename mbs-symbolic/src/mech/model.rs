@@ -7,9 +7,10 @@ use super::dynamics::{SceneEquations, tangent_matrices};
 use super::effects::Loads;
 use super::recursive::{load_tau, newton_euler};
 use super::spatial::{self as s, Matrix};
-use super::system::System;
+use super::system::{Jacobians, System};
 use super::tree::Tree;
-use super::world::{Cols, World};
+use super::world::{Cols, World, composite_inertias};
+use crate::expr::ExprId;
 
 /// Kinematics of a declared point, world axes.
 #[derive(Clone, Debug)]
@@ -42,7 +43,18 @@ pub struct SymbolicModel {
     pub shared_tangents: Vec<SharedTangents>,
     /// Φ, B, Φ_t, γ, ∂(Bᵀλ)/∂q of the constraints (empty without constraints)
     pub constraints: ConstraintEquations,
+    /// whether the Jacobians of frames and points, and M, are assembled at run time from
+    /// the coordinates' twists rather than generated whole: as the model asks (`option
+    /// jacobians = …;`), or when the generated columns would be many ([`ASSEMBLED_COLUMNS`])
+    pub assembled: bool,
+    /// with `assembled`, per node with twists its origin and composite inertia
+    /// (`world::composite_inertias`), from which the runtime assembles M
+    pub composites: Vec<[ExprId; 13]>,
 }
+
+/// Nonzero columns of the frames' and points' Jacobians above which they, and M, are
+/// assembled at run time by default.
+pub const ASSEMBLED_COLUMNS: usize = 2048;
 
 impl SymbolicModel {
     pub fn build(mut sys: System) -> SymbolicModel {
@@ -112,7 +124,7 @@ impl SymbolicModel {
                 shared_tangents.push(SharedTangents { effects, k, c });
             }
         }
-        let points = sys
+        let points: Vec<PointKin> = sys
             .points
             .clone()
             .iter()
@@ -138,7 +150,26 @@ impl SymbolicModel {
             })
             .collect();
         let constraints = ConstraintEquations::build(&mut sys, &tree, &world);
+        let assembled = match sys.options.jacobians {
+            Some(j) => j == Jacobians::Assembled,
+            None => {
+                let frames: usize = tree
+                    .frame_node
+                    .iter()
+                    .map(|&n| world.nodes[n].jv.len() + world.nodes[n].jw.len())
+                    .sum();
+                let points: usize = points.iter().map(|p| p.jacobian.len()).sum();
+                frames + points > ASSEMBLED_COLUMNS
+            }
+        };
+        let composites = if assembled {
+            composite_inertias(&mut sys, &tree, &world)
+        } else {
+            Vec::new()
+        };
         SymbolicModel {
+            assembled,
+            composites,
             sys,
             tree,
             world,

@@ -313,13 +313,14 @@ pub struct Options {
     pub jacobians: Option<Jacobians>,
 }
 
-/// How `kinematics` and `point_kinematics` give the Jacobians of frames and points.
+/// How `kinematics` and `point_kinematics` give the Jacobians of frames and points, and
+/// `dynamics` and `mass_matrix` give M.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Jacobians {
-    /// every column as generated code (O(n²) code on a chain)
+    /// every column and every entry as generated code (O(n²) code on a chain)
     Generated,
-    /// the twists of the coordinates generated (O(n) code), the columns summed from them at
-    /// run time (`mbs::__private::TwistTree`)
+    /// the twists of the coordinates and the composite inertias generated (O(n) code), the
+    /// columns and M summed from them at run time (`mbs::__private::TwistTree`)
     Assembled,
 }
 

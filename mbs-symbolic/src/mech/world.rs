@@ -5,7 +5,8 @@
 //! of its depth.
 
 use super::spatial::{self as s, M3, V3};
-use super::system::Factor;
+use super::spin::spinning_frames;
+use super::system::{Factor, System};
 use super::tree::Tree;
 use crate::expr::{Arena, ExprId, Var};
 
@@ -233,6 +234,93 @@ impl World {
         let x = s::add(a, k.ab, t1);
         s::add(a, x, t2)
     }
+}
+
+/// For every node with twists, in node order, 13 numbers from which the runtime assembles M
+/// (`TwistTree::mass_matrix`): the node's origin o, then the composite inertia of its subtree
+/// about o in world axes, mass m, first moment Σ mᵢ(cᵢ − o), inertia about o (xx, yy, zz, xy,
+/// xz, yz). The composites are carried from child to parent by the lever arm of the factor,
+/// R_parent d, not by differences of world positions, so a model far from the origin keeps
+/// its digits. A body spinning about its node's axis takes its parent's axes (`mech::spin`).
+pub fn composite_inertias(sys: &mut System, tree: &Tree, world: &World) -> Vec<[ExprId; 13]> {
+    let spinning = spinning_frames(sys, tree);
+    let frames = &sys.frames;
+    let a = &mut sys.arena;
+    let z3 = s::zero3(a);
+    let mut mass = vec![a.zero(); tree.nodes.len()];
+    let mut moment = vec![z3; tree.nodes.len()];
+    let mut inertia = vec![[z3; 3]; tree.nodes.len()];
+    let add_m3 = |a: &mut Arena, x: &M3, y: &M3| -> M3 {
+        [
+            s::add(a, x[0], y[0]),
+            s::add(a, x[1], y[1]),
+            s::add(a, x[2], y[2]),
+        ]
+    };
+    for n in (1..tree.nodes.len()).rev() {
+        let parent = tree.nodes[n].parent;
+        for &f in &tree.nodes[n].frames {
+            let Some(inr) = frames[f].inertia else {
+                continue;
+            };
+            let r = if spinning[f] {
+                world.nodes[parent].r
+            } else {
+                world.nodes[n].r
+            };
+            let ri = s::mul_mm(a, &r, &s::sym(&inr.tensor));
+            let iw = s::mul_mm(a, &ri, &s::transpose(&r));
+            mass[n] = a.add(mass[n], inr.mass);
+            inertia[n] = add_m3(a, &inertia[n], &iw);
+        }
+        if parent == 0 {
+            continue;
+        }
+        // about the parent's origin o_p = o_n − d: h + m d and
+        // I + 2(h·d)1 − h dᵀ − d hᵀ + m(|d|²1 − d dᵀ)
+        let (m, h, i) = (mass[n], moment[n], inertia[n]);
+        let (h, i) = match tree.nodes[n].factor {
+            Some(Factor::Disp(dl)) => {
+                let d = s::mul_mv(a, &world.nodes[parent].r, dl);
+                let md = s::scale(a, m, d);
+                let hd = s::dot(a, h, d);
+                let dd = s::dot(a, d, d);
+                let mdd = a.mul(m, dd);
+                let diag = a.scale(2.0, hd);
+                let diag = a.add(diag, mdd);
+                let mut shifted = i;
+                for r in 0..3 {
+                    for c in 0..3 {
+                        let hdt = a.mul(h[r], d[c]);
+                        let dht = a.mul(d[r], h[c]);
+                        let mddt = a.mul(md[r], d[c]);
+                        let off = a.add(hdt, dht);
+                        let off = a.add(off, mddt);
+                        let mut e = a.sub(i[r][c], off);
+                        if r == c {
+                            e = a.add(e, diag);
+                        }
+                        shifted[r][c] = e;
+                    }
+                }
+                (s::add(a, h, md), shifted)
+            }
+            _ => (h, i),
+        };
+        mass[parent] = a.add(mass[parent], m);
+        moment[parent] = s::add(a, moment[parent], h);
+        inertia[parent] = add_m3(a, &inertia[parent], &i);
+    }
+    (1..tree.nodes.len())
+        .filter(|&n| !world.twists[n].is_empty())
+        .map(|n| {
+            let (p, h, i) = (world.nodes[n].p, moment[n], inertia[n]);
+            [
+                p[0], p[1], p[2], mass[n], h[0], h[1], h[2], i[0][0], i[1][1], i[2][2], i[0][1],
+                i[0][2], i[1][2],
+            ]
+        })
+        .collect()
 }
 
 /// Dense n-column form of sparse columns (for emission).

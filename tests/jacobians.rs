@@ -57,17 +57,27 @@ fn max_diff(a: &[f64], b: &[f64]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-#[test]
-fn both_forms_agree() {
-    // the ball joint's chart at the identity, then moved away from it
+/// The mechanism in both forms, the ball joint's chart at the identity, then moved away from
+/// it.
+fn both_forms() -> Vec<(Generated, Assembled, &'static str)> {
     let (c, s) = (0.6f64.cos(), 0.6f64.sin());
     let moved = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]];
+    [(mbs::IDENTITY3, "identity chart"), (moved, "moved chart")]
+        .into_iter()
+        .map(|(chart, label)| {
+            let mut g = Generated::default();
+            let mut a = Assembled::default();
+            g.set_chart(0, chart);
+            a.set_chart(0, chart);
+            (g, a, label)
+        })
+        .collect()
+}
+
+#[test]
+fn both_forms_agree() {
     let mut worst = 0.0f64;
-    for (chart, label) in [(mbs::IDENTITY3, "identity chart"), (moved, "moved chart")] {
-        let mut g = Generated::default();
-        let mut a = Assembled::default();
-        g.set_chart(0, chart);
-        a.set_chart(0, chart);
+    for (g, a, label) in both_forms() {
         for k in 0..8 {
             let (t, q, qd) = state(k);
             let (mut kg, mut ka) = (
@@ -118,14 +128,8 @@ fn both_forms_agree() {
 #[test]
 fn assembled_mass_matrix_equals_generated() {
     let n = Generated::NQ;
-    let (c, s) = (0.6f64.cos(), 0.6f64.sin());
-    let moved = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]];
     let mut worst = 0.0f64;
-    for chart in [mbs::IDENTITY3, moved] {
-        let mut g = Generated::default();
-        let mut a = Assembled::default();
-        g.set_chart(0, chart);
-        a.set_chart(0, chart);
+    for (g, a, _) in both_forms() {
         for k in 0..8 {
             let (t, q, qd) = state(k);
             let (mut mg, mut hg) = (vec![0.0; n * n], vec![0.0; n]);

@@ -26,6 +26,7 @@
 //! trial state), is rejected with `Err(e.reject(…))` instead ([`Effort::reject`]): the step
 //! is retried smaller, as SUNDIALS does with a right-hand side's recoverable error.
 
+use crate::elements::cross;
 use crate::error::{Failure, ModelError, ParamError};
 use crate::model::{Energy, FrameKinematics, Kinematics, Model, ModelInfo, PointKinematics, Pose};
 use std::any::TypeId;
@@ -120,14 +121,6 @@ impl Effort<'_> {
     pub fn generalized_force(&mut self, i: usize, value: f64) {
         self.qg[i] += value;
     }
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 /// qg += Jᵀ f for a 3 × n Jacobian stored column-major (`j[3k + i]`).

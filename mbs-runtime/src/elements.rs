@@ -36,7 +36,8 @@ fn scale(k: f64, a: V3) -> V3 {
     [k * a[0], k * a[1], k * a[2]]
 }
 
-fn cross(a: V3, b: V3) -> V3 {
+/// a × b
+pub(crate) fn cross(a: V3, b: V3) -> V3 {
     [
         a[1] * b[2] - a[2] * b[1],
         a[2] * b[0] - a[0] * b[2],

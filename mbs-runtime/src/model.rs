@@ -4,6 +4,7 @@
 //! nalgebra's `DMatrix`. Lengths are fixed by the model (`NQ`, `NU`, …); passing slices of
 //! other lengths is a programming error and panics.
 
+use crate::elements::cross;
 use crate::error::{ModelError, ParamError};
 use crate::lanes::{F64x4, lane_by_lane};
 use serde::{Deserialize, Serialize, de::DeserializeOwned};
@@ -339,10 +340,6 @@ pub struct TwistTree {
     /// the node of each frame and each declared point (0 for a point fixed in the world)
     pub frame_node: &'static [u32],
     pub point_node: &'static [u32],
-    /// per node, its place among the nodes with twists (`u32::MAX` for the others), whose
-    /// origins and composite inertias follow the twists in the buffer of
-    /// [`TwistTree::mass_matrix`]
-    pub mass_node: &'static [u32],
 }
 
 impl TwistTree {
@@ -353,54 +350,50 @@ impl TwistTree {
             for (f, &node) in out.frames.iter_mut().zip(self.frame_node) {
                 f.jv.fill(0.0);
                 f.jw.fill(0.0);
-                let p = f.pose.position;
-                let mut k = node as usize;
-                while k != 0 {
-                    for t in self.first[k] as usize..self.first[k + 1] as usize {
-                        let x: &[f64; 6] = tw[6 * t..6 * t + 6].try_into().expect("6 values");
-                        let j = 3 * self.coordinate[t] as usize;
-                        add_column(&mut f.jv[j..j + 3], x, p);
-                        let jw = &mut f.jw[j..j + 3];
-                        jw[0] += x[0];
-                        jw[1] += x[1];
-                        jw[2] += x[2];
+                self.along(node, tw, |j, x| {
+                    add_column(&mut f.jv[j..j + 3], x, f.pose.position);
+                    for (jw, w) in f.jw[j..j + 3].iter_mut().zip(x) {
+                        *jw += w;
                     }
-                    k = self.up[k] as usize;
-                }
+                });
             }
         }
         for (pk, &node) in out.points.iter_mut().zip(self.point_node) {
             pk.jv.fill(0.0);
-            let p = pk.position;
-            let mut k = node as usize;
-            while k != 0 {
-                for t in self.first[k] as usize..self.first[k + 1] as usize {
-                    let x: &[f64; 6] = tw[6 * t..6 * t + 6].try_into().expect("6 values");
-                    let j = 3 * self.coordinate[t] as usize;
-                    add_column(&mut pk.jv[j..j + 3], x, p);
-                }
-                k = self.up[k] as usize;
-            }
+            self.along(node, tw, |j, x| {
+                add_column(&mut pk.jv[j..j + 3], x, pk.position)
+            });
         }
     }
-}
 
-impl TwistTree {
+    /// Calls `f(3 × coordinate, twist)` for every twist from `node` to the root.
+    #[inline(always)]
+    fn along(&self, node: u32, tw: &[f64], mut f: impl FnMut(usize, &[f64; 6])) {
+        let mut k = node as usize;
+        while k != 0 {
+            for t in self.first[k] as usize..self.first[k + 1] as usize {
+                f(3 * self.coordinate[t] as usize, twist(tw, t));
+            }
+            k = self.up[k] as usize;
+        }
+    }
+
     /// M (NQ × NQ, column-major) by composite rigid bodies in world axes, from `mw`: the
-    /// twists (6 each: ω, v₀), then per node with twists its origin o and the composite
-    /// inertia of its subtree about o (mass, first moment, inertia xx yy zz xy xz yz). For a
-    /// twist t of node a, F = I_a ξ_t (linear m v + ω × h, angular I ω + h × v, with the
-    /// velocities at o), and M gains ξ_s · F for every twist s of a and of its ancestors.
+    /// twists (6 each: ω, v₀), then per node with twists, in node order, its origin o and the
+    /// composite inertia of its subtree about o (mass, first moment, inertia xx yy zz xy xz
+    /// yz). For a twist t of node a, F = I_a ξ_t (linear m v + ω × h, angular I ω + h × v,
+    /// with the velocities at o), and M gains ξ_s · F for every twist s of a and of its
+    /// ancestors.
     pub fn mass_matrix(&self, mw: &[f64], n: usize, m: &mut [f64]) {
         m.fill(0.0);
-        let nt = self.coordinate.len();
-        let (tw, nodes) = mw.split_at(6 * nt);
+        let (tw, nodes) = mw.split_at(6 * self.coordinate.len());
+        let mut composites = nodes.chunks_exact(13);
         for a in 1..self.up.len() {
             let (t0, t1) = (self.first[a] as usize, self.first[a + 1] as usize);
             if t0 == t1 {
                 continue;
             }
-            let c = &nodes[13 * self.mass_node[a] as usize..][..13];
+            let c = composites.next().expect("a composite per node with twists");
             let o = [c[0], c[1], c[2]];
             let (mass, h) = (c[3], [c[4], c[5], c[6]]);
             let i = [
@@ -409,7 +402,7 @@ impl TwistTree {
                 [c[11], c[12], c[9]],
             ];
             for t in t0..t1 {
-                let x: &[f64; 6] = tw[6 * t..6 * t + 6].try_into().expect("6 values");
+                let x = twist(tw, t);
                 let w = [x[0], x[1], x[2]];
                 // the twist's velocity at o, then F = I_a ξ_t about o
                 let wo = cross(w, o);
@@ -431,7 +424,7 @@ impl TwistTree {
                         self.first[k + 1] as usize
                     };
                     for s in self.first[k] as usize..last {
-                        let y: &[f64; 6] = tw[6 * s..6 * s + 6].try_into().expect("6 values");
+                        let y = twist(tw, s);
                         let value = y[0] * ang[0]
                             + y[1] * ang[1]
                             + y[2] * ang[2]
@@ -457,20 +450,19 @@ impl TwistTree {
     }
 }
 
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
+/// Twist `t` of `tw`: (ω, v₀).
+#[inline(always)]
+fn twist(tw: &[f64], t: usize) -> &[f64; 6] {
+    tw[6 * t..6 * t + 6].try_into().expect("6 values")
 }
 
 /// A column of a Jacobian += v₀ + ω × p, for the twist x = (ω, v₀).
 #[inline(always)]
 fn add_column(col: &mut [f64], x: &[f64; 6], p: [f64; 3]) {
-    col[0] += x[3] + x[1] * p[2] - x[2] * p[1];
-    col[1] += x[4] + x[2] * p[0] - x[0] * p[2];
-    col[2] += x[5] + x[0] * p[1] - x[1] * p[0];
+    let wp = cross([x[0], x[1], x[2]], p);
+    col[0] += x[3] + wp[0];
+    col[1] += x[4] + wp[1];
+    col[2] += x[5] + wp[2];
 }
 
 /// The derivatives [`Model::constraint_parameter_tangents`] writes, column-major, NS columns

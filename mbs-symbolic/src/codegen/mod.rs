@@ -220,7 +220,7 @@ fn emit_params(
             tables.join(",\n")
         );
     }
-    if jacobians_assembled(model) {
+    if model.assembled {
         let _ = writeln!(
             code,
             "#[allow(clippy::all)]\nimpl {ty} {{\n{}\n}}",
@@ -483,12 +483,6 @@ fn tangent_part_fn(i: usize) -> String {
     }
 }
 
-/// Whether the Jacobians of `kinematics` and `point_kinematics`, and M, are assembled at run
-/// time from the coordinates' twists (`SymbolicModel::assembled`).
-pub fn jacobians_assembled(model: &SymbolicModel) -> bool {
-    model.assembled
-}
-
 /// The twists of every node in tree order, with the node each belongs to.
 fn twist_list(model: &SymbolicModel) -> Vec<(usize, Twist)> {
     model
@@ -498,6 +492,11 @@ fn twist_list(model: &SymbolicModel) -> Vec<(usize, Twist)> {
         .enumerate()
         .flat_map(|(n, t)| t.iter().map(move |&t| (n, t)))
         .collect()
+}
+
+/// The six numbers of a twist in the runtime's buffers: ω, then v₀.
+fn twist_values(t: &Twist) -> [ExprId; 6] {
+    [t.w[0], t.w[1], t.w[2], t.v0[0], t.v0[1], t.v0[2]]
 }
 
 /// The associated constant `TWISTS` of the parameter struct: the tree and the coordinate of
@@ -525,21 +524,8 @@ fn twist_tree(model: &SymbolicModel) -> String {
             up[p]
         };
     }
-    let mut with_twists = 0;
-    let mass_node: Vec<String> = model
-        .world
-        .twists
-        .iter()
-        .map(|t| {
-            if t.is_empty() {
-                return u32::MAX.to_string();
-            }
-            with_twists += 1;
-            (with_twists - 1).to_string()
-        })
-        .collect();
     format!(
-        "/// The tree of the twists the Jacobians of `kinematics`, and M, are assembled from.\npub const TWISTS: ::mbs::__private::TwistTree = ::mbs::__private::TwistTree {{ up: {}, first: {}, coordinate: {}, frame_node: {}, point_node: {}, mass_node: {} }};",
+        "/// The tree of the twists the Jacobians of `kinematics`, and M, are assembled from.\npub const TWISTS: ::mbs::__private::TwistTree = ::mbs::__private::TwistTree {{ up: {}, first: {}, coordinate: {}, frame_node: {}, point_node: {} }};",
         list(up.iter().map(|n| n.to_string()).collect()),
         list(first.iter().map(|f| f.to_string()).collect()),
         list(
@@ -550,7 +536,6 @@ fn twist_tree(model: &SymbolicModel) -> String {
         ),
         list(tree.frame_node.iter().map(|n| n.to_string()).collect()),
         list(point_node),
-        list(mass_node),
     )
 }
 
@@ -558,25 +543,17 @@ fn twist_tree(model: &SymbolicModel) -> String {
 /// twists (6 each, as in `kinematics`), then 13 numbers per node with twists (its origin and
 /// composite inertia, `world::composite_inertias`).
 fn mass_outputs(model: &SymbolicModel, f: &mut FnSpec) {
-    let mut k = 0;
-    for (_, tw) in twist_list(model) {
-        for v in [tw.w[0], tw.w[1], tw.w[2], tw.v0[0], tw.v0[1], tw.v0[2]] {
-            f.outputs.push((format!("mw[{k}]"), v));
-            k += 1;
-        }
-    }
-    for c in &model.composites {
-        for &v in c {
-            f.outputs.push((format!("mw[{k}]"), v));
-            k += 1;
-        }
+    let twists = twist_list(model);
+    let values = twists.iter().flat_map(|(_, t)| twist_values(t));
+    let values = values.chain(model.composites.iter().flatten().copied());
+    for (k, v) in values.enumerate() {
+        f.outputs.push((format!("mw[{k}]"), v));
     }
 }
 
 /// Numbers `mw` holds for the assembly of M: 6 per twist, 13 per node with twists.
 fn mass_workspace(model: &SymbolicModel) -> usize {
-    let twists: usize = model.world.twists.iter().map(Vec::len).sum();
-    6 * twists + 13 * model.composites.len()
+    6 * model.world.twist_count() + 13 * model.composites.len()
 }
 
 /// The poses and kinematics of frames and points, the same in every scene: emitted once on
@@ -589,7 +566,7 @@ fn kinematics_specs(
 ) -> Vec<(FnSpec, &'static str)> {
     let a = &model.sys.arena;
     let n = model.sys.ndof();
-    let assembled = jacobians_assembled(model);
+    let assembled = model.assembled;
     let kin_args = if assembled {
         format!("{}, tw: &mut [f64]", with_charts("kinematics"))
     } else {
@@ -667,8 +644,7 @@ fn kinematics_specs(
             }
         }
         for (t, (node, tw)) in twist_list(model).into_iter().enumerate() {
-            let values = [tw.w[0], tw.w[1], tw.w[2], tw.v0[0], tw.v0[1], tw.v0[2]];
-            for (c, v) in values.into_iter().enumerate() {
+            for (c, v) in twist_values(&tw).into_iter().enumerate() {
                 fk.outputs.push((format!("tw[{}]", 6 * t + c), v));
                 if on_points[node] {
                     fp.outputs.push((format!("tw[{}]", 6 * t + c), v));
@@ -1042,8 +1018,7 @@ fn emit_scene(
             .as_ref()
             .is_some_and(|c| c.rest.is_some()),
     };
-    let assembled = jacobians_assembled(model);
-    let twists: usize = model.world.twists.iter().map(Vec::len).sum();
+    let assembled = model.assembled;
     let model_impl = api::model_impl(&ty, &pty, &sizes, |m| {
         match m.name {
         "info" => format!("{info}\n&INFO"),
@@ -1075,7 +1050,7 @@ fn emit_scene(
         // assembled from the twists the generated code writes
         name @ ("kinematics" | "point_kinematics") if assembled => format!(
             "let mut tw = [0.0f64; {}];\nself.params.__{name}(&self.charts, {}, &mut tw);\n{pty}::TWISTS.assemble(&tw, out, {});",
-            6 * twists,
+            6 * model.world.twist_count(),
             m.call(),
             name == "kinematics"
         ),

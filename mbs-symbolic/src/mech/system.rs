@@ -308,8 +308,8 @@ pub struct Options {
     pub batch: bool,
     /// force a formulation; `None` picks the cheaper by op count
     pub formulation: Option<Formulation>,
-    /// force the form of the Jacobians of `kinematics` and `point_kinematics`; `None` picks
-    /// by the size of the model (`codegen::jacobians_assembled`)
+    /// force the form of the Jacobians of `kinematics` and `point_kinematics` and of M;
+    /// `None` picks by the size of the model (`SymbolicModel::assembled`)
     pub jacobians: Option<Jacobians>,
 }
 

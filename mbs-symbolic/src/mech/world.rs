@@ -85,6 +85,11 @@ pub fn q_deps(a: &Arena, roots: &[ExprId]) -> Vec<u16> {
 }
 
 impl World {
+    /// The number of twists of all nodes.
+    pub fn twist_count(&self) -> usize {
+        self.twists.iter().map(Vec::len).sum()
+    }
+
     pub fn build(a: &mut Arena, tree: &Tree) -> World {
         let z = s::zero3(a);
         let ground = NodeKin {

@@ -5,7 +5,7 @@
 //! cargo run --release --example work_precision -- --model dpend --out docs/figures
 //! ```
 //!
-//! `--model` is seed2dof, dpend, chain8, slidercrank, hexapod, fourbar, pendulum3, fastlink,
+//! `--model` is seed2dof, dpend, chain8, dampedchain, slidercrank, hexapod, fourbar, pendulum3, fastlink,
 //! tumble, top or all; `--out DIR` writes
 //! `DIR/wp_MODEL.csv` and `DIR/wp_MODEL.svg`; `--repeats N` times each run N times and keeps
 //! the best (default 5; fewer for a run past 1 s). Each model in its natural setting:
@@ -15,6 +15,10 @@
 //!   at t = 0.5, 1, 2 s, where that reference is reproducible to 1e-11;
 //! - chain8 to 2 s against a self-computed reference (DOPRI5 at rtol 1e-13, checked by RK4
 //!   at h = 5e-5), every 0.05 s;
+//! - dampedchain (six bars, a damper in every joint: decaying modes to 3.1e3 1/s) to 2 s
+//!   against a self-computed reference (DOPRI5 at rtol 1e-13, checked by Radau5 at 1e-12),
+//!   every 0.05 s, with RKC (adaptive, and fixed steps from 20 ms) beside the others: the
+//!   motion it is for;
 //! - slidercrank, form (a) (three coordinates, two loop constraints) to 2 s: projection for
 //!   the explicit schemes, BDF and Radau5, index 3 for the Newmark family and Radau5; against
 //!   form (b) (θ alone, the loop in closed form) computed by DOPRI5 at rtol 1e-13 (checked by
@@ -45,6 +49,7 @@
 //! are in the table and the CSV but not on the chart.
 
 use mbs_models::chain8;
+use mbs_models::damped_chain;
 use mbs_models::dpend;
 use mbs_models::fastlink;
 use mbs_models::fourbar;
@@ -78,10 +83,11 @@ struct Args {
     repeats: usize,
 }
 
-const MODELS: [&str; 10] = [
+const MODELS: [&str; 11] = [
     "seed2dof",
     "dpend",
     "chain8",
+    "dampedchain",
     "slidercrank",
     "hexapod",
     "fourbar",
@@ -105,6 +111,17 @@ fn bdf() -> Scheme {
 }
 
 /// Times t_end/n, 2 t_end/n, … t_end.
+/// A reference computed by mbs: DOPRI5 at rtol 1e-13 at `times`, checked by `check`.
+fn computed<M: Model + Clone + 'static>(
+    model: &M,
+    times: Vec<f64>,
+    check: (Scheme, Setting),
+    options: &mbs::Options,
+) -> Reference {
+    let dopri5 = (Scheme::Dopri5, Setting::Rtol(1e-13));
+    Reference::compute(model, times, dopri5, Some(check), options).expect("reference run")
+}
+
 fn samples(t_end: f64, n: usize) -> Vec<f64> {
     (1..=n).map(|k| t_end * k as f64 / n as f64).collect()
 }
@@ -191,6 +208,20 @@ struct Plan {
     euler: Option<(f64, usize)>,
 }
 
+/// The plan of the chains (2 s).
+fn chain_plan() -> Plan {
+    Plan {
+        dopri5: (3, 11),
+        bdf: (3, 12),
+        radau3: (3, 10),
+        radau5: (3, 12),
+        order2: (3, 8),
+        rk4: (0.01, 7),
+        midpoint: (0.005, 6),
+        euler: None,
+    }
+}
+
 fn sweeps(p: &Plan) -> Vec<Sweep> {
     let mut v = vec![
         Sweep::adaptive(Scheme::Dopri5, &decades(p.dopri5.0, p.dopri5.1)),
@@ -263,40 +294,50 @@ fn study(name: &str, repeats: usize) -> WorkPrecision {
         }
         "chain8" => {
             let model = chain8::Chain8::default();
-            let r = Reference::compute(
+            let r = computed(
                 &model,
                 samples(2.0, 40),
-                (Scheme::Dopri5, Setting::Rtol(1e-13)),
-                Some((Scheme::Rk4, Setting::Step(5e-5))),
+                (Scheme::Rk4, Setting::Step(5e-5)),
                 &mbs::Options::default(),
-            )
-            .expect("reference run");
-            let plan = Plan {
-                dopri5: (3, 11),
-                bdf: (3, 12),
-                radau3: (3, 10),
-                radau5: (3, 12),
-                order2: (3, 8),
-                rk4: (0.01, 7),
-                midpoint: (0.005, 6),
-                euler: None,
-            };
+            );
             let s = finish(Study {
-                sweeps: sweeps(&plan),
+                sweeps: sweeps(&chain_plan()),
                 ..Study::new("chain8", r)
+            });
+            s.run(&model).expect("study")
+        }
+        "dampedchain" => {
+            let model = damped_chain::DampedChain::default();
+            let r = computed(
+                &model,
+                samples(2.0, 40),
+                (Scheme::Radau5, Setting::Rtol(1e-12)),
+                &mbs::Options::default(),
+            );
+            // RK4 below the fast modes' limit, 2.785/ρ ≈ 0.9 ms
+            let plan = Plan {
+                rk4: (5e-4, 6),
+                ..chain_plan()
+            };
+            // the motion RKC is for: its decaying modes (to 3.1e3 1/s) hold the explicit
+            // schemes' steps, RKC's stages grow as their square root
+            let mut sweeps = sweeps(&plan);
+            sweeps.insert(1, Sweep::adaptive(Scheme::Rkc, &decades(2, 8)));
+            sweeps.insert(2, Sweep::fixed(Scheme::Rkc, &halvings(0.02, 7)));
+            let s = finish(Study {
+                sweeps,
+                ..Study::new("dampedchain", r)
             });
             s.run(&model).expect("study")
         }
         "slidercrank" => {
             let closed = slidercrank::SliderCrankClosed::default();
-            let r = Reference::compute(
+            let r = computed(
                 &closed,
                 samples(2.0, 40),
-                (Scheme::Dopri5, Setting::Rtol(1e-13)),
-                Some((Scheme::Rk4, Setting::Step(5e-5))),
+                (Scheme::Rk4, Setting::Step(5e-5)),
                 &mbs::Options::default(),
             )
-            .expect("reference run")
             .map(
                 "form (b) (θ alone, loop in closed form) mapped to form (a)'s (θ, ψ, s) and rates",
                 |_, y| slidercrank::form_a_state(y[0], y[1]).to_vec(),
@@ -335,14 +376,12 @@ fn study(name: &str, repeats: usize) -> WorkPrecision {
                 ),
                 ..mbs::Options::default()
             };
-            let r = Reference::compute(
+            let r = computed(
                 &model,
                 samples(1.0, 20),
-                (Scheme::Dopri5, Setting::Rtol(1e-13)),
-                Some((Scheme::Rk4, Setting::Step(5e-5))),
+                (Scheme::Rk4, Setting::Step(5e-5)),
                 &options,
-            )
-            .expect("reference run");
+            );
             let plan = Plan {
                 dopri5: (3, 11),
                 bdf: (3, 10),
@@ -369,14 +408,12 @@ fn study(name: &str, repeats: usize) -> WorkPrecision {
                 },
                 ..mbs::Options::default()
             };
-            let r = Reference::compute(
+            let r = computed(
                 &model,
                 samples(2.0, 40),
-                (Scheme::Dopri5, Setting::Rtol(1e-13)),
-                Some((Scheme::Radau5, Setting::Rtol(1e-13))),
+                (Scheme::Radau5, Setting::Rtol(1e-13)),
                 &options,
-            )
-            .expect("reference run");
+            );
             let s = finish(Study {
                 sweeps: loop_sweeps::<fourbar::FourBar>(&decades(4, 10)),
                 ..Study::new("fourbar", r)
@@ -478,14 +515,12 @@ where
     M: Model + Clone + 'static,
     Z: Model + Clone + 'static,
 {
-    let r = Reference::compute(
+    let r = computed(
         model,
         times,
-        (Scheme::Dopri5, Setting::Rtol(1e-13)),
-        Some((Scheme::Radau5, Setting::Rtol(1e-13))),
+        (Scheme::Radau5, Setting::Rtol(1e-13)),
         &mbs::Options::default(),
-    )
-    .expect("reference run");
+    );
     let s = finish(Study {
         sweeps: sweeps(plan),
         ..Study::new(format!("{name} (Tball)"), r.clone())

@@ -1,7 +1,7 @@
 //! The command-line front end shared by the per-system programs in `examples/`:
 //!
 //! ```text
-//! --scheme NAME   euler, rk4, dopri5, newmark, hht, gen-alpha, bdf, radau3, radau5, midpoint
+//! --scheme NAME   euler, rk4, rkc, dopri5, newmark, hht, gen-alpha, bdf, radau3, radau5, midpoint
 //! --t-end T       end time (s)
 //! --h H           fixed step (s); without it the scheme controls its step by --rtol/--atol
 //! --rtol R --atol A
@@ -68,7 +68,7 @@ pub const MAX_KEPT: usize = 6000;
 /// `--rtol -1e-6`): the option check then says what is wrong with them.
 #[derive(Parser, Debug, Clone)]
 pub struct RunArgs {
-    /// integration scheme: euler, rk4, dopri5, newmark, hht, gen-alpha, bdf, radau3, radau5,
+    /// integration scheme: euler, rk4, rkc, dopri5, newmark, hht, gen-alpha, bdf, radau3, radau5,
     /// midpoint
     #[arg(long, default_value = "dopri5")]
     pub scheme: String,
@@ -186,7 +186,7 @@ impl RunReport {
 #[derive(Debug, thiserror::Error)]
 pub enum RunError {
     #[error(
-        "unknown scheme `{0}`: use euler, rk4, dopri5, newmark, hht, gen-alpha, bdf, radau3, radau5 or midpoint"
+        "unknown scheme `{0}`: use euler, rk4, rkc, dopri5, newmark, hht, gen-alpha, bdf, radau3, radau5 or midpoint"
     )]
     UnknownScheme(String),
     /// the run could not start (options, parameters, a consistent start); nothing was written

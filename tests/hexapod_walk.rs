@@ -1,6 +1,7 @@
 //! The hexapod walks (`models/src/hexapod_walker.rs`, `examples/hexapod_walk.rs`): the
 //! figures the example prints, asserted with margins on the runs it makes, under the 1 kHz
-//! sampled controller with the example's scheme (RK4, 0.2 ms).
+//! sampled controller with the example's scheme (RKC, 0.5 ms: two steps per control period),
+//! and that scheme against RK4 at 0.2 ms on the same walk.
 //!
 //! - tripod gait on flat ground: ≥ 2 m forward at ≥ 0.1 m/s, heading error ≤ 5°, no foot
 //!   slipping more than 1 cm during one contact, base height within ±1 cm of its set point
@@ -16,17 +17,25 @@
 use mbs::{Options, Output, Scheme, StepControl};
 use mbs_models::hexapod_walker::*;
 
+/// The example's scheme and step.
+const SCHEME: Scheme = Scheme::Rkc;
+const H: f64 = 5e-4;
+
 fn options(t_end: f64) -> Options {
+    options_at(t_end, H)
+}
+
+fn options_at(t_end: f64, h: f64) -> Options {
     Options {
         t_end,
-        step: StepControl::Fixed { h: 2e-4 },
+        step: StepControl::Fixed { h },
         output: Output::Every { dt: 0.005 },
         ..Options::default()
     }
 }
 
 fn run(walker: &Walker, t_end: f64) -> (Walk, Figures) {
-    let w = walk(walker, Control::Sampled, Scheme::Rk4, options(t_end)).expect("reachable start");
+    let w = walk(walker, Control::Sampled, SCHEME, options(t_end)).expect("reachable start");
     if let Some(e) = &w.failure {
         panic!("the walk stopped: {e}");
     }
@@ -96,13 +105,9 @@ fn climbs_a_5_cm_step() {
     assert!(f.max_slip <= 0.01, "{}", f.max_slip);
 }
 
-#[test]
-fn sampled_and_continuous_controllers_walk_alike() {
-    let walker = Walker::new(GaitParams::new(Gait::Tripod, 0.15));
-    let sampled = walk(&walker, Control::Sampled, Scheme::Rk4, options(3.0)).unwrap();
-    let continuous = walk(&walker, Control::Continuous, Scheme::Rk4, options(3.0)).unwrap();
-    assert!(sampled.failure.is_none() && continuous.failure.is_none());
-    let (a, b) = (&sampled.trajectory, &continuous.trajectory);
+/// The largest differences of the base's x, z and pitch between two walks sampled alike.
+fn largest_differences(a: &Walk, b: &Walk) -> [f64; 3] {
+    let (a, b) = (&a.trajectory, &b.trajectory);
     assert_eq!(a.len(), b.len());
     let mut worst = [0.0f64; 3];
     for i in 0..a.len() {
@@ -110,6 +115,48 @@ fn sampled_and_continuous_controllers_walk_alike() {
             worst[k] = worst[k].max((a.q(i)[c] - b.q(i)[c]).abs());
         }
     }
+    worst
+}
+
+#[test]
+fn rkc_walks_as_rk4_does() {
+    // the example's RKC at 0.5 ms (4–5 stages: its fastest modes, friction and the motors'
+    // electrical poles, decay) against RK4 at 0.2 ms (2.785/ρ for ρ up to 1.1e4 1/s)
+    let walker = Walker::new(GaitParams::new(Gait::Tripod, 0.15));
+    let rkc = walk(&walker, Control::Sampled, SCHEME, options(3.0)).unwrap();
+    let rk4 = walk(
+        &walker,
+        Control::Sampled,
+        Scheme::Rk4,
+        options_at(3.0, 2e-4),
+    )
+    .unwrap();
+    assert!(rkc.failure.is_none() && rk4.failure.is_none());
+    let worst = largest_differences(&rkc, &rk4);
+    let (ea, eb) = (rkc.figures().energy, rk4.figures().energy);
+    println!(
+        "RKC against RK4: x {:.2e} m, z {:.2e} m, pitch {:.2e} rad apart; energy {ea:.2} J against {eb:.2} J; evaluations {} against {}",
+        worst[0],
+        worst[1],
+        worst[2],
+        rkc.stats.evaluations(),
+        rk4.stats.evaluations()
+    );
+    assert!(
+        worst[0] < 2e-4 && worst[1] < 5e-5 && worst[2] < 1e-4,
+        "{worst:?}"
+    );
+    assert!((ea - eb).abs() < 0.01 * eb, "{ea} J vs {eb} J");
+    assert!(2 * rkc.stats.evaluations() < rk4.stats.evaluations());
+}
+
+#[test]
+fn sampled_and_continuous_controllers_walk_alike() {
+    let walker = Walker::new(GaitParams::new(Gait::Tripod, 0.15));
+    let sampled = walk(&walker, Control::Sampled, SCHEME, options(3.0)).unwrap();
+    let continuous = walk(&walker, Control::Continuous, SCHEME, options(3.0)).unwrap();
+    assert!(sampled.failure.is_none() && continuous.failure.is_none());
+    let worst = largest_differences(&sampled, &continuous);
     println!(
         "largest differences: x {:.2e} m, z {:.2e} m, pitch {:.2e} rad",
         worst[0], worst[1], worst[2]
@@ -153,26 +200,20 @@ fn faults_are_modelled_or_typed() {
     // a start the legs cannot reach: a typed error before any step
     let mut gait = GaitParams::new(Gait::Tripod, 0.15);
     gait.height = 0.9;
-    let e = walk(
-        &Walker::new(gait),
-        Control::Sampled,
-        Scheme::Rk4,
-        options(1.0),
-    )
-    .err();
+    let e = walk(&Walker::new(gait), Control::Sampled, SCHEME, options(1.0)).err();
     assert!(e.is_some_and(|e| e.to_string().contains("cannot reach")));
 
     // strides the legs cannot reach (2.5 m/s asks for 1.4 m): the sampled controller holds
     // its voltages and says so; the continuous PIDs stop the run with a typed failure that
     // keeps the trajectory
     let walker = Walker::new(GaitParams::new(Gait::Tripod, 2.5));
-    let w = walk(&walker, Control::Sampled, Scheme::Rk4, options(1.5)).unwrap();
+    let w = walk(&walker, Control::Sampled, SCHEME, options(1.5)).unwrap();
     let (t, e) = w.log.failure.as_ref().expect("recorded");
     assert!(
         *t > walker.gait.start && e.to_string().contains("cannot reach"),
         "{t} {e}"
     );
-    let w = walk(&walker, Control::Continuous, Scheme::Rk4, options(1.5)).unwrap();
+    let w = walk(&walker, Control::Continuous, SCHEME, options(1.5)).unwrap();
     let failure = w.failure.as_ref().expect("a typed failure");
     assert!(
         matches!(failure.kind, mbs::Failure::UserEffort { .. }),
@@ -184,7 +225,7 @@ fn faults_are_modelled_or_typed() {
     // motors on a 6 V supply saturate: modelled (voltages clipped), no panic
     let mut walker = Walker::new(GaitParams::new(Gait::Tripod, 0.15));
     walker.motor.v_max = 6.0;
-    let w = walk(&walker, Control::Sampled, Scheme::Rk4, options(3.0)).unwrap();
+    let w = walk(&walker, Control::Sampled, SCHEME, options(3.0)).unwrap();
     let f = w.figures();
     assert!(f.saturated > 0.0 && f.peak_voltage <= 6.0, "{f:?}");
 
@@ -196,7 +237,7 @@ fn faults_are_modelled_or_typed() {
         &walker,
         &Terrain::default(),
         Control::Sampled,
-        Scheme::Rk4,
+        SCHEME,
         options(6.0),
     )
     .unwrap();

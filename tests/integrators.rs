@@ -37,6 +37,7 @@ fn fixed_step_orders_on_seed2dof() {
     let cases = [
         (Scheme::ExplicitEuler, t2 / 2000.0, 0.2),
         (Scheme::Rk4, t2 / 40.0, 1.0),
+        (Scheme::Rkc, t2 / 40.0, 1.0),
         (Scheme::Dopri5, t2 / 20.0, 1.0),
         (Scheme::Newmark(NewmarkParams::default()), t2 / 40.0, 1.0),
         (Scheme::Hht(HhtParams { alpha: -0.1 }), t2 / 40.0, 1.0),

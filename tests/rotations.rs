@@ -137,6 +137,7 @@ fn every_scheme_runs_the_tumble_through_its_flips() {
     let schemes = [
         (Scheme::ExplicitEuler, 0.2, None),
         (Scheme::Rk4, 5e-8, None),
+        (Scheme::Rkc, 5e-4, Some((1e-6, 3e-6))),
         (Scheme::Dopri5, 1e-11, Some((1e-6, 2e-5))),
         (Scheme::Newmark(NewmarkParams::default()), 5e-4, None),
         (Scheme::Hht(HhtParams::default()), 1e-3, Some((1e-6, 2e-3))),

@@ -13,9 +13,11 @@
 //!
 //! - every run reaches t_end;
 //! - no run loses more than 0.2 digits when rtol tightens by a decade;
-//! - no more than 1.5 digits below the median of the asserted sweeps at the same rtol, on
-//!   every model: a user who trusts rtol is not misled by the choice of scheme or method by
-//!   more than that. (Above it is not an error: BDF with partitioning gets 6.1 digits on
+//! - no more than 1.5 digits below the median of the asserted sweeps at the same rtol, or
+//!   below rtol's digits when the median is above them (RKC's sweeps, 0.2–0.5 digits above
+//!   rtol on Cash's pendulum, raised the median at 1e-6 to 6.22 there, 1.54 digits above HHT's
+//!   4.68), on every model: a user who trusts rtol is not misled by the choice of scheme or
+//!   method by more than that. (Above it is not an error: BDF with partitioning gets 6.1 digits on
 //!   fastlink at rtol 1e-7, where the median is 4.3.)
 //!
 //! Not asserted, because not true: within 1.5 digits of rtol itself. On the Cartesian double
@@ -60,6 +62,7 @@ fn claimed(label: &str) -> Option<(f64, f64)> {
         ("gen-alpha" | "hht", _) => Some((1e-4, 1e-7)),
         (_, "index3") => None,
         ("dopri5", _) => Some((1e-6, 1e-10)),
+        ("rkc", _) => Some((1e-4, 1e-8)),
         _ => Some((1e-4, 1e-10)),
     }
 }
@@ -83,6 +86,7 @@ fn sweeps(constrained: bool) -> Vec<Sweep> {
     let rtols = decades(4, 10);
     let schemes = [
         Scheme::Dopri5,
+        Scheme::Rkc,
         Scheme::Bdf(Default::default()),
         Scheme::Radau3,
         Scheme::Radau5,
@@ -104,8 +108,14 @@ fn sweeps(constrained: bool) -> Vec<Sweep> {
     for scheme in schemes {
         for &m in methods {
             let label = format!("{} {}", scheme.name(), m.name());
+            // RKC, of order 2, to 1e-8 (at 1e-8 dpend takes it 204,000 steps)
+            let rtols = if scheme == Scheme::Rkc {
+                &rtols[..5]
+            } else {
+                &rtols[..]
+            };
             out.push(
-                Sweep::adaptive(scheme, &rtols)
+                Sweep::adaptive(scheme, rtols)
                     .with_constraints(m)
                     .labelled(label),
             );
@@ -166,11 +176,14 @@ fn judge(wp: &WorkPrecision, constrained: bool) -> Vec<String> {
         .filter(|p| constrained || !p.label.starts_with("gen-alpha") && !p.label.starts_with("hht"))
         .collect();
     // the median digits of the asserted sweeps at each rtol: the yardstick between schemes
-    let median = |k: usize| {
+    let median = |r: f64| {
         let mut d: Vec<f64> = props
             .iter()
-            .filter(|p| asserted(&p.label, p.rtols[k]))
-            .filter_map(|p| p.digits[k])
+            .filter(|p| asserted(&p.label, r))
+            .filter_map(|p| {
+                let k = p.rtols.iter().position(|&x| (x / r - 1.0).abs() < 1e-9)?;
+                p.digits[k]
+            })
             .collect();
         d.sort_by(f64::total_cmp);
         d.get(d.len() / 2).copied()
@@ -181,7 +194,7 @@ fn judge(wp: &WorkPrecision, constrained: bool) -> Vec<String> {
         }
         let at = |r: f64| format!("{}: {} at rtol {r:e}", wp.title, p.label);
         let mut last: Option<f64> = None;
-        for (k, (&r, d)) in p.rtols.iter().zip(&p.digits).enumerate() {
+        for (&r, d) in p.rtols.iter().zip(&p.digits) {
             if !asserted(&p.label, r) {
                 continue;
             }
@@ -189,8 +202,10 @@ fn judge(wp: &WorkPrecision, constrained: bool) -> Vec<String> {
                 bad.push(format!("{}: failed", at(r)));
                 continue;
             };
-            if let Some(m) = median(k)
-                && d < m - WITHIN
+            // below the median, and below rtol itself: a sweep that reaches rtol is not
+            // made wrong by others that do better
+            if let Some(m) = median(r)
+                && d < m.min(-r.log10()) - WITHIN
             {
                 bad.push(format!("{}: {d:.2} digits, the median {m:.2}", at(r)));
             }
@@ -254,7 +269,7 @@ const GLOBAL_RTOLS: [f64; 3] = [1e-4, 1e-6, 1e-8];
 
 /// The global-control tolerances of the sweep `label`.
 fn global_rtols(label: &str) -> &'static [f64] {
-    let low_order = ["radau3", "gen-alpha", "hht"];
+    let low_order = ["radau3", "gen-alpha", "hht", "rkc"];
     if low_order.iter().any(|s| label.starts_with(s)) {
         &GLOBAL_RTOLS[..2]
     } else {

@@ -88,6 +88,9 @@ pub enum Scheme {
     ExplicitEuler,
     /// classical Runge–Kutta, order 4 (fixed step)
     Rk4,
+    /// Runge–Kutta–Chebyshev, order 2, its stages from the fastest mode (adaptive or fixed
+    /// step): explicit, for motions whose fast modes decay
+    Rkc,
     /// Dormand–Prince 5(4) with dense output (adaptive or fixed step)
     Dopri5,
     /// Newmark (β, γ), second-order form, Newton on accelerations
@@ -112,6 +115,7 @@ impl Scheme {
         match self {
             Scheme::ExplicitEuler => "euler",
             Scheme::Rk4 => "rk4",
+            Scheme::Rkc => "rkc",
             Scheme::Dopri5 => "dopri5",
             Scheme::Newmark(_) => "newmark",
             Scheme::Hht(_) => "hht",
@@ -128,6 +132,7 @@ impl Scheme {
         Some(match name {
             "euler" => Scheme::ExplicitEuler,
             "rk4" => Scheme::Rk4,
+            "rkc" => Scheme::Rkc,
             "dopri5" => Scheme::Dopri5,
             "newmark" => Scheme::Newmark(NewmarkParams::default()),
             "hht" => Scheme::Hht(HhtParams::default()),
@@ -141,10 +146,11 @@ impl Scheme {
     }
 
     /// Every scheme with default parameters.
-    pub fn all() -> [Scheme; 10] {
+    pub fn all() -> [Scheme; 11] {
         [
             "euler",
             "rk4",
+            "rkc",
             "dopri5",
             "newmark",
             "hht",
@@ -170,7 +176,7 @@ impl Scheme {
                     1
                 }
             }
-            Scheme::Hht(_) | Scheme::GenAlpha(_) | Scheme::ImplicitMidpoint => 2,
+            Scheme::Hht(_) | Scheme::GenAlpha(_) | Scheme::ImplicitMidpoint | Scheme::Rkc => 2,
             Scheme::Bdf(p) => p.max_order,
             Scheme::Radau3 => 3,
             Scheme::Radau5 => 5,
@@ -179,7 +185,10 @@ impl Scheme {
 
     /// Whether the scheme solves nonlinear equations (Newton) at each step.
     pub fn is_implicit(&self) -> bool {
-        !matches!(self, Scheme::ExplicitEuler | Scheme::Rk4 | Scheme::Dopri5)
+        !matches!(
+            self,
+            Scheme::ExplicitEuler | Scheme::Rk4 | Scheme::Rkc | Scheme::Dopri5
+        )
     }
 
     /// Spectral radius at infinite frequency ρ∞ of the Newmark family (1: no numerical

@@ -11,6 +11,7 @@
 //! | [`chain8`], [`chain24`] | planar chains of 8 and 24 uniform bars |
 //! | [`chain16_stiff`] | a chain of 16 bars with torsional springs of 1e6 N·m/rad in its joints |
 //! | [`chain30_stiff`] | a swinging chain of 30 light bars with undamped stiff torsional springs |
+//! | [`damped_chain`] | a chain of six bars with a viscous damper in every joint: fast modes that decay |
 //! | [`hexapod`] | 24-dof walking robot, free and standing on its feet |
 //! | [`hexapod_walker`] | the hexapod built to walk: outward legs, DC motors, gait generator, leg inverse kinematics, 1 kHz PIDs, terrain |
 //! | [`human`] | human lower limbs for walking: 14 bodies, 23 coordinates, spline knee, patella, six contact ellipsoids per foot |
@@ -34,6 +35,7 @@ pub mod chain24;
 pub mod chain30_stiff;
 pub mod chain8;
 pub mod conserved;
+pub mod damped_chain;
 pub mod dc_motor;
 pub mod dpend;
 pub mod dpend_cartesian;

@@ -238,7 +238,7 @@ impl Base {
 fn scheme_named(name: &str) -> Result<Scheme, String> {
     Scheme::from_name(name).ok_or_else(|| {
         format!(
-            "unknown scheme `{name}`: use euler, rk4, dopri5, newmark, hht, gen-alpha, bdf, radau3, radau5 or midpoint"
+            "unknown scheme `{name}`: use euler, rk4, rkc, dopri5, newmark, hht, gen-alpha, bdf, radau3, radau5 or midpoint"
         )
     })
 }

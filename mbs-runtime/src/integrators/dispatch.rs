@@ -3,7 +3,7 @@
 
 use super::constrained::Mode;
 use super::stepper::Stepper;
-use super::{bdf, dopri5, explicit, midpoint, newmark, radau};
+use super::{bdf, chebyshev, dopri5, explicit, midpoint, newmark, radau};
 use crate::error::Failure;
 use crate::model::Model;
 use crate::options::{ConstraintMethod, Scheme};
@@ -73,6 +73,7 @@ pub(super) fn stepper_for<M: Model>(scheme: &Scheme, n: usize) -> Box<dyn Steppe
     match *scheme {
         Scheme::ExplicitEuler => Box::new(explicit::Explicit::euler(n)),
         Scheme::Rk4 => Box::new(explicit::Explicit::rk4(n)),
+        Scheme::Rkc => Box::new(chebyshev::Chebyshev::new(n)),
         Scheme::Dopri5 => Box::new(dopri5::Dopri5::new(n)),
         Scheme::Newmark(p) => Box::new(newmark::AlphaFamily::newmark(n, p)),
         Scheme::Hht(p) => Box::new(newmark::AlphaFamily::hht(n, p)),

@@ -156,17 +156,7 @@ impl<M: Model> Stepper<M> for Dopri5 {
             }
             let r = p.accel(cur.t + C[s] * h, &self.q, &self.v, &mut self.ka[s]);
             if let Err(e) = r {
-                // a non-finite stage: too large a step when adaptive, fatal when fixed
-                if ctl.adaptive.is_some() && matches!(e, Failure::NonFinite { .. }) {
-                    self.pi.rejected_otherwise();
-                    return Ok(Attempt::RejectedNewton {
-                        h_next: 0.25 * h,
-                        iterations: 0,
-                        correction: f64::INFINITY,
-                        cause: Some(e),
-                    });
-                }
-                return Err(e);
+                return Attempt::after_stage_failure(e, ctl.adaptive.is_some(), h, &mut self.pi);
             }
         }
         // stage 7 is at (q1, qd1): the new state, first same as last

@@ -57,6 +57,8 @@ pub(crate) struct StabilityWatch {
     rho: f64,
     /// the fastest mode oscillates (δ·J²δ < 0)
     oscillating: bool,
+    /// its eigenvalue (re, im ≥ 0), by `ritz`
+    mode: (f64, f64),
     /// the last step changed the state by more than its size: check before the next one
     lurched: bool,
 }
@@ -69,6 +71,34 @@ fn seed_direction(dq: &mut [f64], dv: &mut [f64]) {
     for i in 0..dq.len() {
         dq[i] = 1.0 + 0.37 * i as f64;
         dv[i] = if i % 2 == 0 { 0.5 } else { -0.8 };
+    }
+}
+
+/// The dot product of two states (positions, velocities).
+fn dot(a: (&Vec<f64>, &Vec<f64>), b: (&Vec<f64>, &Vec<f64>)) -> f64 {
+    let q: f64 = a.0.iter().zip(b.0).map(|(x, y)| x * y).sum();
+    let v: f64 = a.1.iter().zip(b.1).map(|(x, y)| x * y).sum();
+    q + v
+}
+
+/// The eigenvalue (re, im ≥ 0) of largest modulus of J restricted to the Krylov space
+/// {δ, Jδ}, from the Gram matrix of δ and Jδ (g11 = δ·δ, g12 = δ·Jδ, g22 = Jδ·Jδ) and the
+/// projections of J²δ (r1 = δ·J²δ, r2 = Jδ·J²δ): J²δ ≈ c₀δ + c₁Jδ by least squares, whose
+/// λ² = c₁λ + c₀ has the Ritz values as roots; δ ∥ Jδ gives the Rayleigh quotient δ·Jδ/δ·δ.
+pub(crate) fn ritz(g11: f64, g12: f64, g22: f64, r1: f64, r2: f64) -> (f64, f64) {
+    let det = g11 * g22 - g12 * g12;
+    if !(det > 1e-12 * g11 * g22) {
+        return (g12 / g11, 0.0);
+    }
+    let c0 = (r1 * g22 - r2 * g12) / det;
+    let c1 = (g11 * r2 - g12 * r1) / det;
+    let disc = c1 * c1 + 4.0 * c0;
+    if disc < 0.0 {
+        (0.5 * c1, 0.5 * (-disc).sqrt())
+    } else {
+        let root = 0.5 * disc.sqrt();
+        let (a, b) = (0.5 * c1 + root, 0.5 * c1 - root);
+        (if a.abs() >= b.abs() { a } else { b }, 0.0)
     }
 }
 
@@ -128,14 +158,11 @@ impl StabilityWatch {
             jv: z(),
             d0q: z(),
             d0v: z(),
-            probe: Probe {
-                q: z(),
-                v: z(),
-                a: z(),
-            },
+            probe: Probe::new(n),
             steps: 0,
             rho: 0.0,
             oscillating: false,
+            mode: (0.0, 0.0),
             lurched: false,
         }
     }
@@ -156,21 +183,15 @@ impl StabilityWatch {
         } else {
             16
         };
-        if !(self.steps % every == 0 || self.lurched) {
+        if !self.due(every) {
             return Ok(());
         }
-        self.rho = self.estimate_rho(p, cur)?;
         // at the start, and before refusing a step, iterate until the estimate settles:
         // one iteration from the seed direction can be far below ρ, and the message
         // advises a step from it
+        self.refresh(p, cur, false)?;
         if self.steps == 0 || h * self.rho > limit(self.oscillating) {
-            for _ in 0..30 {
-                let last = self.rho;
-                self.rho = self.estimate_rho(p, cur)?;
-                if (self.rho - last).abs() <= 1e-3 * self.rho {
-                    break;
-                }
-            }
+            self.settle(p, cur)?;
         }
         let h_rho = h * self.rho;
         let limit = limit(self.oscillating);
@@ -182,6 +203,49 @@ impl StabilityWatch {
                 limit,
                 h_stable: limit / self.rho,
             });
+        }
+        Ok(())
+    }
+
+    /// Whether an estimate is due: every `every` steps, and after a lurch.
+    pub(crate) fn due(&self, every: usize) -> bool {
+        self.steps % every == 0 || self.lurched
+    }
+
+    /// The accepted steps so far.
+    pub(crate) fn steps(&self) -> usize {
+        self.steps
+    }
+
+    /// The last estimate of the fastest mode's eigenvalue (re, im ≥ 0), from the last power
+    /// iteration's Krylov space {δ, Jδ}: exact once δ lies in the mode's invariant plane.
+    pub(crate) fn mode(&self) -> (f64, f64) {
+        self.mode
+    }
+
+    /// Estimates ρ now: one power iteration, and with `settle` more until it changes by less
+    /// than 0.1 %.
+    pub(crate) fn refresh<M: Model>(
+        &mut self,
+        p: &mut Problem<M>,
+        cur: &State,
+        settle: bool,
+    ) -> Result<(), Failure> {
+        self.rho = self.estimate_rho(p, cur)?;
+        if settle {
+            self.settle(p, cur)?;
+        }
+        Ok(())
+    }
+
+    /// Iterates the estimate until it changes by less than 0.1 % (at most 30 times).
+    fn settle<M: Model>(&mut self, p: &mut Problem<M>, cur: &State) -> Result<(), Failure> {
+        for _ in 0..30 {
+            let last = self.rho;
+            self.rho = self.estimate_rho(p, cur)?;
+            if (self.rho - last).abs() <= 1e-3 * self.rho {
+                break;
+            }
         }
         Ok(())
     }
@@ -206,18 +270,14 @@ impl StabilityWatch {
             seed_direction(&mut self.dq, &mut self.dv);
             return Ok(self.rho);
         }
-        let rayleigh: f64 = self
-            .d0q
-            .iter()
-            .zip(&self.dq)
-            .map(|(a, b)| a * b)
-            .sum::<f64>()
-            + self
-                .d0v
-                .iter()
-                .zip(&self.dv)
-                .map(|(a, b)| a * b)
-                .sum::<f64>();
+        // δ = d0, Jδ = j, J²δ = d
+        let (d0, j, d) = (
+            (&self.d0q, &self.d0v),
+            (&self.jq, &self.jv),
+            (&self.dq, &self.dv),
+        );
+        let rayleigh = dot(d0, d);
+        self.mode = ritz(dot(d0, d0), dot(d0, j), dot(j, j), rayleigh, dot(j, d));
         self.oscillating = rayleigh < 0.0;
         for x in self.dq.iter_mut().chain(self.dv.iter_mut()) {
             *x /= n2;
@@ -238,15 +298,23 @@ fn lurched(cur: &State, next: &State) -> bool {
 }
 
 /// The point a Jacobian-vector product is probed at: q, qd and the accelerations there.
-struct Probe {
+pub(crate) struct Probe {
     q: Vec<f64>,
     v: Vec<f64>,
     a: Vec<f64>,
 }
 
 impl Probe {
+    pub(crate) fn new(n: usize) -> Probe {
+        Probe {
+            q: vec![0.0; n],
+            v: vec![0.0; n],
+            a: vec![0.0; n],
+        }
+    }
+
     /// (oq, ov) = J·(iq, iv) at `s`, by a forward difference of the accelerations.
-    fn apply_j<M: Model>(
+    pub(crate) fn apply_j<M: Model>(
         &mut self,
         p: &mut Problem<M>,
         s: &State,

@@ -7,6 +7,7 @@
 //! | scheme | file | order | steps |
 //! |---|---|---|---|
 //! | explicit Euler, RK4 | `explicit.rs` | 1, 4 | fixed (with a stability check) |
+//! | Runge–Kutta–Chebyshev | `chebyshev.rs` | 2 | fixed or adaptive, stages from the fastest modes |
 //! | Dormand–Prince 5(4) | `dopri5.rs` | 5 | adaptive or fixed, dense output |
 //! | Newmark, HHT-α, generalized-α | `newmark.rs` | 2 | fixed or adaptive |
 //! | implicit midpoint | `midpoint.rs` | 2 | fixed |
@@ -23,6 +24,7 @@
 
 mod at;
 mod bdf;
+mod chebyshev;
 pub(crate) mod constrained;
 mod dense;
 mod dispatch;

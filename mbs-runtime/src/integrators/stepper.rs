@@ -4,7 +4,7 @@
 use super::State;
 use super::newton::NewtonTol;
 use super::problem::Problem;
-use super::step_control::Tolerances;
+use super::step_control::{PiController, Tolerances};
 use crate::charts::Recentring;
 use crate::error::Failure;
 use crate::model::Model;
@@ -23,6 +23,29 @@ pub(crate) enum Attempt {
         correction: f64,
         cause: Option<Failure>,
     },
+}
+
+impl Attempt {
+    /// An evaluation inside an explicit step failed with `e`: with adaptive steps a
+    /// non-finite stage is a step too large, retried at a quarter of h (`pi` told, so that
+    /// the step does not grow right after); anything else, or with a fixed step, is fatal.
+    pub(crate) fn after_stage_failure(
+        e: Failure,
+        adaptive: bool,
+        h: f64,
+        pi: &mut PiController,
+    ) -> Result<Attempt, Failure> {
+        if adaptive && matches!(e, Failure::NonFinite { .. }) {
+            pi.rejected_otherwise();
+            return Ok(Attempt::RejectedNewton {
+                h_next: 0.25 * h,
+                iterations: 0,
+                correction: f64::INFINITY,
+                cause: Some(e),
+            });
+        }
+        Err(e)
+    }
 }
 
 /// Step control and Newton settings handed to the schemes.

@@ -475,7 +475,8 @@ pub struct Options {
     /// explicit fixed-step schemes (explicit Euler, RK4, DOPRI5 with a fixed step) estimate the
     /// largest eigenvalue of the dynamics (two extra evaluations every 16 steps, every 4 near
     /// the limit) and stop with `UnstableStep` when h·ρ leaves the scheme's stability region
-    /// (default true)
+    /// (default true). RKC estimates its modes whatever this says (its stages come from
+    /// them); false lets it step on with its most stages where no stage count holds them.
     pub stability_check: bool,
     /// stop with `Failure::SingularConfiguration` when the coordinates approach a singular
     /// configuration (Euler angles at gimbal lock, joint axes lining up, a coordinate that

@@ -302,7 +302,7 @@ impl Path {
     }
 
     /// ∂l/∂q into `out` (one entry per coordinate of the model); the moment arm about
-    /// coordinate i is −out[i].
+    /// coordinate i is `−out[i]`.
     pub fn gradient(&self, kin: &Kinematics, out: &mut [f64]) {
         out.fill(0.0);
         for (w, (u, _, _)) in self.points.windows(2).zip(self.segments(kin)) {

@@ -14,7 +14,7 @@
 //! - every run reaches t_end;
 //! - no run loses more than 0.2 digits when rtol tightens by a decade;
 //! - no more than 1.5 digits below the median of the asserted sweeps at the same rtol, or
-//!   below rtol's digits when the median is above them (RKC's sweeps, 0.2–0.5 digits above
+//!   below rtol's digits when the median is above them (RKC's sweeps, up to 0.5 digits above
 //!   rtol on Cash's pendulum, raised the median at 1e-6 to 6.22 there, 1.54 digits above HHT's
 //!   4.68), on every model: a user who trusts rtol is not misled by the choice of scheme or
 //!   method by more than that. (Above it is not an error: BDF with partitioning gets 6.1 digits on

@@ -15,7 +15,7 @@
 //! 4), and the walking hexapod's friction modes, slightly oscillating, sat in the pinches at
 //! h = 1 ms: the run went on with its motors' voltage saturated (9.6 kJ drawn instead of
 //! 1.2 kJ). With ε = 2, β is 17 % shorter but the region has no pinch: from Re z = −0.5 to
-//! −β/1.5 it holds a strip of half-width 1.56 (3 stages) to 2.3 (15), and near the imaginary
+//! −β/1.5 it holds a strip of half-width 1.56 (3 stages) to 2.29 (15), and near the imaginary
 //! axis 0.30 (3) to 0.38 (15) — "holds" meaning |R_s(z)| ≤ max(1, e^(Re z))·1.01^(|Im z|/2π):
 //! like every order-2 explicit scheme RKC amplifies an undamped oscillation a little
 //! (|R(iy)| = 1 + O(y⁴)), accepted up to 1 % of its amplitude a period. RKC is for decaying
@@ -48,9 +48,9 @@
 //! origin behind a much faster decaying one converges slowly in the second iteration — the
 //! error test of adaptive steps catches; with a fixed step it is the user's h.
 
-use super::explicit::{Probe, StabilityWatch, ritz};
+use super::explicit::{Probe, StabilityWatch, dot, ritz};
 use super::problem::Problem;
-use super::step_control::{Decision, PiController, Tolerances};
+use super::step_control::{Decision, PiController, Tolerances, order_two_factor};
 use super::{Attempt, State, Step, Stepper};
 use crate::error::Failure;
 use crate::model::Model;
@@ -236,10 +236,6 @@ fn seed(v: &mut [f64]) {
     for (i, x) in v.iter_mut().enumerate() {
         *x = 1.0 + (i as f64 * 0.618_034).fract() - if i % 3 == 0 { 1.2 } else { 0.0 };
     }
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 impl OffAxis {
@@ -496,8 +492,7 @@ impl<M: Model> Stepper<M> for Chebyshev {
             (self.y1[i], self.y1[n + i]) = (next.q[i], next.qd[i]);
         }
         // rtol·f and atol·f, f = 0.3·√rtol (no local tolerance below 100ε)
-        let f =
-            (TOL_FACTOR * tol.rtol.sqrt()).clamp((100.0 * f64::EPSILON / tol.rtol).min(1.0), 1.0);
+        let f = order_two_factor(tol.rtol, TOL_FACTOR, 100.0 * f64::EPSILON);
         let tol = Tolerances {
             rtol: tol.rtol * f,
             atol: tol.atol * f,
@@ -634,6 +629,13 @@ mod tests {
             // an undamped oscillation at hω = 0.5 grows by more than 1 % a period
             assert!(!held(s, Complex::new(0.0, 0.5)), "s = {s}");
         }
+        // the widths the docs quote for 15 stages: 0.38 near the axis, 2.29 from −0.5 on
+        let reach = p.beta[15] / MARGIN;
+        assert!(held(15, Complex::new(0.0, 0.38)));
+        for i in 0..=400 {
+            let x = -0.5 - (reach - 0.5) * i as f64 / 400.0;
+            assert!(held(15, Complex::new(x, 2.29)), "{x}");
+        }
         // past the interval the polynomial grows (β is where T_s leaves [−1, 1]; with the
         // damping |R| is still 0.93 at 1.05 β)
         assert!(p.amplification(4, Complex::new(-1.2 * p.beta[4], 0.0)) > 1.0);
@@ -647,7 +649,8 @@ mod tests {
         assert_eq!(p.stages_for(&[Complex::new(-0.5, 0.0)]), Some(2));
         // an oscillation beyond the strip is held by no number of stages
         assert_eq!(p.stages_for(&[Complex::new(-0.1, 5.0)]), None);
-        // β grows as s²
+        // β grows as s² (the README: 8.1 at 4 stages, 53 at 10)
         assert!(p.beta[100] > 0.5 * 100.0 * 100.0 && p.beta[100] < 0.56 * 100.0 * 100.0);
+        assert!((p.beta[4] - 8.1).abs() < 0.05 && (p.beta[10] - 53.0).abs() < 0.5);
     }
 }

@@ -74,11 +74,13 @@ fn seed_direction(dq: &mut [f64], dv: &mut [f64]) {
     }
 }
 
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
 /// The dot product of two states (positions, velocities).
-fn dot(a: (&Vec<f64>, &Vec<f64>), b: (&Vec<f64>, &Vec<f64>)) -> f64 {
-    let q: f64 = a.0.iter().zip(b.0).map(|(x, y)| x * y).sum();
-    let v: f64 = a.1.iter().zip(b.1).map(|(x, y)| x * y).sum();
-    q + v
+fn dot_states(a: (&[f64], &[f64]), b: (&[f64], &[f64])) -> f64 {
+    dot(a.0, b.0) + dot(a.1, b.1)
 }
 
 /// The eigenvalue (re, im ≥ 0) of largest modulus of J restricted to the Krylov space
@@ -271,11 +273,10 @@ impl StabilityWatch {
             return Ok(self.rho);
         }
         // δ = d0, Jδ = j, J²δ = d
-        let (d0, j, d) = (
-            (&self.d0q, &self.d0v),
-            (&self.jq, &self.jv),
-            (&self.dq, &self.dv),
-        );
+        let d0 = (self.d0q.as_slice(), self.d0v.as_slice());
+        let j = (self.jq.as_slice(), self.jv.as_slice());
+        let d = (self.dq.as_slice(), self.dv.as_slice());
+        let dot = dot_states;
         let rayleigh = dot(d0, d);
         self.mode = ritz(dot(d0, d0), dot(d0, j), dot(j, j), rayleigh, dot(j, d));
         self.oscillating = rayleigh < 0.0;

@@ -112,7 +112,7 @@ use super::at::{Affine, At, Weights};
 use super::constrained::{Constrained, Mode};
 use super::newton::{AccelNewton, NewtonTol};
 use super::problem::{Loops, Problem};
-use super::step_control::next_step;
+use super::step_control::{next_step, order_two_factor};
 use super::{Attempt, Control, State, Step, Stepper};
 use crate::charts::Recentring;
 use crate::error::Failure;
@@ -306,10 +306,7 @@ impl<M: Model> Stepper<M> for AlphaFamily {
         };
         // the step's tolerance is rtol·f, f = 0.3·√rtol (see the module notes), Newton's too
         let f = match ctl.adaptive {
-            Some(tol) => {
-                let floor = (FLOOR / tol.rtol).min(1.0);
-                (TOL_FACTOR * tol.rtol.sqrt()).clamp(floor, 1.0)
-            }
+            Some(tol) => order_two_factor(tol.rtol, TOL_FACTOR, FLOOR),
             None => 1.0,
         };
         let newton = match ctl.adaptive {

@@ -53,6 +53,13 @@ impl Tolerances {
     }
 }
 
+/// The factor f = c·√rtol on both tolerances of an order-2 scheme's local error test (rtol·f,
+/// atol·f), so that its global error, ∝ tol^⅔, follows rtol (Newmark family, RKC); within
+/// [floor/rtol, 1]: no local tolerance below `floor`.
+pub(crate) fn order_two_factor(rtol: f64, c: f64, floor: f64) -> f64 {
+    (c * rtol.sqrt()).clamp((floor / rtol).min(1.0), 1.0)
+}
+
 /// err^(−1/(k+1)): the factor on h that brings the error of an estimate of order k to 1.
 pub(crate) fn optimal_factor(err: f64, order: usize) -> f64 {
     err.powf(-1.0 / (order as f64 + 1.0))

@@ -194,6 +194,9 @@ fn forward_dynamics_equal_the_dense_solve_on_every_model() {
         "hexapod walker",
         &hexapod_walker::HexapodWalker::default(),
     ));
+    see(check("human", &human::Human::default()));
+    see(check("damped chain", &damped_chain::DampedChain::default()));
+    see(check("sprung arm", &sprung_arm::SprungArm::default()));
     println!(
         "worst: qdd {:.2}, log det {:.2} of max(1e-12, 4 ε κ₁(M))",
         worst.0, worst.1

@@ -156,12 +156,48 @@ impl FnSpec {
     }
 }
 
-/// What [`emit_fn`] made: the text of the method(s), the op count of the method and, when
-/// its [`Prefix`] was emitted, the op count of the prefix method.
+/// What [`emit_fn`] made: the text of the method (and of its prefix method), its chunk
+/// methods when it has several, the op count of the method and, when its [`Prefix`] was
+/// emitted, the op count of the prefix method.
 pub struct EmittedFn {
     pub text: String,
+    pub chunks: Vec<Chunk>,
     pub count: OpCount,
     pub prefix: Option<OpCount>,
+}
+
+impl EmittedFn {
+    /// The method and its chunk methods.
+    pub fn full_text(&self) -> String {
+        let mut s = self.text.clone();
+        for c in &self.chunks {
+            s.push_str(&c.text());
+        }
+        s
+    }
+}
+
+/// One chunk method of a method split into chunks: `fn {name}(&self, {args}, w: &mut [..])`,
+/// called with `{call}, w` (`w` the workspace of values that cross chunks).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Chunk {
+    pub name: String,
+    pub args: String,
+    pub call: String,
+    /// the number type's name
+    pub number: &'static str,
+    /// attributes of batch code (empty in `f64` code)
+    pub simd: &'static str,
+    pub body: String,
+}
+
+impl Chunk {
+    pub fn text(&self) -> String {
+        format!(
+            "#[inline(never)]\n{}fn {}(&self, {}, w: &mut [{}]) {{\n{}}}\n",
+            self.simd, self.name, self.args, self.number, self.body
+        )
+    }
 }
 
 /// Emits the method(s) of `spec`; with a [`Prefix`], the outputs are scheduled in two
@@ -170,7 +206,7 @@ pub struct EmittedFn {
 pub fn emit_fn(
     arena: &Arena,
     spec: &FnSpec,
-    names: &RustNames,
+    names: &dyn Naming,
 ) -> Result<EmittedFn, Vec<MissingDerivative>> {
     let roots: Vec<ExprId> = spec.outputs.iter().map(|o| o.1).collect();
     let targets: Vec<String> = spec.outputs.iter().map(|o| o.0.clone()).collect();
@@ -198,6 +234,7 @@ pub fn emit_fn(
         }
     };
     let mut s = String::new();
+    let mut chunks = Vec::new();
     let prelude: String = spec.prelude.iter().map(|p| format!("{p}\n")).collect();
     if em.chunks.len() == 1 {
         let _ = writeln!(
@@ -219,11 +256,14 @@ pub fn emit_fn(
         }
         s.push_str("}\n");
         for (k, c) in em.chunks.iter().enumerate() {
-            let _ = writeln!(
-                s,
-                "#[inline(never)]\n{simd}fn {}_part{k}(&self, {}, w: &mut [{number}]) {{\n{c}}}",
-                spec.name, spec.args
-            );
+            chunks.push(Chunk {
+                name: format!("{}_part{k}", spec.name),
+                args: spec.args.clone(),
+                call: spec.call.clone(),
+                number,
+                simd,
+                body: c.clone(),
+            });
         }
     }
     let prefix_count = prefix.map(|p| {
@@ -253,6 +293,7 @@ pub fn emit_fn(
     });
     Ok(EmittedFn {
         text: s,
+        chunks,
         count: em.count,
         prefix: prefix_count,
     })

@@ -4,6 +4,7 @@
 
 pub mod api;
 pub mod function;
+mod ltdl;
 pub mod shapes;
 
 use crate::expr::emit::MissingDerivative;
@@ -13,7 +14,7 @@ use crate::mech::dynamics::SceneEquations;
 use crate::mech::system::{Formulation, Load, System};
 use crate::mech::world::{self, Twist};
 use api::{Sizes, args};
-use function::{EmittedFn, FnSpec, Prefix, RustNames, emit_fn};
+use function::{Chunk, EmittedFn, FnSpec, Prefix, RustNames, emit_fn};
 use std::fmt::Write;
 use std::time::{Duration, Instant};
 
@@ -108,17 +109,43 @@ pub fn generate(sys: System, vis: &str) -> Result<Generated, Vec<MissingDerivati
     let mut reports = Vec::new();
     let mut missing = Vec::new();
     let shared = emit_params(&model, vis, &mut code, &mut missing);
+    // forward dynamics as dynamics then the model's one LᵀDL, in the scenes where it pays
+    let after: Vec<&SceneEquations> = model
+        .scenes
+        .iter()
+        .filter(|eq| ltdl::after_dynamics(&model, eq))
+        .collect();
+    let ltdl_count = if after.is_empty() {
+        None
+    } else {
+        collect(ltdl::emit(&model, &after), &mut missing, |e| {
+            let _ = writeln!(
+                code,
+                "#[automatically_derived]\n#[allow(unused_variables, clippy::all)]\nimpl {}Params {{\n{}}}",
+                model.sys.name,
+                e.full_text()
+            );
+            e.count
+        })
+    };
+    let mut chunks = Vec::new();
     for eq in &model.scenes {
-        emit_scene(
+        let ltdl = ltdl_count.filter(|_| after.iter().any(|e| std::ptr::eq(*e, eq)));
+        let scene_chunks = emit_scene(
             &model,
             eq,
             vis,
-            &shared,
+            Shared {
+                rows: &shared,
+                ltdl,
+            },
             &mut code,
             &mut reports,
             &mut missing,
         );
+        chunks.push((scene_type(&model.sys, eq.scene), scene_chunks));
     }
+    emit_chunks(&model.sys.name, &chunks, &mut code);
     if !missing.is_empty() {
         missing.dedup();
         return Err(missing);
@@ -334,7 +361,8 @@ fn emit_params(
         charts_path: "charts",
         splines_path: &splines,
     };
-    let mut derived = collect(emit_fn(a, &spec, &names), missing, |e| e.text).unwrap_or_default();
+    let mut derived =
+        collect(emit_fn(a, &spec, &names), missing, |e| e.full_text()).unwrap_or_default();
     // the constraints are the same in every scene: emitted once, here
     // ... and read the charts of rotation joints, which the models hold, as an argument
     let c = &model.constraints;
@@ -415,15 +443,17 @@ fn emit_params(
     }
     let mut ops = Vec::new();
     for (spec, label, part) in shared {
-        if let Some((s, count)) = collect(emit_fn(a, &spec, &names), missing, |e| (e.text, e.count))
-        {
+        if let Some((s, count)) = collect(emit_fn(a, &spec, &names), missing, |e| {
+            (e.full_text(), e.count)
+        }) {
             derived.push_str(&s);
             ops.push((label, count, part));
         }
     }
     for (spec, label) in specs.iter().zip(labels) {
-        if let Some((s, count)) = collect(emit_fn(a, spec, &names), missing, |e| (e.text, e.count))
-        {
+        if let Some((s, count)) = collect(emit_fn(a, spec, &names), missing, |e| {
+            (e.full_text(), e.count)
+        }) {
             derived.push_str(&s);
             if !c.phi.is_empty() {
                 ops.push((label.to_string(), count, None));
@@ -665,15 +695,23 @@ fn dense3(a: &crate::expr::Arena, cols: &world::Cols, n: usize) -> Vec<Vec<ExprI
     (0..3).map(|i| d.iter().map(|c| c[i]).collect()).collect()
 }
 
+/// What a scene takes from the code emitted once for the model: the op-count rows of the
+/// functions on the parameter struct (with the tangents' part, when it is one), and the op
+/// count of the LᵀDL when the scene's forward dynamics is `dynamics` then that LᵀDL.
+struct Shared<'a> {
+    rows: &'a [(String, OpCount, Option<usize>)],
+    ltdl: Option<OpCount>,
+}
+
 fn emit_scene(
     model: &SymbolicModel,
     eq: &SceneEquations,
     vis: &str,
-    shared: &[(String, OpCount, Option<usize>)],
+    shared: Shared,
     code: &mut String,
     reports: &mut Vec<FunctionReport>,
     missing: &mut Vec<MissingDerivative>,
-) {
+) -> Vec<Chunk> {
     let sys = &model.sys;
     let a = &sys.arena;
     let n = sys.ndof();
@@ -726,11 +764,20 @@ fn emit_scene(
         prelude: f.prelude.clone(),
     });
     specs.push((f, Some("dynamics (M, h)")));
-    let mut f = FnSpec::new("__forward_dynamics", api::FORWARD_DYNAMICS_FORCED.args);
-    f.vector("qdd", &eq.forward.qdd);
-    f.vector("pivots", &eq.forward.pivots);
-    let forward_label = format!("forward_dynamics ({})", eq.forward.method.name());
-    specs.push((f, Some(&forward_label)));
+    // fused, or dynamics then the model's LᵀDL (`ltdl`: written below, counted after dynamics)
+    let forward_label = match shared.ltdl {
+        None => format!("forward_dynamics ({})", eq.forward.method.name()),
+        Some(_) => format!(
+            "forward_dynamics (dynamics, then {})",
+            eq.forward.method.name()
+        ),
+    };
+    if shared.ltdl.is_none() {
+        let mut f = FnSpec::new("__forward_dynamics", api::FORWARD_DYNAMICS_FORCED.args);
+        f.vector("qdd", &eq.forward.qdd);
+        f.vector("pivots", &eq.forward.pivots);
+        specs.push((f, Some(&forward_label)));
+    }
     if sys.options.batch {
         // the same outputs on lanes of four states, no op-count rows of their own
         let mut f = FnSpec::lanes("__dynamics_x4", args("dynamics"));
@@ -812,6 +859,7 @@ fn emit_scene(
             .collect()
     });
     let mut methods = String::new();
+    let mut chunks = Vec::new();
     let mut ops: Vec<(String, OpCount)> = Vec::new();
     let mut prefix_count = None;
     for ((_, label), result) in specs.iter().zip(emitted) {
@@ -820,24 +868,32 @@ fn emit_scene(
             None => prefix_count,
             Some(result) => collect(result, missing, |e| {
                 methods.push_str(&e.text);
+                chunks.extend(e.chunks);
                 prefix_count = prefix_count.or(e.prefix);
                 e.count
             }),
         };
-        if let Some(c) = count {
-            if let Some(label) = label {
-                ops.push((label.to_string(), c));
-                reports.push(FunctionReport {
-                    model: ty.clone(),
-                    function: label.to_string(),
-                    ops: c,
-                });
+        let mut rows = vec![];
+        if let (Some(c), Some(label)) = (count, label) {
+            rows.push((label.to_string(), c));
+            // forward dynamics as dynamics then the LᵀDL: its row follows dynamics'
+            if let (Some(l), true) = (shared.ltdl, *label == "dynamics (M, h)") {
+                methods.push_str(&ltdl::forward_method(n));
+                rows.push((forward_label.clone(), ltdl::forward_count(n, c, l)));
             }
+        }
+        for (label, c) in rows {
+            reports.push(FunctionReport {
+                model: ty.clone(),
+                function: label.clone(),
+                ops: c,
+            });
+            ops.push((label, c));
         }
     }
     // the kinematics and constraint functions, emitted once on the parameters, serve every
     // scene; the shared tangents' parts those that add them
-    for (label, c, part) in shared {
+    for (label, c, part) in shared.rows {
         if part.is_some_and(|p| !eq.tangent_parts.contains(&p)) {
             continue;
         }
@@ -1117,4 +1173,63 @@ impl {ty} {{
 #[allow(unused_variables, clippy::all)]
 {model_impl}"
     );
+    chunks
+}
+
+/// The scenes' chunk methods: a chunk whose text is the same in several scenes (the first
+/// chunks of dynamics, where M is computed, on a model with scenes) is emitted once on the
+/// parameter struct, the charts an argument, and each scene's method calls it; the others
+/// as they are, in an `impl` of their scene type.
+fn emit_chunks(model: &str, scenes: &[(String, Vec<Chunk>)], code: &mut String) {
+    // a scene's chunk reads the parameters and the charts through `self` and nothing else
+    let movable = |c: &Chunk| {
+        c.simd.is_empty()
+            && c.body.matches("self.").count()
+                == c.body.matches("self.params.").count() + c.body.matches("self.charts").count()
+    };
+    let repeated =
+        |c: &Chunk| movable(c) && scenes.iter().filter(|(_, cs)| cs.contains(c)).count() > 1;
+    let mut shared: Vec<&Chunk> = Vec::new();
+    for (_, cs) in scenes {
+        for c in cs {
+            if repeated(c) && !shared.contains(&c) {
+                shared.push(c);
+            }
+        }
+    }
+    let header = "#[automatically_derived]\n#[allow(unused_variables, clippy::all)]\n";
+    if !shared.is_empty() {
+        let _ = writeln!(code, "{header}impl {model}Params {{");
+        for c in &shared {
+            let on_params = Chunk {
+                name: format!("__scenes{}", c.name),
+                args: format!("charts: &[[[f64; 3]; 3]], {}", c.args),
+                body: c
+                    .body
+                    .replace("self.params.", "self.")
+                    .replace("self.charts", "charts"),
+                ..(*c).clone()
+            };
+            code.push_str(&on_params.text());
+        }
+        code.push_str("}\n");
+    }
+    for (ty, cs) in scenes {
+        if cs.is_empty() {
+            continue;
+        }
+        let _ = writeln!(code, "{header}impl {ty} {{");
+        for c in cs {
+            if shared.contains(&c) {
+                let _ = writeln!(
+                    code,
+                    "#[inline]\nfn {}(&self, {}, w: &mut [{}]) {{\nself.params.__scenes{}(&self.charts, {}, w)\n}}",
+                    c.name, c.args, c.number, c.name, c.call
+                );
+            } else {
+                code.push_str(&c.text());
+            }
+        }
+        code.push_str("}\n");
+    }
 }

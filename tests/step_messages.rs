@@ -1,10 +1,11 @@
 //! Messages about steps: a fixed step is not judged by h_min, inconsistent step options are
-//! refused before any work, a long run starts with the step its dynamics ask for, and a
-//! non-finite generalized force is not mistaken for a step.
+//! refused before any work, a long run starts with the step its dynamics ask for, a
+//! non-finite generalized force is not mistaken for a step, and an rtol beyond what a scheme's
+//! local error test holds is said.
 
 use mbs_models::seed2dof;
 
-use mbs::{Failure, Options, Output, Scheme, StepControl, simulate};
+use mbs::{BdfParams, Failure, GenAlphaParams, Options, Output, Scheme, StepControl, simulate};
 use mbs_models::undefined_force::{EarlyForce, LateForce};
 use seed2dof::Seed2dof;
 
@@ -189,4 +190,33 @@ fn a_non_finite_initial_value_names_its_coordinate() {
     );
     assert_eq!(name, "qd0");
     assert!(msg.contains("inf at coordinate 1"), "{msg}");
+}
+
+/// The Newmark family holds its local error at 0.3·rtol^1.5, floored at 10⁴ε; RKC at the
+/// same, floored at 100ε; BDF at 0.1·rtol^1.25, floored at 100ε. A tighter rtol than a floor
+/// allows is not held: `Stats::tolerance_floor` says so, and so does the run's summary.
+#[test]
+fn an_rtol_beyond_a_schemes_floor_is_said() {
+    let eps = f64::EPSILON;
+    let gen_alpha = Scheme::GenAlpha(GenAlphaParams::from_rho_inf(0.8));
+    let bdf = Scheme::Bdf(BdfParams::default());
+    for (scheme, rtol, floor) in [
+        (gen_alpha, 1e-6, None),
+        (gen_alpha, 5e-8, None),
+        (gen_alpha, 3e-8, Some(1e4 * eps)),
+        (gen_alpha, 1e-10, Some(1e4 * eps)),
+        (Scheme::Rkc, 2e-9, None),
+        (Scheme::Rkc, 1.5e-9, Some(100.0 * eps)),
+        (bdf, 1e-10, None),
+        (bdf, 5e-11, Some(100.0 * eps)),
+        (Scheme::Radau5, 1e-12, None),
+    ] {
+        let o = quiet(Options::adaptive(0.01, rtol));
+        let (_, stats) = simulate(Seed2dof::default(), scheme, o).unwrap();
+        assert_eq!(stats.tolerance_floor, floor, "{scheme:?} at rtol {rtol:e}");
+        let said = stats
+            .to_string()
+            .contains("its tolerance stopped at its floor");
+        assert_eq!(said, floor.is_some(), "{stats}");
+    }
 }

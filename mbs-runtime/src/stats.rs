@@ -66,6 +66,11 @@ pub struct Stats {
     pub stiff_from: Option<f64>,
     /// which components the local error test controls (nothing at fixed steps)
     pub error_test: ErrorTest,
+    /// `Some(rtol')` when the user's rtol asked of the local error test a tolerance below the
+    /// scheme's floor, which it held instead: the run then gives fewer digits than rtol, where
+    /// a tighter rtol would otherwise have taken more steps (the Newmark family from rtol ≈
+    /// 4e-8 on, its floor 10⁴ε; RKC from ≈ 2e-9, BDF from ≈ 8e-11, their floors 100ε)
+    pub tolerance_floor: Option<f64>,
 }
 
 /// The components an adaptive scheme's local error test measures, so that a user knows what
@@ -229,6 +234,12 @@ impl fmt::Display for Stats {
         }
         if self.error_test != ErrorTest::None {
             write!(f, "\nerror test on: {}", self.error_test)?;
+        }
+        if let Some(floor) = self.tolerance_floor {
+            write!(
+                f,
+                "\nrtol asks more than this scheme's local error test holds: its tolerance stopped at its floor {floor:.1e}, so expect fewer digits than rtol (radau5 follows rtol further)"
+            )?;
         }
         if !self.order_steps.is_empty() {
             let orders: Vec<String> = self

@@ -106,7 +106,7 @@
 use super::at::{Affine, Weights};
 use super::newton::AccelNewton;
 use super::problem::Problem;
-use super::step_control::{elementary_factor, optimal_factor};
+use super::step_control::{Tolerances, elementary_factor, optimal_factor};
 use super::{Attempt, Control, State, Step, Stepper};
 use crate::charts::Recentring;
 use crate::error::Failure;
@@ -355,6 +355,10 @@ impl Bdf {
 }
 
 impl<M: Model> Stepper<M> for Bdf {
+    fn tolerance_floor(&self, rtol: f64) -> Option<f64> {
+        Tolerances::transformed_floored(rtol, TOL_FACTOR, TOL_EXPONENT)
+    }
+
     fn start(&mut self, _p: &mut Problem<M>, s: &State, _ctl: &Control) -> Result<(), Failure> {
         let n = self.n;
         self.d.fill(0.0);

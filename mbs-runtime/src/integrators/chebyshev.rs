@@ -50,7 +50,9 @@
 
 use super::explicit::{Probe, StabilityWatch, dot, ritz};
 use super::problem::Problem;
-use super::step_control::{Decision, PiController, Tolerances, order_two_factor};
+use super::step_control::{
+    Decision, PiController, Tolerances, order_two_factor, order_two_floored,
+};
 use super::{Attempt, State, Step, Stepper};
 use crate::error::Failure;
 use crate::model::Model;
@@ -69,6 +71,8 @@ const MARGIN: f64 = 1.5;
 /// The local error test's tolerances for the user's: rtol·f and atol·f, f = c·√rtol, so that
 /// the global error of an order-2 scheme follows rtol (as the Newmark family's).
 const TOL_FACTOR: f64 = 0.3;
+/// No local tolerance below this (the rounding of a step).
+const FLOOR: f64 = 100.0 * f64::EPSILON;
 
 /// The growth of an undamped oscillation's amplitude a period that the stages accept.
 const GROWTH: f64 = 0.01;
@@ -447,6 +451,10 @@ impl Chebyshev {
 }
 
 impl<M: Model> Stepper<M> for Chebyshev {
+    fn tolerance_floor(&self, rtol: f64) -> Option<f64> {
+        order_two_floored(rtol, TOL_FACTOR, FLOOR)
+    }
+
     fn attempt(&mut self, step: Step<'_, M>) -> Result<Attempt, Failure> {
         let Step(p, cur, h, ctl, next) = step;
         match self.choose(p, cur, h)? {
@@ -492,7 +500,7 @@ impl<M: Model> Stepper<M> for Chebyshev {
             (self.y1[i], self.y1[n + i]) = (next.q[i], next.qd[i]);
         }
         // rtol·f and atol·f, f = 0.3·√rtol (no local tolerance below 100ε)
-        let f = order_two_factor(tol.rtol, TOL_FACTOR, 100.0 * f64::EPSILON);
+        let f = order_two_factor(tol.rtol, TOL_FACTOR, FLOOR);
         let tol = Tolerances {
             rtol: tol.rtol * f,
             atol: tol.atol * f,

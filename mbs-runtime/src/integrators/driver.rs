@@ -121,8 +121,9 @@ impl<M: Model + 'static> Simulation<M> {
         if let Err(e) = stepper.start(&mut problem, &cur, &ctl) {
             return Err(early(e, problem.stats.clone()));
         }
-        if ctl.adaptive.is_some() {
+        if let Some(tol) = ctl.adaptive {
             problem.stats.error_test = stepper.error_test(&problem);
+            problem.stats.tolerance_floor = stepper.tolerance_floor(tol.rtol);
         }
         let h = match options.step {
             StepControl::Fixed { h } => h,

@@ -112,7 +112,7 @@ use super::at::{Affine, At, Weights};
 use super::constrained::{Constrained, Mode};
 use super::newton::{AccelNewton, NewtonTol};
 use super::problem::{Loops, Problem};
-use super::step_control::{next_step, order_two_factor};
+use super::step_control::{next_step, order_two_factor, order_two_floored};
 use super::{Attempt, Control, State, Step, Stepper};
 use crate::charts::Recentring;
 use crate::error::Failure;
@@ -217,6 +217,10 @@ impl AlphaFamily {
 }
 
 impl<M: Model> Stepper<M> for AlphaFamily {
+    fn tolerance_floor(&self, rtol: f64) -> Option<f64> {
+        order_two_floored(rtol, TOL_FACTOR, FLOOR)
+    }
+
     fn error_test(&self, p: &Problem<M>) -> ErrorTest {
         match p.loops.closed() {
             Some(c) if c.mode == Mode::Index2 => ErrorTest::PositionsVelocities,

@@ -33,11 +33,22 @@ impl Tolerances {
     /// under atol = 1e-8 m (springpend at k = 1e8 N/m: 24,000 steps instead of 45).
     /// rtol' never falls below 100ε (or the user's rtol, if tighter): the rounding of a step.
     pub fn transformed(self, c: f64, e: f64) -> Tolerances {
-        let floor = self.rtol.min(100.0 * f64::EPSILON);
         Tolerances {
-            rtol: (c * self.rtol.powf(e)).max(floor),
+            rtol: (c * self.rtol.powf(e)).max(Self::transformed_floor(self.rtol)),
             atol: self.atol,
         }
+    }
+
+    /// The floor of [`Tolerances::transformed`] for `rtol`: 100ε, or rtol if tighter.
+    fn transformed_floor(rtol: f64) -> f64 {
+        rtol.min(100.0 * f64::EPSILON)
+    }
+
+    /// The local tolerance [`Tolerances::transformed`] holds for `rtol` when its floor set it
+    /// (c·rtol^e below the floor), else `None`.
+    pub fn transformed_floored(rtol: f64, c: f64, e: f64) -> Option<f64> {
+        let floor = Self::transformed_floor(rtol);
+        (c * rtol.powf(e) < floor).then_some(floor)
     }
 
     /// Weighted RMS norm of an error vector e against the state scales y0, y1:
@@ -58,6 +69,12 @@ impl Tolerances {
 /// [floor/rtol, 1]: no local tolerance below `floor`.
 pub(crate) fn order_two_factor(rtol: f64, c: f64, floor: f64) -> f64 {
     (c * rtol.sqrt()).clamp((floor / rtol).min(1.0), 1.0)
+}
+
+/// The local tolerance rtol·f of [`order_two_factor`] when its floor set it (c·rtol^1.5
+/// below a floor tighter than rtol), else `None`.
+pub(crate) fn order_two_floored(rtol: f64, c: f64, floor: f64) -> Option<f64> {
+    (c * rtol.sqrt() < floor / rtol && floor < rtol).then_some(floor)
 }
 
 /// err^(−1/(k+1)): the factor on h that brings the error of an estimate of order k to 1.

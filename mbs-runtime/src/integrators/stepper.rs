@@ -81,6 +81,11 @@ pub(crate) trait Stepper<M: Model> {
     fn error_test(&self, _p: &Problem<M>) -> ErrorTest {
         ErrorTest::PositionsVelocities
     }
+    /// The relative tolerance the local error test holds for the user's `rtol` when the
+    /// scheme's floor set it, not its transformation of rtol (`Stats::tolerance_floor`).
+    fn tolerance_floor(&self, _rtol: f64) -> Option<f64> {
+        None
+    }
     /// Called after the driver re-centred the charts of rotation joints at the accepted
     /// state `s` (`moved` says which, and maps accelerations of the old charts into the new
     /// ones; `evaluated`: the model asked for its accelerations anew, so `s.qdd` was

@@ -1187,8 +1187,10 @@ fn emit_chunks(model: &str, scenes: &[(String, Vec<Chunk>)], code: &mut String) 
             && c.body.matches("self.").count()
                 == c.body.matches("self.params.").count() + c.body.matches("self.charts").count()
     };
-    let repeated =
-        |c: &Chunk| movable(c) && scenes.iter().filter(|(_, cs)| cs.contains(c)).count() > 1;
+    // (one scene shares nothing: its chunks are not compared)
+    let repeated = |c: &Chunk| {
+        scenes.len() > 1 && movable(c) && scenes.iter().filter(|(_, cs)| cs.contains(c)).count() > 1
+    };
     let mut shared: Vec<&Chunk> = Vec::new();
     for (_, cs) in scenes {
         for c in cs {

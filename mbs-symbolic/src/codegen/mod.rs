@@ -110,15 +110,21 @@ pub fn generate(sys: System, vis: &str) -> Result<Generated, Vec<MissingDerivati
     let mut missing = Vec::new();
     let shared = emit_params(&model, vis, &mut code, &mut missing);
     // forward dynamics as dynamics then the model's one LᵀDL, in the scenes where it pays
-    let after: Vec<&SceneEquations> = model
+    let after: Vec<bool> = model
         .scenes
         .iter()
-        .filter(|eq| ltdl::after_dynamics(&model, eq))
+        .map(|eq| ltdl::after_dynamics(&model, eq))
         .collect();
-    let ltdl_count = if after.is_empty() {
+    let users: Vec<&SceneEquations> = model
+        .scenes
+        .iter()
+        .zip(&after)
+        .filter_map(|(eq, &a)| a.then_some(eq))
+        .collect();
+    let ltdl_count = if users.is_empty() {
         None
     } else {
-        collect(ltdl::emit(&model, &after), &mut missing, |e| {
+        collect(ltdl::emit(&model, &users), &mut missing, |e| {
             let _ = writeln!(
                 code,
                 "#[automatically_derived]\n#[allow(unused_variables, clippy::all)]\nimpl {}Params {{\n{}}}",
@@ -129,8 +135,8 @@ pub fn generate(sys: System, vis: &str) -> Result<Generated, Vec<MissingDerivati
         })
     };
     let mut chunks = Vec::new();
-    for eq in &model.scenes {
-        let ltdl = ltdl_count.filter(|_| after.iter().any(|e| std::ptr::eq(*e, eq)));
+    for (eq, &after) in model.scenes.iter().zip(&after) {
+        let ltdl = ltdl_count.filter(|_| after);
         let scene_chunks = emit_scene(
             &model,
             eq,

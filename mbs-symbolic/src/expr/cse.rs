@@ -121,7 +121,10 @@ impl Schedule {
             }
         }
         let max_lets = max_lets.max(1);
-        // chunks of at most max_lets within each segment, one (maybe empty) at least
+        let cross = crossings(arena, &order, outputs, &lets, &is_let, &position, top);
+        // chunks of at most max_lets within each segment, one (maybe empty) at least, as few
+        // as the size allows, each cut where the fewest values cross it (they go through the
+        // workspace, a store and a load each, and part the compiler's view of the code)
         let mut chunks = Vec::new();
         let mut segments = Vec::new();
         let mut first = 0;
@@ -129,13 +132,18 @@ impl Schedule {
             let end = first + lets[first..].partition_point(|l| segment_of[l.index()] == s as u32);
             let start_chunk = chunks.len();
             let mut c = first;
-            loop {
-                chunks.push(c..(c + max_lets).min(end));
-                c += max_lets;
-                if c >= end {
-                    break;
-                }
+            while end - c > max_lets {
+                // the chunks after this one must hold the rest
+                let after = (end - c).div_ceil(max_lets) - 1;
+                let lo = (end - after * max_lets).max(c + 1);
+                let cut = (lo..=c + max_lets)
+                    .rev()
+                    .min_by_key(|&e| cross[e])
+                    .expect("a nonempty range");
+                chunks.push(c..cut);
+                c = cut;
             }
+            chunks.push(c..end);
             segments.push(start_chunk..chunks.len());
             first = end;
         }
@@ -175,6 +183,65 @@ impl Schedule {
     }
 }
 
+/// For each cut before `lets[i]` (i in 0..=lets.len()), how many `let`s defined before it are
+/// used after it: a node inlined into its single user is used where that user is, an output
+/// where the last `let` before it is.
+fn crossings(
+    arena: &Arena,
+    order: &[ExprId],
+    outputs: &[ExprId],
+    lets: &[ExprId],
+    is_let: &[bool],
+    position: &[u32],
+    top: usize,
+) -> Vec<u32> {
+    let mut index = vec![u32::MAX; top];
+    for (i, l) in lets.iter().enumerate() {
+        index[l.index()] = i as u32;
+    }
+    // the index of the `let` that computes a node (its own, or its user's when inlined)
+    let mut site = vec![0u32; top];
+    let mut last_use = vec![0u32; lets.len()];
+    let mut used_at = |site: &mut [u32], n: ExprId, at: u32| {
+        if is_let[n.index()] {
+            let u = &mut last_use[index[n.index()] as usize];
+            *u = (*u).max(at);
+        } else {
+            site[n.index()] = site[n.index()].max(at);
+        }
+    };
+    for o in outputs {
+        let before = lets.partition_point(|l| position[l.index()] <= position[o.index()]);
+        used_at(&mut site, *o, before.saturating_sub(1) as u32);
+    }
+    for &n in order.iter().rev() {
+        let here = if is_let[n.index()] {
+            index[n.index()]
+        } else {
+            site[n.index()]
+        };
+        let (ch, k) = arena.node(n).children();
+        for &c in &ch[..k] {
+            used_at(&mut site, c, here);
+        }
+    }
+    let mut delta = vec![0i64; lets.len() + 2];
+    for (d, &u) in last_use.iter().enumerate() {
+        if u as usize > d {
+            delta[d + 1] += 1;
+            delta[u as usize + 1] -= 1;
+        }
+    }
+    let mut live = 0;
+    delta[..=lets.len()]
+        .iter()
+        .map(|d| {
+            live += d;
+            live as u32
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::{Arena, Var};
@@ -191,6 +258,34 @@ mod tests {
         let sch = Schedule::new(&a, &[m, n]);
         assert!(sch.is_let(s));
         assert!(!sch.is_let(m) && !sch.is_let(n));
+    }
+
+    #[test]
+    fn chunks_are_cut_where_the_fewest_values_cross() {
+        // four values, one that gathers them, four that spread it again: nine lets, at most
+        // six per chunk; cut after six, two values would cross (the gathered one and the
+        // first spread), after five only the gathered one
+        let mut a = Arena::new();
+        let q = a.var(Var::Q(0));
+        let mut sum = a.zero();
+        for i in 0..4 {
+            let c = a.num(i as f64 + 2.0);
+            let cq = a.mul(c, q);
+            let v = a.sin(cq);
+            sum = a.add(sum, v);
+        }
+        let w = a.sin(sum);
+        let mut out = a.zero();
+        for j in 0..4 {
+            let c = a.num(j as f64 + 3.0);
+            let cw = a.mul(c, w);
+            let u = a.sin(cw);
+            out = a.add(out, u);
+        }
+        let sch = Schedule::with_max_lets(&a, &[out], 6);
+        assert_eq!(sch.lets.len(), 9);
+        assert_eq!(sch.chunks, vec![0..5, 5..9]);
+        assert_eq!(sch.lets[4], w);
     }
 
     #[test]

@@ -1,6 +1,7 @@
 //! What the benchmarks share.
 
 use std::path::PathBuf;
+use std::time::SystemTime;
 
 /// The state every model is measured at: q and qd of `n` coordinates, away from any symmetry.
 pub fn test_state(n: usize) -> (Vec<f64>, Vec<f64>) {
@@ -9,9 +10,11 @@ pub fn test_state(n: usize) -> (Vec<f64>, Vec<f64>) {
     (q, qd)
 }
 
-/// criterion's median of `group/id` in ns, from its estimates file (none in test mode).
+/// criterion's median of `group/id` in ns, from its estimates file, when this run measured it:
+/// none in test mode, and none for a benchmark a filter left out, whose file is older than
+/// `since` (the start of the run), so that a summary never mixes in an earlier run's figures.
 #[allow(dead_code)] // not every benchmark reads criterion's medians
-pub fn median_ns(group: &str, id: &str) -> Option<f64> {
+pub fn median_ns(group: &str, id: &str, since: SystemTime) -> Option<f64> {
     let dir = std::env::var_os("CARGO_TARGET_DIR")
         .map(PathBuf::from)
         .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target"));
@@ -20,6 +23,9 @@ pub fn median_ns(group: &str, id: &str) -> Option<f64> {
         .join(group)
         .join(id)
         .join("new/estimates.json");
+    if std::fs::metadata(&path).ok()?.modified().ok()? < since {
+        return None;
+    }
     let text = std::fs::read_to_string(path).ok()?;
     let v: serde_json::Value = serde_json::from_str(&text).ok()?;
     v["median"]["point_estimate"].as_f64()

@@ -68,6 +68,7 @@ fn bench<M: Model + Default>(c: &mut Criterion, name: &str, form: &str) {
 }
 
 fn main() {
+    let since = std::time::SystemTime::now();
     let mut c = Criterion::default().configure_from_args();
     bench::<Chain32Generated>(&mut c, "chain32", "generated");
     bench::<Chain32Assembled>(&mut c, "chain32", "assembled");
@@ -85,13 +86,21 @@ fn main() {
         ("arm3d_24", "assembled_dynamics"),
     ];
     // criterion's medians exist after a measuring run (`cargo bench`), not in test mode
-    if median_ns("kinematics_chain32", "generated").is_none() {
+    let medians: Vec<_> = rows
+        .iter()
+        .filter_map(|&(name, id)| {
+            Some((
+                name,
+                id,
+                median_ns(&format!("kinematics_{name}"), id, since)?,
+            ))
+        })
+        .collect();
+    if medians.is_empty() {
         return;
     }
     println!("\nmedians (ns per call)");
-    for (name, id) in rows {
-        if let Some(t) = median_ns(&format!("kinematics_{name}"), id) {
-            println!("{name:<9} {id:<19} {t:>9.1}");
-        }
+    for (name, id, t) in medians {
+        println!("{name:<9} {id:<19} {t:>9.1}");
     }
 }

@@ -87,6 +87,7 @@ fn bench_model<M: Model>(
 }
 
 fn main() {
+    let since = std::time::SystemTime::now();
     let mut c = Criterion::default().configure_from_args();
     let rows = [
         bench_model(&mut c, "chain2", 0.55, Chain2::default()),
@@ -100,17 +101,24 @@ fn main() {
         bench_model(&mut c, "arm3d_24", 0.45, Arm3d24::default()),
     ];
     c.final_summary();
-    // criterion's medians exist after a measuring run (`cargo bench`), not in test mode
-    let medians: Option<Vec<(f64, f64)>> = rows
+    // criterion's medians exist after a measuring run (`cargo bench`), not in test mode; a
+    // filter leaves rows out
+    let medians: Vec<_> = rows
         .iter()
-        .map(|(name, _, _)| {
-            let group = format!("scaling_{name}");
-            Some((median_ns(&group, "dense")?, median_ns(&group, "forward")?))
+        .filter_map(|row| {
+            let group = format!("scaling_{}", row.0);
+            Some((
+                row,
+                median_ns(&group, "dense", since)?,
+                median_ns(&group, "forward", since)?,
+            ))
         })
         .collect();
-    let Some(medians) = medians else { return };
+    if medians.is_empty() {
+        return;
+    }
     println!("\nmedians (ns per call)      dense   forward   ratio   goal");
-    for ((name, n, goal), (d, f)) in rows.iter().zip(medians) {
+    for ((name, n, goal), d, f) in medians {
         let verdict = if f / d <= *goal { "met" } else { "MISSED" };
         println!(
             "{name:<9} {n:>3} dof  {d:>10.1} {f:>9.1}   {:>5.2}×  ≤ {goal:.2}× {verdict}",

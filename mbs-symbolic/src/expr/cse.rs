@@ -265,23 +265,22 @@ mod tests {
         // four values, one that gathers them, four that spread it again: nine lets, at most
         // six per chunk; cut after six, two values would cross (the gathered one and the
         // first spread), after five only the gathered one
+        // Σ sin(c x) over four numbers c
+        let sines = |a: &mut Arena, x, first: f64| {
+            let mut sum = a.zero();
+            for i in 0..4 {
+                let c = a.num(first + i as f64);
+                let cx = a.mul(c, x);
+                let s = a.sin(cx);
+                sum = a.add(sum, s);
+            }
+            sum
+        };
         let mut a = Arena::new();
         let q = a.var(Var::Q(0));
-        let mut sum = a.zero();
-        for i in 0..4 {
-            let c = a.num(i as f64 + 2.0);
-            let cq = a.mul(c, q);
-            let v = a.sin(cq);
-            sum = a.add(sum, v);
-        }
-        let w = a.sin(sum);
-        let mut out = a.zero();
-        for j in 0..4 {
-            let c = a.num(j as f64 + 3.0);
-            let cw = a.mul(c, w);
-            let u = a.sin(cw);
-            out = a.add(out, u);
-        }
+        let gathered = sines(&mut a, q, 2.0);
+        let w = a.sin(gathered);
+        let out = sines(&mut a, w, 3.0);
         let sch = Schedule::with_max_lets(&a, &[out], 6);
         assert_eq!(sch.lets.len(), 9);
         assert_eq!(sch.chunks, vec![0..5, 5..9]);

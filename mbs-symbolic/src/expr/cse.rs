@@ -121,7 +121,13 @@ impl Schedule {
             }
         }
         let max_lets = max_lets.max(1);
-        let cross = crossings(arena, &order, outputs, &lets, &is_let, &position, top);
+        // per output, how many `let`s are scheduled before its root (the last of them is
+        // where the output is assigned)
+        let lets_before: Vec<usize> = outputs
+            .iter()
+            .map(|o| lets.partition_point(|l| position[l.index()] <= position[o.index()]))
+            .collect();
+        let cross = crossings(arena, &order, outputs, &lets_before, &lets, &is_let, top);
         // chunks of at most max_lets within each segment, one (maybe empty) at least, as few
         // as the size allows, each cut where the fewest values cross it (they go through the
         // workspace, a store and a load each, and part the compiler's view of the code)
@@ -157,8 +163,7 @@ impl Schedule {
         // within its segment
         let mut output_chunk = Vec::with_capacity(outputs.len());
         for (s, w) in bounds.windows(2).enumerate() {
-            for o in &outputs[w[0]..w[1]] {
-                let before = lets.partition_point(|l| position[l.index()] <= position[o.index()]);
+            for &before in &lets_before[w[0]..w[1]] {
                 let c = match before.checked_sub(1) {
                     Some(i) => let_chunk[lets[i].index()].unwrap_or(0),
                     None => 0,
@@ -185,14 +190,14 @@ impl Schedule {
 
 /// For each cut before `lets[i]` (i in 0..=lets.len()), how many `let`s defined before it are
 /// used after it: a node inlined into its single user is used where that user is, an output
-/// where the last `let` before it is.
+/// where the last `let` before it is (`lets_before`, per output).
 fn crossings(
     arena: &Arena,
     order: &[ExprId],
     outputs: &[ExprId],
+    lets_before: &[usize],
     lets: &[ExprId],
     is_let: &[bool],
-    position: &[u32],
     top: usize,
 ) -> Vec<u32> {
     let mut index = vec![u32::MAX; top];
@@ -210,9 +215,8 @@ fn crossings(
             site[n.index()] = site[n.index()].max(at);
         }
     };
-    for o in outputs {
-        let before = lets.partition_point(|l| position[l.index()] <= position[o.index()]);
-        used_at(&mut site, *o, before.saturating_sub(1) as u32);
+    for (&o, &before) in outputs.iter().zip(lets_before) {
+        used_at(&mut site, o, before.saturating_sub(1) as u32);
     }
     for &n in order.iter().rev() {
         let here = if is_let[n.index()] {
@@ -225,7 +229,8 @@ fn crossings(
             used_at(&mut site, c, here);
         }
     }
-    let mut delta = vec![0i64; lets.len() + 2];
+    // last uses are indices of `lets`, so u + 1 ≤ lets.len()
+    let mut delta = vec![0i64; lets.len() + 1];
     for (d, &u) in last_use.iter().enumerate() {
         if u as usize > d {
             delta[d + 1] += 1;
@@ -233,7 +238,7 @@ fn crossings(
         }
     }
     let mut live = 0;
-    delta[..=lets.len()]
+    delta
         .iter()
         .map(|d| {
             live += d;
@@ -265,6 +270,7 @@ mod tests {
         // four values, one that gathers them, four that spread it again: nine lets, at most
         // six per chunk; cut after six, two values would cross (the gathered one and the
         // first spread), after five only the gathered one
+
         // Σ sin(c x) over four numbers c
         let sines = |a: &mut Arena, x, first: f64| {
             let mut sum = a.zero();

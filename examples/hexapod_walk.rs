@@ -289,7 +289,7 @@ fn write_outputs(out: &Path, w: &Walk, f: &Figures) -> Result<(), Box<dyn std::e
         model.point_kinematics(ti, &tr.q(i)[..n], &tr.qd(i)[..n], &mut kin);
         for (leg, s) in feet.iter_mut().enumerate() {
             let p = &kin.points[leg];
-            s.push((ti, w.terrain.force(p.position, p.velocity)[2]));
+            s.push((ti, w.terrain.point_force(p.position, p.velocity)[2]));
         }
     }
     let names = ["FL", "FR", "ML", "MR", "RL", "RR"];

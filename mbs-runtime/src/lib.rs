@@ -27,6 +27,7 @@ pub mod options;
 pub mod sensitivity;
 pub mod spline;
 pub mod stats;
+pub mod terrain;
 pub mod trajectory;
 
 pub use analysis::{
@@ -53,4 +54,5 @@ pub use options::{
 pub use sensitivity::Sensitivities;
 pub use spline::Spline;
 pub use stats::{ErrorTest, Stats};
+pub use terrain::Terrain;
 pub use trajectory::{CsvWriter, Observer, Trajectory, state_size};

@@ -13,9 +13,13 @@
 //!   [`mbs::Efforts`] part ([`Drive`]): per joint L di/dt = V − R i − k N q̇, joint torque
 //!   N k i η^tanh(P/P₀) (the gearbox's efficiency η on the power P = N k i q̇ flowing to the
 //!   joint, 1/η when the joint drives the motor, blended over P₀ = 1 W so the law stays
-//!   smooth); the feet's penalty contact with the [`Terrain`] (the law of the language's
-//!   `contact`: F_n = pos(k δ − c δ̇) on penetration δ, regularised Coulomb friction
-//!   μ F_n v_t/√(|v_t|² + ε²)); the electrical energy drawn, ∫ Σ pos(V i) dt, as a state;
+//!   smooth); the feet's penalty contact with the [`Terrain`] of ground and boxes
+//!   ([`mbs::terrain`], the law of the language's `contact`: F_n = pos(k δ − c δ̇) on
+//!   penetration δ, regularised Coulomb friction μ F_n v_t/√(|v_t|² + ε²), its default
+//!   coefficients those of the standing hexapod but for ε = 2e-2 m/s rather than 1e-2: at
+//!   1e-2 the friction's fastest mode, about 1.6e4/s, needs RK4 steps below 0.17 ms, at 2e-2
+//!   they may be 0.25 ms, four per control period; a foot under a tangential force F_t
+//!   creeps at ε F_t/(μ F_n)); the electrical energy drawn, ∫ Σ pos(V i) dt, as a state;
 //! - control ([`Walker`]): a central gait generator (tripod, wave or ripple; step length,
 //!   height, period and duty factor) gives every foot a target in the base frame, with the
 //!   base's heading and lateral drift corrected by the central controller; the pantograph
@@ -24,6 +28,7 @@
 //!   1 kHz ([`Walker::sampled`], a [`mbs::Controller`] holding the voltages between samples);
 //!   the continuous variant ([`Control::Continuous`]) integrates its integral terms as states.
 
+pub use mbs::terrain::{Block, Terrain};
 use mbs::{Effort, Efforts, State};
 use std::f64::consts::PI;
 
@@ -496,127 +501,6 @@ impl Default for Pid {
     }
 }
 
-/// An axis-aligned box standing on the ground: x and y extents and height (m).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Block {
-    pub x: [f64; 2],
-    pub y: [f64; 2],
-    pub height: f64,
-}
-
-/// What the feet stand on: the ground plane z = 0 and boxes on it, with the contact law's
-/// coefficients: those of the standing hexapod (k 1e5 N/m, c 500 N·s/m, μ 0.8) but for the
-/// friction's regularisation, ε = 2e-2 m/s rather than 1e-2: at 1e-2 the friction's fastest
-/// mode (about 1.6e4/s) needs RK4 steps below 0.17 ms, at 2e-2 they may be 0.25 ms (four
-/// per control period); a foot under a tangential force F_t creeps at ε F_t/(μ F_n).
-#[derive(Clone, Debug)]
-pub struct Terrain {
-    pub blocks: Vec<Block>,
-    pub k: f64,
-    pub c: f64,
-    pub mu: f64,
-    pub eps: f64,
-}
-
-impl Default for Terrain {
-    fn default() -> Self {
-        Terrain {
-            blocks: Vec::new(),
-            k: 1e5,
-            c: 500.0,
-            mu: 0.8,
-            eps: 2e-2,
-        }
-    }
-}
-
-impl Terrain {
-    /// Flat ground with a step of `height` from x = `at` on (3 m deep, 2 m wide).
-    pub fn step(at: f64, height: f64) -> Terrain {
-        Terrain {
-            blocks: vec![Block {
-                x: [at, at + 3.0],
-                y: [-1.0, 1.0],
-                height,
-            }],
-            ..Terrain::default()
-        }
-    }
-
-    /// The height of the terrain's top at (x, y): the highest box there, or the ground.
-    pub fn height(&self, p: [f64; 2]) -> f64 {
-        self.blocks
-            .iter()
-            .filter(|b| p[0] > b.x[0] && p[0] < b.x[1] && p[1] > b.y[0] && p[1] < b.y[1])
-            .map(|b| b.height)
-            .fold(0.0, f64::max)
-    }
-
-    /// [`Terrain::height`] with every box edge rounded over `width` (m) by a smooth ramp: what
-    /// the controller plans on, so that a foot target near an edge (or the measured base
-    /// pose that places it) moving by a millimetre does not move its height by a box's.
-    pub fn planned_height(&self, p: [f64; 2], width: f64) -> f64 {
-        let ramp = |d: f64| {
-            let u = (d / width + 0.5).clamp(0.0, 1.0);
-            u * u * (3.0 - 2.0 * u)
-        };
-        self.blocks
-            .iter()
-            .map(|b| {
-                let sx = ramp(p[0] - b.x[0]).min(ramp(b.x[1] - p[0]));
-                let sy = ramp(p[1] - b.y[0]).min(ramp(b.y[1] - p[1]));
-                b.height * sx * sy
-            })
-            .fold(0.0, f64::max)
-    }
-
-    /// Penetration depth and outward normal of the surface point `p` is deepest into, if
-    /// any: the ground below, or the face of a box nearest to a point inside it.
-    pub fn penetration(&self, p: [f64; 3]) -> Option<(f64, [f64; 3])> {
-        let mut best: Option<(f64, [f64; 3])> = (p[2] < 0.0).then_some((-p[2], [0.0, 0.0, 1.0]));
-        for b in &self.blocks {
-            let inside = p[0] > b.x[0] && p[0] < b.x[1] && p[1] > b.y[0] && p[1] < b.y[1];
-            if !inside || p[2] >= b.height {
-                continue;
-            }
-            // the nearest face: top, or one of the four sides
-            let faces = [
-                (b.height - p[2], [0.0, 0.0, 1.0]),
-                (p[0] - b.x[0], [-1.0, 0.0, 0.0]),
-                (b.x[1] - p[0], [1.0, 0.0, 0.0]),
-                (p[1] - b.y[0], [0.0, -1.0, 0.0]),
-                (b.y[1] - p[1], [0.0, 1.0, 0.0]),
-            ];
-            let face = faces
-                .into_iter()
-                .min_by(|u, v| u.0.total_cmp(&v.0))
-                .expect("five faces");
-            if best.is_none_or(|(d, _)| face.0 > d) {
-                best = Some(face);
-            }
-        }
-        best
-    }
-
-    /// The contact force on a foot at `p` moving at `v` (world axes): normal
-    /// pos(k δ − c δ̇) and regularised Coulomb friction μ F_n v_t/√(|v_t|² + ε²).
-    pub fn force(&self, p: [f64; 3], v: [f64; 3]) -> [f64; 3] {
-        let Some((depth, n)) = self.penetration(p) else {
-            return [0.0; 3];
-        };
-        let vn = v[0] * n[0] + v[1] * n[1] + v[2] * n[2];
-        let f_n = (self.k * depth - self.c * vn).max(0.0);
-        let vt = [v[0] - vn * n[0], v[1] - vn * n[1], v[2] - vn * n[2]];
-        let speed = (vt[0] * vt[0] + vt[1] * vt[1] + vt[2] * vt[2]).sqrt();
-        let scale = self.mu * f_n / (speed * speed + self.eps * self.eps).sqrt();
-        [
-            f_n * n[0] - scale * vt[0],
-            f_n * n[1] - scale * vt[1],
-            f_n * n[2] - scale * vt[2],
-        ]
-    }
-}
-
 /// The walking controller: gait generator, central controller, leg inverse kinematics and
 /// joint PIDs.
 #[derive(Clone, Debug)]
@@ -863,7 +747,7 @@ impl<const PID: bool> Efforts for Drive<PID> {
         }
         for leg in 0..LEGS {
             let foot = e.point(leg);
-            let f = self.terrain.force(foot.position, foot.velocity);
+            let f = self.terrain.point_force(foot.position, foot.velocity);
             if f != [0.0; 3] {
                 e.force_at_point(leg, f);
             }

@@ -34,6 +34,8 @@
 //! cycle consistent with flat ground. [`PassiveJoints`] adds passive joint moments
 //! (Anderson's laws, a viscous state per joint), with or without the tracking.
 //! [`ground_forces`] recomputes each foot's ground reaction from the kinematics for reports.
+//! [`OnTerrain`] wraps any of these parts so the feet's ellipsoids also meet the boxes of a
+//! [`Terrain`] (the generated contacts keep the ground).
 //! The muscles are in [`muscles`]: [`MuscleDriven`] runs the model on them, [`muscle_stance`]
 //! stands it on them.
 
@@ -166,6 +168,7 @@ pub use muscles::{
     MusclesAtRest, NM, moment_arms, muscle_cycle, muscle_stance,
 };
 
+use mbs::terrain::{Block, Terrain};
 use mbs::{Effort, Efforts, Kinematics, Model};
 
 /// The cycle of normal walking the model follows (see `models/data/normal_gait.tsv`).
@@ -1254,6 +1257,98 @@ impl Feet {
                 (x, v)
             })
         })
+    }
+}
+
+/// An efforts part `E` of the human model with the feet's twelve ellipsoids also on the
+/// boxes of a [`Terrain`] ([`mbs::terrain`]), by the law of the generated contacts with the
+/// ground y = 0 (the model's `k_foot`, `d_foot`, `mu_foot`, `eps_foot`, Hertz's exponent
+/// 1.5), which stay: the terrain is the boxes alone.
+#[derive(Clone, Debug)]
+pub struct OnTerrain<E> {
+    pub inner: E,
+    pub terrain: Terrain,
+    feet: Feet,
+}
+
+impl<E: Efforts> OnTerrain<E> {
+    /// `inner` with `model`'s feet also on `blocks` (footprints along x and z).
+    pub fn new(model: &Human, inner: E, blocks: Vec<Block>) -> OnTerrain<E> {
+        let p = model.params();
+        let law = mbs::terrain::ContactLaw {
+            k: p.k_foot,
+            c: 0.0,
+            exponent: 1.5,
+            dissipation: p.d_foot,
+            mu: p.mu_foot,
+            eps: p.eps_foot,
+        };
+        let terrain = Terrain {
+            up: 1,
+            ground: false,
+            blocks,
+            law,
+        };
+        OnTerrain {
+            inner,
+            terrain,
+            feet: Feet::of(model.info()),
+        }
+    }
+
+    /// Each foot's total force from the boxes (world axes) at the kinematics `kin` (frames
+    /// set).
+    pub fn forces(&self, kin: &Kinematics) -> [[f64; 3]; 2] {
+        std::array::from_fn(|k| {
+            let mut total = [0.0; 3];
+            for (e, (_, axes)) in FOOT_ELLIPSOIDS.iter().enumerate() {
+                let (pt, fr) = (
+                    &kin.points[self.feet.point[k][e]],
+                    &kin.frames[self.feet.frame[k][e]],
+                );
+                let centre = (pt.position, pt.velocity);
+                self.terrain.ellipsoid_forces(
+                    &fr.pose.rotation,
+                    fr.angular_velocity,
+                    centre,
+                    *axes,
+                    |_, f| total = [0, 1, 2].map(|j| total[j] + f[j]),
+                );
+            }
+            total
+        })
+    }
+}
+
+impl<E: Efforts> Efforts for OnTerrain<E> {
+    const NX: usize = E::NX;
+    const STATE_NAMES: &'static [&'static str] = E::STATE_NAMES;
+
+    fn initial_states(&self, x: &mut [f64]) {
+        self.inner.initial_states(x)
+    }
+
+    fn efforts(&mut self, e: &mut Effort) -> Result<(), String> {
+        self.inner.efforts(e)?;
+        for k in 0..2 {
+            for (j, (name, axes)) in FOOT_ELLIPSOIDS.iter().enumerate() {
+                let (point, frame) = (self.feet.point[k][j], self.feet.frame[k][j]);
+                let pressed = self.terrain.apply_ellipsoid(e, frame, point, *axes);
+                // as the guard does for the ground (`Guard::check`)
+                let thin = axes.iter().copied().fold(f64::INFINITY, f64::min);
+                if pressed.depth > thin {
+                    return Err(e.reject(format!(
+                        "the ellipsoid {name}[{k}] is {:.4} m into a box of the terrain, deeper than its smallest semi-axis ({thin} m): it has passed through the box",
+                        pressed.depth
+                    )));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn state_derivatives(&mut self, e: &Effort, xd: &mut [f64]) -> Result<(), String> {
+        self.inner.state_derivatives(e, xd)
     }
 }
 

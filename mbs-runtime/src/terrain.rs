@@ -1,0 +1,359 @@
+//! Terrain for contacts written in Rust ([`crate::Efforts`]): the ground plane and boxes
+//! standing on it, touched by points (a walking robot's feet) or by ellipsoids fixed on bodies
+//! (a human's feet), with the law of the language's `contact` statement.
+//!
+//! **Geometry.** The ground is the plane of height 0 along the axis `up` (z by default, y for
+//! models in OpenSim's axes); a [`Block`] is a box from the ground to `height`, its footprint
+//! `min`…`max` along the two other axes in increasing order (x and y when z is up, x and z
+//! when y is up).
+//!
+//! **An ellipsoid against a surface.** For a face of outward normal n, the ellipsoid (semi-axes
+//! D = diag(a, b, c) along its body's axes R, centred at x) reaches deepest through it at its
+//! support point along −n, s = x − R D² m / √(mᵀ D² m) with m = Rᵀ n, as the language's
+//! ellipsoid contact (`mech/effects/contact.rs`) computes symbolically against its plane; the
+//! penetration δ is how far s lies behind the face. The ellipsoid overlaps a box when it
+//! lies behind all five of the box's faces (the top and the four sides: the separating-axis
+//! test over the box's face normals, exact for a point); it then touches the box through the
+//! face it is least deep behind, the way out of the box that is shortest. A point is an
+//! ellipsoid of no extent: s = x, and the rule is the point's usual one (inside the box, the
+//! nearest face). The ground and every box an ellipsoid overlaps each push on it; a point
+//! inside a box and below the ground is pushed by both.
+//!
+//! **The law** ([`ContactLaw`], the language's with Hunt–Crossley's terms): δ̇ = −n·v_s with
+//! v_s the velocity of the body's material point at s, F_n = pos(k δ^e (1 + d δ̇) + c δ̇) for
+//! δ > 0, regularised Coulomb friction F_t = −μ F_n v_t / √(v_t·v_t + ε²) with v_t the part
+//! of v_s along the face; the force F_n n + F_t acts at s.
+
+use crate::efforts::Effort;
+use crate::elements::cross;
+
+type V3 = [f64; 3];
+
+fn dot(a: V3, b: V3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// A box standing on the ground: its footprint along the two horizontal axes (in increasing
+/// order of axis) and its height (m).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Block {
+    pub min: [f64; 2],
+    pub max: [f64; 2],
+    pub height: f64,
+}
+
+/// The penalty law of a contact: F_n = pos(k δ^e (1 + d δ̇) + c δ̇) in contact (δ > 0) and
+/// regularised Coulomb friction (the language's `contact(…, k, c, exponent, dissipation, mu,
+/// eps)`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactLaw {
+    /// stiffness k (N/m^e), damping c (N·s/m), exponent e, Hunt–Crossley dissipation d (s/m)
+    pub k: f64,
+    pub c: f64,
+    pub exponent: f64,
+    pub dissipation: f64,
+    /// friction coefficient μ and regularising speed ε (m/s)
+    pub mu: f64,
+    pub eps: f64,
+}
+
+impl Default for ContactLaw {
+    /// Linear: k = 1e5 N/m, c = 500 N·s/m, μ = 0.8, ε = 2e-2 m/s (the walking hexapod's).
+    fn default() -> Self {
+        ContactLaw {
+            k: 1e5,
+            c: 500.0,
+            exponent: 1.0,
+            dissipation: 0.0,
+            mu: 0.8,
+            eps: 2e-2,
+        }
+    }
+}
+
+impl ContactLaw {
+    /// The force (world axes) on a body at depth `depth` behind a face of outward unit
+    /// normal `n`, its material point there moving at `v`; zero out of contact.
+    pub fn force(&self, depth: f64, n: V3, v: V3) -> V3 {
+        if depth <= 0.0 {
+            return [0.0; 3];
+        }
+        let vn = dot(n, v);
+        let elastic = if self.exponent == 1.0 {
+            self.k * depth
+        } else {
+            self.k * depth.powf(self.exponent)
+        };
+        let f_n = (elastic * (1.0 - self.dissipation * vn) - self.c * vn).max(0.0);
+        let vt = [0, 1, 2].map(|j| v[j] - vn * n[j]);
+        let scale = if self.mu == 0.0 {
+            0.0
+        } else {
+            self.mu * f_n / (dot(vt, vt) + self.eps * self.eps).sqrt()
+        };
+        [0, 1, 2].map(|j| f_n * n[j] - scale * vt[j])
+    }
+}
+
+/// Where a body touches a surface: the point (world axes), its depth behind the surface and
+/// the surface's outward normal.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Touch {
+    pub point: V3,
+    pub depth: f64,
+    pub normal: V3,
+}
+
+/// What the terrain does to one ellipsoid: the sum of its forces (world axes) and the depth
+/// of the deepest surface it is behind (0 out of contact).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Pressed {
+    pub force: V3,
+    pub depth: f64,
+}
+
+/// An ellipsoid fixed on a body, in world axes: its centre, its body's axes (columns of
+/// `rotation`) and its semi-axes along them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ellipsoid<'a> {
+    pub centre: V3,
+    pub rotation: &'a [[f64; 3]; 3],
+    pub axes: V3,
+}
+
+impl Ellipsoid<'_> {
+    /// The support point along −n: the ellipsoid's point farthest along −n.
+    pub fn support(&self, n: V3) -> V3 {
+        let r = self.rotation;
+        let m = [0, 1, 2].map(|j| r[0][j] * n[0] + r[1][j] * n[1] + r[2][j] * n[2]);
+        let d2m = [0, 1, 2].map(|j| self.axes[j] * self.axes[j] * m[j]);
+        let s = dot(m, d2m).sqrt();
+        if s == 0.0 {
+            return self.centre;
+        }
+        [0, 1, 2].map(|i| self.centre[i] - dot(r[i], d2m) / s)
+    }
+}
+
+impl Ellipsoid<'static> {
+    /// A point: an ellipsoid of no extent.
+    pub fn point(centre: V3) -> Ellipsoid<'static> {
+        const I: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        Ellipsoid {
+            centre,
+            rotation: &I,
+            axes: [0.0; 3],
+        }
+    }
+}
+
+/// The ground plane along `up` and boxes on it, and the law their contacts follow.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Terrain {
+    /// the vertical axis: 0, 1 or 2 (x, y, z)
+    pub up: usize,
+    /// whether the ground plane is part of the terrain (false: the boxes alone, for a model
+    /// whose own generated contacts meet the ground)
+    pub ground: bool,
+    pub blocks: Vec<Block>,
+    pub law: ContactLaw,
+}
+
+impl Default for Terrain {
+    /// Flat ground z = 0 with the default [`ContactLaw`].
+    fn default() -> Self {
+        Terrain {
+            up: 2,
+            ground: true,
+            blocks: Vec::new(),
+            law: ContactLaw::default(),
+        }
+    }
+}
+
+impl Terrain {
+    /// Flat ground with a step of `height` from the first horizontal coordinate `at` on, 3 m
+    /// deep and 2 m wide (centred on the second horizontal axis).
+    pub fn step(at: f64, height: f64) -> Terrain {
+        Terrain {
+            blocks: vec![Block {
+                min: [at, -1.0],
+                max: [at + 3.0, 1.0],
+                height,
+            }],
+            ..Terrain::default()
+        }
+    }
+
+    /// The two horizontal axes, in increasing order.
+    pub fn horizontal(&self) -> [usize; 2] {
+        match self.up {
+            0 => [1, 2],
+            1 => [0, 2],
+            _ => [0, 1],
+        }
+    }
+
+    /// The horizontal coordinates of a point.
+    pub fn across(&self, p: V3) -> [f64; 2] {
+        self.horizontal().map(|j| p[j])
+    }
+
+    /// The height of the terrain's top above the horizontal position `p`: the highest box
+    /// there, or the ground.
+    pub fn height(&self, p: [f64; 2]) -> f64 {
+        self.blocks
+            .iter()
+            .filter(|b| (0..2).all(|j| p[j] > b.min[j] && p[j] < b.max[j]))
+            .map(|b| b.height)
+            .fold(0.0, f64::max)
+    }
+
+    /// [`Terrain::height`] with every box edge rounded over `width` (m) by a smooth ramp: a
+    /// height to plan footholds on, which a position moving by a millimetre near an edge
+    /// does not move by a box's height.
+    pub fn planned_height(&self, p: [f64; 2], width: f64) -> f64 {
+        let ramp = |d: f64| {
+            let u = (d / width + 0.5).clamp(0.0, 1.0);
+            u * u * (3.0 - 2.0 * u)
+        };
+        self.blocks
+            .iter()
+            .map(|b| {
+                let s = (0..2).map(|j| ramp(p[j] - b.min[j]).min(ramp(b.max[j] - p[j])));
+                b.height * s.product::<f64>()
+            })
+            .fold(0.0, f64::max)
+    }
+
+    /// The unit vector along axis `j`, signed.
+    fn axis(j: usize, sign: f64) -> V3 {
+        let mut n = [0.0; 3];
+        n[j] = sign;
+        n
+    }
+
+    /// Calls `touch` for the ground and each box the ellipsoid `e` overlaps (module docs).
+    pub fn touches(&self, e: &Ellipsoid, mut touch: impl FnMut(Touch)) {
+        let up = self.up;
+        let n = Self::axis(up, 1.0);
+        let s = e.support(n);
+        if self.ground && s[up] < 0.0 {
+            touch(Touch {
+                point: s,
+                depth: -s[up],
+                normal: n,
+            });
+        }
+        let [u, w] = self.horizontal();
+        for b in &self.blocks {
+            // the top, then the sides: (outward normal, the face's coordinate along it)
+            let faces = [
+                (Self::axis(up, 1.0), b.height),
+                (Self::axis(u, -1.0), -b.min[0]),
+                (Self::axis(u, 1.0), b.max[0]),
+                (Self::axis(w, -1.0), -b.min[1]),
+                (Self::axis(w, 1.0), b.max[1]),
+            ];
+            let mut least: Option<Touch> = None;
+            for (n, h) in faces {
+                let s = e.support(n);
+                let depth = h - dot(n, s);
+                if depth <= 0.0 {
+                    least = None;
+                    break;
+                }
+                if least.is_none_or(|t| depth < t.depth) {
+                    least = Some(Touch {
+                        point: s,
+                        depth,
+                        normal: n,
+                    });
+                }
+            }
+            if let Some(t) = least {
+                touch(t);
+            }
+        }
+    }
+
+    /// The deepest surface a point at `p` is behind, if any: its depth and outward normal.
+    pub fn penetration(&self, p: V3) -> Option<(f64, V3)> {
+        let mut best: Option<(f64, V3)> = None;
+        self.touches(&Ellipsoid::point(p), |t| {
+            if best.is_none_or(|(d, _)| t.depth > d) {
+                best = Some((t.depth, t.normal));
+            }
+        });
+        best
+    }
+
+    /// The force (world axes) on a point at `p` moving at `v`: the sum over the surfaces it
+    /// is behind.
+    pub fn point_force(&self, p: V3, v: V3) -> V3 {
+        let mut f = [0.0; 3];
+        self.touches(&Ellipsoid::point(p), |t| {
+            let g = self.law.force(t.depth, t.normal, v);
+            f = [0, 1, 2].map(|j| f[j] + g[j]);
+        });
+        f
+    }
+
+    /// The contact forces on an ellipsoid of semi-axes `axes` along the axes `rotation` of
+    /// its body, centred at `centre` (world axes) moving at `centre_velocity`, the body
+    /// turning at `angular_velocity`: each as (the point it acts at, the force), to `out`.
+    pub fn ellipsoid_forces(
+        &self,
+        rotation: &[[f64; 3]; 3],
+        angular_velocity: V3,
+        (centre, centre_velocity): (V3, V3),
+        axes: V3,
+        mut out: impl FnMut(V3, V3),
+    ) {
+        let e = Ellipsoid {
+            centre,
+            rotation,
+            axes,
+        };
+        self.touches(&e, |t| {
+            let arm = [0, 1, 2].map(|j| t.point[j] - centre[j]);
+            let wxr = cross(angular_velocity, arm);
+            let v = [0, 1, 2].map(|j| centre_velocity[j] + wxr[j]);
+            out(t.point, self.law.force(t.depth, t.normal, v));
+        });
+    }
+
+    /// Applies the contact forces on an ellipsoid of semi-axes `axes` along frame `frame`'s
+    /// axes, centred at declared point `point` (a point of the frame's body), to `e`; returns
+    /// their sum (world axes) and the largest depth (0 out of contact). The user part must
+    /// read frames ([`crate::Efforts::FRAMES`]).
+    pub fn apply_ellipsoid(&self, e: &mut Effort, frame: usize, point: usize, axes: V3) -> Pressed {
+        let p = e.point(point);
+        let centre = (p.position, p.velocity);
+        let k = e.frame(frame);
+        let (rotation, w) = (k.pose.rotation, k.angular_velocity);
+        let mut pressed = Pressed::default();
+        let e_ = Ellipsoid {
+            centre: centre.0,
+            rotation: &rotation,
+            axes,
+        };
+        self.touches(&e_, |t| pressed.depth = pressed.depth.max(t.depth));
+        if pressed.depth == 0.0 {
+            return pressed;
+        }
+        self.ellipsoid_forces(&rotation, w, centre, axes, |at, f| {
+            pressed.force = [0, 1, 2].map(|j| pressed.force[j] + f[j]);
+            e.force_on_frame(frame, at, f);
+        });
+        pressed
+    }
+
+    /// Applies the contact force on declared point `point` to `e`; returns it (world axes).
+    pub fn apply_point(&self, e: &mut Effort, point: usize) -> V3 {
+        let p = e.point(point);
+        let f = self.point_force(p.position, p.velocity);
+        e.force_at_point(point, f);
+        f
+    }
+}

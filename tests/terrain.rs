@@ -1,0 +1,438 @@
+//! Terrain of ground and boxes (`mbs::terrain`) touched by points and by ellipsoids:
+//!
+//! - a point follows the usual rule (inside a box, its nearest face; the ground below it),
+//!   and a sphere against a box's side and top gives the depths and forces worked by hand;
+//! - a tilted ellipsoid's support point lies on its surface with its normal along the face's
+//!   (the closed form checked against the ellipsoid's own equation), and its force on a box's
+//!   top, with damping and friction, equals the law worked from that point;
+//! - an ellipsoid off its body's centre of mass, on the ground or on a box's top, gives the
+//!   same generalised forces as the generated contact (`contact(…, ellipsoid = …)`) with the
+//!   same plane, at 40 states pressed in, turning and sliding;
+//! - the human model stands on a 10 cm platform on its twelve ellipsoids (`OnTerrain`: the
+//!   generated contacts keep the ground, the terrain adds the box): the platform carries its
+//!   weight, half on each foot, and the motion is the stance on the ground raised by the
+//!   platform's height; started 3 cm into the platform it stops with `EffortRejected` naming
+//!   the ellipsoid that passed through.
+
+use mbs::terrain::{Block, ContactLaw, Ellipsoid, Terrain};
+use mbs::{Efforts, Kinematics, Model, Options, Output, Scheme, WithEfforts};
+use mbs_models::human::*;
+
+const G: f64 = 9.80665;
+/// gait2392's 75.1646 kg and two patellas of 0.0862 kg (Rajagopal 2015)
+const MASS: f64 = 75.1646 + 2.0 * 0.0862;
+
+fn close(a: [f64; 3], b: [f64; 3], tol: f64) -> bool {
+    (0..3).all(|j| (a[j] - b[j]).abs() <= tol)
+}
+
+#[test]
+fn a_point_takes_its_nearest_face_and_a_sphere_touches_a_box_as_by_hand() {
+    // a step 5 cm high from x = 0.6 to 3.6, y from −1 to 1
+    let t = Terrain::step(0.6, 0.05);
+    assert_eq!(t.height([0.7, 0.0]), 0.05);
+    assert_eq!(t.height([0.5, 0.0]), 0.0);
+    // inside, 1 cm below the top: the top
+    let (d, n) = t.penetration([0.7, 0.0, 0.04]).expect("inside the step");
+    assert!(
+        (d - 0.01).abs() < 1e-15 && n == [0.0, 0.0, 1.0],
+        "{d} {n:?}"
+    );
+    // inside, 5 mm behind the riser: the riser (outward normal −x)
+    let (d, n) = t.penetration([0.605, 0.0, 0.0]).expect("inside the step");
+    assert!(
+        (d - 0.005).abs() < 1e-15 && n == [-1.0, 0.0, 0.0],
+        "{d} {n:?}"
+    );
+    // below the ground before the step; above it, nothing
+    let (d, n) = t.penetration([0.2, 0.3, -0.002]).expect("below the ground");
+    assert!((d - 0.002).abs() < 1e-15 && n == [0.0, 0.0, 1.0]);
+    assert!(t.penetration([0.2, 0.3, 0.001]).is_none());
+    assert!(t.penetration([0.7, 1.2, 0.01]).is_none(), "beside the step");
+
+    // a sphere of radius 2 cm centred 1 cm before the riser, 3 cm up, pressed against it:
+    // the riser 1 cm deep (the top 4 cm, the ground not at all), the force k·δ along −x at
+    // the sphere's point (0.61, 0, 0.03); at rest, no friction
+    let r = 0.02;
+    let sphere = Ellipsoid {
+        centre: [0.59, 0.0, 0.03],
+        rotation: &[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        axes: [r; 3],
+    };
+    let mut touches = Vec::new();
+    t.touches(&sphere, |x| touches.push(x));
+    assert_eq!(touches.len(), 1, "{touches:?}");
+    let x = touches[0];
+    assert!((x.depth - 0.01).abs() < 1e-15 && x.normal == [-1.0, 0.0, 0.0]);
+    assert!(close(x.point, [0.61, 0.0, 0.03], 1e-15), "{:?}", x.point);
+    let mut forces = Vec::new();
+    let rot = *sphere.rotation;
+    t.ellipsoid_forces(
+        &rot,
+        [0.0; 3],
+        (sphere.centre, [0.0; 3]),
+        sphere.axes,
+        |at, f| forces.push((at, f)),
+    );
+    assert_eq!(forces.len(), 1);
+    assert!(
+        close(forces[0].1, [-1e5 * 0.01, 0.0, 0.0], 1e-9),
+        "{forces:?}"
+    );
+
+    // the same sphere lowered 2.5 cm, 5 mm into the ground too: both push
+    let low = Ellipsoid {
+        centre: [0.59, 0.0, 0.015],
+        ..sphere
+    };
+    let mut touches = Vec::new();
+    t.touches(&low, |x| touches.push((x.depth, x.normal)));
+    touches.sort_by(|a, b| a.0.total_cmp(&b.0));
+    assert_eq!(touches.len(), 2, "{touches:?}");
+    assert!((touches[0].0 - 0.005).abs() < 1e-15 && touches[0].1 == [0.0, 0.0, 1.0]);
+    assert!((touches[1].0 - 0.01).abs() < 1e-15 && touches[1].1 == [-1.0, 0.0, 0.0]);
+}
+
+/// R = Rx(θ) (columns: the body's axes in world axes).
+fn rx(theta: f64) -> [[f64; 3]; 3] {
+    let (s, c) = theta.sin_cos();
+    [[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]]
+}
+
+#[test]
+fn a_tilted_ellipsoid_on_a_box_top_by_hand() {
+    let (a, b, c) = (0.05, 0.03, 0.02);
+    let theta: f64 = 0.4;
+    let r = rx(theta);
+    let t = Terrain {
+        blocks: vec![Block {
+            min: [0.5, -0.5],
+            max: [1.5, 0.5],
+            height: 0.1,
+        }],
+        law: ContactLaw {
+            k: 2e6,
+            c: 10.0,
+            exponent: 1.5,
+            dissipation: 1.0,
+            mu: 0.6,
+            eps: 0.01,
+        },
+        ..Terrain::default()
+    };
+    // the lowest point of Rx(θ)·diag(a, b, c) lies s = √(b² sin²θ + c² cos²θ) below the
+    // centre; centre it 3 mm less than s above the top
+    let (sn, cs) = theta.sin_cos();
+    let s = (b * b * sn * sn + c * c * cs * cs).sqrt();
+    let depth = 0.003;
+    let centre = [1.0, 0.1, 0.1 + s - depth];
+    let e = Ellipsoid {
+        centre,
+        rotation: &r,
+        axes: [a, b, c],
+    };
+    let mut touches = Vec::new();
+    t.touches(&e, |x| touches.push(x));
+    assert_eq!(touches.len(), 1, "{touches:?}");
+    let x = touches[0];
+    assert!(
+        x.normal == [0.0, 0.0, 1.0] && (x.depth - depth).abs() < 1e-15,
+        "{x:?}"
+    );
+    // the support point by hand: centre − (0, sinθ cosθ (b² − c²)/s, s)
+    let hand = [
+        centre[0],
+        centre[1] - sn * cs * (b * b - c * c) / s,
+        centre[2] - s,
+    ];
+    assert!(close(x.point, hand, 1e-15), "{:?} vs {hand:?}", x.point);
+    // on the surface: y = Rᵀ(p − x) has Σ yᵢ²/aᵢ² = 1, and the surface's normal there,
+    // R (yᵢ/aᵢ²), points along −z
+    let d = [0, 1, 2].map(|i| x.point[i] - centre[i]);
+    let y = [0, 1, 2].map(|j| (0..3).map(|i| r[i][j] * d[i]).sum::<f64>());
+    let axes = [a, b, c];
+    let level: f64 = (0..3).map(|j| (y[j] / axes[j]).powi(2)).sum();
+    assert!((level - 1.0).abs() < 1e-14, "{level}");
+    let g = [0, 1, 2].map(|j| y[j] / (axes[j] * axes[j]));
+    let normal = [0, 1, 2].map(|i| (0..3).map(|j| r[i][j] * g[j]).sum::<f64>());
+    assert!(normal[0].abs() < 1e-12 && normal[1].abs() < 1e-12 * normal[2].abs());
+    assert!(normal[2] < 0.0);
+
+    // moving: the centre at v, the body turning at ω; the material point at the support
+    // point moves at v + ω × (p − x); the law by hand
+    let v = [0.3, -0.1, -0.2];
+    let w = [1.0, 2.0, -0.5];
+    let vp = [
+        v[0] + w[1] * d[2] - w[2] * d[1],
+        v[1] + w[2] * d[0] - w[0] * d[2],
+        v[2] + w[0] * d[1] - w[1] * d[0],
+    ];
+    let rate = -vp[2];
+    let f_n = 2e6 * depth.powf(1.5) * (1.0 + rate) + 10.0 * rate;
+    let slide = (vp[0] * vp[0] + vp[1] * vp[1] + 0.01 * 0.01).sqrt();
+    let expect = [-0.6 * f_n * vp[0] / slide, -0.6 * f_n * vp[1] / slide, f_n];
+    let mut forces = Vec::new();
+    t.ellipsoid_forces(&r, w, (centre, v), [a, b, c], |at, f| forces.push((at, f)));
+    assert_eq!(forces.len(), 1);
+    assert!(close(forces[0].0, hand, 1e-15));
+    assert!(f_n > 0.0);
+    assert!(
+        close(forces[0].1, expect, 1e-12 * f_n),
+        "{:?} vs {expect:?}",
+        forces[0].1
+    );
+    // lifted 1 mm clear of the top: no contact
+    let clear = Ellipsoid {
+        centre: [centre[0], centre[1], centre[2] + depth + 1e-3],
+        ..e
+    };
+    let mut n = 0;
+    t.touches(&clear, |_| n += 1);
+    assert_eq!(n, 0);
+}
+
+mbs::multibody! {
+    /// An egg on six coordinates, its contact ellipsoid off its centre of mass, against the
+    /// plane z = floor.
+    pub model Egg {
+        param floor = 0.0;
+        dof x = 0.0; dof y = 0.0; dof z = 0.1; dof a = 0.0; dof b = 0.3; dof r = 0.2;
+        body egg { mass = 0.1; inertia = (4e-5, 5e-5, 6e-5); }
+        TOG[egg] = Tdisp(x, y, z) * Trotz(a) * Troty(b) * Trotx(r);
+        point tip on egg at (0.01, -0.005, 0.004);
+        gravity(0, 0, -9.81);
+        contact(tip, ellipsoid = (0.03, 0.02, 0.025), plane = z, offset = floor, k = 2e6, exponent = 1.5, dissipation = 1.0, mu = 0.6, eps = 0.01);
+    }
+}
+
+mbs::multibody! {
+    /// The egg without its contact.
+    pub model EggAloft {
+        dof x = 0.0; dof y = 0.0; dof z = 0.1; dof a = 0.0; dof b = 0.3; dof r = 0.2;
+        body egg { mass = 0.1; inertia = (4e-5, 5e-5, 6e-5); }
+        TOG[egg] = Tdisp(x, y, z) * Trotz(a) * Troty(b) * Trotx(r);
+        point tip on egg at (0.01, -0.005, 0.004);
+        gravity(0, 0, -9.81);
+    }
+}
+
+/// The egg's ellipsoid on a terrain.
+#[derive(Clone)]
+struct EggOn {
+    terrain: Terrain,
+    frame: usize,
+    point: usize,
+}
+
+impl Efforts for EggOn {
+    fn efforts(&mut self, e: &mut mbs::Effort) -> Result<(), String> {
+        self.terrain
+            .apply_ellipsoid(e, self.frame, self.point, [0.03, 0.02, 0.025]);
+        Ok(())
+    }
+}
+
+/// The generalised forces of the generated contact against those of the same ellipsoid on
+/// `terrain`, at states pressed `floor` + up to 4 mm into it, turning and sliding.
+fn egg_agrees(floor: f64, terrain: Terrain) {
+    let mut generated = Egg::default();
+    let mut p = generated.params().clone();
+    p.floor = floor;
+    generated.set_params(p).unwrap();
+    let aloft = EggAloft::default();
+    let info = aloft.info();
+    let on = WithEfforts::new(
+        EggAloft::default(),
+        EggOn {
+            terrain,
+            frame: info.frame_index("egg").unwrap(),
+            point: info.point_index("tip").unwrap(),
+        },
+    );
+    let n = Egg::NQ;
+    let mut kin = Kinematics::new::<EggAloft>();
+    let mut touched = 0;
+    for k in 0..40 {
+        let u = |j: usize| ((k * 7 + j * 13) as f64 * 0.61803).fract() - 0.5;
+        let mut q: Vec<f64> = (0..n).map(|j| 2.0 * u(j)).collect();
+        let qd: Vec<f64> = (0..n).map(|j| 0.8 * u(j + 6)).collect();
+        // put the lowest point of the ellipsoid 0–4 mm below the floor
+        q[2] = 0.0;
+        aloft.kinematics(0.0, &q, &qd, &mut kin);
+        let f = &kin.frames[info.frame_index("egg").unwrap()];
+        let e = Ellipsoid {
+            centre: kin.points[info.point_index("tip").unwrap()].position,
+            rotation: &f.pose.rotation,
+            axes: [0.03, 0.02, 0.025],
+        };
+        let low = e.support([0.0, 0.0, 1.0])[2];
+        q[2] = floor - low - 0.004 * (u(12) + 0.5);
+        let mut m = vec![0.0; n * n];
+        let (mut h0, mut h1, mut h2) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        aloft.dynamics(0.0, &q, &qd, &[], &mut m, &mut h0);
+        generated.dynamics(0.0, &q, &qd, &[], &mut m, &mut h1);
+        on.dynamics(0.0, &q, &qd, &[], &mut m, &mut h2);
+        let scale = (0..n).map(|i| (h1[i] - h0[i]).abs()).fold(0.0, f64::max);
+        if scale > 0.0 {
+            touched += 1;
+        }
+        for i in 0..n {
+            assert!(
+                (h1[i] - h2[i]).abs() <= 1e-12 * scale.max(1.0),
+                "floor {floor}, state {k}, coordinate {i}: generated {} terrain {}",
+                h1[i],
+                h2[i]
+            );
+        }
+    }
+    assert!(touched >= 35, "{touched} of 40 states in contact");
+}
+
+#[test]
+fn an_ellipsoid_on_the_terrain_is_the_generated_contact() {
+    let law = ContactLaw {
+        k: 2e6,
+        c: 0.0,
+        exponent: 1.5,
+        dissipation: 1.0,
+        mu: 0.6,
+        eps: 0.01,
+    };
+    // the ground
+    egg_agrees(
+        0.0,
+        Terrain {
+            law,
+            ..Terrain::default()
+        },
+    );
+    // a box's top (a box far wider than the egg), the ground left out
+    egg_agrees(
+        0.1,
+        Terrain {
+            ground: false,
+            blocks: vec![Block {
+                min: [-10.0, -10.0],
+                max: [10.0, 10.0],
+                height: 0.1,
+            }],
+            law,
+            ..Terrain::default()
+        },
+    );
+}
+
+#[test]
+fn the_model_stands_on_a_platform() {
+    let model = Human::default();
+    let n = Human::NQ;
+    let reference = GaitReference::still(model.info(), 0.1).unwrap();
+    let (mut q0, qd0) = cycle_start(&model, &reference);
+    // a platform 10 cm high under both feet, the body raised by as much
+    let height = 0.1;
+    q0[1] += height;
+    let platform = Block {
+        min: [-0.5, -0.5],
+        max: [0.5, 0.5],
+        height,
+    };
+    let tracking = Tracking::new(reference.clone(), model.info(), 3000.0, 30.0).unwrap();
+    let feet = OnTerrain::new(&model, tracking, vec![platform]);
+    let on = feet.clone();
+    let options = Options {
+        q0: Some(q0.clone()),
+        qd0: Some(qd0),
+        output: Output::Every { dt: 0.01 },
+        ..Options::adaptive(3.0, 1e-5)
+    };
+    let options_sunk = options.clone();
+    let (tr, stats) = mbs::simulate(
+        WithEfforts::new(model.clone(), feet),
+        Scheme::Radau5,
+        options.clone(),
+    )
+    .expect("standing on the platform is a regular run");
+    // the same stance on the ground (the generated contacts), 10 cm lower
+    let mut q_ground = q0.clone();
+    q_ground[1] -= height;
+    let tracking = Tracking::new(reference.clone(), model.info(), 3000.0, 30.0).unwrap();
+    let (flat, _) = mbs::simulate(
+        WithEfforts::new(model.clone(), tracking),
+        Scheme::Radau5,
+        Options {
+            q0: Some(q_ground),
+            ..options
+        },
+    )
+    .expect("standing on the ground is a regular run");
+    let last = tr.len() - 1;
+    let (ql, qdl) = (&tr.q(last)[..n], &tr.qd(last)[..n]);
+    let mut kin = Kinematics::new::<Human>();
+    model.kinematics(tr.t[last], ql, qdl, &mut kin);
+    let f = on.forces(&kin);
+    let weight = MASS * G;
+    println!(
+        "standing 3 s on a {height} m platform, radau5 rtol 1e-5: {} steps; pelvis moved \
+         ({:+.2e}, {:+.2e}, {:+.2e}) m; the platform carries {:.4} and {:.4} of the weight",
+        stats.steps,
+        ql[0] - q0[0],
+        ql[1] - q0[1],
+        ql[2] - q0[2],
+        f[0][1] / weight,
+        f[1][1] / weight
+    );
+    assert!(((f[0][1] + f[1][1]) / weight - 1.0).abs() < 0.01);
+    assert!((f[0][1] / weight - 0.5).abs() < 0.05 && (f[1][1] / weight - 0.5).abs() < 0.05);
+    for j in 0..3 {
+        assert!((ql[j] - q0[j]).abs() < 0.01, "pelvis drifted along {j}");
+        assert!(
+            qdl[j].abs() < 1e-2,
+            "pelvis still moving along {j}: {}",
+            qdl[j]
+        );
+    }
+    // the stance on the ground, raised by the platform's height, at every output instant
+    let mut apart = 0.0f64;
+    for (i, &t) in tr.t.iter().enumerate() {
+        let j = flat
+            .t
+            .iter()
+            .position(|&u| u == t)
+            .expect("the same output instants");
+        for c in 0..n {
+            let shift = if c == 1 { height } else { 0.0 };
+            apart = apart.max((tr.q(i)[c] - flat.q(j)[c] - shift).abs());
+        }
+    }
+    println!("largest difference to the stance on the ground, raised: {apart:.2e}");
+    assert!(apart < 1e-8, "{apart}");
+    // started 3 cm into the platform: a typed failure naming the ellipsoid
+    let mut sunk = q0.clone();
+    sunk[1] -= 0.03;
+    let tracking = Tracking::new(reference, model.info(), 3000.0, 30.0).unwrap();
+    let e = mbs::simulate(
+        WithEfforts::new(
+            model.clone(),
+            OnTerrain::new(&model, tracking, vec![platform]),
+        ),
+        Scheme::Radau5,
+        Options {
+            q0: Some(sunk),
+            ..options_sunk
+        },
+    )
+    .expect_err("a foot through the platform stops the run");
+    println!("{e}");
+    assert!(matches!(e.kind, mbs::Failure::EffortRejected { .. }), "{e}");
+    assert!(e.to_string().contains("passed through the box"), "{e}");
+    // every foot ellipsoid that touches, touches the platform's top
+    let sp = support_points(&model, &kin);
+    for foot in &sp {
+        for (x, _) in foot {
+            assert!(
+                x[1] > height - 0.01,
+                "an ellipsoid below the platform's top: {x:?}"
+            );
+        }
+    }
+}

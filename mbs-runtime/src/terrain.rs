@@ -74,6 +74,7 @@ impl Default for ContactLaw {
 impl ContactLaw {
     /// The force (world axes) on a body at depth `depth` behind a face of outward unit
     /// normal `n`, its material point there moving at `v`; zero out of contact.
+    #[inline]
     pub fn force(&self, depth: f64, n: V3, v: V3) -> V3 {
         if depth <= 0.0 {
             return [0.0; 3];
@@ -123,7 +124,11 @@ pub struct Ellipsoid<'a> {
 
 impl Ellipsoid<'_> {
     /// The support point along −n: the ellipsoid's point farthest along −n.
+    #[inline]
     pub fn support(&self, n: V3) -> V3 {
+        if self.axes == [0.0; 3] {
+            return self.centre;
+        }
         let r = self.rotation;
         let m = [0, 1, 2].map(|j| r[0][j] * n[0] + r[1][j] * n[1] + r[2][j] * n[2]);
         let d2m = [0, 1, 2].map(|j| self.axes[j] * self.axes[j] * m[j]);
@@ -246,7 +251,18 @@ impl Terrain {
             });
         }
         let [u, w] = self.horizontal();
+        // the box around the ellipsoid: no face of a box beyond it can be reached
+        let reach = e.axes.iter().copied().fold(0.0, f64::max);
+        let x = e.centre;
         for b in &self.blocks {
+            if x[up] - reach >= b.height
+                || x[u] + reach <= b.min[0]
+                || x[u] - reach >= b.max[0]
+                || x[w] + reach <= b.min[1]
+                || x[w] - reach >= b.max[1]
+            {
+                continue;
+            }
             // the top, then the sides: (outward normal, the face's coordinate along it)
             let faces = [
                 (Self::axis(up, 1.0), b.height),
@@ -290,6 +306,7 @@ impl Terrain {
 
     /// The force (world axes) on a point at `p` moving at `v`: the sum over the surfaces it
     /// is behind.
+    #[inline]
     pub fn point_force(&self, p: V3, v: V3) -> V3 {
         let mut f = [0.0; 3];
         self.touches(&Ellipsoid::point(p), |t| {

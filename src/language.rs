@@ -221,6 +221,10 @@
 //! touch the normal force jumps to c δ̇ (integrators with error control take small steps
 //! there); c ≈ 2 ζ √(k m) gives a damping ratio ζ for a mass m on the contact.
 //!
+//! A contact meets one plane. Terrain of the ground and boxes on it is described in Rust
+//! ([`crate::terrain`]): a [`crate::terrain::Terrain`] applies the same law to points and to
+//! ellipsoids on bodies from an [`crate::Efforts`] part, through each face's support point.
+//!
 //! **Bushings**: with d = p_B − p_A, Δp = R_Aᵀ d, Δv = R_Aᵀ (v_B − v_A − ω_A × d) (B's origin
 //! relative to the point of A it coincides with, in A's axes), R = R_Aᵀ R_B,
 //! θ = ½ (R₃₂ − R₂₃, R₁₃ − R₃₁, R₂₁ − R₁₂) (the rotation vector of B relative to A for small

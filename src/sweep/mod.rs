@@ -439,7 +439,7 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
     /// Runs every run into `dir/results.csv` (after [`Sweep::prepare`]), skipping those the
     /// table has.
     /// With the `parquet` feature, a sweep with every run in its table also writes
-    /// `dir/results.parquet` ([`parquet`]).
+    /// `dir/results.parquet` (the module `parquet`).
     pub fn run(&self, dir: &Path, runs: &RunList) -> Result<Summary, SweepError> {
         self.prepare(dir, runs)?;
         let table = dir.join("results.csv");

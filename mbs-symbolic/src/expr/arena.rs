@@ -16,6 +16,9 @@ pub struct Arena {
     pub(super) dmemo: FxHashMap<u64, ExprId>,
     pub(super) user_fns: Vec<UserFn>,
     pub(super) splines: Vec<SplineTable>,
+    /// while set, a product of a value of parameters alone (computed once per call) keeps
+    /// that value's coefficient with it (`Arena::mul`)
+    pub(crate) keep_fixed: bool,
 }
 
 /// Direction of differentiation.
@@ -70,6 +73,7 @@ impl Arena {
             dmemo: FxHashMap::default(),
             user_fns: Vec::new(),
             splines: Vec::new(),
+            keep_fixed: false,
         };
         let z = a.intern(Node::Num(num_bits(0.0)));
         let o = a.intern(Node::Num(num_bits(1.0)));
@@ -126,6 +130,11 @@ impl Arena {
     /// False only when `id` certainly depends on none of q, qd, qdd, t, inputs.
     pub(crate) fn mask(&self, id: ExprId) -> u128 {
         self.deps[id.index()]
+    }
+
+    /// True when `id` depends on parameters at most: a value computed once per call.
+    pub(crate) fn is_fixed(&self, id: ExprId) -> bool {
+        self.deps[id.index()] & !Var::PARAM_BITS == 0
     }
 
     /// True when the expression is a constant number.

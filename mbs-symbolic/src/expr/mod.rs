@@ -60,6 +60,9 @@ pub enum Var {
 }
 
 impl Var {
+    /// The bits of the dependency mask that parameters take.
+    pub(crate) const PARAM_BITS: u128 = 0xf << 121;
+
     /// Bit of the dependency mask: coordinates, velocities and accelerations get 40 bits each,
     /// parameters and inputs share a few. Collisions only make the mask conservative.
     pub(crate) fn mask(self) -> u128 {

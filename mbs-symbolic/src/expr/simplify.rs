@@ -261,6 +261,14 @@ impl Arena {
         // numeric factors float to the front of a product
         let (ca, ta) = self.split_coef(a);
         let (cb, tb) = self.split_coef(b);
+        // but while `keep_fixed` is set, (c·P)·x stays so, one product, when P depends on
+        // parameters alone and c·P is a value of its own: c·(P·x) would take two
+        if self.keep_fixed {
+            let (fa, fb) = (self.is_fixed(a), self.is_fixed(b));
+            if fa && !fb && ca != 1.0 && cb == 1.0 || fb && !fa && cb != 1.0 && ca == 1.0 {
+                return self.intern(Node::Mul(a.min(b), a.max(b)));
+            }
+        }
         if ca != 1.0 || cb != 1.0 {
             let p = self.mul(ta, tb);
             return self.scale(ca * cb, p);
@@ -449,6 +457,33 @@ impl Arena {
 #[cfg(test)]
 mod tests {
     use super::super::{Arena, Node, Var};
+
+    #[test]
+    fn a_factor_of_parameters_keeps_its_coefficient_while_asked() {
+        // c·P with P of parameters alone, times a state value x and y
+        let mut a = Arena::new();
+        let (p, x, y) = (a.var(Var::Param(0)), a.var(Var::Q(0)), a.var(Var::Qd(0)));
+        let cp = a.scale(1.0 / 12.0, p);
+        let (px, py) = (a.mul(cp, x), a.mul(cp, y));
+        // floated out: 1/12·(P·x) and 1/12·(P·y), whose sum collects the like terms
+        assert!(matches!(a.node(px), Node::Mul(c, _) if a.as_num(c).is_some()));
+        let flops = |a: &Arena, r: &[_]| crate::expr::ops(a, r).flops();
+        assert_eq!(flops(&a, &[cp, px, py]), 5);
+        a.keep_fixed = true;
+        let (kx, ky) = (a.mul(cp, x), a.mul(cp, y));
+        a.keep_fixed = false;
+        // kept: (c·P)·x and (c·P)·y, c·P computed once
+        assert!(matches!(a.node(kx), Node::Mul(u, v) if u == cp || v == cp));
+        assert_eq!(flops(&a, &[cp, kx, ky]), 3);
+        // a product of two state values, or of parameters alone, floats as before
+        let cx = a.scale(0.5, x);
+        a.keep_fixed = true;
+        let xy = a.mul(cx, y);
+        let pp = a.mul(cp, p);
+        a.keep_fixed = false;
+        assert!(matches!(a.node(xy), Node::Mul(c, _) if a.as_num(c) == Some(0.5)));
+        assert!(matches!(a.node(pp), Node::Mul(c, _) if a.as_num(c).is_some()));
+    }
 
     #[test]
     fn zeros_ones_and_signs_fold() {

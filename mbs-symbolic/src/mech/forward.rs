@@ -12,11 +12,14 @@
 //!   pass), 6 % fewer operations on spatial arms (9–10 % on planar chains, where
 //!   `mech::dynamics` keeps h: the same latency, measured no faster). It needs every
 //!   coordinate to move exactly one node of the tree (a coordinate shared by two factors
-//!   couples them outside the tree). Three things keep a spatial arm's joint at 220–250
+//!   couples them outside the tree). Four things keep a spatial arm's joint at 205–230
 //!   flops, where a full spatial transform per elementary factor cost about 300: translations
 //!   that no coordinate moves and no branch separates are taken in one step; a rotation about
-//!   a coordinate axis turns a 3×3 block by the double angle (`Turn`); and the zeros an
-//!   elimination leaves are set (`Art::clear_along`). The recursion is a chain of dependent
+//!   a coordinate axis turns a 3×3 block by the double angle (`Turn`); the zeros an
+//!   elimination leaves are set (`Art::clear_along`); and products keep the coefficient of a
+//!   factor of parameters alone (`Arena::keep_fixed`, set by `mech::dynamics` while it
+//!   builds forward dynamics: an inertia m (a² + b²)/12 times a state value is one product,
+//!   not 1/12 floated out times two; 6 % of the arms' operations). The recursion is a chain of dependent
 //!   steps through a division per coordinate, so its time on a planar chain is its latency,
 //!   not its operation count: `Elimination` says where a rotation's coordinate is
 //!   eliminated, and both are built.

@@ -72,7 +72,7 @@ fn a_point_takes_its_nearest_face_and_a_sphere_touches_a_box_as_by_hand() {
         [0.0; 3],
         (sphere.centre, [0.0; 3]),
         sphere.axes,
-        |at, f| forces.push((at, f)),
+        |x, f| forces.push((x.point, f)),
     );
     assert_eq!(forces.len(), 1);
     assert!(
@@ -172,7 +172,9 @@ fn a_tilted_ellipsoid_on_a_box_top_by_hand() {
     let slide = (vp[0] * vp[0] + vp[1] * vp[1] + 0.01 * 0.01).sqrt();
     let expect = [-0.6 * f_n * vp[0] / slide, -0.6 * f_n * vp[1] / slide, f_n];
     let mut forces = Vec::new();
-    t.ellipsoid_forces(&r, w, (centre, v), [a, b, c], |at, f| forces.push((at, f)));
+    t.ellipsoid_forces(&r, w, (centre, v), [a, b, c], |x, f| {
+        forces.push((x.point, f))
+    });
     assert_eq!(forces.len(), 1);
     assert!(close(forces[0].0, hand, 1e-15));
     assert!(f_n > 0.0);

@@ -20,7 +20,8 @@ use crate::model::Kinematics;
 
 type V3 = [f64; 3];
 
-fn dot(a: V3, b: V3) -> f64 {
+/// a · b
+pub(crate) fn dot(a: V3, b: V3) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 

@@ -25,13 +25,9 @@
 //! of v_s along the face; the force F_n n + F_t acts at s.
 
 use crate::efforts::Effort;
-use crate::elements::cross;
+use crate::elements::{cross, dot};
 
 type V3 = [f64; 3];
-
-fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
 
 /// A box standing on the ground: its footprint along the two horizontal axes (in increasing
 /// order of axis) and its height (m).
@@ -129,14 +125,21 @@ impl Ellipsoid<'_> {
         if self.axes == [0.0; 3] {
             return self.centre;
         }
+        let r = self.reach(n);
+        [0, 1, 2].map(|i| self.centre[i] + r[i])
+    }
+
+    /// From the centre to the support point along −n: −R D² m / √(mᵀ D² m), m = Rᵀ n.
+    #[inline]
+    pub fn reach(&self, n: V3) -> V3 {
         let r = self.rotation;
         let m = [0, 1, 2].map(|j| r[0][j] * n[0] + r[1][j] * n[1] + r[2][j] * n[2]);
         let d2m = [0, 1, 2].map(|j| self.axes[j] * self.axes[j] * m[j]);
         let s = dot(m, d2m).sqrt();
         if s == 0.0 {
-            return self.centre;
+            return [0.0; 3];
         }
-        [0, 1, 2].map(|i| self.centre[i] - dot(r[i], d2m) / s)
+        [0, 1, 2].map(|i| -dot(r[i], d2m) / s)
     }
 }
 
@@ -197,11 +200,6 @@ impl Terrain {
             1 => [0, 2],
             _ => [0, 1],
         }
-    }
-
-    /// The horizontal coordinates of a point.
-    pub fn across(&self, p: V3) -> [f64; 2] {
-        self.horizontal().map(|j| p[j])
     }
 
     /// The height of the terrain's top above the horizontal position `p`: the highest box
@@ -318,14 +316,14 @@ impl Terrain {
 
     /// The contact forces on an ellipsoid of semi-axes `axes` along the axes `rotation` of
     /// its body, centred at `centre` (world axes) moving at `centre_velocity`, the body
-    /// turning at `angular_velocity`: each as (the point it acts at, the force), to `out`.
+    /// turning at `angular_velocity`: each as (where it touches, the force), to `out`.
     pub fn ellipsoid_forces(
         &self,
         rotation: &[[f64; 3]; 3],
         angular_velocity: V3,
         (centre, centre_velocity): (V3, V3),
         axes: V3,
-        mut out: impl FnMut(V3, V3),
+        mut out: impl FnMut(&Touch, V3),
     ) {
         let e = Ellipsoid {
             centre,
@@ -336,7 +334,7 @@ impl Terrain {
             let arm = [0, 1, 2].map(|j| t.point[j] - centre[j]);
             let wxr = cross(angular_velocity, arm);
             let v = [0, 1, 2].map(|j| centre_velocity[j] + wxr[j]);
-            out(t.point, self.law.force(t.depth, t.normal, v));
+            out(&t, self.law.force(t.depth, t.normal, v));
         });
     }
 
@@ -350,27 +348,22 @@ impl Terrain {
         let k = e.frame(frame);
         let (rotation, w) = (k.pose.rotation, k.angular_velocity);
         let mut pressed = Pressed::default();
-        let e_ = Ellipsoid {
-            centre: centre.0,
-            rotation: &rotation,
-            axes,
-        };
-        self.touches(&e_, |t| pressed.depth = pressed.depth.max(t.depth));
-        if pressed.depth == 0.0 {
-            return pressed;
-        }
-        self.ellipsoid_forces(&rotation, w, centre, axes, |at, f| {
+        self.ellipsoid_forces(&rotation, w, centre, axes, |t, f| {
+            pressed.depth = pressed.depth.max(t.depth);
             pressed.force = [0, 1, 2].map(|j| pressed.force[j] + f[j]);
-            e.force_on_frame(frame, at, f);
+            e.force_on_frame(frame, t.point, f);
         });
         pressed
     }
 
-    /// Applies the contact force on declared point `point` to `e`; returns it (world axes).
+    /// Applies the contact force on declared point `point` to `e` (nothing out of contact);
+    /// returns it (world axes).
     pub fn apply_point(&self, e: &mut Effort, point: usize) -> V3 {
         let p = e.point(point);
         let f = self.point_force(p.position, p.velocity);
-        e.force_at_point(point, f);
+        if f != [0.0; 3] {
+            e.force_at_point(point, f);
+        }
         f
     }
 }

@@ -746,11 +746,7 @@ impl<const PID: bool> Efforts for Drive<PID> {
             e.generalized_force(FIRST_JOINT + j, tau);
         }
         for leg in 0..LEGS {
-            let foot = e.point(leg);
-            let f = self.terrain.point_force(foot.position, foot.velocity);
-            if f != [0.0; 3] {
-                e.force_at_point(leg, f);
-            }
+            self.terrain.apply_point(e, leg);
         }
         Ok(())
     }

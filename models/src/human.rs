@@ -168,7 +168,7 @@ pub use muscles::{
     MusclesAtRest, NM, moment_arms, muscle_cycle, muscle_stance,
 };
 
-use mbs::terrain::{Block, Terrain};
+use mbs::terrain::{Block, Ellipsoid, Terrain};
 use mbs::{Effort, Efforts, Kinematics, Model};
 
 /// The cycle of normal walking the model follows (see `models/data/normal_gait.tsv`).
@@ -1241,14 +1241,14 @@ impl Feet {
             std::array::from_fn(|e| {
                 let axes = FOOT_ELLIPSOIDS[e].1;
                 let (pt, fr) = (&kin.points[self.point[k][e]], &kin.frames[self.frame[k][e]]);
-                let r = fr.pose.rotation;
-                // m = Rᵀ n with n = y; support point x − R D² m / s
-                let m = [r[1][0], r[1][1], r[1][2]];
-                let u = [0, 1, 2].map(|j| axes[j] * axes[j] * m[j]);
-                let s = (0..3).map(|j| m[j] * u[j]).sum::<f64>().sqrt();
-                let arm = [0, 1, 2].map(|row| -(0..3).map(|j| r[row][j] * u[j]).sum::<f64>() / s);
-                let w = fr.angular_velocity;
+                let ellipsoid = Ellipsoid {
+                    centre: pt.position,
+                    rotation: &fr.pose.rotation,
+                    axes,
+                };
+                let arm = ellipsoid.reach([0.0, 1.0, 0.0]);
                 let x = [0, 1, 2].map(|j| pt.position[j] + arm[j]);
+                let w = fr.angular_velocity;
                 let v = [
                     pt.velocity[0] + w[1] * arm[2] - w[2] * arm[1],
                     pt.velocity[1] + w[2] * arm[0] - w[0] * arm[2],

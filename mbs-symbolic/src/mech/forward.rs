@@ -19,10 +19,10 @@
 //!   elimination leaves are set (`Art::clear_along`); and products keep the coefficient of a
 //!   factor of parameters alone (`Arena::keep_fixed`, set by `mech::dynamics` while it
 //!   builds forward dynamics: an inertia m (a² + b²)/12 times a state value is one product,
-//!   not 1/12 floated out times two; 6 % of the arms' operations). The recursion is a chain of dependent
-//!   steps through a division per coordinate, so its time on a planar chain is its latency,
-//!   not its operation count: `Elimination` says where a rotation's coordinate is
-//!   eliminated, and both are built.
+//!   not 1/12 floated out times two; 6 % of the arms' operations). The recursion is a chain
+//!   of dependent steps through a division per coordinate, so its time on a planar chain is
+//!   its latency, not its operation count: `Elimination` says where a rotation's coordinate
+//!   is eliminated, and both are built.
 //! - **Sparse LᵀDL** (Featherstone's LTDL): M = LᵀDL eliminated from the last coordinate to the
 //!   first, so that a tree whose parents come before their children keeps its zeros (no
 //!   fill-in); structural zeros fold in the arena. It serves any M, and small models, where it

@@ -15,6 +15,10 @@
 use super::State;
 use crate::options::Options;
 
+/// The weights of [`Tolerances::error_norm`] are at least this many ε times the state's
+/// largest entry.
+pub(crate) const ROUNDING: f64 = 100.0;
+
 /// Relative and absolute tolerance of the local error: a component y_i of error e_i counts as
 /// e_i / (atol + rtol·|y_i|).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -52,12 +56,20 @@ impl Tolerances {
     }
 
     /// Weighted RMS norm of an error vector e against the state scales y0, y1:
-    /// sqrt(mean (e_i / (atol + rtol·max(|y0_i|, |y1_i|)))²).
+    /// sqrt(mean (e_i / w_i)²), w_i = atol + rtol·max(|y0_i|, |y1_i|), but never below
+    /// [`ROUNDING`]·ε (or rtol, if tighter) times the state's largest entry: a component is
+    /// computed from the
+    /// others (a closed loop's velocities from one another), so its rounding follows the
+    /// largest of them, and a weight below that asks for digits no step size gives (the step
+    /// would shrink to h_min: fastlink's coupler turning through zero at 2e-3 rad/s while its
+    /// crank turns at 1,100 rad/s, under atol = 1e-12).
     pub fn error_norm(&self, e: &[f64], y0: &[f64], y1: &[f64]) -> f64 {
         let (rtol, atol) = (self.rtol, self.atol);
+        let largest = y0.iter().chain(y1).fold(0.0f64, |m, y| m.max(y.abs()));
+        let floor = (ROUNDING * f64::EPSILON).min(rtol) * largest;
         let mut s = 0.0;
         for i in 0..e.len() {
-            let w = atol + rtol * y0[i].abs().max(y1[i].abs());
+            let w = (atol + rtol * y0[i].abs().max(y1[i].abs())).max(floor);
             s += (e[i] / w) * (e[i] / w);
         }
         (s / e.len().max(1) as f64).sqrt()
@@ -291,6 +303,24 @@ mod tests {
         let n = tol.error_norm(&e, &[2.0, -0.5], &[1.0, 0.25]);
         assert!(close(n, ((1.0 + 4.0) / 2.0f64).sqrt()), "{n}");
         assert_eq!(tol.error_norm(&[], &[], &[]), 0.0);
+    }
+
+    #[test]
+    fn no_weight_asks_for_less_than_the_rounding_of_the_largest_entry() {
+        let tol = Tolerances {
+            rtol: 1e-11,
+            atol: 1e-12,
+        };
+        // a velocity through zero beside one of 1,000: its weight is 100ε·1,000, not
+        // atol + rtol·0.002 ≈ 1.02e-12
+        let e = [0.0, 3e-12];
+        let floor = ROUNDING * f64::EPSILON * 1000.0;
+        let n = tol.error_norm(&e, &[1000.0, 0.002], &[999.0, -0.001]);
+        assert!(close(n, (3e-12 / floor) / 2.0f64.sqrt()), "{n}");
+        // beside a largest entry of 1 the floor (2.2e-14) is below the weight
+        let n = tol.error_norm(&e, &[1.0, 0.002], &[1.0, -0.001]);
+        let w = 1e-12 + 1e-11 * 0.002;
+        assert!(close(n, (3e-12 / w) / 2.0f64.sqrt()), "{n}");
     }
 
     #[test]

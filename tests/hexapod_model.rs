@@ -123,7 +123,7 @@ fn hexapod_feet_hang_above_the_ground_at_the_start() {
 }
 
 /// The contact-free scene carries no code of the `contact` and `pd` effects: its counts are
-/// the README's (M+h 6,192 flops, 42 sin/cos, with the base on a free joint whose
+/// the README's (M+h 5,887 flops, 42 sin/cos, with the base on a free joint whose
 /// translation is in world axes), as before the effects existed.
 #[test]
 fn hexapod_free_scene_keeps_the_contact_free_op_counts() {
@@ -138,7 +138,7 @@ fn hexapod_free_scene_keeps_the_contact_free_op_counts() {
     };
     let dynamics = count("dynamics");
     println!("Hexapod (Free) M+h: {dynamics}");
-    assert_eq!((dynamics.flops(), dynamics.funcs), (6192, 42));
+    assert_eq!((dynamics.flops(), dynamics.funcs), (5887, 42));
     assert_eq!(count("static_forces").flops(), 1020);
     assert_eq!(count("power").flops(), 0);
 }

@@ -114,17 +114,19 @@ fn dpend_errors(states: &[(f64, Vec<f64>, Vec<f64>)]) -> Vec<f64> {
         .collect()
 }
 
-/// The issue asks every adaptive scheme for dpend within 1e-6 of the reference at t = 10 s at
-/// rtol 1e-10. BDF misses it by about 700×: measured 7.3e-4 (7,372 steps, 146 rejected,
-/// 15,840 evaluations). SciPy's `BDF` (the same formulation) gives 4.6e-4 on the same problem
-/// and tolerances, its DOP853 9e-6 (reference file), DOPRI5 here 3.7e-5. The cause is the
-/// pendulum, not the scheme. Why 1e-6 at t = 10 s is out of reach at rtol 1e-10, measured:
-/// - up to 5 s BDF at rtol 1e-10 stays within ~1e-6 (errors 5e-9, 2e-8, 7e-8, 6e-7 at
-///   0.5, 1, 2, 5 s), then the error grows ×1000 in the next 5 s (7e-4 at 10 s);
+/// Every adaptive scheme was asked for dpend within 1e-6 of the reference at t = 10 s at
+/// rtol 1e-10. BDF misses it: measured 1.6e-5 (17,142 steps, 277 rejected; 7.3e-4 before its
+/// tolerance mapping and other roundings of the generated code: on this motion the figure at
+/// 10 s moves by orders of magnitude with the rounding). SciPy's `BDF` (the same formulation)
+/// gives 4.6e-4 on the same problem and tolerances, its DOP853 9e-6 (reference file), DOPRI5
+/// here 3.7e-5. The cause is the pendulum, not the scheme. Why 1e-6 at t = 10 s is out of
+/// reach at rtol 1e-10, measured:
+/// - up to 5 s BDF at rtol 1e-10 stays far within 1e-6 (errors 9e-11, 5e-10, 1.4e-9, 1.1e-8
+///   at 0.5, 1, 2, 5 s), then the error grows ×1000 in the next 5 s;
 /// - a shift of 1e-10 of q0 alone moves the state at 10 s by ~2e-5 (amplification ~2e5):
-///   every one of the ~7,000 local errors of ~1e-10 (rtol·|y|, |y| up to 14) is amplified
-///   likewise, so rtol 1e-10 cannot give 1e-6; BDF5's global error goes as rtol^(5/6);
-/// - tightening rtol reaches it: 2e-6 at rtol 1e-13, 3e-7 at rtol 1e-14 (33,000 steps).
+///   every one of the local errors of ~1e-10 (rtol·|y|, |y| up to 14) is amplified
+///   likewise, so rtol 1e-10 cannot be relied on for 1e-6;
+/// - tightening rtol reaches it: 5.6e-7 at rtol 1e-14 (29,777 steps).
 #[test]
 fn dpend_error_is_amplified_by_the_chaos() {
     let (states, st) = dpend_run(1e-10, 1e-12, 0.0);

@@ -6,6 +6,10 @@ use mbs_symbolic::mech::system::{Formulation, Load, System};
 
 /// chainN of MODELS.md: N uniform bars (l = 0.5 m, 1 kg), relative angles, gravity.
 fn chain(n: usize) -> SymbolicModel {
+    SymbolicModel::build(chain_system(n))
+}
+
+fn chain_system(n: usize) -> System {
     let mut sys = System::new(&format!("Chain{n}"));
     let l = sys.param("l", 0.5);
     let m = sys.param("m", 1.0);
@@ -36,7 +40,49 @@ fn chain(n: usize) -> SymbolicModel {
     }
     let mg = sys.arena.neg(g);
     sys.effect(None, vec![Load::Gravity([z, mg, z])]);
-    SymbolicModel::build(sys)
+    sys
+}
+
+/// The scaling benchmark's spatial arm of n links (0.3 m × 0.05 m × 0.05 m, 1 kg) on
+/// revolute joints whose axes alternate z, y; gravity along −z.
+fn arm_system(n: usize) -> System {
+    let mut sys = System::new(&format!("Arm{n}"));
+    let g = sys.param("g", 9.81);
+    let len = sys.param("len", 0.3);
+    let w = sys.param("w", 0.05);
+    let m = sys.param("m", 1.0);
+    let a = &mut sys.arena;
+    let (ww, ll) = (a.mul(w, w), a.mul(len, len));
+    let ww2 = a.add(ww, ww);
+    let llww = a.add(ll, ww);
+    let (mx, my) = (a.mul(m, ww2), a.mul(m, llww));
+    let (ixx, iyy) = (a.scale(1.0 / 12.0, mx), a.scale(1.0 / 12.0, my));
+    let half = a.scale(0.5, len);
+    let z = a.zero();
+    let inertia = mbs_symbolic::mech::system::Inertia {
+        mass: m,
+        tensor: [ixx, iyy, iyy, z, z, z],
+    };
+    let mut parent = None;
+    for k in 0..n {
+        sys.dof(&format!("q[{k}]"), 0.2, 0.0);
+        let qk = sys.q(k);
+        let mut factors = Vec::new();
+        if parent.is_some() {
+            factors.push(mbs_symbolic::mech::system::Factor::Disp([half, z, z]));
+        }
+        let axis = if k % 2 == 0 {
+            [0.0, 0.0, 1.0]
+        } else {
+            [0.0, 1.0, 0.0]
+        };
+        factors.push(sys.rot(axis, qk));
+        factors.push(mbs_symbolic::mech::system::Factor::Disp([half, z, z]));
+        parent = Some(sys.frame(&format!("link{k}"), parent, factors, Some(inertia)));
+    }
+    let mg = sys.arena.neg(g);
+    sys.effect(None, vec![Load::Gravity([z, z, mg])]);
+    sys
 }
 
 fn mass_and_bias(model: &SymbolicModel) -> (usize, usize, usize) {
@@ -93,6 +139,24 @@ fn both_formulations_are_built_and_the_cheaper_is_chosen() {
         let vp = ops(a, &e.vp.as_ref().expect("built").roots()).flops();
         let rec = ops(a, &e.rec.roots()).flops();
         assert_eq!(ops(a, &e.chosen().roots()).flops(), vp.min(rec));
+    }
+}
+
+/// Products of a factor of parameters alone and a state value either keep that factor's
+/// coefficient or float it out: the arm is cheaper kept, the chain floated, and each is
+/// built in its cheaper form.
+#[test]
+fn of_the_two_forms_of_products_the_cheaper_is_built() {
+    for (sys, kept_wins) in [(chain_system(8), false), (arm_system(6), true)] {
+        let floated = SymbolicModel::build_with(sys.clone(), false).cost();
+        let kept = SymbolicModel::build_with(sys.clone(), true).cost();
+        assert_eq!(
+            kept < floated,
+            kept_wins,
+            "{}: kept {kept}, floated {floated}",
+            sys.name
+        );
+        assert_eq!(SymbolicModel::build(sys).cost(), kept.min(floated));
     }
 }
 

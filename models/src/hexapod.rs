@@ -161,7 +161,7 @@ mbs::multibody! {
 }
 
 /// The hexapod without contact or controllers (gravity only): the type of the contact-free
-/// figures (M+h 6,192 flops).
+/// figures (M+h 5,887 flops).
 pub type Hexapod = HexapodFree;
 
 /// The hexapod thrown: `model`'s declared state (legs at their PD references) with the base

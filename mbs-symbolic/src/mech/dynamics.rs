@@ -293,9 +293,9 @@ fn forward_dynamics(
     // inertias (m (a² + b²)/12 and the like) multiply state values many times over, and
     // floating the coefficient out (for the sums' like terms, which M and h need) would
     // cost a product each time (arm3d_12: 2,648 → 2,483 flops)
-    sys.arena.keep_fixed = true;
+    let kept = std::mem::replace(&mut sys.arena.keep_fixed, true);
     let f = forward_forms(sys, tree, world, loads, mb, &h);
-    sys.arena.keep_fixed = false;
+    sys.arena.keep_fixed = kept;
     f
 }
 

@@ -1,8 +1,8 @@
 //! Work guards on generated code: operation counts are deterministic, so they are asserted.
 
 use mbs_symbolic::SymbolicModel;
-use mbs_symbolic::expr::ops;
-use mbs_symbolic::mech::system::{Formulation, Load, System};
+use mbs_symbolic::expr::{ExprId, ops};
+use mbs_symbolic::mech::system::{Factor, Formulation, Inertia, Load, System};
 
 /// chainN of MODELS.md: N uniform bars (l = 0.5 m, 1 kg), relative angles, gravity.
 fn chain(n: usize) -> SymbolicModel {
@@ -22,25 +22,40 @@ fn chain_system(n: usize) -> System {
     let mll = a.mul(m, ll);
     let i = a.scale(1.0 / 12.0, mll);
     let z = a.zero();
-    let inertia = mbs_symbolic::mech::system::Inertia {
+    let inertia = Inertia {
         mass: m,
         tensor: [i, z, i, z, z, z],
     };
-    let mut parent = None;
-    for k in 0..n {
-        sys.dof(&format!("q[{k}]"), 0.3, 0.0);
-        let qk = sys.q(k);
-        let mut factors = Vec::new();
-        if parent.is_some() {
-            factors.push(mbs_symbolic::mech::system::Factor::Disp([z, mhl, z]));
-        }
-        factors.push(sys.rot([0.0, 0.0, 1.0], qk));
-        factors.push(mbs_symbolic::mech::system::Factor::Disp([z, mhl, z]));
-        parent = Some(sys.frame(&format!("bar{k}"), parent, factors, Some(inertia)));
-    }
+    serial(&mut sys, n, ("bar", 0.3), [z, mhl, z], inertia, |_| {
+        [0.0, 0.0, 1.0]
+    });
     let mg = sys.arena.neg(g);
     sys.effect(None, vec![Load::Gravity([z, mg, z])]);
     sys
+}
+
+/// `n` bodies `name[k]` in series, body k turning by q[k] (starting at `q0`) about `axis(k)`
+/// between two displacements `offset` (the first body without the one before).
+fn serial(
+    sys: &mut System,
+    n: usize,
+    (name, q0): (&str, f64),
+    offset: [ExprId; 3],
+    inertia: Inertia,
+    axis: impl Fn(usize) -> [f64; 3],
+) {
+    let mut parent = None;
+    for k in 0..n {
+        sys.dof(&format!("q[{k}]"), q0, 0.0);
+        let qk = sys.q(k);
+        let mut factors = Vec::new();
+        if parent.is_some() {
+            factors.push(Factor::Disp(offset));
+        }
+        factors.push(sys.rot(axis(k), qk));
+        factors.push(Factor::Disp(offset));
+        parent = Some(sys.frame(&format!("{name}{k}"), parent, factors, Some(inertia)));
+    }
 }
 
 /// The scaling benchmark's spatial arm of n links (0.3 m × 0.05 m × 0.05 m, 1 kg) on
@@ -59,27 +74,17 @@ fn arm_system(n: usize) -> System {
     let (ixx, iyy) = (a.scale(1.0 / 12.0, mx), a.scale(1.0 / 12.0, my));
     let half = a.scale(0.5, len);
     let z = a.zero();
-    let inertia = mbs_symbolic::mech::system::Inertia {
+    let inertia = Inertia {
         mass: m,
         tensor: [ixx, iyy, iyy, z, z, z],
     };
-    let mut parent = None;
-    for k in 0..n {
-        sys.dof(&format!("q[{k}]"), 0.2, 0.0);
-        let qk = sys.q(k);
-        let mut factors = Vec::new();
-        if parent.is_some() {
-            factors.push(mbs_symbolic::mech::system::Factor::Disp([half, z, z]));
-        }
-        let axis = if k % 2 == 0 {
+    serial(&mut sys, n, ("link", 0.2), [half, z, z], inertia, |k| {
+        if k % 2 == 0 {
             [0.0, 0.0, 1.0]
         } else {
             [0.0, 1.0, 0.0]
-        };
-        factors.push(sys.rot(axis, qk));
-        factors.push(mbs_symbolic::mech::system::Factor::Disp([half, z, z]));
-        parent = Some(sys.frame(&format!("link{k}"), parent, factors, Some(inertia)));
-    }
+        }
+    });
     let mg = sys.arena.neg(g);
     sys.effect(None, vec![Load::Gravity([z, z, mg])]);
     sys

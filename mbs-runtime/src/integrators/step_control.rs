@@ -15,8 +15,8 @@
 use super::State;
 use crate::options::Options;
 
-/// The weights of [`Tolerances::error_norm`] are at least this many ε times the state's
-/// largest entry.
+/// The rounding a step carries, in ε: the floor of the local tolerance rtol' and, times the
+/// state's largest entry, of the weights of [`Tolerances::error_norm`].
 pub(crate) const ROUNDING: f64 = 100.0;
 
 /// Relative and absolute tolerance of the local error: a component y_i of error e_i counts as
@@ -43,9 +43,10 @@ impl Tolerances {
         }
     }
 
-    /// The floor of [`Tolerances::transformed`] for `rtol`: 100ε, or rtol if tighter.
+    /// The floor of [`Tolerances::transformed`] for `rtol`: [`ROUNDING`]·ε, or rtol if
+    /// tighter.
     fn transformed_floor(rtol: f64) -> f64 {
-        rtol.min(100.0 * f64::EPSILON)
+        rtol.min(ROUNDING * f64::EPSILON)
     }
 
     /// The local tolerance [`Tolerances::transformed`] holds for `rtol` when its floor set it
@@ -57,16 +58,16 @@ impl Tolerances {
 
     /// Weighted RMS norm of an error vector e against the state scales y0, y1:
     /// sqrt(mean (e_i / w_i)²), w_i = atol + rtol·max(|y0_i|, |y1_i|), but never below
-    /// [`ROUNDING`]·ε (or rtol, if tighter) times the state's largest entry: a component is
-    /// computed from the
-    /// others (a closed loop's velocities from one another), so its rounding follows the
-    /// largest of them, and a weight below that asks for digits no step size gives (the step
-    /// would shrink to h_min: fastlink's coupler turning through zero at 2e-3 rad/s while its
-    /// crank turns at 1,100 rad/s, under atol = 1e-12).
+    /// [`ROUNDING`]·ε (or rtol, if tighter: the floor of [`Tolerances::transformed`]) times
+    /// the state's largest entry: a component is computed from the others (a closed loop's
+    /// velocities from one another), so its rounding follows the largest of them, and a
+    /// weight below that asks for digits no step size gives (the step would shrink to h_min:
+    /// fastlink's coupler turning through zero at 2e-3 rad/s while its crank turns at
+    /// 1,100 rad/s, under atol = 1e-12).
     pub fn error_norm(&self, e: &[f64], y0: &[f64], y1: &[f64]) -> f64 {
         let (rtol, atol) = (self.rtol, self.atol);
         let largest = y0.iter().chain(y1).fold(0.0f64, |m, y| m.max(y.abs()));
-        let floor = (ROUNDING * f64::EPSILON).min(rtol) * largest;
+        let floor = Self::transformed_floor(rtol) * largest;
         let mut s = 0.0;
         for i in 0..e.len() {
             let w = (atol + rtol * y0[i].abs().max(y1[i].abs())).max(floor);

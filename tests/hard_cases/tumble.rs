@@ -216,7 +216,7 @@ fn tumble_keeps_its_energy_until_the_euler_singularity_which_is_a_typed_error() 
             [
                 10000, 0, 0, 0, 1, 4469, 50340, 4468, 8936, 33560, 16780, 4469,
             ], // ZYX radau5
-            [1214, 0, 0, 0, 7289, 7, 0, 0, 7, 8, 0, 0],              // XYZ dopri5
+            [1221, 0, 0, 0, 7331, 7, 0, 0, 7, 8, 0, 0],              // XYZ dopri5
             [2576, 12, 0, 0, 15533, 7, 0, 0, 7, 8, 0, 0],            // ZYX turned dopri5
             [3427, 17, 0, 0, 20666, 0, 0, 0, 0, 0, 0, 0],            // ZYX dopri5
         ],

@@ -469,7 +469,7 @@ impl<M: Model> Stepper<M> for Bdf {
         for i in 0..m {
             self.err[i] = error_const(k) * self.corr[i];
         }
-        let err = tol.error_norm(&self.err, &self.y0, &self.y1);
+        let err = tol.error_norm(&self.err, &self.y0, &self.y1, self.y0.len() / 2);
         if !(err <= 1.0) {
             let fac = elementary_factor(err, k, safety, MIN_FACTOR, f64::INFINITY);
             return Ok(Attempt::RejectedError { h_next: h * fac });
@@ -484,7 +484,7 @@ impl<M: Model> Stepper<M> for Bdf {
                 for i in 0..m {
                     self.err[i] = error_const(k - 1) * (self.d[k * m + i] + self.corr[i]);
                 }
-                tol.error_norm(&self.err, &self.y0, &self.y1)
+                tol.error_norm(&self.err, &self.y0, &self.y1, self.y0.len() / 2)
             } else {
                 f64::INFINITY
             };
@@ -492,7 +492,7 @@ impl<M: Model> Stepper<M> for Bdf {
                 for i in 0..m {
                     self.err[i] = error_const(k + 1) * (self.corr[i] - self.d[(k + 1) * m + i]);
                 }
-                tol.error_norm(&self.err, &self.y0, &self.y1)
+                tol.error_norm(&self.err, &self.y0, &self.y1, self.y0.len() / 2)
             } else {
                 f64::INFINITY
             };
@@ -521,7 +521,7 @@ impl<M: Model> Stepper<M> for Bdf {
                     }
                     self.err[i] = error_const(2) * s;
                 }
-                let err_2 = tol.error_norm(&self.err, &self.y0, &self.y1);
+                let err_2 = tol.error_norm(&self.err, &self.y0, &self.y1, self.y0.len() / 2);
                 if optimal_factor(err_2, 2) > DROP_GAIN * f {
                     self.drop_votes += 1;
                     if self.drop_votes >= DROP_VOTES {

@@ -505,10 +505,10 @@ impl<M: Model> Stepper<M> for Chebyshev {
             rtol: tol.rtol * f,
             atol: tol.atol * f,
         };
-        match self
-            .pi
-            .decide(h, tol.error_norm(&self.err, &self.y0, &self.y1))
-        {
+        match self.pi.decide(
+            h,
+            tol.error_norm(&self.err, &self.y0, &self.y1, self.y0.len() / 2),
+        ) {
             Decision::Accept { h_next } => {
                 self.watch.accepted(cur, next);
                 Ok(Attempt::Accepted { h_next })

@@ -181,7 +181,7 @@ impl<M: Model> Stepper<M> for Dopri5 {
             self.y1[i] = next.q[i];
             self.y1[n + i] = next.qd[i];
         }
-        let err = tol.error_norm(&self.err, &self.y0, &self.y1);
+        let err = tol.error_norm(&self.err, &self.y0, &self.y1, self.y0.len() / 2);
         match self.pi.decide(h, err) {
             Decision::Accept { h_next } => {
                 self.dense(cur, next, h);

@@ -363,10 +363,10 @@ impl<M: Model> Stepper<M> for AlphaFamily {
             // them, where Φ(q₁) = 0 holds anyway
             p.tangent_part(cur.t + h, &next.q, &mut self.err)?;
         }
-        let eq = tol.error_norm(&self.err, &cur.q, &next.q);
+        let eq = tol.error_norm(&self.err, &cur.q, &next.q, cur.q.len());
         // index 2: positions and velocities, otherwise positions (local error ∝ h³)
         let err = if self.index2 {
-            let ev = tol.error_norm(&self.err_v, &cur.qd, &next.qd);
+            let ev = tol.error_norm(&self.err_v, &cur.qd, &next.qd, cur.qd.len());
             (0.5 * (eq * eq + ev * ev)).sqrt() / f
         } else {
             eq / f

@@ -59,19 +59,29 @@ impl Tolerances {
     /// Weighted RMS norm of an error vector e against the state scales y0, y1:
     /// sqrt(mean (e_i / w_i)²), w_i = atol + rtol·max(|y0_i|, |y1_i|), but never below
     /// [`ROUNDING`]·ε (or rtol, if tighter: the floor of [`Tolerances::transformed`]) times
-    /// the state's largest entry: a component is computed from the others (a closed loop's
-    /// velocities from one another), so its rounding follows the largest of them, and a
-    /// weight below that asks for digits no step size gives (the step would shrink to h_min:
-    /// fastlink's coupler turning through zero at 2e-3 rad/s while its crank turns at
-    /// 1,100 rad/s, under atol = 1e-12).
-    pub fn error_norm(&self, e: &[f64], y0: &[f64], y1: &[f64]) -> f64 {
+    /// the largest entry of the same kind: a component is computed from the others (a closed
+    /// loop's velocities from one another), so its rounding follows the largest of them, and
+    /// a weight below that asks for digits no step size gives (the step would shrink to
+    /// h_min: fastlink's coupler turning through zero at 2e-3 rad/s while its crank turns at
+    /// 1,100 rad/s, under atol = 1e-12). The entries come in blocks of `kind` of one kind
+    /// (positions, then velocities, then the rest: multipliers), so that a velocity's
+    /// magnitude never floors a position's weight.
+    pub fn error_norm(&self, e: &[f64], y0: &[f64], y1: &[f64], kind: usize) -> f64 {
         let (rtol, atol) = (self.rtol, self.atol);
-        let largest = y0.iter().chain(y1).fold(0.0f64, |m, y| m.max(y.abs()));
-        let floor = Self::transformed_floor(rtol) * largest;
+        let n = e.len();
+        let bounds = [0, kind.min(n), (2 * kind).min(n), n];
         let mut s = 0.0;
-        for i in 0..e.len() {
-            let w = (atol + rtol * y0[i].abs().max(y1[i].abs())).max(floor);
-            s += (e[i] / w) * (e[i] / w);
+        for b in bounds.windows(2) {
+            let (start, end) = (b[0], b[1]);
+            let largest = y0[start..end]
+                .iter()
+                .chain(&y1[start..end])
+                .fold(0.0f64, |m, y| m.max(y.abs()));
+            let floor = Self::transformed_floor(rtol) * largest;
+            for i in start..end {
+                let w = (atol + rtol * y0[i].abs().max(y1[i].abs())).max(floor);
+                s += (e[i] / w) * (e[i] / w);
+            }
         }
         (s / e.len().max(1) as f64).sqrt()
     }
@@ -301,9 +311,9 @@ mod tests {
         };
         // weights 1e-6 + 1e-3·2 and 1e-6 + 1e-3·0.5
         let e = [2.001e-3, -1.002e-3];
-        let n = tol.error_norm(&e, &[2.0, -0.5], &[1.0, 0.25]);
+        let n = tol.error_norm(&e, &[2.0, -0.5], &[1.0, 0.25], 2);
         assert!(close(n, ((1.0 + 4.0) / 2.0f64).sqrt()), "{n}");
-        assert_eq!(tol.error_norm(&[], &[], &[]), 0.0);
+        assert_eq!(tol.error_norm(&[], &[], &[], 0), 0.0);
     }
 
     #[test]
@@ -316,12 +326,45 @@ mod tests {
         // atol + rtol·0.002 ≈ 1.02e-12
         let e = [0.0, 3e-12];
         let floor = ROUNDING * f64::EPSILON * 1000.0;
-        let n = tol.error_norm(&e, &[1000.0, 0.002], &[999.0, -0.001]);
+        let n = tol.error_norm(&e, &[1000.0, 0.002], &[999.0, -0.001], 2);
         assert!(close(n, (3e-12 / floor) / 2.0f64.sqrt()), "{n}");
         // beside a largest entry of 1 the floor (2.2e-14) is below the weight
-        let n = tol.error_norm(&e, &[1.0, 0.002], &[1.0, -0.001]);
+        let n = tol.error_norm(&e, &[1.0, 0.002], &[1.0, -0.001], 2);
         let w = 1e-12 + 1e-11 * 0.002;
         assert!(close(n, (3e-12 / w) / 2.0f64.sqrt()), "{n}");
+    }
+
+    #[test]
+    fn the_rounding_floor_of_a_weight_comes_from_entries_of_its_own_kind() {
+        let tol = Tolerances {
+            rtol: 1e-11,
+            atol: 1e-12,
+        };
+        // (q0, q1, qd0, qd1, λ): a position of 0.01 m beside a velocity of 1,000 and a
+        // multiplier of 1e6; each weight's floor is 100ε times the largest of its kind
+        let (y0, y1) = (
+            [0.01, 0.002, 1000.0, 0.002, 1e6],
+            [0.01, 0.002, 999.0, -0.001, 1e6],
+        );
+        let floor = |largest: f64| ROUNDING * f64::EPSILON * largest;
+        let weight = |i: usize, largest: f64| {
+            (1e-12 + 1e-11 * f64::abs(y0[i]).max(f64::abs(y1[i]))).max(floor(largest))
+        };
+        let e = [1e-13, 2e-13, 3e-13, 4e-13, 5e-10];
+        let expected = [0.01, 0.01, 1000.0, 1000.0, 1e6]
+            .iter()
+            .enumerate()
+            .map(|(i, &l)| (e[i] / weight(i, l)).powi(2))
+            .sum::<f64>()
+            / 5.0;
+        let n = tol.error_norm(&e, &y0, &y1, 2);
+        assert!(close(n, expected.sqrt()), "{n} against {}", expected.sqrt());
+        // the position q1 keeps its own weight (atol + rtol·0.002), not 100ε·1,000
+        assert!(weight(1, 0.01) < 1.1e-12 && floor(1000.0) > 2e-11);
+        // one kind over the whole vector: the velocity's magnitude floors every weight
+        let all = tol.error_norm(&e[..4], &y0[..4], &y1[..4], 4);
+        let by_kind = tol.error_norm(&e[..4], &y0[..4], &y1[..4], 2);
+        assert!(all < 0.1 * by_kind, "{all} {by_kind}");
     }
 
     #[test]

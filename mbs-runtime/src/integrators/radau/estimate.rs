@@ -61,7 +61,9 @@ impl Radau {
         self.y0[n..].copy_from_slice(&cur.qd);
         self.y1[..n].copy_from_slice(&next.q);
         self.y1[n..].copy_from_slice(&next.qd);
-        let mut err = tol.weights.error_norm(&self.err, &self.y0, &self.y1);
+        let mut err = tol
+            .weights
+            .error_norm(&self.err, &self.y0, &self.y1, self.n);
         if err >= 1.0 && (self.first || self.reject) {
             // RADAU5: replace f(y₀) by f(y₀ + err), which damps the estimate's stiff part
             for r in 0..n {
@@ -74,7 +76,9 @@ impl Radau {
                     self.rv[r] += g * (self.ax[r] - cur.qdd[r]);
                 }
                 self.filter(p, g);
-                err = tol.weights.error_norm(&self.err, &self.y0, &self.y1);
+                err = tol
+                    .weights
+                    .error_norm(&self.err, &self.y0, &self.y1, self.n);
             }
         }
         err.max(1e-10)
@@ -132,7 +136,8 @@ impl Radau {
         self.y1[..n].copy_from_slice(&next.q);
         self.y1[n..2 * n].copy_from_slice(&next.qd);
         self.y1[2 * n..].copy_from_slice(&next.lambda[..nc]);
-        tol.weights.error_norm(&self.err, &self.y0, &self.y1)
+        tol.weights
+            .error_norm(&self.err, &self.y0, &self.y1, self.n)
     }
 
     /// Index 3: RADAU5's estimate for the DAE E y' = f(y), y = (q, v, λ), f = (v, h + Bᵀλ,
@@ -172,7 +177,9 @@ impl Radau {
                     self.bv[r] -= g * self.ax[r];
                 }
                 self.filter3(p, g, h);
-                err = tol.weights.error_norm(&self.err, &self.y0, &self.y1);
+                err = tol
+                    .weights
+                    .error_norm(&self.err, &self.y0, &self.y1, self.n);
             }
         }
         err.max(1e-10)

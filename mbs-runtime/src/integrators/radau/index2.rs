@@ -222,7 +222,9 @@ impl Radau {
                 }
                 if self.psix.iter().all(|x| x.is_finite()) {
                     self.filter2(p, g, h);
-                    err = tol.weights.error_norm(&self.err, &self.y0, &self.y1);
+                    err = tol
+                        .weights
+                        .error_norm(&self.err, &self.y0, &self.y1, self.n);
                 }
             }
         }

@@ -12,7 +12,7 @@ use common::*;
 use mbs_symbolic::SymbolicModel;
 use mbs_symbolic::expr::ExprId;
 use mbs_symbolic::mech::effects::Loads;
-use mbs_symbolic::mech::forward::{Elimination, articulated, bias_wrenches};
+use mbs_symbolic::mech::forward::{Elimination, Outward, articulated, bias_wrenches};
 use mbs_symbolic::mech::system::{Attach, Load};
 
 const TREES: u64 = 40;
@@ -389,7 +389,14 @@ fn balance(
             let (direct, bias) = bias_wrenches(&mut model.sys, &model.tree, &model.world, &loads);
             let mut aba = Vec::new();
             for e in [Elimination::ParentAxes, Elimination::ChildAxes] {
-                let f = articulated(&mut model.sys, &model.tree, &direct, Some(&bias), e);
+                let f = articulated(
+                    &mut model.sys,
+                    &model.tree,
+                    &direct,
+                    Some(&bias),
+                    e,
+                    Outward::ReadyFirst,
+                );
                 aba.extend(f.map(|f| f.qdd).unwrap_or_default());
             }
             out.articulated += !aba.is_empty() as usize;

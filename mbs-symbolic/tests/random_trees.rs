@@ -9,7 +9,7 @@ use common::*;
 use mbs_symbolic::SymbolicModel;
 use mbs_symbolic::expr::ExprId;
 use mbs_symbolic::mech::effects::Loads;
-use mbs_symbolic::mech::forward::{Elimination, articulated, bias_wrenches, ltdl};
+use mbs_symbolic::mech::forward::{Elimination, Outward, articulated, bias_wrenches, ltdl};
 use mbs_symbolic::mech::tree::canonical;
 
 const TREES: u64 = 100;
@@ -222,14 +222,16 @@ impl Checks {
             (mb.m.clone(), mb.h.clone())
         };
         // articulated bodies in both places of elimination, applied to h and to the bodies'
-        // wrenches of Newton–Euler
+        // wrenches of Newton–Euler, their outward pass as built and in ready order
         let effects = model.scenes[0].effects.clone();
         let loads = Loads::build(&mut model.sys, &model.tree, &model.world, &effects);
         let (direct, bias) = bias_wrenches(&mut model.sys, &model.tree, &model.world, &loads);
         let mut aba = Vec::new();
         for (rhs, bias) in [(&h_sym, None), (&direct, Some(&bias[..]))] {
             for e in [Elimination::ParentAxes, Elimination::ChildAxes] {
-                aba.extend(articulated(&mut model.sys, &model.tree, rhs, bias, e));
+                for o in [Outward::AsBuilt, Outward::ReadyFirst] {
+                    aba.extend(articulated(&mut model.sys, &model.tree, rhs, bias, e, o));
+                }
             }
         }
         let sparse = ltdl(&mut model.sys.arena, &m_sym, &h_sym);

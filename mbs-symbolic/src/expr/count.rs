@@ -37,33 +37,26 @@ pub fn ops_of_nodes(arena: &Arena, nodes: &[ExprId]) -> OpCount {
     c
 }
 
+/// Latency of one node's operation in cycles (see [`critical_path`]).
+pub fn latency(node: Node) -> u32 {
+    match node {
+        Node::Num(_) | Node::Var(_) => 0,
+        Node::Add(..) | Node::Sub(..) | Node::Neg(..) => 3,
+        Node::Mul(..) => 4,
+        Node::Powi(_, k) => 4 * (k.unsigned_abs()).saturating_sub(1),
+        Node::Div(..) => 13,
+        Node::Func(super::Func::Sqrt, _) => 15,
+        _ => 40,
+    }
+}
+
 /// Latency of the longest chain of dependent operations from the inputs to any of `roots`,
 /// in cycles of a typical out-of-order core (add 3, multiply 4, divide 13, square root 15,
 /// other functions 40): what bounds straight-line code whose work is a recursion, as the
 /// articulated-body algorithm's, rather than its operation count.
 pub fn critical_path(arena: &Arena, roots: &[ExprId]) -> u32 {
-    let nodes = arena.reachable(roots);
-    let Some(top) = nodes.last() else {
-        return 0;
-    };
-    // children come before their parents in the arena, and `reachable` is sorted
-    let mut depth = vec![0u32; top.index() + 1];
-    for &n in &nodes {
-        let node = arena.node(n);
-        let own = match node {
-            Node::Num(_) | Node::Var(_) => 0,
-            Node::Add(..) | Node::Sub(..) | Node::Neg(..) => 3,
-            Node::Mul(..) => 4,
-            Node::Powi(_, k) => 4 * (k.unsigned_abs()).saturating_sub(1),
-            Node::Div(..) => 13,
-            Node::Func(super::Func::Sqrt, _) => 15,
-            _ => 40,
-        };
-        let (ch, k) = node.children();
-        let before = ch[..k].iter().map(|c| depth[c.index()]).max().unwrap_or(0);
-        depth[n.index()] = before + own;
-    }
-    roots.iter().map(|r| depth[r.index()]).max().unwrap_or(0)
+    let mut ready = super::ready::Ready::default();
+    roots.iter().map(|&r| ready.of(arena, r)).max().unwrap_or(0)
 }
 
 #[cfg(test)]

@@ -2,7 +2,9 @@
 //! (or the one the model forces), tangents when asked for, energies, power, static forces.
 
 use super::effects::Loads;
-use super::forward::{Elimination, Forward, articulated, bias_wrenches, ltdl, ltdl_estimate};
+use super::forward::{
+    Elimination, Forward, Outward, articulated, bias_wrenches, ltdl, ltdl_estimate,
+};
 use super::recursive::{body_kinematics, crba, newton_euler, spinning_body_motion};
 use super::spin::spinning_frames;
 
@@ -317,7 +319,8 @@ fn forward_forms(
     mb: &MassBias,
     h: &[ExprId],
 ) -> Forward {
-    let Some(parent) = articulated(sys, tree, h, None, Elimination::ParentAxes) else {
+    let plain = Outward::AsBuilt;
+    let Some(parent) = articulated(sys, tree, h, None, Elimination::ParentAxes, plain) else {
         return ltdl(&mut sys.arena, &mb.m, h);
     };
     // the articulated bodies also take the bodies' wrenches of Newton–Euler's outward pass,
@@ -325,29 +328,37 @@ fn forward_forms(
     let (direct, bias) = bias_wrenches(sys, tree, world, loads);
     let direct = forced(&mut sys.arena, &direct);
     // the quickest by the time estimate, the first on a tie: on the planar chains the
-    // wrenches save operations (9–10 %) but not latency, and measured no faster
+    // wrenches save operations (9–10 %) but not latency, and measured no faster. The forms
+    // are compared with their outward pass as built, on which the estimate's choices were
+    // measured; the chosen one is then built with its terms in ready order (`Outward`).
     let time = |a: &Arena, f: &Forward| time_estimate(a, &f.roots());
-    let mut best = (time(&sys.arena, &parent), parent);
-    for (rhs, bias, order) in [
+    let candidates = [
+        (h, None, Elimination::ParentAxes),
         (h, None, Elimination::ChildAxes),
-        (&direct, Some(&bias[..]), Elimination::ParentAxes),
-        (&direct, Some(&bias[..]), Elimination::ChildAxes),
-    ] {
-        let f = articulated(sys, tree, rhs, bias, order).expect("the same tree");
+        (&direct[..], Some(&bias[..]), Elimination::ParentAxes),
+        (&direct[..], Some(&bias[..]), Elimination::ChildAxes),
+    ];
+    let mut best = (time(&sys.arena, &parent), 0, parent);
+    for (i, &(rhs, bias, order)) in candidates.iter().enumerate().skip(1) {
+        let f = articulated(sys, tree, rhs, bias, order, plain).expect("the same tree");
         let t = time(&sys.arena, &f);
         if t < best.0 {
-            best = (t, f);
+            best = (t, i, f);
         }
     }
-    let (aba_time, aba) = best;
+    let (aba_time, chosen, aba) = best;
     let aba_flops = crate::expr::ops(&sys.arena, &aba.roots()).flops();
+    let ordered = |sys: &mut System| {
+        let (rhs, bias, order) = candidates[chosen];
+        articulated(sys, tree, rhs, bias, order, Outward::ReadyFirst).expect("the same tree")
+    };
     // two flops per multiply–subtract: far above, LᵀDL is not worth building (long chains)
     if 2 * ltdl_estimate(&sys.arena, &mb.m) > 4 * aba_flops {
-        return aba;
+        return ordered(sys);
     }
     let sparse = ltdl(&mut sys.arena, &mb.m, h);
     if aba_time < time(&sys.arena, &sparse) {
-        aba
+        ordered(sys)
     } else {
         sparse
     }

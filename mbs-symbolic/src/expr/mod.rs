@@ -16,7 +16,7 @@ mod simplify;
 mod spline;
 
 pub use arena::Arena;
-pub use count::{OpCount, critical_path, latency, ops, ops_of_nodes};
+pub use count::{OpCount, critical_path, ops, ops_of_nodes};
 pub use eval::{Env, SliceEnv};
 pub use spline::{SplineError, evaluate as spline_value, natural_coefficients};
 

@@ -566,8 +566,12 @@ impl Study {
         if !(self.floor >= 0.0 && self.floor.is_finite()) {
             return invalid("floor", self.floor, "must be ≥ 0 and finite");
         }
-        if !(self.atol_factor >= 0.0 && self.atol_factor.is_finite()) {
-            return invalid("atol_factor", self.atol_factor, "must be ≥ 0 and finite");
+        if !(self.atol_factor > 0.0 && self.atol_factor.is_finite()) {
+            return invalid(
+                "atol_factor",
+                self.atol_factor,
+                "must be > 0 and finite (a run's atol must be > 0)",
+            );
         }
         if self.repeats == 0 {
             return invalid("repeats", 0.0, "must be at least 1");

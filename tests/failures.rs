@@ -78,6 +78,19 @@ fn invalid_options_are_named_before_any_work() {
         (Scheme::Rk4, Options::fixed(1.0, -0.01), "h"),
         (Scheme::Dopri5, Options::adaptive(1.0, 1e-16), "rtol"),
         (Scheme::Dopri5, Options::adaptive(1.0, 0.0), "rtol"),
+        // a component at zero would have no tolerance (Radau's Newton divided by it)
+        (
+            Scheme::Radau5,
+            Options {
+                step: mbs::StepControl::Adaptive {
+                    rtol: 1e-6,
+                    atol: 0.0,
+                    h0: None,
+                },
+                ..Options::adaptive(1.0, 1e-6)
+            },
+            "atol",
+        ),
         (
             Scheme::GenAlpha(GenAlphaParams::from_rho_inf(1.5)),
             Options::fixed(1.0, 0.01),

@@ -6,6 +6,7 @@
 use mbs_models::seed2dof;
 
 use mbs::{BdfParams, Failure, GenAlphaParams, Options, Output, Scheme, StepControl, simulate};
+use mbs_models::fastlink::FastLink;
 use mbs_models::undefined_force::{EarlyForce, LateForce};
 use seed2dof::Seed2dof;
 
@@ -218,5 +219,42 @@ fn an_rtol_beyond_a_schemes_floor_is_said() {
             .to_string()
             .contains("its tolerance stopped at its floor");
         assert_eq!(said, floor.is_some(), "{stats}");
+    }
+}
+
+/// A component near zero beside large ones of its kind, under an atol below their rounding,
+/// is tested at that rounding (100ε times the largest of its kind), not at atol: fastlink's
+/// velocities (a crank at 1,100 rad/s, a coupler turning through zero) under atol = 1e-12.
+/// `Stats::floored_steps` counts such steps and the summary says so; at atol = 1e-9, above
+/// that rounding, there are none. (The Newmark family tests its positions against its own
+/// floor, 10⁴ε, on the tolerance: its weights never reach this one at atol 1e-12.)
+#[test]
+fn a_weight_held_at_its_rounding_is_said() {
+    let bdf = Scheme::Bdf(BdfParams::default());
+    for (scheme, rtol) in [(Scheme::Dopri5, 1e-10), (Scheme::Radau3, 1e-8), (bdf, 1e-8)] {
+        let run = |atol: f64| {
+            let o = Options {
+                step: StepControl::Adaptive {
+                    rtol,
+                    atol,
+                    h0: None,
+                },
+                ..quiet(Options::adaptive(0.03, rtol))
+            };
+            simulate(FastLink::default(), scheme, o).unwrap().1
+        };
+        let (low, high) = (run(1e-12), run(1e-9));
+        println!(
+            "{scheme:?} at rtol {rtol:e}: {} of {} steps held at the rounding under atol 1e-12, {} under 1e-9",
+            low.floored_steps, low.steps, high.floored_steps
+        );
+        assert!(low.floored_steps > 0, "{scheme:?}: {low}");
+        assert!(low.to_string().contains("held a component at its rounding"));
+        assert_eq!(high.floored_steps, 0, "{scheme:?}: {high}");
+        assert!(
+            !high
+                .to_string()
+                .contains("held a component at its rounding")
+        );
     }
 }

@@ -670,8 +670,12 @@ impl Options {
                         "must be at least 10 ε (2.2e-15): no scheme resolves below rounding",
                     ));
                 }
-                if !(atol >= 0.0) || !atol.is_finite() {
-                    return Err(invalid("atol", atol, "must be ≥ 0"));
+                if !(atol > 0.0) || !atol.is_finite() {
+                    return Err(invalid(
+                        "atol",
+                        atol,
+                        "must be > 0 and finite: under atol = 0 a component at zero (a start at rest) has no tolerance at all; take the magnitude below which a component need not be resolved (rtol/100 by default)",
+                    ));
                 }
                 if let Some(h0) = h0 {
                     if !(h0 > 0.0) || !h0.is_finite() {

@@ -71,6 +71,11 @@ pub struct Stats {
     /// a tighter rtol would otherwise have taken more steps (the Newmark family from rtol ≈
     /// 4e-8 on, its floor 10⁴ε; RKC from ≈ 2e-9, BDF from ≈ 8e-11, their floors 100ε)
     pub tolerance_floor: Option<f64>,
+    /// accepted steps whose error test raised some component's weight atol + rtol'·|y_i| to
+    /// its rounding floor, 100ε times the largest entry of its kind (positions, velocities,
+    /// multipliers): a component near zero beside large ones of its kind, under an atol
+    /// below that rounding, was tested at the digits rounding leaves it, not at atol
+    pub floored_steps: usize,
 }
 
 /// The components an adaptive scheme's local error test measures, so that a user knows what
@@ -239,6 +244,13 @@ impl fmt::Display for Stats {
             write!(
                 f,
                 "\nrtol asks more than this scheme's local error test holds: its tolerance stopped at its floor {floor:.1e}, so expect fewer digits than rtol (radau5 follows rtol further)"
+            )?;
+        }
+        if self.floored_steps > 0 {
+            write!(
+                f,
+                "\nin {} of {} steps the error test held a component at its rounding (100ε times the largest of its kind), not at atol: atol asks digits no step gives there",
+                self.floored_steps, self.steps
             )?;
         }
         if !self.order_steps.is_empty() {

@@ -292,12 +292,15 @@ pub(crate) struct Bdf {
     spectrum: Spectrum,
     /// selections in a row at which order 2 would have taken DROP_GAIN times the step
     drop_votes: usize,
+    /// whether the last error test raised a weight to its rounding floor
+    floored: bool,
 }
 
 impl Bdf {
     pub fn new(n: usize, max_order: usize) -> Bdf {
         let z = |m: usize| vec![0.0; m];
         Bdf {
+            floored: false,
             n,
             max_order: max_order.clamp(1, MAX_ORDER),
             order: 1,
@@ -355,6 +358,10 @@ impl Bdf {
 }
 
 impl<M: Model> Stepper<M> for Bdf {
+    fn floored(&self) -> bool {
+        self.floored
+    }
+
     fn tolerance_floor(&self, rtol: f64) -> Option<f64> {
         Tolerances::transformed_floored(rtol, TOL_FACTOR, TOL_EXPONENT)
     }
@@ -469,7 +476,9 @@ impl<M: Model> Stepper<M> for Bdf {
         for i in 0..m {
             self.err[i] = error_const(k) * self.corr[i];
         }
-        let err = tol.error_norm(&self.err, &self.y0, &self.y1, self.y0.len() / 2);
+        let norm = tol.norm(&self.err, &self.y0, &self.y1, self.y0.len() / 2);
+        let err = norm.value;
+        self.floored = norm.floored;
         if !(err <= 1.0) {
             let fac = elementary_factor(err, k, safety, MIN_FACTOR, f64::INFINITY);
             return Ok(Attempt::RejectedError { h_next: h * fac });

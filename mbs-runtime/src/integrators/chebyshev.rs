@@ -352,12 +352,15 @@ pub(crate) struct Chebyshev {
     pi: PiController,
     /// the fastest mode is to be estimated anew before the next attempt (after a rejection)
     stale: bool,
+    /// whether the last error test raised a weight to its rounding floor
+    floored: bool,
 }
 
 impl Chebyshev {
     pub fn new(n: usize) -> Chebyshev {
         let z = || vec![0.0; n];
         Chebyshev {
+            floored: false,
             n,
             k: Coefficients::new(),
             poly: Polynomials::new(),
@@ -451,6 +454,10 @@ impl Chebyshev {
 }
 
 impl<M: Model> Stepper<M> for Chebyshev {
+    fn floored(&self) -> bool {
+        self.floored
+    }
+
     fn tolerance_floor(&self, rtol: f64) -> Option<f64> {
         order_two_floored(rtol, TOL_FACTOR, FLOOR)
     }
@@ -505,10 +512,9 @@ impl<M: Model> Stepper<M> for Chebyshev {
             rtol: tol.rtol * f,
             atol: tol.atol * f,
         };
-        match self.pi.decide(
-            h,
-            tol.error_norm(&self.err, &self.y0, &self.y1, self.y0.len() / 2),
-        ) {
+        let norm = tol.norm(&self.err, &self.y0, &self.y1, self.y0.len() / 2);
+        self.floored = norm.floored;
+        match self.pi.decide(h, norm.value) {
             Decision::Accept { h_next } => {
                 self.watch.accepted(cur, next);
                 Ok(Attempt::Accepted { h_next })

@@ -96,6 +96,8 @@ pub(crate) struct Dopri5 {
     cont_v: [Vec<f64>; 5],
     /// with a fixed step: the largest |λ| against the stability region (as RK4's)
     watch: StabilityWatch,
+    /// whether the last error test raised a weight to its rounding floor
+    floored: bool,
 }
 
 /// DOPRI5's stability radius with a fixed step, the edge of |R(z)| ≤ 1 (R(z) = Σ₀⁵ zᵏ/k! +
@@ -112,6 +114,7 @@ impl Dopri5 {
         let s7 = || [z(), z(), z(), z(), z(), z(), z()];
         let s5 = || [z(), z(), z(), z(), z()];
         Dopri5 {
+            floored: false,
             n,
             kv: s7(),
             ka: s7(),
@@ -132,6 +135,10 @@ impl Dopri5 {
 }
 
 impl<M: Model> Stepper<M> for Dopri5 {
+    fn floored(&self) -> bool {
+        self.floored
+    }
+
     fn attempt(&mut self, step: Step<'_, M>) -> Result<Attempt, Failure> {
         let Step(p, cur, h, ctl, next) = step;
         let n = self.n;
@@ -181,8 +188,9 @@ impl<M: Model> Stepper<M> for Dopri5 {
             self.y1[i] = next.q[i];
             self.y1[n + i] = next.qd[i];
         }
-        let err = tol.error_norm(&self.err, &self.y0, &self.y1, self.y0.len() / 2);
-        match self.pi.decide(h, err) {
+        let norm = tol.norm(&self.err, &self.y0, &self.y1, self.y0.len() / 2);
+        self.floored = norm.floored;
+        match self.pi.decide(h, norm.value) {
             Decision::Accept { h_next } => {
                 self.dense(cur, next, h);
                 self.stiffness_test(p, cur.t, h);

@@ -462,6 +462,9 @@ impl<M: Model + 'static> Simulation<M> {
                 }
                 Err(kind) => return Err(self.fail(kind, h)),
                 Ok(Attempt::Accepted { h_next }) => {
+                    if self.stepper.floored() {
+                        self.problem.stats.floored_steps += 1;
+                    }
                     self.next.t = if last {
                         t_stop
                     } else if fixed {

@@ -146,12 +146,15 @@ pub(crate) struct AlphaFamily {
     lam: Vec<f64>,
     /// the constraints are solved at index 2
     index2: bool,
+    /// whether the last error test raised a weight to its rounding floor
+    floored: bool,
 }
 
 impl AlphaFamily {
     fn new(n: usize, alpha_m: f64, alpha_f: f64, beta: f64, gamma: f64) -> AlphaFamily {
         let z = || vec![0.0; n];
         AlphaFamily {
+            floored: false,
             alpha_m,
             alpha_f,
             beta,
@@ -217,6 +220,10 @@ impl AlphaFamily {
 }
 
 impl<M: Model> Stepper<M> for AlphaFamily {
+    fn floored(&self) -> bool {
+        self.floored
+    }
+
     fn tolerance_floor(&self, rtol: f64) -> Option<f64> {
         order_two_floored(rtol, TOL_FACTOR, FLOOR)
     }
@@ -363,13 +370,15 @@ impl<M: Model> Stepper<M> for AlphaFamily {
             // them, where Φ(q₁) = 0 holds anyway
             p.tangent_part(cur.t + h, &next.q, &mut self.err)?;
         }
-        let eq = tol.error_norm(&self.err, &cur.q, &next.q, cur.q.len());
+        let eq = tol.norm(&self.err, &cur.q, &next.q, cur.q.len());
+        self.floored = eq.floored;
         // index 2: positions and velocities, otherwise positions (local error ∝ h³)
         let err = if self.index2 {
-            let ev = tol.error_norm(&self.err_v, &cur.qd, &next.qd, cur.qd.len());
-            (0.5 * (eq * eq + ev * ev)).sqrt() / f
+            let ev = tol.norm(&self.err_v, &cur.qd, &next.qd, cur.qd.len());
+            self.floored |= ev.floored;
+            (0.5 * (eq.value * eq.value + ev.value * ev.value)).sqrt() / f
         } else {
-            eq / f
+            eq.value / f
         };
         let order = 2;
         if err <= 1.0 {

@@ -67,10 +67,15 @@ impl Tolerances {
     /// (positions, then velocities, then the rest: multipliers), so that a velocity's
     /// magnitude never floors a position's weight.
     pub fn error_norm(&self, e: &[f64], y0: &[f64], y1: &[f64], kind: usize) -> f64 {
+        self.norm(e, y0, y1, kind).value
+    }
+
+    /// [`Tolerances::error_norm`], and whether the floor set a weight (`Stats::floored_steps`).
+    pub fn norm(&self, e: &[f64], y0: &[f64], y1: &[f64], kind: usize) -> ErrorNorm {
         let (rtol, atol) = (self.rtol, self.atol);
         let n = e.len();
         let bounds = [0, kind.min(n), (2 * kind).min(n), n];
-        let mut s = 0.0;
+        let (mut s, mut floored) = (0.0, false);
         for b in bounds.windows(2) {
             let (start, end) = (b[0], b[1]);
             let largest = y0[start..end]
@@ -79,12 +84,26 @@ impl Tolerances {
                 .fold(0.0f64, |m, y| m.max(y.abs()));
             let floor = Self::transformed_floor(rtol) * largest;
             for i in start..end {
-                let w = (atol + rtol * y0[i].abs().max(y1[i].abs())).max(floor);
+                let w = atol + rtol * y0[i].abs().max(y1[i].abs());
+                floored |= w < floor;
+                let w = w.max(floor);
                 s += (e[i] / w) * (e[i] / w);
             }
         }
-        (s / e.len().max(1) as f64).sqrt()
+        ErrorNorm {
+            value: (s / e.len().max(1) as f64).sqrt(),
+            floored,
+        }
     }
+}
+
+/// A weighted error norm ([`Tolerances::norm`]) and whether the rounding floor raised the
+/// weight of some component above atol + rtol·|y|: that component was tested at the digits
+/// rounding leaves it, fewer than the tolerances asked.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct ErrorNorm {
+    pub value: f64,
+    pub floored: bool,
 }
 
 /// The factor f = c·√rtol on both tolerances of an order-2 scheme's local error test (rtol·f,
@@ -365,6 +384,10 @@ mod tests {
         let all = tol.error_norm(&e[..4], &y0[..4], &y1[..4], 4);
         let by_kind = tol.error_norm(&e[..4], &y0[..4], &y1[..4], 2);
         assert!(all < 0.1 * by_kind, "{all} {by_kind}");
+        // the floor is said: the velocity qd1 (1e-12 + 1e-11·0.002 against 100ε·1,000) sits
+        // on it; the positions alone do not
+        assert!(tol.norm(&e, &y0, &y1, 2).floored);
+        assert!(!tol.norm(&e[..2], &y0[..2], &y1[..2], 2).floored);
     }
 
     #[test]

@@ -103,6 +103,11 @@ pub(crate) trait Stepper<M: Model> {
         let _ = (moved, evaluated);
         self.start(p, s, ctl)
     }
+    /// Whether the error test of the step just accepted raised some component's weight to
+    /// its rounding floor (`Stats::floored_steps`; [`super::step_control::ErrorNorm`]).
+    fn floored(&self) -> bool {
+        false
+    }
     /// Called once the driver has accepted the step from `prev` to `cur`.
     fn accepted(&mut self, _p: &mut Problem<M>, _prev: &State, _cur: &State) {}
     /// Dense output on [prev.t, cur.t]: by default the quintic Hermite interpolant of

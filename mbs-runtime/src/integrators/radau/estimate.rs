@@ -61,9 +61,7 @@ impl Radau {
         self.y0[n..].copy_from_slice(&cur.qd);
         self.y1[..n].copy_from_slice(&next.q);
         self.y1[n..].copy_from_slice(&next.qd);
-        let mut err = tol
-            .weights
-            .error_norm(&self.err, &self.y0, &self.y1, self.n);
+        let mut err = self.weighted_norm(tol);
         if err >= 1.0 && (self.first || self.reject) {
             // RADAU5: replace f(y₀) by f(y₀ + err), which damps the estimate's stiff part
             for r in 0..n {
@@ -76,9 +74,7 @@ impl Radau {
                     self.rv[r] += g * (self.ax[r] - cur.qdd[r]);
                 }
                 self.filter(p, g);
-                err = tol
-                    .weights
-                    .error_norm(&self.err, &self.y0, &self.y1, self.n);
+                err = self.weighted_norm(tol);
             }
         }
         err.max(1e-10)
@@ -126,6 +122,14 @@ impl Radau {
         }
     }
 
+    /// The weighted norm of `err` against the states stacked in `y0`, `y1` (q and qd, then
+    /// λ), noting whether the rounding floor set a weight (`Stats::floored_steps`).
+    pub(super) fn weighted_norm(&mut self, tol: &Tol) -> f64 {
+        let norm = tol.weights.norm(&self.err, &self.y0, &self.y1, self.n);
+        self.floored = norm.floored;
+        norm.value
+    }
+
     /// The weighted norm of `err` over (q, qd, λ), the weights taken from the states before
     /// and after the step (stacked into `y0`, `y1`).
     pub(super) fn error_with_multipliers(&mut self, cur: &State, next: &State, tol: &Tol) -> f64 {
@@ -136,8 +140,7 @@ impl Radau {
         self.y1[..n].copy_from_slice(&next.q);
         self.y1[n..2 * n].copy_from_slice(&next.qd);
         self.y1[2 * n..].copy_from_slice(&next.lambda[..nc]);
-        tol.weights
-            .error_norm(&self.err, &self.y0, &self.y1, self.n)
+        self.weighted_norm(tol)
     }
 
     /// Index 3: RADAU5's estimate for the DAE E y' = f(y), y = (q, v, λ), f = (v, h + Bᵀλ,
@@ -177,9 +180,7 @@ impl Radau {
                     self.bv[r] -= g * self.ax[r];
                 }
                 self.filter3(p, g, h);
-                err = tol
-                    .weights
-                    .error_norm(&self.err, &self.y0, &self.y1, self.n);
+                err = self.weighted_norm(tol);
             }
         }
         err.max(1e-10)

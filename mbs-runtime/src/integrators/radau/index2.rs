@@ -222,9 +222,7 @@ impl Radau {
                 }
                 if self.psix.iter().all(|x| x.is_finite()) {
                     self.filter2(p, g, h);
-                    err = tol
-                        .weights
-                        .error_norm(&self.err, &self.y0, &self.y1, self.n);
+                    err = self.weighted_norm(tol);
                 }
             }
         }

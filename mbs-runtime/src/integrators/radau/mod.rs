@@ -502,6 +502,8 @@ pub(crate) struct Radau {
     /// stage), which the error estimate's f(y₀) needs; the state holds the index-1 ones
     own_end: Vec<f64>,
     psix: Vec<f64>,
+    /// whether the last error test raised a weight to its rounding floor
+    floored: bool,
 }
 
 impl Radau {
@@ -509,6 +511,7 @@ impl Radau {
         let z = || vec![0.0; n];
         let zs = || vec![0.0; s * n];
         Radau {
+            floored: false,
             k: Coefficients::new(s),
             n,
             m: vec![0.0; n * n],
@@ -593,6 +596,10 @@ const NEWTON_RELAX: f64 = 1.2;
 const NEWTON_MARGIN: f64 = 0.9;
 
 impl<M: Model> Stepper<M> for Radau {
+    fn floored(&self) -> bool {
+        self.floored
+    }
+
     fn error_test(&self, p: &Problem<M>) -> ErrorTest {
         if p.loops.index3().is_some() {
             ErrorTest::PositionsScaledVelocities

@@ -5,6 +5,11 @@
 //! - a tilted ellipsoid's support point lies on its surface with its normal along the face's
 //!   (the closed form checked against the ellipsoid's own equation), and its force on a box's
 //!   top, with damping and friction, equals the law worked from that point;
+//! - beside a box's edge or corner, behind the planes of its faces, a sphere touches the box
+//!   only when it reaches the edge or the corner, at the depth and along the normal its
+//!   distance to them gives, and a tilted ellipsoid there takes the way out the largest
+//!   separation of the box's and the ellipsoid's support functions gives, against that
+//!   function sampled over the unit sphere;
 //! - an ellipsoid off its body's centre of mass, on the ground or on a box's top, gives the
 //!   same generalised forces as the generated contact (`contact(…, ellipsoid = …)`) with the
 //!   same plane, at 40 states pressed in, turning and sliding;
@@ -91,6 +96,177 @@ fn a_point_takes_its_nearest_face_and_a_sphere_touches_a_box_as_by_hand() {
     assert_eq!(touches.len(), 2, "{touches:?}");
     assert!((touches[0].0 - 0.005).abs() < 1e-15 && touches[0].1 == [0.0, 0.0, 1.0]);
     assert!((touches[1].0 - 0.01).abs() < 1e-15 && touches[1].1 == [-1.0, 0.0, 0.0]);
+}
+
+/// Beside a box's edge or corner, behind the planes of both (or all three) faces, a sphere
+/// touches the box only if it reaches the edge or the corner: at the depth r − (its centre's
+/// distance to them), along the line from them to its centre. (Taken face by face, the
+/// first sphere was 4 mm behind both the riser and the top, and the second 8 mm.)
+#[test]
+fn a_sphere_beside_an_edge_or_a_corner_touches_it_as_its_distance_says() {
+    // the step's top edge runs along y at x = 0.6, z = 0.05; its corner at y = −1
+    let t = Terrain::step(0.6, 0.05);
+    let r = 0.02;
+    let at = |centre: [f64; 3]| {
+        let sphere = Ellipsoid {
+            centre,
+            rotation: &[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            axes: [r; 3],
+        };
+        let mut touches = Vec::new();
+        t.touches(&sphere, |x| touches.push(x));
+        touches
+    };
+    // 1.6 cm out along both faces: 2.26 cm from the edge, clear of it
+    assert!(at([0.6 - 0.016, 0.0, 0.05 + 0.016]).is_empty());
+    let s2 = std::f64::consts::FRAC_1_SQRT_2;
+    let s3 = 1.0 / 3f64.sqrt();
+    for (centre, edge, normal) in [
+        // 1.2 cm out along both faces: 1.70 cm from the edge
+        ([0.588, 0.3, 0.062], [0.6, 0.3, 0.05], [-s2, 0.0, s2]),
+        // 1 cm out along the three faces from the corner: 1.73 cm from it
+        ([0.59, -1.01, 0.06], [0.6, -1.0, 0.05], [-s3, -s3, s3]),
+    ] {
+        let touches = at(centre);
+        assert_eq!(touches.len(), 1, "{touches:?}");
+        let x = touches[0];
+        let d = (0..3)
+            .map(|j| (centre[j] - edge[j]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        assert!((x.depth - (r - d)).abs() < 1e-15, "{x:?}: depth {}", r - d);
+        assert!(close(x.normal, normal, 1e-12), "{x:?}");
+        let point = [0, 1, 2].map(|j| centre[j] - r * normal[j]);
+        assert!(close(x.point, point, 1e-12), "{x:?}");
+        // at rest, the law's force along that normal
+        let mut forces = Vec::new();
+        let rot = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        t.ellipsoid_forces(&rot, [0.0; 3], (centre, [0.0; 3]), [r; 3], |_, f| {
+            forces.push(f)
+        });
+        let f = normal.map(|n| 1e5 * (r - d) * n);
+        assert!(forces.len() == 1 && close(forces[0], f, 1e-9), "{forces:?}");
+    }
+}
+
+/// A tilted ellipsoid against a box's edge and corner: the way out the terrain finds is the
+/// largest separation n·(x − c) − Σ hᵢ|nᵢ| − √(nᵀ R D² Rᵀ n) over the unit sphere, against
+/// that function sampled on a grid of 400 × 800 directions (then refined around the best):
+/// the depths agree to 1e-9 m and the normals to 1e-4, and where every direction's
+/// separation is positive there is no touch, though the ellipsoid is behind the planes of
+/// both faces at the edge (the face-by-face rule's contact).
+#[test]
+fn a_tilted_ellipsoid_at_an_edge_takes_the_shortest_way_out() {
+    let t = Terrain {
+        blocks: vec![Block {
+            min: [0.5, -0.5],
+            max: [1.5, 0.5],
+            height: 0.1,
+        }],
+        ground: false,
+        ..Terrain::default()
+    };
+    let (c, h) = ([1.0, 0.0, 0.05], [0.5, 0.5, 0.05]);
+    let axes = [0.03, 0.015, 0.01];
+    // R = Rz(0.7) Rx(0.4)
+    let (sz, cz) = 0.7f64.sin_cos();
+    let rz = [[cz, -sz, 0.0], [sz, cz, 0.0], [0.0, 0.0, 1.0]];
+    let r1 = rx(0.4);
+    let r: [[f64; 3]; 3] =
+        std::array::from_fn(|i| std::array::from_fn(|j| (0..3).map(|k| rz[i][k] * r1[k][j]).sum()));
+    let q: [[f64; 3]; 3] = std::array::from_fn(|i| {
+        std::array::from_fn(|j| (0..3).map(|k| r[i][k] * axes[k] * axes[k] * r[j][k]).sum())
+    });
+    let sep = |x: [f64; 3], n: [f64; 3]| {
+        let qn: f64 = (0..3)
+            .map(|i| n[i] * (0..3).map(|j| q[i][j] * n[j]).sum::<f64>())
+            .sum();
+        (0..3)
+            .map(|i| n[i] * (x[i] - c[i]) - h[i] * n[i].abs())
+            .sum::<f64>()
+            - qn.sqrt()
+    };
+    let dir = |th: f64, ph: f64| [th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos()];
+    let largest = |x: [f64; 3]| {
+        let (mut best, mut arg) = (f64::NEG_INFINITY, (0.0, 0.0));
+        let (m, k) = (400, 800);
+        for a in 0..=m {
+            for b in 0..k {
+                let (th, ph) = (
+                    std::f64::consts::PI * a as f64 / m as f64,
+                    2.0 * std::f64::consts::PI * b as f64 / k as f64,
+                );
+                let s = sep(x, dir(th, ph));
+                if s > best {
+                    (best, arg) = (s, (th, ph));
+                }
+            }
+        }
+        // refined: coordinate steps halving down to 1e-9 rad
+        let mut step = std::f64::consts::PI / m as f64;
+        while step > 1e-9 {
+            let mut moved = false;
+            for (dt, dp) in [(step, 0.0), (-step, 0.0), (0.0, step), (0.0, -step)] {
+                let s = sep(x, dir(arg.0 + dt, arg.1 + dp));
+                if s > best {
+                    (best, arg, moved) = (s, (arg.0 + dt, arg.1 + dp), true);
+                }
+            }
+            if !moved {
+                step *= 0.5;
+            }
+        }
+        (best, dir(arg.0, arg.1))
+    };
+    for (x, touching) in [
+        // beside the edge x = 0.5, z = 0.1 (along y), behind both faces' planes
+        ([0.5 - 0.008, 0.1, 0.1 + 0.004], true),
+        ([0.5 - 0.02, 0.1, 0.1 + 0.009], false),
+        // at the corner (0.5, 0.5, 0.1)
+        ([0.5 - 0.006, 0.5 + 0.004, 0.1 + 0.005], true),
+        // on the top, away from the edges: a face
+        ([1.0, 0.0, 0.1 + 0.005], true),
+    ] {
+        let e = Ellipsoid {
+            centre: x,
+            rotation: &r,
+            axes,
+        };
+        let mut touches = Vec::new();
+        t.touches(&e, |x| touches.push(x));
+        let (s, n) = largest(x);
+        println!(
+            "centre {x:?}: largest separation {s:.3e} along {n:.4?}; the terrain's: {touches:.4?}"
+        );
+        assert_eq!(touches.len(), touching as usize, "{x:?}: {touches:?}");
+        assert_eq!(s < 0.0, touching, "{x:?}: {s}");
+        // face by face, even the clear one would have touched: it is behind the top's and
+        // the side's planes
+        let faces = [
+            [0.0, 0.0, 1.0],
+            [-1.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.0, 1.0, 0.0],
+        ]
+        .map(|n| sep(x, n))
+        .into_iter()
+        .fold(f64::NEG_INFINITY, f64::max);
+        assert!(faces < 0.0, "{x:?}: {faces}");
+        if let Some(t) = touches.first() {
+            assert!(
+                (t.depth + s).abs() < 1e-9,
+                "{x:?}: {} against {}",
+                t.depth,
+                -s
+            );
+            assert!(
+                close(t.normal, n, 1e-4),
+                "{x:?}: {:?} against {n:?}",
+                t.normal
+            );
+        }
+    }
 }
 
 /// R = Rx(θ) (columns: the body's axes in world axes).

@@ -11,13 +11,20 @@
 //! D = diag(a, b, c) along its body's axes R, centred at x) reaches deepest through it at its
 //! support point along −n, s = x − R D² m / √(mᵀ D² m) with m = Rᵀ n, as the language's
 //! ellipsoid contact (`mech/effects/contact.rs`) computes symbolically against its plane; the
-//! penetration δ is how far s lies behind the face. The ellipsoid overlaps a box when it
-//! lies behind all five of the box's faces (the top and the four sides: the separating-axis
-//! test over the box's face normals, exact for a point); it then touches the box through the
-//! face it is least deep behind, the way out of the box that is shortest. A point is an
-//! ellipsoid of no extent: s = x, and the rule is the point's usual one (inside the box, the
-//! nearest face). The ground and every box an ellipsoid overlaps each push on it; a point
-//! inside a box and below the ground is pushed by both.
+//! penetration δ is how far s lies behind the face. Against a box the way out that is
+//! shortest decides: over every unit n, the separation s(n) = n·(x − c) − Σ hᵢ|nᵢ| − √(nᵀQn)
+//! (c and h the box's centre and half-sizes, Q = R D² Rᵀ: the box's and the ellipsoid's
+//! support functions) is largest along the normal of that way out, and the ellipsoid
+//! overlaps the box when that largest s is negative; it touches through the plane of normal n
+//! at depth −s, at its support point along −n. Along a face's normal s is minus the depth
+//! behind that face; near an edge or a corner the largest s is reached between faces, at the
+//! signed distance from the edge or the corner to the ellipsoid (an ellipse's, projected
+//! across the edge), so an ellipsoid beside an edge, behind the planes of both faces but
+//! clear of the box, does not touch it, and one pressed on the edge is pushed away from the
+//! edge rather than out of a face. A point is an ellipsoid of no extent: s = x, and the rule
+//! is the point's usual one (inside the box, the nearest face). The ground and every box an
+//! ellipsoid overlaps each push on it; a point inside a box and below the ground is pushed
+//! by both.
 //!
 //! **The law** ([`ContactLaw`], the language's with Hunt–Crossley's terms): δ̇ = −n·v_s with
 //! v_s the velocity of the body's material point at s, F_n = pos(k δ^e (1 + d δ̇) + c δ̇) for
@@ -261,34 +268,103 @@ impl Terrain {
             {
                 continue;
             }
-            // the top, then the sides: (outward normal, the face's coordinate along it)
-            let faces = [
-                (Self::axis(up, 1.0), b.height),
-                (Self::axis(u, -1.0), -b.min[0]),
-                (Self::axis(u, 1.0), b.max[0]),
-                (Self::axis(w, -1.0), -b.min[1]),
-                (Self::axis(w, 1.0), b.max[1]),
-            ];
-            let mut least: Option<Touch> = None;
-            for (n, h) in faces {
-                let s = e.support(n);
-                let depth = h - dot(n, s);
-                if depth <= 0.0 {
-                    least = None;
-                    break;
-                }
-                if least.is_none_or(|t| depth < t.depth) {
-                    least = Some(Touch {
-                        point: s,
-                        depth,
-                        normal: n,
-                    });
-                }
-            }
-            if let Some(t) = least {
+            if let Some(t) = Self::block_touch(e, b, up, [u, w]) {
                 touch(t);
             }
         }
+    }
+
+    /// Where the ellipsoid `e` touches block `b` (module docs), if it does: the largest
+    /// separation s(n) = n·(x − c) − Σ hᵢ|nᵢ| − √(nᵀQn) over unit n (x the ellipsoid's
+    /// centre, c and h the box's centre and half-sizes, Q = R D² Rᵀ), taken over the normal
+    /// cones of the box's top, sides, upper and vertical edges and upper corners. A face's
+    /// separation is its own (−depth behind it); within an edge's or a corner's cone s(n) =
+    /// n·(x − f) − √(nᵀQn), f a point of the edge or the corner, whose largest value is the
+    /// signed distance from f to the ellipsoid (`nearest_normal`): it counts when the normal
+    /// it is reached at lies in that cone.
+    fn block_touch(e: &Ellipsoid, b: &Block, up: usize, [u, w]: [usize; 2]) -> Option<Touch> {
+        let (mut centre, mut half) = ([0.0; 3], [0.0; 3]);
+        (centre[up], half[up]) = (0.5 * b.height, 0.5 * b.height);
+        for (j, a) in [u, w].into_iter().enumerate() {
+            centre[a] = 0.5 * (b.min[j] + b.max[j]);
+            half[a] = 0.5 * (b.max[j] - b.min[j]);
+        }
+        let q = [0, 1, 2].map(|i| e.centre[i] - centre[i]);
+        // Q = R D² Rᵀ, and the separation of a unit n
+        let r = e.rotation;
+        let d2 = e.axes.map(|a| a * a);
+        let qm: [[f64; 3]; 3] = std::array::from_fn(|i| {
+            std::array::from_fn(|j| (0..3).map(|k| r[i][k] * d2[k] * r[j][k]).sum())
+        });
+        let support = |n: V3| dot(n, [0, 1, 2].map(|i| dot(qm[i], n))).sqrt();
+        let separation =
+            |n: V3| dot(n, q) - (0..3).map(|i| half[i] * n[i].abs()).sum::<f64>() - support(n);
+        let mut best: Option<(f64, V3)> = None;
+        let mut consider = |s: f64, n: V3| {
+            if best.is_none_or(|(b, _)| s > b) {
+                best = Some((s, n));
+            }
+        };
+        // the top and the sides, each as its depth behind it
+        for (j, sign) in [(up, 1.0), (u, -1.0), (u, 1.0), (w, -1.0), (w, 1.0)] {
+            let n = Self::axis(j, sign);
+            let face = centre[j] * sign + half[j];
+            consider(dot(n, e.support(n)) - face, n);
+        }
+        // edges along axis i (not the bottom's), then the upper corners
+        for i in 0..3 {
+            let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+            for (sj, sk) in [(-1.0, -1.0), (-1.0, 1.0), (1.0, -1.0), (1.0, 1.0)] {
+                if (j == up && sj < 0.0) || (k == up && sk < 0.0) {
+                    continue;
+                }
+                // the point of the edge's line in the plane of j and k, and the ellipse Q
+                // projects to on that plane, in its principal axes
+                let p = [q[j] - sj * half[j], q[k] - sk * half[k]];
+                let (a, bb, c) = (qm[j][j], qm[j][k], qm[k][k]);
+                let mean = 0.5 * (a + c);
+                let radius = (0.25 * (a - c) * (a - c) + bb * bb).sqrt();
+                let l = [mean + radius, (mean - radius).max(0.0)];
+                let v = if bb == 0.0 {
+                    if a >= c { [1.0, 0.0] } else { [0.0, 1.0] }
+                } else {
+                    let v = [bb, l[0] - a];
+                    let norm = (v[0] * v[0] + v[1] * v[1]).sqrt();
+                    [v[0] / norm, v[1] / norm]
+                };
+                let pp = [v[0] * p[0] + v[1] * p[1], -v[1] * p[0] + v[0] * p[1]];
+                let Some(m) = nearest_normal(l, pp) else {
+                    continue;
+                };
+                let mut n = [0.0; 3];
+                n[j] = v[0] * m[0] - v[1] * m[1];
+                n[k] = v[1] * m[0] + v[0] * m[1];
+                if sj * n[j] >= 0.0 && sk * n[k] >= 0.0 {
+                    consider(separation(n), n);
+                }
+            }
+        }
+        for corner in 0..4 {
+            let mut sign = [1.0; 3];
+            sign[u] = if corner & 1 == 0 { -1.0 } else { 1.0 };
+            sign[w] = if corner & 2 == 0 { -1.0 } else { 1.0 };
+            let p = [0, 1, 2].map(|i| q[i] - sign[i] * half[i]);
+            // in the ellipsoid's axes (the columns of R)
+            let pp = [0, 1, 2].map(|k| (0..3).map(|i| r[i][k] * p[i]).sum::<f64>());
+            let Some(m) = nearest_normal(d2, pp) else {
+                continue;
+            };
+            let n = [0, 1, 2].map(|i| dot(r[i], m));
+            if (0..3).all(|i| sign[i] * n[i] >= 0.0) {
+                consider(separation(n), n);
+            }
+        }
+        let (s, n) = best?;
+        (s < 0.0).then(|| Touch {
+            point: e.support(n),
+            depth: -s,
+            normal: n,
+        })
     }
 
     /// The deepest surface a point at `p` is behind, if any: its depth and outward normal.
@@ -366,4 +442,58 @@ impl Terrain {
         }
         f
     }
+}
+
+/// For a centred ellipsoid (K = 3) or ellipse (K = 2) of squared semi-axes `l` along its
+/// principal axes and a point `q` in those axes, the unit n (same axes) at which
+/// n·q − √(Σ lᵢnᵢ²) is largest: the direction from the surface's point nearest q toward q
+/// (outside) or away from it (inside), both the outward normal there, nᵢ ∝ qᵢ/(lᵢ + t) with t
+/// the root of g(t) = Σ lᵢqᵢ²/(lᵢ + t)² − 1 (decreasing and convex for t > −min l: Newton's
+/// steps kept in a bracket). `None` for q at the centre.
+fn nearest_normal<const K: usize>(l: [f64; K], q: [f64; K]) -> Option<[f64; K]> {
+    let norm = q.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if norm == 0.0 {
+        return None;
+    }
+    let largest = l.iter().copied().fold(0.0, f64::max);
+    if largest == 0.0 {
+        return Some(q.map(|x| x / norm));
+    }
+    let g = |t: f64| {
+        let (mut v, mut d) = (-1.0, 0.0);
+        for i in 0..K {
+            let a = l[i] + t;
+            let r = l[i] * q[i] * q[i] / (a * a);
+            v += r;
+            d -= 2.0 * r / a;
+        }
+        (v, d)
+    };
+    let smallest = l.iter().copied().fold(f64::INFINITY, f64::min);
+    // g(hi) ≤ 0: each term is at most l_max q²/hi²
+    let (mut lo, mut hi) = (-smallest, largest.sqrt() * norm);
+    let mut t = hi;
+    for _ in 0..100 {
+        let (v, d) = g(t);
+        if v == 0.0 {
+            break;
+        }
+        if v > 0.0 {
+            lo = t;
+        } else {
+            hi = t;
+        }
+        let newton = t - v / d;
+        t = if newton > lo && newton < hi {
+            newton
+        } else {
+            0.5 * (lo + hi)
+        };
+        if hi - lo <= 4.0 * f64::EPSILON * hi.abs().max(lo.abs()) {
+            break;
+        }
+    }
+    let m: [f64; K] = std::array::from_fn(|i| q[i] / (l[i] + t));
+    let size = m.iter().map(|x| x * x).sum::<f64>().sqrt();
+    (size > 0.0 && size.is_finite()).then(|| m.map(|x| x / size))
 }

@@ -101,7 +101,8 @@ fn a_point_takes_its_nearest_face_and_a_sphere_touches_a_box_as_by_hand() {
 /// Beside a box's edge or corner, behind the planes of both (or all three) faces, a sphere
 /// touches the box only if it reaches the edge or the corner: at the depth r − (its centre's
 /// distance to them), along the line from them to its centre. (Taken face by face, the
-/// first sphere was 4 mm behind both the riser and the top, and the second 8 mm.)
+/// first sphere was 4 mm behind both the riser and the top, and the second 8 mm.) Rolled off
+/// the top over the edge, 5 mm in, its depth and normal change continuously.
 #[test]
 fn a_sphere_beside_an_edge_or_a_corner_touches_it_as_its_distance_says() {
     // the step's top edge runs along y at x = 0.6, z = 0.05; its corner at y = −1
@@ -146,6 +147,27 @@ fn a_sphere_beside_an_edge_or_a_corner_touches_it_as_its_distance_says() {
         });
         let f = normal.map(|n| 1e5 * (r - d) * n);
         assert!(forces.len() == 1 && close(forces[0], f, 1e-9), "{forces:?}");
+    }
+    // pressed 5 mm into the top and rolled off it over the edge: the depth and the normal
+    // go continuously from the top's (5 mm, up) to the edge's (r − distance, from the edge)
+    let z = 0.05 + r - 0.005;
+    for k in 0..=40 {
+        let x = 0.61 - 0.001 * k as f64;
+        let touches = at([x, 0.0, z]);
+        let (dx, dz) = ((x - 0.6).min(0.0), z - 0.05);
+        let d = (dx * dx + dz * dz).sqrt();
+        if d >= r {
+            assert!(touches.is_empty(), "{x}: {touches:?}");
+            continue;
+        }
+        assert_eq!(touches.len(), 1, "{x}: {touches:?}");
+        let t = touches[0];
+        assert!(
+            (t.depth - (r - d)).abs() < 1e-15,
+            "{x}: {t:?} against {}",
+            r - d
+        );
+        assert!(close(t.normal, [dx / d, 0.0, dz / d], 1e-12), "{x}: {t:?}");
     }
 }
 

@@ -249,7 +249,10 @@ fn a_weight_held_at_its_rounding_is_said() {
             low.floored_steps, low.steps, high.floored_steps
         );
         assert!(low.floored_steps > 0, "{scheme:?}: {low}");
-        assert!(low.to_string().contains("held a component at its rounding"));
+        assert!(
+            low.to_string().contains("held a component at its rounding"),
+            "{low}"
+        );
         assert_eq!(high.floored_steps, 0, "{scheme:?}: {high}");
         assert!(
             !high

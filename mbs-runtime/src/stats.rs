@@ -71,10 +71,12 @@ pub struct Stats {
     /// a tighter rtol would otherwise have taken more steps (the Newmark family from rtol ≈
     /// 4e-8 on, its floor 10⁴ε; RKC from ≈ 2e-9, BDF from ≈ 8e-11, their floors 100ε)
     pub tolerance_floor: Option<f64>,
-    /// accepted steps whose error test raised some component's weight atol + rtol'·|y_i| to
+    /// accepted steps whose error test raised some component's weight atol' + rtol'·|y_i| to
     /// its rounding floor, 100ε times the largest entry of its kind (positions, velocities,
-    /// multipliers): a component near zero beside large ones of its kind, under an atol
-    /// below that rounding, was tested at the digits rounding leaves it, not at atol
+    /// multipliers): a component near zero beside large ones of its kind was tested at the
+    /// digits rounding leaves it, not at the tolerance asked of it (the user's atol, or the
+    /// scheme's transformation of it: RKC's local tolerance at rtol 1e-8 is 0.3·rtol^1.5 on
+    /// atol too, below the rounding of a fast mechanism's slow components)
     pub floored_steps: usize,
 }
 
@@ -249,7 +251,7 @@ impl fmt::Display for Stats {
         if self.floored_steps > 0 {
             write!(
                 f,
-                "\nin {} of {} steps the error test held a component at its rounding (100ε times the largest of its kind), not at atol: atol asks digits no step gives there",
+                "\nin {} of {} steps the error test held a component at its rounding (100ε times the largest of its kind), below which the tolerance asked of it lies: it got the digits rounding leaves",
                 self.floored_steps, self.steps
             )?;
         }

@@ -449,7 +449,10 @@ impl Terrain {
 /// n·q − √(Σ lᵢnᵢ²) is largest: the direction from the surface's point nearest q toward q
 /// (outside) or away from it (inside), both the outward normal there, nᵢ ∝ qᵢ/(lᵢ + t) with t
 /// the root of g(t) = Σ lᵢqᵢ²/(lᵢ + t)² − 1 (decreasing and convex for t > −min l: Newton's
-/// steps kept in a bracket). `None` for q at the centre.
+/// steps kept in a bracket). `None` for q at the centre. For q inside and on a principal
+/// plane, deeper than that plane's own way out (a box's corner sunk past the ellipsoid's
+/// medial axis, beyond what a contact model resolves), the root may give a stationary
+/// direction rather than the largest: the face and edge candidates then bound the answer.
 fn nearest_normal<const K: usize>(l: [f64; K], q: [f64; K]) -> Option<[f64; K]> {
     let norm = q.iter().map(|x| x * x).sum::<f64>().sqrt();
     if norm == 0.0 {

@@ -299,6 +299,11 @@ impl Terrain {
         let support = |n: V3| dot(n, [0, 1, 2].map(|i| dot(qm[i], n))).sqrt();
         let separation =
             |n: V3| dot(n, q) - (0..3).map(|i| half[i] * n[i].abs()).sum::<f64>() - support(n);
+        // the ellipsoid within the plane of the face along axis i on side `sign`: it then
+        // reaches an edge or a corner on that plane from within, along a normal pointing
+        // back across the plane (outside the feature's cone), and the feature is skipped
+        let reach = [0, 1, 2].map(|i| qm[i][i].sqrt());
+        let within = |i: usize, sign: f64| sign * q[i] + reach[i] <= half[i];
         let mut best: Option<(f64, V3)> = None;
         let mut consider = |s: f64, n: V3| {
             if best.is_none_or(|(b, _)| s > b) {
@@ -315,7 +320,8 @@ impl Terrain {
         for i in 0..3 {
             let (j, k) = ((i + 1) % 3, (i + 2) % 3);
             for (sj, sk) in [(-1.0, -1.0), (-1.0, 1.0), (1.0, -1.0), (1.0, 1.0)] {
-                if (j == up && sj < 0.0) || (k == up && sk < 0.0) {
+                if (j == up && sj < 0.0) || (k == up && sk < 0.0) || within(j, sj) || within(k, sk)
+                {
                     continue;
                 }
                 // the point of the edge's line in the plane of j and k, and the ellipse Q
@@ -348,6 +354,9 @@ impl Terrain {
             let mut sign = [1.0; 3];
             sign[u] = if corner & 1 == 0 { -1.0 } else { 1.0 };
             sign[w] = if corner & 2 == 0 { -1.0 } else { 1.0 };
+            if (0..3).any(|i| within(i, sign[i])) {
+                continue;
+            }
             let p = [0, 1, 2].map(|i| q[i] - sign[i] * half[i]);
             // in the ellipsoid's axes (the columns of R)
             let pp = [0, 1, 2].map(|k| (0..3).map(|i| r[i][k] * p[i]).sum::<f64>());
@@ -449,7 +458,7 @@ impl Terrain {
 /// n·q − √(Σ lᵢnᵢ²) is largest: the direction from the surface's point nearest q toward q
 /// (outside) or away from it (inside), both the outward normal there, nᵢ ∝ qᵢ/(lᵢ + t) with t
 /// the root of g(t) = Σ lᵢqᵢ²/(lᵢ + t)² − 1 (decreasing and convex for t > −min l: Newton's
-/// steps kept in a bracket). `None` for q at the centre. For q inside and on a principal
+/// steps from the left of the root, kept in a bracket). `None` for q at the centre. For q inside and on a principal
 /// plane, deeper than that plane's own way out (a box's corner sunk past the ellipsoid's
 /// medial axis, beyond what a contact model resolves), the root may give a stationary
 /// direction rather than the largest: the face and edge candidates then bound the answer.
@@ -475,7 +484,12 @@ fn nearest_normal<const K: usize>(l: [f64; K], q: [f64; K]) -> Option<[f64; K]> 
     let smallest = l.iter().copied().fold(f64::INFINITY, f64::min);
     // g(hi) ≤ 0: each term is at most l_max q²/hi²
     let (mut lo, mut hi) = (-smallest, largest.sqrt() * norm);
-    let mut t = hi;
+    // g ≥ 0 where one term is 1, at t = √lᵢ|qᵢ| − lᵢ: from the largest of these Newton's
+    // steps stay left of the root (g convex) and do not overshoot
+    let left = (0..K)
+        .map(|i| l[i].sqrt() * q[i].abs() - l[i])
+        .fold(f64::NEG_INFINITY, f64::max);
+    let mut t = if left > lo { left } else { hi };
     for _ in 0..100 {
         let (v, d) = g(t);
         if v == 0.0 {
@@ -486,7 +500,12 @@ fn nearest_normal<const K: usize>(l: [f64; K], q: [f64; K]) -> Option<[f64; K]> 
         } else {
             hi = t;
         }
-        let newton = t - v / d;
+        let step = -v / d;
+        // converged: Newton's step is at the rounding of t and the axes
+        if step.abs() <= 4.0 * f64::EPSILON * (t.abs() + largest) {
+            break;
+        }
+        let newton = t + step;
         t = if newton > lo && newton < hi {
             newton
         } else {

@@ -708,13 +708,12 @@ pub fn articulated(
                     a.mul(num, j.inv_d)
                 }
                 Outward::ReadyFirst => {
-                    let mut signed = Vec::with_capacity(7);
+                    let mut signed = vec![(a.mul(j.u, j.inv_d), false)];
                     for i in 0..3 {
                         for (wi, xi) in [(j.w.0[i], x.0[i]), (j.w.1[i], x.1[i])] {
                             signed.push((a.mul(wi, xi), true));
                         }
                     }
-                    signed.insert(0, (a.mul(j.u, j.inv_d), false));
                     ready_combination(a, &mut ready, signed)
                 }
             };

@@ -795,11 +795,15 @@ impl RunArgs {
         let (outputs, peak_held) = (recorder.outputs, recorder.peak_held);
         let (trajectory, energy, csv) = recorder.finish();
         // forces written in Rust (`mbs::WithEfforts`) may do work the model cannot tell
-        let conservative = stats.user_efforts == 0
-            && info
-                .ops
+        // (the power's row, or the rows of its parts shared by the scenes: "power, …")
+        let power = || {
+            info.ops
                 .iter()
-                .any(|(f, ops)| *f == "power" && ops.flops() == 0);
+                .filter(|(f, _)| f.split(',').next() == Some("power"))
+        };
+        let conservative = stats.user_efforts == 0
+            && power().next().is_some()
+            && power().all(|(_, ops)| ops.flops() == 0);
         let report = RunReport {
             scheme,
             trajectory,

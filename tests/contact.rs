@@ -101,6 +101,29 @@ mbs::multibody! {
 }
 
 mbs::multibody! {
+    /// `Crate`'s `Hung` scene written without effects or scenes: its τ, static forces,
+    /// energies, power and tangents are its own functions, each whole.
+    pub model CrateWhole {
+        param k = 2e4; param c = 100.0; param mu = 0.5; param eps = 1e-4;
+        dof x = 0.0; dof y = 0.0; dof z = 0.3; dof a = 0.3; dof b = 0.2; dof r = -0.15;
+        body box1 { mass = 1.0; inertia = (0.2 * 0.2 / 6, 0.2 * 0.2 / 6, 0.2 * 0.2 / 6); }
+        point c0 on box1 at (-0.1, -0.1, -0.1);
+        point c1 on box1 at (0.1, -0.1, -0.1);
+        point c2 on box1 at (0.1, 0.1, -0.1);
+        point c3 on box1 at (-0.1, 0.1, -0.1);
+        point hook on ground at (0.3, 0.2, 1.0);
+        TOG[box1] = Tdisp(x, y, z) * Trotz(a) * Troty(b) * Trotx(r);
+        gravity(0, 0, -9.81);
+        contact(c0, k = k, c = c, mu = mu, eps = eps);
+        contact(c1, k = k, c = c, mu = mu, eps = eps);
+        contact(c2, k = k, c = c, mu = mu, eps = eps);
+        contact(c3, k = k, c = c, mu = mu, eps = eps);
+        spring(hook, c2, k = 50, l0 = 0.5, c = 0.7);
+        option tangents;
+    }
+}
+
+mbs::multibody! {
     /// The box with gravity as an effect of its own: a scene whose effects beyond the common
     /// ones hold gravity (which acts through the bodies) builds its tangents whole; the others
     /// share theirs.
@@ -264,6 +287,77 @@ fn tangents_shared_by_scenes_match_central_differences() {
     assert_eq!(parts(&WeighedFree::default()), [common]);
     assert_eq!(parts(&WeighedFloor::default()), [common, floor]);
     assert_eq!(parts(&WeighedHeavy::default()), ["tangents (K, C)"]);
+}
+
+/// With several scenes, τ, the static forces, the energies and the power are sums of parts
+/// generated once too (the bodies' and gravity's, then each group of effects'): `Crate`'s
+/// `Hung` scene gives what `CrateWhole`, the same system in one piece, gives.
+#[test]
+fn parts_shared_by_scenes_sum_to_the_scene_s_equations() {
+    let (hung, whole) = (CrateHung::default(), CrateWhole::default());
+    let n = CrateWhole::NQ;
+    // three corners in the floor, sliding, the spring stretched
+    let q = [0.1, -0.2, 0.0985, 0.4, 0.05, -0.03];
+    let qd = [0.7, -0.4, -0.05, 1.5, 0.3, -0.6];
+    let qdd = [0.3, -1.0, 2.0, 0.5, -0.2, 0.1];
+    let close = |a: &[f64], b: &[f64], what: &str| {
+        let scale = 1.0 + max_abs(b);
+        let d = a
+            .iter()
+            .zip(b)
+            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+        assert!(d <= 1e-12 * scale, "{what}: {a:?} against {b:?}");
+    };
+    let (mut t1, mut t2) = (vec![0.0; n], vec![0.0; n]);
+    hung.inverse_dynamics(0.0, &q, &qd, &qdd, &[], &mut t1);
+    whole.inverse_dynamics(0.0, &q, &qd, &qdd, &[], &mut t2);
+    close(&t1, &t2, "inverse dynamics");
+    // and τ = M qdd − h of the scene's own dynamics
+    let (mut m, mut h) = (vec![0.0; n * n], vec![0.0; n]);
+    hung.dynamics(0.0, &q, &qd, &[], &mut m, &mut h);
+    let mh: Vec<f64> = (0..n)
+        .map(|i| (0..n).map(|j| m[i + n * j] * qdd[j]).sum::<f64>() - h[i])
+        .collect();
+    close(&t1, &mh, "inverse dynamics against M qdd − h");
+    hung.static_forces(0.0, &q, &[], &mut t1);
+    whole.static_forces(0.0, &q, &[], &mut t2);
+    close(&t1, &t2, "static forces");
+    let (e1, e2) = (hung.energy(0.0, &q, &qd), whole.energy(0.0, &q, &qd));
+    close(
+        &[e1.kinetic, e1.potential],
+        &[e2.kinetic, e2.potential],
+        "energies",
+    );
+    let (p1, p2) = (
+        hung.power(0.0, &q, &qd, &[]),
+        whole.power(0.0, &q, &qd, &[]),
+    );
+    close(&[p1], &[p2], "power");
+    assert!(
+        p1 < 0.0,
+        "the floor's friction and the spring's damper dissipate: {p1}"
+    );
+    let (mut k1, mut c1) = (vec![0.0; n * n], vec![0.0; n * n]);
+    let (mut k2, mut c2) = (vec![0.0; n * n], vec![0.0; n * n]);
+    hung.tangents(0.0, &q, &qd, &qdd, &[], &mut k1, &mut c1)
+        .unwrap();
+    whole
+        .tangents(0.0, &q, &qd, &qdd, &[], &mut k2, &mut c2)
+        .unwrap();
+    close(&k1, &k2, "K");
+    close(&c1, &c2, "C");
+    // each generated once: the scene's rows are the parts'
+    let rows = |f: &str| -> Vec<&'static str> {
+        let rows = hung.info().ops.iter().map(|(label, _)| *label);
+        rows.filter(|l| l.split(',').next() == Some(f)).collect()
+    };
+    for f in ["inverse_dynamics", "static_forces", "energy", "power"] {
+        let parts: Vec<String> = ["common part", "effects floor", "effects hung"]
+            .iter()
+            .map(|p| format!("{f}, {p}"))
+            .collect();
+        assert_eq!(rows(f), parts, "{f}");
+    }
 }
 
 #[test]

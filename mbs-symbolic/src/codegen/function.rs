@@ -148,6 +148,16 @@ impl FnSpec {
         }
     }
 
+    /// Adds a vector to `target`, which holds one already (as [`FnSpec::matrix_added`]).
+    pub fn vector_added(&mut self, a: &Arena, target: &str, v: &[ExprId]) {
+        self.accumulate = true;
+        for (i, &e) in v.iter().enumerate() {
+            if !a.is_num(e, 0.0) {
+                self.outputs.push((format!("{target}[{i}]"), e));
+            }
+        }
+    }
+
     /// Adds a vector output `target[i]`.
     pub fn vector(&mut self, target: &str, v: &[ExprId]) {
         for (i, &e) in v.iter().enumerate() {

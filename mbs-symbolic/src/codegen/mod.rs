@@ -427,25 +427,65 @@ fn emit_params(
         .into_iter()
         .map(|(f, label)| (f, label.to_string(), None))
         .collect();
-    // the tangents shared by the scenes: of the bodies and the effects every scene has
+    // τ and its tangents shared by the scenes: of the bodies and the effects every scene has
     // (written), then of each group of other effects (added)
-    for (i, part) in model.shared_tangents.iter().enumerate() {
-        let mut f = FnSpec::new(&tangent_part_fn(i), &with_charts("tangents"));
-        let label = if i == 0 {
-            f.matrix(a, "k", &part.k);
-            f.matrix(a, "c", &part.c);
-            "tangents (K, C), common part".to_string()
+    for (i, part) in model.shared_parts.iter().enumerate() {
+        let names: Vec<&str> = part
+            .effects
+            .iter()
+            .filter_map(|&e| sys.effects[e].name.as_deref())
+            .collect();
+        let which = if i == 0 {
+            "common part".to_string()
         } else {
-            f.matrix_added(a, "k", &part.k);
-            f.matrix_added(a, "c", &part.c);
-            let names: Vec<&str> = part
-                .effects
-                .iter()
-                .filter_map(|&e| sys.effects[e].name.as_deref())
-                .collect();
-            format!("tangents (K, C), effects {}", names.join(", "))
+            format!("effects {}", names.join(", "))
         };
-        shared.push((f, label, Some(i)));
+        // the first part writes its outputs, the others add theirs
+        // τ too when the scenes take their tangents from the parts (see the scenes' τ below)
+        let tau = sys.options.tangents.then(|| {
+            let args = with_charts("inverse_dynamics");
+            ("inverse_dynamics", args, "tau", part.tau.clone())
+        });
+        let vectors = tau.into_iter().chain([
+            (
+                "static_forces",
+                with_charts("static_forces"),
+                "h",
+                part.static_h.clone(),
+            ),
+            (
+                "energy",
+                format!("{}, e: &mut [f64]", with_charts("energy")),
+                "e",
+                vec![part.kinetic, part.potential],
+            ),
+            (
+                "power",
+                format!("{}, e: &mut [f64]", with_charts("power")),
+                "e",
+                vec![part.power],
+            ),
+        ]);
+        for (function, args, target, v) in vectors {
+            let mut f = FnSpec::new(&shared_part_fn(function, i), &args);
+            if i == 0 {
+                f.vector(target, &v);
+            } else {
+                f.vector_added(a, target, &v);
+            }
+            shared.push((f, format!("{function}, {which}"), Some(i)));
+        }
+        if sys.options.tangents {
+            let mut f = FnSpec::new(&shared_part_fn("tangents", i), &with_charts("tangents"));
+            if i == 0 {
+                f.matrix(a, "k", &part.k);
+                f.matrix(a, "c", &part.c);
+            } else {
+                f.matrix_added(a, "k", &part.k);
+                f.matrix_added(a, "c", &part.c);
+            }
+            shared.push((f, format!("tangents (K, C), {which}"), Some(i)));
+        }
     }
     let mut ops = Vec::new();
     for (spec, label, part) in shared {
@@ -512,10 +552,12 @@ Ok(())
 }
 
 /// The name of the function of part `i` of the tangents the scenes share.
-fn tangent_part_fn(i: usize) -> String {
+/// The method on the parameter struct of shared part `i` of `function` (`inverse_dynamics`,
+/// `tangents`): `__tangents_common`, `__tangents_effects1`, …
+fn shared_part_fn(function: &str, i: usize) -> String {
     match i {
-        0 => "__tangents_common".to_string(),
-        _ => format!("__tangents_effects{i}"),
+        0 => format!("__{function}_common"),
+        _ => format!("__{function}_effects{i}"),
     }
 }
 
@@ -802,9 +844,18 @@ fn emit_scene(
     }
     specs.push((f, Some("mass_matrix")));
     let mass_matrix_spec = specs.len() - 1;
-    let mut f = FnSpec::new("__inverse_dynamics", args("inverse_dynamics"));
-    f.vector("tau", eq.tau());
-    specs.push((f, Some("inverse_dynamics")));
+    // τ as the sum of the shared parts when the scene takes its tangents from them, else its
+    // own in one function: without generated tangents the implicit schemes difference τ,
+    // and as the sum of parts (which no longer share subexpressions) it takes 8–9 % more
+    // operations on the hexapod, 15 % more time in a Radau5 run of its `Standing`
+    let shared_tau = !eq.shared_parts.is_empty() && sys.options.tangents;
+    if !shared_tau {
+        let mut f = FnSpec::new("__inverse_dynamics", args("inverse_dynamics"));
+        f.vector("tau", eq.tau());
+        specs.push((f, Some("inverse_dynamics")));
+    }
+    // (static forces, energy and power: of the shared parts when the scene has them)
+    let own = eq.shared_parts.is_empty();
     if let Some((kt, ct)) = &eq.tangents {
         let mut f = FnSpec::new("__tangents", args("tangents"));
         f.matrix(a, "k", kt);
@@ -827,18 +878,22 @@ fn emit_scene(
         f.matrix(a, "dk", dk);
         specs.push((f, Some("rest_tangent_derivatives (M', C', K')")));
     }
-    let mut f = FnSpec::new("__static_forces", args("static_forces"));
-    f.vector("h", &eq.static_h);
-    specs.push((f, Some("static_forces")));
+    if own {
+        let mut f = FnSpec::new("__static_forces", args("static_forces"));
+        f.vector("h", &eq.static_h);
+        specs.push((f, Some("static_forces")));
+    }
     let mut f = FnSpec::new("__input_matrix", args("input_matrix"));
     f.matrix(a, "b", &eq.input_matrix);
     specs.push((f, Some("input_matrix")));
-    let mut f = FnSpec::new("__energy", &format!("{}, e: &mut [f64]", args("energy")));
-    f.vector("e", &[eq.kinetic, eq.potential]);
-    specs.push((f, Some("energy")));
-    let mut f = FnSpec::new("__power", &format!("{}, e: &mut [f64]", args("power")));
-    f.vector("e", &[eq.power]);
-    specs.push((f, Some("power")));
+    if own {
+        let mut f = FnSpec::new("__energy", &format!("{}, e: &mut [f64]", args("energy")));
+        f.vector("e", &[eq.kinetic, eq.potential]);
+        specs.push((f, Some("energy")));
+        let mut f = FnSpec::new("__power", &format!("{}, e: &mut [f64]", args("power")));
+        f.vector("e", &[eq.power]);
+        specs.push((f, Some("power")));
+    }
     let mut f = FnSpec::new("__initial_state", args("initial_state"));
     let q0: Vec<ExprId> = sys.dofs.iter().map(|d| d.q0).collect();
     let qd0: Vec<ExprId> = sys.dofs.iter().map(|d| d.qd0).collect();
@@ -900,7 +955,7 @@ fn emit_scene(
     // the kinematics and constraint functions, emitted once on the parameters, serve every
     // scene; the shared tangents' parts those that add them
     for (label, c, part) in shared.rows {
-        if part.is_some_and(|p| !eq.tangent_parts.contains(&p)) {
+        if part.is_some_and(|p| !eq.shared_parts.contains(&p)) {
             continue;
         }
         ops.push((label.clone(), *c));
@@ -1022,7 +1077,7 @@ fn emit_scene(
             .map(|d| d.independent.to_string())
             .collect::<Vec<_>>()
             .join(", "),
-        tan = eq.tangents.is_some() || !eq.tangent_parts.is_empty(),
+        tan = eq.tangents.is_some() || (!eq.shared_parts.is_empty() && sys.options.tangents),
         shapes = shapes::literal(&shapes::shapes(sys)),
         joints = sys
             .rotation_joints
@@ -1039,18 +1094,29 @@ fn emit_scene(
             .collect::<Vec<_>>()
             .join(", "),
     );
-    let tangents_body = if !eq.tangent_parts.is_empty() {
-        let calls: String = eq
-            .tangent_parts
+    // the calls of the shared parts a scene adds
+    let part_calls = |function: &str| -> String {
+        let mut call = api::method_named(function).call();
+        if matches!(function, "energy" | "power") {
+            call.push_str(", &mut e");
+        }
+        eq.shared_parts
             .iter()
             .map(|&i| {
                 format!(
-                    "self.params.{}(&self.charts, t, q, qd, qdd, u, k, c);\n",
-                    tangent_part_fn(i)
+                    "self.params.{}(&self.charts, {call});\n",
+                    shared_part_fn(function, i)
                 )
             })
-            .collect();
-        calls + "Ok(())"
+            .collect()
+    };
+    let shared_body = |function: &str| (!eq.shared_parts.is_empty()).then(|| part_calls(function));
+    let inverse_dynamics_body = shared_body("inverse_dynamics").filter(|_| sys.options.tangents);
+    let static_forces_body = shared_body("static_forces");
+    let energy_body = shared_body("energy");
+    let power_body = shared_body("power");
+    let tangents_body = if !eq.shared_parts.is_empty() && sys.options.tangents {
+        part_calls("tangents") + "Ok(())"
     } else if eq.tangents.is_some() {
         "self.__tangents(t, q, qd, qdd, u, k, c);\nOk(())".to_string()
     } else {
@@ -1083,61 +1149,98 @@ fn emit_scene(
     let assembled = model.assembled;
     let model_impl = api::model_impl(&ty, &pty, &sizes, |m| {
         match m.name {
-        "info" => format!("{info}\n&INFO"),
-        "params" => "&self.params".into(),
-        "set_params" => {
-            "::mbs::Parameters::validate(&params)?;\nself.params = params;\nOk(())".into()
-        }
-        "tangents" => tangents_body.clone(),
-        "parameter_tangents" => format!("self.__parameter_tangents({})", m.call()) + ";\nOk(())",
-        "rest_tangent_derivatives" => {
-            format!("self.__rest_tangent_derivatives({})", m.call()) + ";\nOk(())"
-        }
-        "constraint_parameter_tangents" => format!(
-            "self.params.__constraint_parameter_tangents(&self.charts, t, q, qd, qdd, lambda, {})",
-            ["dphi_dp", "drate_dq", "drate_dp", "dacc_dq", "dacc_dqd", "dacc_dp", "dforce_dp"]
-                .map(|f| format!("&mut out.{f}"))
-                .join(", ")
-        ) + ";\nOk(())",
-        "constraint_rest_derivatives" => {
-            format!("self.params.__constraint_rest_derivatives(&self.charts, {})", m.call()) + ";\nOk(())"
-        }
-        "energy" => "let mut e = [0.0f64; 2];\nself.__energy(t, q, qd, &mut e);\n::mbs::Energy { kinetic: e[0], potential: e[1] }".into(),
-        "power" => "let mut e = [0.0f64; 1];\nself.__power(t, q, qd, u, &mut e);\ne[0]".into(),
-        // the constraint functions live on the parameter struct, shared by every scene
-        name if name.starts_with("constraint") => {
-            format!("self.params.__{name}(&self.charts, {})", m.call())
-        }
-        // ... and so do the poses and kinematics of frames and points, whose Jacobians may be
-        // assembled from the twists the generated code writes
-        name @ ("kinematics" | "point_kinematics") if assembled => format!(
-            "let mut tw = [0.0f64; {}];\nself.params.__{name}(&self.charts, {}, &mut tw);\n{pty}::TWISTS.assemble(&tw, out, {});",
-            6 * model.world.twist_count(),
-            m.call(),
-            name == "kinematics"
-        ),
-        name @ ("frames" | "kinematics" | "point_kinematics") => {
-            format!("self.params.__{name}(&self.charts, {})", m.call())
-        }
-        // M assembled from the twists and composite inertias the generated code writes
-        name @ ("dynamics" | "mass_matrix") if assembled => format!(
-            "let mut mw = [0.0f64; {}];\nself.__{name}({}, &mut mw);\n{pty}::TWISTS.mass_matrix(&mw, {n}, m);",
-            mass_workspace(model),
-            m.call()
-        ),
-        // SIMD code where the processor runs it, else the one-state function lane by lane
-        // one function with the added generalised force f, at f = 0 or given
-        "forward_dynamics" => format!("self.__forward_dynamics(t, q, qd, u, &[0.0; {n}], qdd, pivots)"),
-        "forward_dynamics_forced" => format!("self.__forward_dynamics({})", m.call()),
-        name @ ("dynamics_x4" | "forward_dynamics_x4") => {
-            let one = name.trim_end_matches("_x4");
-            let (a, b) = if one == "dynamics" { ("m", "h") } else { ("qdd", "pivots") };
-            let call = if one == "dynamics" {
+            "info" => format!("{info}\n&INFO"),
+            "params" => "&self.params".into(),
+            "set_params" => {
+                "::mbs::Parameters::validate(&params)?;\nself.params = params;\nOk(())".into()
+            }
+            "tangents" => tangents_body.clone(),
+            "inverse_dynamics" if inverse_dynamics_body.is_some() => {
+                inverse_dynamics_body.clone().unwrap_or_default()
+            }
+            "parameter_tangents" => {
+                format!("self.__parameter_tangents({})", m.call()) + ";\nOk(())"
+            }
+            "rest_tangent_derivatives" => {
+                format!("self.__rest_tangent_derivatives({})", m.call()) + ";\nOk(())"
+            }
+            "constraint_parameter_tangents" => {
+                format!(
+                    "self.params.__constraint_parameter_tangents(&self.charts, t, q, qd, qdd, lambda, {})",
+                    [
+                        "dphi_dp",
+                        "drate_dq",
+                        "drate_dp",
+                        "dacc_dq",
+                        "dacc_dqd",
+                        "dacc_dp",
+                        "dforce_dp"
+                    ]
+                    .map(|f| format!("&mut out.{f}"))
+                    .join(", ")
+                ) + ";\nOk(())"
+            }
+            "constraint_rest_derivatives" => {
+                format!(
+                    "self.params.__constraint_rest_derivatives(&self.charts, {})",
+                    m.call()
+                ) + ";\nOk(())"
+            }
+            "energy" => format!(
+                "let mut e = [0.0f64; 2];\n{}::mbs::Energy {{ kinetic: e[0], potential: e[1] }}",
+                energy_body
+                    .clone()
+                    .unwrap_or_else(|| "self.__energy(t, q, qd, &mut e);\n".into())
+            ),
+            "power" => format!(
+                "let mut e = [0.0f64; 1];\n{}e[0]",
+                power_body
+                    .clone()
+                    .unwrap_or_else(|| "self.__power(t, q, qd, u, &mut e);\n".into())
+            ),
+            "static_forces" if static_forces_body.is_some() => {
+                static_forces_body.clone().unwrap_or_default()
+            }
+            // the constraint functions live on the parameter struct, shared by every scene
+            name if name.starts_with("constraint") => {
+                format!("self.params.__{name}(&self.charts, {})", m.call())
+            }
+            // ... and so do the poses and kinematics of frames and points, whose Jacobians may be
+            // assembled from the twists the generated code writes
+            name @ ("kinematics" | "point_kinematics") if assembled => format!(
+                "let mut tw = [0.0f64; {}];\nself.params.__{name}(&self.charts, {}, &mut tw);\n{pty}::TWISTS.assemble(&tw, out, {});",
+                6 * model.world.twist_count(),
+                m.call(),
+                name == "kinematics"
+            ),
+            name @ ("frames" | "kinematics" | "point_kinematics") => {
+                format!("self.params.__{name}(&self.charts, {})", m.call())
+            }
+            // M assembled from the twists and composite inertias the generated code writes
+            name @ ("dynamics" | "mass_matrix") if assembled => format!(
+                "let mut mw = [0.0f64; {}];\nself.__{name}({}, &mut mw);\n{pty}::TWISTS.mass_matrix(&mw, {n}, m);",
+                mass_workspace(model),
                 m.call()
-            } else {
-                format!("t, q, qd, u, &[::mbs::F64x4::ZERO; {n}], qdd, pivots")
-            };
-            format!(
+            ),
+            // SIMD code where the processor runs it, else the one-state function lane by lane
+            // one function with the added generalised force f, at f = 0 or given
+            "forward_dynamics" => {
+                format!("self.__forward_dynamics(t, q, qd, u, &[0.0; {n}], qdd, pivots)")
+            }
+            "forward_dynamics_forced" => format!("self.__forward_dynamics({})", m.call()),
+            name @ ("dynamics_x4" | "forward_dynamics_x4") => {
+                let one = name.trim_end_matches("_x4");
+                let (a, b) = if one == "dynamics" {
+                    ("m", "h")
+                } else {
+                    ("qdd", "pivots")
+                };
+                let call = if one == "dynamics" {
+                    m.call()
+                } else {
+                    format!("t, q, qd, u, &[::mbs::F64x4::ZERO; {n}], qdd, pivots")
+                };
+                format!(
                 "if ::mbs::lanes::simd_available() {{
 #[allow(unused_unsafe)]
 // SAFETY: the processor has the features the batch code is compiled for
@@ -1146,9 +1249,9 @@ unsafe {{ self.__{name}({call}) }}
 ::mbs::lanes::lane_by_lane(t, [q, qd, u], [{a}, {b}], |t, [q, qd, u], [{a}, {b}]| ::mbs::Model::{one}(self, t, q, qd, u, {a}, {b}))
 }}"
             )
+            }
+            name => format!("self.__{name}({})", m.call()),
         }
-        name => format!("self.__{name}({})", m.call()),
-    }
     });
     let nj = sys.rotation_joints.len();
     let _ = write!(

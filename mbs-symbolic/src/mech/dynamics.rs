@@ -59,12 +59,13 @@ pub struct SceneEquations {
     /// ∂h/∂u (dense, row-major, NQ × NU): how inputs enter the equations
     pub input_matrix: Matrix,
     /// K_t = ∂τ/∂q and C_t = ∂τ/∂qd (dense, row-major), when the model asks for them and the
-    /// scene does not take them from the model's shared parts (`tangent_parts`)
+    /// scene does not take them from the model's shared parts (`shared_parts`)
     pub tangents: Option<(Matrix, Matrix)>,
-    /// With tangents shared by the scenes: the parts of `SymbolicModel::shared_tangents` whose
-    /// sum is this scene's K_t and C_t (the bodies' and the common effects' first, then the
-    /// groups of its other effects); empty when the scene builds its own (`tangents`)
-    pub tangent_parts: Vec<usize>,
+    /// With parts shared by the scenes: the parts of `SymbolicModel::shared_parts` whose
+    /// sum is this scene's τ, and its K_t and C_t (the bodies' and the common effects' first,
+    /// then the groups of its other effects); empty when the scene has its own (`tau()`,
+    /// `tangents`)
+    pub shared_parts: Vec<usize>,
     /// ∂τ/∂p (NQ × NS) for the parameters marked `sensitive`, in declaration order
     pub param_tangents: Option<Matrix>,
     /// With sensitive parameters and tangents: how M, C = ∂τ/∂qd and K = ∂τ/∂q at rest
@@ -101,7 +102,7 @@ impl SceneEquations {
     ) -> SceneEquations {
         let nd = sys.ndof();
         let effects = sys.scene_effects(scene);
-        // the scene takes its tangents from the model's shared parts when its own effects (the
+        // the scene takes τ and its tangents from the model's shared parts when its own effects (the
         // ones not every scene has) act on the coordinates without gravity, which acts through
         // the bodies
         let shares = common.is_some_and(|common| {
@@ -212,7 +213,7 @@ impl SceneEquations {
             static_h,
             input_matrix,
             tangents,
-            tangent_parts: if shares { vec![0] } else { Vec::new() },
+            shared_parts: if shares { vec![0] } else { Vec::new() },
             param_tangents,
             rest_tangent_derivatives,
             kinetic,
@@ -374,7 +375,7 @@ fn time_estimate(a: &Arena, roots: &[ExprId]) -> u32 {
 
 /// Kinetic energy Σ ½ m v_G² + ½ ωᵀ Φ ω, and potential energy of gravity, springs, contacts
 /// and bushings (gravity's measured from the world origin).
-fn energies(sys: &mut System, tree: &Tree, world: &World, loads: &Loads) -> (ExprId, ExprId) {
+pub fn energies(sys: &mut System, tree: &Tree, world: &World, loads: &Loads) -> (ExprId, ExprId) {
     let bk = body_kinematics(&mut sys.arena, tree, None, false);
     let spinning = spinning_frames(sys, tree);
     let a = &mut sys.arena;

@@ -3,14 +3,15 @@
 //! depend on the kinematics and not on each other.
 
 use super::constraints::ConstraintEquations;
-use super::dynamics::{SceneEquations, tangent_matrices};
+use super::dynamics::{SceneEquations, energies, tangent_matrices};
 use super::effects::Loads;
 use super::recursive::{load_tau, newton_euler};
 use super::spatial::{self as s, Matrix};
 use super::system::{Jacobians, System};
 use super::tree::Tree;
 use super::world::{Cols, World, composite_inertias};
-use crate::expr::ExprId;
+use crate::expr::{ExprId, Var};
+use rustc_hash::FxHashMap;
 
 /// Kinematics of a declared point, world axes.
 #[derive(Clone, Debug)]
@@ -22,10 +23,41 @@ pub struct PointKin {
     pub bias: s::V3,
 }
 
-/// K_t and C_t of some loads, emitted once for the scenes that add them.
-pub struct SharedTangents {
+/// K_t and C_t of τ when the model asks for tangents, empty matrices otherwise.
+fn tangents(sys: &mut System, tau: &[ExprId]) -> (Matrix, Matrix) {
+    if sys.options.tangents {
+        tangent_matrices(&mut sys.arena, tau)
+    } else {
+        (Vec::new(), Vec::new())
+    }
+}
+
+/// −τ at qd = 0 and qdd = 0: the static forces h(q, 0) of τ = M qdd − h.
+fn at_rest(sys: &mut System, tau: &[ExprId]) -> Vec<ExprId> {
+    let a = &mut sys.arena;
+    let mut zero = FxHashMap::default();
+    for k in 0..tau.len() {
+        zero.insert(Var::Qd(k as u16), a.zero());
+        zero.insert(Var::Qdd(k as u16), a.zero());
+    }
+    let tau0 = a.substitute(tau, &zero);
+    tau0.into_iter().map(|t| a.neg(t)).collect()
+}
+
+/// A part of τ shared by scenes: the bodies' and the common effects' (the first), or a group
+/// of other effects', emitted once for the scenes that add them (τ is linear in the loads),
+/// with its K_t and C_t when the model asks for tangents (empty otherwise).
+pub struct SharedParts {
     /// the effects whose loads these are (and the bodies', for the first part)
     pub effects: Vec<usize>,
+    pub tau: Vec<ExprId>,
+    /// −τ at qd = 0, qdd = 0: the part's static forces
+    pub static_h: Vec<ExprId>,
+    /// kinetic energy (the bodies', in the first part; 0 in the others), potential energy
+    /// and power of the non-conservative effects
+    pub kinetic: ExprId,
+    pub potential: ExprId,
+    pub power: ExprId,
     pub k: Matrix,
     pub c: Matrix,
 }
@@ -39,8 +71,8 @@ pub struct SymbolicModel {
     pub scenes: Vec<SceneEquations>,
     /// With tangents and several scenes, emitted once each: K and C of the bodies and the
     /// effects every scene has (the first part), then of each group of the other effects that
-    /// the same scenes have; a scene's K and C are the sum of its `tangent_parts`
-    pub shared_tangents: Vec<SharedTangents>,
+    /// the same scenes have; a scene's K and C are the sum of its `shared_parts`
+    pub shared_parts: Vec<SharedParts>,
     /// Φ, B, Φ_t, γ, ∂(Bᵀλ)/∂q of the constraints (empty without constraints)
     pub constraints: ConstraintEquations,
     /// whether the Jacobians of frames and points, and M, are assembled at run time from
@@ -91,11 +123,7 @@ impl SymbolicModel {
                     + eq.tangents.as_ref().map_or(0, |(k, c)| matrices(k, c))
             })
             .sum();
-        let shared: usize = self
-            .shared_tangents
-            .iter()
-            .map(|t| matrices(&t.k, &t.c))
-            .sum();
+        let shared: usize = self.shared_parts.iter().map(|t| matrices(&t.k, &t.c)).sum();
         scenes + shared
     }
 
@@ -110,34 +138,38 @@ impl SymbolicModel {
         } else {
             (0..sys.scenes.len()).map(Some).collect()
         };
-        // τ is linear in the loads: the tangents of the bodies and of the effects every
-        // scene has are built once (not with sensitive parameters, whose derivatives at rest
-        // are built from each scene's whole tangents)
-        let common: Option<Vec<usize>> = (sys.options.tangents
-            && scenes.len() > 1
-            && !sys.params.iter().any(|p| p.sensitive))
-        .then(|| {
-            let all: Vec<Vec<usize>> = scenes.iter().map(|&s| sys.scene_effects(s)).collect();
-            all[0]
-                .iter()
-                .copied()
-                .filter(|e| all.iter().all(|v| v.contains(e)))
-                .collect()
-        });
+        // τ is linear in the loads: τ of the bodies and of the effects every scene has, and
+        // its tangents, are built once (not with sensitive parameters, whose derivatives at
+        // rest are built from each scene's whole tangents)
+        let common: Option<Vec<usize>> =
+            (scenes.len() > 1 && !sys.params.iter().any(|p| p.sensitive)).then(|| {
+                let all: Vec<Vec<usize>> = scenes.iter().map(|&s| sys.scene_effects(s)).collect();
+                all[0]
+                    .iter()
+                    .copied()
+                    .filter(|e| all.iter().all(|v| v.contains(e)))
+                    .collect()
+            });
         let mut scenes: Vec<SceneEquations> = scenes
             .into_iter()
             .map(|s| SceneEquations::build(&mut sys, &tree, &world, s, common.as_deref()))
             .collect();
         let sharing: Vec<usize> = (0..scenes.len())
-            .filter(|&i| !scenes[i].tangent_parts.is_empty())
+            .filter(|&i| !scenes[i].shared_parts.is_empty())
             .collect();
-        let mut shared_tangents = Vec::new();
+        let mut shared_parts = Vec::new();
         if let Some(common) = common.filter(|_| !sharing.is_empty()) {
             let loads = Loads::build(&mut sys, &tree, &world, &common);
             let tau = newton_euler(&mut sys, &tree, &world, &loads, true);
-            let (k, c) = tangent_matrices(&mut sys.arena, &tau);
-            shared_tangents.push(SharedTangents {
+            let (k, c) = tangents(&mut sys, &tau);
+            let (kinetic, potential) = energies(&mut sys, &tree, &world, &loads);
+            shared_parts.push(SharedParts {
                 effects: common.clone(),
+                static_h: at_rest(&mut sys, &tau),
+                tau,
+                kinetic,
+                potential,
+                power: loads.power.unwrap_or(sys.arena.zero()),
                 k,
                 c,
             });
@@ -162,11 +194,21 @@ impl SymbolicModel {
             for (users, effects) in groups {
                 let loads = Loads::build(&mut sys, &tree, &world, &effects);
                 let tau = load_tau(&mut sys, &tree, &world, &loads);
-                let (k, c) = tangent_matrices(&mut sys.arena, &tau);
+                let (k, c) = tangents(&mut sys, &tau);
                 for i in users {
-                    scenes[i].tangent_parts.push(shared_tangents.len());
+                    scenes[i].shared_parts.push(shared_parts.len());
                 }
-                shared_tangents.push(SharedTangents { effects, k, c });
+                let zero = sys.arena.zero();
+                shared_parts.push(SharedParts {
+                    effects,
+                    static_h: at_rest(&mut sys, &tau),
+                    tau,
+                    kinetic: zero,
+                    potential: loads.elastic_potential.unwrap_or(zero),
+                    power: loads.power.unwrap_or(zero),
+                    k,
+                    c,
+                });
             }
         }
         let points: Vec<PointKin> = sys
@@ -221,7 +263,7 @@ impl SymbolicModel {
             world,
             points,
             scenes,
-            shared_tangents,
+            shared_parts,
             constraints,
         }
     }

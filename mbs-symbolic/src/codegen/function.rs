@@ -1,5 +1,5 @@
 //! One generated method: outputs scheduled, emitted, and split into chunk methods when there
-//! are more than [`MAX_LETS`](crate::expr::cse::MAX_LETS) temporaries.
+//! are more than [`MAX_LETS`] temporaries.
 
 use crate::expr::cse::{MAX_LETS, Schedule};
 use crate::expr::emit::{LANES_TYPE, MissingDerivative, Naming, Numbers, emit};

@@ -427,8 +427,9 @@ fn emit_params(
         .into_iter()
         .map(|(f, label)| (f, label.to_string(), None))
         .collect();
-    // τ and its tangents shared by the scenes: of the bodies and the effects every scene has
-    // (written), then of each group of other effects (added)
+    // the parts the scenes share (static forces, energies, power and, with tangents, τ, K
+    // and C): of the bodies and the effects every scene has (written), then of each group of
+    // other effects (added); τ only with tangents (see the scenes' τ in `emit_scene`)
     for (i, part) in model.shared_parts.iter().enumerate() {
         let names: Vec<&str> = part
             .effects
@@ -440,8 +441,6 @@ fn emit_params(
         } else {
             format!("effects {}", names.join(", "))
         };
-        // the first part writes its outputs, the others add theirs
-        // τ too when the scenes take their tangents from the parts (see the scenes' τ below)
         let tau = sys.options.tangents.then(|| {
             let args = with_charts("inverse_dynamics");
             ("inverse_dynamics", args, "tau", part.tau.clone())
@@ -551,9 +550,9 @@ Ok(())
     ops
 }
 
-/// The name of the function of part `i` of the tangents the scenes share.
-/// The method on the parameter struct of shared part `i` of `function` (`inverse_dynamics`,
-/// `tangents`): `__tangents_common`, `__tangents_effects1`, …
+/// The method on the parameter struct of shared part `i` of `function` (`static_forces`,
+/// `energy`, `power`, `inverse_dynamics`, `tangents`): `__tangents_common`,
+/// `__tangents_effects1`, …
 fn shared_part_fn(function: &str, i: usize) -> String {
     match i {
         0 => format!("__{function}_common"),
@@ -844,18 +843,18 @@ fn emit_scene(
     }
     specs.push((f, Some("mass_matrix")));
     let mass_matrix_spec = specs.len() - 1;
-    // τ as the sum of the shared parts when the scene takes its tangents from them, else its
-    // own in one function: without generated tangents the implicit schemes difference τ,
-    // and as the sum of parts (which no longer share subexpressions) it takes 8–9 % more
-    // operations on the hexapod, 15 % more time in a Radau5 run of its `Standing`
-    let shared_tau = !eq.shared_parts.is_empty() && sys.options.tangents;
+    // the static forces, energy and power of the shared parts when the scene has them; τ as
+    // their sum too when the scene takes its tangents from them, else its own in one
+    // function: without generated tangents the implicit schemes difference τ, and as the sum
+    // of parts (which no longer share subexpressions) it takes 8–9 % more operations on the
+    // hexapod, 16–18 % more time in a Radau5 run of its `Standing`
+    let own = eq.shared_parts.is_empty();
+    let shared_tau = !own && sys.options.tangents;
     if !shared_tau {
         let mut f = FnSpec::new("__inverse_dynamics", args("inverse_dynamics"));
         f.vector("tau", eq.tau());
         specs.push((f, Some("inverse_dynamics")));
     }
-    // (static forces, energy and power: of the shared parts when the scene has them)
-    let own = eq.shared_parts.is_empty();
     if let Some((kt, ct)) = &eq.tangents {
         let mut f = FnSpec::new("__tangents", args("tangents"));
         f.matrix(a, "k", kt);
@@ -953,7 +952,7 @@ fn emit_scene(
         }
     }
     // the kinematics and constraint functions, emitted once on the parameters, serve every
-    // scene; the shared tangents' parts those that add them
+    // scene; the shared parts those that add them
     for (label, c, part) in shared.rows {
         if part.is_some_and(|p| !eq.shared_parts.contains(&p)) {
             continue;
@@ -1077,7 +1076,7 @@ fn emit_scene(
             .map(|d| d.independent.to_string())
             .collect::<Vec<_>>()
             .join(", "),
-        tan = eq.tangents.is_some() || (!eq.shared_parts.is_empty() && sys.options.tangents),
+        tan = eq.tangents.is_some() || shared_tau,
         shapes = shapes::literal(&shapes::shapes(sys)),
         joints = sys
             .rotation_joints
@@ -1110,12 +1109,12 @@ fn emit_scene(
             })
             .collect()
     };
-    let shared_body = |function: &str| (!eq.shared_parts.is_empty()).then(|| part_calls(function));
-    let inverse_dynamics_body = shared_body("inverse_dynamics").filter(|_| sys.options.tangents);
+    let shared_body = |function: &str| (!own).then(|| part_calls(function));
+    let inverse_dynamics_body = shared_tau.then(|| part_calls("inverse_dynamics"));
     let static_forces_body = shared_body("static_forces");
     let energy_body = shared_body("energy");
     let power_body = shared_body("power");
-    let tangents_body = if !eq.shared_parts.is_empty() && sys.options.tangents {
+    let tangents_body = if shared_tau {
         part_calls("tangents") + "Ok(())"
     } else if eq.tangents.is_some() {
         "self.__tangents(t, q, qd, qdd, u, k, c);\nOk(())".to_string()

@@ -62,9 +62,9 @@ pub struct SceneEquations {
     /// scene does not take them from the model's shared parts (`shared_parts`)
     pub tangents: Option<(Matrix, Matrix)>,
     /// With parts shared by the scenes: the parts of `SymbolicModel::shared_parts` whose
-    /// sum is this scene's τ, and its K_t and C_t (the bodies' and the common effects' first,
-    /// then the groups of its other effects); empty when the scene has its own (`tau()`,
-    /// `tangents`)
+    /// sums are this scene's static forces, energies, power and, with tangents, τ, K_t and C_t
+    /// (the bodies' and the common effects' first, then the groups of its other effects);
+    /// empty when the scene has its own
     pub shared_parts: Vec<usize>,
     /// ∂τ/∂p (NQ × NS) for the parameters marked `sensitive`, in declaration order
     pub param_tangents: Option<Matrix>,
@@ -102,9 +102,9 @@ impl SceneEquations {
     ) -> SceneEquations {
         let nd = sys.ndof();
         let effects = sys.scene_effects(scene);
-        // the scene takes τ and its tangents from the model's shared parts when its own effects (the
-        // ones not every scene has) act on the coordinates without gravity, which acts through
-        // the bodies
+        // the scene takes its static forces, energies, power (and, with tangents, τ and its
+        // tangents) from the model's shared parts when its own effects (the ones not every
+        // scene has) act on the coordinates without gravity, which acts through the bodies
         let shares = common.is_some_and(|common| {
             let own = effects.iter().filter(|e| !common.contains(e));
             let loads = own.flat_map(|&e| &sys.effects[e].loads);

@@ -69,9 +69,10 @@ pub struct SymbolicModel {
     pub world: World,
     pub points: Vec<PointKin>,
     pub scenes: Vec<SceneEquations>,
-    /// With tangents and several scenes, emitted once each: K and C of the bodies and the
-    /// effects every scene has (the first part), then of each group of the other effects that
-    /// the same scenes have; a scene's K and C are the sum of its `shared_parts`
+    /// With several scenes, emitted once each: τ, static forces, energies, power (and K, C
+    /// with tangents) of the bodies and the effects every scene has (the first part), then of
+    /// each group of the other effects that the same scenes have; a scene's are the sum of
+    /// its `shared_parts`
     pub shared_parts: Vec<SharedParts>,
     /// Φ, B, Φ_t, γ, ∂(Bᵀλ)/∂q of the constraints (empty without constraints)
     pub constraints: ConstraintEquations,

@@ -15,7 +15,9 @@
 //! vertical and fore–aft ground reaction forces in body weights (first peak, trough, second
 //! peak, braking, propulsion, the fore–aft means over the stance's halves), the vertical
 //! impulse against weight × time, the fraction of the cycle with no foot on the ground, the
-//! residual torque, the joint moments (the tracking torques) and the time the run takes.
+//! residual torque, the whole-body angular momentum about the centre of mass (normalised as
+//! Herr & Popovic 2008 do), the joint moments (the tracking torques) and the time the run
+//! takes.
 //!
 //! **Mode 1 on muscles**: the same cycle with the 18 muscles taking the sagittal moments
 //! over (`muscle_cycle`: excitations from static optimisation with reserves at each instant
@@ -136,6 +138,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
     let forces = CycleForces::of(&model, &tracking, &tr, weight);
     print(&forces, mass);
+    if let Some((h, [m, v, height])) = normalised_angular_momentum(&model, &tr, period) {
+        println!(
+            "  whole-body angular momentum about the centre of mass over the cycle, / (M V H) = / ({m:.1} kg × {v:.2} m/s × {height:.2} m): \
+             fore–aft axis [{:+.3}, {:+.3}], vertical [{:+.3}, {:+.3}], lateral [{:+.3}, {:+.3}]",
+            h[0][0], h[0][1], h[1][0], h[1][1], h[2][0], h[2][1]
+        );
+    }
     plots(&forces, mass, &out, &tr, &tracking, info)?;
     mbs::anim::write_html(&out.join("walk.html"), wrapped.info(), &tr)?;
     tr.write_csv(std::fs::File::create(out.join("gait.csv"))?)?;

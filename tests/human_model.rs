@@ -19,7 +19,8 @@
 //!   double hump, braking then propulsion, and the weight's vertical impulse; on muscles
 //!   (the tracking as reserves) the reserves carry less than half the moments, the walk
 //!   unchanged;
-//! - residual torques hold the pelvis on its reference orientation.
+//! - residual torques hold the pelvis on its reference orientation;
+//! - in flight, the angular momentum about the centre of mass (`Centroid`) is conserved.
 
 // the knots below are the sources' numbers (−1.0472 is a table value, not −π/3)
 #![allow(clippy::approx_constant)]
@@ -629,4 +630,82 @@ fn residual_torques_hold_the_pelvis_on_its_reference_orientation() {
     // free, the tilt stays (no torque acts on the whole body in the air); held, it decays
     assert!((free - 0.05).abs() < 0.01, "{free}");
     assert!(held.abs() < 0.1 * 0.05, "{held}");
+}
+
+/// In flight the ground pushes nowhere: under gravity and the tracking's internal torques
+/// the angular momentum about the centre of mass ([`Centroid`]) stays what it was while the
+/// legs swing through half a cycle, and the momentum changes by the weight's impulse.
+#[test]
+fn in_flight_the_angular_momentum_about_the_centre_of_mass_is_conserved() {
+    let model = Human::default();
+    let info = model.info();
+    let n = Human::NQ;
+    let reference = GaitReference::fit(&GaitTable::normal(), info, 1.1, FIT_HARMONICS)
+        .unwrap()
+        .symmetric(info)
+        .unwrap();
+    let (mut q0, mut qd0) = reference_state(&model, &reference, 0.0);
+    q0[1] = 10.0;
+    qd0[0] = 1.2;
+    qd0[3] = 0.3;
+    qd0[5] = -0.2;
+    let tracking = Tracking::new(reference, info, 3000.0, 30.0).unwrap();
+    let t_end = 0.55;
+    let options = Options {
+        q0: Some(q0),
+        qd0: Some(qd0),
+        output: Output::Every { dt: 0.05 },
+        ..Options::adaptive(t_end, 1e-9)
+    };
+    let (tr, _) = mbs::simulate(
+        mbs::WithEfforts::new(model.clone(), tracking),
+        Scheme::Radau5,
+        options,
+    )
+    .unwrap();
+    let mass = total_mass(&model);
+    let mut m = vec![0.0; n * n];
+    let mut at = |s: usize| {
+        let (q, qd) = (&tr.q(s)[..n], &tr.qd(s)[..n]);
+        model.mass_matrix(tr.t[s], q, &mut m);
+        Centroid::of(q, qd, &m, mass).expect("the pelvis away from its angles' singularity")
+    };
+    let first = at(0);
+    let scale = first
+        .angular_momentum
+        .iter()
+        .map(|h| h.abs())
+        .fold(1.0, f64::max);
+    let mut worst = 0.0f64;
+    let mut swing = 0.0f64;
+    for s in 1..tr.len() {
+        let c = at(s);
+        for k in 0..3 {
+            worst = worst.max((c.angular_momentum[k] - first.angular_momentum[k]).abs() / scale);
+        }
+        let dt = tr.t[s] - tr.t[0];
+        let expected = [
+            first.momentum[0],
+            first.momentum[1] - mass * G * dt,
+            first.momentum[2],
+        ];
+        for (k, (got, want)) in c.momentum.iter().zip(expected).enumerate() {
+            assert!(
+                (got - want).abs() < 1e-6 * mass,
+                "momentum {k} at t = {}: {got} against {want}",
+                tr.t[s],
+            );
+        }
+        let (q, q0) = (&tr.q(s)[..n], &tr.q(0)[..n]);
+        swing = swing.max((6..n).map(|j| (q[j] - q0[j]).abs()).fold(0.0, f64::max));
+    }
+    println!(
+        "in flight {t_end} s: angular momentum about the centre of mass {:?} kg·m²/s, its largest change {worst:.2e} of the largest component; joints swung up to {swing:.2} rad",
+        first.angular_momentum
+    );
+    assert!(swing > 0.3, "the legs hardly moved: {swing}");
+    assert!(
+        worst < 1e-6,
+        "angular momentum changed by {worst:.2e} of it"
+    );
 }

@@ -755,6 +755,99 @@ pub fn total_mass(model: &Human) -> f64 {
     m[0]
 }
 
+/// The centre of mass and the angular momentum about it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Centroid {
+    /// the centre of mass (world, m)
+    pub position: [f64; 3],
+    /// the linear momentum (world, kg·m/s)
+    pub momentum: [f64; 3],
+    /// the angular momentum about the centre of mass (world axes, kg·m²/s)
+    pub angular_momentum: [f64; 3],
+}
+
+impl Centroid {
+    /// At (q, q̇), from the mass matrix `m` there (row-major, `Human::NQ` square) and the
+    /// model's `mass`, the pelvis' chart the identity. The pelvis' translation rows give the
+    /// momentum; the columns of its first two angles (rotations about the world's z and
+    /// about Rz(a) y, at the pelvis' origin O) give the centre of mass from O; the
+    /// generalised momenta of its three angles are the momentum about O along their axes
+    /// (z, Rz(a) y, Rz(a) Ry(b) x), less that of the whole mass at the centre of mass.
+    /// `None` where those axes are dependent (cos b = 0, the angles' singularity).
+    pub fn of(q: &[f64], qd: &[f64], m: &[f64], mass: f64) -> Option<Centroid> {
+        let nq = Human::NQ;
+        let row = |r: usize| (0..nq).map(|j| m[r * nq + j] * qd[j]).sum::<f64>();
+        let (sa, ca) = q[3].sin_cos();
+        let (sb, cb) = q[4].sin_cos();
+        let rel = [
+            m[nq + 3] / mass,
+            -m[3] / mass,
+            (ca * m[4] + sa * m[nq + 4]) / mass,
+        ];
+        let axes = mbs::DMatrix::from_row_slice(
+            3,
+            3,
+            &[0.0, 0.0, 1.0, -sa, ca, 0.0, ca * cb, sa * cb, -sb],
+        );
+        let h_o = axes.lu().solve(&mbs::DMatrix::from_column_slice(
+            3,
+            1,
+            &[row(3), row(4), row(5)],
+        ))?;
+        let p = [row(0), row(1), row(2)];
+        Some(Centroid {
+            position: std::array::from_fn(|k| q[k] + rel[k]),
+            momentum: p,
+            angular_momentum: [
+                h_o[0] - (rel[1] * p[2] - rel[2] * p[1]),
+                h_o[1] - (rel[2] * p[0] - rel[0] * p[2]),
+                h_o[2] - (rel[0] * p[1] - rel[1] * p[0]),
+            ],
+        })
+    }
+}
+
+/// The whole-body angular momentum about the centre of mass over the last whole cycle of
+/// `tr` (a run of `model`, its first `Human::NQ` coordinates; [`last_cycle_start`]),
+/// normalised as Herr & Popovic (2008, "Angular momentum in human walking") do: by the mass,
+/// the centre of mass' mean height over the ground and the walking speed (its mean
+/// fore–aft speed over the cycle). Per world axis (fore–aft x, vertical y, lateral z): the
+/// least and the largest value, and (M, V, H). `None` if the run has fewer than two
+/// samples in that cycle or reaches the pelvis' angles' singularity.
+pub fn normalised_angular_momentum(
+    model: &Human,
+    tr: &mbs::Trajectory,
+    period: f64,
+) -> Option<([[f64; 2]; 3], [f64; 3])> {
+    let n = Human::NQ;
+    let mass = total_mass(model);
+    let start = last_cycle_start(tr, period);
+    let mut m = vec![0.0; n * n];
+    let mut samples = Vec::new();
+    for s in (0..tr.len()).filter(|s| tr.t[*s] >= start - 1e-9) {
+        let (q, qd) = (&tr.q(s)[..n], &tr.qd(s)[..n]);
+        model.mass_matrix(tr.t[s], q, &mut m);
+        samples.push((tr.t[s], Centroid::of(q, qd, &m, mass)?));
+    }
+    let (first, last) = (samples.first()?, samples.last()?);
+    let time = last.0 - first.0;
+    if samples.len() < 2 || time <= 0.0 {
+        return None;
+    }
+    let speed = (last.1.position[0] - first.1.position[0]) / time;
+    let height = samples.iter().map(|(_, c)| c.position[1]).sum::<f64>() / samples.len() as f64;
+    let scale = mass * speed * height;
+    let range = |k: usize| {
+        samples
+            .iter()
+            .map(|(_, c)| c.angular_momentum[k] / scale)
+            .fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], v| {
+                [lo.min(v), hi.max(v)]
+            })
+    };
+    Some(([range(0), range(1), range(2)], [mass, speed, height]))
+}
+
 /// The least-squares problem of [`GaitReference::grounded`].
 struct Pass<'a> {
     model: &'a Human,

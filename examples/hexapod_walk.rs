@@ -282,10 +282,11 @@ fn write_outputs(out: &Path, w: &Walk, f: &Figures) -> Result<(), Box<dyn std::e
             (0..tr.len()).map(|i| (t[i], tr.qd(i)[0])).collect(),
         )],
     )?;
-    let model = HexapodWalker::default();
+    let mut model = HexapodWalker::default();
     let mut kin = mbs::Kinematics::new::<HexapodWalker>();
     let mut feet = vec![Vec::new(); LEGS];
     for (i, &ti) in t.iter().enumerate() {
+        mbs::charts::use_charts_of(&mut model, tr, i);
         model.point_kinematics(ti, &tr.q(i)[..n], &tr.qd(i)[..n], &mut kin);
         for (leg, s) in feet.iter_mut().enumerate() {
             let p = &kin.points[leg];

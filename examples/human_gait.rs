@@ -371,7 +371,9 @@ fn muscle_plot(
         .iter()
         .map(|(u, _)| Series::new(&u.name, Vec::new()))
         .collect();
+    let mut model = model.clone();
     for s in 0..tr.len() {
+        mbs::charts::use_charts_of(&mut model, tr, s);
         model.kinematics(tr.t[s], &tr.q(s)[..n], &tr.qd(s)[..n], &mut kin);
         let x = &tr.qd(s)[n..];
         for (i, line) in lines.iter_mut().enumerate() {

@@ -950,8 +950,11 @@ impl Walk {
             [f64::INFINITY, f64::NEG_INFINITY],
             [f64::INFINITY, f64::NEG_INFINITY],
         );
+        let mut model = model.clone();
         for i in 0..tr.len() {
             let (q, qd) = (&tr.q(i)[..n], &tr.qd(i)[..n]);
+            // the base's angles in the chart the run read them in
+            mbs::charts::use_charts_of(&mut model, tr, i);
             model.point_kinematics(tr.t[i], q, qd, &mut kin);
             for (leg, slot) in touch.iter_mut().enumerate() {
                 let p = kin.points[leg].position;

@@ -767,42 +767,57 @@ pub struct Centroid {
 }
 
 impl Centroid {
-    /// At (q, q̇), from the mass matrix `m` there (row-major, `Human::NQ` square) and the
-    /// model's `mass`, the pelvis' chart the identity. The pelvis' translation rows give the
-    /// momentum; the columns of its first two angles (rotations about the world's z and
-    /// about Rz(a) y, at the pelvis' origin O) give the centre of mass from O; the
-    /// generalised momenta of its three angles are the momentum about O along their axes
-    /// (z, Rz(a) y, Rz(a) Ry(b) x), less that of the whole mass at the centre of mass.
-    /// `None` where those axes are dependent (cos b = 0, the angles' singularity).
-    pub fn of(q: &[f64], qd: &[f64], m: &[f64], mass: f64) -> Option<Centroid> {
+    /// At (t, q, q̇), from `model`'s mass matrix there and its pelvis' chart C (q, q̇ read
+    /// in it, as the simulation left them: [`mbs::charts::use_charts_of`]). The pelvis'
+    /// angles turn about the world axes a₁ = C z, a₂ = C Rz(a) y, a₃ = C Rz(a) Ry(b) x at the
+    /// pelvis' origin O, so the translation rows of their columns of M are m (aⱼ × r), r the
+    /// centre of mass from O, and their generalised momenta are aⱼ · H_O. The pelvis'
+    /// translation rows give the momentum; H_G = H_O − r × p. `None` where the axes are
+    /// dependent (cos b = 0, the chart's singularity, which the simulation re-centres away
+    /// from).
+    pub fn of(model: &Human, t: f64, q: &[f64], qd: &[f64]) -> Option<Centroid> {
         let nq = Human::NQ;
+        let mut m = vec![0.0; nq * nq];
+        model.mass_matrix(t, q, &mut m);
+        let mass = m[0];
         let row = |r: usize| (0..nq).map(|j| m[r * nq + j] * qd[j]).sum::<f64>();
+        let column = |j: usize| [0, 1, 2].map(|r| m[r * nq + j] / mass);
+        let c = model.chart(0);
+        let turn = |v: [f64; 3]| -> [f64; 3] {
+            std::array::from_fn(|i| (0..3).map(|k| c[i][k] * v[k]).sum())
+        };
         let (sa, ca) = q[3].sin_cos();
         let (sb, cb) = q[4].sin_cos();
-        let rel = [
-            m[nq + 3] / mass,
-            -m[3] / mass,
-            (ca * m[4] + sa * m[nq + 4]) / mass,
+        let axes = [
+            turn([0.0, 0.0, 1.0]),
+            turn([-sa, ca, 0.0]),
+            turn([ca * cb, sa * cb, -sb]),
         ];
-        let axes = mbs::DMatrix::from_row_slice(
-            3,
-            3,
-            &[0.0, 0.0, 1.0, -sa, ca, 0.0, ca * cb, sa * cb, -sb],
-        );
-        let h_o = axes.lu().solve(&mbs::DMatrix::from_column_slice(
+        let cross = |u: [f64; 3], v: [f64; 3]| {
+            [
+                u[1] * v[2] - u[2] * v[1],
+                u[2] * v[0] - u[0] * v[2],
+                u[0] * v[1] - u[1] * v[0],
+            ]
+        };
+        let dot = |u: [f64; 3], v: [f64; 3]| (0..3).map(|i| u[i] * v[i]).sum::<f64>();
+        // r from a₁ × r and a₂ × r (a₁ ⊥ a₂): its part across a₁, (a₁ × r) × a₁, and its
+        // part along a₁, which lies across a₂
+        let across = cross(column(3), axes[0]);
+        let along = dot(cross(column(4), axes[1]), axes[0]);
+        let rel: [f64; 3] = std::array::from_fn(|i| across[i] + along * axes[0][i]);
+        let a = mbs::DMatrix::from_fn(3, 3, |i, j| axes[i][j]);
+        let h_o = a.lu().solve(&mbs::DMatrix::from_column_slice(
             3,
             1,
             &[row(3), row(4), row(5)],
         ))?;
         let p = [row(0), row(1), row(2)];
+        let rp = cross(rel, p);
         Some(Centroid {
             position: std::array::from_fn(|k| q[k] + rel[k]),
             momentum: p,
-            angular_momentum: [
-                h_o[0] - (rel[1] * p[2] - rel[2] * p[1]),
-                h_o[1] - (rel[2] * p[0] - rel[0] * p[2]),
-                h_o[2] - (rel[0] * p[1] - rel[1] * p[0]),
-            ],
+            angular_momentum: std::array::from_fn(|k| h_o[k] - rp[k]),
         })
     }
 }
@@ -822,12 +837,12 @@ pub fn normalised_angular_momentum(
     let n = Human::NQ;
     let mass = total_mass(model);
     let start = last_cycle_start(tr, period);
-    let mut m = vec![0.0; n * n];
+    let mut model = model.clone();
     let mut samples = Vec::new();
     for s in (0..tr.len()).filter(|s| tr.t[*s] >= start - 1e-9) {
         let (q, qd) = (&tr.q(s)[..n], &tr.qd(s)[..n]);
-        model.mass_matrix(tr.t[s], q, &mut m);
-        samples.push((tr.t[s], Centroid::of(q, qd, &m, mass)?));
+        mbs::charts::use_charts_of(&mut model, tr, s);
+        samples.push((tr.t[s], Centroid::of(&model, tr.t[s], q, qd)?));
     }
     let (first, last) = (samples.first()?, samples.last()?);
     let time = last.0 - first.0;
@@ -1596,9 +1611,12 @@ impl CycleForces {
         let (mut grf, mut impulse, mut airborne, mut r2, mut rmax) =
             (Vec::new(), 0.0, 0.0, 0.0, 0.0f64);
         let mut last: Option<(f64, f64)> = None;
+        let mut model = model.clone();
         for i in (0..tr.len()).filter(|i| tr.t[*i] >= start - 1e-9) {
             let (q, qd) = (&tr.q(i)[..n], &tr.qd(i)[..n]);
-            let f = ground_forces(model, tr.t[i], q, qd, &mut kin);
+            // the pelvis' angles in the chart the run read them in
+            mbs::charts::use_charts_of(&mut model, tr, i);
+            let f = ground_forces(&model, tr.t[i], q, qd, &mut kin);
             let torque = tracking.pelvis_torque(tr.t[i], &kin);
             let r = torque.iter().map(|x| x * x).sum::<f64>().sqrt();
             let bw = |v: [f64; 3]| v.map(|x| x / weight);

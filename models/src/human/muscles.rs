@@ -700,9 +700,11 @@ pub fn muscle_cycle(
     let mut kin = Kinematics::new::<Human>();
     let mut activations = Vec::with_capacity(instants.len());
     let mut shares = Vec::with_capacity(instants.len());
+    let mut read = model.clone();
     for &s in &instants {
         let (t, q, qd) = (tr.t[s], &tr.q(s)[..n], &tr.qd(s)[..n]);
-        model.kinematics(t, q, qd, &mut kin);
+        mbs::charts::use_charts_of(&mut read, tr, s);
+        read.kinematics(t, q, qd, &mut kin);
         let torques: Vec<(usize, f64)> = tracking.torques(t, q, qd).collect();
         let moments = driven.moments_asked(info, &torques, q)?;
         let (a, reserves) = driven

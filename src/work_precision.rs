@@ -670,7 +670,11 @@ impl Study {
         joints
     }
 
-    fn measure<M: Model>(&self, model: &M, tr: &Trajectory) -> Result<Accuracy, RunFailure> {
+    fn measure<M: Model + Clone>(
+        &self,
+        model: &M,
+        tr: &Trajectory,
+    ) -> Result<Accuracy, RunFailure> {
         let r = &self.reference;
         let y = tr.measured_states(&self.joints(model));
         let times_match = y.len() == r.times.len()

@@ -245,11 +245,14 @@ impl Trajectory {
 
     /// Largest |Φ_i(t, q)| of `model`'s constraints over the outputs (0 without constraints):
     /// the drift of a run, on the integrator's own states with `Output::Steps`, on
-    /// interpolated ones between them otherwise.
-    pub fn constraint_residual<M: crate::model::Model>(&self, model: &M) -> f64 {
+    /// interpolated ones between them otherwise; each output read in the charts the run read
+    /// it in (on a copy of `model`).
+    pub fn constraint_residual<M: crate::model::Model + Clone>(&self, model: &M) -> f64 {
         let mut phi = vec![0.0; M::NC];
         let mut worst = 0.0f64;
+        let mut model = model.clone();
         for i in 0..self.len() {
+            crate::charts::use_charts_of(&mut model, self, i);
             model.constraints(self.t[i], self.q(i), &mut phi);
             worst = phi.iter().fold(worst, |w, p| w.max(p.abs()));
         }

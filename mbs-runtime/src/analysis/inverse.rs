@@ -91,22 +91,31 @@ pub fn inverse_dynamics_along<M: Model>(
 }
 
 /// τ along a recorded trajectory (its t, q, qd, qdd), e.g. to check that a simulation needed
-/// no actuation, or to drive a model along a measured motion.
-pub fn inverse_dynamics_of<M: Model>(
+/// no actuation, or to drive a model along a measured motion. Each output is read in the
+/// charts the run read it in ([`crate::charts::use_charts_of`], on a copy of `model`).
+pub fn inverse_dynamics_of<M: Model + Clone>(
     model: &M,
     trajectory: &Trajectory,
     u: &[f64],
 ) -> Result<Efforts, AnalysisError> {
-    let mut i = 0;
-    inverse_dynamics_along(model, &trajectory.t, u, |_| {
-        let s = (
-            trajectory.q(i).to_vec(),
-            trajectory.qd(i).to_vec(),
-            trajectory.qdd(i).to_vec(),
-        );
-        i += 1;
-        s
-    })
+    let mut read = model.clone();
+    let mut out = inverse_dynamics_along(model, &[], u, |_| (vec![], vec![], vec![]))?;
+    for i in 0..trajectory.len() {
+        crate::charts::use_charts_of(&mut read, trajectory, i);
+        let one = inverse_dynamics_along(&read, &trajectory.t[i..=i], u, |_| state(trajectory, i))?;
+        out.t.extend(one.t);
+        out.tau.extend(one.tau);
+    }
+    Ok(out)
+}
+
+/// Output `i` of `trajectory`: (q, qd, qdd).
+fn state(trajectory: &Trajectory, i: usize) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    (
+        trajectory.q(i).to_vec(),
+        trajectory.qd(i).to_vec(),
+        trajectory.qdd(i).to_vec(),
+    )
 }
 
 /// Actuator efforts and constraint reactions along a motion of a constrained model
@@ -304,21 +313,29 @@ pub fn inverse_dynamics_actuated_along<M: Model>(
     Ok(out)
 }
 
-/// [`inverse_dynamics_actuated_along`] along a recorded trajectory (its t, q, qd, qdd).
-pub fn inverse_dynamics_actuated_of<M: Model>(
+/// [`inverse_dynamics_actuated_along`] along a recorded trajectory (its t, q, qd, qdd), each
+/// output read in the charts the run read it in (on a copy of `model`).
+pub fn inverse_dynamics_actuated_of<M: Model + Clone>(
     model: &M,
     trajectory: &Trajectory,
     u: &[f64],
     actuated: &[usize],
 ) -> Result<ActuatedEfforts, AnalysisError> {
-    let mut i = 0;
-    inverse_dynamics_actuated_along(model, &trajectory.t, u, actuated, |_| {
-        let s = (
-            trajectory.q(i).to_vec(),
-            trajectory.qd(i).to_vec(),
-            trajectory.qdd(i).to_vec(),
-        );
-        i += 1;
-        s
-    })
+    let mut read = model.clone();
+    let mut out =
+        inverse_dynamics_actuated_along(model, &[], u, actuated, |_| (vec![], vec![], vec![]))?;
+    for i in 0..trajectory.len() {
+        crate::charts::use_charts_of(&mut read, trajectory, i);
+        let one =
+            inverse_dynamics_actuated_along(&read, &trajectory.t[i..=i], u, actuated, |_| {
+                state(trajectory, i)
+            })?;
+        out.t.extend(one.t);
+        out.tau.extend(one.tau);
+        out.lambda.extend(one.lambda);
+        out.phi.extend(one.phi);
+        out.phi_dot.extend(one.phi_dot);
+        out.phi_ddot.extend(one.phi_ddot);
+    }
+    Ok(out)
 }

@@ -11,7 +11,8 @@
 //!   each foot, the pelvis stays within a centimetre;
 //! - passive joint moments: the law by hand, the viscous states' relaxation along a run,
 //!   and a collapsing body caught near its joints' ranges (without them its toes spin);
-//! - a knee beyond its splines' tables and a foot through the ground are typed failures;
+//! - a knee beyond its splines' tables, a foot through the ground and a body fallen through
+//!   it are typed failures;
 //! - the symmetric grounded cycle levels the feet in double support and keeps them from
 //!   sliding apart, lifts the swinging foot and keeps the centre of mass' acceleration
 //!   within the bounds asked, at nearly the published walking speed;
@@ -410,7 +411,17 @@ fn a_knee_beyond_its_tables_or_a_foot_through_the_ground_is_a_typed_failure() {
     println!("{e}");
     assert!(matches!(e.kind, mbs::Failure::EffortRejected { .. }), "{e}");
     assert!(e.to_string().contains("into the ground"), "{e}");
-    let _ = n;
+    // the body dropped upside down from a metre: its torso reaches the ground first, and
+    // nothing but the feet meets the ground
+    let reference = GaitReference::still(info, 0.1).unwrap();
+    let mut q = q0.clone();
+    q[1] = 1.0;
+    q[5] = std::f64::consts::PI;
+    let e = run(held(reference), q, vec![0.0; n]);
+    println!("{e}");
+    assert!(matches!(e.kind, mbs::Failure::EffortRejected { .. }), "{e}");
+    assert!(e.to_string().contains("frame torso"), "{e}");
+    assert!(e.t > 0.3 && e.trajectory.len() > 1, "the fall is kept");
 }
 
 /// The lowest support point of each foot at `t` on `reference` (pelvis at the model's start).

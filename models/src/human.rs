@@ -1465,9 +1465,11 @@ pub const KNEE_TABLE: f64 = 2.0944;
 
 /// What a run of the model must not do silently, checked at every evaluation of the parts
 /// that drive it ([`Tracking`], [`PassiveJoints`]): a knee beyond its splines' tables (the
-/// tibia's translation would be extrapolated) and an ellipsoid deeper in the ground than its
-/// smallest semi-axis (the foot has passed through the ground). Each is an `Err` naming the
-/// coordinate or the ellipsoid. In a run ([`Guard::apply`]) it rejects the state
+/// tibia's translation would be extrapolated), an ellipsoid deeper in the ground than its
+/// smallest semi-axis (the foot has passed through the ground), and the origin of the
+/// pelvis, the torso, a hip or a knee below the ground (only the feet meet the ground: a
+/// body that falls goes through it). Each is an `Err` naming the coordinate, the ellipsoid
+/// or the frame. In a run ([`Guard::apply`]) it rejects the state
 /// ([`mbs::Effort::reject`]): an overshooting trial state of a large step is retried smaller,
 /// and a motion that really goes there stops with `Failure::EffortRejected`, trajectory
 /// kept.
@@ -1475,6 +1477,8 @@ pub const KNEE_TABLE: f64 = 2.0944;
 pub struct Guard {
     feet: Feet,
     knees: [usize; 2],
+    /// the frames above the feet that must stay above the ground, and their names
+    above: [(usize, &'static str); 6],
 }
 
 impl Guard {
@@ -1482,6 +1486,21 @@ impl Guard {
         Ok(Guard {
             feet: Feet::of(info),
             knees: [dof_index(info, "knee[0]")?, dof_index(info, "knee[1]")?],
+            above: {
+                let frame = |name: &'static str| {
+                    info.frame_index(name)
+                        .map(|i| (i, name))
+                        .ok_or_else(|| format!("the model has no frame `{name}`"))
+                };
+                [
+                    frame("pelvis_o")?,
+                    frame("torso")?,
+                    frame("femur_o[0]")?,
+                    frame("femur_o[1]")?,
+                    frame("tibia_o[0]")?,
+                    frame("tibia_o[1]")?,
+                ]
+            },
         })
     }
 
@@ -1513,6 +1532,15 @@ impl Guard {
                         -x[1]
                     ));
                 }
+            }
+        }
+        for (i, name) in self.above {
+            let y = kin.frames[i].pose.position[1];
+            if y < 0.0 {
+                return Err(format!(
+                    "the frame {name} is {:.1e} m below the ground: the body has fallen through it (only the feet's ellipsoids meet the ground)",
+                    -y
+                ));
             }
         }
         Ok(())

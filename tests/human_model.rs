@@ -207,6 +207,8 @@ fn the_model_stands_on_its_feet() {
         options,
     )
     .expect("standing is a regular run");
+    // no walking speed to normalise the angular momentum by
+    assert!(normalised_angular_momentum(&model, &tr, 1.1).is_none());
     let last = tr.len() - 1;
     let (ql, qdl) = (&tr.q(last)[..n], &tr.qd(last)[..n]);
     let mut kin = Kinematics::new::<Human>();
@@ -537,6 +539,15 @@ fn the_prescribed_cycle_gives_a_normal_double_hump_braking_then_propulsion_also_
     )
     .unwrap();
     let weight = total_mass(&model) * G;
+    // the whole-body angular momentum over the cycle, normalised by mass, speed and height
+    let (h, [_, speed, height]) = normalised_angular_momentum(&model, &tr, period).unwrap();
+    println!("angular momentum / (M V H), V = {speed:.2} m/s, H = {height:.2} m: {h:?}");
+    assert!((1.0..1.3).contains(&speed) && (0.85..1.0).contains(&height));
+    assert!(
+        h.iter()
+            .all(|[lo, hi]| lo < hi && lo.abs() < 0.2 && hi.abs() < 0.2),
+        "{h:?}"
+    );
     let c = CycleForces::of(&model, &tracking, &tr, weight);
     let (right, left) = (c.figures(0), c.figures(1));
     println!(

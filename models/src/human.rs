@@ -828,7 +828,8 @@ impl Centroid {
 /// the centre of mass' mean height over the ground and the walking speed (its mean
 /// fore–aft speed over the cycle). Per world axis (fore–aft x, vertical y, lateral z): the
 /// least and the largest value, and (M, V, H). `None` if the run has fewer than two
-/// samples in that cycle or reaches the pelvis' angles' singularity.
+/// samples in that cycle, walks forward (x) at less than 0.1 m/s over it (the normalisation
+/// needs a walking speed), or reaches the pelvis' angles' singularity.
 pub fn normalised_angular_momentum(
     model: &Human,
     tr: &mbs::Trajectory,
@@ -850,6 +851,9 @@ pub fn normalised_angular_momentum(
         return None;
     }
     let speed = (last.1.position[0] - first.1.position[0]) / time;
+    if speed < 0.1 {
+        return None;
+    }
     let height = samples.iter().map(|(_, c)| c.position[1]).sum::<f64>() / samples.len() as f64;
     let scale = mass * speed * height;
     let range = |k: usize| {

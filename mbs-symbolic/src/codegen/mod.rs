@@ -1109,11 +1109,25 @@ fn emit_scene(
             })
             .collect()
     };
-    let shared_body = |function: &str| (!own).then(|| part_calls(function));
-    let inverse_dynamics_body = shared_tau.then(|| part_calls("inverse_dynamics"));
-    let static_forces_body = shared_body("static_forces");
-    let energy_body = shared_body("energy");
-    let power_body = shared_body("power");
+    // the methods whose bodies are these calls
+    let mut shared_bodies: Vec<(&str, String)> = Vec::new();
+    if shared_tau {
+        shared_bodies.push(("inverse_dynamics", part_calls("inverse_dynamics")));
+    }
+    if !own {
+        shared_bodies.push(("static_forces", part_calls("static_forces")));
+        shared_bodies.push((
+            "energy",
+            format!(
+                "let mut e = [0.0f64; 2];\n{}::mbs::Energy {{ kinetic: e[0], potential: e[1] }}",
+                part_calls("energy")
+            ),
+        ));
+        shared_bodies.push((
+            "power",
+            format!("let mut e = [0.0f64; 1];\n{}e[0]", part_calls("power")),
+        ));
+    }
     let tangents_body = if shared_tau {
         part_calls("tangents") + "Ok(())"
     } else if eq.tangents.is_some() {
@@ -1147,6 +1161,9 @@ fn emit_scene(
     };
     let assembled = model.assembled;
     let model_impl = api::model_impl(&ty, &pty, &sizes, |m| {
+        if let Some((_, body)) = shared_bodies.iter().find(|(name, _)| *name == m.name) {
+            return body.clone();
+        }
         match m.name {
             "info" => format!("{info}\n&INFO"),
             "params" => "&self.params".into(),
@@ -1154,9 +1171,6 @@ fn emit_scene(
                 "::mbs::Parameters::validate(&params)?;\nself.params = params;\nOk(())".into()
             }
             "tangents" => tangents_body.clone(),
-            "inverse_dynamics" if inverse_dynamics_body.is_some() => {
-                inverse_dynamics_body.clone().unwrap_or_default()
-            }
             "parameter_tangents" => {
                 format!("self.__parameter_tangents({})", m.call()) + ";\nOk(())"
             }
@@ -1185,21 +1199,8 @@ fn emit_scene(
                     m.call()
                 ) + ";\nOk(())"
             }
-            "energy" => format!(
-                "let mut e = [0.0f64; 2];\n{}::mbs::Energy {{ kinetic: e[0], potential: e[1] }}",
-                energy_body
-                    .clone()
-                    .unwrap_or_else(|| "self.__energy(t, q, qd, &mut e);\n".into())
-            ),
-            "power" => format!(
-                "let mut e = [0.0f64; 1];\n{}e[0]",
-                power_body
-                    .clone()
-                    .unwrap_or_else(|| "self.__power(t, q, qd, u, &mut e);\n".into())
-            ),
-            "static_forces" if static_forces_body.is_some() => {
-                static_forces_body.clone().unwrap_or_default()
-            }
+            "energy" => "let mut e = [0.0f64; 2];\nself.__energy(t, q, qd, &mut e);\n::mbs::Energy { kinetic: e[0], potential: e[1] }".into(),
+            "power" => "let mut e = [0.0f64; 1];\nself.__power(t, q, qd, u, &mut e);\ne[0]".into(),
             // the constraint functions live on the parameter struct, shared by every scene
             name if name.starts_with("constraint") => {
                 format!("self.params.__{name}(&self.charts, {})", m.call())

@@ -175,11 +175,7 @@ impl SceneEquations {
         });
         let rest_tangent_derivatives = match (&tangents, param_tangents.is_some()) {
             (Some((k, c)), true) => {
-                let mut rest = FxHashMap::default();
-                for j in 0..nd {
-                    rest.insert(Var::Qd(j as u16), a.zero());
-                    rest.insert(Var::Qdd(j as u16), a.zero());
-                }
+                let rest = at_rest(a, nd);
                 let m: Matrix = tau
                     .iter()
                     .map(|&t| (0..nd).map(|j| a.diff(t, Var::Qdd(j as u16))).collect())
@@ -371,6 +367,16 @@ fn forward_forms(
 fn time_estimate(a: &Arena, roots: &[ExprId]) -> u32 {
     let flops = crate::expr::ops(a, roots).flops() as u32;
     (flops / 2).max(crate::expr::critical_path(a, roots))
+}
+
+/// The substitution of a state at rest, qd = 0 and qdd = 0 (n coordinates).
+pub fn at_rest(a: &mut Arena, n: usize) -> FxHashMap<Var, ExprId> {
+    let mut rest = FxHashMap::default();
+    for k in 0..n {
+        rest.insert(Var::Qd(k as u16), a.zero());
+        rest.insert(Var::Qdd(k as u16), a.zero());
+    }
+    rest
 }
 
 /// Kinetic energy Σ ½ m v_G² + ½ ωᵀ Φ ω, and potential energy of gravity, springs, contacts

@@ -3,15 +3,14 @@
 //! depend on the kinematics and not on each other.
 
 use super::constraints::ConstraintEquations;
-use super::dynamics::{SceneEquations, energies, tangent_matrices};
+use super::dynamics::{SceneEquations, at_rest, energies, tangent_matrices};
 use super::effects::Loads;
 use super::recursive::{load_tau, newton_euler};
 use super::spatial::{self as s, Matrix};
 use super::system::{Jacobians, System};
 use super::tree::Tree;
 use super::world::{Cols, World, composite_inertias};
-use crate::expr::{ExprId, Var};
-use rustc_hash::FxHashMap;
+use crate::expr::ExprId;
 
 /// Kinematics of a declared point, world axes.
 #[derive(Clone, Debug)]
@@ -33,14 +32,10 @@ fn tangents(sys: &mut System, tau: &[ExprId]) -> (Matrix, Matrix) {
 }
 
 /// −τ at qd = 0 and qdd = 0: the static forces h(q, 0) of τ = M qdd − h.
-fn at_rest(sys: &mut System, tau: &[ExprId]) -> Vec<ExprId> {
+fn static_forces(sys: &mut System, tau: &[ExprId]) -> Vec<ExprId> {
     let a = &mut sys.arena;
-    let mut zero = FxHashMap::default();
-    for k in 0..tau.len() {
-        zero.insert(Var::Qd(k as u16), a.zero());
-        zero.insert(Var::Qdd(k as u16), a.zero());
-    }
-    let tau0 = a.substitute(tau, &zero);
+    let rest = at_rest(a, tau.len());
+    let tau0 = a.substitute(tau, &rest);
     tau0.into_iter().map(|t| a.neg(t)).collect()
 }
 
@@ -166,7 +161,7 @@ impl SymbolicModel {
             let (kinetic, potential) = energies(&mut sys, &tree, &world, &loads);
             shared_parts.push(SharedParts {
                 effects: common.clone(),
-                static_h: at_rest(&mut sys, &tau),
+                static_h: static_forces(&mut sys, &tau),
                 tau,
                 kinetic,
                 potential,
@@ -202,7 +197,7 @@ impl SymbolicModel {
                 let zero = sys.arena.zero();
                 shared_parts.push(SharedParts {
                     effects,
-                    static_h: at_rest(&mut sys, &tau),
+                    static_h: static_forces(&mut sys, &tau),
                     tau,
                     kinetic: zero,
                     potential: loads.elastic_potential.unwrap_or(zero),

@@ -54,40 +54,15 @@ pub fn inverse_dynamics_along<M: Model>(
     u: &[f64],
     mut path: impl FnMut(f64) -> (Vec<f64>, Vec<f64>, Vec<f64>),
 ) -> Result<Efforts, AnalysisError> {
-    let n = M::NQ;
-    if u.len() != M::NU {
-        return Err(Failure::InvalidOption {
-            name: "u",
-            value: u.len().to_string(),
-            reason: "must have one value per input",
-        }
-        .into());
-    }
-    let info = model.info();
-    let mut tau = Vec::with_capacity(n * times.len());
-    let mut row = vec![0.0; n];
+    let mut out = efforts(model, u, times.len())?;
+    let mut row = vec![0.0; M::NQ];
     for &t in times {
         let (q, qd, qdd) = path(t);
-        if q.len() != n || qd.len() != n || qdd.len() != n {
-            return Err(Failure::InvalidOption {
-                name: "path",
-                value: t.to_string(),
-                reason: "must give q, qd and qdd with one value per coordinate",
-            }
-            .into());
-        }
-        for v in [&q, &qd, &qdd] {
-            check(model, "path", v)?;
-        }
-        model.inverse_dynamics(t, &q, &qd, &qdd, u, &mut row);
-        check(model, "τ", &row)?;
-        tau.extend_from_slice(&row);
+        tau_at(model, t, [&q, &qd, &qdd], u, &mut row)?;
+        out.t.push(t);
+        out.tau.extend_from_slice(&row);
     }
-    Ok(Efforts {
-        dof_names: (0..n).map(|i| info.dof_label(i)).collect(),
-        t: times.to_vec(),
-        tau,
-    })
+    Ok(out)
 }
 
 /// τ along a recorded trajectory (its t, q, qd, qdd), e.g. to check that a simulation needed
@@ -98,24 +73,71 @@ pub fn inverse_dynamics_of<M: Model + Clone>(
     trajectory: &Trajectory,
     u: &[f64],
 ) -> Result<Efforts, AnalysisError> {
+    let mut out = efforts(model, u, trajectory.len())?;
     let mut read = model.clone();
-    let mut out = inverse_dynamics_along(model, &[], u, |_| (vec![], vec![], vec![]))?;
+    let mut row = vec![0.0; M::NQ];
     for i in 0..trajectory.len() {
         crate::charts::use_charts_of(&mut read, trajectory, i);
-        let one = inverse_dynamics_along(&read, &trajectory.t[i..=i], u, |_| state(trajectory, i))?;
-        out.t.extend(one.t);
-        out.tau.extend(one.tau);
+        let t = trajectory.t[i];
+        tau_at(&read, t, state(trajectory, i), u, &mut row)?;
+        out.t.push(t);
+        out.tau.extend_from_slice(&row);
     }
     Ok(out)
 }
 
-/// Output `i` of `trajectory`: (q, qd, qdd).
-fn state(trajectory: &Trajectory, i: usize) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
-    (
-        trajectory.q(i).to_vec(),
-        trajectory.qd(i).to_vec(),
-        trajectory.qdd(i).to_vec(),
-    )
+/// Output `i` of `trajectory`: [q, qd, qdd].
+fn state(trajectory: &Trajectory, i: usize) -> [&[f64]; 3] {
+    [trajectory.q(i), trajectory.qd(i), trajectory.qdd(i)]
+}
+
+/// No efforts yet, room for `times` times, once the inputs `u` are checked.
+fn efforts<M: Model>(model: &M, u: &[f64], times: usize) -> Result<Efforts, AnalysisError> {
+    let n = M::NQ;
+    if u.len() != M::NU {
+        return Err(Failure::InvalidOption {
+            name: "u",
+            value: u.len().to_string(),
+            reason: "must have one value per input",
+        }
+        .into());
+    }
+    let info = model.info();
+    Ok(Efforts {
+        dof_names: (0..n).map(|i| info.dof_label(i)).collect(),
+        t: Vec::with_capacity(times),
+        tau: Vec::with_capacity(n * times),
+    })
+}
+
+/// τ at one time of a motion into `row`, the state and τ checked.
+fn tau_at<M: Model>(
+    model: &M,
+    t: f64,
+    state: [&[f64]; 3],
+    u: &[f64],
+    row: &mut [f64],
+) -> Result<(), AnalysisError> {
+    check_state::<M>(model, t, state)?;
+    let [q, qd, qdd] = state;
+    model.inverse_dynamics(t, q, qd, qdd, u, row);
+    check(model, "τ", row)
+}
+
+/// One value per coordinate in q, qd and qdd, all finite.
+fn check_state<M: Model>(model: &M, t: f64, state: [&[f64]; 3]) -> Result<(), AnalysisError> {
+    if state.iter().any(|v| v.len() != M::NQ) {
+        return Err(Failure::InvalidOption {
+            name: "path",
+            value: t.to_string(),
+            reason: "must give q, qd and qdd with one value per coordinate",
+        }
+        .into());
+    }
+    for v in state {
+        check(model, "path", v)?;
+    }
+    Ok(())
 }
 
 /// Actuator efforts and constraint reactions along a motion of a constrained model
@@ -195,120 +217,10 @@ pub fn inverse_dynamics_actuated_along<M: Model>(
     actuated: &[usize],
     mut path: impl FnMut(f64) -> (Vec<f64>, Vec<f64>, Vec<f64>),
 ) -> Result<ActuatedEfforts, AnalysisError> {
-    let (n, nc) = (M::NQ, M::NC);
-    let info = model.info();
-    let names = info.constraints;
-    let invalid = |name: &'static str, value: String, reason: &'static str| {
-        AnalysisError::from(Failure::InvalidOption {
-            name,
-            value,
-            reason,
-        })
-    };
-    if u.len() != M::NU {
-        return Err(invalid(
-            "u",
-            u.len().to_string(),
-            "must have one value per input",
-        ));
-    }
-    if let Some(&i) = actuated.iter().find(|&&i| i >= n) {
-        return Err(invalid(
-            "actuated",
-            i.to_string(),
-            "is not a coordinate index",
-        ));
-    }
-    if (1..actuated.len()).any(|k| actuated[..k].contains(&actuated[k])) {
-        return Err(invalid(
-            "actuated",
-            format!("{actuated:?}"),
-            "names a coordinate twice",
-        ));
-    }
-    if actuated.len() + nc != n {
-        return Err(invalid(
-            "actuated",
-            format!(
-                "{} coordinates ({} constraints, {} coordinates)",
-                actuated.len(),
-                nc,
-                n
-            ),
-            "the actuated coordinates and the constraints must number NQ together: actuate NQ − NC coordinates (one per degree of freedom)",
-        ));
-    }
-    let unactuated: Vec<usize> = (0..n).filter(|i| !actuated.contains(i)).collect();
-    let na = actuated.len();
-    let mut out = ActuatedEfforts {
-        actuated: actuated.iter().map(|&i| info.dof_label(i)).collect(),
-        actuated_indices: actuated.to_vec(),
-        constraint_names: names.iter().map(|s| s.to_string()).collect(),
-        t: times.to_vec(),
-        tau: Vec::with_capacity(na * times.len()),
-        lambda: Vec::with_capacity(nc * times.len()),
-        phi: Vec::with_capacity(times.len()),
-        phi_dot: Vec::with_capacity(times.len()),
-        phi_ddot: Vec::with_capacity(times.len()),
-    };
-    let mut lu = Lu::<f64>::new(n);
-    let mut tau = vec![0.0; n];
-    let (mut phi, mut phi_t, mut gamma) = (vec![0.0; nc], vec![0.0; nc], vec![0.0; nc]);
+    let (mut solver, mut out) = Actuation::new(model, u, actuated, times.len())?;
     for &t in times {
         let (q, qd, qdd) = path(t);
-        if q.len() != n || qd.len() != n || qdd.len() != n {
-            return Err(invalid(
-                "path",
-                t.to_string(),
-                "must give q, qd and qdd with one value per coordinate",
-            ));
-        }
-        for v in [&q, &qd, &qdd] {
-            check(model, "path", v)?;
-        }
-        model.inverse_dynamics(t, &q, &qd, &qdd, u, &mut tau);
-        check(model, "τ", &tau)?;
-        let b = if nc > 0 {
-            reduce::jacobian(model, t, &q)?
-        } else {
-            nalgebra::DMatrix::zeros(0, n)
-        };
-        // [S Bᵀ] (n × n): column k < na is e_actuated[k], column na + i is row i of B
-        let a = lu.matrix_mut();
-        a.fill(0.0);
-        for (k, &j) in actuated.iter().enumerate() {
-            a[j + n * k] = 1.0;
-        }
-        for i in 0..nc {
-            for j in 0..n {
-                a[j + n * (na + i)] = b[(i, j)];
-            }
-        }
-        if let Err(s) = lu.factor() {
-            reduce::rank_check(&b, names)?;
-            return Err(Failure::SingularMatrix {
-                matrix: "[S Bᵀ]: B over the unactuated coordinates (the actuated coordinates cannot drive the mechanism here)",
-                rcond: s.rcond,
-                coordinates: unactuated.iter().map(|&i| info.dof_label(i)).collect(),
-            }
-            .into());
-        }
-        let mut x = tau.clone();
-        lu.solve(&mut x);
-        check(model, "[τ_a, λ]", &x)?;
-        out.tau.extend_from_slice(&x[..na]);
-        out.lambda.extend_from_slice(&x[na..]);
-        // how consistent the motion is
-        if nc > 0 {
-            model.constraints(t, &q, &mut phi);
-            model.constraint_rate(t, &q, &mut phi_t);
-            model.constraint_bias(t, &q, &qd, &mut gamma);
-        }
-        let row = |i: usize, v: &[f64]| (0..n).map(|j| b[(i, j)] * v[j]).sum::<f64>();
-        let worst = |f: &dyn Fn(usize) -> f64| (0..nc).map(f).fold(0.0, |m: f64, v| m.max(v.abs()));
-        out.phi.push(worst(&|i| phi[i]));
-        out.phi_dot.push(worst(&|i| row(i, &qd) + phi_t[i]));
-        out.phi_ddot.push(worst(&|i| row(i, &qdd) - gamma[i]));
+        solver.push(model, t, [&q, &qd, &qdd], u, &mut out)?;
     }
     Ok(out)
 }
@@ -321,21 +233,160 @@ pub fn inverse_dynamics_actuated_of<M: Model + Clone>(
     u: &[f64],
     actuated: &[usize],
 ) -> Result<ActuatedEfforts, AnalysisError> {
+    let (mut solver, mut out) = Actuation::new(model, u, actuated, trajectory.len())?;
     let mut read = model.clone();
-    let mut out =
-        inverse_dynamics_actuated_along(model, &[], u, actuated, |_| (vec![], vec![], vec![]))?;
     for i in 0..trajectory.len() {
         crate::charts::use_charts_of(&mut read, trajectory, i);
-        let one =
-            inverse_dynamics_actuated_along(&read, &trajectory.t[i..=i], u, actuated, |_| {
-                state(trajectory, i)
-            })?;
-        out.t.extend(one.t);
-        out.tau.extend(one.tau);
-        out.lambda.extend(one.lambda);
-        out.phi.extend(one.phi);
-        out.phi_dot.extend(one.phi_dot);
-        out.phi_ddot.extend(one.phi_ddot);
+        solver.push(&read, trajectory.t[i], state(trajectory, i), u, &mut out)?;
     }
     Ok(out)
+}
+
+/// `S τ_a + Bᵀλ = M qdd − h` solved one time after another, with its work space.
+struct Actuation<'a> {
+    actuated: &'a [usize],
+    unactuated: Vec<usize>,
+    lu: Lu<f64>,
+    tau: Vec<f64>,
+    phi: Vec<f64>,
+    phi_t: Vec<f64>,
+    gamma: Vec<f64>,
+}
+
+impl<'a> Actuation<'a> {
+    /// Checks `u` and `actuated` against `model`; the solver and the efforts, none yet (room
+    /// for `times` times).
+    fn new<M: Model>(
+        model: &M,
+        u: &[f64],
+        actuated: &'a [usize],
+        times: usize,
+    ) -> Result<(Actuation<'a>, ActuatedEfforts), AnalysisError> {
+        let (n, nc) = (M::NQ, M::NC);
+        let info = model.info();
+        let invalid = |name: &'static str, value: String, reason: &'static str| {
+            AnalysisError::from(Failure::InvalidOption {
+                name,
+                value,
+                reason,
+            })
+        };
+        if u.len() != M::NU {
+            return Err(invalid(
+                "u",
+                u.len().to_string(),
+                "must have one value per input",
+            ));
+        }
+        if let Some(&i) = actuated.iter().find(|&&i| i >= n) {
+            return Err(invalid(
+                "actuated",
+                i.to_string(),
+                "is not a coordinate index",
+            ));
+        }
+        if (1..actuated.len()).any(|k| actuated[..k].contains(&actuated[k])) {
+            return Err(invalid(
+                "actuated",
+                format!("{actuated:?}"),
+                "names a coordinate twice",
+            ));
+        }
+        if actuated.len() + nc != n {
+            return Err(invalid(
+                "actuated",
+                format!(
+                    "{} coordinates ({} constraints, {} coordinates)",
+                    actuated.len(),
+                    nc,
+                    n
+                ),
+                "the actuated coordinates and the constraints must number NQ together: actuate NQ − NC coordinates (one per degree of freedom)",
+            ));
+        }
+        let na = actuated.len();
+        let out = ActuatedEfforts {
+            actuated: actuated.iter().map(|&i| info.dof_label(i)).collect(),
+            actuated_indices: actuated.to_vec(),
+            constraint_names: info.constraints.iter().map(|s| s.to_string()).collect(),
+            t: Vec::with_capacity(times),
+            tau: Vec::with_capacity(na * times),
+            lambda: Vec::with_capacity(nc * times),
+            phi: Vec::with_capacity(times),
+            phi_dot: Vec::with_capacity(times),
+            phi_ddot: Vec::with_capacity(times),
+        };
+        let solver = Actuation {
+            actuated,
+            unactuated: (0..n).filter(|i| !actuated.contains(i)).collect(),
+            lu: Lu::<f64>::new(n),
+            tau: vec![0.0; n],
+            phi: vec![0.0; nc],
+            phi_t: vec![0.0; nc],
+            gamma: vec![0.0; nc],
+        };
+        Ok((solver, out))
+    }
+
+    /// τ_a, λ and the motion's consistency at one time, appended to `out`.
+    fn push<M: Model>(
+        &mut self,
+        model: &M,
+        t: f64,
+        state: [&[f64]; 3],
+        u: &[f64],
+        out: &mut ActuatedEfforts,
+    ) -> Result<(), AnalysisError> {
+        let (n, nc, na) = (M::NQ, M::NC, self.actuated.len());
+        let info = model.info();
+        let names = info.constraints;
+        check_state::<M>(model, t, state)?;
+        let [q, qd, qdd] = state;
+        model.inverse_dynamics(t, q, qd, qdd, u, &mut self.tau);
+        check(model, "τ", &self.tau)?;
+        let b = if nc > 0 {
+            reduce::jacobian(model, t, q)?
+        } else {
+            nalgebra::DMatrix::zeros(0, n)
+        };
+        // [S Bᵀ] (n × n): column k < na is e_actuated[k], column na + i is row i of B
+        let a = self.lu.matrix_mut();
+        a.fill(0.0);
+        for (k, &j) in self.actuated.iter().enumerate() {
+            a[j + n * k] = 1.0;
+        }
+        for i in 0..nc {
+            for j in 0..n {
+                a[j + n * (na + i)] = b[(i, j)];
+            }
+        }
+        if let Err(s) = self.lu.factor() {
+            reduce::rank_check(&b, names)?;
+            return Err(Failure::SingularMatrix {
+                matrix: "[S Bᵀ]: B over the unactuated coordinates (the actuated coordinates cannot drive the mechanism here)",
+                rcond: s.rcond,
+                coordinates: self.unactuated.iter().map(|&i| info.dof_label(i)).collect(),
+            }
+            .into());
+        }
+        let mut x = self.tau.clone();
+        self.lu.solve(&mut x);
+        check(model, "[τ_a, λ]", &x)?;
+        out.t.push(t);
+        out.tau.extend_from_slice(&x[..na]);
+        out.lambda.extend_from_slice(&x[na..]);
+        // how consistent the motion is
+        let (phi, phi_t, gamma) = (&mut self.phi, &mut self.phi_t, &mut self.gamma);
+        if nc > 0 {
+            model.constraints(t, q, phi);
+            model.constraint_rate(t, q, phi_t);
+            model.constraint_bias(t, q, qd, gamma);
+        }
+        let row = |i: usize, v: &[f64]| (0..n).map(|j| b[(i, j)] * v[j]).sum::<f64>();
+        let worst = |f: &dyn Fn(usize) -> f64| (0..nc).map(f).fold(0.0, |m: f64, v| m.max(v.abs()));
+        out.phi.push(worst(&|i| phi[i]));
+        out.phi_dot.push(worst(&|i| row(i, qd) + phi_t[i]));
+        out.phi_ddot.push(worst(&|i| row(i, qdd) - gamma[i]));
+        Ok(())
+    }
 }

@@ -67,11 +67,58 @@ fn tripod_walks_two_metres_straight_on_flat_ground() {
     assert!(f.saturated < 0.01, "{}", f.saturated);
 }
 
+/// Reads the base's angles at every output of `tr` in a chart tilted by the ZYX `angles`,
+/// as the runtime would after re-centring it: q's angles change, the motion does not (the
+/// rates are left as they are: the walk's figures read positions).
+fn read_in_chart(tr: &mut mbs::Trajectory, angles: [f64; 3]) {
+    use mbs::Model;
+    use mbs::charts::{array, joint_rotation, quaternion_near, zyx, zyx_angles_of};
+    let joint = HexapodWalker::default().info().rotation_joints[0];
+    let chart = zyx(angles);
+    let k = tr.charts[0].len() as u32;
+    let zero = vec![0.0; tr.nq()];
+    let c = joint_rotation(&array(&chart), &joint, &zero);
+    tr.charts[0].push(quaternion_near(&c, None));
+    let back = array(&chart.transpose());
+    let (n, joints) = (tr.nq(), tr.joint_names.len());
+    for i in 0..tr.len() {
+        let r = joint_rotation(&back, &joint, tr.q(i));
+        let a = zyx_angles_of(quaternion_near(&r, None));
+        for (s, &j) in joint.angles.iter().enumerate() {
+            tr.q_data[i * n + j] = a[s];
+        }
+        tr.chart_data[i * joints] = k;
+    }
+}
+
 #[test]
 fn turns_on_the_spot() {
     let mut gait = GaitParams::new(Gait::Tripod, 0.0);
     gait.yaw_rate = 0.2;
-    let (_, f) = run(&Walker::new(gait.clone()), 8.0);
+    let (mut w, f) = run(&Walker::new(gait.clone()), 8.0);
+
+    // the figures of the same walk with the base's angles read in a chart tilted by 1 rad
+    // (as after a re-centring) are the same: they read the base's orientation, not q
+    let pitch = w.trajectory.q(100)[4];
+    read_in_chart(&mut w.trajectory, [0.6, 1.0, -0.3]);
+    assert!(
+        (w.trajectory.q(100)[4] - pitch).abs() > 0.5,
+        "the chart moved q"
+    );
+    let g = w.figures();
+    println!("{f:?}\n{g:?}");
+    for (a, b) in [
+        (f.turned_deg, g.turned_deg),
+        (f.heading_error_deg, g.heading_error_deg),
+        (f.pitch_range_deg, g.pitch_range_deg),
+        (f.roll_range_deg, g.roll_range_deg),
+        (f.height_error, g.height_error),
+        (f.max_slip, g.max_slip),
+    ] {
+        assert!((a - b).abs() < 1e-9, "{a} against {b}");
+    }
+    assert_eq!(f.contacts, g.contacts);
+
     let planned = (gait.yaw_rate * gait.ramp_integral(8.0)).to_degrees();
     assert!(planned > 75.0, "{planned}");
     assert!(

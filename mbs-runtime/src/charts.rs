@@ -31,6 +31,18 @@ pub fn matrix_of(q: [f64; 4]) -> [[f64; 3]; 3] {
     array(u.to_rotation_matrix().matrix())
 }
 
+/// The ZYX angles `[a, b, c]` of a rotation given as a unit quaternion `[x, y, z, w]` (a
+/// trajectory's [`orientation`](crate::Trajectory::orientation)), `R = Rz(a) · Ry(b) · Rx(c)`
+/// with b in [−π/2, π/2] and a, c in (−π, π]: the yaw, pitch and roll of the rotation
+/// whatever chart its coordinates were read in (singular where cos b = 0, where a and c
+/// share one angle).
+pub fn zyx_angles_of(q: [f64; 4]) -> [f64; 3] {
+    let [x, y, z, w] = q;
+    let u = UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(w, x, y, z));
+    let (roll, pitch, yaw) = u.euler_angles();
+    [yaw, pitch, roll]
+}
+
 /// The angular velocity of the joint in its own (child) axes, `J(b, c) · (ȧ, ḃ, ċ)`.
 pub fn body_rates(angles: [f64; 3], rates: [f64; 3]) -> [f64; 3] {
     let (sb, cb) = angles[1].sin_cos();
@@ -306,6 +318,23 @@ mod tests {
         let rx = Rotation3::from_axis_angle(&nalgebra::Vector3::x_axis(), c);
         let e = (rz * ry * rx).into_inner();
         assert!((zyx([a, b, c]) - e).norm() < 1e-15);
+    }
+
+    #[test]
+    fn zyx_angles_of_a_rotation_read_in_any_chart() {
+        let angles = [2.9, -1.2, 0.4];
+        // the same rotation read in a chart tilted by 1 rad: C · E(q') = E(angles)
+        let chart = zyx([0.5, 1.0, -0.3]);
+        let q = {
+            let r = Rotation3::from_matrix_unchecked(chart.transpose() * zyx(angles));
+            let (c, b, a) = r.euler_angles();
+            [a, b, c]
+        };
+        let u = joint_rotation(&array(&chart), &joint(), &q);
+        let back = zyx_angles_of(quaternion_near(&u, None));
+        for k in 0..3 {
+            assert!((back[k] - angles[k]).abs() < 1e-12, "{back:?}");
+        }
     }
 
     #[test]

@@ -527,7 +527,10 @@ impl Walker {
 
     /// The central controller's corrections at time `t` from the base's x, y, ψ in `q`:
     /// velocity (base frame) and yaw rate added to the gait's, that bring the heading back to
-    /// its plan and (walking straight) the base back onto its line.
+    /// its plan and (walking straight) the base back onto its line. ψ = q[3] is the base's
+    /// yaw while its chart is the start's; the runtime moves the chart (and q's angles) only
+    /// once the base has pitched past 60°, fallen, when this reading is no longer its yaw.
+    /// The walk's figures read the recorded orientation ([`Walk::base_angles`]).
     pub fn command(&self, t: f64, q: &[f64]) -> ([f64; 2], f64) {
         let g = &self.gait;
         let psi_ref = self.origin[2] + g.yaw_rate * g.ramp_integral(t);
@@ -911,6 +914,29 @@ impl Walk {
         self.trajectory.q(i)
     }
 
+    /// The base's yaw, pitch and roll (ZYX) at every output, read from its recorded
+    /// orientation rather than from q, whose angles are in another chart once the base has
+    /// pitched past 60° (the runtime re-centres it); the yaw unwrapped from output to output,
+    /// from the start's heading coordinate.
+    pub fn base_angles(&self) -> Vec<[f64; 3]> {
+        let tr = &self.trajectory;
+        let wrap = |a: f64| (a + PI).rem_euclid(2.0 * PI) - PI;
+        let mut out: Vec<[f64; 3]> = Vec::with_capacity(tr.len());
+        for i in 0..tr.len() {
+            let mut a = match tr.orientation_data.is_empty() {
+                true => [tr.q(i)[3], tr.q(i)[4], tr.q(i)[5]],
+                false => {
+                    let o = tr.orientation(i);
+                    mbs::charts::zyx_angles_of([o[0], o[1], o[2], o[3]])
+                }
+            };
+            let near = out.last().map_or(tr.q(0)[3], |p| p[0]);
+            a[0] = near + wrap(a[0] - near);
+            out.push(a);
+        }
+        out
+    }
+
     /// The figures of the walk.
     pub fn figures(&self) -> Figures {
         use mbs::Model;
@@ -936,7 +962,8 @@ impl Walk {
         let (d_end, l_end) = along(self.q(last));
         f.distance = d_end;
         f.lateral = l_end;
-        f.turned_deg = (self.q(last)[3] - self.walker.origin[2]).to_degrees();
+        let angles = self.base_angles();
+        f.turned_deg = (angles[last][0] - self.walker.origin[2]).to_degrees();
         let first = (0..tr.len()).find(|&i| tr.t[i] >= after);
         if let Some(i1) = first {
             let (d1, _) = along(self.q(i1));
@@ -951,7 +978,7 @@ impl Walk {
             [f64::INFINITY, f64::NEG_INFINITY],
         );
         let mut model = model.clone();
-        for i in 0..tr.len() {
+        for (i, &[yaw, b, c]) in angles.iter().enumerate() {
             let (q, qd) = (&tr.q(i)[..n], &tr.qd(i)[..n]);
             // the base's angles in the chart the run read them in
             mbs::charts::use_charts_of(&mut model, tr, i);
@@ -972,11 +999,15 @@ impl Walk {
                 let psi_ref = self.walker.origin[2] + g.yaw_rate * g.ramp_integral(tr.t[i]);
                 f.heading_error_deg = f
                     .heading_error_deg
-                    .max(wrap(q[3] - psi_ref).abs().to_degrees());
-                let z_ref = reference_height(g, &self.walker.terrain, BasePose::of(q));
+                    .max(wrap(yaw - psi_ref).abs().to_degrees());
+                let pose = BasePose {
+                    psi: yaw,
+                    ..BasePose::of(q)
+                };
+                let z_ref = reference_height(g, &self.walker.terrain, pose);
                 f.height_error = f.height_error.max((q[2] - z_ref).abs());
-                pitch = [pitch[0].min(q[4]), pitch[1].max(q[4])];
-                roll = [roll[0].min(q[5]), roll[1].max(q[5])];
+                pitch = [pitch[0].min(b), pitch[1].max(b)];
+                roll = [roll[0].min(c), roll[1].max(c)];
             }
             for j in 0..JOINTS {
                 f.peak_current = f.peak_current.max(tr.qd(i)[n + j].abs());

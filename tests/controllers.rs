@@ -178,3 +178,80 @@ fn dc_motor_reaches_its_speed_set_point() {
         assert_eq!(st.samples, 1501);
     }
 }
+
+mbs::multibody! {
+    /// A brick (three unequal inertias) on a spherical joint without gravity, pitching at
+    /// 3 rad/s from rest: its ZYX pitch passes 60° within half a second and the runtime
+    /// re-centres its chart. An input torque about world z, held at zero.
+    model Brick {
+        dof a = 0.0;
+        dof b = 0.0, qd = 3.0;
+        dof c = 0.0, qd = 0.5;
+        input torque;
+        body brick { mass = 1.0; inertia = (0.1, 0.2, 0.3); }
+        TOG[brick] = Tball(a, b, c);
+        torque(brick, axis = z, u[0]);
+    }
+}
+
+/// At a sample: its time, the brick's ZYX angles read in the charts, and the angles in q.
+type Seen = (f64, [f64; 3], [f64; 3]);
+
+/// Records, at every sample, the brick's ZYX angles read in the charts it is handed, and
+/// the angles in q.
+struct Attitude {
+    seen: Rc<RefCell<Vec<Seen>>>,
+}
+
+impl mbs::Controller for Attitude {
+    fn sample(&mut self, _: f64, _: &State, _: &mut [f64]) {
+        panic!("a controller that takes the charts is handed them");
+    }
+
+    fn sample_in_charts(&mut self, t: f64, s: &State, charts: &[[[f64; 3]; 3]], u: &mut [f64]) {
+        use mbs::Model;
+        use mbs::charts::{joint_rotation, quaternion_near, zyx_angles_of};
+        let joint = &Brick::default().info().rotation_joints[0];
+        let r = joint_rotation(&charts[0], joint, &s.q);
+        let world = zyx_angles_of(quaternion_near(&r, None));
+        self.seen
+            .borrow_mut()
+            .push((t, world, [s.q[0], s.q[1], s.q[2]]));
+        u[0] = 0.0;
+    }
+}
+
+#[test]
+fn a_controller_reads_a_rotation_in_the_charts_it_is_handed() {
+    use std::f64::consts::PI;
+    let seen = Rc::new(RefCell::new(Vec::new()));
+    let inputs = Inputs::new().controller(0.01, Attitude { seen: seen.clone() });
+    let options = Options {
+        output: Output::Every { dt: 0.01 },
+        ..Options::adaptive(2.0, 1e-10)
+    };
+    let (tr, st) = simulate_with(Brick::default(), Scheme::Dopri5, options, inputs).unwrap();
+    assert!(st.chart_switches >= 1, "{}", st.chart_switches);
+    let (mut worst, mut moved, mut compared) = (0.0f64, 0.0f64, 0);
+    for (t, world, in_q) in seen.borrow().iter() {
+        let Some(i) = (0..tr.len()).find(|&i| (tr.t[i] - t).abs() < 1e-9) else {
+            continue;
+        };
+        let o = tr.orientation(i);
+        let recorded = mbs::charts::zyx_angles_of([o[0], o[1], o[2], o[3]]);
+        let apart = |x: f64, y: f64| (x - y + PI).rem_euclid(2.0 * PI) - PI;
+        for k in 0..3 {
+            worst = worst.max(apart(world[k], recorded[k]).abs());
+            moved = moved.max(apart(in_q[k], recorded[k]).abs());
+        }
+        compared += 1;
+    }
+    println!(
+        "{compared} samples, {} re-centrings: the angles read in the charts within {worst:.1e} rad of the recorded orientation's, q's up to {moved:.2} rad from them",
+        st.chart_switches
+    );
+    assert!(compared > 150, "{compared}");
+    assert!(worst < 1e-9, "{worst:e}");
+    // the test would not see a controller that read q alone
+    assert!(moved > 0.5, "{moved}");
+}

@@ -292,3 +292,56 @@ fn faults_are_modelled_or_typed() {
     let f = w.figures();
     assert!(f.contacts > 0 && f.distance.is_finite());
 }
+
+#[test]
+fn the_sampled_controller_reads_the_heading_in_the_base_chart() {
+    use mbs::charts::{array, joint_rotation, quaternion_near, zyx, zyx_angles_of};
+    use mbs::{Controller, Model, State};
+    let walker = Walker::new(GaitParams::new(Gait::Tripod, 0.15));
+    let n = HexapodWalker::NQ;
+    let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
+    walker.initial_state(&mut q, &mut qd).unwrap();
+    q[3] = 0.3; // off its planned heading: the controller turns it back
+    let state = |q: &[f64]| State {
+        t: 1.0,
+        q: q.to_vec(),
+        qd: qd.clone(),
+        qdd: vec![0.0; n],
+        lambda: Vec::new(),
+    };
+    // the same pose read in a chart tilted as after a re-centring
+    let joint = HexapodWalker::default().info().rotation_joints[0];
+    let chart = zyx([0.6, 1.0, -0.3]);
+    let r = joint_rotation(&array(&chart.transpose()), &joint, &q);
+    let mut tilted = q.clone();
+    for (k, a) in zyx_angles_of(quaternion_near(&r, None))
+        .into_iter()
+        .enumerate()
+    {
+        tilted[joint.angles[k]] = a;
+    }
+    let start = array(&zyx([0.0; 3]));
+    let volts = |q: &[f64], chart: Option<[[f64; 3]; 3]>| {
+        let mut c = walker.sampled(1e-3, VoltageLog::default());
+        let mut u = [0.0; 18];
+        match chart {
+            Some(chart) => c.sample_in_charts(1.0, &state(q), &[chart], &mut u),
+            None => c.sample(1.0, &state(q), &mut u),
+        }
+        u
+    };
+    let (plain, read) = (volts(&q, Some(start)), volts(&tilted, Some(array(&chart))));
+    let blind = volts(&tilted, None);
+    let apart = |a: [f64; 18], b: [f64; 18]| {
+        a.iter()
+            .zip(&b)
+            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+    };
+    println!(
+        "voltages: read in the tilted chart {:.1e} V from the start's, q[3] taken as the heading {:.2} V",
+        apart(plain, read),
+        apart(plain, blind)
+    );
+    assert!(apart(plain, read) < 1e-9);
+    assert!(apart(plain, blind) > 0.1);
+}

@@ -29,7 +29,7 @@
 //!   the continuous variant ([`Control::Continuous`]) integrates its integral terms as states.
 
 pub use mbs::terrain::{Block, Terrain};
-use mbs::{Effort, Efforts, State};
+use mbs::{Effort, Efforts};
 use std::f64::consts::PI;
 
 /// Gear ratio of every joint: the rotors of the model turn this many times as fast.
@@ -528,9 +528,10 @@ impl Walker {
     /// The central controller's corrections at time `t` from the base's x, y, ψ in `q`:
     /// velocity (base frame) and yaw rate added to the gait's, that bring the heading back to
     /// its plan and (walking straight) the base back onto its line. ψ = q[3] is the base's
-    /// yaw while its chart is the start's; the runtime moves the chart (and q's angles) only
-    /// once the base has pitched past 60°, fallen, when this reading is no longer its yaw.
-    /// The walk's figures read the recorded orientation ([`Walk::base_angles`]).
+    /// yaw while its chart is the start's; the runtime moves the chart (and q's angles) once
+    /// the base has pitched past 60°, fallen. The sampled controller then hands this the yaw
+    /// read in the chart ([`Sampled`]); the continuous PIDs see q alone and read q[3]; the
+    /// walk's figures read the recorded orientation ([`Walk::base_angles`]).
     pub fn command(&self, t: f64, q: &[f64]) -> ([f64; 2], f64) {
         let g = &self.gait;
         let psi_ref = self.origin[2] + g.yaw_rate * g.ramp_integral(t);
@@ -606,35 +607,80 @@ impl Walker {
     /// the voltage is clipped), voltages held until the next sample. `log` receives
     /// (t, voltages) at every sample; an unreachable foot target holds the last voltages
     /// and is recorded in `log`'s failure slot.
-    pub fn sampled(
-        &self,
-        period: f64,
-        log: VoltageLog,
-    ) -> impl FnMut(f64, &State, &mut [f64]) + use<> {
-        let walker = self.clone();
-        let mut integral = [0.0; JOINTS];
-        move |t, s, u| {
-            let mut log = log.borrow_mut();
-            let (targets, rates) = match walker.targets_and_rates(t, &s.q) {
-                Ok(x) => x,
-                Err(e) => {
-                    log.failure.get_or_insert((t, e));
-                    return;
-                }
-            };
-            let mut v = [0.0; JOINTS];
-            for j in 0..JOINTS {
-                let (q, qd) = (s.q[FIRST_JOINT + j], s.qd[FIRST_JOINT + j]);
-                let e = targets[j] - q;
-                let raw = walker.pid_voltage(e, integral[j] + e * period, rates[j] - qd);
-                let vmax = walker.motor.v_max;
-                v[j] = raw.clamp(-vmax, vmax);
-                if raw.abs() <= vmax {
-                    integral[j] += e * period;
-                }
-                u[j] = v[j];
+    pub fn sampled(&self, period: f64, log: VoltageLog) -> Sampled {
+        Sampled {
+            walker: self.clone(),
+            period,
+            integral: [0.0; JOINTS],
+            log,
+        }
+    }
+}
+
+/// The walker's sampled controller ([`Walker::sampled`]).
+pub struct Sampled {
+    walker: Walker,
+    period: f64,
+    integral: [f64; JOINTS],
+    log: VoltageLog,
+}
+
+impl Sampled {
+    /// One sample at the base pose and joint angles of `q` (ψ = q[3] the base's yaw).
+    fn at(&mut self, t: f64, q: &[f64], qd: &[f64], u: &mut [f64]) {
+        let walker = &self.walker;
+        let mut log = self.log.borrow_mut();
+        let (targets, rates) = match walker.targets_and_rates(t, q) {
+            Ok(x) => x,
+            Err(e) => {
+                log.failure.get_or_insert((t, e));
+                return;
             }
-            log.samples.push((t, v));
+        };
+        let mut v = [0.0; JOINTS];
+        for j in 0..JOINTS {
+            let (q, qd) = (q[FIRST_JOINT + j], qd[FIRST_JOINT + j]);
+            let e = targets[j] - q;
+            let raw = walker.pid_voltage(e, self.integral[j] + e * self.period, rates[j] - qd);
+            let vmax = walker.motor.v_max;
+            v[j] = raw.clamp(-vmax, vmax);
+            if raw.abs() <= vmax {
+                self.integral[j] += e * self.period;
+            }
+            u[j] = v[j];
+        }
+        log.samples.push((t, v));
+    }
+}
+
+impl mbs::Controller for Sampled {
+    /// Reads the base's heading as q[3], its yaw in the start's chart.
+    fn sample(&mut self, t: f64, s: &mbs::State, u: &mut [f64]) {
+        self.at(t, &s.q, &s.qd, u);
+    }
+
+    /// Reads the base's heading in its chart: once the base has pitched past 60° the runtime
+    /// has moved the chart, and q[3] is no longer its yaw.
+    fn sample_in_charts(
+        &mut self,
+        t: f64,
+        s: &mbs::State,
+        charts: &[[[f64; 3]; 3]],
+        u: &mut [f64],
+    ) {
+        use mbs::Model;
+        use mbs::charts::{joint_rotation, quaternion_near, zyx_angles_of};
+        const START: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        match charts.first() {
+            Some(chart) if *chart != START => {
+                let mut q = [0.0; HexapodWalker::NQ];
+                q.copy_from_slice(&s.q[..HexapodWalker::NQ]);
+                let base = &HexapodWalker::default().info().rotation_joints[0];
+                let r = joint_rotation(chart, base, &q);
+                q[3] = zyx_angles_of(quaternion_near(&r, None))[0];
+                self.at(t, &q, &s.qd, u);
+            }
+            _ => self.at(t, &s.q, &s.qd, u),
         }
     }
 }

@@ -65,6 +65,8 @@ pub struct Simulation<M: Model> {
     assembly: Option<Assembly>,
     /// sampled controllers: period, samples taken, the controller
     controllers: Vec<(f64, u64, Box<dyn Controller>)>,
+    /// the charts of the rotation joints, handed to the controllers at each sample
+    charts: Vec<[[f64; 3]; 3]>,
     /// rotation joints: the re-centrings of the last accepted step, each joint's chart
     /// number and last recorded quaternion, and a buffer of orientations to record
     moved: Vec<Recentring>,
@@ -168,6 +170,7 @@ impl<M: Model + 'static> Simulation<M> {
             options,
             assembly,
             controllers,
+            charts: vec![[[0.0; 3]; 3]; joints.len()],
             moved: Vec::with_capacity(joints.len()),
             chart_numbers: vec![0; joints.len()],
             last_quaternion: vec![None; joints.len()],
@@ -383,10 +386,11 @@ impl<M: Model + 'static> Simulation<M> {
     fn sample(&mut self) -> Result<(), Failure> {
         let (t0, t) = (self.options.t0, self.cur.t);
         let mut any = false;
+        read_charts(&self.problem.model, &mut self.charts);
         for (p, k, c) in self.controllers.iter_mut() {
             let due = t0 + *k as f64 * *p;
             if due <= t + 1e-12 * t.abs().max(1.0) {
-                c.sample(t, &self.cur, &mut self.problem.held);
+                c.sample_in_charts(t, &self.cur, &self.charts, &mut self.problem.held);
                 *k += 1;
                 self.problem.stats.samples += 1;
                 any = true;
@@ -741,6 +745,16 @@ fn consistent_start<M: Model>(
     Ok(Some(a))
 }
 
+/// The chart of every rotation joint of `model`, into `charts` (no allocation once it has
+/// its length).
+fn read_charts<M: Model>(model: &M, charts: &mut Vec<[[f64; 3]; 3]>) {
+    let n = model.info().rotation_joints.len();
+    charts.resize(n, [[0.0; 3]; 3]);
+    for (j, c) in charts.iter_mut().enumerate() {
+        *c = model.chart(j);
+    }
+}
+
 /// The controllers' first sample on the consistent positions and velocities, then qdd₀
 /// (and λ₀) there; singular configurations are judged against the factor of M found now.
 fn first_sample<M: Model>(
@@ -750,8 +764,10 @@ fn first_sample<M: Model>(
     implicit: bool,
     cur: &mut State,
 ) -> Result<(), Failure> {
+    let mut charts = Vec::new();
+    read_charts(&problem.model, &mut charts);
     for (_, count, c) in controllers.iter_mut() {
-        c.sample(cur.t, cur, &mut problem.held);
+        c.sample_in_charts(cur.t, cur, &charts, &mut problem.held);
         *count = 1;
         problem.stats.samples += 1;
     }

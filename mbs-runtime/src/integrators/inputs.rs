@@ -8,8 +8,22 @@ pub(crate) type InputFn = Box<dyn FnMut(f64, &mut [f64])>;
 
 /// A controller sampled every period: it reads the state at the sample instant and writes
 /// the inputs it drives into `u`, held until its next sample (zero-order hold).
+///
+/// The angles of a rotation joint (`Tball`, `Tfree`) in `state.q` are read in the joint's
+/// chart, which the runtime moves when the joint turns past 60° from it
+/// ([`crate::charts`]): a controller that reads a free body's orientation implements
+/// [`Controller::sample_in_charts`], which also gets the charts, and reads it with
+/// [`crate::charts::joint_rotation`].
 pub trait Controller {
     fn sample(&mut self, t: f64, state: &State, u: &mut [f64]);
+
+    /// [`Controller::sample`] with the chart of every rotation joint of the model (rows, in
+    /// the order of `ModelInfo::rotation_joints`), the rotation the state's angles are
+    /// measured from: `R = chart · Rz(a) · Ry(b) · Rx(c)`. By default it calls `sample`.
+    fn sample_in_charts(&mut self, t: f64, state: &State, charts: &[[[f64; 3]; 3]], u: &mut [f64]) {
+        let _ = charts;
+        self.sample(t, state, u)
+    }
 }
 
 impl<F: FnMut(f64, &State, &mut [f64])> Controller for F {

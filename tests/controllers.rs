@@ -255,3 +255,45 @@ fn a_controller_reads_a_rotation_in_the_charts_it_is_handed() {
     // the test would not see a controller that read q alone
     assert!(moved > 0.5, "{moved}");
 }
+
+/// Efforts that read the brick's rotation from q in the chart they are handed and compare it
+/// with its frame's pose; they apply nothing.
+#[derive(Clone)]
+struct ReadsCharts {
+    worst: Rc<RefCell<f64>>,
+}
+
+impl mbs::Efforts for ReadsCharts {
+    fn efforts(&mut self, e: &mut mbs::Effort) -> Result<(), String> {
+        use mbs::Model;
+        let joint = &Brick::default().info().rotation_joints[0];
+        let r = mbs::charts::joint_rotation(&e.chart(0), joint, e.q).to_rotation_matrix();
+        let pose = e.frame(0).pose.rotation;
+        let mut worst = self.worst.borrow_mut();
+        for i in 0..3 {
+            for k in 0..3 {
+                *worst = worst.max((r[(i, k)] - pose[i][k]).abs());
+            }
+        }
+        Ok(())
+    }
+}
+
+#[test]
+fn efforts_read_a_rotation_in_the_charts_they_are_handed() {
+    let worst = Rc::new(RefCell::new(0.0));
+    let model = mbs::WithEfforts::new(
+        Brick::default(),
+        ReadsCharts {
+            worst: worst.clone(),
+        },
+    );
+    let (_, st) = mbs::simulate(model, Scheme::Dopri5, Options::adaptive(2.0, 1e-10)).unwrap();
+    let worst = *worst.borrow();
+    println!(
+        "{} re-centrings: the rotation read in the charts within {worst:.1e} of the frame's pose",
+        st.chart_switches
+    );
+    assert!(st.chart_switches >= 1);
+    assert!(worst < 1e-12, "{worst:e}");
+}

@@ -68,6 +68,8 @@ pub struct Effort<'a> {
     pub u: &'a [f64],
     /// kinematics of the wrapped model's frames and points at (t, q, qd)
     pub kin: &'a Kinematics,
+    /// the charts of the rotation joints ([`Effort::chart`])
+    charts: &'a [[[f64; 3]; 3]],
     qg: &'a mut [f64],
     rejected: bool,
 }
@@ -83,6 +85,14 @@ impl Effort<'_> {
     pub fn reject(&mut self, message: impl Into<String>) -> String {
         self.rejected = true;
         message.into()
+    }
+
+    /// The chart of rotation joint `joint` (the order of `ModelInfo::rotation_joints`): the
+    /// rotation its angles in `q` are measured from, `R = chart · Rz(a) · Ry(b) · Rx(c)`,
+    /// which the runtime moves past 60° of turn ([`crate::charts`]). Read a free body's
+    /// orientation with [`crate::charts::joint_rotation`], or from its frame's pose.
+    pub fn chart(&self, joint: usize) -> [[f64; 3]; 3] {
+        self.charts[joint]
     }
 
     /// Kinematics of frame (or body) `i` (`ModelInfo::frame_index`); unset when the user
@@ -146,6 +156,7 @@ struct Scratch {
     qp: Vec<f64>,
     vp: Vec<f64>,
     up: Vec<f64>,
+    charts: Vec<[[f64; 3]; 3]>,
 }
 
 /// A generated model with efforts and extra states written in Rust: a [`Model`] with
@@ -186,6 +197,7 @@ impl<M: Model + 'static, E: Efforts> WithEfforts<M, E> {
             qp: z(big),
             vp: z(big),
             up: z(M::NU),
+            charts: vec![[[0.0; 3]; 3]; model.info().rotation_joints.len()],
         };
         let info = extended_info::<M, E>(model.info());
         WithEfforts {
@@ -265,6 +277,9 @@ impl<M: Model, E: Efforts> WithEfforts<M, E> {
         };
         qg.fill(0.0);
         xd.fill(0.0);
+        for (j, c) in s.charts.iter_mut().enumerate() {
+            *c = self.model.chart(j);
+        }
         let mut user = self.user.borrow_mut();
         let mut e = Effort {
             t,
@@ -273,6 +288,7 @@ impl<M: Model, E: Efforts> WithEfforts<M, E> {
             x: &qd[n..],
             u,
             kin: &s.kin,
+            charts: &s.charts,
             qg,
             rejected: false,
         };

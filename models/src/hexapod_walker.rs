@@ -529,9 +529,9 @@ impl Walker {
     /// velocity (base frame) and yaw rate added to the gait's, that bring the heading back to
     /// its plan and (walking straight) the base back onto its line. ψ = q[3] is the base's
     /// yaw while its chart is the start's; the runtime moves the chart (and q's angles) once
-    /// the base has pitched past 60°, fallen. The sampled controller then hands this the yaw
-    /// read in the chart ([`Sampled`]); the continuous PIDs see q alone and read q[3]; the
-    /// walk's figures read the recorded orientation ([`Walk::base_angles`]).
+    /// the base has pitched past 60°, fallen. The sampled controller and the continuous PIDs
+    /// then hand this the yaw read in the chart ([`Sampled`], [`Drive`]); the walk's figures
+    /// read the recorded orientation ([`Walk::base_angles`]).
     pub fn command(&self, t: f64, q: &[f64]) -> ([f64; 2], f64) {
         let g = &self.gait;
         let psi_ref = self.origin[2] + g.yaw_rate * g.ramp_integral(t);
@@ -668,21 +668,32 @@ impl mbs::Controller for Sampled {
         charts: &[[[f64; 3]; 3]],
         u: &mut [f64],
     ) {
-        use mbs::Model;
-        use mbs::charts::{joint_rotation, quaternion_near, zyx_angles_of};
-        const START: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-        match charts.first() {
-            Some(chart) if *chart != START => {
-                let mut q = [0.0; HexapodWalker::NQ];
-                q.copy_from_slice(&s.q[..HexapodWalker::NQ]);
-                let base = &HexapodWalker::default().info().rotation_joints[0];
-                let r = joint_rotation(chart, base, &q);
-                q[3] = zyx_angles_of(quaternion_near(&r, None))[0];
-                self.at(t, &q, &s.qd, u);
-            }
-            _ => self.at(t, &s.q, &s.qd, u),
+        match charts.first().and_then(|c| with_yaw(&s.q, c)) {
+            Some(q) => self.at(t, &q, &s.qd, u),
+            None => self.at(t, &s.q, &s.qd, u),
         }
     }
+}
+
+/// The walker's coordinates.
+const NQ: usize = <HexapodWalker as mbs::Model>::NQ;
+
+/// The walker's q (its first [`NQ`] values) with the base's yaw in q[3] when
+/// its angles are read in `chart`, another chart than the start's (the runtime moves it once
+/// the base has pitched past 60°); `None` in the start's chart, where q[3] is the yaw.
+fn with_yaw(q: &[f64], chart: &[[f64; 3]; 3]) -> Option<[f64; NQ]> {
+    use mbs::Model;
+    use mbs::charts::{joint_rotation, quaternion_near, zyx_angles_of};
+    const START: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    if *chart == START {
+        return None;
+    }
+    let mut out = [0.0; NQ];
+    out.copy_from_slice(&q[..NQ]);
+    let base = &HexapodWalker::default().info().rotation_joints[0];
+    let r = joint_rotation(chart, base, &out);
+    out[3] = zyx_angles_of(quaternion_near(&r, None))[0];
+    Some(out)
 }
 
 /// What the sampled controller records: the voltages at every sample, and the first foot
@@ -762,9 +773,11 @@ impl<const PID: bool> Drive<PID> {
             v.copy_from_slice(&e.u[..JOINTS]);
             return Ok((v, errors));
         }
+        // the base's heading read in its chart
+        let yawed = with_yaw(e.q, &e.chart(0));
         let (targets, rates) = self
             .walker
-            .targets_and_rates(e.t, e.q)
+            .targets_and_rates(e.t, yawed.as_ref().map_or(e.q, |q| &q[..]))
             .map_err(|u| u.to_string())?;
         let vmax = self.walker.motor.v_max;
         for j in 0..JOINTS {

@@ -742,30 +742,16 @@ fn a_run_read_in_a_re_centred_chart_is_post_processed_in_it() {
     let (q0, qd0) = cycle_start(&model, &reference);
     let tracking = held(reference);
     // the pelvis' rotation Rz(a) Ry(b) Rx(c) turned by `yaw` about the world's vertical (y)
+    let pelvis = model.info().rotation_joints[0];
     let turn = |q: &mut [f64], yaw: f64| {
-        let rot = |axis: usize, t: f64| {
-            let (s, c) = t.sin_cos();
-            let mut r = [[0.0; 3]; 3];
-            let (i, j) = ((axis + 1) % 3, (axis + 2) % 3);
-            r[axis][axis] = 1.0;
-            r[i][i] = c;
-            r[j][j] = c;
-            r[j][i] = s;
-            r[i][j] = -s;
-            r
-        };
-        let mul = |x: [[f64; 3]; 3], y: [[f64; 3]; 3]| -> [[f64; 3]; 3] {
-            std::array::from_fn(|i| {
-                std::array::from_fn(|j| (0..3).map(|k| x[i][k] * y[k][j]).sum())
-            })
-        };
-        let r = mul(
-            rot(1, yaw),
-            mul(mul(rot(2, q[3]), rot(1, q[4])), rot(0, q[5])),
-        );
-        q[3] = r[1][0].atan2(r[0][0]);
-        q[4] = (-r[2][0]).asin();
-        q[5] = r[2][1].atan2(r[2][2]);
+        use mbs::charts::{array, joint_rotation, quaternion_near, zyx, zyx_angles_of};
+        let r = joint_rotation(&array(&zyx([0.0, yaw, 0.0])), &pelvis, q);
+        for (k, a) in zyx_angles_of(quaternion_near(&r, None))
+            .into_iter()
+            .enumerate()
+        {
+            q[pelvis.angles[k]] = a;
+        }
     };
     let run = |yaw: f64| {
         let mut q = q0.clone();

@@ -236,9 +236,18 @@ pub fn use_charts_of<M: Model>(model: &mut M, tr: &crate::Trajectory, i: usize) 
 
 /// The charts of every rotation joint of `model`.
 pub fn charts_of<M: Model>(model: &M) -> Vec<[[f64; 3]; 3]> {
-    (0..model.info().rotation_joints.len())
-        .map(|j| model.chart(j))
-        .collect()
+    let mut charts = Vec::new();
+    read_charts(model, &mut charts);
+    charts
+}
+
+/// The charts of every rotation joint of `model` into `charts` (no allocation once it has
+/// their number): what a controller or an effort is handed at each call.
+pub fn read_charts<M: Model>(model: &M, charts: &mut Vec<[[f64; 3]; 3]>) {
+    charts.resize(model.info().rotation_joints.len(), [[0.0; 3]; 3]);
+    for (j, c) in charts.iter_mut().enumerate() {
+        *c = model.chart(j);
+    }
 }
 
 /// Whether some rotation joint of `model` is read, at `q`, in a chart of quality below

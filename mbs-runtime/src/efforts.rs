@@ -277,9 +277,7 @@ impl<M: Model, E: Efforts> WithEfforts<M, E> {
         };
         qg.fill(0.0);
         xd.fill(0.0);
-        for (j, c) in s.charts.iter_mut().enumerate() {
-            *c = self.model.chart(j);
-        }
+        crate::charts::read_charts(&self.model, &mut s.charts);
         let mut user = self.user.borrow_mut();
         let mut e = Effort {
             t,

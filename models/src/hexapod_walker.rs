@@ -982,13 +982,9 @@ impl Walk {
         let wrap = |a: f64| (a + PI).rem_euclid(2.0 * PI) - PI;
         let mut out: Vec<[f64; 3]> = Vec::with_capacity(tr.len());
         for i in 0..tr.len() {
-            let mut a = match tr.orientation_data.is_empty() {
-                true => [tr.q(i)[3], tr.q(i)[4], tr.q(i)[5]],
-                false => {
-                    let o = tr.orientation(i);
-                    mbs::charts::zyx_angles_of([o[0], o[1], o[2], o[3]])
-                }
-            };
+            // the base's rotation, recorded at every output (the model's one rotation joint)
+            let o = tr.orientation(i);
+            let mut a = mbs::charts::zyx_angles_of([o[0], o[1], o[2], o[3]]);
             let near = out.last().map_or(tr.q(0)[3], |p| p[0]);
             a[0] = near + wrap(a[0] - near);
             out.push(a);

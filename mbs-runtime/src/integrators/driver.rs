@@ -386,7 +386,7 @@ impl<M: Model + 'static> Simulation<M> {
     fn sample(&mut self) -> Result<(), Failure> {
         let (t0, t) = (self.options.t0, self.cur.t);
         let mut any = false;
-        read_charts(&self.problem.model, &mut self.charts);
+        charts::read_charts(&self.problem.model, &mut self.charts);
         for (p, k, c) in self.controllers.iter_mut() {
             let due = t0 + *k as f64 * *p;
             if due <= t + 1e-12 * t.abs().max(1.0) {
@@ -745,16 +745,6 @@ fn consistent_start<M: Model>(
     Ok(Some(a))
 }
 
-/// The chart of every rotation joint of `model`, into `charts` (no allocation once it has
-/// its length).
-fn read_charts<M: Model>(model: &M, charts: &mut Vec<[[f64; 3]; 3]>) {
-    let n = model.info().rotation_joints.len();
-    charts.resize(n, [[0.0; 3]; 3]);
-    for (j, c) in charts.iter_mut().enumerate() {
-        *c = model.chart(j);
-    }
-}
-
 /// The controllers' first sample on the consistent positions and velocities, then qdd₀
 /// (and λ₀) there; singular configurations are judged against the factor of M found now.
 fn first_sample<M: Model>(
@@ -764,8 +754,7 @@ fn first_sample<M: Model>(
     implicit: bool,
     cur: &mut State,
 ) -> Result<(), Failure> {
-    let mut charts = Vec::new();
-    read_charts(&problem.model, &mut charts);
+    let charts = charts::charts_of(&problem.model);
     for (_, count, c) in controllers.iter_mut() {
         c.sample_in_charts(cur.t, cur, &charts, &mut problem.held);
         *count = 1;

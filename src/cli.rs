@@ -269,9 +269,19 @@ fn failure_text(e: &SimError) -> String {
         Failure::TooMuchWork { max_steps } => format!(
             "more than {max_steps} steps {at}: raise --max-steps, take larger steps (a larger --h or a looser --rtol), or use a scheme suited to the stiffness (--scheme radau5 or bdf)"
         ),
-        Failure::StepTooSmall { h_min } => format!(
-            "the step fell below {h_min:e} s {at}: the solution may be singular or too stiff for the scheme (try --scheme radau5 or bdf)"
-        ),
+        Failure::StepTooSmall { h_min, held_by } => match held_by {
+            Some(b) if b.tolerance_is_the_fix() => format!(
+                "the step fell below {h_min:e} s {at}: {}",
+                b.advice("--atol")
+            ),
+            _ => format!(
+                "the step fell below {h_min:e} s {at}: the solution may be singular or too stiff for the scheme (try --scheme radau5 or bdf){}",
+                held_by
+                    .as_ref()
+                    .map(|b| format!("; {}", b.held()))
+                    .unwrap_or_default()
+            ),
+        },
         Failure::UnstableStep {
             scheme,
             rho,

@@ -261,3 +261,84 @@ fn a_weight_held_at_its_rounding_is_said() {
         );
     }
 }
+
+fn adaptive(t_end: f64, rtol: f64, atol: f64) -> Options {
+    Options {
+        step: StepControl::Adaptive {
+            rtol,
+            atol,
+            h0: None,
+        },
+        ..quiet(Options::adaptive(t_end, rtol))
+    }
+}
+
+/// Radau's Newton weights its corrections like the error test, not below the rounding of the
+/// values its stages handle: a double pendulum released at rest under atol = 1e-30 (any atol
+/// from about 1e-25 down) stopped at t = 0 with "Newton did not converge … (last correction
+/// 2.3e1)", the rounding of velocities that start at zero weighed against atol alone; it now
+/// takes the steps it takes under atol = 1e-20 and lands on the same motion.
+#[test]
+fn radau_runs_from_rest_under_a_tiny_atol() {
+    use mbs_models::dpend::DoublePendulum;
+    for scheme in [Scheme::Radau5, Scheme::Radau3] {
+        let run = |atol: f64| {
+            simulate(DoublePendulum::default(), scheme, adaptive(2.0, 1e-6, atol))
+                .unwrap_or_else(|e| panic!("{scheme:?} under atol {atol:e}: {e}"))
+        };
+        let ((tiny, tiny_stats), (small, small_stats)) = (run(1e-30), run(1e-20));
+        let (a, b) = (tiny.q(tiny.len() - 1), small.q(small.len() - 1));
+        let apart = a.iter().zip(b).map(|(x, y)| (x - y).abs());
+        assert!(apart.fold(0.0, f64::max) < 1e-6, "{scheme:?}");
+        assert!(
+            tiny_stats.steps <= small_stats.steps + small_stats.steps / 10,
+            "{scheme:?}: {} steps under atol 1e-30, {} under 1e-20",
+            tiny_stats.steps,
+            small_stats.steps
+        );
+    }
+}
+
+/// A step that falls below h_min names the component its last error test was held by, its
+/// error and tolerance, and what set that tolerance. The standing hexapod under atol = 1e-30
+/// (its feet meet the ground at t ≈ 0.048 s, where a joint velocity of about 1e-10 rad/s is
+/// tested at its rounding, 100ε times the largest velocity): the message says to raise atol,
+/// not that the motion is stiff. A step held by rtol (the 2-dof seed at rtol 1e-10 with
+/// h_min = 0.01 s) names its component with no such advice.
+#[test]
+fn a_step_below_h_min_names_the_component_that_held_it() {
+    use mbs_models::hexapod::HexapodStanding;
+    let e = simulate(
+        HexapodStanding::default(),
+        Scheme::Dopri5,
+        adaptive(1.0, 1e-6, 1e-30),
+    )
+    .unwrap_err();
+    let Failure::StepTooSmall {
+        held_by: Some(b), ..
+    } = &e.kind
+    else {
+        panic!("{e}")
+    };
+    println!("{e}");
+    assert!(b.component.starts_with("the velocity of q["), "{e}");
+    assert_eq!(b.set_by, "rounding", "{e}");
+    assert!(b.error.abs() > b.tolerance, "{e}");
+    assert!(e.to_string().contains("raise atol"), "{e}");
+    assert!(e.t > 0.04, "{e}");
+    let o = Options {
+        h_min: Some(0.01),
+        ..quiet(Options::adaptive(10.0, 1e-10))
+    };
+    let e = simulate(Seed2dof::default(), Scheme::Dopri5, o).unwrap_err();
+    let Failure::StepTooSmall {
+        held_by: Some(b), ..
+    } = &e.kind
+    else {
+        panic!("{e}")
+    };
+    println!("{e}");
+    assert_eq!(b.set_by, "rtol", "{e}");
+    assert!(b.component.contains("q["), "{e}");
+    assert!(!e.to_string().contains("raise atol"), "{e}");
+}

@@ -77,6 +77,75 @@ pub fn check_inertia(body: &'static str, t: [f64; 6]) -> Result<(), ParamError> 
 /// Why a simulation stopped early. Each variant carries what is needed to act on it; the
 /// time, step, work done and the trajectory so far travel with it in
 /// [`SimError`](crate::SimError).
+/// The component that weighed most in the error test that last rejected a step, named when
+/// the step falls below h_min: a step held by one coordinate of a stiff or singular motion, or
+/// by a tolerance tighter than the arithmetic resolves.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HeldBy {
+    /// `q[7] (name)`, `the velocity of q[7] (name)` or `λ[2]`
+    pub component: String,
+    /// its magnitude, max(|y| before, |y| after the step)
+    pub value: f64,
+    /// its error estimate
+    pub error: f64,
+    /// its weight in the test: the scheme's local tolerance atol' + rtol'·|y|, or the rounding
+    /// floor
+    pub tolerance: f64,
+    /// what set the weight: `"atol"`, `"rtol"` or `"rounding"` (100ε times the largest entry
+    /// of its kind)
+    pub set_by: &'static str,
+}
+
+impl HeldBy {
+    /// What follows "the step fell below h_min": that the solution may be singular or too
+    /// stiff, and the component the error test was held by; where the tolerance was atol's
+    /// or the rounding floor, the fix instead (raise atol).
+    pub fn clause(held_by: &Option<HeldBy>) -> String {
+        Self::clause_naming(held_by, "atol")
+    }
+
+    /// [`HeldBy::clause`] with the absolute tolerance called `atol` (`--atol` on a command
+    /// line).
+    pub fn clause_naming(held_by: &Option<HeldBy>, atol: &str) -> String {
+        const STIFF: &str = " (the solution may be singular or too stiff for the scheme)";
+        match held_by {
+            None => STIFF.into(),
+            Some(b) if b.tolerance_is_the_fix() => format!(": {}", b.advice(atol)),
+            Some(b) => format!("{STIFF}; {}", b.held()),
+        }
+    }
+
+    /// Whether the tolerance, not the motion, held the step: it was atol's or the rounding
+    /// floor's.
+    pub fn tolerance_is_the_fix(&self) -> bool {
+        matches!(self.set_by, "atol" | "rounding")
+    }
+
+    /// "the error test was held by … set by …", and for a tolerance of atol or of the
+    /// rounding floor the fix, raising `atol`.
+    pub fn advice(&self, atol: &str) -> String {
+        match self.set_by {
+            "atol" => format!(
+                "{}: if a component this small need not be resolved so finely, raise {atol}",
+                self.held()
+            ),
+            "rounding" => format!(
+                "{} (100ε times the largest entry of its kind), above what atol and rtol asked: raise {atol} to at least that",
+                self.held()
+            ),
+            _ => self.held(),
+        }
+    }
+
+    /// "the error test was held by C = v, its error e against a tolerance of w set by …".
+    pub fn held(&self) -> String {
+        format!(
+            "the error test was held by {} = {:.3e}, its error {:.2e} against a tolerance of {:.2e} set by {}",
+            self.component, self.value, self.error, self.tolerance, self.set_by
+        )
+    }
+}
+
 #[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]
 pub enum Failure {
@@ -88,10 +157,13 @@ pub enum Failure {
     },
     #[error("invalid parameters: {0}")]
     InvalidParameters(ParamError),
-    #[error(
-        "the step fell below h_min = {h_min:e} (the solution may be singular or too stiff for the scheme)"
-    )]
-    StepTooSmall { h_min: f64 },
+    #[error("the step fell below h_min = {h_min:e}{}", HeldBy::clause(held_by))]
+    StepTooSmall {
+        h_min: f64,
+        /// the component that weighed most in the last error test (none when the scheme has
+        /// no error test, or rejected the step for another cause)
+        held_by: Option<HeldBy>,
+    },
     #[error(
         "more than {max_steps} steps (raise Options::max_steps, loosen the tolerance, or use a scheme suited to the stiffness)"
     )]

@@ -106,7 +106,7 @@
 use super::at::{Affine, Weights};
 use super::newton::AccelNewton;
 use super::problem::Problem;
-use super::step_control::{Tolerances, elementary_factor, optimal_factor};
+use super::step_control::{Largest, Tolerances, elementary_factor, optimal_factor};
 use super::{Attempt, Control, State, Step, Stepper};
 use crate::charts::Recentring;
 use crate::error::Failure;
@@ -294,6 +294,8 @@ pub(crate) struct Bdf {
     drop_votes: usize,
     /// whether the last error test raised a weight to its rounding floor
     floored: bool,
+    /// the component that weighed most in the last error test
+    held_by: Option<Largest>,
 }
 
 impl Bdf {
@@ -301,6 +303,7 @@ impl Bdf {
         let z = |m: usize| vec![0.0; m];
         Bdf {
             floored: false,
+            held_by: None,
             n,
             max_order: max_order.clamp(1, MAX_ORDER),
             order: 1,
@@ -360,6 +363,10 @@ impl Bdf {
 impl<M: Model> Stepper<M> for Bdf {
     fn floored(&self) -> bool {
         self.floored
+    }
+
+    fn held_by(&self) -> Option<Largest> {
+        self.held_by
     }
 
     fn tolerance_floor(&self, rtol: f64) -> Option<f64> {
@@ -479,6 +486,7 @@ impl<M: Model> Stepper<M> for Bdf {
         let norm = tol.norm(&self.err, &self.y0, &self.y1, self.y0.len() / 2);
         let err = norm.value;
         self.floored = norm.floored;
+        self.held_by = norm.held_by;
         if !(err <= 1.0) {
             let fac = elementary_factor(err, k, safety, MIN_FACTOR, f64::INFINITY);
             return Ok(Attempt::RejectedError { h_next: h * fac });

@@ -51,7 +51,7 @@
 use super::explicit::{Probe, StabilityWatch, dot, ritz};
 use super::problem::Problem;
 use super::step_control::{
-    Decision, PiController, Tolerances, order_two_factor, order_two_floored,
+    Decision, Largest, PiController, Tolerances, order_two_factor, order_two_floored,
 };
 use super::{Attempt, State, Step, Stepper};
 use crate::error::Failure;
@@ -354,6 +354,8 @@ pub(crate) struct Chebyshev {
     stale: bool,
     /// whether the last error test raised a weight to its rounding floor
     floored: bool,
+    /// the component that weighed most in the last error test
+    held_by: Option<Largest>,
 }
 
 impl Chebyshev {
@@ -361,6 +363,7 @@ impl Chebyshev {
         let z = || vec![0.0; n];
         Chebyshev {
             floored: false,
+            held_by: None,
             n,
             k: Coefficients::new(),
             poly: Polynomials::new(),
@@ -458,6 +461,10 @@ impl<M: Model> Stepper<M> for Chebyshev {
         self.floored
     }
 
+    fn held_by(&self) -> Option<Largest> {
+        self.held_by
+    }
+
     fn tolerance_floor(&self, rtol: f64) -> Option<f64> {
         order_two_floored(rtol, TOL_FACTOR, FLOOR)
     }
@@ -514,6 +521,7 @@ impl<M: Model> Stepper<M> for Chebyshev {
         };
         let norm = tol.norm(&self.err, &self.y0, &self.y1, self.y0.len() / 2);
         self.floored = norm.floored;
+        self.held_by = norm.held_by;
         match self.pi.decide(h, norm.value) {
             Decision::Accept { h_next } => {
                 self.watch.accepted(cur, next);

@@ -17,7 +17,7 @@
 
 use super::explicit::StabilityWatch;
 use super::problem::Problem;
-use super::step_control::{Decision, PiController};
+use super::step_control::{Decision, Largest, PiController};
 use super::{Attempt, State, Step, Stepper};
 use crate::error::Failure;
 use crate::model::Model;
@@ -98,6 +98,8 @@ pub(crate) struct Dopri5 {
     watch: StabilityWatch,
     /// whether the last error test raised a weight to its rounding floor
     floored: bool,
+    /// the component that weighed most in the last error test
+    held_by: Option<Largest>,
 }
 
 /// DOPRI5's stability radius with a fixed step, the edge of |R(z)| ≤ 1 (R(z) = Σ₀⁵ zᵏ/k! +
@@ -115,6 +117,7 @@ impl Dopri5 {
         let s5 = || [z(), z(), z(), z(), z()];
         Dopri5 {
             floored: false,
+            held_by: None,
             n,
             kv: s7(),
             ka: s7(),
@@ -137,6 +140,10 @@ impl Dopri5 {
 impl<M: Model> Stepper<M> for Dopri5 {
     fn floored(&self) -> bool {
         self.floored
+    }
+
+    fn held_by(&self) -> Option<Largest> {
+        self.held_by
     }
 
     fn attempt(&mut self, step: Step<'_, M>) -> Result<Attempt, Failure> {
@@ -190,6 +197,7 @@ impl<M: Model> Stepper<M> for Dopri5 {
         }
         let norm = tol.norm(&self.err, &self.y0, &self.y1, self.y0.len() / 2);
         self.floored = norm.floored;
+        self.held_by = norm.held_by;
         match self.pi.decide(h, norm.value) {
             Decision::Accept { h_next } => {
                 self.dense(cur, next, h);

@@ -8,7 +8,7 @@ use super::inputs::{Controller, Inputs};
 use super::newton::NewtonTol;
 use super::problem::{Loops, Problem};
 use super::sim_error::SimError;
-use super::step_control::{StepBounds, Tolerances, initial_step};
+use super::step_control::{Largest, StepBounds, Tolerances, initial_step};
 use super::stepper::{Attempt, Control, Step, Stepper};
 use super::{Integrator, State};
 use crate::charts::{self, Recentring};
@@ -56,6 +56,9 @@ pub struct Simulation<M: Model> {
     attempts: usize,
     /// why the last attempt was rejected, when an evaluation failed (reported if h collapses)
     last_cause: Option<Failure>,
+    /// the component that weighed most in the error test, when that test rejected the last
+    /// attempt (`Failure::StepTooSmall` names it)
+    held_by: Option<Largest>,
     traj: Trajectory,
     /// pending output times (for `Output::Every` and `Times`), next one first
     out_times: Vec<f64>,
@@ -162,6 +165,7 @@ impl<M: Model + 'static> Simulation<M> {
             h: h.min(options.h_max()),
             attempts: 0,
             last_cause: None,
+            held_by: None,
             traj,
             out_times,
             out_next: 0,
@@ -448,10 +452,11 @@ impl<M: Model + 'static> Simulation<M> {
             }
             if h < h_min && !last && !fixed {
                 // the cause of the rejections that shrank the step, when there is one
+                let held_by = self.held_by.map(|b| b.held_by(|i| self.problem.label(i)));
                 let kind = self
                     .last_cause
                     .take()
-                    .unwrap_or(Failure::StepTooSmall { h_min });
+                    .unwrap_or(Failure::StepTooSmall { h_min, held_by });
                 return Err(self.fail(kind, h));
             }
             self.attempts += 1;
@@ -462,6 +467,7 @@ impl<M: Model + 'static> Simulation<M> {
                 Err(kind @ Failure::EffortRejected { .. }) if !fixed && h > h_min => {
                     self.problem.stats.rejected_effort += 1;
                     self.last_cause = Some(kind);
+                    self.held_by = None;
                     self.h = (0.25 * h).max(h_min);
                 }
                 Err(kind) => return Err(self.fail(kind, h)),
@@ -486,6 +492,7 @@ impl<M: Model + 'static> Simulation<M> {
                     self.problem.stats.record_step(h);
                     self.problem.stats.user_efforts = self.problem.model.user_evaluations();
                     self.last_cause = None;
+                    self.held_by = None;
                     self.prev.copy_from(&self.cur);
                     std::mem::swap(&mut self.cur, &mut self.next);
                     self.stepper
@@ -512,6 +519,7 @@ impl<M: Model + 'static> Simulation<M> {
                 Ok(Attempt::RejectedError { h_next }) => {
                     // only adaptive schemes test errors
                     self.problem.stats.rejected_error += 1;
+                    self.held_by = self.stepper.held_by();
                     self.h = h_next;
                 }
                 Ok(Attempt::RejectedNewton {
@@ -544,6 +552,7 @@ impl<M: Model + 'static> Simulation<M> {
                         return Err(self.fail(kind, h));
                     }
                     self.last_cause = cause;
+                    self.held_by = None;
                     self.h = h_next.max(h_min);
                 }
             }

@@ -112,7 +112,7 @@ use super::at::{Affine, At, Weights};
 use super::constrained::{Constrained, Mode};
 use super::newton::{AccelNewton, NewtonTol};
 use super::problem::{Loops, Problem};
-use super::step_control::{next_step, order_two_factor, order_two_floored};
+use super::step_control::{Largest, next_step, order_two_factor, order_two_floored};
 use super::{Attempt, Control, State, Step, Stepper};
 use crate::charts::Recentring;
 use crate::error::Failure;
@@ -148,6 +148,8 @@ pub(crate) struct AlphaFamily {
     index2: bool,
     /// whether the last error test raised a weight to its rounding floor
     floored: bool,
+    /// the component that weighed most in the last error test
+    held_by: Option<Largest>,
 }
 
 impl AlphaFamily {
@@ -155,6 +157,7 @@ impl AlphaFamily {
         let z = || vec![0.0; n];
         AlphaFamily {
             floored: false,
+            held_by: None,
             alpha_m,
             alpha_f,
             beta,
@@ -222,6 +225,10 @@ impl AlphaFamily {
 impl<M: Model> Stepper<M> for AlphaFamily {
     fn floored(&self) -> bool {
         self.floored
+    }
+
+    fn held_by(&self) -> Option<Largest> {
+        self.held_by
     }
 
     fn tolerance_floor(&self, rtol: f64) -> Option<f64> {
@@ -372,10 +379,14 @@ impl<M: Model> Stepper<M> for AlphaFamily {
         }
         let eq = tol.norm(&self.err, &cur.q, &next.q, cur.q.len());
         self.floored = eq.floored;
+        self.held_by = eq.held_by;
         // index 2: positions and velocities, otherwise positions (local error ∝ h³)
         let err = if self.index2 {
             let ev = tol.norm(&self.err_v, &cur.qd, &next.qd, cur.qd.len());
             self.floored |= ev.floored;
+            if ev.value > eq.value {
+                self.held_by = ev.held_by.map(Largest::as_velocity);
+            }
             (0.5 * (eq.value * eq.value + ev.value * ev.value)).sqrt() / f
         } else {
             eq.value / f

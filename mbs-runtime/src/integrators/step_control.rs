@@ -76,7 +76,8 @@ impl Tolerances {
         let n = e.len();
         let bounds = [0, kind.min(n), (2 * kind).min(n), n];
         let (mut s, mut floored) = (0.0, false);
-        for b in bounds.windows(2) {
+        let (mut top, mut held_by) = (-1.0, None);
+        for (block, b) in bounds.windows(2).enumerate() {
             let (start, end) = (b[0], b[1]);
             let largest = y0[start..end]
                 .iter()
@@ -84,15 +85,92 @@ impl Tolerances {
                 .fold(0.0f64, |m, y| m.max(y.abs()));
             let floor = Self::transformed_floor(rtol) * largest;
             for i in start..end {
-                let w = atol + rtol * y0[i].abs().max(y1[i].abs());
+                let magnitude = y0[i].abs().max(y1[i].abs());
+                let w = atol + rtol * magnitude;
                 floored |= w < floor;
-                let w = w.max(floor);
-                s += (e[i] / w) * (e[i] / w);
+                let weight = w.max(floor);
+                let term = (e[i] / weight) * (e[i] / weight);
+                s += term;
+                // the first NaN term, else the largest
+                if !(term <= top) && !(top.is_nan()) {
+                    top = term;
+                    let set_by = if w < floor {
+                        WeightBy::Rounding
+                    } else if atol >= rtol * magnitude {
+                        WeightBy::Atol
+                    } else {
+                        WeightBy::Rtol
+                    };
+                    held_by = Some(Largest {
+                        block,
+                        index: i - start,
+                        error: e[i],
+                        magnitude,
+                        weight,
+                        set_by,
+                    });
+                }
             }
         }
         ErrorNorm {
             value: (s / e.len().max(1) as f64).sqrt(),
             floored,
+            held_by,
+        }
+    }
+}
+
+/// The component of an error vector whose term |e_i|/w_i weighed most in its norm: what held
+/// the step, named by `Failure::StepTooSmall` when the step falls below h_min.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Largest {
+    /// its block in the norm's vector: 0 positions, 1 velocities, 2 multipliers
+    pub block: usize,
+    /// its index in the block
+    pub index: usize,
+    pub error: f64,
+    /// max(|y0_i|, |y1_i|)
+    pub magnitude: f64,
+    pub weight: f64,
+    pub set_by: WeightBy,
+}
+
+/// What set a component's weight in an error norm.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum WeightBy {
+    Atol,
+    Rtol,
+    /// the rounding floor, [`ROUNDING`]·ε times the largest entry of its kind
+    Rounding,
+}
+
+impl Largest {
+    /// The same component in a vector of velocities alone (a norm taken over qd only).
+    pub fn as_velocity(self) -> Largest {
+        Largest {
+            block: self.block + 1,
+            ..self
+        }
+    }
+
+    /// What held the step, in words for `Failure::StepTooSmall`: the component labelled by
+    /// `label` (coordinate index → "q[3] (name)"), its error and tolerance, and what set it.
+    pub fn held_by(&self, label: impl Fn(usize) -> String) -> crate::error::HeldBy {
+        let component = match self.block {
+            0 => label(self.index),
+            1 => format!("the velocity of {}", label(self.index)),
+            _ => format!("λ[{}]", self.index),
+        };
+        crate::error::HeldBy {
+            component,
+            value: self.magnitude,
+            error: self.error,
+            tolerance: self.weight,
+            set_by: match self.set_by {
+                WeightBy::Atol => "atol",
+                WeightBy::Rtol => "rtol",
+                WeightBy::Rounding => "rounding",
+            },
         }
     }
 }
@@ -104,6 +182,8 @@ impl Tolerances {
 pub(crate) struct ErrorNorm {
     pub value: f64,
     pub floored: bool,
+    /// the component whose term weighed most (none for an empty vector)
+    pub held_by: Option<Largest>,
 }
 
 /// The factor f = c·√rtol on both tolerances of an order-2 scheme's local error test (rtol·f,

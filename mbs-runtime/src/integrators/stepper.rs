@@ -108,6 +108,11 @@ pub(crate) trait Stepper<M: Model> {
     fn floored(&self) -> bool {
         false
     }
+    /// The component that weighed most in the last error test (none for a scheme without
+    /// one): `Failure::StepTooSmall` names it.
+    fn held_by(&self) -> Option<super::step_control::Largest> {
+        None
+    }
     /// Called once the driver has accepted the step from `prev` to `cur`.
     fn accepted(&mut self, _p: &mut Problem<M>, _prev: &State, _cur: &State) {}
     /// Dense output on [prev.t, cur.t]: by default the quintic Hermite interpolant of

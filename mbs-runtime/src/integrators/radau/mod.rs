@@ -328,7 +328,7 @@ mod tableau;
 use super::at::At;
 use super::constrained::Mode;
 use super::problem::Problem;
-use super::step_control::{Predictive, Tolerances};
+use super::step_control::{Largest, Predictive, ROUNDING, Tolerances};
 use super::{Attempt, Control, State, Step, Stepper};
 use crate::charts::Recentring;
 use crate::error::Failure;
@@ -504,6 +504,8 @@ pub(crate) struct Radau {
     psix: Vec<f64>,
     /// whether the last error test raised a weight to its rounding floor
     floored: bool,
+    /// the component that weighed most in the last error test
+    held_by: Option<Largest>,
 }
 
 impl Radau {
@@ -512,6 +514,7 @@ impl Radau {
         let zs = || vec![0.0; s * n];
         Radau {
             floored: false,
+            held_by: None,
             k: Coefficients::new(s),
             n,
             m: vec![0.0; n * n],
@@ -600,6 +603,10 @@ impl<M: Model> Stepper<M> for Radau {
         self.floored
     }
 
+    fn held_by(&self) -> Option<Largest> {
+        self.held_by
+    }
+
     fn error_test(&self, p: &Problem<M>) -> ErrorTest {
         if p.loops.index3().is_some() {
             ErrorTest::PositionsScaledVelocities
@@ -649,9 +656,18 @@ impl<M: Model> Stepper<M> for Radau {
         let Step(p, cur, h, ctl, next) = step;
         let (s, n) = (self.k.s, self.n);
         let tol = Tol::new(ctl, s);
+        // Newton's weights, like the error test's, not below the rounding of the values the
+        // stages handle: [`ROUNDING`]·ε (or rtol', if tighter) times the largest position
+        // |q| + h|qd| + h²|qdd| and the largest velocity |qd| + h|qdd|. Without it a start at
+        // rest under a tiny atol weighted its velocities by atol alone: under atol = 1e-30 the
+        // rounding of the stage velocities (1e-29) failed Newton down to h_min at t = 0.
+        let largest = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let (qmax, vmax, amax) = (largest(&cur.q), largest(&cur.qd), largest(&cur.qdd));
+        let f = tol.weights.rtol.min(ROUNDING * f64::EPSILON);
+        let (floor_q, floor_v) = (f * (qmax + h * (vmax + h * amax)), f * (vmax + h * amax));
         for r in 0..n {
-            self.scq[r] = tol.weights.atol + tol.weights.rtol * cur.q[r].abs();
-            self.scv[r] = tol.weights.atol + tol.weights.rtol * cur.qd[r].abs();
+            self.scq[r] = (tol.weights.atol + tol.weights.rtol * cur.q[r].abs()).max(floor_q);
+            self.scv[r] = (tol.weights.atol + tol.weights.rtol * cur.qd[r].abs()).max(floor_v);
         }
         if self.index2 {
             // λ, an index-2 component, weighted by h as RADAU5 weights them (in Newton and

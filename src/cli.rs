@@ -43,8 +43,8 @@
 
 use crate::plot::{Chart, Series, line_chart};
 use crate::{
-    ConstraintMethod, ConstraintOptions, CsvWriter, Failure, GlobalControl, GlobalReport, Inputs,
-    Model, Options, Output, Scheme, SimError, Simulation, Stats, StepControl, Trajectory,
+    ConstraintMethod, ConstraintOptions, CsvWriter, Failure, GlobalControl, GlobalReport, HeldMost,
+    Inputs, Model, Options, Output, Scheme, SimError, Simulation, Stats, StepControl, Trajectory,
     error::short, simulate_global,
 };
 /// `RunArgs::parse()` needs this trait in scope: programs can name it without depending on
@@ -266,8 +266,12 @@ fn failure_text(e: &SimError) -> String {
             Some(f) => format!("{f} {value} is invalid: {reason}"),
             None => e.to_string(),
         },
-        Failure::TooMuchWork { max_steps } => format!(
-            "more than {max_steps} steps {at}: raise --max-steps, take larger steps (a larger --h or a looser --rtol), or use a scheme suited to the stiffness (--scheme radau5 or bdf)"
+        Failure::TooMuchWork {
+            max_steps,
+            held_most,
+        } => format!(
+            "more than {max_steps} steps {at}: raise --max-steps, take larger steps (a larger --h or a looser --rtol), or use a scheme suited to the stiffness (--scheme radau5 or bdf){}",
+            HeldMost::clause(held_most)
         ),
         Failure::StepTooSmall { h_min, held_by } => match held_by {
             Some(b) if b.tolerance_is_the_fix() => format!(

@@ -224,7 +224,7 @@ fn a_failing_run_writes_what_it_computed() {
         panic!("{e}")
     };
     assert!(
-        matches!(failure.kind, Failure::TooMuchWork { max_steps: 100 }),
+        matches!(failure.kind, Failure::TooMuchWork { max_steps: 100, .. }),
         "{failure}"
     );
     assert!(e.to_string().contains("--max-steps"), "{e}");

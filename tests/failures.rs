@@ -190,7 +190,7 @@ fn work_limits_are_typed_errors() {
     };
     let e = simulate(Seed2dof::default(), Scheme::Dopri5, o).unwrap_err();
     assert!(
-        matches!(e.kind, Failure::TooMuchWork { max_steps: 50 }),
+        matches!(e.kind, Failure::TooMuchWork { max_steps: 50, .. }),
         "{e}"
     );
     assert_eq!(e.trajectory.len(), e.stats.steps + 1);
@@ -200,4 +200,35 @@ fn work_limits_are_typed_errors() {
     };
     let e = simulate(Seed2dof::default(), Scheme::Dopri5, o).unwrap_err();
     assert!(matches!(e.kind, Failure::StepTooSmall { .. }), "{e}");
+}
+
+/// A run out of steps names the component whose error test held most of its steps: the
+/// seed's second mass oscillating on its spring against a first mass 10¹² times heavier
+/// (which then hardly moves, its spring to the ground removed), under DOPRI5 and BDF (one
+/// scheme controlling the step by its order, the other by its PI controller).
+#[test]
+fn a_run_out_of_steps_names_the_component_that_held_them() {
+    let mut model = Seed2dof::default();
+    let mut p = model.params().clone();
+    p.m1 = 1e12;
+    p.k1 = 0.0;
+    model.set_params(p).unwrap();
+    for scheme in [Scheme::Dopri5, Scheme::Bdf(Default::default())] {
+        let o = Options {
+            max_steps: 300,
+            ..Options::adaptive(100.0, 1e-8)
+        };
+        let e = simulate(model.clone(), scheme, o).unwrap_err();
+        println!("{scheme:?}: {e}");
+        let Failure::TooMuchWork {
+            held_most: Some(h), ..
+        } = &e.kind
+        else {
+            panic!("{e}")
+        };
+        assert!(h.component.contains("q[1]"), "{e}");
+        assert!(h.steps as f64 > 0.9 * h.of as f64, "{e}");
+        assert!(h.of > 0 && h.of <= e.stats.steps, "{e}");
+        assert!(e.to_string().contains("was held by"), "{e}");
+    }
 }

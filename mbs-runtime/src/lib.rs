@@ -35,7 +35,7 @@ pub use analysis::{
     static_equilibrium,
 };
 pub use efforts::{Effort, Efforts, WithEfforts};
-pub use error::{Failure, HeldBy, ModelError, ParamError, check_inertia};
+pub use error::{Failure, HeldBy, HeldMost, ModelError, ParamError, check_inertia};
 pub use integrators::{
     Assembly, Controller, GlobalControl, GlobalReport, GlobalRun, Inputs, Integrator, SimError,
     Simulation, State, assemble, simulate, simulate_global, simulate_with,

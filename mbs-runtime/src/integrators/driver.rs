@@ -12,7 +12,7 @@ use super::step_control::{Largest, StepBounds, Tolerances, initial_step};
 use super::stepper::{Attempt, Control, Step, Stepper};
 use super::{Integrator, State};
 use crate::charts::{self, Recentring};
-use crate::error::Failure;
+use crate::error::{Failure, HeldMost};
 use crate::model::{Model, Pose};
 use crate::options::{Options, Output, Scheme, StepControl};
 use crate::stats::Stats;
@@ -59,6 +59,9 @@ pub struct Simulation<M: Model> {
     /// the component that weighed most in the error test, when that test rejected the last
     /// attempt (`Failure::StepTooSmall` names it)
     held_by: Option<Largest>,
+    /// per coordinate (its position and velocity), then per multiplier: the accepted steps
+    /// whose error test it held
+    held_counts: Vec<u32>,
     traj: Trajectory,
     /// pending output times (for `Output::Every` and `Times`), next one first
     out_times: Vec<f64>,
@@ -153,6 +156,7 @@ impl<M: Model + 'static> Simulation<M> {
             _ => out_times.len(),
         };
         traj.reserve(expected, options.energy, options.frames);
+        let held_counts = vec![0; M::NQ + cur.lambda.len()];
         let mut sim = Simulation {
             problem,
             stepper,
@@ -166,6 +170,7 @@ impl<M: Model + 'static> Simulation<M> {
             attempts: 0,
             last_cause: None,
             held_by: None,
+            held_counts,
             traj,
             out_times,
             out_next: 0,
@@ -292,6 +297,27 @@ impl<M: Model + 'static> Simulation<M> {
         let s = std::mem::replace(&mut self.cur, State::zeros(0, 0));
         self.record(&s);
         self.cur = s;
+    }
+
+    /// The coordinate (its position or velocity) or multiplier whose error test held the most
+    /// accepted steps, and how many.
+    fn held_most(&self) -> Option<HeldMost> {
+        let of: u32 = self.held_counts.iter().sum();
+        let (i, &steps) = self
+            .held_counts
+            .iter()
+            .enumerate()
+            .max_by_key(|&(i, c)| (*c, std::cmp::Reverse(i)))?;
+        let n = self.problem.n;
+        (of > 0).then(|| HeldMost {
+            component: if i < n {
+                format!("{} (its position or velocity)", self.problem.label(i))
+            } else {
+                format!("λ[{}]", i - n)
+            },
+            steps: steps as usize,
+            of: of as usize,
+        })
     }
 
     fn fail(&self, kind: Failure, h: f64) -> SimError {
@@ -429,7 +455,10 @@ impl<M: Model + 'static> Simulation<M> {
                         t,
                         max_steps,
                     },
-                    None => Failure::TooMuchWork { max_steps },
+                    None => Failure::TooMuchWork {
+                        max_steps,
+                        held_most: self.held_most(),
+                    },
                 };
                 return Err(self.fail(kind, self.h));
             }
@@ -474,6 +503,14 @@ impl<M: Model + 'static> Simulation<M> {
                 Ok(Attempt::Accepted { h_next }) => {
                     if self.stepper.floored() {
                         self.problem.stats.floored_steps += 1;
+                    }
+                    if let Some(b) = self.stepper.held_by() {
+                        let n = self.problem.n;
+                        // a coordinate's position and velocity together, then the multipliers
+                        let i = if b.block < 2 { b.index } else { n + b.index };
+                        if let Some(c) = self.held_counts.get_mut(i) {
+                            *c += 1;
+                        }
                     }
                     self.next.t = if last {
                         t_stop

@@ -135,6 +135,20 @@ pub(crate) struct Largest {
     pub set_by: WeightBy,
 }
 
+/// A component of an error norm's vector in words: block 0 positions (`label` of the
+/// coordinate, "q[3] (name)"), 1 velocities, 2 multipliers.
+pub(crate) fn component_name(
+    block: usize,
+    index: usize,
+    label: impl Fn(usize) -> String,
+) -> String {
+    match block {
+        0 => label(index),
+        1 => format!("the velocity of {}", label(index)),
+        _ => format!("λ[{index}]"),
+    }
+}
+
 /// What set a component's weight in an error norm.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum WeightBy {
@@ -156,13 +170,8 @@ impl Largest {
     /// What held the step, in words for `Failure::StepTooSmall`: the component labelled by
     /// `label` (coordinate index → "q[3] (name)"), its error and tolerance, and what set it.
     pub fn held_by(&self, label: impl Fn(usize) -> String) -> crate::error::HeldBy {
-        let component = match self.block {
-            0 => label(self.index),
-            1 => format!("the velocity of {}", label(self.index)),
-            _ => format!("λ[{}]", self.index),
-        };
         crate::error::HeldBy {
-            component,
+            component: component_name(self.block, self.index, label),
             value: self.magnitude,
             error: self.error,
             tolerance: self.weight,

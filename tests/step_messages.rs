@@ -313,6 +313,15 @@ fn radau_runs_from_rest_under_a_tiny_atol() {
 /// h_min = 0.01 s) names its component with no such advice.
 #[test]
 fn a_step_below_h_min_names_the_component_that_held_it() {
+    use mbs::{HeldBy, SimError};
+    fn held_by(e: &SimError) -> &HeldBy {
+        match &e.kind {
+            Failure::StepTooSmall {
+                held_by: Some(b), ..
+            } => b,
+            _ => panic!("{e}"),
+        }
+    }
     use mbs_models::hexapod::HexapodStanding;
     let e = simulate(
         HexapodStanding::default(),
@@ -320,12 +329,7 @@ fn a_step_below_h_min_names_the_component_that_held_it() {
         adaptive(1.0, 1e-6, 1e-30),
     )
     .unwrap_err();
-    let Failure::StepTooSmall {
-        held_by: Some(b), ..
-    } = &e.kind
-    else {
-        panic!("{e}")
-    };
+    let b = held_by(&e);
     println!("{e}");
     assert!(b.component.starts_with("the velocity of q["), "{e}");
     assert_eq!(b.set_by, "rounding", "{e}");
@@ -337,12 +341,7 @@ fn a_step_below_h_min_names_the_component_that_held_it() {
         ..quiet(Options::adaptive(10.0, 1e-10))
     };
     let e = simulate(Seed2dof::default(), Scheme::Dopri5, o).unwrap_err();
-    let Failure::StepTooSmall {
-        held_by: Some(b), ..
-    } = &e.kind
-    else {
-        panic!("{e}")
-    };
+    let b = held_by(&e);
     println!("{e}");
     assert_eq!(b.set_by, "rtol", "{e}");
     assert!(b.component.contains("q["), "{e}");

@@ -232,3 +232,34 @@ fn a_run_out_of_steps_names_the_component_that_held_them() {
         assert!(e.to_string().contains("was held by"), "{e}");
     }
 }
+
+/// Newton that fails at a fixed step names the component of its last correction with the
+/// largest weighted term: the double pendulum at h = 0.3 s, where every implicit scheme's
+/// Newton diverges from the start, its outer link's velocity the largest correction.
+#[test]
+fn newton_that_fails_names_its_largest_correction() {
+    use mbs_models::dpend::DoublePendulum;
+    let schemes = [
+        Scheme::GenAlpha(Default::default()),
+        Scheme::Hht(Default::default()),
+        Scheme::Radau5,
+        Scheme::Bdf(Default::default()),
+        Scheme::ImplicitMidpoint,
+    ];
+    for scheme in schemes {
+        let o = Options {
+            output: Output::Last,
+            ..Options::fixed(10.0, 0.3)
+        };
+        let e = simulate(DoublePendulum::default(), scheme, o).unwrap_err();
+        println!("{scheme:?}: {e}");
+        let Failure::NewtonDiverged {
+            largest: Some(c), ..
+        } = &e.kind
+        else {
+            panic!("{scheme:?}: {e}")
+        };
+        assert_eq!(c, "the velocity of q[1]", "{scheme:?}: {e}");
+        assert!(e.to_string().contains("largest in the velocity of q[1]"));
+    }
+}

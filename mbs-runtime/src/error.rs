@@ -202,9 +202,15 @@ pub enum Failure {
         held_most: Option<HeldMost>,
     },
     #[error(
-        "Newton did not converge in {iterations} iterations (last correction {correction:e}) at the smallest step allowed (h_min for adaptive steps; a fixed step is not reduced: take a smaller h)"
+        "Newton did not converge in {iterations} iterations (last correction {correction:e}{}) at the smallest step allowed (h_min for adaptive steps; a fixed step is not reduced: take a smaller h)",
+        largest.as_ref().map(|c| format!(", largest in {c}")).unwrap_or_default()
     )]
-    NewtonDiverged { iterations: usize, correction: f64 },
+    NewtonDiverged {
+        iterations: usize,
+        correction: f64,
+        /// the component of the last correction with the largest weighted term
+        largest: Option<String>,
+    },
     #[error("{matrix} is singular (rcond ≈ {rcond:.1e}) near coordinates {}", coordinates.join(", "))]
     SingularMatrix {
         matrix: &'static str,

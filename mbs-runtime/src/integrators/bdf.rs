@@ -369,6 +369,10 @@ impl<M: Model> Stepper<M> for Bdf {
         self.held_by
     }
 
+    fn newton_largest(&self) -> Option<(usize, usize)> {
+        self.newton.largest
+    }
+
     fn tolerance_floor(&self, rtol: f64) -> Option<f64> {
         Tolerances::transformed_floored(rtol, TOL_FACTOR, TOL_EXPONENT)
     }

@@ -8,7 +8,7 @@ use super::inputs::{Controller, Inputs};
 use super::newton::NewtonTol;
 use super::problem::{Loops, Problem};
 use super::sim_error::SimError;
-use super::step_control::{Largest, StepBounds, Tolerances, initial_step};
+use super::step_control::{Largest, StepBounds, Tolerances, component_name, initial_step};
 use super::stepper::{Attempt, Control, Step, Stepper};
 use super::{Integrator, State};
 use crate::charts::{self, Recentring};
@@ -582,9 +582,14 @@ impl<M: Model + 'static> Simulation<M> {
                             })
                     );
                     if fixed || h <= h_min || fatal {
+                        let largest = self
+                            .stepper
+                            .newton_largest()
+                            .map(|(block, i)| component_name(block, i, |j| self.problem.label(j)));
                         let kind = cause.unwrap_or(Failure::NewtonDiverged {
                             iterations,
                             correction,
+                            largest,
                         });
                         return Err(self.fail(kind, h));
                     }

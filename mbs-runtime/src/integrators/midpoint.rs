@@ -36,6 +36,10 @@ impl Midpoint {
 }
 
 impl<M: Model> Stepper<M> for Midpoint {
+    fn newton_largest(&self) -> Option<(usize, usize)> {
+        self.newton.largest
+    }
+
     fn start(&mut self, _p: &mut Problem<M>, s: &State, _ctl: &Control) -> Result<(), Failure> {
         self.a.copy_from_slice(&s.qdd);
         Ok(())

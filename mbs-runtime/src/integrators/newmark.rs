@@ -231,6 +231,10 @@ impl<M: Model> Stepper<M> for AlphaFamily {
         self.held_by
     }
 
+    fn newton_largest(&self) -> Option<(usize, usize)> {
+        self.newton.largest
+    }
+
     fn tolerance_floor(&self, rtol: f64) -> Option<f64> {
         order_two_floored(rtol, TOL_FACTOR, FLOOR)
     }

@@ -45,6 +45,7 @@
 
 use super::at::{Affine, At, Weights};
 use super::problem::Problem;
+use super::step_control::Argmax;
 use crate::error::Failure;
 use crate::linalg::Lu;
 use crate::model::Model;
@@ -113,6 +114,9 @@ pub(crate) struct AccelNewton {
     v: Vec<f64>,
     r: Vec<f64>,
     a0: Vec<f64>,
+    /// the component of the last iteration's correction with the largest weighted term:
+    /// (block, index), block 0 positions, 1 velocities, 2 multipliers
+    pub largest: Option<(usize, usize)>,
 }
 
 impl AccelNewton {
@@ -141,6 +145,7 @@ impl AccelNewton {
             v: vec![0.0; n],
             r: vec![0.0; n],
             a0: vec![0.0; n],
+            largest: None,
         }
     }
 
@@ -300,6 +305,7 @@ impl AccelNewton {
                     (0.0, 0.0, 0.0)
                 };
                 let mut s = 0.0;
+                let mut largest = Argmax::default();
                 if self.index2 {
                     for k in 0..nc {
                         self.nu[k] -= self.r[n + nc + k];
@@ -319,13 +325,17 @@ impl AccelNewton {
                     let eq = beta * dq / (tol.atol + tol.rtol * self.q[i].abs() + fq);
                     let ev = gamma * d / (tol.atol + tol.rtol * self.v[i].abs() + fv);
                     s += eq * eq + ev * ev;
+                    largest.see(eq * eq, 0, i);
+                    largest.see(ev * ev, 1, i);
                 }
                 for k in 0..nc {
                     let d = -self.r[n + k];
                     lambda[k] += d;
                     let el = d / (tol.atol + tol.rtol * lambda[k].abs() + fl);
                     s += el * el;
+                    largest.see(el * el, 2, k);
                 }
+                self.largest = largest.at;
                 let norm = (s / (2 * n + nc).max(1) as f64).sqrt();
                 last = norm;
                 if !norm.is_finite() {

@@ -76,7 +76,7 @@ impl Tolerances {
         let n = e.len();
         let bounds = [0, kind.min(n), (2 * kind).min(n), n];
         let (mut s, mut floored) = (0.0, false);
-        let (mut top, mut held_by) = (-1.0, None);
+        let (mut top, mut held_by) = (Argmax::default(), None);
         for (block, b) in bounds.windows(2).enumerate() {
             let (start, end) = (b[0], b[1]);
             let largest = y0[start..end]
@@ -91,9 +91,7 @@ impl Tolerances {
                 let weight = w.max(floor);
                 let term = (e[i] / weight) * (e[i] / weight);
                 s += term;
-                // the first NaN term, else the largest
-                if !(term <= top) && !(top.is_nan()) {
-                    top = term;
+                if top.see(term, block, i - start) {
                     let set_by = if w < floor {
                         WeightBy::Rounding
                     } else if atol >= rtol * magnitude {
@@ -117,6 +115,36 @@ impl Tolerances {
             floored,
             held_by,
         }
+    }
+}
+
+/// The largest of a run of weighted terms of a norm (the first NaN, if any), and where it is:
+/// (block, index in the block), block 0 positions, 1 velocities, 2 multipliers.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Argmax {
+    top: f64,
+    pub at: Option<(usize, usize)>,
+}
+
+impl Default for Argmax {
+    fn default() -> Argmax {
+        Argmax {
+            top: -1.0,
+            at: None,
+        }
+    }
+}
+
+impl Argmax {
+    /// Takes `term` of component `index` of `block` into account; true when it is the new
+    /// largest.
+    pub fn see(&mut self, term: f64, block: usize, index: usize) -> bool {
+        let new = !(term <= self.top) && !self.top.is_nan();
+        if new {
+            self.top = term;
+            self.at = Some((block, index));
+        }
+        new
     }
 }
 

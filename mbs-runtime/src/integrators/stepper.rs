@@ -113,6 +113,12 @@ pub(crate) trait Stepper<M: Model> {
     fn held_by(&self) -> Option<super::step_control::Largest> {
         None
     }
+    /// The component of Newton's last correction with the largest weighted term, (block,
+    /// index) as [`super::step_control::Argmax`] gives it (none for an explicit scheme):
+    /// `Failure::NewtonDiverged` names it.
+    fn newton_largest(&self) -> Option<(usize, usize)> {
+        None
+    }
     /// Called once the driver has accepted the step from `prev` to `cur`.
     fn accepted(&mut self, _p: &mut Problem<M>, _prev: &State, _cur: &State) {}
     /// Dense output on [prev.t, cur.t]: by default the quintic Hermite interpolant of

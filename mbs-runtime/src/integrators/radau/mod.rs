@@ -504,6 +504,9 @@ pub(crate) struct Radau {
     psix: Vec<f64>,
     /// whether the last error test raised a weight to its rounding floor
     floored: bool,
+    /// the component of Newton's last correction with the largest weighted term (block,
+    /// index), set by `correction_norm`
+    newton_largest: std::cell::Cell<Option<(usize, usize)>>,
     /// the component that weighed most in the last error test
     held_by: Option<Largest>,
 }
@@ -515,6 +518,7 @@ impl Radau {
         Radau {
             floored: false,
             held_by: None,
+            newton_largest: std::cell::Cell::new(None),
             k: Coefficients::new(s),
             n,
             m: vec![0.0; n * n],
@@ -605,6 +609,10 @@ impl<M: Model> Stepper<M> for Radau {
 
     fn held_by(&self) -> Option<Largest> {
         self.held_by
+    }
+
+    fn newton_largest(&self) -> Option<(usize, usize)> {
+        self.newton_largest.get()
     }
 
     fn error_test(&self, p: &Problem<M>) -> ErrorTest {

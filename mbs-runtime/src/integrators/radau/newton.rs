@@ -3,6 +3,7 @@
 
 use super::super::State;
 use super::super::problem::Problem;
+use super::super::step_control::Argmax;
 use super::index2::border2;
 use super::index3::border;
 use super::tableau::re;
@@ -252,6 +253,7 @@ impl Radau {
         let (s, n, nc) = (self.k.s, self.n, self.nc);
         let (a, a2) = (&self.k.a, &self.k.a2);
         let mut sum = 0.0;
+        let mut largest = Argmax::default();
         for i in 0..s {
             for r in 0..n {
                 let (mut dv, mut dq) = (0.0, 0.0);
@@ -261,12 +263,16 @@ impl Radau {
                 }
                 let (eq, ev) = (h * h * dq / self.scq[r], h * dv / self.scv[r]);
                 sum += eq * eq + ev * ev;
+                largest.see(eq * eq, 0, r);
+                largest.see(ev * ev, 1, r);
             }
             for r in 0..nc {
                 let el = self.dlam[i * nc + r] / self.scl[r];
                 sum += el * el;
+                largest.see(el * el, 2, r);
             }
         }
+        self.newton_largest.set(largest.at);
         if self.index2 {
             sum += self.mu_correction_sum(h);
         }

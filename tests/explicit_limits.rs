@@ -220,9 +220,13 @@ fn dopri5_detects_stiffness_and_says_so() {
             scheme,
             t: from,
             max_steps,
+            held_most,
         } => {
             assert_eq!((scheme, max_steps), ("dopri5", 2000));
             assert_eq!(from, t, "the same detection as the full run");
+            // the error test of the steps is held by the stiff coordinate
+            let h = held_most.expect("an error test held the steps");
+            assert!(h.component.starts_with("q[0]"), "{text}");
         }
         other => panic!("{other}"),
     }

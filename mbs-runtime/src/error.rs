@@ -301,14 +301,17 @@ pub enum Failure {
         supported: &'static str,
     },
     #[error(
-        "more than {max_steps} steps on a stiff problem: from t = {} the step of {scheme} was held by its stability region (h·|λ| > 3.25 for 15 accepted steps in a row), not by accuracy; use radau5 or bdf",
-        short(*t)
+        "more than {max_steps} steps on a stiff problem: from t = {} the step of {scheme} was held by its stability region (h·|λ| > 3.25 for 15 accepted steps in a row), not by accuracy; use radau5 or bdf{}",
+        short(*t),
+        HeldMost::clause(held_most)
     )]
     LikelyStiff {
         scheme: &'static str,
         /// the end of the first run of steps found stiff
         t: f64,
         max_steps: usize,
+        /// the component whose error test held the most accepted steps
+        held_most: Option<HeldMost>,
     },
     #[error(
         "global error control: {} after {runs} runs, the most accurate at local rtol {rtol:.1e}{}{}; loosen rtol, or use a scheme of higher order (radau5, dopri5, bdf) or another constraint method",

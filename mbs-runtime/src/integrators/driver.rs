@@ -454,6 +454,7 @@ impl<M: Model + 'static> Simulation<M> {
                         scheme: self.scheme.name(),
                         t,
                         max_steps,
+                        held_most: self.held_most(),
                     },
                     None => Failure::TooMuchWork {
                         max_steps,

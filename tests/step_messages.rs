@@ -347,3 +347,27 @@ fn a_step_below_h_min_names_the_component_that_held_it() {
     assert!(b.component.contains("q["), "{e}");
     assert!(!e.to_string().contains("raise atol"), "{e}");
 }
+
+/// An rtol of 1 or more accepts any step (DOPRI5 on the double pendulum at rtol 2 let the
+/// velocities grow to 7e17 rad/s before its step fell below h_min), and an output every 1e-300
+/// s asks for more outputs than memory holds (it panicked building their times): both are
+/// refused before any work, naming the option.
+#[test]
+fn a_tolerance_of_a_hundred_percent_and_outputs_beyond_memory_are_refused() {
+    let (name, msg) = invalid(Scheme::Dopri5, quiet(Options::adaptive(10.0, 2.0)));
+    assert_eq!(name, "rtol", "{msg}");
+    assert!(msg.contains("must be < 1"), "{msg}");
+    let o = Options {
+        output: Output::Every { dt: 1e-300 },
+        ..Options::adaptive(10.0, 1e-6)
+    };
+    let (name, msg) = invalid(Scheme::Dopri5, o);
+    assert_eq!(name, "output.dt", "{msg}");
+    assert!(msg.contains("10⁸ outputs"), "{msg}");
+    // the largest rtol below 1 and a dense output within the bound still run
+    let o = Options {
+        output: Output::Every { dt: 1e-3 },
+        ..Options::adaptive(1.0, 0.5)
+    };
+    assert!(simulate(Seed2dof::default(), Scheme::Radau5, o).is_ok());
+}

@@ -663,6 +663,13 @@ impl Options {
                 if !(rtol > 0.0) || !rtol.is_finite() {
                     return Err(invalid("rtol", rtol, "must be > 0"));
                 }
+                if rtol >= 1.0 {
+                    return Err(invalid(
+                        "rtol",
+                        rtol,
+                        "must be < 1: a relative tolerance of 100 % accepts any step, and the motion grows without a word (a double pendulum at rtol 2 reached 7e17 rad/s); take 1e-3 for about 3 digits",
+                    ));
+                }
                 if rtol < 10.0 * f64::EPSILON {
                     return Err(invalid(
                         "rtol",
@@ -728,6 +735,17 @@ impl Options {
             Output::Every { dt } if !(*dt > 0.0) || !dt.is_finite() => {
                 return Err(invalid("output.dt", dt, "must be > 0 and finite"));
             }
+            Output::Every { dt } if (self.t_end - self.t0) / dt > MAX_OUTPUTS => {
+                return Err(invalid(
+                    "output.dt",
+                    format!(
+                        "{} (with t_end − t0 = {})",
+                        short(*dt),
+                        short(self.t_end - self.t0)
+                    ),
+                    "gives more than 10⁸ outputs, more than the trajectory can hold: take a larger dt, or Output::Steps or Output::Last",
+                ));
+            }
             Output::Times(ts) => {
                 if ts
                     .iter()
@@ -789,6 +807,10 @@ impl Options {
         validate_scheme(scheme)
     }
 }
+
+/// The most outputs `Output::Every` may ask for: 10⁸ (the trajectory stores q, q̇ and q̈ of
+/// each, 2.4 GB for a single coordinate).
+const MAX_OUTPUTS: f64 = 1e8;
 
 /// Parameters of a scheme within their ranges of stability.
 pub fn validate_scheme(scheme: &Scheme) -> Result<(), Failure> {

@@ -292,8 +292,11 @@ fn failure_text(e: &SimError) -> String {
             h_rho,
             limit,
             h_stable,
+            at_end,
         } => format!(
-            "h·ρ = {h_rho:.3} leaves the stability region of {scheme} (limit {limit:.3}; ρ ≈ {rho:.4e} 1/s is the fastest mode) {at}: take --h {:.1e} or smaller, or an implicit scheme (--scheme radau5)",
+            "{}h·ρ = {h_rho:.3} leaves the stability region of {scheme} (limit {limit:.3}; ρ ≈ {rho:.4e} 1/s is the fastest mode{}) {at}: take --h {:.1e} or smaller, or an implicit scheme (--scheme radau5)",
+            if *at_end { crate::error::LURCHED } else { "" },
+            if *at_end { " there" } else { "" },
             shorten(*h_stable)
         ),
         Failure::ConstraintDrift {

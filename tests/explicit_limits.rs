@@ -277,3 +277,36 @@ fn dopri5_finds_no_stiffness_on_smooth_problems() {
         "{e}"
     );
 }
+
+/// A fixed step that is the whole run is checked after it is taken: the double pendulum,
+/// released where gravity has no stiffness (ρ ≈ 0 at the start, so the check before the step
+/// passes), in one step of 10 s ran to the end with its energy 100 % off and no word under
+/// explicit Euler, RK4 and fixed-step DOPRI5. The step changes the state by more than its own
+/// size; ρ at its end refuses it, at t = 0 with the start kept, advising a step no larger than
+/// a hundredth of it (that end state is one the step blew up).
+#[test]
+fn a_single_step_over_the_whole_run_is_checked_at_its_end() {
+    use mbs_models::dpend::DoublePendulum;
+    for scheme in [Scheme::ExplicitEuler, Scheme::Rk4, Scheme::Dopri5] {
+        let o = Options {
+            output: Output::Steps,
+            ..Options::fixed(10.0, 10.0)
+        };
+        let e = simulate(DoublePendulum::default(), scheme, o).unwrap_err();
+        println!("{scheme:?}: {e}");
+        let Failure::UnstableStep {
+            at_end, h_stable, ..
+        } = e.kind
+        else {
+            panic!("{scheme:?}: {e}")
+        };
+        assert!(at_end, "{e}");
+        assert!(h_stable <= 0.1 + 1e-12, "{e}");
+        assert_eq!(e.t, 0.0);
+        assert_eq!(e.trajectory.len(), 1, "the start kept");
+        assert!(
+            e.to_string()
+                .contains("changed the state by more than its own size")
+        );
+    }
+}

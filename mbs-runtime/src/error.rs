@@ -77,6 +77,9 @@ pub fn check_inertia(body: &'static str, t: [f64; 6]) -> Result<(), ParamError> 
 /// Why a simulation stopped early. Each variant carries what is needed to act on it; the
 /// time, step, work done and the trajectory so far travel with it in
 /// [`SimError`](crate::SimError).
+/// How [`Failure::UnstableStep`] starts when ρ was estimated at the end of the step.
+pub const LURCHED: &str = "the step changed the state by more than its own size: at its end ";
+
 /// The component that weighed most in the error test that last rejected a step, named when
 /// the step falls below h_min: a step held by one coordinate of a stiff or singular motion, or
 /// by a tolerance tighter than the arithmetic resolves.
@@ -241,7 +244,9 @@ pub enum Failure {
         coordinate: String,
     },
     #[error(
-        "h·ρ = {h_rho:.3} leaves the stability region of {scheme} (limit {limit:.3}; ρ ≈ {rho:.4e} 1/s is the fastest mode): take h < {h_stable:.4e} s or an implicit scheme"
+        "{}h·ρ = {h_rho:.3} leaves the stability region of {scheme} (limit {limit:.3}; ρ ≈ {rho:.4e} 1/s is the fastest mode{}): take h < {h_stable:.4e} s or an implicit scheme",
+        if *at_end { LURCHED } else { "" },
+        if *at_end { " there" } else { "" }
     )]
     UnstableStep {
         scheme: &'static str,
@@ -249,6 +254,10 @@ pub enum Failure {
         h_rho: f64,
         limit: f64,
         h_stable: f64,
+        /// ρ was estimated at the end of a step that changed the state by more than its own
+        /// size (the check before the step had found it stable): h_stable is then at least a
+        /// hundredth of the step, since a state the step blew up says little of the model
+        at_end: bool,
     },
     #[error(
         "the constraints are redundant or degenerate: B = ∂Φ/∂q has rank {rank} for {nc} constraints (smallest singular value {sigma_min:.2e}); involved: {}; remove the redundant equations (e.g. the out-of-plane ones of a planar loop) or start away from the singular configuration",

@@ -494,6 +494,7 @@ impl<M: Model> Stepper<M> for Chebyshev {
                     h_rho,
                     limit: f * h_rho,
                     h_stable: f * h,
+                    at_end: false,
                 });
             }
         }

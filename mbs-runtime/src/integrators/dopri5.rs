@@ -178,6 +178,9 @@ impl<M: Model> Stepper<M> for Dopri5 {
         next.qd.copy_from_slice(&self.v);
         next.qdd.copy_from_slice(&self.ka[6]);
         let Some(tol) = ctl.adaptive else {
+            if ctl.stability_check {
+                self.watch.after(p, (cur, next, h), "DOPRI5", limit)?;
+            }
             self.dense(cur, next, h);
             self.watch.accepted(cur, next);
             return Ok(Attempt::Accepted { h_next: h });

@@ -204,6 +204,47 @@ impl StabilityWatch {
                 h_rho,
                 limit,
                 h_stable: limit / self.rho,
+                at_end: false,
+            });
+        }
+        Ok(())
+    }
+
+    /// After a step of size h from `cur` to `next`, before it is accepted: when the step
+    /// changed the state by more than its own size (a lurch), ρ is estimated at `next` and the
+    /// step refused with `UnstableStep` when h·ρ exceeds the limit. The check before each
+    /// step sees the state the step starts from; a run whose last step lurches has no next
+    /// step to catch it (the double pendulum started where gravity has no stiffness, one step
+    /// of explicit Euler to t_end = 10 s: ρ ≈ 0 at the start, the energy 100 % off at the end,
+    /// no word).
+    pub(crate) fn after<M: Model>(
+        &mut self,
+        p: &mut Problem<M>,
+        steps: (&State, &State, f64),
+        scheme: &'static str,
+        limit: impl Fn(bool) -> f64,
+    ) -> Result<(), Failure> {
+        let (cur, next, h) = steps;
+        if !lurched(cur, next) {
+            return Ok(());
+        }
+        // as before a step: one power iteration, iterated until it settles before a refusal
+        self.refresh(p, next, false)?;
+        if h * self.rho > limit(self.oscillating) {
+            self.settle(p, next)?;
+        }
+        let (h_rho, limit) = (h * self.rho, limit(self.oscillating));
+        if h_rho > limit {
+            // the step's end may be a state the step blew up, whose ρ says little of the
+            // model's (1e38 1/s after one DOPRI5 step of 10 s): the step advised is at least
+            // a hundredth of this one, and the checks before each smaller step judge it
+            return Err(Failure::UnstableStep {
+                scheme,
+                rho: self.rho,
+                h_rho,
+                limit,
+                h_stable: (limit / self.rho).max(0.01 * h),
+                at_end: true,
             });
         }
         Ok(())
@@ -398,6 +439,11 @@ impl<M: Model> Stepper<M> for Explicit {
         p.check("q", &next.q)?;
         p.check("qd", &next.qd)?;
         p.accel(t + h, &next.q, &next.qd, &mut next.qdd)?;
+        if ctl.stability_check {
+            let kind = self.kind;
+            self.watch
+                .after(p, (cur, next, h), self.name(), |osc| limit(kind, osc))?;
+        }
         self.watch.accepted(cur, next);
         Ok(Attempt::Accepted { h_next: h })
     }

@@ -100,6 +100,16 @@ fn print_figures(label: &str, f: &Figures) {
     println!("  real-time factor {:.1}", f.real_time_factor);
 }
 
+/// A walk that started: an unreachable start, or options refused before the first output (a
+/// walk with no trajectory to read figures from), is the program's error.
+fn started(w: Result<Walk, Unreachable>) -> Result<Walk, String> {
+    let w = w.map_err(|e| e.to_string())?;
+    match &w.failure {
+        Some(e) if w.trajectory.is_empty() => Err(e.to_string()),
+        _ => Ok(w),
+    }
+}
+
 fn main() {
     use clap::{CommandFactory, FromArgMatches};
     // this program's defaults: RKC (at 0.5 ms unless --h: two steps per control period),
@@ -139,7 +149,7 @@ fn run(args: &Args) -> Result<(), String> {
     if args.compare {
         return compare(&walker, scheme, options, args.run.out.as_deref());
     }
-    let w = walk(&walker, control, scheme, options).map_err(|e| e.to_string())?;
+    let w = started(walk(&walker, control, scheme, options))?;
     let f = w.figures();
     let label = format!(
         "{} gait at {} m/s{} on {} ground, {} control, {}",
@@ -200,7 +210,7 @@ fn compare(
     );
     let (mut energy, mut height) = (Vec::new(), Vec::new());
     for (name, w) in [("quick", &quick), ("slow", &slow)] {
-        let r = walk(w, Control::Sampled, scheme, options.clone()).map_err(|e| e.to_string())?;
+        let r = started(walk(w, Control::Sampled, scheme, options.clone()))?;
         let f = r.figures();
         let tr = &r.trajectory;
         let n = HexapodWalker::NQ;

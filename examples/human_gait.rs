@@ -40,29 +40,47 @@ use mbs::{Kinematics, Model, Options, Output, Scheme, Trajectory, WithEfforts};
 use mbs_models::human::*;
 use std::path::PathBuf;
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
+fn main() -> std::process::ExitCode {
+    match gait() {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
+
+fn gait() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
     let value = |name: &str| {
         args.iter()
             .position(|a| a == name)
             .and_then(|i| args.get(i + 1))
     };
-    let number = |name: &str, default: f64| -> Result<f64, String> {
-        match value(name) {
-            None => Ok(default),
+    // a number within [low, high] (finite), or the default
+    let number = |name: &str, default: f64, low: f64, high: f64| -> Result<f64, String> {
+        let x = match value(name) {
+            None => return Ok(default),
             Some(v) => v
-                .parse()
-                .map_err(|_| format!("{name} takes a number, not `{v}`")),
+                .parse::<f64>()
+                .map_err(|_| format!("{name} takes a number, not `{v}`"))?,
+        };
+        if x.is_finite() && (low..=high).contains(&x) {
+            Ok(x)
+        } else {
+            Err(format!(
+                "{name} {x} is out of range: take a number in [{low}, {high}]"
+            ))
         }
     };
-    let period = number("--period", 1.1)?;
-    let kp = number("--kp", GAIT_KP)?;
-    let pelvis_kp = number("--pelvis", GAIT_PELVIS_KP)?;
-    let cycles = number("--cycles", 2.0)?.round().max(1.0);
-    let clearance = number("--clearance", 0.02)?;
-    let dissipation = number("--dissipation", GAIT_DISSIPATION)?;
-    let stiffness = number("--stiffness", Human::default().params().k_foot)?;
-    let muscle_rtol = number("--muscle-rtol", 1e-4)?;
+    let period = number("--period", 1.1, 0.5, 3.0)?;
+    let kp = number("--kp", GAIT_KP, 1.0, 1e8)?;
+    let pelvis_kp = number("--pelvis", GAIT_PELVIS_KP, 0.0, 1e8)?;
+    let cycles = number("--cycles", 2.0, 1.0, 100.0)?.round();
+    let clearance = number("--clearance", 0.02, 0.0, 0.2)?;
+    let dissipation = number("--dissipation", GAIT_DISSIPATION, 0.0, 1e3)?;
+    let stiffness = number("--stiffness", Human::default().params().k_foot, 1.0, 1e12)?;
+    let muscle_rtol = number("--muscle-rtol", 1e-4, 1e-12, 0.1)?;
     let out = PathBuf::from(value("--out").map_or("target/human_gait", |s| s.as_str()));
     std::fs::create_dir_all(&out)?;
 

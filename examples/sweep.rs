@@ -64,6 +64,10 @@ fn arg(name: &str) -> Option<String> {
 fn main() {
     let runs: usize = arg("--runs").and_then(|s| s.parse().ok()).unwrap_or(1000);
     let repeat: usize = arg("--repeat").and_then(|s| s.parse().ok()).unwrap_or(7);
+    if runs == 0 || repeat == 0 {
+        eprintln!("error: --runs and --repeat take whole numbers of 1 or more");
+        std::process::exit(1);
+    }
     let out = arg("--out").map_or_else(
         || std::env::temp_dir().join(format!("mbs-sweep-example-{}", std::process::id())),
         std::path::PathBuf::from,

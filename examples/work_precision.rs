@@ -78,9 +78,9 @@ struct Args {
     /// write DIR/wp_MODEL.csv and DIR/wp_MODEL.svg
     #[arg(long)]
     out: Option<PathBuf>,
-    /// timed repeats per run, the best kept
-    #[arg(long, default_value_t = 5)]
-    repeats: usize,
+    /// timed repeats per run, the best kept (1 or more)
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u16).range(1..))]
+    repeats: u16,
 }
 
 const MODELS: [&str; 11] = [
@@ -568,11 +568,14 @@ fn main() {
         vec![args.model.as_str()]
     };
     if let Some(dir) = &args.out {
-        std::fs::create_dir_all(dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
+        if let Err(e) = std::fs::create_dir_all(dir) {
+            eprintln!("error: cannot create {}: {e}", dir.display());
+            std::process::exit(1);
+        }
     }
     for name in names {
         let start = Instant::now();
-        let wp = study(name, args.repeats);
+        let wp = study(name, args.repeats.into());
         println!("{wp}");
         println!("cheapest run per scheme to d significant digits at t_end:");
         for d in [3.0, 5.0, 7.0, 9.0] {

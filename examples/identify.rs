@@ -275,7 +275,8 @@ fn main() -> Result<(), Error> {
         .skip_while(|a| a != "--out")
         .nth(1)
         .map_or_else(|| std::path::PathBuf::from("."), std::path::PathBuf::from);
-    std::fs::create_dir_all(&out)?;
+    std::fs::create_dir_all(&out)
+        .map_err(|e| Error::msg(format!("cannot create {}: {e}", out.display())))?;
     let (truth, _) = simulate(model_at(&TRUE)?, Scheme::Dopri5, options())?;
     let mut measured: Vec<f64> = truth.q_data.clone();
     for (m, e) in measured.iter_mut().zip(noise(truth.q_data.len(), 1e-3)) {

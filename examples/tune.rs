@@ -143,7 +143,8 @@ fn main() -> Result<(), Error> {
         .skip_while(|a| a != "--out")
         .nth(1)
         .map_or_else(|| std::path::PathBuf::from("."), std::path::PathBuf::from);
-    std::fs::create_dir_all(&out)?;
+    std::fs::create_dir_all(&out)
+        .map_err(|e| Error::msg(format!("cannot create {}: {e}", out.display())))?;
 
     // the exact gradient against central differences, once
     let (tr, _) = simulate(Sensitivities::new(arm(&START)?)?, Scheme::Dopri5, options())?;

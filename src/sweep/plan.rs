@@ -301,12 +301,15 @@ impl Plan {
             }
         }
         let need_runs = || {
-            self.sweep.runs.filter(|&n| n > 0).ok_or_else(|| {
-                SweepError::Plan(format!(
-                    "a {} design needs `runs = N` (N > 0) in [sweep]",
-                    design.name()
-                ))
-            })
+            self.sweep
+                .runs
+                .filter(|&n| n > 0 && n <= MAX_RUNS)
+                .ok_or_else(|| {
+                    SweepError::Plan(format!(
+                        "a {} design needs `runs = N` (0 < N ≤ {MAX_RUNS}) in [sweep]",
+                        design.name()
+                    ))
+                })
         };
         let mut rng = ChaCha8Rng::seed_from_u64(self.sweep.seed.unwrap_or(0));
         let rows = match design {
@@ -316,6 +319,17 @@ impl Plan {
                     .iter()
                     .map(Variable::grid_values)
                     .collect::<Result<Vec<_>, _>>()?;
+                let runs = axes
+                    .iter()
+                    .try_fold(1usize, |n, a| n.checked_mul(a.len()))
+                    .filter(|&n| n <= MAX_RUNS);
+                if runs.is_none() {
+                    let counts: Vec<String> = axes.iter().map(|a| a.len().to_string()).collect();
+                    return Err(SweepError::Plan(format!(
+                        "the grid has {} runs, more than {MAX_RUNS}: take fewer values per variable, or a Latin hypercube (design = \"lhs\")",
+                        counts.join(" × ")
+                    )));
+                }
                 grid(&axes)
             }
             DesignKind::MonteCarlo => {
@@ -417,20 +431,23 @@ impl Variable {
             self.set_fields().len(),
         ) {
             (Some(v), None, None, 1) if !v.is_empty() => Ok(v.clone()),
-            (None, Some([a, b]), Some(n), 2) if n >= 1 && a.is_finite() && b.is_finite() => Ok((0
-                ..n)
-                .map(|i| {
-                    let s = if n == 1 {
-                        0.0
-                    } else {
-                        i as f64 / (n - 1) as f64
-                    };
-                    Value::Num(if i + 1 == n { b } else { a + s * (b - a) })
-                })
-                .collect()),
-            _ => Err(bad(
-                "either `values = [...]` (not empty) or `range = [from, to]` with `count = N` (N ≥ 1)",
-            )),
+            (None, Some([a, b]), Some(n), 2)
+                if (1..=MAX_RUNS).contains(&n) && a.is_finite() && b.is_finite() =>
+            {
+                Ok((0..n)
+                    .map(|i| {
+                        let s = if n == 1 {
+                            0.0
+                        } else {
+                            i as f64 / (n - 1) as f64
+                        };
+                        Value::Num(if i + 1 == n { b } else { a + s * (b - a) })
+                    })
+                    .collect())
+            }
+            _ => Err(bad(&format!(
+                "either `values = [...]` (not empty) or `range = [from, to]` with `count = N` (1 ≤ N ≤ {MAX_RUNS})"
+            ))),
         }
     }
 
@@ -466,6 +483,10 @@ impl Variable {
         }
     }
 }
+
+/// The most runs a plan may make: 10⁸ (the run list is held in memory and written to
+/// `runs.csv`; a grid of 10¹² runs aborted allocating it).
+const MAX_RUNS: usize = 100_000_000;
 
 /// Every combination, the last axis varying fastest.
 fn grid(axes: &[Vec<Value>]) -> Vec<Vec<Value>> {
@@ -632,6 +653,15 @@ mod tests {
         assert!(e("[sweep]\ndesign = \"grid\"\n[[vary]]\nname = \"a\"\nvalues = [1]\n[[vary]]\nname = \"a\"\nvalues = [2]\n").contains("varied twice"));
         assert!(e("[sweep]\ndesign = \"grid\"\nrns = 3\n").contains("rns"));
         assert!(e("[sweep]\ndesign = \"sobol\"\n").contains("sobol"));
+        // more runs than memory holds (these aborted allocating the run list)
+        let axis =
+            |name: &str| format!("[[vary]]\nname = \"{name}\"\nrange = [0, 1]\ncount = 100000\n");
+        let grid = format!("[sweep]\ndesign = \"grid\"\n{}{}", axis("a"), axis("b"));
+        assert!(e(&grid).contains("100000 × 100000 runs, more than 100000000"));
+        let one = "[sweep]\ndesign = \"grid\"\n[[vary]]\nname = \"a\"\nrange = [0, 1]\ncount = 1000000000000\n";
+        assert!(e(one).contains("1 ≤ N ≤ 100000000"));
+        let mc = "[sweep]\ndesign = \"monte-carlo\"\nruns = 1000000000000\n[[vary]]\nname = \"a\"\nuniform = [0, 1]\n";
+        assert!(e(mc).contains("0 < N ≤ 100000000"));
     }
 
     #[test]

@@ -234,7 +234,7 @@ fn failed_runs_are_rows_that_say_why() {
     assert!(t < 1.0);
     assert_ne!(column(&table, "steps")[1], "");
     assert_eq!(column(&table, "steps")[2], "");
-    assert_eq!(column(&table, "t_end")[1], "");
+    assert_eq!(column(&table, "t_last")[1], "");
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -371,5 +371,37 @@ fn a_complete_sweep_is_also_a_parquet_file_of_the_same_table() {
         assert!(matches!(fields[2].1, Field::Str(_) | Field::Null));
         assert!(matches!(fields[0].1, Field::Long(_)));
     }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A metric named like a varied setting or a column of the table would double that column
+/// (the per-system programs' final-state metric was `t_end`, the setting's name: a plan that
+/// varied t_end had two `t_end` columns); the sweep is refused before any run, and the final
+/// state's time is `t_last`.
+#[test]
+fn a_metric_that_would_double_a_column_is_refused() {
+    let plan = Plan::from_toml(
+        "[sweep]\ndesign = \"grid\"\n[[vary]]\nname = \"t_end\"\nvalues = [1, 2]\n",
+    )
+    .unwrap();
+    let runs = plan.runs(Path::new(".")).unwrap();
+    let dir = scratch("doubled");
+    let sweep = |name: &'static str| {
+        Sweep::new(DoublePendulum::default, &plan, Scheme::Dopri5, base())
+            .unwrap()
+            .metrics(Metrics::new([name], |_: &DoublePendulum, _| vec![0.0]))
+    };
+    for name in ["t_end", "steps"] {
+        let e = sweep(name).run(&dir, &runs).unwrap_err();
+        assert!(
+            e.to_string().contains(&format!("two columns `{name}`")),
+            "{e}"
+        );
+        assert!(!dir.join("results.csv").exists());
+    }
+    let s = Sweep::new(DoublePendulum::default, &plan, Scheme::Dopri5, base()).unwrap();
+    let s = s.metrics(Metrics::final_state(&DoublePendulum::default()));
+    assert!(s.run(&dir, &runs).is_ok());
+    assert_eq!(column(&dir.join("results.csv"), "t_last"), ["1.0", "2.0"]);
     let _ = std::fs::remove_dir_all(&dir);
 }

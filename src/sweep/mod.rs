@@ -132,13 +132,14 @@ impl<M: Model> Metrics<M> {
         }
     }
 
-    /// The final time, each coordinate and velocity at the last output (`q_end.NAME`,
-    /// `qd_end.NAME`) and the energy drift max |E(t) − E(0)| relative to max(|E(0)|, max
+    /// The time of the last output (`t_last`: not `t_end`, the name of the setting a plan may
+    /// vary, whose column it would have doubled), each coordinate and velocity there
+    /// (`q_end.NAME`, `qd_end.NAME`) and the energy drift max |E(t) − E(0)| relative to max(|E(0)|, max
     /// kinetic energy) (`energy_drift`; NaN if energy was not recorded): the metrics of the
     /// per-system programs' sweeps.
     pub fn final_state(model: &M) -> Metrics<M> {
         let dofs = model.info().dofs;
-        let mut names = vec!["t_end".to_string()];
+        let mut names = vec!["t_last".to_string()];
         names.extend(dofs.iter().map(|d| format!("q_end.{d}")));
         names.extend(dofs.iter().map(|d| format!("qd_end.{d}")));
         names.push("energy_drift".into());
@@ -390,6 +391,15 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
     /// Writes `dir/plan.toml` (the plan with the simulation settings the runs start from) and
     /// `dir/runs.csv`, or checks that the folder holds this sweep already.
     pub fn prepare(&self, dir: &Path, runs: &RunList) -> Result<(), SweepError> {
+        // a metric named like a variable or a fixed column would double it in the table
+        let columns = self.columns(runs);
+        for (i, c) in columns.iter().enumerate() {
+            if columns[..i].contains(c) {
+                return Err(SweepError::Plan(format!(
+                    "the table would have two columns `{c}` (a metric named like a variable or like one of the table's own columns): rename the metric"
+                )));
+            }
+        }
         std::fs::create_dir_all(dir).map_err(|source| SweepError::Io {
             path: dir.to_path_buf(),
             source,

@@ -74,9 +74,6 @@ pub fn check_inertia(body: &'static str, t: [f64; 6]) -> Result<(), ParamError> 
     }
 }
 
-/// Why a simulation stopped early. Each variant carries what is needed to act on it; the
-/// time, step, work done and the trajectory so far travel with it in
-/// [`SimError`](crate::SimError).
 /// How [`Failure::UnstableStep`] starts when ρ was estimated at the end of the step.
 pub const LURCHED: &str = "the step changed the state by more than its own size: at its end ";
 
@@ -176,6 +173,9 @@ impl HeldBy {
     }
 }
 
+/// Why a simulation stopped early. Each variant carries what is needed to act on it; the
+/// time, step, work done and the trajectory so far travel with it in
+/// [`SimError`](crate::SimError).
 #[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]
 pub enum Failure {

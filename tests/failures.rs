@@ -230,6 +230,18 @@ fn a_run_out_of_steps_names_the_component_that_held_them() {
         assert!(h.steps as f64 > 0.9 * h.of as f64, "{e}");
         assert!(h.of > 0 && h.of <= e.stats.steps, "{e}");
         assert!(e.to_string().contains("was held by"), "{e}");
+        // a run that ends says the same in its Stats
+        let (_, stats) = simulate(model.clone(), scheme, Options::adaptive(1.0, 1e-8)).unwrap();
+        let h = stats.held_most.as_ref().expect("held");
+        assert!(
+            h.component.contains("q[1]") && h.of == stats.steps,
+            "{stats}"
+        );
+        assert!(
+            stats
+                .to_string()
+                .contains("the error test was held by q[1]")
+        );
     }
 }
 

@@ -99,7 +99,7 @@ pub struct HeldBy {
 /// The coordinate (its position or velocity) or multiplier whose term weighed most in the
 /// error tests of the most accepted steps of a run: what kept the steps small when a run runs
 /// out of steps.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct HeldMost {
     /// `q[7] (name) (its position or velocity)` or `λ[2]`
     pub component: String,

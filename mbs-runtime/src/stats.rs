@@ -78,6 +78,10 @@ pub struct Stats {
     /// scheme's transformation of it: RKC's local tolerance at rtol 1e-8 is 0.3·rtol^1.5 on
     /// atol too, below the rounding of a fast mechanism's slow components)
     pub floored_steps: usize,
+    /// the coordinate (its position or velocity) or multiplier whose error test held the most
+    /// accepted steps, and how many: what sets the step of an adaptive run (none at fixed
+    /// steps)
+    pub held_most: Option<crate::error::HeldMost>,
 }
 
 /// The components an adaptive scheme's local error test measures, so that a user knows what
@@ -246,6 +250,15 @@ impl fmt::Display for Stats {
             write!(
                 f,
                 "\nrtol asks more than this scheme's local error test holds: its tolerance stopped at its floor {floor:.1e}, so expect fewer digits than rtol (radau5 follows rtol further)"
+            )?;
+        }
+        if let Some(h) = &self.held_most {
+            write!(
+                f,
+                "\nthe error test was held by {} in {:.0} % of the {} accepted steps",
+                h.component,
+                100.0 * h.steps as f64 / h.of.max(1) as f64,
+                h.of
             )?;
         }
         if self.floored_steps > 0 {

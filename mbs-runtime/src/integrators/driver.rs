@@ -262,6 +262,7 @@ impl<M: Model + 'static> Simulation<M> {
             self.record_cur();
         }
         self.problem.stats.user_efforts = self.problem.model.user_evaluations();
+        self.problem.stats.held_most = self.held_most();
         (self.problem.model, self.traj, self.problem.stats)
     }
 
@@ -322,6 +323,7 @@ impl<M: Model + 'static> Simulation<M> {
 
     fn fail(&self, kind: Failure, h: f64) -> SimError {
         let mut stats = self.problem.stats.clone();
+        stats.held_most = self.held_most();
         stats.user_efforts = self.problem.model.user_evaluations();
         SimError {
             kind,

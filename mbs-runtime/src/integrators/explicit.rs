@@ -188,26 +188,46 @@ impl StabilityWatch {
         if !self.due(every) {
             return Ok(());
         }
-        // at the start, and before refusing a step, iterate until the estimate settles:
-        // one iteration from the seed direction can be far below ρ, and the message
-        // advises a step from it
-        self.refresh(p, cur, false)?;
-        if self.steps == 0 || h * self.rho > limit(self.oscillating) {
-            self.settle(p, cur)?;
+        let first = self.steps == 0;
+        self.judge(p, (cur, h, scheme), limit, first, false)
+    }
+
+    /// Estimates ρ at `s` and refuses a step h with `UnstableStep` when h·ρ exceeds the limit.
+    /// At the start (`settle`), and before refusing a step, the estimate is iterated until it
+    /// settles: one iteration from the seed direction can be far below ρ, and the message
+    /// advises a step from it. `at_end`: `s` is the end of the step (see [`Self::after`]).
+    fn judge<M: Model>(
+        &mut self,
+        p: &mut Problem<M>,
+        (s, h, scheme): (&State, f64, &'static str),
+        limit: impl Fn(bool) -> f64,
+        settle: bool,
+        at_end: bool,
+    ) -> Result<(), Failure> {
+        self.refresh(p, s, false)?;
+        if settle || h * self.rho > limit(self.oscillating) {
+            self.settle(p, s)?;
         }
-        let h_rho = h * self.rho;
-        let limit = limit(self.oscillating);
-        if h_rho > limit {
-            return Err(Failure::UnstableStep {
-                scheme,
-                rho: self.rho,
-                h_rho,
-                limit,
-                h_stable: limit / self.rho,
-                at_end: false,
-            });
+        let (h_rho, limit) = (h * self.rho, limit(self.oscillating));
+        if h_rho <= limit {
+            return Ok(());
         }
-        Ok(())
+        // the end of a step may be a state the step blew up, whose ρ says little of the
+        // model's (1e38 1/s after one DOPRI5 step of 10 s): the step advised is then at least
+        // a hundredth of this one, and the checks before each smaller step judge it
+        let h_stable = limit / self.rho;
+        Err(Failure::UnstableStep {
+            scheme,
+            rho: self.rho,
+            h_rho,
+            limit,
+            h_stable: if at_end {
+                h_stable.max(0.01 * h)
+            } else {
+                h_stable
+            },
+            at_end,
+        })
     }
 
     /// After a step of size h from `cur` to `next`, before it is accepted: when the step
@@ -228,26 +248,7 @@ impl StabilityWatch {
         if !lurched(cur, next) {
             return Ok(());
         }
-        // as before a step: one power iteration, iterated until it settles before a refusal
-        self.refresh(p, next, false)?;
-        if h * self.rho > limit(self.oscillating) {
-            self.settle(p, next)?;
-        }
-        let (h_rho, limit) = (h * self.rho, limit(self.oscillating));
-        if h_rho > limit {
-            // the step's end may be a state the step blew up, whose ρ says little of the
-            // model's (1e38 1/s after one DOPRI5 step of 10 s): the step advised is at least
-            // a hundredth of this one, and the checks before each smaller step judge it
-            return Err(Failure::UnstableStep {
-                scheme,
-                rho: self.rho,
-                h_rho,
-                limit,
-                h_stable: (limit / self.rho).max(0.01 * h),
-                at_end: true,
-            });
-        }
-        Ok(())
+        self.judge(p, (next, h, scheme), limit, false, true)
     }
 
     /// Whether an estimate is due: every `every` steps, and after a lurch.

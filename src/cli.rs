@@ -294,8 +294,9 @@ fn failure_text(e: &SimError) -> String {
             h_stable,
             at_end,
         } => format!(
-            "{}h·ρ = {h_rho:.3} leaves the stability region of {scheme} (limit {limit:.3}; ρ ≈ {rho:.4e} 1/s is the fastest mode{}) {at}: take --h {:.1e} or smaller, or an implicit scheme (--scheme radau5)",
+            "{}h·ρ = {} leaves the stability region of {scheme} (limit {limit:.3}; ρ ≈ {rho:.4e} 1/s is the fastest mode{}) {at}: take --h {:.1e} or smaller, or an implicit scheme (--scheme radau5)",
             if *at_end { crate::error::LURCHED } else { "" },
+            crate::error::h_rho_text(*h_rho),
             if *at_end { " there" } else { "" },
             shorten(*h_stable)
         ),

@@ -308,5 +308,12 @@ fn a_single_step_over_the_whole_run_is_checked_at_its_end() {
             e.to_string()
                 .contains("changed the state by more than its own size")
         );
+        // h·ρ past 10⁶ in three digits of a power of ten, not forty digits
+        let text = e.to_string();
+        let h_rho = text
+            .split("h·ρ = ")
+            .nth(1)
+            .and_then(|t| t.split(' ').next());
+        assert!(h_rho.is_some_and(|x| x.len() < 12), "{text}");
     }
 }

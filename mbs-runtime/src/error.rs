@@ -74,6 +74,16 @@ pub fn check_inertia(body: &'static str, t: [f64; 6]) -> Result<(), ParamError> 
     }
 }
 
+/// h·ρ in [`Failure::UnstableStep`]'s message: three decimals, or three digits of a power
+/// of ten past 10⁶ (a step that blew the state up gives h·ρ of 1e39, not 40 digits).
+pub fn h_rho_text(h_rho: f64) -> String {
+    if h_rho.abs() < 1e6 {
+        format!("{h_rho:.3}")
+    } else {
+        format!("{h_rho:.3e}")
+    }
+}
+
 /// How [`Failure::UnstableStep`] starts when ρ was estimated at the end of the step.
 pub const LURCHED: &str = "the step changed the state by more than its own size: at its end ";
 
@@ -244,8 +254,9 @@ pub enum Failure {
         coordinate: String,
     },
     #[error(
-        "{}h·ρ = {h_rho:.3} leaves the stability region of {scheme} (limit {limit:.3}; ρ ≈ {rho:.4e} 1/s is the fastest mode{}): take h < {h_stable:.4e} s or an implicit scheme",
+        "{}h·ρ = {} leaves the stability region of {scheme} (limit {limit:.3}; ρ ≈ {rho:.4e} 1/s is the fastest mode{}): take h < {h_stable:.4e} s or an implicit scheme",
         if *at_end { LURCHED } else { "" },
+        h_rho_text(*h_rho),
         if *at_end { " there" } else { "" }
     )]
     UnstableStep {

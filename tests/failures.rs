@@ -204,8 +204,8 @@ fn work_limits_are_typed_errors() {
 
 /// A run out of steps names the component whose error test held most of its steps: the
 /// seed's second mass oscillating on its spring against a first mass 10¹² times heavier
-/// (which then hardly moves, its spring to the ground removed), under DOPRI5 and BDF (one
-/// scheme controlling the step by its order, the other by its PI controller).
+/// (which then hardly moves, its spring to the ground removed), under DOPRI5 and BDF (a PI
+/// controller of the step, and an elementary one with a choice of order).
 #[test]
 fn a_run_out_of_steps_names_the_component_that_held_them() {
     let mut model = Seed2dof::default();

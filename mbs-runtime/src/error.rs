@@ -119,17 +119,25 @@ pub struct HeldMost {
 }
 
 impl HeldMost {
-    /// "; the error test of 87 % of the 1,204 steps was held by …" (empty without one).
+    /// "; the error test was held by … in 87 % of the 1204 accepted steps" (empty without
+    /// one).
     pub fn clause(held_most: &Option<HeldMost>) -> String {
-        match held_most {
-            None => String::new(),
-            Some(h) => format!(
-                "; the error test of {:.0} % of the {} accepted steps was held by {}",
-                100.0 * h.steps as f64 / h.of.max(1) as f64,
-                h.of,
-                h.component
-            ),
-        }
+        held_most
+            .as_ref()
+            .map_or(String::new(), |h| format!("; {h}"))
+    }
+}
+
+impl std::fmt::Display for HeldMost {
+    /// "the error test was held by … in 87 % of the 1204 accepted steps".
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "the error test was held by {} in {:.0} % of the {} accepted steps",
+            self.component,
+            100.0 * self.steps as f64 / self.of.max(1) as f64,
+            self.of
+        )
     }
 }
 
@@ -138,16 +146,10 @@ impl HeldBy {
     /// stiff, and the component the error test was held by; where the tolerance was atol's
     /// or the rounding floor, the fix instead (raise atol).
     pub fn clause(held_by: &Option<HeldBy>) -> String {
-        Self::clause_naming(held_by, "atol")
-    }
-
-    /// [`HeldBy::clause`] with the absolute tolerance called `atol` (`--atol` on a command
-    /// line).
-    pub fn clause_naming(held_by: &Option<HeldBy>, atol: &str) -> String {
         const STIFF: &str = " (the solution may be singular or too stiff for the scheme)";
         match held_by {
             None => STIFF.into(),
-            Some(b) if b.tolerance_is_the_fix() => format!(": {}", b.advice(atol)),
+            Some(b) if b.tolerance_is_the_fix() => format!(": {}", b.advice("atol")),
             Some(b) => format!("{STIFF}; {}", b.held()),
         }
     }
@@ -159,7 +161,8 @@ impl HeldBy {
     }
 
     /// "the error test was held by … set by …", and for a tolerance of atol or of the
-    /// rounding floor the fix, raising `atol`.
+    /// rounding floor the fix, raising `atol` (the option's name: `--atol` on a command
+    /// line).
     pub fn advice(&self, atol: &str) -> String {
         match self.set_by {
             "atol" => format!(

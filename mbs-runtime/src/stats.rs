@@ -253,13 +253,7 @@ impl fmt::Display for Stats {
             )?;
         }
         if let Some(h) = &self.held_most {
-            write!(
-                f,
-                "\nthe error test was held by {} in {:.0} % of the {} accepted steps",
-                h.component,
-                100.0 * h.steps as f64 / h.of.max(1) as f64,
-                h.of
-            )?;
+            write!(f, "\n{h}")?;
         }
         if self.floored_steps > 0 {
             write!(

@@ -106,7 +106,7 @@
 use super::at::{Affine, Weights};
 use super::newton::AccelNewton;
 use super::problem::Problem;
-use super::step_control::{Largest, Tolerances, elementary_factor, optimal_factor};
+use super::step_control::{ErrorNorm, Tolerances, elementary_factor, optimal_factor};
 use super::{Attempt, Control, State, Step, Stepper};
 use crate::charts::Recentring;
 use crate::error::Failure;
@@ -292,18 +292,15 @@ pub(crate) struct Bdf {
     spectrum: Spectrum,
     /// selections in a row at which order 2 would have taken DROP_GAIN times the step
     drop_votes: usize,
-    /// whether the last error test raised a weight to its rounding floor
-    floored: bool,
-    /// the component that weighed most in the last error test
-    held_by: Option<Largest>,
+    /// the last error test
+    test: ErrorNorm,
 }
 
 impl Bdf {
     pub fn new(n: usize, max_order: usize) -> Bdf {
         let z = |m: usize| vec![0.0; m];
         Bdf {
-            floored: false,
-            held_by: None,
+            test: ErrorNorm::default(),
             n,
             max_order: max_order.clamp(1, MAX_ORDER),
             order: 1,
@@ -361,12 +358,8 @@ impl Bdf {
 }
 
 impl<M: Model> Stepper<M> for Bdf {
-    fn floored(&self) -> bool {
-        self.floored
-    }
-
-    fn held_by(&self) -> Option<Largest> {
-        self.held_by
+    fn last_test(&self) -> ErrorNorm {
+        self.test
     }
 
     fn newton_largest(&self) -> Option<(usize, usize)> {
@@ -489,8 +482,7 @@ impl<M: Model> Stepper<M> for Bdf {
         }
         let norm = tol.norm(&self.err, &self.y0, &self.y1, self.y0.len() / 2);
         let err = norm.value;
-        self.floored = norm.floored;
-        self.held_by = norm.held_by;
+        self.test = norm;
         if !(err <= 1.0) {
             let fac = elementary_factor(err, k, safety, MIN_FACTOR, f64::INFINITY);
             return Ok(Attempt::RejectedError { h_next: h * fac });

@@ -51,7 +51,7 @@
 use super::explicit::{Probe, StabilityWatch, dot, ritz};
 use super::problem::Problem;
 use super::step_control::{
-    Decision, Largest, PiController, Tolerances, order_two_factor, order_two_floored,
+    Decision, ErrorNorm, PiController, Tolerances, order_two_factor, order_two_floored,
 };
 use super::{Attempt, State, Step, Stepper};
 use crate::error::Failure;
@@ -352,18 +352,15 @@ pub(crate) struct Chebyshev {
     pi: PiController,
     /// the fastest mode is to be estimated anew before the next attempt (after a rejection)
     stale: bool,
-    /// whether the last error test raised a weight to its rounding floor
-    floored: bool,
-    /// the component that weighed most in the last error test
-    held_by: Option<Largest>,
+    /// the last error test
+    test: ErrorNorm,
 }
 
 impl Chebyshev {
     pub fn new(n: usize) -> Chebyshev {
         let z = || vec![0.0; n];
         Chebyshev {
-            floored: false,
-            held_by: None,
+            test: ErrorNorm::default(),
             n,
             k: Coefficients::new(),
             poly: Polynomials::new(),
@@ -457,12 +454,8 @@ impl Chebyshev {
 }
 
 impl<M: Model> Stepper<M> for Chebyshev {
-    fn floored(&self) -> bool {
-        self.floored
-    }
-
-    fn held_by(&self) -> Option<Largest> {
-        self.held_by
+    fn last_test(&self) -> ErrorNorm {
+        self.test
     }
 
     fn tolerance_floor(&self, rtol: f64) -> Option<f64> {
@@ -521,8 +514,7 @@ impl<M: Model> Stepper<M> for Chebyshev {
             atol: tol.atol * f,
         };
         let norm = tol.norm(&self.err, &self.y0, &self.y1, self.y0.len() / 2);
-        self.floored = norm.floored;
-        self.held_by = norm.held_by;
+        self.test = norm;
         match self.pi.decide(h, norm.value) {
             Decision::Accept { h_next } => {
                 self.watch.accepted(cur, next);

@@ -17,7 +17,7 @@
 
 use super::explicit::StabilityWatch;
 use super::problem::Problem;
-use super::step_control::{Decision, Largest, PiController};
+use super::step_control::{Decision, ErrorNorm, PiController};
 use super::{Attempt, State, Step, Stepper};
 use crate::error::Failure;
 use crate::model::Model;
@@ -96,10 +96,8 @@ pub(crate) struct Dopri5 {
     cont_v: [Vec<f64>; 5],
     /// with a fixed step: the largest |λ| against the stability region (as RK4's)
     watch: StabilityWatch,
-    /// whether the last error test raised a weight to its rounding floor
-    floored: bool,
-    /// the component that weighed most in the last error test
-    held_by: Option<Largest>,
+    /// the last error test
+    test: ErrorNorm,
 }
 
 /// DOPRI5's stability radius with a fixed step, the edge of |R(z)| ≤ 1 (R(z) = Σ₀⁵ zᵏ/k! +
@@ -116,8 +114,7 @@ impl Dopri5 {
         let s7 = || [z(), z(), z(), z(), z(), z(), z()];
         let s5 = || [z(), z(), z(), z(), z()];
         Dopri5 {
-            floored: false,
-            held_by: None,
+            test: ErrorNorm::default(),
             n,
             kv: s7(),
             ka: s7(),
@@ -138,12 +135,8 @@ impl Dopri5 {
 }
 
 impl<M: Model> Stepper<M> for Dopri5 {
-    fn floored(&self) -> bool {
-        self.floored
-    }
-
-    fn held_by(&self) -> Option<Largest> {
-        self.held_by
+    fn last_test(&self) -> ErrorNorm {
+        self.test
     }
 
     fn attempt(&mut self, step: Step<'_, M>) -> Result<Attempt, Failure> {
@@ -199,8 +192,7 @@ impl<M: Model> Stepper<M> for Dopri5 {
             self.y1[n + i] = next.qd[i];
         }
         let norm = tol.norm(&self.err, &self.y0, &self.y1, self.y0.len() / 2);
-        self.floored = norm.floored;
-        self.held_by = norm.held_by;
+        self.test = norm;
         match self.pi.decide(h, norm.value) {
             Decision::Accept { h_next } => {
                 self.dense(cur, next, h);

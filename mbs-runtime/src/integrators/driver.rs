@@ -504,10 +504,11 @@ impl<M: Model + 'static> Simulation<M> {
                 }
                 Err(kind) => return Err(self.fail(kind, h)),
                 Ok(Attempt::Accepted { h_next }) => {
-                    if self.stepper.floored() {
+                    let test = self.stepper.last_test();
+                    if test.floored {
                         self.problem.stats.floored_steps += 1;
                     }
-                    if let Some(b) = self.stepper.held_by() {
+                    if let Some(b) = test.held_by {
                         let n = self.problem.n;
                         // a coordinate's position and velocity together, then the multipliers
                         let i = if b.block < 2 { b.index } else { n + b.index };
@@ -559,7 +560,7 @@ impl<M: Model + 'static> Simulation<M> {
                 Ok(Attempt::RejectedError { h_next }) => {
                     // only adaptive schemes test errors
                     self.problem.stats.rejected_error += 1;
-                    self.held_by = self.stepper.held_by();
+                    self.held_by = self.stepper.last_test().held_by;
                     self.h = h_next;
                 }
                 Ok(Attempt::RejectedNewton {

@@ -112,7 +112,7 @@ use super::at::{Affine, At, Weights};
 use super::constrained::{Constrained, Mode};
 use super::newton::{AccelNewton, NewtonTol};
 use super::problem::{Loops, Problem};
-use super::step_control::{Largest, next_step, order_two_factor, order_two_floored};
+use super::step_control::{ErrorNorm, Largest, next_step, order_two_factor, order_two_floored};
 use super::{Attempt, Control, State, Step, Stepper};
 use crate::charts::Recentring;
 use crate::error::Failure;
@@ -146,18 +146,15 @@ pub(crate) struct AlphaFamily {
     lam: Vec<f64>,
     /// the constraints are solved at index 2
     index2: bool,
-    /// whether the last error test raised a weight to its rounding floor
-    floored: bool,
-    /// the component that weighed most in the last error test
-    held_by: Option<Largest>,
+    /// the last error test
+    test: ErrorNorm,
 }
 
 impl AlphaFamily {
     fn new(n: usize, alpha_m: f64, alpha_f: f64, beta: f64, gamma: f64) -> AlphaFamily {
         let z = || vec![0.0; n];
         AlphaFamily {
-            floored: false,
-            held_by: None,
+            test: ErrorNorm::default(),
             alpha_m,
             alpha_f,
             beta,
@@ -223,12 +220,8 @@ impl AlphaFamily {
 }
 
 impl<M: Model> Stepper<M> for AlphaFamily {
-    fn floored(&self) -> bool {
-        self.floored
-    }
-
-    fn held_by(&self) -> Option<Largest> {
-        self.held_by
+    fn last_test(&self) -> ErrorNorm {
+        self.test
     }
 
     fn newton_largest(&self) -> Option<(usize, usize)> {
@@ -382,14 +375,13 @@ impl<M: Model> Stepper<M> for AlphaFamily {
             p.tangent_part(cur.t + h, &next.q, &mut self.err)?;
         }
         let eq = tol.norm(&self.err, &cur.q, &next.q, cur.q.len());
-        self.floored = eq.floored;
-        self.held_by = eq.held_by;
+        self.test = eq;
         // index 2: positions and velocities, otherwise positions (local error ∝ h³)
         let err = if self.index2 {
             let ev = tol.norm(&self.err_v, &cur.qd, &next.qd, cur.qd.len());
-            self.floored |= ev.floored;
+            self.test.floored |= ev.floored;
             if ev.value > eq.value {
-                self.held_by = ev.held_by.map(Largest::as_velocity);
+                self.test.held_by = ev.held_by.map(Largest::as_velocity);
             }
             (0.5 * (eq.value * eq.value + ev.value * ev.value)).sqrt() / f
         } else {

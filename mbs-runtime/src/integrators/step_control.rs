@@ -45,7 +45,7 @@ impl Tolerances {
 
     /// The floor of [`Tolerances::transformed`] for `rtol`: [`ROUNDING`]·ε, or rtol if
     /// tighter.
-    fn transformed_floor(rtol: f64) -> f64 {
+    pub fn transformed_floor(rtol: f64) -> f64 {
         rtol.min(ROUNDING * f64::EPSILON)
     }
 
@@ -214,8 +214,9 @@ impl Largest {
 
 /// A weighted error norm ([`Tolerances::norm`]) and whether the rounding floor raised the
 /// weight of some component above atol + rtol·|y|: that component was tested at the digits
-/// rounding leaves it, fewer than the tolerances asked.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// rounding leaves it, fewer than the tolerances asked. A scheme keeps its last error test's
+/// for the driver (`Stepper::last_test`; the default, none taken).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct ErrorNorm {
     pub value: f64,
     pub floored: bool,

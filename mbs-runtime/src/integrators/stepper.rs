@@ -103,15 +103,11 @@ pub(crate) trait Stepper<M: Model> {
         let _ = (moved, evaluated);
         self.start(p, s, ctl)
     }
-    /// Whether the error test of the step just accepted raised some component's weight to
-    /// its rounding floor (`Stats::floored_steps`; [`super::step_control::ErrorNorm`]).
-    fn floored(&self) -> bool {
-        false
-    }
-    /// The component that weighed most in the last error test (none for a scheme without
-    /// one): `Failure::StepTooSmall` names it.
-    fn held_by(&self) -> Option<super::step_control::Largest> {
-        None
+    /// The last error test (none for a scheme without one): whether it raised some
+    /// component's weight to its rounding floor (`Stats::floored_steps`) and the component
+    /// that weighed most (`Failure::StepTooSmall`, `Stats::held_most`).
+    fn last_test(&self) -> super::step_control::ErrorNorm {
+        Default::default()
     }
     /// The component of Newton's last correction with the largest weighted term, (block,
     /// index) as [`super::step_control::Argmax`] gives it (none for an explicit scheme):

@@ -126,8 +126,7 @@ impl Radau {
     /// λ), noting whether the rounding floor set a weight (`Stats::floored_steps`).
     pub(super) fn weighted_norm(&mut self, tol: &Tol) -> f64 {
         let norm = tol.weights.norm(&self.err, &self.y0, &self.y1, self.n);
-        self.floored = norm.floored;
-        self.held_by = norm.held_by;
+        self.test = norm;
         norm.value
     }
 

@@ -328,7 +328,7 @@ mod tableau;
 use super::at::At;
 use super::constrained::Mode;
 use super::problem::Problem;
-use super::step_control::{Largest, Predictive, ROUNDING, Tolerances};
+use super::step_control::{ErrorNorm, Predictive, Tolerances};
 use super::{Attempt, Control, State, Step, Stepper};
 use crate::charts::Recentring;
 use crate::error::Failure;
@@ -502,13 +502,11 @@ pub(crate) struct Radau {
     /// stage), which the error estimate's f(y₀) needs; the state holds the index-1 ones
     own_end: Vec<f64>,
     psix: Vec<f64>,
-    /// whether the last error test raised a weight to its rounding floor
-    floored: bool,
+    /// the last error test
+    test: ErrorNorm,
     /// the component of Newton's last correction with the largest weighted term (block,
     /// index), set by `correction_norm`
     newton_largest: std::cell::Cell<Option<(usize, usize)>>,
-    /// the component that weighed most in the last error test
-    held_by: Option<Largest>,
 }
 
 impl Radau {
@@ -516,8 +514,7 @@ impl Radau {
         let z = || vec![0.0; n];
         let zs = || vec![0.0; s * n];
         Radau {
-            floored: false,
-            held_by: None,
+            test: ErrorNorm::default(),
             newton_largest: std::cell::Cell::new(None),
             k: Coefficients::new(s),
             n,
@@ -603,12 +600,8 @@ const NEWTON_RELAX: f64 = 1.2;
 const NEWTON_MARGIN: f64 = 0.9;
 
 impl<M: Model> Stepper<M> for Radau {
-    fn floored(&self) -> bool {
-        self.floored
-    }
-
-    fn held_by(&self) -> Option<Largest> {
-        self.held_by
+    fn last_test(&self) -> ErrorNorm {
+        self.test
     }
 
     fn newton_largest(&self) -> Option<(usize, usize)> {
@@ -665,13 +658,13 @@ impl<M: Model> Stepper<M> for Radau {
         let (s, n) = (self.k.s, self.n);
         let tol = Tol::new(ctl, s);
         // Newton's weights, like the error test's, not below the rounding of the values the
-        // stages handle: [`ROUNDING`]·ε (or rtol', if tighter) times the largest position
+        // stages handle: 100ε (or rtol', if tighter) times the largest position
         // |q| + h|qd| + h²|qdd| and the largest velocity |qd| + h|qdd|. Without it a start at
         // rest under a tiny atol weighted its velocities by atol alone: under atol = 1e-30 the
         // rounding of the stage velocities (1e-29) failed Newton down to h_min at t = 0.
         let largest = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         let (qmax, vmax, amax) = (largest(&cur.q), largest(&cur.qd), largest(&cur.qdd));
-        let f = tol.weights.rtol.min(ROUNDING * f64::EPSILON);
+        let f = Tolerances::transformed_floor(tol.weights.rtol);
         let (floor_q, floor_v) = (f * (qmax + h * (vmax + h * amax)), f * (vmax + h * amax));
         for r in 0..n {
             self.scq[r] = (tol.weights.atol + tol.weights.rtol * cur.q[r].abs()).max(floor_q);

@@ -1,12 +1,14 @@
 #!/usr/bin/env bash
 # Compile time and peak memory of one model in a crate of its own, dependencies built first
 # and not timed: release builds of a 24-joint spatial arm, a 32-bar planar chain, the
-# hexapod with exact tangents and a 200-bar chain, then a debug build of the arm, and the arm
-# with the batch functions of `option batch;`.
+# hexapod with exact tangents (its forward dynamics called, then a program that runs it with
+# Radau5) and a 200-bar chain, then a debug build of the arm, and the arm with the batch
+# functions of `option batch;`.
 #
 #   benches/compile_time.sh            # all cases
-#   benches/compile_time.sh chain32    # one case (arm24, chain32, hexapod, chain200, arm24-dev,
-#                                      # arm24-batch: the arm with `option batch;`)
+#   benches/compile_time.sh chain32    # one case (arm24, chain32, hexapod, hexapod-radau,
+#                                      # chain200, arm24-dev, arm24-batch: the arm with
+#                                      # `option batch;`)
 #   benches/compile_time.sh --generator-unoptimised [cases]
 #
 # The model crate's Cargo.toml has the profile lines the README recommends: the generator
@@ -63,6 +65,23 @@ hexapod() { # the hexapod of models/src with `option tangents;` before its closi
     echo 'pub type Model = Hexapod;'
 }
 
+# what `main` does besides forward dynamics: nothing, or (hexapod-radau) a Radau5 run of the
+# standing hexapod with its tangents, so that every function a run calls is compiled
+no_run() {
+    echo 'pub fn run() {}'
+}
+radau_run() {
+    cat <<'RS'
+pub fn run() {
+    let mut options = mbs::Options::default();
+    options.t_end = 0.2;
+    let (_, stats) = mbs::simulate(HexapodStanding::default(), mbs::Scheme::Radau5, options)
+        .expect("the standing hexapod's run");
+    println!("Radau5, standing hexapod: {} steps", stats.steps);
+}
+RS
+}
+
 cat > "$dir/src/main.rs" <<'RS'
 #[allow(unused_macros)]
 mod model;
@@ -79,6 +98,7 @@ fn main() {
     let u4 = vec![F64x4::ZERO; model::Model::NU];
     m.forward_dynamics_x4(F64x4::ZERO, &q4, &z4, &u4, &mut a4, &mut p4);
     println!("{} dof, qdd[0] = {:.6} ({:.6} in a batch)", n, qdd[0], a4[0].lane(0));
+    model::run();
 }
 RS
 
@@ -86,16 +106,17 @@ cd "$dir"
 export CARGO_TARGET_DIR="$dir/target"
 # for every build, the untimed ones too: a change of it rebuilds the path dependencies
 export CARGO_INCREMENTAL=0
-cases=("${@:-arm24 chain32 hexapod chain200 arm24-dev arm24-batch}")
+cases=("${@:-arm24 chain32 hexapod hexapod-radau chain200 arm24-dev arm24-batch}")
 for case in ${cases[@]}; do
     profile=release
     case "$case" in
-        arm24) arm 24 > src/model.rs ;;
-        chain32) chain 32 > src/model.rs ;;
-        chain200) chain 200 > src/model.rs ;;
-        hexapod) hexapod > src/model.rs ;;
-        arm24-dev) arm 24 > src/model.rs; profile=dev ;;
-        arm24-batch) arm 24 batch > src/model.rs ;;
+        arm24) { arm 24; no_run; } > src/model.rs ;;
+        chain32) { chain 32; no_run; } > src/model.rs ;;
+        chain200) { chain 200; no_run; } > src/model.rs ;;
+        hexapod) { hexapod; no_run; } > src/model.rs ;;
+        hexapod-radau) { hexapod; radau_run; } > src/model.rs ;;
+        arm24-dev) { arm 24; no_run; } > src/model.rs; profile=dev ;;
+        arm24-batch) { arm 24 batch; no_run; } > src/model.rs ;;
         *) echo "unknown case $case" >&2; exit 2 ;;
     esac
     flag=$([ "$profile" = release ] && echo --release || true)

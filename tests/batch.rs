@@ -3,7 +3,8 @@
 //! function the generated code may call (a free base with its chart, contacts with `pos`,
 //! `step` and friction, a Rust function, an input, time) and on a 24-joint arm whose functions
 //! are split into chunks; a model without the option answers through the trait's lane-by-lane
-//! default.
+//! default. The one-state chunks of that arm declared in a function's body compute what those
+//! of the arm declared in a module compute.
 
 #![allow(unused_macros)]
 
@@ -155,4 +156,37 @@ fn models_without_the_option_answer_lane_by_lane() {
     let model = mbs_models::dpend::DoublePendulum::default();
     const { assert!(!mbs_models::dpend::DoublePendulum::BATCH_GENERATED) };
     assert_eq!(compare(&model, 0.3), 0.0);
+}
+
+/// One-state chunks are methods of types declared in modules of their own (the compiler puts
+/// each module's code in a code-generation unit of its own), given their methods where the
+/// model is: a model declared in a function's body, whose types no module can name, compiles
+/// too, and its chunks compute what the same model's compute in a module.
+#[test]
+fn a_chunked_model_declared_in_a_function_body() {
+    arm!(Arm24Here, 24, 11, 23, 22);
+    let (here, there) = (Arm24Here::default(), Arm24::default());
+    let (_, dynamics) = here
+        .info()
+        .ops
+        .iter()
+        .find(|(label, _)| label.starts_with("dynamics"))
+        .unwrap();
+    assert!(dynamics.lets > 1500, "{dynamics:?}");
+    let (qs, qds) = states(&here, 0.3);
+    for (q, qd) in qs.iter().zip(&qds) {
+        let a = one_state(&here, q, qd);
+        assert_eq!(a, one_state(&there, q, qd));
+        assert!(a.2.iter().all(|v| v.is_finite()) && a.2.iter().any(|&v| v != 0.0));
+    }
+}
+
+/// M, h and qdd at one state.
+fn one_state<M: Model>(model: &M, q: &[f64], qd: &[f64]) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let n = M::NQ;
+    let (mut m, mut h) = (vec![0.0; n * n], vec![0.0; n]);
+    let (mut qdd, mut pivots) = (vec![0.0; n], vec![0.0; n]);
+    model.dynamics(0.0, q, qd, &[], &mut m, &mut h);
+    model.forward_dynamics(0.0, q, qd, &[], &mut qdd, &mut pivots);
+    (m, h, qdd)
 }

@@ -177,17 +177,18 @@ pub struct EmittedFn {
 }
 
 impl EmittedFn {
-    /// The method and its chunk methods.
-    pub fn full_text(&self) -> String {
+    /// The method and its chunk methods, for an `impl` of `self_ty`; the chunks' own modules
+    /// (see [`Chunk::text`]) are added to `items`.
+    pub fn full_text(&self, self_ty: &str, items: &mut String) -> String {
         let mut s = self.text.clone();
         for c in &self.chunks {
-            s.push_str(&c.text());
+            s.push_str(&c.text(self_ty, items));
         }
         s
     }
 }
 
-/// One chunk method of a method split into chunks: `fn {name}(&self, {args}, w: &mut [..])`,
+/// One chunk method of a method split into chunks: `fn {name}(&self, {args}, w: &mut [..; N])`,
 /// called with `{call}, w` (`w` the workspace of values that cross chunks).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Chunk {
@@ -198,16 +199,67 @@ pub struct Chunk {
     pub number: &'static str,
     /// attributes of batch code (empty in `f64` code)
     pub simd: &'static str,
+    /// the length of `w`, an array: the compiler then knows that every read and write of it
+    /// is in bounds (the chunk functions of other modules are compiled without their caller)
+    pub workspace: usize,
     pub body: String,
 }
 
 impl Chunk {
-    pub fn text(&self) -> String {
+    /// The chunk for an `impl` of `self_ty`: a method that calls the chunk's code, a method of
+    /// a type of a module of its own, which this adds to `items` (outside the `impl`).
+    ///
+    /// The compiler puts a method in the code-generation unit of its type's module, so that
+    /// LLVM compiles the chunks on several cores. A Radau5 run of the standing hexapod with
+    /// tangents, in a crate of its own (`benches/compile_time.sh`'s, release), built in
+    /// 8.6–8.8 s where 10.0–10.3 s with the chunks in one unit; the tangents alone, only
+    /// `forward_dynamics` called, 3.5–3.8 where 3.6–4.0 s. The type is a wrapper of a
+    /// reference, declared in the module and given its methods here, where `self_ty` is
+    /// named: a model declared in a function's body has no path from a module. Batch code stays
+    /// a method: its target features would make the call from the method unsafe.
+    pub fn text(&self, self_ty: &str, items: &mut String) -> String {
+        if !self.simd.is_empty() {
+            return format!(
+                "#[inline(never)]\n{}fn {}(&self, {}, w: &mut [{}; {}]) {{\n{}}}\n",
+                self.simd, self.name, self.args, self.number, self.workspace, self.body
+            );
+        }
+        let module = format!("__{self_ty}{}", self.name);
+        let _ = write!(
+            items,
+            "#[doc(hidden)]\n#[allow(non_snake_case)]\nmod {module} {{\npub struct Chunk<T>(pub T);\n}}\n\
+             #[automatically_derived]\n#[allow(unused_variables, clippy::all)]\n\
+             impl {module}::Chunk<&{self_ty}> {{\n#[inline(never)]\n\
+             fn run(self, {}, w: &mut [{}; {}]) {{\nlet this = self.0;\n{}}}\n}}\n",
+            self.args,
+            self.number,
+            self.workspace,
+            self_to_this(&self.body)
+        );
         format!(
-            "#[inline(never)]\n{}fn {}(&self, {}, w: &mut [{}]) {{\n{}}}\n",
-            self.simd, self.name, self.args, self.number, self.body
+            "#[inline]\nfn {}(&self, {}, w: &mut [{}; {}]) {{\n{module}::Chunk(self).run({}, w)\n}}\n",
+            self.name, self.args, self.number, self.workspace, self.call
         )
     }
+}
+
+/// A method's body as a function's whose first argument is `this`: `self.` → `this.` (a
+/// chunk reads parameters and charts through `self`, and nothing else of it).
+fn self_to_this(body: &str) -> String {
+    let mut out = String::with_capacity(body.len());
+    let mut rest = body;
+    while let Some(k) = rest.find("self.") {
+        let before = rest[..k].chars().next_back();
+        out.push_str(&rest[..k]);
+        if before.is_some_and(|c| c.is_alphanumeric() || c == '_') {
+            out.push_str("self.");
+        } else {
+            out.push_str("this.");
+        }
+        rest = &rest[k + 5..];
+    }
+    out.push_str(rest);
+    out
 }
 
 /// Emits the method(s) of `spec`; with a [`Prefix`], the outputs are scheduled in two
@@ -272,6 +324,7 @@ pub fn emit_fn(
                 call: spec.call.clone(),
                 number,
                 simd,
+                workspace: em.workspace,
                 body: c.clone(),
             });
         }

@@ -125,12 +125,14 @@ pub fn generate(sys: System, vis: &str) -> Result<Generated, Vec<MissingDerivati
         None
     } else {
         collect(ltdl::emit(&model, &users), &mut missing, |e| {
+            let mut items = String::new();
+            let ty = format!("{}Params", model.sys.name);
             let _ = writeln!(
                 code,
-                "#[automatically_derived]\n#[allow(unused_variables, clippy::all)]\nimpl {}Params {{\n{}}}",
-                model.sys.name,
-                e.full_text()
+                "#[automatically_derived]\n#[allow(unused_variables, clippy::all)]\nimpl {ty} {{\n{}}}",
+                e.full_text(&ty, &mut items)
             );
+            code.push_str(&items);
             e.count
         })
     };
@@ -367,8 +369,11 @@ fn emit_params(
         charts_path: "charts",
         splines_path: &splines,
     };
-    let mut derived =
-        collect(emit_fn(a, &spec, &names), missing, |e| e.full_text()).unwrap_or_default();
+    let mut items = String::new();
+    let mut derived = collect(emit_fn(a, &spec, &names), missing, |e| {
+        e.full_text(&ty, &mut items)
+    })
+    .unwrap_or_default();
     // the constraints are the same in every scene: emitted once, here
     // ... and read the charts of rotation joints, which the models hold, as an argument
     let c = &model.constraints;
@@ -489,7 +494,7 @@ fn emit_params(
     let mut ops = Vec::new();
     for (spec, label, part) in shared {
         if let Some((s, count)) = collect(emit_fn(a, &spec, &names), missing, |e| {
-            (e.full_text(), e.count)
+            (e.full_text(&ty, &mut items), e.count)
         }) {
             derived.push_str(&s);
             ops.push((label, count, part));
@@ -497,7 +502,7 @@ fn emit_params(
     }
     for (spec, label) in specs.iter().zip(labels) {
         if let Some((s, count)) = collect(emit_fn(a, spec, &names), missing, |e| {
-            (e.full_text(), e.count)
+            (e.full_text(&ty, &mut items), e.count)
         }) {
             derived.push_str(&s);
             if !c.phi.is_empty() {
@@ -509,6 +514,7 @@ fn emit_params(
         code,
         "#[automatically_derived]\n#[allow(unused_variables, clippy::all)]\nimpl {ty} {{\n{derived}}}"
     );
+    code.push_str(&items);
     let values: Vec<String> = sys
         .params
         .iter()
@@ -1309,19 +1315,22 @@ fn emit_chunks(model: &str, scenes: &[(String, Vec<Chunk>)], code: &mut String) 
         }
     }
     let header = "#[automatically_derived]\n#[allow(unused_variables, clippy::all)]\n";
+    let mut items = String::new();
     if !shared.is_empty() {
-        let _ = writeln!(code, "{header}impl {model}Params {{");
+        let ty = format!("{model}Params");
+        let _ = writeln!(code, "{header}impl {ty} {{");
         for c in &shared {
             let on_params = Chunk {
                 name: format!("__scenes{}", c.name),
                 args: format!("charts: &[[[f64; 3]; 3]], {}", c.args),
+                call: format!("charts, {}", c.call),
                 body: c
                     .body
                     .replace("self.params.", "self.")
                     .replace("self.charts", "charts"),
                 ..(*c).clone()
             };
-            code.push_str(&on_params.text());
+            code.push_str(&on_params.text(&ty, &mut items));
         }
         code.push_str("}\n");
     }
@@ -1334,13 +1343,14 @@ fn emit_chunks(model: &str, scenes: &[(String, Vec<Chunk>)], code: &mut String) 
             if shared.contains(&c) {
                 let _ = writeln!(
                     code,
-                    "#[inline]\nfn {}(&self, {}, w: &mut [{}]) {{\nself.params.__scenes{}(&self.charts, {}, w)\n}}",
-                    c.name, c.args, c.number, c.name, c.call
+                    "#[inline]\nfn {}(&self, {}, w: &mut [{}; {}]) {{\nself.params.__scenes{}(&self.charts, {}, w)\n}}",
+                    c.name, c.args, c.number, c.workspace, c.name, c.call
                 );
             } else {
-                code.push_str(&c.text());
+                code.push_str(&c.text(ty, &mut items));
             }
         }
         code.push_str("}\n");
     }
+    code.push_str(&items);
 }

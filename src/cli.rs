@@ -278,6 +278,10 @@ fn failure_text(e: &SimError) -> String {
                 "the step fell below {h_min:e} s {at}: {}",
                 b.advice("--atol")
             ),
+            Some(b) if b.ran_away() => format!(
+                "the step fell below {h_min:e} s {at}: {}",
+                b.runaway("--rtol")
+            ),
             _ => format!(
                 "the step fell below {h_min:e} s {at}: the solution may be singular or too stiff for the scheme (try --scheme radau5 or bdf){}",
                 held_by

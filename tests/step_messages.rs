@@ -346,6 +346,40 @@ fn a_step_below_h_min_names_the_component_that_held_it() {
     assert_eq!(b.set_by, "rtol", "{e}");
     assert!(b.component.contains("q["), "{e}");
     assert!(!e.to_string().contains("raise atol"), "{e}");
+    assert!(!b.ran_away() && !e.to_string().contains("ran away"), "{e}");
+}
+
+/// A motion that runs away under a loose rtol is said to: DOPRI5 on the double pendulum
+/// released at rest gains energy from its steps' errors, and the error a relative tolerance
+/// allows grows with the motion; at rtol 0.2 its velocities grow past a million times their
+/// start (from rest: past 1e6 rad/s) and its step falls below h_min. The message says the
+/// motion ran away and to tighten rtol, not that it may be stiff (it said so before, and to
+/// try Radau5 or BDF).
+#[test]
+fn a_motion_that_runs_away_under_a_loose_rtol_is_said_to() {
+    use mbs_models::dpend::DoublePendulum;
+    let o = quiet(Options::adaptive(10.0, 0.2));
+    let e = simulate(DoublePendulum::default(), Scheme::Dopri5, o).unwrap_err();
+    println!("{e}");
+    let Failure::StepTooSmall {
+        held_by: Some(b), ..
+    } = &e.kind
+    else {
+        panic!("{e}")
+    };
+    assert!(b.ran_away(), "{e}");
+    assert_eq!((b.set_by, b.start), ("rtol", 0.0), "{e}");
+    assert!(
+        b.component.starts_with("the velocity of q[") && b.value > 1e6,
+        "{e}"
+    );
+    let text = e.to_string();
+    assert!(
+        text.contains("ran away") && text.contains("tighten rtol"),
+        "{e}"
+    );
+    assert!(!text.contains("stiff"), "{e}");
+    assert!(e.t < 2.0, "{e}");
 }
 
 /// An rtol of 1 or more accepts any step (DOPRI5 on the double pendulum at rtol 2 let the

@@ -59,6 +59,9 @@ pub struct Simulation<M: Model> {
     /// the component that weighed most in the error test, when that test rejected the last
     /// attempt (`Failure::StepTooSmall` names it)
     held_by: Option<Largest>,
+    /// the largest position and velocity of the start, against which a component that held
+    /// the step is judged to have run away (`HeldBy::ran_away`)
+    start_scale: [f64; 2],
     /// per coordinate (its position and velocity), then per multiplier: the accepted steps
     /// whose error test it held
     held_counts: Vec<u32>,
@@ -157,7 +160,10 @@ impl<M: Model + 'static> Simulation<M> {
         };
         traj.reserve(expected, options.energy, options.frames);
         let held_counts = vec![0; M::NQ + cur.lambda.len()];
+        let largest = |v: &[f64]| v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        let start_scale = [largest(&cur.q), largest(&cur.qd)];
         let mut sim = Simulation {
+            start_scale,
             problem,
             stepper,
             scheme,
@@ -484,7 +490,9 @@ impl<M: Model + 'static> Simulation<M> {
             }
             if h < h_min && !last && !fixed {
                 // the cause of the rejections that shrank the step, when there is one
-                let held_by = self.held_by.map(|b| b.held_by(|i| self.problem.label(i)));
+                let held_by = self
+                    .held_by
+                    .map(|b| b.held_by(|i| self.problem.label(i), self.start_scale));
                 let kind = self
                     .last_cause
                     .take()

@@ -196,9 +196,15 @@ impl Largest {
     }
 
     /// What held the step, in words for `Failure::StepTooSmall`: the component labelled by
-    /// `label` (coordinate index → "q[3] (name)"), its error and tolerance, and what set it.
-    pub fn held_by(&self, label: impl Fn(usize) -> String) -> crate::error::HeldBy {
+    /// `label` (coordinate index → "q[3] (name)"), its error and tolerance, what set it, and
+    /// the largest entry of its kind at the start (`start`: positions, velocities).
+    pub fn held_by(
+        &self,
+        label: impl Fn(usize) -> String,
+        start: [f64; 2],
+    ) -> crate::error::HeldBy {
         crate::error::HeldBy {
+            start: start.get(self.block).copied().unwrap_or(f64::NAN),
             component: component_name(self.block, self.index, label),
             value: self.magnitude,
             error: self.error,

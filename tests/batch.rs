@@ -140,13 +140,7 @@ fn chunked_functions_on_lanes() {
     const { assert!(Arm24::BATCH_GENERATED) };
     // more temporaries than one function holds (1,500): the code is split into chunks that
     // pass values through a workspace of lanes
-    let (_, dynamics) = model
-        .info()
-        .ops
-        .iter()
-        .find(|(label, _)| label.starts_with("dynamics"))
-        .unwrap();
-    assert!(dynamics.lets > 1500, "{dynamics:?}");
+    assert!(dynamics_lets(&model) > 1500);
     let worst = compare(&model, 0.3);
     println!("Arm24: worst relative difference {worst:.1e}");
 }
@@ -166,13 +160,7 @@ fn models_without_the_option_answer_lane_by_lane() {
 fn a_chunked_model_declared_in_a_function_body() {
     arm!(Arm24Here, 24, 11, 23, 22);
     let (here, there) = (Arm24Here::default(), Arm24::default());
-    let (_, dynamics) = here
-        .info()
-        .ops
-        .iter()
-        .find(|(label, _)| label.starts_with("dynamics"))
-        .unwrap();
-    assert!(dynamics.lets > 1500, "{dynamics:?}");
+    assert!(dynamics_lets(&here) > 1500);
     let (qs, qds) = states(&here, 0.3);
     for (q, qd) in qs.iter().zip(&qds) {
         let a = one_state(&here, q, qd);
@@ -189,4 +177,15 @@ fn one_state<M: Model>(model: &M, q: &[f64], qd: &[f64]) -> (Vec<f64>, Vec<f64>,
     model.dynamics(0.0, q, qd, &[], &mut m, &mut h);
     model.forward_dynamics(0.0, q, qd, &[], &mut qdd, &mut pivots);
     (m, h, qdd)
+}
+
+/// The `let`s of a model's generated `dynamics`.
+fn dynamics_lets<M: Model>(model: &M) -> usize {
+    let (_, dynamics) = model
+        .info()
+        .ops
+        .iter()
+        .find(|(label, _)| label.starts_with("dynamics"))
+        .unwrap();
+    dynamics.lets
 }

@@ -210,10 +210,10 @@ impl Chunk {
     /// a type of a module of its own, which this adds to `items` (outside the `impl`).
     ///
     /// The compiler puts a method in the code-generation unit of its type's module, so that
-    /// LLVM compiles the chunks on several cores. A Radau5 run of the standing hexapod with
-    /// tangents, in a crate of its own (`benches/compile_time.sh`'s, release), built in
-    /// 8.6–8.8 s where 10.0–10.3 s with the chunks in one unit; the tangents alone, only
-    /// `forward_dynamics` called, 3.5–3.8 where 3.6–4.0 s. The type is a wrapper of a
+    /// LLVM compiles the chunks on several cores. A program that runs the hexapod with
+    /// tangents with Radau5 (`benches/compile_time.sh hexapod-radau`) built in 8.7–8.9 s
+    /// where 10.9–11.4 s with the chunks in the model's one unit; the `hexapod` case, whose
+    /// program calls forward dynamics alone, in 3.6–3.9 where 3.9–4.0 s. The type is a wrapper of a
     /// reference, declared in the module and given its methods here, where `self_ty` is
     /// named: a model declared in a function's body has no path from a module. Batch code stays
     /// a method: its target features would make the call from the method unsafe.

@@ -273,23 +273,18 @@ fn failure_text(e: &SimError) -> String {
             "more than {max_steps} steps {at}: raise --max-steps, take larger steps (a larger --h or a looser --rtol), or use a scheme suited to the stiffness (--scheme radau5 or bdf){}",
             HeldMost::clause(held_most)
         ),
-        Failure::StepTooSmall { h_min, held_by } => match held_by {
-            Some(b) if b.tolerance_is_the_fix() => format!(
-                "the step fell below {h_min:e} s {at}: {}",
-                b.advice("--atol")
-            ),
-            Some(b) if b.ran_away() => format!(
-                "the step fell below {h_min:e} s {at}: {}",
-                b.runaway("--rtol")
-            ),
-            _ => format!(
-                "the step fell below {h_min:e} s {at}: the solution may be singular or too stiff for the scheme (try --scheme radau5 or bdf){}",
-                held_by
-                    .as_ref()
-                    .map(|b| format!("; {}", b.held()))
-                    .unwrap_or_default()
-            ),
-        },
+        Failure::StepTooSmall { h_min, held_by } => {
+            match held_by.as_ref().and_then(|b| b.fix("--atol", "--rtol")) {
+                Some(fix) => format!("the step fell below {h_min:e} s {at}: {fix}"),
+                None => format!(
+                    "the step fell below {h_min:e} s {at}: the solution may be singular or too stiff for the scheme (try --scheme radau5 or bdf){}",
+                    held_by
+                        .as_ref()
+                        .map(|b| format!("; {}", b.held()))
+                        .unwrap_or_default()
+                ),
+            }
+        }
         Failure::UnstableStep {
             scheme,
             rho,
@@ -298,10 +293,8 @@ fn failure_text(e: &SimError) -> String {
             h_stable,
             at_end,
         } => format!(
-            "{}h·ρ = {} leaves the stability region of {scheme} (limit {limit:.3}; ρ ≈ {rho:.4e} 1/s is the fastest mode{}) {at}: take --h {:.1e} or smaller, or an implicit scheme (--scheme radau5)",
-            if *at_end { crate::error::LURCHED } else { "" },
-            crate::error::h_rho_text(*h_rho),
-            if *at_end { " there" } else { "" },
+            "{} {at}: take --h {:.1e} or smaller, or an implicit scheme (--scheme radau5)",
+            crate::error::unstable_text(scheme, *rho, *h_rho, *limit, *at_end),
             shorten(*h_stable)
         ),
         Failure::ConstraintDrift {

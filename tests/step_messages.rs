@@ -368,7 +368,7 @@ fn a_motion_that_runs_away_under_a_loose_rtol_is_said_to() {
         panic!("{e}")
     };
     assert!(b.ran_away(), "{e}");
-    assert_eq!((b.set_by, b.start), ("rtol", 0.0), "{e}");
+    assert_eq!((b.set_by, b.start), ("rtol", Some(0.0)), "{e}");
     assert!(
         b.component.starts_with("the velocity of q[") && b.value > 1e6,
         "{e}"

@@ -74,14 +74,24 @@ pub fn check_inertia(body: &'static str, t: [f64; 6]) -> Result<(), ParamError> 
     }
 }
 
-/// h·ρ in [`Failure::UnstableStep`]'s message: three decimals, or three digits of a power
-/// of ten past 10⁶ (a step that blew the state up gives h·ρ of 1e39, not 40 digits).
-pub fn h_rho_text(h_rho: f64) -> String {
-    if h_rho.abs() < 1e6 {
+/// What [`Failure::UnstableStep`]'s message says before its advice (a step to take): that
+/// h·ρ leaves the scheme's stability region, with h·ρ in three decimals, or three digits of a
+/// power of ten past 10⁶ (a step that blew the state up gives h·ρ of 1e39, not 40 digits),
+/// and, when ρ was read at the end of the step, that the step lurched.
+pub fn unstable_text(scheme: &str, rho: f64, h_rho: f64, limit: f64, at_end: bool) -> String {
+    let h_rho = if h_rho.abs() < 1e6 {
         format!("{h_rho:.3}")
     } else {
         format!("{h_rho:.3e}")
-    }
+    };
+    let (lurched, there) = if at_end {
+        (LURCHED, " there")
+    } else {
+        ("", "")
+    };
+    format!(
+        "{lurched}h·ρ = {h_rho} leaves the stability region of {scheme} (limit {limit:.3}; ρ ≈ {rho:.4e} 1/s is the fastest mode{there})"
+    )
 }
 
 /// The growth past which a component whose tolerance rtol set has run away
@@ -89,7 +99,7 @@ pub fn h_rho_text(h_rho: f64) -> String {
 pub const RAN_AWAY: f64 = 1e6;
 
 /// How [`Failure::UnstableStep`] starts when ρ was estimated at the end of the step.
-pub const LURCHED: &str = "the step changed the state by more than its own size: at its end ";
+const LURCHED: &str = "the step changed the state by more than its own size: at its end ";
 
 /// The component that weighed most in the error test that last rejected a step, named when
 /// the step falls below h_min: a step held by one coordinate of a stiff or singular motion, or
@@ -109,8 +119,8 @@ pub struct HeldBy {
     /// of its kind)
     pub set_by: &'static str,
     /// the largest entry of its kind (positions or velocities) in the state the run started
-    /// from; NaN for a multiplier
-    pub start: f64,
+    /// from; none for a multiplier
+    pub start: Option<f64>,
 }
 
 /// The coordinate (its position or velocity) or multiplier whose term weighed most in the
@@ -156,9 +166,25 @@ impl HeldBy {
         const STIFF: &str = " (the solution may be singular or too stiff for the scheme)";
         match held_by {
             None => STIFF.into(),
-            Some(b) if b.tolerance_is_the_fix() => format!(": {}", b.advice("atol")),
-            Some(b) if b.ran_away() => format!(": {}", b.runaway("rtol")),
-            Some(b) => format!("{STIFF}; {}", b.held()),
+            Some(b) => match b.fix("atol", "rtol") {
+                Some(fix) => format!(": {fix}"),
+                None => format!("{STIFF}; {}", b.held()),
+            },
+        }
+    }
+
+    /// What to change when the step fell below h_min for a reason other than the motion's
+    /// stiffness, with the options named `atol` and `rtol` (`--atol`, `--rtol` on a command
+    /// line): raise atol when its tolerance or the rounding floor held the step
+    /// ([`HeldBy::advice`]), tighten rtol when the motion ran away ([`HeldBy::runaway`]);
+    /// `None` otherwise.
+    pub fn fix(&self, atol: &str, rtol: &str) -> Option<String> {
+        if self.tolerance_is_the_fix() {
+            Some(self.advice(atol))
+        } else if self.ran_away() {
+            Some(self.runaway(rtol))
+        } else {
+            None
         }
     }
 
@@ -169,20 +195,23 @@ impl HeldBy {
             "the motion ran away: {} grew to {:.1e} where the largest entry of its kind was {} at the start; a relative tolerance lets each step's error grow with the motion, and a motion that gains energy from those errors runs away (DOPRI5 on the double pendulum released at rest: at rtol 0.2 within 1.4 s, at 0.02 within 34 s); tighten {rtol} ({})",
             self.component,
             self.value,
-            if self.start == 0.0 {
-                "0".to_string()
-            } else {
-                format!("{:.1e}", self.start)
+            match self.start {
+                Some(0.0) => "0".to_string(),
+                Some(v) => format!("{v:.1e}"),
+                None => "unknown".to_string(),
             },
             self.held()
         )
     }
 
-    /// Whether rtol set the tolerance of a component that grew past [`RAN_AWAY`] times the
-    /// largest entry of its kind at the start (or [`RAN_AWAY`] in SI units, from rest): the
-    /// steps fell below h_min because the motion ran away, not because it is stiff.
+    /// Whether rtol set the tolerance of a position or velocity that grew past [`RAN_AWAY`]
+    /// times the largest entry of its kind at the start (or [`RAN_AWAY`] in SI units, from
+    /// rest): the steps fell below h_min because the motion ran away, not because it is stiff.
     pub fn ran_away(&self) -> bool {
-        self.set_by == "rtol" && self.value > RAN_AWAY * self.start.max(1.0)
+        self.set_by == "rtol"
+            && self
+                .start
+                .is_some_and(|start| self.value > RAN_AWAY * start.max(1.0))
     }
 
     /// Whether the tolerance, not the motion, held the step: it was atol's or the rounding
@@ -288,10 +317,8 @@ pub enum Failure {
         coordinate: String,
     },
     #[error(
-        "{}h·ρ = {} leaves the stability region of {scheme} (limit {limit:.3}; ρ ≈ {rho:.4e} 1/s is the fastest mode{}): take h < {h_stable:.4e} s or an implicit scheme",
-        if *at_end { LURCHED } else { "" },
-        h_rho_text(*h_rho),
-        if *at_end { " there" } else { "" }
+        "{}: take h < {h_stable:.4e} s or an implicit scheme",
+        unstable_text(scheme, *rho, *h_rho, *limit, *at_end)
     )]
     UnstableStep {
         scheme: &'static str,

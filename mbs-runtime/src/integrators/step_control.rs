@@ -204,7 +204,7 @@ impl Largest {
         start: [f64; 2],
     ) -> crate::error::HeldBy {
         crate::error::HeldBy {
-            start: start.get(self.block).copied().unwrap_or(f64::NAN),
+            start: start.get(self.block).copied(),
             component: component_name(self.block, self.index, label),
             value: self.magnitude,
             error: self.error,

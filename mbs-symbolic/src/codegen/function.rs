@@ -1,6 +1,7 @@
 //! One generated method: outputs scheduled, emitted, and split into chunk methods when there
 //! are more than [`MAX_LETS`] temporaries.
 
+use super::formulas::Formulas;
 use crate::expr::cse::{MAX_LETS, Schedule};
 use crate::expr::emit::{LANES_TYPE, MissingDerivative, Naming, Numbers, emit};
 use crate::expr::{Arena, ExprId, OpCount, Var};
@@ -179,10 +180,10 @@ pub struct EmittedFn {
 impl EmittedFn {
     /// The method and its chunk methods, for an `impl` of `self_ty`; the chunks' own modules
     /// (see [`Chunk::text`]) are added to `items`.
-    pub fn full_text(&self, self_ty: &str, items: &mut String) -> String {
+    pub fn full_text(&self, self_ty: &str, items: &mut String, formulas: &mut Formulas) -> String {
         let mut s = self.text.clone();
         for c in &self.chunks {
-            s.push_str(&c.text(self_ty, items));
+            s.push_str(&c.text(self_ty, items, formulas));
         }
         s
     }
@@ -217,7 +218,9 @@ impl Chunk {
     /// reference, declared in the module and given its methods here, where `self_ty` is
     /// named: a model declared in a function's body has no path from a module. Batch code stays
     /// a method: its target features would make the call from the method unsafe.
-    pub fn text(&self, self_ty: &str, items: &mut String) -> String {
+    ///
+    /// The `let`s of an `f64` chunk call the model's `formulas` (see [`Formulas`]).
+    pub fn text(&self, self_ty: &str, items: &mut String, formulas: &mut Formulas) -> String {
         if !self.simd.is_empty() {
             return format!(
                 "#[inline(never)]\n{}fn {}(&self, {}, w: &mut [{}; {}]) {{\n{}}}\n",
@@ -234,7 +237,7 @@ impl Chunk {
             self.args,
             self.number,
             self.workspace,
-            self_to_this(&self.body)
+            self_to_this(&formulas.rewrite(&self.body))
         );
         format!(
             "#[inline]\nfn {}(&self, {}, w: &mut [{}; {}]) {{\n{module}::Chunk(self).run({}, w)\n}}\n",

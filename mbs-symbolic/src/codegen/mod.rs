@@ -3,6 +3,7 @@
 //! The text is what the macro emits (parsed into tokens) and what `mbs expand` prints.
 
 pub mod api;
+pub mod formulas;
 pub mod function;
 mod ltdl;
 pub mod shapes;
@@ -14,6 +15,7 @@ use crate::mech::dynamics::SceneEquations;
 use crate::mech::system::{Formulation, Load, System};
 use crate::mech::world::{self, Twist};
 use api::{Sizes, args};
+use formulas::Formulas;
 use function::{Chunk, EmittedFn, FnSpec, Prefix, RustNames, emit_fn};
 use std::fmt::Write;
 use std::time::{Duration, Instant};
@@ -108,7 +110,8 @@ pub fn generate(sys: System, vis: &str) -> Result<Generated, Vec<MissingDerivati
     let mut code = String::new();
     let mut reports = Vec::new();
     let mut missing = Vec::new();
-    let shared = emit_params(&model, vis, &mut code, &mut missing);
+    let mut formulas = Formulas::new(&model.sys.name);
+    let shared = emit_params(&model, vis, &mut code, &mut missing, &mut formulas);
     // forward dynamics as dynamics then the model's one LᵀDL, in the scenes where it pays
     let after: Vec<bool> = model
         .scenes
@@ -130,7 +133,7 @@ pub fn generate(sys: System, vis: &str) -> Result<Generated, Vec<MissingDerivati
             let _ = writeln!(
                 code,
                 "#[automatically_derived]\n#[allow(unused_variables, clippy::all)]\nimpl {ty} {{\n{}}}",
-                e.full_text(&ty, &mut items)
+                e.full_text(&ty, &mut items, &mut formulas)
             );
             code.push_str(&items);
             e.count
@@ -153,7 +156,8 @@ pub fn generate(sys: System, vis: &str) -> Result<Generated, Vec<MissingDerivati
         );
         chunks.push((scene_type(&model.sys, eq.scene), scene_chunks));
     }
-    emit_chunks(&model.sys.name, &chunks, &mut code);
+    emit_chunks(&model.sys.name, &chunks, &mut code, &mut formulas);
+    code.push_str(&formulas.text());
     if !missing.is_empty() {
         missing.dedup();
         return Err(missing);
@@ -197,6 +201,7 @@ fn emit_params(
     vis: &str,
     code: &mut String,
     missing: &mut Vec<MissingDerivative>,
+    formulas: &mut Formulas,
 ) -> Vec<(String, OpCount, Option<usize>)> {
     let sys = &model.sys;
     let a = &sys.arena;
@@ -371,7 +376,7 @@ fn emit_params(
     };
     let mut items = String::new();
     let mut derived = collect(emit_fn(a, &spec, &names), missing, |e| {
-        e.full_text(&ty, &mut items)
+        e.full_text(&ty, &mut items, formulas)
     })
     .unwrap_or_default();
     // the constraints are the same in every scene: emitted once, here
@@ -494,7 +499,7 @@ fn emit_params(
     let mut ops = Vec::new();
     for (spec, label, part) in shared {
         if let Some((s, count)) = collect(emit_fn(a, &spec, &names), missing, |e| {
-            (e.full_text(&ty, &mut items), e.count)
+            (e.full_text(&ty, &mut items, formulas), e.count)
         }) {
             derived.push_str(&s);
             ops.push((label, count, part));
@@ -502,7 +507,7 @@ fn emit_params(
     }
     for (spec, label) in specs.iter().zip(labels) {
         if let Some((s, count)) = collect(emit_fn(a, spec, &names), missing, |e| {
-            (e.full_text(&ty, &mut items), e.count)
+            (e.full_text(&ty, &mut items, formulas), e.count)
         }) {
             derived.push_str(&s);
             if !c.phi.is_empty() {
@@ -1295,7 +1300,12 @@ impl {ty} {{
 /// chunks of dynamics, where M is computed, on a model with scenes) is emitted once on the
 /// parameter struct, the charts an argument, and each scene's method calls it; the others
 /// as they are, in an `impl` of their scene type.
-fn emit_chunks(model: &str, scenes: &[(String, Vec<Chunk>)], code: &mut String) {
+fn emit_chunks(
+    model: &str,
+    scenes: &[(String, Vec<Chunk>)],
+    code: &mut String,
+    formulas: &mut Formulas,
+) {
     // a scene's chunk reads the parameters and the charts through `self` and nothing else
     let movable = |c: &Chunk| {
         c.simd.is_empty()
@@ -1330,7 +1340,7 @@ fn emit_chunks(model: &str, scenes: &[(String, Vec<Chunk>)], code: &mut String) 
                     .replace("self.charts", "charts"),
                 ..(*c).clone()
             };
-            code.push_str(&on_params.text(&ty, &mut items));
+            code.push_str(&on_params.text(&ty, &mut items, formulas));
         }
         code.push_str("}\n");
     }
@@ -1347,7 +1357,7 @@ fn emit_chunks(model: &str, scenes: &[(String, Vec<Chunk>)], code: &mut String) 
                     c.name, c.args, c.number, c.workspace, c.name, c.call
                 );
             } else {
-                code.push_str(&c.text(ty, &mut items));
+                code.push_str(&c.text(ty, &mut items, formulas));
             }
         }
         code.push_str("}\n");

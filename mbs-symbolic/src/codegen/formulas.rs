@@ -1,10 +1,10 @@
-//! Formulas: the arithmetic of a `let` in a chunk written once as a function and called.
+//! Formulas: the arithmetic of a value in a chunk written once as a function and called.
 //!
 //! rustc's front end checks every operator of the generated code one by one (each `a * b`
 //! looks up `Mul` for `f64`, registers and solves its obligations), and in a model the size of
 //! the hexapod with tangents that is most of its build. The same few forms come back in
 //! thousands of `let`s (`a * b - c * d`: a rotation's row), so in the chunks of a split
-//! function a `let` of at least [`MIN_OPS`] operations becomes a call of the formula of its
+//! function a value (a `let`, an output) of at least [`MIN_OPS`] operations becomes a call of the formula of its
 //! form, `let x7 = __HexapodFormulas::f2(c, a, s, b);`, the formula a function of one
 //! module per model, `#[inline(always)]`:
 //!
@@ -21,7 +21,7 @@
 use std::fmt::Write;
 
 /// The least number of operations (`+ - * /`, unary minus included) of a `let` written as a
-/// formula: a call costs the front end about as much as two operators.
+/// formula: a call costs the front end about as much as two or three operators.
 pub const MIN_OPS: usize = 3;
 
 /// Methods of `f64` a formula may call (what the generator writes as `x.name(…)`).
@@ -93,6 +93,7 @@ impl Formulas {
         }
         let mut any = false;
         let values: Vec<String> = split_top(list)
+            .into_iter()
             .map(|v| match self.call(v) {
                 Some(c) => {
                     any = true;
@@ -155,7 +156,7 @@ impl Formulas {
 }
 
 /// The elements of a list `a, f(b, c), d` (commas outside parentheses).
-fn split_top(list: &str) -> impl Iterator<Item = &str> {
+fn split_top(list: &str) -> Vec<&str> {
     let mut depth = 0i32;
     let mut start = 0;
     let mut parts = Vec::new();
@@ -171,7 +172,7 @@ fn split_top(list: &str) -> impl Iterator<Item = &str> {
         }
     }
     parts.push(list[start..].trim());
-    parts.into_iter()
+    parts
 }
 
 /// The leaves of `rhs` (byte ranges of names and numbers) and its number of operations, or

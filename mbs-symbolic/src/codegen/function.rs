@@ -219,7 +219,7 @@ impl Chunk {
     /// named: a model declared in a function's body has no path from a module. Batch code stays
     /// a method: its target features would make the call from the method unsafe.
     ///
-    /// The `let`s of an `f64` chunk call the model's `formulas` (see [`Formulas`]).
+    /// The values of an `f64` chunk call the model's `formulas` (see [`Formulas`]).
     pub fn text(&self, self_ty: &str, items: &mut String, formulas: &mut Formulas) -> String {
         if !self.simd.is_empty() {
             return format!(

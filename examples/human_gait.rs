@@ -6,7 +6,9 @@
 //! with flat ground (`GaitReference::grounded`: periodic corrections of the leg angles so
 //! that the feet are level and move together in double support, the swinging foot clears
 //! the standing one by up to `--clearance`, the centre of mass accelerates within the
-//! normal cycle's bounds and the ground's force points at it in single support), tracked by
+//! normal cycle's bounds and the ground's force points at it in single support; printed
+//! with what the cycle still asks of the ground: how far beyond the standing feet the centre
+//! of pressure it needs lies, and the free moment it needs), tracked by
 //! stiff joint spring–dampers (`--kp`, default 3·10⁴ N·m/rad), the pelvis' translation free
 //! on the contacts and its orientation held by residual torques (`--pelvis`, as OpenSim's
 //! residual reduction does; 0 leaves it free), the feet's Hunt–Crossley stiffness and
@@ -15,7 +17,7 @@
 //! vertical and fore–aft ground reaction forces in body weights (first peak, trough, second
 //! peak, braking, propulsion, the fore–aft means over the stance's halves), the vertical
 //! impulse against weight × time, the fraction of the cycle with no foot on the ground, the
-//! residual torque, the whole-body angular momentum about the centre of mass (normalised as
+//! residual torque (rms in all and about each world axis), the whole-body angular momentum about the centre of mass (normalised as
 //! Herr & Popovic 2008 do), the joint moments (the tracking torques) and the time the run
 //! takes.
 //!
@@ -122,7 +124,9 @@ fn gait() -> Result<(), Box<dyn std::error::Error>> {
         println!(
             "  {what:>9}: {:.2} m/s; in double support the feet level within {:.1} mm, sliding apart at up to {:.2} m/s; \
              swing clearance {:+.1} mm from the asked; centre of mass accelerating within \
-             [{:.2}, {:.2}] g fore–aft, [{:.2}, {:.2}] g vertically, [{:.2}, {:.2}] g laterally",
+             [{:.2}, {:.2}] g fore–aft, [{:.2}, {:.2}] g vertically, [{:.2}, {:.2}] g laterally; \
+             the centre of pressure the motion needs up to {:.2} m beyond the standing feet fore–aft and {:.2} m \
+             laterally, a free moment up to {:.0} N·m",
             g.speed,
             1e3 * g.level,
             g.slip,
@@ -132,7 +136,10 @@ fn gait() -> Result<(), Box<dyn std::error::Error>> {
             a[1][0],
             a[1][1],
             a[2][0],
-            a[2][1]
+            a[2][1],
+            g.pressure_beyond[0],
+            g.pressure_beyond[1],
+            g.free_moment
         );
     }
     let reference = grounded.reference;
@@ -280,11 +287,15 @@ fn print(c: &CycleForces, mass: f64) {
         100.0 * c.airborne
     );
     println!(
-        "  residual torque on the pelvis: rms {:.0} N·m, peak {:.0} N·m ({:.2} and {:.2} N·m/kg)",
+        "  residual torque on the pelvis: rms {:.0} N·m, peak {:.0} N·m ({:.2} and {:.2} N·m/kg); \
+         rms about the fore–aft axis {:.0}, the vertical {:.0}, the lateral {:.0} N·m",
         c.residual_rms,
         c.residual_peak,
         c.residual_rms / mass,
-        c.residual_peak / mass
+        c.residual_peak / mass,
+        c.residual_axes[0],
+        c.residual_axes[1],
+        c.residual_axes[2]
     );
 }
 

@@ -497,6 +497,23 @@ fn the_grounded_cycle_levels_the_feet_keeps_them_together_and_bounds_the_centre_
         raw.speed
     );
     assert!(g.largest_change < 20f64.to_radians());
+    // what the cycle still asks of the ground: the centre of pressure its motion needs lies
+    // beyond the standing feet (the residual torques supply that moment), less so than the
+    // fitted cycle's, whose vertical force nearly vanishes at instants
+    println!(
+        "centre of pressure beyond the standing feet (fore–aft, lateral): fitted {:.2?} m, grounded {:.3?} m; \
+         free moment up to {:.0} and {:.0} N·m",
+        raw.pressure_beyond, g.pressure_beyond, raw.free_moment, g.free_moment
+    );
+    assert!(
+        (0..2)
+            .all(|k| g.pressure_beyond[k].is_finite()
+                && g.pressure_beyond[k] < raw.pressure_beyond[k])
+            && g.free_moment.is_finite(),
+        "{:?} {:?}",
+        g.pressure_beyond,
+        raw.pressure_beyond
+    );
     // the corrected series are what the pass measured: the reference at an instant of
     // double support has its feet level
     let [right, left] = lowest_points(&model, &g.reference, 0.05 * 1.1);
@@ -551,8 +568,16 @@ fn the_prescribed_cycle_gives_a_normal_double_hump_braking_then_propulsion_also_
     let c = CycleForces::of(&model, &tracking, &tr, weight);
     let (right, left) = (c.figures(0), c.figures(1));
     println!(
-        "{} steps; right {right:.2?}; left {left:.2?}; impulse ratio {:.4}, airborne {:.3}, residual rms {:.0} N·m",
-        stats.steps, c.impulse_ratio, c.airborne, c.residual_rms
+        "{} steps; right {right:.2?}; left {left:.2?}; impulse ratio {:.4}, airborne {:.3}, residual rms {:.0} N·m \
+         (about the fore–aft, vertical and lateral axes {:.0?})",
+        stats.steps, c.impulse_ratio, c.airborne, c.residual_rms, c.residual_axes
+    );
+    // the axes' parts make up the whole
+    let parts = c.residual_axes.iter().map(|a| a * a).sum::<f64>().sqrt();
+    assert!(
+        (parts / c.residual_rms - 1.0).abs() < 1e-9,
+        "{parts} {}",
+        c.residual_rms
     );
     let within = |x: Option<f64>, lo: f64, hi: f64| x.is_some_and(|v| v >= lo && v <= hi);
     // each foot: the double hump in the normal ranges, braking then propulsion

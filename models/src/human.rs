@@ -632,6 +632,7 @@ impl GaitReference {
         }
         let samples = pass.samples(&x, &mut kin);
         let (level, clearance, acceleration, slip) = pass.measure(&samples);
+        let (pressure_beyond, free_moment) = pass.pressure(&samples);
         let speed = pass.speed(&samples);
         let largest_change = (0..how.samples)
             .flat_map(|s| {
@@ -650,6 +651,8 @@ impl GaitReference {
             speed,
             largest_change,
             iterations,
+            pressure_beyond,
+            free_moment,
         })
     }
 
@@ -741,6 +744,15 @@ pub struct Grounded {
     /// the largest correction of an angle (rad)
     pub largest_change: f64,
     pub iterations: usize,
+    /// what the cycle asks of the ground, which the pass does not correct (the residual
+    /// torques on the pelvis supply what the feet cannot): the largest distance (m) by
+    /// which the centre of pressure the motion needs (its angular momentum's rate about the
+    /// centre of mass and the centre's acceleration) lies beyond the standing feet's
+    /// support, fore–aft and lateral (along and across the line between the feet in double
+    /// support)
+    pub pressure_beyond: [f64; 2],
+    /// and the largest free moment about the vertical it needs there (N·m)
+    pub free_moment: f64,
 }
 
 const G: f64 = 9.80665;
@@ -779,6 +791,12 @@ impl Centroid {
         let nq = Human::NQ;
         let mut m = vec![0.0; nq * nq];
         model.mass_matrix(t, q, &mut m);
+        Centroid::from_mass_matrix(model, q, qd, &m)
+    }
+
+    /// As [`Centroid::of`], `m` the mass matrix at q (row-major).
+    fn from_mass_matrix(model: &Human, q: &[f64], qd: &[f64], m: &[f64]) -> Option<Centroid> {
+        let nq = Human::NQ;
         let mass = m[0];
         let row = |r: usize| (0..nq).map(|j| m[r * nq + j] * qd[j]).sum::<f64>();
         let column = |j: usize| [0, 1, 2].map(|r| m[r * nq + j] / mass);
@@ -929,11 +947,12 @@ impl Pass<'_> {
                     let low = hard - SOFT * sum.ln();
                     let v = [0, 2]
                         .map(|j| sp[k].iter().zip(&w).map(|(p, w)| w * p.1[j]).sum::<f64>() / sum);
-                    let x = sp[k].iter().zip(&w).map(|(p, w)| w * p.0[0]).sum::<f64>() / sum;
+                    let x = [0, 2]
+                        .map(|j| sp[k].iter().zip(&w).map(|(p, w)| w * p.0[j]).sum::<f64>() / sum);
                     (low, v, x)
                 };
                 let (r, l) = (lowest(0), lowest(1));
-                let (low, contact, contact_x) = ([r.0, l.0], [r.1, l.1], [r.2, l.2]);
+                let (low, contact, at) = ([r.0, l.0], [r.1, l.1], [r.2, l.2]);
                 // the centre of mass' height from the potential, lifted clear of the ground;
                 // its velocity from the momentum (the pelvis' translation at rest)
                 q[1] += 2.0;
@@ -944,12 +963,19 @@ impl Pass<'_> {
                 // the centre of mass' x from the mass matrix' column of the pelvis' first
                 // angle (a rotation about the world's z: Σ mᵢ ẑ × (x_Gᵢ − pelvis))
                 let com_x = q[0] + m[nq + 3] / mass;
+                // the angular momentum about the centre of mass and the centre's z (NaN at
+                // the pelvis' angles' singularity)
+                let centroid = Centroid::from_mass_matrix(self.model, &q, &qd, &m);
                 Sample {
                     low,
                     height: com - low[0].min(low[1]),
                     contact,
-                    contact_x,
+                    contact_x: [at[0][0], at[1][0]],
+                    contact_z: [at[0][1], at[1][1]],
                     com_x,
+                    com_z: centroid.map_or(f64::NAN, |c| c.position[2]),
+                    angular_momentum: centroid.map_or([f64::NAN; 3], |c| c.angular_momentum),
+                    support: sp.map(|f| f.map(|p| p.0)),
                     com_velocity: [momentum(0) / mass, momentum(2) / mass],
                 }
             })
@@ -1075,6 +1101,58 @@ impl Pass<'_> {
         r
     }
 
+    /// The centre of pressure (x, z) the ground's force must have at instant `s` of
+    /// `samples` (`acc` their accelerations, g) for the reference's motion, and the free
+    /// moment about the vertical it needs there (N·m): the ground's force is m (a + g ŷ), and
+    /// its moment about the centre of mass, from a point on the ground (the lower foot's
+    /// height), must be the angular momentum's rate (central differences over the cycle).
+    fn centre_of_pressure(
+        &self,
+        samples: &[Sample],
+        acc: &[[f64; 3]],
+        s: usize,
+    ) -> ([f64; 2], f64) {
+        let n = samples.len();
+        let dt = self.period / n as f64;
+        let (p, q) = ((s + n - 1) % n, (s + 1) % n);
+        let hd: [f64; 3] = std::array::from_fn(|k| {
+            (samples[q].angular_momentum[k] - samples[p].angular_momentum[k]) / (2.0 * dt)
+        });
+        let f = [0, 1, 2].map(|k| self.weight * (acc[s][k] + if k == 1 { 1.0 } else { 0.0 }));
+        let dy = -samples[s].height;
+        // (d × F)_x = dy Fz − dz Fy = Ḣx, (d × F)_z = dx Fy − dy Fx = Ḣz
+        let dz = (dy * f[2] - hd[0]) / f[1];
+        let dx = (hd[2] + dy * f[0]) / f[1];
+        let free = hd[1] - (dz * f[0] - dx * f[2]);
+        ([samples[s].com_x + dx, samples[s].com_z + dz], free)
+    }
+
+    /// The largest distances by which the centre of pressure the motion needs lies beyond
+    /// the standing feet's support over the cycle ([`Sample::beyond`]: fore–aft and lateral
+    /// in single support, along and across the line between the feet in double support,
+    /// the larger of each pair), and the largest free moment it needs (N·m); NaN where the
+    /// pelvis' angles are singular.
+    fn pressure(&self, samples: &[Sample]) -> ([f64; 2], f64) {
+        let acc = self.accelerations(samples);
+        let n = samples.len();
+        let (mut beyond, mut free) = ([0.0f64; 2], 0.0f64);
+        for s in 0..n {
+            let (cop, moment) = self.centre_of_pressure(samples, &acc, s);
+            let stands = match self.phase(s as f64 / n as f64) {
+                Some((true, _)) => [true, false],
+                Some((false, _)) => [false, true],
+                None => [true, true],
+            };
+            if cop.iter().chain([&moment]).any(|v| v.is_nan()) {
+                return ([f64::NAN; 2], f64::NAN);
+            }
+            let b = samples[s].beyond(cop, stands);
+            beyond = [beyond[0].max(b[0]).max(b[1]), beyond[1].max(b[2]).max(b[3])];
+            free = free.max(moment.abs());
+        }
+        (beyond, free)
+    }
+
     /// (largest level difference, least clearance margin, [least, largest] acceleration per
     /// axis, largest slip in double support).
     fn measure(&self, samples: &[Sample]) -> (f64, f64, [[f64; 2]; 3], f64) {
@@ -1119,9 +1197,62 @@ struct Sample {
     contact: [[f64; 2]; 2],
     /// the centre of mass' horizontal velocity (x, z) relative to the pelvis' translation
     com_velocity: [f64; 2],
-    /// each foot's contact (its lowest points blended) and the centre of mass along x (m)
+    /// each foot's contact (its lowest points blended) and the centre of mass along x and
+    /// z (m)
     contact_x: [f64; 2],
+    contact_z: [f64; 2],
     com_x: f64,
+    com_z: f64,
+    /// the angular momentum about the centre of mass (world axes, kg·m²/s)
+    angular_momentum: [f64; 3],
+    /// each foot's ellipsoids' support points (world, m)
+    support: [[[f64; 3]; 6]; 2],
+}
+
+impl Sample {
+    /// How far the point `c` (x, z) lies beyond the support of the standing feet
+    /// (`stands`) along four directions: ±x and ±z in single support, and in
+    /// double support along and across the line from one foot's contact to the other's.
+    /// The support's extent along a direction is a soft maximum of the feet's ellipsoids'
+    /// support points along it, each weighted by how close it is to its foot's lowest (over
+    /// 1 mm), so that it changes smoothly as a foot rolls.
+    fn beyond(&self, c: [f64; 2], stands: [bool; 2]) -> [f64; 4] {
+        let (t, n) = if stands == [true, true] {
+            let d = [
+                self.contact_x[0] - self.contact_x[1],
+                self.contact_z[0] - self.contact_z[1],
+            ];
+            let l = d[0].hypot(d[1]).max(1e-9);
+            ([d[0] / l, d[1] / l], [-d[1] / l, d[0] / l])
+        } else {
+            ([1.0, 0.0], [0.0, 1.0])
+        };
+        let dirs = [t, [-t[0], -t[1]], n, [-n[0], -n[1]]];
+        dirs.map(|u| {
+            let along = |p: &[f64; 3]| p[0] * u[0] + p[2] * u[1];
+            let top = self
+                .support
+                .iter()
+                .flatten()
+                .map(along)
+                .fold(f64::NEG_INFINITY, f64::max);
+            let (mut num, mut den) = (0.0, 0.0);
+            for (k, points) in self.support.iter().enumerate() {
+                if !stands[k] {
+                    continue;
+                }
+                let low = points.iter().map(|p| p[1]).fold(f64::INFINITY, f64::min);
+                for p in points {
+                    let along = along(p);
+                    let w = (-(p[1] - low) / 1e-3 + (along - top) / 5e-3).exp();
+                    num += w * along;
+                    den += w;
+                }
+            }
+            let extent = num / den;
+            (c[0] * u[0] + c[1] * u[1] - extent).max(0.0)
+        })
+    }
 }
 
 fn rot(axis: usize, a: f64) -> [[f64; 3]; 3] {
@@ -1605,6 +1736,9 @@ pub struct CycleForces {
     /// the residual torque on the pelvis: rms and peak (N·m)
     pub residual_rms: f64,
     pub residual_peak: f64,
+    /// the residual torque's rms about each world axis: fore–aft (roll), vertical (yaw),
+    /// lateral (pitch) (N·m)
+    pub residual_axes: [f64; 3],
     /// the fraction of the cycle the trajectory covers (1 unless the run stopped)
     pub covered: f64,
 }
@@ -1642,6 +1776,7 @@ impl CycleForces {
         let start = last_cycle_start(tr, period);
         let (mut grf, mut impulse, mut airborne, mut r2, mut rmax) =
             (Vec::new(), 0.0, 0.0, 0.0, 0.0f64);
+        let mut axes2 = [0.0; 3];
         let mut last: Option<(f64, f64)> = None;
         let mut model = model.clone();
         for i in (0..tr.len()).filter(|i| tr.t[*i] >= start - 1e-9) {
@@ -1661,6 +1796,9 @@ impl CycleForces {
                     airborne += dt;
                 }
                 r2 += r * r * dt;
+                for (a, m) in axes2.iter_mut().zip(torque) {
+                    *a += m * m * dt;
+                }
             }
             last = Some((tr.t[i], vertical));
             rmax = rmax.max(r);
@@ -1672,6 +1810,7 @@ impl CycleForces {
             airborne: airborne / t,
             residual_rms: (r2 / t).sqrt(),
             residual_peak: rmax,
+            residual_axes: axes2.map(|a| (a / t).sqrt()),
             covered: (t / period).min(1.0),
         }
     }

@@ -514,6 +514,48 @@ fn the_grounded_cycle_levels_the_feet_keeps_them_together_and_bounds_the_centre_
         g.pressure_beyond,
         raw.pressure_beyond
     );
+    // asked of the grounded cycle, the pass puts that centre of pressure within the feet
+    // and lowers the free moment, keeping the feet level and together and the speed
+    let clock = std::time::Instant::now();
+    let pressed = g
+        .reference
+        .grounded(
+            &model,
+            &Grounding {
+                pressure: [30.0, 10.0],
+                ..Default::default()
+            },
+        )
+        .unwrap();
+    println!(
+        "pressed ({} iterations, {:.1} s, angles corrected by up to {:.1}° more): centre of pressure beyond \
+         the standing feet {:.4?} m, free moment up to {:.0} N·m; {:.2} m/s, feet level within {:.1} mm, \
+         sliding apart at up to {:.2} m/s, clearance {:+.1} mm, accelerations {:.2?} g",
+        pressed.iterations,
+        clock.elapsed().as_secs_f64(),
+        pressed.largest_change.to_degrees(),
+        pressed.pressure_beyond,
+        pressed.free_moment,
+        pressed.speed,
+        1e3 * pressed.level,
+        pressed.slip,
+        1e3 * pressed.clearance,
+        pressed.acceleration
+    );
+    assert!(
+        pressed.pressure_beyond.iter().all(|b| *b < 0.005)
+            && pressed.free_moment < 0.5 * g.free_moment,
+        "{pressed:?}"
+    );
+    assert!(
+        pressed.level < 0.005 && pressed.clearance > -0.002 && pressed.slip < 0.05,
+        "{pressed:?}"
+    );
+    assert!(
+        (pressed.speed / raw.speed - 1.0).abs() < 0.15,
+        "{}",
+        pressed.speed
+    );
     // the corrected series are what the pass measured: the reference at an instant of
     // double support has its feet level
     let [right, left] = lowest_points(&model, &g.reference, 0.05 * 1.1);

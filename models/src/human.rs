@@ -496,7 +496,9 @@ impl GaitReference {
     /// - the walking speed (the standing contact's mean backward speed) stays near the
     ///   uncorrected reference's (a residual per 0.1 m/s, as light as the others);
     /// - the corrections stay small (a penalty, the hips' adduction and rotation twice as
-    ///   costly).
+    ///   costly);
+    /// - with [`Grounding::pressure`], the centre of pressure the motion needs lies within
+    ///   the standing feet's support and the free moment it needs is small.
     ///
     /// A foot's lowest point and its contact are its ellipsoids' support points blended by
     /// a soft minimum over 0.5 mm of height (the hard minimum jumps from ellipsoid to
@@ -706,13 +708,23 @@ pub struct Grounding {
     /// the weight of the corrections' coefficients (per radian) against the residuals
     /// (centimetres of level or clearance, tenths of g beyond the bound)
     pub penalty: f64,
+    /// the weights of what the cycle asks of the ground ([`Grounded::pressure_beyond`],
+    /// [`Grounded::free_moment`]): of the distance by which the centre of pressure its motion
+    /// needs lies beyond the standing feet, times the vertical force in body weights (per
+    /// metre), and of the free moment (per body weight × metre). Zero (the default) leaves
+    /// them out. Asked of a cycle already grounded (`grounded` again on its reference), so
+    /// that the pass starts near the answer: asked of the fitted cycle, whose centre of
+    /// pressure lies metres off, the corrections land in different places for weights a
+    /// factor of three apart
+    pub pressure: [f64; 2],
 }
 
 impl Default for Grounding {
     /// The normal cycle's events (right heel strike at 0, left toe-off at 13 %, left heel
     /// strike at 50 %, right toe-off at 63 %), 2 cm of clearance, ± 0.25 g fore–aft, ± 0.2 g
     /// vertically (the dynamics add a few hundredths to the peaks) and ± 0.1 g laterally,
-    /// five harmonics, 100 instants, 800 iterations at most, a penalty of 3.
+    /// five harmonics, 100 instants, 800 iterations at most, a penalty of 3, no weight on
+    /// the centre of pressure.
     fn default() -> Self {
         Grounding {
             double: [[0.0, 0.13], [0.5, 0.63]],
@@ -722,6 +734,7 @@ impl Default for Grounding {
             samples: 100,
             iterations: 800,
             penalty: 3.0,
+            pressure: [0.0; 2],
         }
     }
 }
@@ -982,6 +995,15 @@ impl Pass<'_> {
             .collect()
     }
 
+    /// The standing feet (right, left) at instant `s` of `n`.
+    fn stands(&self, s: usize, n: usize) -> [bool; 2] {
+        match self.phase(s as f64 / n as f64) {
+            Some((true, _)) => [true, false],
+            Some((false, _)) => [false, true],
+            None => [true, true],
+        }
+    }
+
     /// Whether `phase` is in double support; else whether the right foot stands, and the
     /// fraction of the swing.
     fn phase(&self, phase: f64) -> Option<(bool, f64)> {
@@ -1086,6 +1108,16 @@ impl Pass<'_> {
                 None => 0.0,
             };
             r.push(10.0 * pivot);
+            // the centre of pressure the motion needs within the standing feet, and a small
+            // free moment ([`Grounding::pressure`])
+            let [wp, wf] = self.how.pressure;
+            if wp != 0.0 || wf != 0.0 {
+                let (cop, free) = self.centre_of_pressure(&samples, &acc, s);
+                for v in sample.beyond(cop, self.stands(s, n)) {
+                    r.push(wp * (1.0 + acc[s][1]) * v);
+                }
+                r.push(wf * free / self.weight);
+            }
             for (a, bound) in acc[s].iter().zip(self.how.max_acceleration) {
                 r.push(10.0 * (a.abs() - bound).max(0.0));
             }
@@ -1138,11 +1170,7 @@ impl Pass<'_> {
         let (mut beyond, mut free) = ([0.0f64; 2], 0.0f64);
         for s in 0..n {
             let (cop, moment) = self.centre_of_pressure(samples, &acc, s);
-            let stands = match self.phase(s as f64 / n as f64) {
-                Some((true, _)) => [true, false],
-                Some((false, _)) => [false, true],
-                None => [true, true],
-            };
+            let stands = self.stands(s, n);
             if cop.iter().chain([&moment]).any(|v| v.is_nan()) {
                 return ([f64::NAN; 2], f64::NAN);
             }

@@ -884,3 +884,102 @@ fn a_run_read_in_a_re_centred_chart_is_post_processed_in_it() {
         assert!((c.angular_momentum[k] - d.angular_momentum[k]).abs() < 1e-12);
     }
 }
+
+/// What `GaitReference::grounded` asks of the ground, checked against the model's inverse
+/// dynamics: along the fitted cycle (the body lifted clear of the ground, the pelvis' translation
+/// still), the external force and moment about the pelvis' origin that produce the motion
+/// (τ = M q̈ − h on the pelvis' coordinates, q̈ by differences of the reference's rates) are
+/// those of the momentum, m (a_G + g ŷ) and Ḣ_G + (G − O) × F (`Centroid` differenced); and
+/// the centre of pressure `pressure_point` places has no horizontal moment about it.
+#[test]
+fn the_ground_wrench_a_cycle_needs_is_its_inverse_dynamics() {
+    let model = Human::default();
+    let info = model.info();
+    let reference = GaitReference::fit(&GaitTable::normal(), info, 1.1, FIT_HARMONICS)
+        .unwrap()
+        .symmetric(info)
+        .unwrap();
+    let n = Human::NQ;
+    let mass = total_mass(&model);
+    let weight = mass * G;
+    let state = |t: f64| {
+        let (mut q, qd) = reference_state(&model, &reference, t);
+        q[1] += 2.0;
+        (q, qd)
+    };
+    let cross = |u: [f64; 3], v: [f64; 3]| {
+        [
+            u[1] * v[2] - u[2] * v[1],
+            u[2] * v[0] - u[0] * v[2],
+            u[0] * v[1] - u[1] * v[0],
+        ]
+    };
+    let dt = 1e-4;
+    let (mut worst_force, mut worst_moment, mut worst_point) = (0.0f64, 0.0f64, 0.0f64);
+    for s in 0..20 {
+        let t = s as f64 * 1.1 / 20.0;
+        let (q, qd) = state(t);
+        let ((_, qd_m), (_, qd_p)) = (state(t - dt), state(t + dt));
+        let qdd: Vec<f64> = (0..n).map(|i| (qd_p[i] - qd_m[i]) / (2.0 * dt)).collect();
+        let mut tau = vec![0.0; n];
+        model.inverse_dynamics(t, &q, &qd, &qdd, &[], &mut tau);
+        // the pelvis' angles turn about a₁ = z, a₂ = Rz(a) y, a₃ = Rz(a) Ry(b) x
+        let (sa, ca) = q[3].sin_cos();
+        let (sb, cb) = q[4].sin_cos();
+        let axes = [[0.0, 0.0, 1.0], [-sa, ca, 0.0], [ca * cb, sa * cb, -sb]];
+        let a = mbs::DMatrix::from_fn(3, 3, |i, j| axes[i][j]);
+        let m_o = a
+            .lu()
+            .solve(&mbs::DMatrix::from_column_slice(3, 1, &tau[3..6]))
+            .unwrap();
+        let force = [tau[0], tau[1], tau[2]];
+        // the momentum's side
+        let centroid = |t: f64| {
+            let (q, qd) = state(t);
+            Centroid::of(&model, t, &q, &qd).unwrap()
+        };
+        let (cm, c0, cp) = (centroid(t - dt), centroid(t), centroid(t + dt));
+        let a_g: [f64; 3] = std::array::from_fn(|k| {
+            (cp.position[k] - 2.0 * c0.position[k] + cm.position[k]) / (dt * dt)
+        });
+        let hd: [f64; 3] =
+            std::array::from_fn(|k| (cp.angular_momentum[k] - cm.angular_momentum[k]) / (2.0 * dt));
+        let f_c: [f64; 3] = std::array::from_fn(|k| mass * (a_g[k] + if k == 1 { G } else { 0.0 }));
+        let arm: [f64; 3] = std::array::from_fn(|k| c0.position[k] - q[k]);
+        let moment = cross(arm, f_c);
+        for k in 0..3 {
+            worst_force = worst_force.max((force[k] - f_c[k]).abs() / weight);
+            worst_moment = worst_moment.max((m_o[k] - hd[k] - moment[k]).abs() / weight);
+        }
+        // the centre of pressure on a plane 0.9 m below the centre of mass, from the
+        // dynamics' force and moment about the centre of mass
+        let m_g: [f64; 3] = {
+            let back = cross(arm, force);
+            std::array::from_fn(|k| m_o[k] - back[k])
+        };
+        let ground = c0.position[1] - 0.9;
+        let (c, free) = pressure_point(force, m_g, c0.position, ground);
+        let about = cross(
+            [
+                c0.position[0] - c[0],
+                c0.position[1] - ground,
+                c0.position[2] - c[1],
+            ],
+            force,
+        );
+        let at_c: [f64; 3] = std::array::from_fn(|k| m_g[k] + about[k]);
+        worst_point = worst_point
+            .max(at_c[0].abs() / weight)
+            .max(at_c[2].abs() / weight)
+            .max((at_c[1] - free).abs() / weight);
+    }
+    println!(
+        "over the cycle, per body weight: force {worst_force:.1e}, moment about the pelvis {worst_moment:.1e} m, \
+         the centre of pressure's moment {worst_point:.1e} m"
+    );
+    assert!(
+        worst_force < 1e-5 && worst_moment < 1e-5,
+        "{worst_force} {worst_moment}"
+    );
+    assert!(worst_point < 1e-12, "{worst_point}");
+}

@@ -770,6 +770,26 @@ pub struct Grounded {
 
 const G: f64 = 9.80665;
 
+/// The centre of pressure (x, z) on the ground y = `ground` of a force `force` whose moment
+/// about the point `com` is `moment` (world axes, y up), and the free moment about the
+/// vertical it then needs there: the point c on the ground where (c − com) × F has the
+/// moment's horizontal components, and what is left of its vertical one. For a body's
+/// motion, F = m (a_G + g ŷ) and the moment about the centre of mass the rate of the
+/// angular momentum about it. NaN when the force has no vertical component.
+pub fn pressure_point(
+    force: [f64; 3],
+    moment: [f64; 3],
+    com: [f64; 3],
+    ground: f64,
+) -> ([f64; 2], f64) {
+    let (f, dy) = (force, ground - com[1]);
+    // (d × F)_x = dy Fz − dz Fy = Mx, (d × F)_z = dx Fy − dy Fx = Mz
+    let dz = (dy * f[2] - moment[0]) / f[1];
+    let dx = (moment[2] + dy * f[0]) / f[1];
+    let free = moment[1] - (dz * f[0] - dx * f[2]);
+    ([com[0] + dx, com[2] + dz], free)
+}
+
 /// The model's mass (the translation block of its mass matrix).
 pub fn total_mass(model: &Human) -> f64 {
     let n = Human::NQ;
@@ -1151,12 +1171,8 @@ impl Pass<'_> {
             (samples[q].angular_momentum[k] - samples[p].angular_momentum[k]) / (2.0 * dt)
         });
         let f = [0, 1, 2].map(|k| self.weight * (acc[s][k] + if k == 1 { 1.0 } else { 0.0 }));
-        let dy = -samples[s].height;
-        // (d × F)_x = dy Fz − dz Fy = Ḣx, (d × F)_z = dx Fy − dy Fx = Ḣz
-        let dz = (dy * f[2] - hd[0]) / f[1];
-        let dx = (hd[2] + dy * f[0]) / f[1];
-        let free = hd[1] - (dz * f[0] - dx * f[2]);
-        ([samples[s].com_x + dx, samples[s].com_z + dz], free)
+        let sample = &samples[s];
+        pressure_point(f, hd, [sample.com_x, sample.height, sample.com_z], 0.0)
     }
 
     /// The largest distances by which the centre of pressure the motion needs lies beyond

@@ -527,7 +527,7 @@ impl Walker {
 
     /// The central controller's corrections at time `t` from the base's x, y, ψ in `q`:
     /// velocity (base frame) and yaw rate added to the gait's, that bring the heading back to
-    /// its plan and (walking straight) the base back onto its line. ψ = q[3] is the base's
+    /// its plan and (walking straight) the base back onto its line. ψ = q\[3\] is the base's
     /// yaw while its chart is the start's; the runtime moves the chart (and q's angles) once
     /// the base has pitched past 60°, fallen. The sampled controller and the continuous PIDs
     /// then hand this the yaw read in the chart ([`Sampled`], [`Drive`]); the walk's figures
@@ -654,13 +654,13 @@ impl Sampled {
 }
 
 impl mbs::Controller for Sampled {
-    /// Reads the base's heading as q[3], its yaw in the start's chart.
+    /// Reads the base's heading as q\[3\], its yaw in the start's chart.
     fn sample(&mut self, t: f64, s: &mbs::State, u: &mut [f64]) {
         self.at(t, &s.q, &s.qd, u);
     }
 
     /// Reads the base's heading in its chart: once the base has pitched past 60° the runtime
-    /// has moved the chart, and q[3] is no longer its yaw.
+    /// has moved the chart, and q\[3\] is no longer its yaw.
     fn sample_in_charts(
         &mut self,
         t: f64,

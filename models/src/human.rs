@@ -2088,7 +2088,7 @@ const PASSIVE_STATES: [&str; 17] = [
 /// their states.
 #[derive(Clone, Debug)]
 pub struct PassiveJoints {
-    /// (coordinate of the model, its law), in [`TRACKED`]'s order
+    /// (coordinate of the model, its law), in `TRACKED`'s order
     pub joints: Vec<(usize, PassiveLaw)>,
     /// viscous damping d (N·m·s/rad) of every joint
     pub damping: f64,
@@ -2130,7 +2130,7 @@ impl PassiveJoints {
             .collect()
     }
 
-    /// The passive moment on joint `k` (in [`TRACKED`]'s order) at coordinate `q`, with
+    /// The passive moment on joint `k` (in `TRACKED`'s order) at coordinate `q`, with
     /// viscous state `v`.
     pub fn moment(&self, k: usize, q: f64, v: f64) -> f64 {
         self.joints[k].1.elastic(q) + v

@@ -19,9 +19,9 @@
 //! vertical and fore–aft ground reaction forces in body weights (first peak, trough, second
 //! peak, braking, propulsion, the fore–aft means over the stance's halves), the vertical
 //! impulse against weight × time, the fraction of the cycle with no foot on the ground, the
-//! residual torque (rms in all and about each world axis), the whole-body angular momentum about the centre of mass (normalised as
-//! Herr & Popovic 2008 do), the joint moments (the tracking torques) and the time the run
-//! takes.
+//! residual torque (rms in all and about each world axis), the whole-body angular momentum
+//! about the centre of mass (normalised as Herr & Popovic 2008 do), the joint moments (the
+//! tracking torques) and the time the run takes.
 //!
 //! **Mode 1 on muscles**: the same cycle with the 18 muscles taking the sagittal moments
 //! over (`muscle_cycle`: excitations from static optimisation with reserves at each instant

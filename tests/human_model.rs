@@ -427,6 +427,15 @@ fn a_knee_beyond_its_tables_or_a_foot_through_the_ground_is_a_typed_failure() {
 }
 
 /// The lowest support point of each foot at `t` on `reference` (pelvis at the model's start).
+/// OpenSim's normal cycle over `period`, fitted and made symmetric as mode 1 runs it.
+fn normal_cycle(model: &Human, period: f64) -> GaitReference {
+    let info = model.info();
+    GaitReference::fit(&GaitTable::normal(), info, period, FIT_HARMONICS)
+        .unwrap()
+        .symmetric(info)
+        .unwrap()
+}
+
 fn lowest_points(model: &Human, reference: &GaitReference, t: f64) -> [f64; 2] {
     let (q, qd) = reference_state(model, reference, t);
     let mut kin = Kinematics::new::<Human>();
@@ -443,11 +452,7 @@ fn lowest_points(model: &Human, reference: &GaitReference, t: f64) -> [f64; 2] {
 #[test]
 fn the_grounded_cycle_levels_the_feet_keeps_them_together_and_bounds_the_centre_of_mass() {
     let model = Human::default();
-    let info = model.info();
-    let fitted = GaitReference::fit(&GaitTable::normal(), info, 1.1, FIT_HARMONICS)
-        .unwrap()
-        .symmetric(info)
-        .unwrap();
+    let fitted = normal_cycle(&model, 1.1);
     // no iteration: the measures of the fitted cycle itself
     let raw = fitted
         .grounded(
@@ -573,10 +578,7 @@ fn the_prescribed_cycle_gives_a_normal_double_hump_braking_then_propulsion_also_
     model.set_params(params).unwrap();
     let info = model.info();
     let period = 1.1;
-    let fitted = GaitReference::fit(&GaitTable::normal(), info, period, FIT_HARMONICS)
-        .unwrap()
-        .symmetric(info)
-        .unwrap();
+    let fitted = normal_cycle(&model, period);
     let reference = fitted
         .grounded(&model, &Grounding::default())
         .unwrap()
@@ -729,10 +731,7 @@ fn in_flight_the_angular_momentum_about_the_centre_of_mass_is_conserved() {
     let model = Human::default();
     let info = model.info();
     let n = Human::NQ;
-    let reference = GaitReference::fit(&GaitTable::normal(), info, 1.1, FIT_HARMONICS)
-        .unwrap()
-        .symmetric(info)
-        .unwrap();
+    let reference = normal_cycle(&model, 1.1);
     let (mut q0, mut qd0) = reference_state(&model, &reference, 0.0);
     q0[1] = 10.0;
     qd0[0] = 1.2;
@@ -894,11 +893,7 @@ fn a_run_read_in_a_re_centred_chart_is_post_processed_in_it() {
 #[test]
 fn the_ground_wrench_a_cycle_needs_is_its_inverse_dynamics() {
     let model = Human::default();
-    let info = model.info();
-    let reference = GaitReference::fit(&GaitTable::normal(), info, 1.1, FIT_HARMONICS)
-        .unwrap()
-        .symmetric(info)
-        .unwrap();
+    let reference = normal_cycle(&model, 1.1);
     let n = Human::NQ;
     let mass = total_mass(&model);
     let weight = mass * G;

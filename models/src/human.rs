@@ -543,7 +543,7 @@ impl GaitReference {
         let nx = 5 * (2 * how.harmonics + 1);
         let mut kin = Kinematics::new::<Human>();
         let mut x = vec![0.0; nx];
-        pass.speed = pass.speed(&pass.samples(&x, &mut kin));
+        pass.speed = pass.speed(&pass.samples(&x, &mut kin, false));
         let cost = |r: &[f64]| r.iter().map(|v| v * v).sum::<f64>();
         let mut r = pass.residuals(&x, &mut kin);
         let mut mu = 1e-3;
@@ -632,7 +632,7 @@ impl GaitReference {
                 }
             }
         }
-        let samples = pass.samples(&x, &mut kin);
+        let samples = pass.samples(&x, &mut kin, true);
         let (level, clearance, acceleration, slip) = pass.measure(&samples);
         let (pressure_beyond, free_moment) = pass.pressure(&samples);
         let speed = pass.speed(&samples);
@@ -949,8 +949,10 @@ impl Pass<'_> {
         (v, rate)
     }
 
-    /// The corrected reference at each instant of the cycle.
-    fn samples(&self, x: &[f64], kin: &mut Kinematics) -> Vec<Sample> {
+    /// The corrected reference at each instant of the cycle; `with_momentum`, each sample's
+    /// angular momentum and centre of mass' z too (what the centre of pressure needs; NaN
+    /// without).
+    fn samples(&self, x: &[f64], kin: &mut Kinematics, with_momentum: bool) -> Vec<Sample> {
         let n = self.how.samples;
         let nq = Human::NQ;
         let (mut q, mut qd, mut m) = (vec![0.0; nq], vec![0.0; nq], vec![0.0; nq * nq]);
@@ -998,7 +1000,9 @@ impl Pass<'_> {
                 let com_x = q[0] + m[nq + 3] / mass;
                 // the angular momentum about the centre of mass and the centre's z (NaN at
                 // the pelvis' angles' singularity)
-                let centroid = Centroid::from_mass_matrix(self.model, &q, &qd, &m);
+                let centroid = with_momentum
+                    .then(|| Centroid::from_mass_matrix(self.model, &q, &qd, &m))
+                    .flatten();
                 Sample {
                     low,
                     height: com - low[0].min(low[1]),
@@ -1097,7 +1101,8 @@ impl Pass<'_> {
     }
 
     fn residuals(&self, x: &[f64], kin: &mut Kinematics) -> Vec<f64> {
-        let samples = self.samples(x, kin);
+        let [wp, wf] = self.how.pressure;
+        let samples = self.samples(x, kin, wp != 0.0 || wf != 0.0);
         let acc = self.accelerations(&samples);
         let n = samples.len();
         let mut r = Vec::with_capacity(7 * n + 1 + x.len());
@@ -1130,7 +1135,6 @@ impl Pass<'_> {
             r.push(10.0 * pivot);
             // the centre of pressure the motion needs within the standing feet, and a small
             // free moment ([`Grounding::pressure`])
-            let [wp, wf] = self.how.pressure;
             if wp != 0.0 || wf != 0.0 {
                 let (cop, free) = self.centre_of_pressure(&samples, &acc, s);
                 for v in sample.beyond(cop, self.stands(s, n)) {

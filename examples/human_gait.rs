@@ -14,7 +14,8 @@
 //! stiff joint spring–dampers (`--kp`, default 3·10⁴ N·m/rad), the pelvis' translation free
 //! on the contacts and its orientation held by residual torques (`--pelvis`, as OpenSim's
 //! residual reduction does; 0 leaves it free), the feet's Hunt–Crossley stiffness and
-//! dissipation `--stiffness`, `--dissipation` (default the model's stiffness and 10 s/m).
+//! dissipation `--stiffness`, `--dissipation` (default the model's stiffness and 10 s/m), the
+//! friction's slip speed `--eps` (default the model's, 0.01 m/s).
 //! The run lasts `--cycles` cycles (default 2) and the last one is reported: each foot's
 //! vertical and fore–aft ground reaction forces in body weights (first peak, trough, second
 //! peak, braking, propulsion, the fore–aft means over the stance's halves), the vertical
@@ -86,6 +87,7 @@ fn gait() -> Result<(), Box<dyn std::error::Error>> {
     let free = number("--free", 0.0, 0.0, 1e4)?;
     let dissipation = number("--dissipation", GAIT_DISSIPATION, 0.0, 1e3)?;
     let stiffness = number("--stiffness", Human::default().params().k_foot, 1.0, 1e12)?;
+    let eps = number("--eps", Human::default().params().eps_foot, 1e-6, 1.0)?;
     let muscle_rtol = number("--muscle-rtol", 1e-4, 1e-12, 0.1)?;
     let out = PathBuf::from(value("--out").map_or("target/human_gait", |s| s.as_str()));
     std::fs::create_dir_all(&out)?;
@@ -94,6 +96,7 @@ fn gait() -> Result<(), Box<dyn std::error::Error>> {
     let mut params = model.params().clone();
     params.d_foot = dissipation;
     params.k_foot = stiffness;
+    params.eps_foot = eps;
     model.set_params(params)?;
     let info = model.info();
     let mass = total_mass(&model);

@@ -13,7 +13,8 @@
 //! small free moment, `Grounding::pressure`, 30 and 10 a choice that works), tracked by
 //! stiff joint spring–dampers (`--kp`, default 3·10⁴ N·m/rad), the pelvis' translation free
 //! on the contacts and its orientation held by residual torques (`--pelvis`, as OpenSim's
-//! residual reduction does; 0 leaves it free), the feet's Hunt–Crossley stiffness and
+//! residual reduction does; 0 leaves it free; `--pelvis-axes a,b,c` their shares about the
+//! fore–aft, vertical and lateral axes, default 1,1,1), the feet's Hunt–Crossley stiffness and
 //! dissipation `--stiffness`, `--dissipation` (default the model's stiffness and 10 s/m), the
 //! friction's slip speed `--eps` (default the model's, 0.01 m/s).
 //! The run lasts `--cycles` cycles (default 2) and the last one is reported: each foot's
@@ -87,6 +88,21 @@ fn gait() -> Result<(), Box<dyn std::error::Error>> {
     let free = number("--free", 0.0, 0.0, 1e4)?;
     let dissipation = number("--dissipation", GAIT_DISSIPATION, 0.0, 1e3)?;
     let stiffness = number("--stiffness", Human::default().params().k_foot, 1.0, 1e12)?;
+    // the residual torques' shares about the three world axes, each in [0, 1]
+    let axes: [f64; 3] = match value("--pelvis-axes") {
+        None => [1.0; 3],
+        Some(v) => {
+            let bad = || format!("--pelvis-axes takes three numbers in [0, 1] as a,b,c, not `{v}`");
+            let parts = v
+                .split(',')
+                .map(|x| x.trim().parse::<f64>().map_err(|_| bad()))
+                .collect::<Result<Vec<f64>, String>>()?;
+            match parts[..] {
+                [a, b, c] if [a, b, c].iter().all(|x| (0.0..=1.0).contains(x)) => [a, b, c],
+                _ => return Err(bad().into()),
+            }
+        }
+    };
     let eps = number("--eps", Human::default().params().eps_foot, 1e-6, 1.0)?;
     let muscle_rtol = number("--muscle-rtol", 1e-4, 1e-12, 0.1)?;
     let out = PathBuf::from(value("--out").map_or("target/human_gait", |s| s.as_str()));
@@ -171,6 +187,7 @@ fn gait() -> Result<(), Box<dyn std::error::Error>> {
     let mut tracking = Tracking::new(reference.clone(), info, kp, kp / 100.0)?;
     tracking.pelvis_kp = pelvis_kp;
     tracking.pelvis_kd = pelvis_kp / 10.0;
+    tracking.pelvis_axes = axes;
     let options = Options {
         q0: Some(q0),
         qd0: Some(qd0),

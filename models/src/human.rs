@@ -1339,6 +1339,9 @@ pub struct Tracking {
     /// default) leaves the pelvis free
     pub pelvis_kp: f64,
     pub pelvis_kd: f64,
+    /// the residual torques' share about each world axis (fore–aft, vertical, lateral): 1
+    /// each by default, 0 leaves the pelvis free to turn about that axis
+    pub pelvis_axes: [f64; 3],
     pelvis: usize,
     pub guard: Guard,
 }
@@ -1361,6 +1364,7 @@ impl Tracking {
             toes: [dof_index(info, "mtp[0]")?, dof_index(info, "mtp[1]")?],
             pelvis_kp: 0.0,
             pelvis_kd: 0.0,
+            pelvis_axes: [1.0; 3],
             pelvis: info
                 .frame_index("pelvis_o")
                 .ok_or("the model has no frame `pelvis_o`")?,
@@ -1461,7 +1465,9 @@ impl Tracking {
             (d[1][0] - d[0][1]) / (4.0 * h),
         ];
         let w = k.angular_velocity;
-        std::array::from_fn(|i| self.pelvis_kp * theta[i] + self.pelvis_kd * (w_ref[i] - w[i]))
+        std::array::from_fn(|i| {
+            self.pelvis_axes[i] * (self.pelvis_kp * theta[i] + self.pelvis_kd * (w_ref[i] - w[i]))
+        })
     }
 }
 

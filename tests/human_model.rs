@@ -714,13 +714,19 @@ fn residual_torques_hold_the_pelvis_on_its_reference_orientation() {
     let free = run(tracking.clone());
     tracking.pelvis_kp = 3000.0;
     tracking.pelvis_kd = 300.0;
-    let held = run(tracking);
+    let held = run(tracking.clone());
+    // held about the fore–aft and vertical axes only, the pitch (about the lateral axis) is
+    // left free
+    tracking.pelvis_axes = [1.0, 1.0, 0.0];
+    let unpitched = run(tracking);
     println!(
-        "pelvis pitch error after 0.4 s in the air: free {free:+.4} rad, held {held:+.2e} rad"
+        "pelvis pitch error after 0.4 s in the air: free {free:+.4} rad, held {held:+.2e} rad, \
+         held about the other axes {unpitched:+.4} rad"
     );
     // free, the tilt stays (no torque acts on the whole body in the air); held, it decays
     assert!((free - 0.05).abs() < 0.01, "{free}");
     assert!(held.abs() < 0.1 * 0.05, "{held}");
+    assert!((unpitched - 0.05).abs() < 0.01, "{unpitched}");
 }
 
 /// In flight the ground pushes nowhere: under gravity and the tracking's internal torques

@@ -16,7 +16,13 @@
 //! residual reduction does; 0 leaves it free; `--pelvis-axes a,b,c` their shares about the
 //! fore–aft, vertical and lateral axes, default 1,1,1), the feet's Hunt–Crossley stiffness and
 //! dissipation `--stiffness`, `--dissipation` (default the model's stiffness and 10 s/m), the
-//! friction's slip speed `--eps` (default the model's, 0.01 m/s).
+//! friction's slip speed `--eps` (default the model's, 0.01 m/s). With `--balance` the
+//! pelvis' orientation is left to a balance controller (`Balance`, `Balanced`: an ankle
+//! strategy of gain `--ankle` and time `--ankle-time`, default 1 and 0.1 s, and a foot
+//! placement of gains `--place` and `--place-time`, default 2 and 0.3 s, filtered over
+//! `--filter`, default 0.1 s) where the residual torques' shares leave it free, and the
+//! program reports that run alone (`--pressure 30 --free 10 --pelvis-axes 0,1,0 --balance`:
+//! free to pitch and roll).
 //! The run lasts `--cycles` cycles (default 2) and the last one is reported: each foot's
 //! vertical and fore–aft ground reaction forces in body weights (first peak, trough, second
 //! peak, braking, propulsion, the fore–aft means over the stance's halves), the vertical
@@ -42,7 +48,7 @@
 //! ```
 
 use mbs::plot::{Chart, Series, line_chart};
-use mbs::{Kinematics, Model, Options, Output, Scheme, Trajectory, WithEfforts};
+use mbs::{Efforts, Kinematics, Model, Options, Output, Scheme, Trajectory, WithEfforts};
 use mbs_models::human::*;
 use std::path::PathBuf;
 
@@ -103,6 +109,16 @@ fn gait() -> Result<(), Box<dyn std::error::Error>> {
             }
         }
     };
+    let balance = args.iter().any(|a| a == "--balance");
+    let ankle = [
+        number("--ankle", 1.0, 0.0, 100.0)?,
+        number("--ankle-time", 0.1, 0.0, 10.0)?,
+    ];
+    let placement = [
+        number("--place", 2.0, 0.0, 100.0)?,
+        number("--place-time", 0.3, 0.0, 10.0)?,
+    ];
+    let filter = number("--filter", 0.1, 1e-3, 10.0)?;
     let eps = number("--eps", Human::default().params().eps_foot, 1e-6, 1.0)?;
     let muscle_rtol = number("--muscle-rtol", 1e-4, 1e-12, 0.1)?;
     let out = PathBuf::from(value("--out").map_or("target/human_gait", |s| s.as_str()));
@@ -188,6 +204,29 @@ fn gait() -> Result<(), Box<dyn std::error::Error>> {
     tracking.pelvis_kp = pelvis_kp;
     tracking.pelvis_kd = pelvis_kp / 10.0;
     tracking.pelvis_axes = axes;
+    if balance {
+        // the pelvis free to pitch and roll on the balance controller: report this run alone
+        tracking.balance = Some(Balance::new(&model, &reference, ankle, placement)?);
+        let balanced = Balanced::new(&model, tracking.clone(), filter)?;
+        let options = Options {
+            q0: Some([q0.clone(), vec![0.0; Balanced::NX]].concat()),
+            qd0: Some([qd0.clone(), vec![0.0; Balanced::NX]].concat()),
+            output: Output::Every { dt: 0.005 },
+            frames: true,
+            ..Options::adaptive(cycles * period, 1e-5)
+        };
+        let what = format!("{cycles} cycles balanced");
+        let tr = run(
+            WithEfforts::new(model.clone(), balanced),
+            options,
+            &what,
+            cycles,
+        );
+        print(&CycleForces::of(&model, &tracking, &tr, weight), mass);
+        tr.write_csv(std::fs::File::create(out.join("gait.csv"))?)?;
+        println!("CSV in {}", out.display());
+        return Ok(());
+    }
     let options = Options {
         q0: Some(q0),
         qd0: Some(qd0),

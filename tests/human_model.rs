@@ -26,7 +26,7 @@
 // the knots below are the sources' numbers (−1.0472 is a table value, not −π/3)
 #![allow(clippy::approx_constant)]
 
-use mbs::{Kinematics, Model, Options, Output, Scheme};
+use mbs::{Efforts, Kinematics, Model, Options, Output, Scheme};
 use mbs_models::human::*;
 
 const G: f64 = 9.80665;
@@ -565,6 +565,54 @@ fn the_grounded_cycle_levels_the_feet_keeps_them_together_and_bounds_the_centre_
     // double support has its feet level
     let [right, left] = lowest_points(&model, &g.reference, 0.05 * 1.1);
     assert!((right - left).abs() < 0.005, "{right} {left}");
+
+    // the pressed cycle walks two cycles with the pelvis free to pitch and roll on the
+    // balance controller, the residual torque about the vertical alone holding its turn
+    // (`human_gait -- --pressure 30 --free 10 --pelvis-axes 0,1,0 --balance`)
+    let mut walker = model.clone();
+    let mut params = walker.params().clone();
+    params.d_foot = GAIT_DISSIPATION;
+    walker.set_params(params).unwrap();
+    let info = walker.info();
+    let reference = pressed.reference;
+    let mut tracking = Tracking::new(reference.clone(), info, GAIT_KP, GAIT_KP / 100.0).unwrap();
+    tracking.pelvis_kp = GAIT_PELVIS_KP;
+    tracking.pelvis_kd = GAIT_PELVIS_KP / 10.0;
+    tracking.pelvis_axes = [0.0, 1.0, 0.0];
+    tracking.balance = Some(Balance::new(&walker, &reference, [1.0, 0.1], [2.0, 0.3]).unwrap());
+    let balanced = Balanced::new(&walker, tracking.clone(), 0.1).unwrap();
+    let (q0, qd0) = cycle_start(&walker, &reference);
+    let options = Options {
+        q0: Some([q0, vec![0.0; Balanced::NX]].concat()),
+        qd0: Some([qd0, vec![0.0; Balanced::NX]].concat()),
+        output: Output::Every { dt: 0.005 },
+        frames: true,
+        ..Options::adaptive(2.0 * 1.1, 1e-5)
+    };
+    let (tr, _) = mbs::simulate(
+        mbs::WithEfforts::new(walker.clone(), balanced),
+        Scheme::Radau5,
+        options,
+    )
+    .unwrap();
+    let weight = total_mass(&walker) * 9.80665;
+    let c = CycleForces::of(&walker, &tracking, &tr, weight);
+    let (right, left) = (c.figures(0), c.figures(1));
+    println!("balanced, pelvis free to pitch and roll: right {right:?}, left {left:?}");
+    let within = |x: Option<f64>, lo: f64, hi: f64| x.is_some_and(|v| v >= lo && v <= hi);
+    for f in [right, left] {
+        assert!(within(f.first_peak, 1.0, 1.35), "{f:?}");
+        assert!(within(f.second_peak, 1.0, 1.35), "{f:?}");
+        assert!(within(f.trough, 0.6, 0.9), "{f:?}");
+        assert!(within(f.braking, -0.3, -0.05), "{f:?}");
+        assert!(within(f.propulsion, 0.05, 0.4), "{f:?}");
+    }
+    assert!((c.impulse_ratio - 1.0).abs() < 0.05, "{}", c.impulse_ratio);
+    let axes = c.residual_axes;
+    assert!(
+        axes[0] == 0.0 && axes[2] == 0.0 && axes[1] > 0.0,
+        "{axes:?}"
+    );
 }
 
 /// Mode 1 as the gait program runs it: the grounded normal cycle tracked, the pelvis held by

@@ -830,20 +830,8 @@ impl Centroid {
     /// As [`Centroid::of`], `m` the mass matrix at q (row-major).
     fn from_mass_matrix(model: &Human, q: &[f64], qd: &[f64], m: &[f64]) -> Option<Centroid> {
         let nq = Human::NQ;
-        let mass = m[0];
         let row = |r: usize| (0..nq).map(|j| m[r * nq + j] * qd[j]).sum::<f64>();
-        let column = |j: usize| [0, 1, 2].map(|r| m[r * nq + j] / mass);
-        let c = model.chart(0);
-        let turn = |v: [f64; 3]| -> [f64; 3] {
-            std::array::from_fn(|i| (0..3).map(|k| c[i][k] * v[k]).sum())
-        };
-        let (sa, ca) = q[3].sin_cos();
-        let (sb, cb) = q[4].sin_cos();
-        let axes = [
-            turn([0.0, 0.0, 1.0]),
-            turn([-sa, ca, 0.0]),
-            turn([ca * cb, sa * cb, -sb]),
-        ];
+        let (axes, rel) = pelvis_axes_and_centre(model, q, m);
         let cross = |u: [f64; 3], v: [f64; 3]| {
             [
                 u[1] * v[2] - u[2] * v[1],
@@ -851,12 +839,6 @@ impl Centroid {
                 u[0] * v[1] - u[1] * v[0],
             ]
         };
-        let dot = |u: [f64; 3], v: [f64; 3]| (0..3).map(|i| u[i] * v[i]).sum::<f64>();
-        // r from a₁ × r and a₂ × r (a₁ ⊥ a₂): its part across a₁, (a₁ × r) × a₁, and its
-        // part along a₁, which lies across a₂
-        let across = cross(column(3), axes[0]);
-        let along = dot(cross(column(4), axes[1]), axes[0]);
-        let rel: [f64; 3] = std::array::from_fn(|i| across[i] + along * axes[0][i]);
         let a = mbs::DMatrix::from_fn(3, 3, |i, j| axes[i][j]);
         let h_o = a.lu().solve(&mbs::DMatrix::from_column_slice(
             3,
@@ -871,6 +853,54 @@ impl Centroid {
             angular_momentum: std::array::from_fn(|k| h_o[k] - rp[k]),
         })
     }
+}
+
+/// The world axes the pelvis' angles turn about, a₁ = C z, a₂ = C Rz(a) y,
+/// a₃ = C Rz(a) Ry(b) x (C the model's chart of the pelvis), and the centre of mass from the
+/// pelvis' origin, r, from the translation rows of the angles' columns of `m` (the mass
+/// matrix at q, row-major), which are m (aⱼ × r).
+fn pelvis_axes_and_centre(model: &Human, q: &[f64], m: &[f64]) -> ([[f64; 3]; 3], [f64; 3]) {
+    let nq = Human::NQ;
+    let mass = m[0];
+    let column = |j: usize| [0, 1, 2].map(|r| m[r * nq + j] / mass);
+    let c = model.chart(0);
+    let turn =
+        |v: [f64; 3]| -> [f64; 3] { std::array::from_fn(|i| (0..3).map(|k| c[i][k] * v[k]).sum()) };
+    let (sa, ca) = q[3].sin_cos();
+    let (sb, cb) = q[4].sin_cos();
+    let axes = [
+        turn([0.0, 0.0, 1.0]),
+        turn([-sa, ca, 0.0]),
+        turn([ca * cb, sa * cb, -sb]),
+    ];
+    let cross = |u: [f64; 3], v: [f64; 3]| {
+        [
+            u[1] * v[2] - u[2] * v[1],
+            u[2] * v[0] - u[0] * v[2],
+            u[0] * v[1] - u[1] * v[0],
+        ]
+    };
+    let dot = |u: [f64; 3], v: [f64; 3]| (0..3).map(|i| u[i] * v[i]).sum::<f64>();
+    // r from a₁ × r and a₂ × r (a₁ ⊥ a₂): its part across a₁, (a₁ × r) × a₁, and its
+    // part along a₁, which lies across a₂
+    let across = cross(column(3), axes[0]);
+    let along = dot(cross(column(4), axes[1]), axes[0]);
+    (
+        axes,
+        std::array::from_fn(|i| across[i] + along * axes[0][i]),
+    )
+}
+
+/// The centre of mass (world) and the linear momentum at (q, q̇), `m` the mass matrix at q
+/// (row-major), the pelvis' angles read in `model`'s chart; no allocation.
+pub fn mass_centre(model: &Human, q: &[f64], qd: &[f64], m: &[f64]) -> ([f64; 3], [f64; 3]) {
+    let nq = Human::NQ;
+    let row = |r: usize| (0..nq).map(|j| m[r * nq + j] * qd[j]).sum::<f64>();
+    let (_, rel) = pelvis_axes_and_centre(model, q, m);
+    (
+        std::array::from_fn(|k| q[k] + rel[k]),
+        [row(0), row(1), row(2)],
+    )
 }
 
 /// The whole-body angular momentum about the centre of mass over the last whole cycle of
@@ -1343,6 +1373,9 @@ pub struct Tracking {
     /// each by default, 0 leaves the pelvis free to turn about that axis
     pub pelvis_axes: [f64; 3],
     pelvis: usize,
+    /// a balance controller ([`Balance`]): its ankle strategy turns the standing feet's
+    /// references here, its foot placement needs [`Balanced`]; none by default
+    pub balance: Option<Balance>,
     pub guard: Guard,
 }
 
@@ -1368,6 +1401,7 @@ impl Tracking {
             pelvis: info
                 .frame_index("pelvis_o")
                 .ok_or("the model has no frame `pelvis_o`")?,
+            balance: None,
             guard: Guard::new(info)?,
         })
     }
@@ -1440,6 +1474,16 @@ impl Tracking {
         if self.pelvis_kp == 0.0 && self.pelvis_kd == 0.0 {
             return [0.0; 3];
         }
+        let (theta, dw) = self.pelvis_error(t, kin);
+        std::array::from_fn(|i| {
+            self.pelvis_axes[i] * (self.pelvis_kp * theta[i] + self.pelvis_kd * dw[i])
+        })
+    }
+
+    /// The pelvis' orientation error at `t`: θ, the small rotation from its orientation to
+    /// the reference's (½ vee(E − Eᵀ), E = R_ref Rᵀ), and ω_ref − ω (ω_ref by central
+    /// differences), world axes.
+    fn pelvis_error(&self, t: f64, kin: &Kinematics) -> ([f64; 3], [f64; 3]) {
         let k = &kin.frames[self.pelvis];
         let r = k.pose.rotation;
         let rr = self.reference.pelvis_rotation(t);
@@ -1465,9 +1509,7 @@ impl Tracking {
             (d[1][0] - d[0][1]) / (4.0 * h),
         ];
         let w = k.angular_velocity;
-        std::array::from_fn(|i| {
-            self.pelvis_axes[i] * (self.pelvis_kp * theta[i] + self.pelvis_kd * (w_ref[i] - w[i]))
-        })
+        (theta, std::array::from_fn(|i| w_ref[i] - w[i]))
     }
 }
 
@@ -1482,8 +1524,288 @@ impl Efforts for Tracking {
         if torque != [0.0; 3] {
             e.torque_on_frame(self.pelvis, torque);
         }
+        if let Some(b) = &self.balance {
+            for (joints, dq) in b.ankle_changes(self, e.t, e.kin) {
+                for (j, d) in joints.iter().zip(dq) {
+                    e.generalized_force(*j, self.kp * d);
+                }
+            }
+        }
         Ok(())
     }
+}
+
+/// Points per cycle of [`Balance`]'s table.
+const BALANCE_POINTS: usize = 400;
+
+/// A balance controller for the tracked cycle with the pelvis free to pitch and roll. It
+/// turns the joints' references in two ways:
+///
+/// - **ankle strategy** ([`Tracking::balance`]): the standing feet's ankle, subtalar and hip
+///   rotation references turn so that, the foot held, they would turn the pelvis by
+///   g (θ + τ (ω_ref − ω)) toward its reference orientation (θ its orientation error), each
+///   foot by its nearness to the ground (fully within 2 mm, not from 10 mm up);
+/// - **foot placement** ([`Balanced`], filtered): the swinging legs' hip flexion, adduction
+///   and knee references turn so that the foot moves, level, by c_d e + c_v ė horizontally
+///   (clamped to 0.1 m each way), as Hof's extrapolated centre of mass asks, e the centre of
+///   mass relative to the standing feet's soles less the reference cycle's at the same
+///   instant, each foot weighted by its nearness and stillness (none from 0.3 m/s).
+#[derive(Clone, Debug)]
+pub struct Balance {
+    /// g and τ (s) of the ankle strategy
+    pub ankle: [f64; 2],
+    /// c_d (m/m) and c_v (s) of the foot placement
+    pub placement: [f64; 2],
+    /// over the cycle, per foot: the centre of mass' position and velocity relative to the
+    /// foot's sole in the reference cycle (x and z of each)
+    table: Vec<[[f64; 4]; 2]>,
+    /// per leg: the calcaneus frame, the ankle, subtalar and hip rotation coordinates, the
+    /// hip flexion, adduction and knee coordinates
+    legs: [(usize, [usize; 3], [usize; 3]); 2],
+    feet: Feet,
+}
+
+impl Balance {
+    /// The controller for `reference` (its table of the centre of mass over the feet).
+    pub fn new(
+        model: &Human,
+        reference: &GaitReference,
+        ankle: [f64; 2],
+        placement: [f64; 2],
+    ) -> Result<Balance, String> {
+        let info = model.info();
+        let mut legs = [(0, [0; 3], [0; 3]); 2];
+        for (k, leg) in legs.iter_mut().enumerate() {
+            let dof = |n: &str| dof_index(info, &format!("{n}[{k}]"));
+            let calcn = format!("calcn_o[{k}]");
+            *leg = (
+                info.frame_index(&calcn)
+                    .ok_or(format!("the model has no frame `{calcn}`"))?,
+                [dof("ankle")?, dof("subtalar")?, dof("hip_rotation")?],
+                [dof("hip_flexion")?, dof("hip_adduction")?, dof("knee")?],
+            );
+        }
+        let feet = Feet::of(info);
+        let mut kin = Kinematics::new::<Human>();
+        let mut m = vec![0.0; Human::NQ * Human::NQ];
+        let mut table = Vec::with_capacity(BALANCE_POINTS);
+        for i in 0..BALANCE_POINTS {
+            let t = reference.period * i as f64 / BALANCE_POINTS as f64;
+            let (q, qd) = reference_state(model, reference, t);
+            model.kinematics(t, &q, &qd, &mut kin);
+            model.mass_matrix(t, &q, &mut m);
+            let (g, p) = mass_centre(model, &q, &qd, &m);
+            let v = p.map(|p| p / m[0]);
+            let soles = feet.soles(&kin);
+            table.push(soles.map(|(x, w)| [g[0] - x[0], g[2] - x[2], v[0] - w[0], v[2] - w[2]]));
+        }
+        Ok(Balance {
+            ankle,
+            placement,
+            table,
+            legs,
+            feet,
+        })
+    }
+
+    /// The reference's relative position and velocity over foot `k` at `t` (linear between
+    /// the table's points, periodic).
+    fn reference(&self, period: f64, k: usize, t: f64) -> [f64; 4] {
+        let n = self.table.len();
+        let x = (t / period).rem_euclid(1.0) * n as f64;
+        let i = (x.floor() as usize).min(n - 1);
+        let f = x - i as f64;
+        let (a, b) = (self.table[i][k], self.table[(i + 1) % n][k]);
+        std::array::from_fn(|j| a[j] + f * (b[j] - a[j]))
+    }
+
+    /// Each foot's nearness to the ground: 1 within 2 mm, 0 from 10 mm up.
+    fn nearness(&self, kin: &Kinematics) -> [f64; 2] {
+        self.feet.support_points(kin).map(|foot| {
+            let low = foot.iter().map(|(x, _)| x[1]).fold(f64::INFINITY, f64::min);
+            ((0.01 - low) / 0.008).clamp(0.0, 1.0)
+        })
+    }
+
+    /// The ankle strategy's changes of the standing legs' references at `t`, `kin`: per leg,
+    /// the ankle, subtalar and hip rotation coordinates and their changes (rad).
+    pub fn ankle_changes(
+        &self,
+        tracking: &Tracking,
+        t: f64,
+        kin: &Kinematics,
+    ) -> [([usize; 3], [f64; 3]); 2] {
+        let mut out = self.legs.map(|(_, j, _)| (j, [0.0; 3]));
+        let [g, tau] = self.ankle;
+        let near = self.nearness(kin);
+        let sum = (near[0] + near[1]).max(1.0);
+        if g == 0.0 {
+            return out;
+        }
+        let (theta, dw) = tracking.pelvis_error(t, kin);
+        let r: [f64; 3] = std::array::from_fn(|i| -g * (theta[i] + tau * dw[i]));
+        for (k, (frame, joints, _)) in self.legs.iter().enumerate() {
+            if near[k] == 0.0 {
+                continue;
+            }
+            // the pelvis turns relative to the foot by −Σ a_j Δq_j, a_j the foot's angular
+            // velocity per unit rate of joint j: solve A Δq = −r
+            let jw = &kin.frames[*frame].jw;
+            let a: [[f64; 3]; 3] =
+                std::array::from_fn(|i| std::array::from_fn(|c| jw[3 * joints[c] + i]));
+            if let Some(dq) = solve3(a, r) {
+                out[k].1 = dq.map(|d| d * near[k] / sum);
+            }
+        }
+        out
+    }
+
+    /// The foot placement's changes of the swinging legs' hip flexion, adduction and knee
+    /// references at `t`, `kin`, the centre of mass at `g` moving at `v` (world).
+    pub fn placement_changes(
+        &self,
+        period: f64,
+        t: f64,
+        kin: &Kinematics,
+        g: [f64; 3],
+        v: [f64; 3],
+    ) -> [[f64; 3]; 2] {
+        let mut out = [[0.0; 3]; 2];
+        let [cd, cv] = self.placement;
+        let near = self.nearness(kin);
+        let soles = self.feet.soles(kin);
+        // the standing feet: near the ground and still (a foot swinging past it does not
+        // count)
+        let stand: [f64; 2] = std::array::from_fn(|k| {
+            let w = soles[k].1;
+            near[k] * (1.0 - w[0].hypot(w[2]) / 0.3).clamp(0.0, 1.0)
+        });
+        let total = stand[0] + stand[1];
+        if total == 0.0 {
+            return out;
+        }
+        let mut e = [0.0; 2];
+        for k in 0..2 {
+            let (x, w) = soles[k];
+            let r = self.reference(period, k, t);
+            for (a, j) in [0, 2].into_iter().enumerate() {
+                let dx = g[j] - x[j] - r[a];
+                let dv = v[j] - w[j] - r[2 + a];
+                e[a] += stand[k] / total * (cd * dx + cv * dv);
+            }
+        }
+        let e = e.map(|x| x.clamp(-0.1, 0.1));
+        for (k, (frame, _, joints)) in self.legs.iter().enumerate() {
+            let swing = 1.0 - near[k];
+            if swing == 0.0 {
+                continue;
+            }
+            // the foot moves by J Δq (hip flexion, adduction and knee columns), level
+            let jv = &kin.frames[*frame].jv;
+            let a: [[f64; 3]; 3] =
+                std::array::from_fn(|i| std::array::from_fn(|c| jv[3 * joints[c] + i]));
+            if let Some(dq) = solve3(a, [e[0], 0.0, e[1]]) {
+                out[k] = dq.map(|d| swing * d);
+            }
+        }
+        out
+    }
+}
+
+/// [`Tracking`] (with its [`Balance`]'s ankle strategy, if any) and the balance's foot
+/// placement, its changes of the references filtered: six extra states x, the changes of the
+/// legs' hip flexion, adduction and knee references, ẋ = (target − x)/T. Unfiltered, the
+/// placement and the stiff tracking close a loop faster than the body moves (the swinging
+/// leg's reaction moves the centre of mass over the feet within milliseconds).
+#[derive(Clone, Debug)]
+pub struct Balanced {
+    pub tracking: Tracking,
+    /// T (s), > 0
+    pub filter: f64,
+    model: Human,
+    mass: f64,
+    m: Vec<f64>,
+}
+
+impl Balanced {
+    /// `tracking` with its `balance` set, the placement filtered over `filter` seconds.
+    pub fn new(model: &Human, tracking: Tracking, filter: f64) -> Result<Balanced, String> {
+        if tracking.balance.is_none() {
+            return Err("Balanced needs a tracking with its `balance` set".into());
+        }
+        if !(filter > 0.0 && filter.is_finite()) {
+            return Err(format!(
+                "the balance's filter time {filter} s must be positive and finite"
+            ));
+        }
+        Ok(Balanced {
+            tracking,
+            filter,
+            model: model.clone(),
+            mass: total_mass(model),
+            m: vec![0.0; Human::NQ * Human::NQ],
+        })
+    }
+}
+
+impl Efforts for Balanced {
+    const NX: usize = 6;
+    const STATE_NAMES: &'static [&'static str] = &[
+        "balance:hip_flexion[0]",
+        "balance:hip_adduction[0]",
+        "balance:knee[0]",
+        "balance:hip_flexion[1]",
+        "balance:hip_adduction[1]",
+        "balance:knee[1]",
+    ];
+
+    fn efforts(&mut self, e: &mut Effort) -> Result<(), String> {
+        self.tracking.efforts(e)?;
+        if let Some(b) = &self.tracking.balance {
+            for (k, (_, _, joints)) in b.legs.iter().enumerate() {
+                for (c, j) in joints.iter().enumerate() {
+                    e.generalized_force(*j, self.tracking.kp * e.x[3 * k + c]);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn state_derivatives(&mut self, e: &Effort, xd: &mut [f64]) -> Result<(), String> {
+        let Some(b) = &self.tracking.balance else {
+            xd.fill(0.0);
+            return Ok(());
+        };
+        self.model.set_chart(0, e.chart(0));
+        self.model.mass_matrix(e.t, e.q, &mut self.m);
+        let (g, p) = mass_centre(&self.model, e.q, e.qd, &self.m);
+        let v = p.map(|p| p / self.mass);
+        let target = b.placement_changes(self.tracking.reference.period, e.t, e.kin, g, v);
+        for (i, x) in xd.iter_mut().enumerate() {
+            *x = (target[i / 3][i % 3] - e.x[i]) / self.filter;
+        }
+        Ok(())
+    }
+}
+
+/// The solution of the 3 × 3 system a x = b by Cramer's rule, `None` where a is singular.
+fn solve3(a: [[f64; 3]; 3], b: [f64; 3]) -> Option<[f64; 3]> {
+    let det = |m: [[f64; 3]; 3]| {
+        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+    };
+    let d = det(a);
+    if d.abs() < 1e-12 {
+        return None;
+    }
+    Some(std::array::from_fn(|c| {
+        let mut m = a;
+        for (row, v) in m.iter_mut().zip(b) {
+            row[c] = v;
+        }
+        det(m) / d
+    }))
 }
 
 /// The contact ellipsoids of one foot, as in the model: point name and semi-axes.
@@ -1530,6 +1852,20 @@ impl Feet {
             point: std::array::from_fn(|k| std::array::from_fn(|e| index(k, e).0)),
             frame: std::array::from_fn(|k| std::array::from_fn(|e| index(k, e).1)),
         }
+    }
+
+    /// Per foot, the mean of its ellipsoids' support points: position and velocity.
+    pub fn soles(&self, kin: &Kinematics) -> [([f64; 3], [f64; 3]); 2] {
+        self.support_points(kin).map(|foot| {
+            let mut m = ([0.0; 3], [0.0; 3]);
+            for (x, v) in foot {
+                for j in 0..3 {
+                    m.0[j] += x[j] / 6.0;
+                    m.1[j] += v[j] / 6.0;
+                }
+            }
+            m
+        })
     }
 
     /// See [`support_points`].

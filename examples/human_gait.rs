@@ -19,7 +19,7 @@
 //! friction's slip speed `--eps` (default the model's, 0.01 m/s). With `--balance` the
 //! pelvis' orientation is left to a balance controller (`Balance`, `Balanced`: an ankle
 //! strategy of gain `--ankle` and time `--ankle-time`, default 1 and 0.1 s, and a foot
-//! placement of gains `--place` and `--place-time`, default 2 and 0.3 s, filtered over
+//! placement of gains `--place` and `--place-time`, default 1 and 0.5 s, filtered over
 //! `--filter`, default 0.1 s) where the residual torques' shares leave it free, and the
 //! program reports that run alone (`--pressure 30 --free 10 --pelvis-axes 0,1,0 --balance`:
 //! free to pitch and roll).
@@ -115,8 +115,8 @@ fn gait() -> Result<(), Box<dyn std::error::Error>> {
         number("--ankle-time", 0.1, 0.0, 10.0)?,
     ];
     let placement = [
-        number("--place", 2.0, 0.0, 100.0)?,
-        number("--place-time", 0.3, 0.0, 10.0)?,
+        number("--place", 1.0, 0.0, 100.0)?,
+        number("--place-time", 0.5, 0.0, 10.0)?,
     ];
     let filter = number("--filter", 0.1, 1e-3, 10.0)?;
     let eps = number("--eps", Human::default().params().eps_foot, 1e-6, 1.0)?;

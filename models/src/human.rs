@@ -1596,7 +1596,7 @@ impl Balance {
             model.mass_matrix(t, &q, &mut m);
             let (g, p) = mass_centre(model, &q, &qd, &m);
             let v = p.map(|p| p / m[0]);
-            let soles = feet.soles(&kin);
+            let soles = feet.support_points(&kin).map(sole);
             table.push(soles.map(|(x, w)| [g[0] - x[0], g[2] - x[2], v[0] - w[0], v[2] - w[2]]));
         }
         Ok(Balance {
@@ -1619,9 +1619,10 @@ impl Balance {
         std::array::from_fn(|j| a[j] + f * (b[j] - a[j]))
     }
 
-    /// Each foot's nearness to the ground: 1 within 2 mm, 0 from 10 mm up.
-    fn nearness(&self, kin: &Kinematics) -> [f64; 2] {
-        self.feet.support_points(kin).map(|foot| {
+    /// Each foot's nearness to the ground from its ellipsoids' support `points`: 1 within
+    /// 2 mm, 0 from 10 mm up.
+    fn nearness(points: &[[([f64; 3], [f64; 3]); 6]; 2]) -> [f64; 2] {
+        points.map(|foot| {
             let low = foot.iter().map(|(x, _)| x[1]).fold(f64::INFINITY, f64::min);
             ((0.01 - low) / 0.008).clamp(0.0, 1.0)
         })
@@ -1637,11 +1638,11 @@ impl Balance {
     ) -> [([usize; 3], [f64; 3]); 2] {
         let mut out = self.legs.map(|(_, j, _)| (j, [0.0; 3]));
         let [g, tau] = self.ankle;
-        let near = self.nearness(kin);
-        let sum = (near[0] + near[1]).max(1.0);
         if g == 0.0 {
             return out;
         }
+        let near = Balance::nearness(&self.feet.support_points(kin));
+        let sum = (near[0] + near[1]).max(1.0);
         let (theta, dw) = tracking.pelvis_error(t, kin);
         let r: [f64; 3] = std::array::from_fn(|i| -g * (theta[i] + tau * dw[i]));
         for (k, (frame, joints, _)) in self.legs.iter().enumerate() {
@@ -1672,8 +1673,9 @@ impl Balance {
     ) -> [[f64; 3]; 2] {
         let mut out = [[0.0; 3]; 2];
         let [cd, cv] = self.placement;
-        let near = self.nearness(kin);
-        let soles = self.feet.soles(kin);
+        let points = self.feet.support_points(kin);
+        let near = Balance::nearness(&points);
+        let soles = points.map(sole);
         // the standing feet: near the ground and still (a foot swinging past it does not
         // count)
         let stand: [f64; 2] = std::array::from_fn(|k| {
@@ -1723,7 +1725,7 @@ pub struct Balanced {
     /// T (s), > 0
     pub filter: f64,
     model: Human,
-    mass: f64,
+    /// the mass matrix' buffer (its first entry the body's mass)
     m: Vec<f64>,
 }
 
@@ -1742,7 +1744,6 @@ impl Balanced {
             tracking,
             filter,
             model: model.clone(),
-            mass: total_mass(model),
             m: vec![0.0; Human::NQ * Human::NQ],
         })
     }
@@ -1779,13 +1780,25 @@ impl Efforts for Balanced {
         self.model.set_chart(0, e.chart(0));
         self.model.mass_matrix(e.t, e.q, &mut self.m);
         let (g, p) = mass_centre(&self.model, e.q, e.qd, &self.m);
-        let v = p.map(|p| p / self.mass);
+        let v = p.map(|p| p / self.m[0]);
         let target = b.placement_changes(self.tracking.reference.period, e.t, e.kin, g, v);
         for (i, x) in xd.iter_mut().enumerate() {
             *x = (target[i / 3][i % 3] - e.x[i]) / self.filter;
         }
         Ok(())
     }
+}
+
+/// A foot's sole: the mean of its ellipsoids' support points, position and velocity.
+fn sole(foot: [([f64; 3], [f64; 3]); 6]) -> ([f64; 3], [f64; 3]) {
+    let mut m = ([0.0; 3], [0.0; 3]);
+    for (x, v) in foot {
+        for j in 0..3 {
+            m.0[j] += x[j] / 6.0;
+            m.1[j] += v[j] / 6.0;
+        }
+    }
+    m
 }
 
 /// The solution of the 3 × 3 system a x = b by Cramer's rule, `None` where a is singular.
@@ -1852,20 +1865,6 @@ impl Feet {
             point: std::array::from_fn(|k| std::array::from_fn(|e| index(k, e).0)),
             frame: std::array::from_fn(|k| std::array::from_fn(|e| index(k, e).1)),
         }
-    }
-
-    /// Per foot, the mean of its ellipsoids' support points: position and velocity.
-    pub fn soles(&self, kin: &Kinematics) -> [([f64; 3], [f64; 3]); 2] {
-        self.support_points(kin).map(|foot| {
-            let mut m = ([0.0; 3], [0.0; 3]);
-            for (x, v) in foot {
-                for j in 0..3 {
-                    m.0[j] += x[j] / 6.0;
-                    m.1[j] += v[j] / 6.0;
-                }
-            }
-            m
-        })
     }
 
     /// See [`support_points`].

@@ -361,6 +361,16 @@ fn print(c: &CycleForces, mass: f64) {
     println!(
         "        [normal gait: peaks 1.0–1.3, trough 0.6–0.9; braking in the first half, propulsion in the second]"
     );
+    let landing = |v: Option<[f64; 3]>| {
+        v.map_or("—".to_string(), |[x, y, z]| {
+            format!("{y:+.2} vertically, {x:+.2} fore–aft, {z:+.2} laterally")
+        })
+    };
+    println!(
+        "  the feet came down at (their lowest point's velocity before they touched, m/s): right {}; left {}",
+        landing(c.landing[0]),
+        landing(c.landing[1])
+    );
     println!(
         "  vertical impulse / (weight × time) = {:.3} [within 5 % of 1]; no foot on the ground during {:.0} % of the cycle",
         c.impulse_ratio,

@@ -616,6 +616,16 @@ fn the_grounded_cycle_levels_the_feet_keeps_them_together_and_bounds_the_centre_
          pitch {pitch:.3?}, roll {roll:.3?} rad; residual {:.1?} N·m",
         c.residual_axes
     );
+    // the feet land faster than the held cycle's (the test above): the placement's offsets
+    // still move when the heel touches
+    println!(
+        "landing velocities (fore–aft, vertical, lateral; m/s): {:.3?}",
+        c.landing
+    );
+    for v in c.landing {
+        let [x, y, z] = v.expect("each foot lands in the cycle");
+        assert!(y < -0.3 && x < -0.2 && z.abs() > 0.3, "{v:?}");
+    }
     let within = |x: Option<f64>, lo: f64, hi: f64| x.is_some_and(|v| v >= lo && v <= hi);
     for f in [right, left] {
         // a double hump, its first peak above the normal range
@@ -703,6 +713,19 @@ fn the_prescribed_cycle_gives_a_normal_double_hump_braking_then_propulsion_also_
         assert!(within(g.propulsion, 0.05, 0.4), "{g:?}");
         assert!(within(g.first_half, -0.3, -0.02), "{g:?}");
         assert!(within(g.second_half, 0.02, 0.3), "{g:?}");
+    }
+    // the heels come down gently, hardly sliding fore–aft, as in the reference (whose
+    // swinging foot still moves toward the midline at 0.12 m/s when it lands)
+    println!(
+        "landing velocities (fore–aft, vertical, lateral; m/s): {:.3?}",
+        c.landing
+    );
+    for v in c.landing {
+        let [x, y, z] = v.expect("each foot lands in the cycle");
+        assert!(
+            (-0.3..-0.05).contains(&y) && x.abs() < 0.1 && z.abs() < 0.2,
+            "{v:?}"
+        );
     }
     // residual torques below 2 N·m/kg rms
     assert!(

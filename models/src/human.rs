@@ -2130,6 +2130,12 @@ pub struct CycleForces {
     pub residual_axes: [f64; 3],
     /// the fraction of the cycle the trajectory covers (1 unless the run stopped)
     pub covered: f64,
+    /// per foot, how it came down at its heel strike: of its landings (its vertical force
+    /// rising through 2 % of weight) from 5 % of the cycle before its start, the nearest to
+    /// the foot's heel strike in the reference (0 % for the right, 50 % for the left), the
+    /// velocity of its lowest point at the last output instant before (fore–aft, vertical,
+    /// lateral; m/s); `None` where it did not land
+    pub landing: [Option<[f64; 3]>; 2],
 }
 
 /// One foot's figures over its own cycle (0 % at its heel strike), in body weights: the
@@ -2168,11 +2174,32 @@ impl CycleForces {
         let mut axes2 = [0.0; 3];
         let mut last: Option<(f64, f64)> = None;
         let mut model = model.clone();
-        for i in (0..tr.len()).filter(|i| tr.t[*i] >= start - 1e-9) {
+        // per foot: the landing nearest its heel strike so far, its distance (cycles)
+        let mut landing: [Option<(f64, [f64; 3])>; 2] = [None; 2];
+        // per foot: its vertical force and its lowest point's velocity at the instant before
+        let mut before: [Option<(f64, [f64; 3])>; 2] = [None; 2];
+        for i in (0..tr.len()).filter(|i| tr.t[*i] >= start - 0.05 * period - 1e-9) {
             let (q, qd) = (&tr.q(i)[..n], &tr.qd(i)[..n]);
             // the pelvis' angles in the chart the run read them in
             mbs::charts::use_charts_of(&mut model, tr, i);
             let f = ground_forces(&model, tr.t[i], q, qd, &mut kin);
+            for (k, points) in support_points(&model, &kin).iter().enumerate() {
+                let low = points.iter().min_by(|a, b| a.0[1].total_cmp(&b.0[1]));
+                let v = low.map_or([0.0; 3], |(_, v)| *v);
+                if let Some((fy, v0)) = before[k] {
+                    if fy < 0.02 * weight && f[k][1] >= 0.02 * weight {
+                        let u = ((tr.t[i] - start) / period - 0.5 * k as f64).rem_euclid(1.0);
+                        let d = u.min(1.0 - u);
+                        if landing[k].is_none_or(|(d0, _)| d < d0) {
+                            landing[k] = Some((d, v0));
+                        }
+                    }
+                }
+                before[k] = Some((f[k][1], v));
+            }
+            if tr.t[i] < start - 1e-9 {
+                continue;
+            }
             let torque = tracking.pelvis_torque(tr.t[i], &kin);
             let r = torque.iter().map(|x| x * x).sum::<f64>().sqrt();
             let bw = |v: [f64; 3]| v.map(|x| x / weight);
@@ -2201,6 +2228,7 @@ impl CycleForces {
             residual_peak: rmax,
             residual_axes: axes2.map(|a| (a / t).sqrt()),
             covered: (t / period).min(1.0),
+            landing: landing.map(|l| l.map(|(_, v)| v)),
         }
     }
 

@@ -44,6 +44,11 @@ fn relative(a: &mbs::Pose, b: &mbs::Pose) -> [f64; 3] {
 }
 
 /// Every joint held on `reference` by stiff spring–dampers (the toes' too), the pelvis free.
+/// Whether a figure was reached and lies in [lo, hi].
+fn within(x: Option<f64>, lo: f64, hi: f64) -> bool {
+    x.is_some_and(|v| v >= lo && v <= hi)
+}
+
 fn held(reference: GaitReference) -> Tracking {
     Tracking::new(reference, Human::default().info(), 3000.0, 30.0).unwrap()
 }
@@ -626,7 +631,6 @@ fn the_grounded_cycle_levels_the_feet_keeps_them_together_and_bounds_the_centre_
         let [x, y, z] = v.expect("each foot lands in the cycle");
         assert!(y < -0.3 && x < -0.2 && z.abs() > 0.3, "{v:?}");
     }
-    let within = |x: Option<f64>, lo: f64, hi: f64| x.is_some_and(|v| v >= lo && v <= hi);
     for f in [right, left] {
         // a double hump, its first peak above the normal range
         assert!(within(f.first_peak, 1.0, 1.8), "{f:?}");
@@ -703,7 +707,6 @@ fn the_prescribed_cycle_gives_a_normal_double_hump_braking_then_propulsion_also_
         "{parts} {}",
         c.residual_rms
     );
-    let within = |x: Option<f64>, lo: f64, hi: f64| x.is_some_and(|v| v >= lo && v <= hi);
     // each foot: the double hump in the normal ranges, braking then propulsion
     for g in [right, left] {
         assert!(within(g.first_peak, 1.0, 1.3), "{g:?}");

@@ -1651,10 +1651,7 @@ impl Balance {
             }
             // the pelvis turns relative to the foot by −Σ a_j Δq_j, a_j the foot's angular
             // velocity per unit rate of joint j: solve A Δq = −r
-            let jw = &kin.frames[*frame].jw;
-            let a: [[f64; 3]; 3] =
-                std::array::from_fn(|i| std::array::from_fn(|c| jw[3 * joints[c] + i]));
-            if let Some(dq) = solve3(a, r) {
+            if let Some(dq) = solve3(columns(&kin.frames[*frame].jw, joints), r) {
                 out[k].1 = dq.map(|d| d * near[k] / sum);
             }
         }
@@ -1703,9 +1700,7 @@ impl Balance {
                 continue;
             }
             // the foot moves by J Δq (hip flexion, adduction and knee columns), level
-            let jv = &kin.frames[*frame].jv;
-            let a: [[f64; 3]; 3] =
-                std::array::from_fn(|i| std::array::from_fn(|c| jv[3 * joints[c] + i]));
+            let a = columns(&kin.frames[*frame].jv, joints);
             if let Some(dq) = solve3(a, [e[0], 0.0, e[1]]) {
                 out[k] = dq.map(|d| swing * d);
             }
@@ -1787,6 +1782,12 @@ impl Efforts for Balanced {
         }
         Ok(())
     }
+}
+
+/// The 3 × 3 matrix of a frame's Jacobian `j` (3 × NQ, column-major) in the coordinates
+/// `joints`.
+fn columns(j: &[f64], joints: &[usize; 3]) -> [[f64; 3]; 3] {
+    std::array::from_fn(|i| std::array::from_fn(|c| j[3 * joints[c] + i]))
 }
 
 /// A foot's sole: the mean of its ellipsoids' support points, position and velocity.

@@ -32,8 +32,9 @@
 //! tracking torques) and the time the run takes.
 //!
 //! **Mode 1 on muscles**: the same cycle with the 18 muscles taking the sagittal moments
-//! over (`muscle_cycle`: excitations from static optimisation with reserves at each instant
-//! of the tracked cycle, fitted over it), the tracking left on as reserve actuators: the
+//! over (`muscle_cycle`: activations from static optimisation with reserves at each instant
+//! of the tracked cycle, fitted over it, and the excitations under which the activations
+//! follow that fit), the tracking left on as reserve actuators: the
 //! reserves' torques against the tracking's alone, the forces, and the time per cycle
 //! (Radau5 at `--muscle-rtol`, default 1e-4).
 //!

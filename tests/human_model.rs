@@ -18,8 +18,8 @@
 //!   within the bounds asked, at nearly the published walking speed;
 //! - the prescribed cycle (mode 1, as the gait program runs it) gives each foot a normal
 //!   double hump, braking then propulsion, and the weight's vertical impulse; on muscles
-//!   (the tracking as reserves) the reserves carry less than half the moments, the walk
-//!   unchanged;
+//!   (the tracking as reserves, the excitations made to lead the activations by their
+//!   dynamics) the reserves carry less than 40 % of the moments (rms), the walk unchanged;
 //! - residual torques hold the pelvis on its reference orientation;
 //! - in flight, the angular momentum about the centre of mass (`Centroid`) is conserved.
 
@@ -772,8 +772,10 @@ fn the_prescribed_cycle_gives_a_normal_double_hump_braking_then_propulsion_also_
         stats_m.steps,
         100.0 * share
     );
-    // the muscles take over more than half of the moments (rms), and the walk stays normal
-    assert!(reserves < 0.5 * alone, "{reserves} {alone}");
+    // the muscles take over more than 60 % of the moments (rms: 18.5 of 50.3 N·m left to
+    // the reserves; 22.0 when the excitations were the activations, their lag ignored), and
+    // the walk stays normal
+    assert!(reserves < 0.4 * alone, "{reserves} {alone}");
     assert!(
         within(g.first_peak, 1.0, 1.3) && within(g.second_peak, 1.0, 1.3),
         "{g:?}"

@@ -4,7 +4,8 @@
 //!   force and fibre length rate and the activation rate equal SymPy's
 //!   `physics.biomechanics` (values below, computed with SymPy 1.14's
 //!   `MusculotendonDeGroote2016.with_defaults(…, FIBER_LENGTH_EXPLICIT)` and
-//!   `FirstOrderActivationDeGroote2016.with_defaults`, v_max = 10 l_opt);
+//!   `FirstOrderActivationDeGroote2016.with_defaults`, v_max = 10 l_opt), and the
+//!   activation dynamics inverted (`excitation_for_rate`) gives back the rate asked;
 //! - the quadriceps' insertions on the patella follow OpenSim's moving points on the tibia;
 //! - the paths' ∂l/∂q from the generated point Jacobians equal central differences of the
 //!   length, and l̇ = ∂l/∂q · q̇;
@@ -49,6 +50,26 @@ fn curves_meet_their_anchor_points_and_sympy() {
             41.6650777412621
         ) < 1e-12
     );
+    // the activation dynamics inverted: the excitation found gives the rate asked, or the
+    // bound nearest it where none can
+    for a in [0.01, 0.2, 0.5, 0.9] {
+        for rate in [-10.0, -1.0, 0.0, 3.0, 40.0] {
+            let times = [0.015, 0.06];
+            let e = muscle::excitation_for_rate(a, rate, times);
+            let (least, most) = (
+                muscle::activation_rate(0.0, a, times),
+                muscle::activation_rate(1.0, a, times),
+            );
+            let asked = rate.clamp(least, most);
+            let made = muscle::activation_rate(e, a, times);
+            assert!(
+                (made - asked).abs() < 1e-9 * (1.0 + asked.abs()),
+                "{a} {rate}: {made}"
+            );
+        }
+    }
+    assert_eq!(muscle::excitation_for_rate(0.5, 1e3, [0.015, 0.06]), 1.0);
+    assert_eq!(muscle::excitation_for_rate(0.5, -1e3, [0.015, 0.06]), 0.0);
     let soleus = Musculotendon::new("soleus", 5137.0, 0.05, 0.25, 0.43633231);
     let vasti = Musculotendon::new("vasti", 5000.0, 0.087, 0.136, 0.05235988);
     for (unit, l, a, lm, force, rate) in [

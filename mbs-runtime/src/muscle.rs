@@ -10,6 +10,8 @@
 //!
 //! - activation: ȧ = (½ + a₀) / (τ_a (½ + 1.5a)) · (e − a) + (½ + 1.5a)(½ − a₀) / τ_d · (e − a),
 //!   a₀ = ½ tanh(b (e − a)), b = 10, e the excitation, by default τ_a = 15 ms, τ_d = 60 ms;
+//!   ȧ rises with e, so the excitation that makes a follow a given course is found at each
+//!   instant from a and ȧ ([`excitation_for_rate`]);
 //! - geometry at constant fibre thickness: l_M sin α = l_opt sin α_opt, so the tendon length
 //!   is l_T = l_MT − l_M cos α;
 //! - equilibrium of fibre and tendon (the fibre-length explicit form): the tendon force
@@ -103,6 +105,29 @@ pub fn activation_rate(e: f64, a: f64, [tau_a, tau_d]: [f64; 2]) -> f64 {
     ((0.5 + a0) / (tau_a * a1) + a1 * (0.5 - a0) / tau_d) * (e - a)
 }
 
+/// The excitation in [0, 1] under which activation `a` changes at `rate` (1/s): the
+/// activation dynamics of [`activation_rate`] inverted, as an excitation pattern that must
+/// make the activations follow a given course needs (ȧ rises with the excitation: found by
+/// bisection, to 1e-15). Where no excitation gives that rate, the nearest bound, 0 or 1.
+pub fn excitation_for_rate(a: f64, rate: f64, times: [f64; 2]) -> f64 {
+    let (mut low, mut high) = (0.0, 1.0);
+    if activation_rate(low, a, times) >= rate {
+        return low;
+    }
+    if activation_rate(high, a, times) <= rate {
+        return high;
+    }
+    while high - low > 1e-15 {
+        let mid = 0.5 * (low + high);
+        if activation_rate(mid, a, times) < rate {
+            low = mid;
+        } else {
+            high = mid;
+        }
+    }
+    0.5 * (low + high)
+}
+
 /// What a musculotendon unit cannot do.
 #[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]
@@ -184,6 +209,11 @@ impl Musculotendon {
     /// ȧ at excitation `e` and activation `a`.
     pub fn activation_rate(&self, e: f64, a: f64) -> f64 {
         activation_rate(e, a, self.activation_times)
+    }
+
+    /// The excitation under which activation `a` changes at `rate` ([`excitation_for_rate`]).
+    pub fn excitation_for_rate(&self, a: f64, rate: f64) -> f64 {
+        excitation_for_rate(a, rate, self.activation_times)
     }
 
     fn thickness(&self) -> f64 {

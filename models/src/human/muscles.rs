@@ -114,6 +114,9 @@ pub struct Muscles {
     /// each unit's excitation over time (clamped to [`MIN_ACTIVATION`], 1]); empty: the
     /// constant `excitation`
     pub pattern: Vec<Fourier>,
+    /// each unit's activation over time that `pattern` produces (clamped alike), for a
+    /// run's start; empty: the excitation's
+    pub activation_pattern: Vec<Fourier>,
 }
 
 impl Muscles {
@@ -146,7 +149,17 @@ impl Muscles {
             units,
             excitation: vec![0.0; NM],
             pattern: Vec::new(),
+            activation_pattern: Vec::new(),
         })
+    }
+
+    /// Unit `i`'s activation at `t` on its excitation's pattern: `activation_pattern`'s
+    /// where there is one, else the excitation (at rest on a constant one).
+    pub fn activation_at(&self, i: usize, t: f64) -> f64 {
+        match self.activation_pattern.get(i) {
+            Some(f) => f.eval(t)[0].clamp(MIN_ACTIVATION, 1.0),
+            None => self.excitation_at(i, t),
+        }
     }
 
     /// Unit `i`'s excitation at `t`.
@@ -421,14 +434,15 @@ pub struct MuscleDriven {
 
 impl MuscleDriven {
     /// The extra states of a start at `t`, the kinematics `kin` and velocities `qd`:
-    /// relaxed passive moments, activations equal to the excitations and fibres at rest.
+    /// relaxed passive moments, activations as [`Muscles::activation_at`] gives them (equal
+    /// to the excitations unless an activation pattern is set) and fibres at rest.
     pub fn initial_states(&self, t: f64, kin: &Kinematics, qd: &[f64]) -> Result<Vec<f64>, String> {
         let mut x = self.passive.relaxed(qd);
-        let e: Vec<f64> = (0..NM).map(|i| self.muscles.excitation_at(i, t)).collect();
-        x.extend_from_slice(&e);
+        let a: Vec<f64> = (0..NM).map(|i| self.muscles.activation_at(i, t)).collect();
+        x.extend_from_slice(&a);
         let fibres = self
             .muscles
-            .equilibrium(kin, &e)
+            .equilibrium(kin, &a)
             .map_err(|e| e.to_string())?;
         x.extend(fibres);
         Ok(x)
@@ -662,9 +676,11 @@ impl MuscleCycle {
 /// `tr`, a run of `tracking` on `model` sampled uniformly (`Output::Every`): at each output
 /// instant the tracking torques at [`MUSCLE_JOINTS`] less the passive elastic moments,
 /// asked of the muscles by [`Muscles::excitations_with_reserves`] with `baseline` and
-/// reserves costing as much per [`RESERVE`] as a full activation (the fibres at rest: the
-/// speed of lengthening and the activation's lag are left to the reserves); each
-/// unit's activations over the cycle fitted with `harmonics` harmonics, its excitation.
+/// reserves costing as much per [`RESERVE`] as a full activation (the fibres at rest: their
+/// speed of lengthening is left to the reserves); each unit's activations over the cycle
+/// fitted with `harmonics` harmonics, and its excitation the one under which its activation
+/// follows that series (the activation dynamics inverted at each instant,
+/// [`mbs::muscle::excitation_for_rate`], fitted alike; the activations start on the series).
 /// The tracking stays on every joint.
 pub fn muscle_cycle(
     model: &Human,
@@ -716,14 +732,31 @@ pub fn muscle_cycle(
         activations.push(a);
         shares.push(share);
     }
-    driven.muscles.pattern = (0..NM)
+    // the samples begin at `start`, a whole number of periods: the series are in the run's
+    // time as they are
+    let fitted: Vec<Fourier> = (0..NM)
         .map(|m| {
             let column: Vec<f64> = activations.iter().map(|a| a[m]).collect();
-            // the samples begin at `start`, a whole number of periods: the series is in
-            // the run's time as it is
             Fourier::fit(&column, harmonics, period)
         })
         .collect();
+    // the excitations that make the activations follow those series: the activation
+    // dynamics inverted at each instant, fitted alike
+    driven.muscles.pattern = fitted
+        .iter()
+        .zip(&driven.muscles.units)
+        .map(|(f, (unit, _))| {
+            let column: Vec<f64> = instants
+                .iter()
+                .map(|&s| {
+                    let [a, rate, _] = f.eval(tr.t[s]);
+                    unit.excitation_for_rate(a.clamp(MIN_ACTIVATION, 1.0), rate)
+                })
+                .collect();
+            Fourier::fit(&column, harmonics, period)
+        })
+        .collect();
+    driven.muscles.activation_pattern = fitted;
     driven.passive.tracking = Some(tracking.clone());
     Ok(MuscleCycle {
         driven,

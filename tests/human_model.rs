@@ -43,12 +43,12 @@ fn relative(a: &mbs::Pose, b: &mbs::Pose) -> [f64; 3] {
     [0, 1, 2].map(|j| (0..3).map(|i| a.rotation[i][j] * d[i]).sum())
 }
 
-/// Every joint held on `reference` by stiff spring–dampers (the toes' too), the pelvis free.
 /// Whether a figure was reached and lies in [lo, hi].
 fn within(x: Option<f64>, lo: f64, hi: f64) -> bool {
     x.is_some_and(|v| v >= lo && v <= hi)
 }
 
+/// Every joint held on `reference` by stiff spring–dampers (the toes' too), the pelvis free.
 fn held(reference: GaitReference) -> Tracking {
     Tracking::new(reference, Human::default().info(), 3000.0, 30.0).unwrap()
 }

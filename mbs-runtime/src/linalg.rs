@@ -108,6 +108,18 @@ pub trait Field:
 {
     fn abs(self) -> f64;
     fn from_f64(x: f64) -> Self;
+    /// A size ordered as [`Field::abs`] is, cheaper to compute: the pivots' search compares
+    /// these (a complex number's squared modulus, where its modulus takes a `hypot`).
+    fn pivot_size(self) -> f64 {
+        self.abs()
+    }
+    /// |re| + |im| for a complex number, within a factor √2 of its modulus: the matrix norm
+    /// the singular-pivot threshold is measured against.
+    fn norm1(self) -> f64 {
+        self.abs()
+    }
+    /// Whether the number is exactly zero.
+    fn is_zero(self) -> bool;
 }
 
 impl Field for f64 {
@@ -116,6 +128,9 @@ impl Field for f64 {
     }
     fn from_f64(x: f64) -> Self {
         x
+    }
+    fn is_zero(self) -> bool {
+        self == 0.0
     }
 }
 
@@ -181,6 +196,15 @@ impl Field for C64 {
     fn from_f64(x: f64) -> Self {
         C64::new(x, 0.0)
     }
+    fn pivot_size(self) -> f64 {
+        self.re * self.re + self.im * self.im
+    }
+    fn norm1(self) -> f64 {
+        self.re.abs() + self.im.abs()
+    }
+    fn is_zero(self) -> bool {
+        self.re == 0.0 && self.im == 0.0
+    }
 }
 
 /// An LU factorisation with partial pivoting, P A = L U, kept in its own buffers.
@@ -217,18 +241,19 @@ impl<T: Field> Lu<T> {
         let n = self.n;
         let a = &mut self.lu;
         let anorm = (0..n)
-            .map(|j| a[j * n..(j + 1) * n].iter().map(|x| x.abs()).sum::<f64>())
+            .map(|j| a[j * n..(j + 1) * n].iter().map(|x| x.norm1()).sum::<f64>())
             .fold(0.0, f64::max);
         for k in 0..n {
-            let (mut p, mut best) = (k, a[k + n * k].abs());
+            let (mut p, mut size) = (k, a[k + n * k].pivot_size());
             for i in k + 1..n {
-                let v = a[i + n * k].abs();
-                if v > best {
-                    best = v;
+                let v = a[i + n * k].pivot_size();
+                if v > size {
+                    size = v;
                     p = i;
                 }
             }
             self.piv[k] = p;
+            let best = a[p + n * k].abs();
             if !(best > f64::EPSILON * anorm * n as f64) || !best.is_finite() {
                 let rcond = if anorm > 0.0 { best / anorm } else { 0.0 };
                 return Err(Singular { column: k, rcond });
@@ -244,7 +269,7 @@ impl<T: Field> Lu<T> {
             }
             for j in k + 1..n {
                 let akj = a[k + n * j];
-                if akj.abs() == 0.0 {
+                if akj.is_zero() {
                     continue;
                 }
                 for i in k + 1..n {

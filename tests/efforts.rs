@@ -157,6 +157,134 @@ fn tangents_of_the_hooked_model_match_differences() {
     assert!(worst < 1e-6);
 }
 
+/// The four buffers of three numbers the differences use.
+fn buffers(w: &mut [[f64; 3]; 4]) -> mbs::DifferenceBuffers<'_> {
+    let [tau0, tau1, qp, vp] = w;
+    mbs::DifferenceBuffers { tau0, tau1, qp, vp }
+}
+
+/// The push at the tip through a first-order lag, ẋ = (push·cos t − x)/T, and the damper
+/// between the bars: efforts that read q, qd and an extra state.
+struct Lagged(Extra);
+
+impl Efforts for Lagged {
+    const NX: usize = 1;
+    const STATE_NAMES: &'static [&'static str] = &["push"];
+    fn efforts(&mut self, e: &mut Effort) -> Result<(), String> {
+        let Extra {
+            bar1, bar2, tip, c, ..
+        } = self.0;
+        let tau = -c * e.qd[1] * e.q[0].cos();
+        e.torque_on_frame(bar2, [0.0, 0.0, tau]);
+        e.torque_on_frame(bar1, [0.0, 0.0, -tau]);
+        e.force_at_point(tip, [e.x[0], 0.0, 0.0]);
+        Ok(())
+    }
+    fn state_derivatives(&mut self, e: &Effort, xd: &mut [f64]) -> Result<(), String> {
+        xd[0] = (self.0.push * e.t.cos() - e.x[0] * (1.0 + e.q[1] * e.q[1])) / 0.2;
+        Ok(())
+    }
+}
+
+/// With extra states, the wrapper's differenced tangents are the default's differences of
+/// its τ to the bit, with fewer evaluations: none for the states' integrals (nothing reads
+/// them) and the user part alone for the states; its tangents (the wrapped model's exact
+/// ones, the user part differenced) match central differences.
+#[test]
+fn the_wrappers_differences_skip_what_no_state_reads() {
+    let bare = DpBare::default();
+    let extra = Lagged(Extra::new(bare.info()));
+    let m = WithEfforts::new(bare, extra);
+    let (q, qd, qdd) = ([0.3, -0.8, 0.0], [1.1, -0.6, 0.4], [0.2, 0.5, -0.3]);
+    let mut work = [[0.0; 3]; 4];
+    let (mut k0, mut c0, mut k1, mut c1) = ([0.0; 9], [0.0; 9], [0.0; 9], [0.0; 9]);
+    let before = m.user_evaluations();
+    let all = mbs::differenced_tangents(
+        &m,
+        0.7,
+        &q,
+        &qd,
+        &qdd,
+        &[],
+        &mut k0,
+        &mut c0,
+        buffers(&mut work),
+    );
+    let middle = m.user_evaluations();
+    let wrapped = m.differenced_tangents(
+        0.7,
+        &q,
+        &qd,
+        &qdd,
+        &[],
+        &mut k1,
+        &mut c1,
+        buffers(&mut work),
+    );
+    let after = m.user_evaluations();
+    let bits = |x: &[f64; 9]| x.map(f64::to_bits);
+    assert_eq!(bits(&k0), bits(&k1));
+    assert_eq!(bits(&c0), bits(&c1));
+    // 2·3 + 1 evaluations of τ and of the user part; 2·2 + 1 of the wrapped model and
+    // 2·2 + 1 + 1 of the user part
+    assert_eq!((all, middle - before), (7, 7));
+    assert_eq!((wrapped, after - middle), (5, 6));
+    // the extra state drives the tip and its own rate, and its integral nothing
+    assert!(c1[2 * 3] != 0.0 && c1[2 * 3 + 2] != 0.0 && k1[6..] == [0.0; 3]);
+    // the iteration matrix M + γ'C + β'K alike: 3 + 1 evaluations of τ and of the user part
+    // by default; 2 + 1 of the wrapped model's and 3 + 1 of the user part's
+    let (mut a0, mut a1, mut ap) = ([0.0; 9], [0.0; 9], [0.0; 3]);
+    let w = [0.25 * 0.01, 0.5 * 0.1];
+    let all = mbs::differenced_iteration_matrix(
+        &m,
+        0.7,
+        [&q, &qd, &qdd],
+        &[],
+        w,
+        &mut a0,
+        buffers(&mut work),
+        &mut ap,
+    );
+    let middle = m.user_evaluations();
+    let wrapped = m.differenced_iteration_matrix(
+        0.7,
+        [&q, &qd, &qdd],
+        &[],
+        w,
+        &mut a1,
+        buffers(&mut work),
+        &mut ap,
+    );
+    let last = m.user_evaluations();
+    assert_eq!(a0.map(f64::to_bits), a1.map(f64::to_bits));
+    assert_eq!((all, middle - after), (4, 4));
+    assert_eq!((wrapped, last - middle), (3, 4));
+
+    let (mut k, mut c) = ([0.0; 9], [0.0; 9]);
+    m.tangents(0.7, &q, &qd, &qdd, &[], &mut k, &mut c).unwrap();
+    let eps = 1e-6;
+    let mut worst = 0.0f64;
+    for j in 0..3 {
+        for (which, exact) in [(0, &k), (1, &c)] {
+            let (mut a, mut b) = ((q, qd), (q, qd));
+            if which == 0 {
+                a.0[j] += eps;
+                b.0[j] -= eps;
+            } else {
+                a.1[j] += eps;
+                b.1[j] -= eps;
+            }
+            let (ta, tb) = (tau(&m, &a.0, &a.1, &qdd), tau(&m, &b.0, &b.1, &qdd));
+            for i in 0..3 {
+                let cd = (ta[i] - tb[i]) / (2.0 * eps);
+                worst = worst.max((exact[i + 3 * j] - cd).abs());
+            }
+        }
+    }
+    println!("tangents with an extra state vs central differences: {worst:.1e}");
+    assert!(worst < 1e-6);
+}
+
 /// A unit mass pushed by a force x that decays by ẋ = −x/T: y(t) = x₀T²(e^(−t/T) − 1 + t/T).
 struct Decaying {
     body: usize,

@@ -42,8 +42,9 @@ pub use integrators::{
 };
 pub use lanes::{F64x4, LANES};
 pub use model::{
-    ConstraintTangents, Energy, FrameKinematics, IDENTITY3, Kinematics, Model, ModelInfo, OpCount,
-    OpsTable, Parameters, PointKinematics, Pose, RotationJoint, ShapeInfo, ShapeKind,
+    ConstraintTangents, DifferenceBuffers, Energy, FrameKinematics, IDENTITY3, Kinematics, Model,
+    ModelInfo, OpCount, OpsTable, Parameters, PointKinematics, Pose, RotationJoint, ShapeInfo,
+    ShapeKind, differenced_iteration_matrix, differenced_tangents,
 };
 /// The matrices of [`Linearization`] (nalgebra's), named without a dependency of one's own.
 pub use nalgebra::DMatrix;

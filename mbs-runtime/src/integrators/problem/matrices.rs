@@ -5,7 +5,7 @@ use super::super::at::{At, Weights};
 use super::Problem;
 use crate::error::Failure;
 use crate::linalg::Lu;
-use crate::model::Model;
+use crate::model::{DifferenceBuffers, Model};
 use crate::options::IterationMatrix;
 
 impl<M: Model> Problem<M> {
@@ -66,33 +66,21 @@ impl<M: Model> Problem<M> {
                 a.copy_from_slice(&self.m);
             }
             IterationMatrix::FiniteDifferences => {
-                self.model
-                    .inverse_dynamics(t, q, qd, qdd, &self.u, &mut self.tau0);
-                self.stats.inverse_dynamics += 1;
-                self.qp.copy_from_slice(q);
-                self.vp.copy_from_slice(qd);
-                self.ap.copy_from_slice(qdd);
-                for j in 0..n {
-                    let eps = f64::EPSILON.sqrt() * qdd[j].abs().max(1.0);
-                    self.qp[j] += beta * eps;
-                    self.vp[j] += gamma * eps;
-                    self.ap[j] += eps;
-                    self.model.inverse_dynamics(
-                        t,
-                        &self.qp,
-                        &self.vp,
-                        &self.ap,
-                        &self.u,
-                        &mut self.tau1,
-                    );
-                    self.stats.inverse_dynamics += 1;
-                    self.qp[j] = q[j];
-                    self.vp[j] = qd[j];
-                    self.ap[j] = qdd[j];
-                    for i in 0..n {
-                        a[i + n * j] = (self.tau1[i] - self.tau0[i]) / eps;
-                    }
-                }
+                let work = DifferenceBuffers {
+                    tau0: &mut self.tau0,
+                    tau1: &mut self.tau1,
+                    qp: &mut self.qp,
+                    vp: &mut self.vp,
+                };
+                self.stats.inverse_dynamics += self.model.differenced_iteration_matrix(
+                    t,
+                    [q, qd, qdd],
+                    &self.u,
+                    [beta, gamma],
+                    a,
+                    work,
+                    &mut self.ap,
+                );
             }
         }
         if let Some(f) = self.model.take_failure() {
@@ -135,7 +123,6 @@ impl<M: Model> Problem<M> {
         if self.ode() {
             return self.ode_tangent_matrices(at, m, c, k);
         }
-        let n = self.n;
         self.model.mass_matrix(t, q, m);
         self.stats.mass_matrix += 1;
         match self.iteration {
@@ -154,31 +141,15 @@ impl<M: Model> Problem<M> {
                 k.fill(0.0);
             }
             IterationMatrix::FiniteDifferences => {
-                self.model
-                    .inverse_dynamics(t, q, qd, qdd, &self.u, &mut self.tau0);
-                self.stats.inverse_dynamics += 1;
-                self.qp.copy_from_slice(q);
-                self.vp.copy_from_slice(qd);
-                for j in 0..n {
-                    // the increment actually represented in floating point
-                    let eps = (q[j] + f64::EPSILON.sqrt() * q[j].abs().max(1.0)) - q[j];
-                    self.qp[j] = q[j] + eps;
-                    self.model
-                        .inverse_dynamics(t, &self.qp, qd, qdd, &self.u, &mut self.tau1);
-                    self.qp[j] = q[j];
-                    for i in 0..n {
-                        k[i + n * j] = (self.tau1[i] - self.tau0[i]) / eps;
-                    }
-                    let eps = (qd[j] + f64::EPSILON.sqrt() * qd[j].abs().max(1.0)) - qd[j];
-                    self.vp[j] = qd[j] + eps;
-                    self.model
-                        .inverse_dynamics(t, q, &self.vp, qdd, &self.u, &mut self.tau1);
-                    self.vp[j] = qd[j];
-                    for i in 0..n {
-                        c[i + n * j] = (self.tau1[i] - self.tau0[i]) / eps;
-                    }
-                }
-                self.stats.inverse_dynamics += 2 * n;
+                let work = DifferenceBuffers {
+                    tau0: &mut self.tau0,
+                    tau1: &mut self.tau1,
+                    qp: &mut self.qp,
+                    vp: &mut self.vp,
+                };
+                self.stats.inverse_dynamics += self
+                    .model
+                    .differenced_tangents(t, q, qd, qdd, &self.u, k, c, work);
             }
         }
         self.check("M", m)?;

@@ -157,10 +157,16 @@ fn tangents_of_the_hooked_model_match_differences() {
     assert!(worst < 1e-6);
 }
 
-/// The four buffers of three numbers the differences use.
-fn buffers(w: &mut [[f64; 3]; 4]) -> mbs::DifferenceBuffers<'_> {
-    let [tau0, tau1, qp, vp] = w;
-    mbs::DifferenceBuffers { tau0, tau1, qp, vp }
+/// The five buffers of three numbers the differences use.
+fn buffers(w: &mut [[f64; 3]; 5]) -> mbs::DifferenceBuffers<'_> {
+    let [tau0, tau1, qp, vp, ap] = w;
+    mbs::DifferenceBuffers {
+        tau0,
+        tau1,
+        qp,
+        vp,
+        ap,
+    }
 }
 
 /// The push at the tip through a first-order lag, ẋ = (push·cos t − x)/T, and the damper
@@ -196,31 +202,14 @@ fn the_wrappers_differences_skip_what_no_state_reads() {
     let extra = Lagged(Extra::new(bare.info()));
     let m = WithEfforts::new(bare, extra);
     let (q, qd, qdd) = ([0.3, -0.8, 0.0], [1.1, -0.6, 0.4], [0.2, 0.5, -0.3]);
-    let mut work = [[0.0; 3]; 4];
+    let mut work = [[0.0; 3]; 5];
+    let state = [&q[..], &qd[..], &qdd[..]];
     let (mut k0, mut c0, mut k1, mut c1) = ([0.0; 9], [0.0; 9], [0.0; 9], [0.0; 9]);
     let before = m.user_evaluations();
-    let all = mbs::differenced_tangents(
-        &m,
-        0.7,
-        &q,
-        &qd,
-        &qdd,
-        &[],
-        &mut k0,
-        &mut c0,
-        buffers(&mut work),
-    );
+    let all =
+        mbs::differenced_tangents(&m, 0.7, state, &[], [&mut k0, &mut c0], buffers(&mut work));
     let middle = m.user_evaluations();
-    let wrapped = m.differenced_tangents(
-        0.7,
-        &q,
-        &qd,
-        &qdd,
-        &[],
-        &mut k1,
-        &mut c1,
-        buffers(&mut work),
-    );
+    let wrapped = m.differenced_tangents(0.7, state, &[], [&mut k1, &mut c1], buffers(&mut work));
     let after = m.user_evaluations();
     let bits = |x: &[f64; 9]| x.map(f64::to_bits);
     assert_eq!(bits(&k0), bits(&k1));
@@ -233,28 +222,12 @@ fn the_wrappers_differences_skip_what_no_state_reads() {
     assert!(c1[2 * 3] != 0.0 && c1[2 * 3 + 2] != 0.0 && k1[6..] == [0.0; 3]);
     // the iteration matrix M + γ'C + β'K alike: 3 + 1 evaluations of τ and of the user part
     // by default; 2 + 1 of the wrapped model's and 3 + 1 of the user part's
-    let (mut a0, mut a1, mut ap) = ([0.0; 9], [0.0; 9], [0.0; 3]);
+    let (mut a0, mut a1) = ([0.0; 9], [0.0; 9]);
     let w = [0.25 * 0.01, 0.5 * 0.1];
-    let all = mbs::differenced_iteration_matrix(
-        &m,
-        0.7,
-        [&q, &qd, &qdd],
-        &[],
-        w,
-        &mut a0,
-        buffers(&mut work),
-        &mut ap,
-    );
+    let all =
+        mbs::differenced_iteration_matrix(&m, 0.7, state, &[], w, &mut a0, buffers(&mut work));
     let middle = m.user_evaluations();
-    let wrapped = m.differenced_iteration_matrix(
-        0.7,
-        [&q, &qd, &qdd],
-        &[],
-        w,
-        &mut a1,
-        buffers(&mut work),
-        &mut ap,
-    );
+    let wrapped = m.differenced_iteration_matrix(0.7, state, &[], w, &mut a1, buffers(&mut work));
     let last = m.user_evaluations();
     assert_eq!(a0.map(f64::to_bits), a1.map(f64::to_bits));
     assert_eq!((all, middle - after), (4, 4));

@@ -586,16 +586,15 @@ impl<M: Model, E: Efforts> Model for WithEfforts<M, E> {
     fn differenced_tangents(
         &self,
         t: f64,
-        q: &[f64],
-        qd: &[f64],
-        qdd: &[f64],
+        [q, qd, qdd]: [&[f64]; 3],
         u: &[f64],
-        k: &mut [f64],
-        c: &mut [f64],
+        [k, c]: [&mut [f64]; 2],
         work: DifferenceBuffers<'_>,
     ) -> usize {
         let (n, big) = (M::NQ, Self::NQ);
-        let DifferenceBuffers { tau0, tau1, qp, vp } = work;
+        let DifferenceBuffers {
+            tau0, tau1, qp, vp, ..
+        } = work;
         let s = &mut *self.scratch.borrow_mut();
         if !self.differences_base(s, t, [q, qd, qdd], u, tau0) {
             k.fill(f64::NAN);
@@ -641,10 +640,15 @@ impl<M: Model, E: Efforts> Model for WithEfforts<M, E> {
         [beta, gamma]: [f64; 2],
         a: &mut [f64],
         work: DifferenceBuffers<'_>,
-        ap: &mut [f64],
     ) -> usize {
         let (n, big) = (M::NQ, Self::NQ);
-        let DifferenceBuffers { tau0, tau1, qp, vp } = work;
+        let DifferenceBuffers {
+            tau0,
+            tau1,
+            qp,
+            vp,
+            ap,
+        } = work;
         let s = &mut *self.scratch.borrow_mut();
         if !self.differences_base(s, t, [q, qd, qdd], u, tau0) {
             a.fill(f64::NAN);

@@ -516,12 +516,15 @@ pub trait Parameters:
     fn validate(&self) -> Result<(), ParamError>;
 }
 
-/// Buffers of NQ numbers each for [`Model::differenced_tangents`].
+/// Buffers of NQ numbers each for [`Model::differenced_tangents`] and
+/// [`Model::differenced_iteration_matrix`]: τ at the base and at a moved state, the moved
+/// coordinates, rates and accelerations.
 pub struct DifferenceBuffers<'a> {
     pub tau0: &'a mut [f64],
     pub tau1: &'a mut [f64],
     pub qp: &'a mut [f64],
     pub vp: &'a mut [f64],
+    pub ap: &'a mut [f64],
 }
 
 /// The forward-difference increment of a value x: √ε·max(|x|, 1) as represented in floating
@@ -532,20 +535,18 @@ pub fn increment(x: f64) -> f64 {
 
 /// [`Model::differenced_tangents`] as its default does it: τ differenced along each
 /// coordinate's position and rate, 2·NQ + 1 evaluations of [`Model::inverse_dynamics`].
-#[allow(clippy::too_many_arguments)]
 pub fn differenced_tangents<M: Model + ?Sized>(
     model: &M,
     t: f64,
-    q: &[f64],
-    qd: &[f64],
-    qdd: &[f64],
+    [q, qd, qdd]: [&[f64]; 3],
     u: &[f64],
-    k: &mut [f64],
-    c: &mut [f64],
+    [k, c]: [&mut [f64]; 2],
     work: DifferenceBuffers<'_>,
 ) -> usize {
     let n = q.len();
-    let DifferenceBuffers { tau0, tau1, qp, vp } = work;
+    let DifferenceBuffers {
+        tau0, tau1, qp, vp, ..
+    } = work;
     model.inverse_dynamics(t, q, qd, qdd, u, tau0);
     qp.copy_from_slice(q);
     vp.copy_from_slice(qd);
@@ -569,8 +570,7 @@ pub fn differenced_tangents<M: Model + ?Sized>(
 }
 
 /// [`Model::differenced_iteration_matrix`] as its default does it: NQ + 1 evaluations of
-/// [`Model::inverse_dynamics`], `ap` NQ long for the moved accelerations.
-#[allow(clippy::too_many_arguments)]
+/// [`Model::inverse_dynamics`].
 pub fn differenced_iteration_matrix<M: Model + ?Sized>(
     model: &M,
     t: f64,
@@ -579,10 +579,15 @@ pub fn differenced_iteration_matrix<M: Model + ?Sized>(
     [beta, gamma]: [f64; 2],
     a: &mut [f64],
     work: DifferenceBuffers<'_>,
-    ap: &mut [f64],
 ) -> usize {
     let n = q.len();
-    let DifferenceBuffers { tau0, tau1, qp, vp } = work;
+    let DifferenceBuffers {
+        tau0,
+        tau1,
+        qp,
+        vp,
+        ap,
+    } = work;
     model.inverse_dynamics(t, q, qd, qdd, u, tau0);
     qp.copy_from_slice(q);
     vp.copy_from_slice(qd);
@@ -754,45 +759,39 @@ pub trait Model {
         c: &mut [f64],
     ) -> Result<(), ModelError>;
 
-    /// K_t = ∂τ/∂q and C_t = ∂τ/∂qd (NQ × NQ each, column-major) by forward differences of
-    /// [`Model::inverse_dynamics`], what the schemes use without generated tangents; returns
+    /// K_t = ∂τ/∂q and C_t = ∂τ/∂qd (NQ × NQ each, column-major, into `out`) at
+    /// `state` = (q, qd, qdd) by forward differences of [`Model::inverse_dynamics`], what the schemes use without generated tangents; returns
     /// how many evaluations of τ it made. The default differences τ along each coordinate's
     /// position and rate, 2·NQ + 1 evaluations, each increment the one represented in floating
     /// point of √ε·max(|x|, 1). A wrapper that knows its structure may do less for the same
     /// numbers ([`crate::WithEfforts`]: the integrals of its extra states are read by nothing,
     /// and a change of an extra state leaves the wrapped model's kinematics as they are).
-    #[allow(clippy::too_many_arguments)]
     fn differenced_tangents(
         &self,
         t: f64,
-        q: &[f64],
-        qd: &[f64],
-        qdd: &[f64],
+        state: [&[f64]; 3],
         u: &[f64],
-        k: &mut [f64],
-        c: &mut [f64],
+        out: [&mut [f64]; 2],
         work: DifferenceBuffers<'_>,
     ) -> usize {
-        differenced_tangents(self, t, q, qd, qdd, u, k, c, work)
+        differenced_tangents(self, t, state, u, out, work)
     }
 
-    /// The iteration matrix M + γ'·C_t + β'·K_t (NQ × NQ, column-major) by forward
-    /// differences of [`Model::inverse_dynamics`] along (β'·e_j, γ'·e_j, e_j), the increment
+    /// The iteration matrix M + γ'·C_t + β'·K_t (NQ × NQ, column-major; `weights` = [β', γ'])
+    /// at `state` = (q, qd, qdd) by forward differences of [`Model::inverse_dynamics`] along (β'·e_j, γ'·e_j, e_j), the increment
     /// √ε·max(|qdd_j|, 1); returns how many evaluations of τ it made (NQ + 1 by default).
     /// [`crate::WithEfforts`] does less for the same numbers, as in
     /// [`Model::differenced_tangents`].
-    #[allow(clippy::too_many_arguments)]
     fn differenced_iteration_matrix(
         &self,
         t: f64,
-        [q, qd, qdd]: [&[f64]; 3],
+        state: [&[f64]; 3],
         u: &[f64],
-        [beta, gamma]: [f64; 2],
+        weights: [f64; 2],
         a: &mut [f64],
         work: DifferenceBuffers<'_>,
-        ap: &mut [f64],
     ) -> usize {
-        differenced_iteration_matrix(self, t, [q, qd, qdd], u, [beta, gamma], a, work, ap)
+        differenced_iteration_matrix(self, t, state, u, weights, a, work)
     }
 
     /// ∂τ/∂p (NQ × NS, column-major, NS = `SENSITIVE.len()`) at (t, q, qd, qdd, u): how the

@@ -71,6 +71,7 @@ impl<M: Model> Problem<M> {
                     tau1: &mut self.tau1,
                     qp: &mut self.qp,
                     vp: &mut self.vp,
+                    ap: &mut self.ap,
                 };
                 self.stats.inverse_dynamics += self.model.differenced_iteration_matrix(
                     t,
@@ -79,7 +80,6 @@ impl<M: Model> Problem<M> {
                     [beta, gamma],
                     a,
                     work,
-                    &mut self.ap,
                 );
             }
         }
@@ -146,10 +146,11 @@ impl<M: Model> Problem<M> {
                     tau1: &mut self.tau1,
                     qp: &mut self.qp,
                     vp: &mut self.vp,
+                    ap: &mut self.ap,
                 };
-                self.stats.inverse_dynamics += self
-                    .model
-                    .differenced_tangents(t, q, qd, qdd, &self.u, k, c, work);
+                self.stats.inverse_dynamics +=
+                    self.model
+                        .differenced_tangents(t, [q, qd, qdd], &self.u, [k, c], work);
             }
         }
         self.check("M", m)?;

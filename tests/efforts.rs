@@ -130,15 +130,22 @@ fn tau<M: Model>(m: &M, q: &[f64], qd: &[f64], qdd: &[f64]) -> Vec<f64> {
 
 #[test]
 fn tangents_of_the_hooked_model_match_differences() {
-    let m = hooked();
-    let (q, qd, qdd) = ([0.3, -0.8], [1.1, -0.6], [0.2, 0.5]);
-    let (mut k, mut c) = ([0.0; 4], [0.0; 4]);
-    m.tangents(0.7, &q, &qd, &qdd, &[], &mut k, &mut c).unwrap();
+    let worst = tangents_gap(&hooked(), &[0.3, -0.8], &[1.1, -0.6], &[0.2, 0.5]);
+    println!("tangents vs central differences: {worst:.1e}");
+    assert!(worst < 1e-6);
+}
+
+/// The largest gap between a model's tangents at (q, qd, qdd) and central differences of
+/// its τ.
+fn tangents_gap<M: Model>(m: &M, q: &[f64], qd: &[f64], qdd: &[f64]) -> f64 {
+    let n = M::NQ;
+    let (mut k, mut c) = (vec![0.0; n * n], vec![0.0; n * n]);
+    m.tangents(0.7, q, qd, qdd, &[], &mut k, &mut c).unwrap();
     let eps = 1e-6;
     let mut worst = 0.0f64;
-    for j in 0..2 {
+    for j in 0..n {
         for (which, exact) in [(0, &k), (1, &c)] {
-            let (mut a, mut b) = ((q, qd), (q, qd));
+            let (mut a, mut b) = ((q.to_vec(), qd.to_vec()), (q.to_vec(), qd.to_vec()));
             if which == 0 {
                 a.0[j] += eps;
                 b.0[j] -= eps;
@@ -146,15 +153,14 @@ fn tangents_of_the_hooked_model_match_differences() {
                 a.1[j] += eps;
                 b.1[j] -= eps;
             }
-            let (ta, tb) = (tau(&m, &a.0, &a.1, &qdd), tau(&m, &b.0, &b.1, &qdd));
-            for i in 0..2 {
+            let (ta, tb) = (tau(m, &a.0, &a.1, qdd), tau(m, &b.0, &b.1, qdd));
+            for i in 0..n {
                 let cd = (ta[i] - tb[i]) / (2.0 * eps);
-                worst = worst.max((exact[i + 2 * j] - cd).abs());
+                worst = worst.max((exact[i + n * j] - cd).abs());
             }
         }
     }
-    println!("tangents vs central differences: {worst:.1e}");
-    assert!(worst < 1e-6);
+    worst
 }
 
 /// The five buffers of three numbers the differences use.
@@ -233,27 +239,7 @@ fn the_wrappers_differences_skip_what_no_state_reads() {
     assert_eq!((all, middle - after), (4, 4));
     assert_eq!((wrapped, last - middle), (3, 4));
 
-    let (mut k, mut c) = ([0.0; 9], [0.0; 9]);
-    m.tangents(0.7, &q, &qd, &qdd, &[], &mut k, &mut c).unwrap();
-    let eps = 1e-6;
-    let mut worst = 0.0f64;
-    for j in 0..3 {
-        for (which, exact) in [(0, &k), (1, &c)] {
-            let (mut a, mut b) = ((q, qd), (q, qd));
-            if which == 0 {
-                a.0[j] += eps;
-                b.0[j] -= eps;
-            } else {
-                a.1[j] += eps;
-                b.1[j] -= eps;
-            }
-            let (ta, tb) = (tau(&m, &a.0, &a.1, &qdd), tau(&m, &b.0, &b.1, &qdd));
-            for i in 0..3 {
-                let cd = (ta[i] - tb[i]) / (2.0 * eps);
-                worst = worst.max((exact[i + 3 * j] - cd).abs());
-            }
-        }
-    }
+    let worst = tangents_gap(&m, &q, &qd, &qdd);
     println!("tangents with an extra state vs central differences: {worst:.1e}");
     assert!(worst < 1e-6);
 }

@@ -66,21 +66,10 @@ impl<M: Model> Problem<M> {
                 a.copy_from_slice(&self.m);
             }
             IterationMatrix::FiniteDifferences => {
-                let work = DifferenceBuffers {
-                    tau0: &mut self.tau0,
-                    tau1: &mut self.tau1,
-                    qp: &mut self.qp,
-                    vp: &mut self.vp,
-                    ap: &mut self.ap,
-                };
-                self.stats.inverse_dynamics += self.model.differenced_iteration_matrix(
-                    t,
-                    [q, qd, qdd],
-                    &self.u,
-                    [beta, gamma],
-                    a,
-                    work,
-                );
+                let (model, u, work) = self.differencing();
+                let evaluations =
+                    model.differenced_iteration_matrix(t, [q, qd, qdd], u, [beta, gamma], a, work);
+                self.stats.inverse_dynamics += evaluations;
             }
         }
         if let Some(f) = self.model.take_failure() {
@@ -92,6 +81,18 @@ impl<M: Model> Problem<M> {
             self.watch_mchk(t, q)?;
         }
         Ok(())
+    }
+
+    /// The model, its inputs at the time `inputs_at` set, and the buffers its differences use.
+    fn differencing(&mut self) -> (&M, &[f64], DifferenceBuffers<'_>) {
+        let work = DifferenceBuffers {
+            tau0: &mut self.tau0,
+            tau1: &mut self.tau1,
+            qp: &mut self.qp,
+            vp: &mut self.vp,
+            ap: &mut self.ap,
+        };
+        (&self.model, &self.u, work)
     }
 
     /// M, C_t and K_t (n × n, column-major) the last iteration matrix was made of, when it was
@@ -141,16 +142,9 @@ impl<M: Model> Problem<M> {
                 k.fill(0.0);
             }
             IterationMatrix::FiniteDifferences => {
-                let work = DifferenceBuffers {
-                    tau0: &mut self.tau0,
-                    tau1: &mut self.tau1,
-                    qp: &mut self.qp,
-                    vp: &mut self.vp,
-                    ap: &mut self.ap,
-                };
-                self.stats.inverse_dynamics +=
-                    self.model
-                        .differenced_tangents(t, [q, qd, qdd], &self.u, [k, c], work);
+                let (model, u, work) = self.differencing();
+                let evaluations = model.differenced_tangents(t, [q, qd, qdd], u, [k, c], work);
+                self.stats.inverse_dynamics += evaluations;
             }
         }
         self.check("M", m)?;

@@ -157,7 +157,7 @@ impl Muscles {
     /// where there is one, else the excitation (at rest on a constant one).
     pub fn activation_at(&self, i: usize, t: f64) -> f64 {
         match self.activation_pattern.get(i) {
-            Some(f) => f.eval(t)[0].clamp(MIN_ACTIVATION, 1.0),
+            Some(f) => on_series(f, t),
             None => self.excitation_at(i, t),
         }
     }
@@ -165,7 +165,7 @@ impl Muscles {
     /// Unit `i`'s excitation at `t`.
     pub fn excitation_at(&self, i: usize, t: f64) -> f64 {
         match self.pattern.get(i) {
-            Some(f) => f.eval(t)[0].clamp(MIN_ACTIVATION, 1.0),
+            Some(f) => on_series(f, t),
             None => self.excitation[i],
         }
     }
@@ -360,6 +360,11 @@ impl Muscles {
         let f = self.forces_at_rest(kin, &a).map_err(err)?;
         Ok((a, residual(&f)))
     }
+}
+
+/// A series of excitations or activations at `t`, clamped to [`MIN_ACTIVATION`, 1].
+fn on_series(f: &Fourier, t: f64) -> f64 {
+    f.eval(t)[0].clamp(MIN_ACTIVATION, 1.0)
 }
 
 /// Names of the extra states of [`MuscleDriven`] after the passive joints' 17: the 18

@@ -83,7 +83,7 @@ RS
 }
 
 cat > "$dir/src/main.rs" <<'RS'
-#[allow(unused_macros)]
+#[allow(unused_macros, dead_code)]
 mod model;
 use mbs::{F64x4, Model};
 fn main() {

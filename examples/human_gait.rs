@@ -63,8 +63,71 @@ fn main() -> std::process::ExitCode {
     }
 }
 
+/// The options, each with its value's form and default (the module's documentation says
+/// what each does).
+const USAGE: &str = "\
+usage: human_gait [options]
+  --period S         the cycle's period (1.1 s)
+  --kp K             the joints' tracking stiffness (3e4 N·m/rad)
+  --pelvis K         the residual torques' stiffness on the pelvis (3e4 N·m/rad; 0: free)
+  --pelvis-axes a,b,c  their shares about the fore–aft, vertical and lateral axes (1,1,1)
+  --cycles N         cycles run; the last is reported (2)
+  --clearance M      the swinging foot's clearance at mid-swing (0.02 m)
+  --pressure W       the second pass' weight on the centre of pressure (0: no second pass)
+  --free W           its weight on the free moment (0)
+  --dissipation D    the feet's Hunt–Crossley dissipation (10 s/m)
+  --stiffness K      the feet's Hunt–Crossley stiffness (the model's)
+  --eps V            the friction's slip speed (the model's, 0.01 m/s)
+  --balance          the balance controller where the residual torques leave the pelvis free
+  --ankle G          its ankle strategy's gain (1)
+  --ankle-time T     its ankle strategy's time (0.1 s)
+  --place C          its foot placement's gain on position (1)
+  --place-time C     its foot placement's gain on velocity (0.5 s)
+  --filter T         the placement's filter time (0.1 s)
+  --muscle-rtol R    Radau5's rtol on the muscles (1e-4)
+  --out DIR          where the plots, animation and CSV go (target/human_gait)
+  --help             this text";
+
+/// The options that take a value; `--balance` and `--help` take none.
+const VALUED: [&str; 18] = [
+    "--period",
+    "--kp",
+    "--pelvis",
+    "--pelvis-axes",
+    "--cycles",
+    "--clearance",
+    "--pressure",
+    "--free",
+    "--dissipation",
+    "--stiffness",
+    "--eps",
+    "--ankle",
+    "--ankle-time",
+    "--place",
+    "--place-time",
+    "--filter",
+    "--muscle-rtol",
+    "--out",
+];
+
 fn gait() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
+    // every argument an option of `USAGE` (a misspelt one would leave its default in
+    // place, and the run would not be the one asked for)
+    let mut rest = args.iter().skip(1);
+    while let Some(a) = rest.next() {
+        if a == "--help" || a == "-h" {
+            println!("{USAGE}");
+            return Ok(());
+        }
+        if VALUED.contains(&a.as_str()) {
+            if rest.next().is_none() {
+                return Err(format!("{a} takes a value\n{USAGE}").into());
+            }
+        } else if a != "--balance" {
+            return Err(format!("unknown argument `{a}`\n{USAGE}").into());
+        }
+    }
     let value = |name: &str| {
         args.iter()
             .position(|a| a == name)

@@ -143,6 +143,14 @@ fn print(wp: &WorkPrecision) {
 fn main() {
     let which = std::env::args().nth(1).unwrap_or_else(|| "all".into());
     let all = which == "all";
+    let models = ["pendulum3", "slidercrank", "fourbar", "dpend"];
+    if !all && !models.contains(&which.as_str()) {
+        eprintln!(
+            "error: unknown model `{which}`: name one of {} or `all` (the default)",
+            models.join(", ")
+        );
+        std::process::exit(1);
+    }
     if all || which == "pendulum3" {
         let s = study("pendulum3", pendulum3_reference(), true);
         print(&s.run(&pendulum3::Pendulum3::default()).expect("study"));

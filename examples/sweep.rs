@@ -54,6 +54,7 @@ fn metrics() -> Metrics<DoublePendulum> {
     Metrics::new(["tip_x_end", "tip_y_end", "tip_y_max"], metric_values)
 }
 
+/// The value after `name` among the arguments, if it is there.
 fn arg(name: &str) -> Option<String> {
     let args: Vec<String> = std::env::args().collect();
     args.iter()
@@ -61,13 +62,39 @@ fn arg(name: &str) -> Option<String> {
         .and_then(|i| args.get(i + 1).cloned())
 }
 
-fn main() {
-    let runs: usize = arg("--runs").and_then(|s| s.parse().ok()).unwrap_or(1000);
-    let repeat: usize = arg("--repeat").and_then(|s| s.parse().ok()).unwrap_or(7);
-    if runs == 0 || repeat == 0 {
-        eprintln!("error: --runs and --repeat take whole numbers of 1 or more");
-        std::process::exit(1);
+/// A whole number of 1 or more after `name`, or `default`.
+fn count(name: &str, default: usize) -> usize {
+    match arg(name).map(|s| s.parse::<usize>()) {
+        None => default,
+        Some(Ok(n)) if n > 0 => n,
+        _ => fail(&format!("{name} takes a whole number of 1 or more")),
     }
+}
+
+fn fail(message: &str) -> ! {
+    eprintln!("error: {message}\nusage: sweep [--runs 1000] [--repeat 7] [--out DIR]");
+    std::process::exit(1);
+}
+
+fn main() {
+    // every argument an option with its value (a misspelt one would run the defaults)
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.iter().any(|a| a == "--help" || a == "-h") {
+        println!("usage: sweep [--runs 1000] [--repeat 7] [--out DIR]");
+        return;
+    }
+    for pair in args.chunks(2) {
+        match pair {
+            [name, _] if ["--runs", "--repeat", "--out"].contains(&name.as_str()) => {}
+            [name] if ["--runs", "--repeat", "--out"].contains(&name.as_str()) => {
+                fail(&format!("{name} takes a value"))
+            }
+            [other, ..] => fail(&format!("unknown argument `{other}`")),
+            [] => {}
+        }
+    }
+    let runs = count("--runs", 1000);
+    let repeat = count("--repeat", 7);
     let out = arg("--out").map_or_else(
         || std::env::temp_dir().join(format!("mbs-sweep-example-{}", std::process::id())),
         std::path::PathBuf::from,

@@ -82,7 +82,7 @@ usage: human_gait [options]
   --ankle G          its ankle strategy's gain (1)
   --ankle-time T     its ankle strategy's time (0.1 s)
   --place C          its foot placement's gain on position (1)
-  --place-time C     its foot placement's gain on velocity (0.5 s)
+  --place-time T     its foot placement's gain on velocity (0.5 s)
   --filter T         the placement's filter time (0.1 s)
   --muscle-rtol R    Radau5's rtol on the muscles (1e-4)
   --out DIR          where the plots, animation and CSV go (target/human_gait)

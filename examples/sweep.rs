@@ -71,8 +71,10 @@ fn count(name: &str, default: usize) -> usize {
     }
 }
 
+const USAGE: &str = "usage: sweep [--runs 1000] [--repeat 7] [--out DIR]";
+
 fn fail(message: &str) -> ! {
-    eprintln!("error: {message}\nusage: sweep [--runs 1000] [--repeat 7] [--out DIR]");
+    eprintln!("error: {message}\n{USAGE}");
     std::process::exit(1);
 }
 
@@ -80,7 +82,7 @@ fn main() {
     // every argument an option with its value (a misspelt one would run the defaults)
     let args: Vec<String> = std::env::args().skip(1).collect();
     if args.iter().any(|a| a == "--help" || a == "-h") {
-        println!("usage: sweep [--runs 1000] [--repeat 7] [--out DIR]");
+        println!("{USAGE}");
         return;
     }
     for pair in args.chunks(2) {

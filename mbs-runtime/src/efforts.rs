@@ -36,7 +36,7 @@ use crate::elements::cross;
 use crate::error::{Failure, ModelError, ParamError};
 use crate::model::{
     DifferenceBuffers, Energy, FrameKinematics, Kinematics, Model, ModelInfo, PointKinematics,
-    Pose, increment,
+    Pose, increment, iteration_column,
 };
 use std::any::TypeId;
 use std::cell::{Cell, Ref, RefCell, RefMut};
@@ -659,20 +659,18 @@ impl<M: Model, E: Efforts> Model for WithEfforts<M, E> {
         ap.copy_from_slice(qdd);
         // the extra states first, on the kinematics of the unmoved state
         for j in (n..big).chain(0..n) {
-            let eps = f64::EPSILON.sqrt() * qdd[j].abs().max(1.0);
-            qp[j] += beta * eps;
-            vp[j] += gamma * eps;
-            ap[j] += eps;
-            let ok = self.moved_tau(s, t, [qp, vp, ap], u, j, tau1);
-            qp[j] = q[j];
-            vp[j] = qd[j];
-            ap[j] = qdd[j];
+            let ok = iteration_column(
+                j,
+                [q, qd, qdd],
+                [beta, gamma],
+                [&mut *qp, &mut *vp, &mut *ap],
+                (tau0, &mut *tau1),
+                &mut a[big * j..big * (j + 1)],
+                |moved, tau1| self.moved_tau(s, t, moved, u, j, tau1),
+            );
             if !ok {
                 a.fill(f64::NAN);
                 return 1 + n;
-            }
-            for i in 0..big {
-                a[i + big * j] = (tau1[i] - tau0[i]) / eps;
             }
         }
         1 + n

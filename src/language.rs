@@ -592,7 +592,7 @@
 //! All the mistakes of a model are reported at once. The macro still emits placeholder types
 //! (the parameter struct with its fields, the model types with `new` and the
 //! [`Model`](crate::Model) trait), so the code using them does not fail in cascade. Each
-//! message has a compile-fail case under `tests/ui/`.
+//! message has a compile-fail case under `compile-fail/tests/ui/`.
 //!
 //! ## Reading the generated code
 //!

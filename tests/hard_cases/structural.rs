@@ -7,7 +7,7 @@
 //! (b) a coordinate that moves no mass: a massless terminal frame turned by its own
 //!     coordinate is a compile-time error, "coordinate `q[1]` moves no body with mass, so the
 //!     mass matrix would be singular: …", covered by the trybuild case
-//!     `tests/ui/physics/coordinate_moves_no_mass.rs` (checked here to still say so). A
+//!     `compile-fail/tests/ui/physics/coordinate_moves_no_mass.rs` (checked here to still say so). A
 //!     coordinate that turns a point mass about its own centre passes that check (it is in
 //!     the pose of a body with mass) yet moves no mass: refused at the start of every scheme
 //!     with `SingularMatrix` naming it alone.
@@ -66,7 +66,7 @@ fn structurally_singular_models_are_refused_naming_their_coordinates() {
     // (b) at compile time: the trybuild case and its expected message
     let ui = concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/tests/ui/physics/coordinate_moves_no_mass"
+        "/compile-fail/tests/ui/physics/coordinate_moves_no_mass"
     );
     let source = std::fs::read_to_string(format!("{ui}.rs")).unwrap();
     let stderr = std::fs::read_to_string(format!("{ui}.stderr")).unwrap();
@@ -75,7 +75,7 @@ fn structurally_singular_models_are_refused_naming_their_coordinates() {
         "coordinate `q[1]` moves no body with mass, so the mass matrix would be singular"
     ));
     println!(
-        "massless terminal frame: compile error (tests/ui/physics/coordinate_moves_no_mass.rs): {}",
+        "massless terminal frame: compile error (compile-fail/tests/ui/physics/coordinate_moves_no_mass.rs): {}",
         stderr.lines().next().unwrap()
     );
     // (c) reached during a run

@@ -1,7 +1,7 @@
 //! The `mbs::Model` trait as generated code implements it: one table of its methods, from
 //! which both a generated model's `impl` and the placeholder of a model with errors are
 //! written. Compiling either against the trait is the check that the table is right
-//! (`tests/ui/cascade` compiles placeholders, every `multibody!` model the full impl).
+//! (`compile-fail/tests/ui/cascade` compiles placeholders, every `multibody!` model the full impl).
 
 /// A method of `mbs::Model`: `fn {name}({receiver}, {args}) -> {ret}`.
 pub struct Method {

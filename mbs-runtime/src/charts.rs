@@ -244,6 +244,14 @@ pub fn charts_of<M: Model>(model: &M) -> Vec<[[f64; 3]; 3]> {
 /// The charts of every rotation joint of `model` into `charts` (no allocation once it has
 /// their number): what a controller or an effort is handed at each call.
 pub fn read_charts<M: Model>(model: &M, charts: &mut Vec<[[f64; 3]; 3]>) {
+    read_charts_erased(model, charts)
+}
+
+/// [`read_charts`] on the model behind the schemes.
+pub(crate) fn read_charts_erased(
+    model: &dyn crate::erased::ErasedModel,
+    charts: &mut Vec<[[f64; 3]; 3]>,
+) {
     charts.resize(model.info().rotation_joints.len(), [[0.0; 3]; 3]);
     for (j, c) in charts.iter_mut().enumerate() {
         *c = model.chart(j);
@@ -269,6 +277,17 @@ pub fn recentre_below<M: Model>(
     threshold: f64,
     q: &mut [f64],
     qd: &mut [f64],
+    qdd: Option<&mut [f64]>,
+    moved: &mut Vec<Recentring>,
+) -> bool {
+    recentre_below_erased(model, threshold, [q, qd], qdd, moved)
+}
+
+/// [`recentre_below`] on the model behind the schemes.
+pub(crate) fn recentre_below_erased(
+    model: &mut dyn crate::erased::ErasedModel,
+    threshold: f64,
+    [q, qd]: [&mut [f64]; 2],
     qdd: Option<&mut [f64]>,
     moved: &mut Vec<Recentring>,
 ) -> bool {

@@ -15,6 +15,7 @@ pub mod analysis;
 pub mod charts;
 pub mod efforts;
 pub mod elements;
+pub(crate) mod erased;
 pub mod error;
 pub mod inertia;
 pub mod integrators;

@@ -111,7 +111,6 @@ use super::{Attempt, Control, State, Step, Stepper};
 use crate::charts::Recentring;
 use crate::error::Failure;
 use crate::linalg::{cholesky, cholesky_solve};
-use crate::model::Model;
 
 const MAX_ORDER: usize = 5;
 /// The error test's tolerance: rtol' = 0.1·rtol^1.25, atol kept (see the module
@@ -357,7 +356,7 @@ impl Bdf {
     }
 }
 
-impl<M: Model> Stepper<M> for Bdf {
+impl Stepper for Bdf {
     fn last_test(&self) -> ErrorNorm {
         self.test
     }
@@ -370,7 +369,7 @@ impl<M: Model> Stepper<M> for Bdf {
         Tolerances::transformed_floored(rtol, TOL_FACTOR, TOL_EXPONENT)
     }
 
-    fn start(&mut self, _p: &mut Problem<M>, s: &State, _ctl: &Control) -> Result<(), Failure> {
+    fn start(&mut self, _p: &mut Problem, s: &State, _ctl: &Control) -> Result<(), Failure> {
         let n = self.n;
         self.d.fill(0.0);
         // D = (y₀, 1·f(y₀)) sampled at h = 1; the first attempt re-samples it at its step
@@ -391,7 +390,7 @@ impl<M: Model> Stepper<M> for Bdf {
     /// with fresh matrices.
     fn rechart(
         &mut self,
-        p: &mut Problem<M>,
+        p: &mut Problem,
         s: &State,
         ctl: &Control,
         _moved: &[Recentring],
@@ -401,7 +400,7 @@ impl<M: Model> Stepper<M> for Bdf {
         self.start(p, s, ctl)
     }
 
-    fn attempt(&mut self, step: Step<'_, M>) -> Result<Attempt, Failure> {
+    fn attempt(&mut self, step: Step<'_>) -> Result<Attempt, Failure> {
         let Step(p, cur, h, ctl, next) = step;
         let (n, m, k) = (self.n, 2 * self.n, self.order);
         // steps on a fixed grid differ from h in the last bits: not a change of step
@@ -568,7 +567,7 @@ impl<M: Model> Stepper<M> for Bdf {
         Ok(Attempt::Accepted { h_next })
     }
 
-    fn accepted(&mut self, p: &mut Problem<M>, _prev: &State, cur: &State) {
+    fn accepted(&mut self, p: &mut Problem, _prev: &State, cur: &State) {
         let (n, m, k) = (self.n, 2 * self.n, self.order);
         p.stats.record_order(k);
         // ∇^{k+2}y_{n+1} = corr − ∇^{k+1}yₙ, ∇^{k+1}y_{n+1} = corr, ∇ʲy_{n+1} = ∇ʲyₙ + ∇^{j+1}y_{n+1}

@@ -55,7 +55,6 @@ use super::step_control::{
 };
 use super::{Attempt, State, Step, Stepper};
 use crate::error::Failure;
-use crate::model::Model;
 use nalgebra::Complex;
 use std::f64::consts::PI;
 
@@ -258,9 +257,9 @@ impl OffAxis {
     }
 
     /// out = p(J)·x = J(Jx) + ρJx.
-    fn apply_p<M: Model>(
+    fn apply_p(
         probe: &mut Probe,
-        p: &mut Problem<M>,
+        p: &mut Problem,
         cur: &State,
         rho: f64,
         x: &[f64],
@@ -282,9 +281,9 @@ impl OffAxis {
 
     /// One power iteration on p(J), or with `settle` iterations until |μ| changes by less
     /// than 1 %; ρ the fastest mode's modulus.
-    fn estimate<M: Model>(
+    fn estimate(
         &mut self,
-        p: &mut Problem<M>,
+        p: &mut Problem,
         cur: &State,
         rho: f64,
         settle: bool,
@@ -402,12 +401,7 @@ impl Chebyshev {
 
     /// Estimates the fastest mode once (with `settle`, to convergence) and keeps it among
     /// the recent ones.
-    fn refresh<M: Model>(
-        &mut self,
-        p: &mut Problem<M>,
-        cur: &State,
-        settle: bool,
-    ) -> Result<(), Failure> {
+    fn refresh(&mut self, p: &mut Problem, cur: &State, settle: bool) -> Result<(), Failure> {
         self.watch.refresh(p, cur, settle)?;
         let (re, im) = self.watch.mode();
         self.recent.rotate_right(1);
@@ -419,9 +413,9 @@ impl Chebyshev {
     /// the mode farthest off the axis (estimated anew first when due); when none up to MAX_STAGES hold
     /// them, estimated to convergence, then `Err(f)` with the largest fraction f of h some
     /// number of stages holds.
-    fn choose<M: Model>(
+    fn choose(
         &mut self,
-        p: &mut Problem<M>,
+        p: &mut Problem,
         cur: &State,
         h: f64,
     ) -> Result<Result<usize, f64>, Failure> {
@@ -453,7 +447,7 @@ impl Chebyshev {
     }
 }
 
-impl<M: Model> Stepper<M> for Chebyshev {
+impl Stepper for Chebyshev {
     fn last_test(&self) -> ErrorNorm {
         self.test
     }
@@ -462,7 +456,7 @@ impl<M: Model> Stepper<M> for Chebyshev {
         order_two_floored(rtol, TOL_FACTOR, FLOOR)
     }
 
-    fn attempt(&mut self, step: Step<'_, M>) -> Result<Attempt, Failure> {
+    fn attempt(&mut self, step: Step<'_>) -> Result<Attempt, Failure> {
         let Step(p, cur, h, ctl, next) = step;
         match self.choose(p, cur, h)? {
             Ok(s) => self.stages = s,
@@ -529,9 +523,9 @@ impl<M: Model> Stepper<M> for Chebyshev {
 }
 
 impl Chebyshev {
-    fn stage_loop<M: Model>(
+    fn stage_loop(
         &mut self,
-        p: &mut Problem<M>,
+        p: &mut Problem,
         cur: &State,
         h: f64,
         next: &mut State,

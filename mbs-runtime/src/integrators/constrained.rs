@@ -21,9 +21,9 @@
 
 use super::State;
 use super::at::At;
+use crate::erased::ErasedModel;
 use crate::error::Failure;
 use crate::linalg::{Lu, Singular, backward, cholesky, cholesky_solve, forward, norm1};
-use crate::model::Model;
 use crate::options::ConstraintOptions;
 use crate::stats::Stats;
 use serde::Serialize;
@@ -89,8 +89,8 @@ pub(crate) struct Constrained {
 }
 
 impl Constrained {
-    pub fn new<M: Model>(model: &M, mode: Mode, o: &ConstraintOptions) -> Constrained {
-        let (n, nc) = (M::NQ, M::NC);
+    pub fn new(model: &dyn ErasedModel, mode: Mode, o: &ConstraintOptions) -> Constrained {
+        let (n, nc) = (model.nq(), model.nc());
         let info = model.info();
         let z = |k: usize| vec![0.0; k];
         Constrained {
@@ -134,7 +134,7 @@ impl Constrained {
             .unwrap_or_else(|| format!("#{i}"))
     }
 
-    pub fn eval_phi<M: Model>(&mut self, m: &M, st: &mut Stats, t: f64, q: &[f64]) {
+    pub fn eval_phi(&mut self, m: &dyn ErasedModel, st: &mut Stats, t: f64, q: &[f64]) {
         m.constraints(t, q, &mut self.phi);
         st.constraints += 1;
     }
@@ -144,9 +144,9 @@ impl Constrained {
     /// again afterwards. The Φ̇ rows of the stabilized index-2 iteration matrices need it
     /// (the Newmark family's and Radau's).
     #[allow(clippy::too_many_arguments)]
-    pub fn rate_jacobian<M: Model>(
+    pub fn rate_jacobian(
         &mut self,
-        m: &M,
+        m: &dyn ErasedModel,
         st: &mut Stats,
         t: f64,
         q: &[f64],
@@ -178,12 +178,12 @@ impl Constrained {
         self.b.copy_from_slice(b);
     }
 
-    pub fn eval_b<M: Model>(&mut self, m: &M, st: &mut Stats, t: f64, q: &[f64]) {
+    pub fn eval_b(&mut self, m: &dyn ErasedModel, st: &mut Stats, t: f64, q: &[f64]) {
         m.constraint_jacobian(t, q, &mut self.b);
         st.constraints += 1;
     }
 
-    fn eval_phi_t<M: Model>(&mut self, m: &M, st: &mut Stats, t: f64, q: &[f64]) {
+    fn eval_phi_t(&mut self, m: &dyn ErasedModel, st: &mut Stats, t: f64, q: &[f64]) {
         m.constraint_rate(t, q, &mut self.phi_t);
         st.constraints += 1;
     }
@@ -230,16 +230,22 @@ impl Constrained {
 
     /// The failure for a singular S at (t, q): rank, smallest singular value and the
     /// constraints involved, from the SVD of B (the run stops: allocating is fine).
-    pub fn rank_failure<M: Model>(&mut self, m: &M, st: &mut Stats, t: f64, q: &[f64]) -> Failure {
+    pub fn rank_failure(
+        &mut self,
+        m: &dyn ErasedModel,
+        st: &mut Stats,
+        t: f64,
+        q: &[f64],
+    ) -> Failure {
         self.eval_b(m, st, t, q);
         rank_failure(&self.b, self.nc, self.n, &self.names)
     }
 
     /// qdd and λ of the index-1 equations at (t, q, qd), with L the Cholesky factor of M(q)
     /// and `h` = h(q, qd); Baumgarte's terms when the mode has them.
-    pub fn kkt<M: Model>(
+    pub fn kkt(
         &mut self,
-        m: &M,
+        m: &dyn ErasedModel,
         st: &mut Stats,
         l: &[f64],
         at: At,
@@ -285,9 +291,9 @@ impl Constrained {
 
     /// Projects the state's q onto Φ(q, t) = 0 and qd onto Φ̇ = 0 in the metric of M (L its
     /// Cholesky factor at the unprojected q).
-    pub fn project<M: Model>(
+    pub fn project(
         &mut self,
-        m: &M,
+        m: &dyn ErasedModel,
         st: &mut Stats,
         l: &[f64],
         s: &mut State,
@@ -360,9 +366,9 @@ impl Constrained {
 
     /// Partitioning: q_d and qd_d completed from q_i, qd_i (starting from the given q_d)
     /// into `self.qc`, `self.vc`.
-    pub fn complete<M: Model>(
+    pub fn complete(
         &mut self,
-        m: &M,
+        m: &dyn ErasedModel,
         st: &mut Stats,
         t: f64,
         q: &[f64],
@@ -566,9 +572,9 @@ impl Constrained {
     }
 
     /// `ConstraintDrift` when some |Φ_i(t, q)| exceeds the drift tolerance.
-    pub fn check_drift<M: Model>(
+    pub fn check_drift(
         &mut self,
-        m: &M,
+        m: &dyn ErasedModel,
         st: &mut Stats,
         t: f64,
         q: &[f64],
@@ -711,15 +717,26 @@ pub(crate) fn least_correction(
 /// assembly branch; then the velocities of those
 /// coordinates from B qd = −Φ_t. Typed errors: redundant constraints (rank of B), too many
 /// coordinates marked independent, no convergence, a change of branch.
-pub fn assemble<M: Model>(
+pub fn assemble<M: crate::model::Model + 'static>(
     model: &M,
     t: f64,
     q: &mut [f64],
     qd: &mut [f64],
     o: &ConstraintOptions,
 ) -> Result<Assembly, Failure> {
+    assemble_erased(model, t, q, qd, o)
+}
+
+/// [`assemble`] on the model behind the schemes.
+pub(crate) fn assemble_erased(
+    model: &dyn ErasedModel,
+    t: f64,
+    q: &mut [f64],
+    qd: &mut [f64],
+    o: &ConstraintOptions,
+) -> Result<Assembly, Failure> {
     use nalgebra::DMatrix;
-    let (n, nc) = (M::NQ, M::NC);
+    let (n, nc) = (model.nq(), model.nc());
     let info = model.info();
     let names: Vec<String> = info.constraints.iter().map(|s| s.to_string()).collect();
     let label = |i: usize| info.dof_label(i);

@@ -5,7 +5,6 @@ use super::constrained::Mode;
 use super::stepper::Stepper;
 use super::{bdf, chebyshev, dopri5, explicit, midpoint, newmark, radau};
 use crate::error::Failure;
-use crate::model::Model;
 use crate::options::{ConstraintMethod, Scheme};
 
 /// The constraint method a scheme runs: `Auto` resolved, unsupported pairs refused.
@@ -69,7 +68,7 @@ const INDEX3_SCHEMES: &str = "index-3 constraints are solved by gen-alpha, hht, 
 /// The schemes that solve the stabilized index-2 equations, for messages.
 const INDEX2_SCHEMES: &str = "the stabilized index-2 form is solved by gen-alpha, hht, newmark, radau3 and radau5; every scheme takes the constraints with Projection, Baumgarte or Partitioning";
 
-pub(super) fn stepper_for<M: Model>(scheme: &Scheme, n: usize) -> Box<dyn Stepper<M>> {
+pub(super) fn stepper_for(scheme: &Scheme, n: usize) -> Box<dyn Stepper> {
     match *scheme {
         Scheme::ExplicitEuler => Box::new(explicit::Explicit::euler(n)),
         Scheme::Rk4 => Box::new(explicit::Explicit::rk4(n)),

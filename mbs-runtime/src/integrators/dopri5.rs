@@ -20,7 +20,6 @@ use super::problem::Problem;
 use super::step_control::{Decision, ErrorNorm, PiController};
 use super::{Attempt, State, Step, Stepper};
 use crate::error::Failure;
-use crate::model::Model;
 
 const C: [f64; 7] = [0.0, 0.2, 0.3, 0.8, 8.0 / 9.0, 1.0, 1.0];
 const A: [[f64; 6]; 7] = [
@@ -134,12 +133,12 @@ impl Dopri5 {
     }
 }
 
-impl<M: Model> Stepper<M> for Dopri5 {
+impl Stepper for Dopri5 {
     fn last_test(&self) -> ErrorNorm {
         self.test
     }
 
-    fn attempt(&mut self, step: Step<'_, M>) -> Result<Attempt, Failure> {
+    fn attempt(&mut self, step: Step<'_>) -> Result<Attempt, Failure> {
         let Step(p, cur, h, ctl, next) = step;
         let n = self.n;
         if ctl.adaptive.is_none() && ctl.stability_check {
@@ -232,7 +231,7 @@ const NONSTIFF_STEPS: usize = 6;
 
 impl Dopri5 {
     /// Hairer's test on the step just accepted from t: h·|λ| ≈ h‖k₇ − k₆‖/‖y₇ − y₆‖.
-    fn stiffness_test<M: Model>(&mut self, p: &mut Problem<M>, t: f64, h: f64) {
+    fn stiffness_test(&mut self, p: &mut Problem, t: f64, h: f64) {
         let (mut num, mut den) = (0.0, 0.0);
         for i in 0..self.n {
             let dv = self.kv[6][i] - self.kv[5][i];

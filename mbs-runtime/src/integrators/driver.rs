@@ -2,7 +2,7 @@
 //! consistent state, proposes steps, lands on stop and sample times, records outputs and
 //! turns failures into `SimError`s.
 
-use super::constrained::{Assembly, Constrained, Mode, assemble};
+use super::constrained::{Assembly, Constrained, Mode, assemble_erased};
 use super::dispatch::{constraint_mode, stepper_for};
 use super::inputs::{Controller, Inputs};
 use super::newton::NewtonTol;
@@ -12,11 +12,13 @@ use super::step_control::{Largest, StepBounds, Tolerances, component_name, initi
 use super::stepper::{Attempt, Control, Step, Stepper};
 use super::{Integrator, State};
 use crate::charts::{self, Recentring};
+use crate::erased::OwnedModel;
 use crate::error::{Failure, HeldMost};
 use crate::model::{Model, Pose};
 use crate::options::{Options, Output, Scheme, StepControl};
 use crate::stats::Stats;
 use crate::trajectory::{Observer, Trajectory};
+use std::marker::PhantomData;
 
 /// Runs `scheme` on `model` with `options` to the end; on failure, the error keeps the
 /// trajectory up to the failure.
@@ -36,15 +38,22 @@ pub fn simulate_with<M: Model + 'static>(
     inputs: Inputs,
 ) -> Result<(Trajectory, Stats), SimError> {
     let mut sim = Simulation::with_inputs(model, scheme, options, inputs)?;
-    let t_end = sim.options.t_end;
+    let t_end = sim.run.options.t_end;
     sim.integrate_to(t_end)?;
     Ok(sim.finish())
 }
 
 /// A running simulation: the model, the scheme, the state, the outputs and the work done.
 pub struct Simulation<M: Model> {
-    problem: Problem<M>,
-    stepper: Box<dyn Stepper<M>>,
+    run: Run,
+    model: PhantomData<fn() -> M>,
+}
+
+/// A simulation with its model's type erased: all of its work, compiled once whatever the
+/// model (`crate::erased`).
+struct Run {
+    problem: Problem,
+    stepper: Box<dyn Stepper>,
     scheme: Scheme,
     options: Options,
     ctl: Control,
@@ -100,8 +109,89 @@ impl<M: Model + 'static> Simulation<M> {
         inputs: Inputs,
     ) -> Result<Simulation<M>, SimError> {
         let names = Names::of(&model);
+        validate(&model, &scheme, &options, &inputs)
+            .map_err(|e| names.failure_at_start(e, options.t0, Stats::default()))?;
+        let run = Run::start(Box::new(model), names, scheme, options, inputs)?;
+        Ok(Simulation {
+            run,
+            model: PhantomData,
+        })
+    }
+
+    /// Adds an observer that sees every output as it is recorded.
+    pub fn observe(&mut self, o: impl Observer + 'static) {
+        self.run.observers.push(Box::new(o));
+    }
+
+    /// The scheme.
+    pub fn scheme(&self) -> Scheme {
+        self.run.scheme
+    }
+
+    /// The model.
+    pub fn model(&self) -> &M {
+        let any = self.run.problem.model.as_any();
+        any.downcast_ref()
+            .expect("the model the simulation was made with")
+    }
+
+    /// How the start was made consistent (constrained models only): residuals before and
+    /// after, iterations, the largest change.
+    pub fn assembly(&self) -> Option<&Assembly> {
+        self.run.assembly.as_ref()
+    }
+
+    /// The independent coordinates of coordinate partitioning, as they are now (empty for
+    /// other methods).
+    pub fn independent_coordinates(&self) -> Vec<String> {
+        self.run.independent_coordinates()
+    }
+
+    /// The step the next attempt will use.
+    pub fn h(&self) -> f64 {
+        self.run.h
+    }
+
+    /// Hands the outputs recorded since the last call to `sink`, then forgets them: a long run
+    /// written to disk as it goes keeps flat memory (a later failure's trajectory holds only
+    /// the outputs recorded after this call).
+    pub fn drain_outputs<R>(&mut self, sink: impl FnOnce(&Trajectory) -> R) -> R {
+        let r = sink(&self.run.traj);
+        self.run.traj.clear_outputs();
+        r
+    }
+
+    /// Trajectory and work counters (records the final state for `Output::Last`).
+    pub fn finish(self) -> (Trajectory, Stats) {
+        let (_, traj, stats) = self.run.finish();
+        (traj, stats)
+    }
+
+    /// [`Simulation::finish`], handing back the model too (its charts as the run left them),
+    /// for quantities computed from the trajectory afterwards (a sweep's metrics).
+    pub fn finish_with_model(self) -> (M, Trajectory, Stats) {
+        let (model, traj, stats) = self.run.finish();
+        let model = model.into_any().downcast::<M>();
+        (
+            *model.expect("the model the simulation was made with"),
+            traj,
+            stats,
+        )
+    }
+}
+
+impl Run {
+    /// From validated options: a consistent start, the scheme started on it, the outputs
+    /// at t₀.
+    fn start(
+        model: Box<dyn OwnedModel>,
+        names: Names,
+        scheme: Scheme,
+        options: Options,
+        inputs: Inputs,
+    ) -> Result<Run, SimError> {
         let early = |kind: Failure, stats: Stats| names.failure_at_start(kind, options.t0, stats);
-        validate(&model, &scheme, &options, &inputs).map_err(|e| early(e, Stats::default()))?;
+        let (n, nc, nframes) = (model.nq(), model.nc(), model.nframes());
         let mut problem = Problem::new(model, options.iteration_matrix);
         problem.input_fn = inputs.function;
         let mut controllers: Vec<(f64, u64, Box<dyn Controller>)> = inputs
@@ -113,7 +203,7 @@ impl<M: Model + 'static> Simulation<M> {
             // the order history is counted per order: sized now, not while stepping
             problem.stats.order_steps = vec![0; p.max_order];
         }
-        let mut cur = State::zeros(M::NQ, M::NC);
+        let mut cur = State::zeros(n, nc);
         let start = initial_state(&mut problem, &options, &mut cur)
             .and_then(|_| consistent_start(&mut problem, &scheme, &options, &mut cur))
             .and_then(|assembly| {
@@ -128,7 +218,7 @@ impl<M: Model + 'static> Simulation<M> {
             });
         let assembly = start.map_err(|e| early(e, problem.stats.clone()))?;
         let ctl = control(&options);
-        let mut stepper = stepper_for::<M>(&scheme, M::NQ);
+        let mut stepper = stepper_for(&scheme, n);
         if let Err(e) = stepper.start(&mut problem, &cur, &ctl) {
             return Err(early(e, problem.stats.clone()));
         }
@@ -159,10 +249,10 @@ impl<M: Model + 'static> Simulation<M> {
             _ => out_times.len(),
         };
         traj.reserve(expected, options.energy, options.frames);
-        let held_counts = vec![0; M::NQ + cur.lambda.len()];
+        let held_counts = vec![0; n + cur.lambda.len()];
         let largest = |v: &[f64]| v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
         let start_scale = [largest(&cur.q), largest(&cur.qd)];
-        let mut sim = Simulation {
+        let mut sim = Run {
             start_scale,
             problem,
             stepper,
@@ -180,7 +270,7 @@ impl<M: Model + 'static> Simulation<M> {
             traj,
             out_times,
             out_next: 0,
-            poses: vec![Pose::default(); M::NFRAMES],
+            poses: vec![Pose::default(); nframes],
             observers: Vec::new(),
             options,
             assembly,
@@ -211,59 +301,17 @@ impl<M: Model + 'static> Simulation<M> {
         }
     }
 
-    /// Adds an observer that sees every output as it is recorded.
-    pub fn observe(&mut self, o: impl Observer + 'static) {
-        self.observers.push(Box::new(o));
-    }
-
-    /// The scheme.
-    pub fn scheme(&self) -> Scheme {
-        self.scheme
-    }
-
-    /// The model.
-    pub fn model(&self) -> &M {
-        &self.problem.model
-    }
-
-    /// How the start was made consistent (constrained models only): residuals before and
-    /// after, iterations, the largest change.
-    pub fn assembly(&self) -> Option<&Assembly> {
-        self.assembly.as_ref()
-    }
-
-    /// The independent coordinates of coordinate partitioning, as they are now (empty for
-    /// other methods).
-    pub fn independent_coordinates(&self) -> Vec<String> {
+    /// The independent coordinates of coordinate partitioning, as they are now.
+    fn independent_coordinates(&self) -> Vec<String> {
         match self.problem.loops.closed() {
             Some(c) if c.mode == Mode::Partitioning => c.independent_labels(),
             _ => Vec::new(),
         }
     }
 
-    /// The step the next attempt will use.
-    pub fn h(&self) -> f64 {
-        self.h
-    }
-
-    /// Hands the outputs recorded since the last call to `sink`, then forgets them: a long run
-    /// written to disk as it goes keeps flat memory (a later failure's trajectory holds only
-    /// the outputs recorded after this call).
-    pub fn drain_outputs<R>(&mut self, sink: impl FnOnce(&Trajectory) -> R) -> R {
-        let r = sink(&self.traj);
-        self.traj.clear_outputs();
-        r
-    }
-
-    /// Trajectory and work counters (records the final state for `Output::Last`).
-    pub fn finish(self) -> (Trajectory, Stats) {
-        let (_, traj, stats) = self.finish_with_model();
-        (traj, stats)
-    }
-
-    /// [`Simulation::finish`], handing back the model too (its charts as the run left them),
-    /// for quantities computed from the trajectory afterwards (a sweep's metrics).
-    pub fn finish_with_model(mut self) -> (M, Trajectory, Stats) {
+    /// The model, the trajectory and the work counters (the final state recorded for
+    /// `Output::Last`).
+    fn finish(mut self) -> (Box<dyn OwnedModel>, Trajectory, Stats) {
         if self.options.output == Output::Last && self.traj.is_empty() {
             self.record_cur();
         }
@@ -373,11 +421,10 @@ impl<M: Model + 'static> Simulation<M> {
             return Ok(());
         }
         let cur = &mut self.cur;
-        let evaluate = charts::recentre_below(
-            &mut self.problem.model,
+        let evaluate = charts::recentre_below_erased(
+            self.problem.model.erased_mut(),
             threshold,
-            &mut cur.q,
-            &mut cur.qd,
+            [&mut cur.q, &mut cur.qd],
             Some(&mut cur.qdd),
             &mut self.moved,
         );
@@ -424,7 +471,7 @@ impl<M: Model + 'static> Simulation<M> {
     fn sample(&mut self) -> Result<(), Failure> {
         let (t0, t) = (self.options.t0, self.cur.t);
         let mut any = false;
-        charts::read_charts(&self.problem.model, &mut self.charts);
+        charts::read_charts_erased(self.problem.model.erased(), &mut self.charts);
         for (p, k, c) in self.controllers.iter_mut() {
             let due = t0 + *k as f64 * *p;
             if due <= t + 1e-12 * t.abs().max(1.0) {
@@ -626,7 +673,7 @@ impl<M: Model + 'static> Simulation<M> {
     }
 }
 
-impl<M: Model + 'static> Integrator for Simulation<M> {
+impl Run {
     fn step(&mut self) -> Result<(), SimError> {
         if self.cur.t >= self.options.t_end {
             return Ok(());
@@ -642,17 +689,27 @@ impl<M: Model + 'static> Integrator for Simulation<M> {
         }
         Ok(())
     }
+}
+
+impl<M: Model + 'static> Integrator for Simulation<M> {
+    fn step(&mut self) -> Result<(), SimError> {
+        self.run.step()
+    }
+
+    fn integrate_to(&mut self, t: f64) -> Result<(), SimError> {
+        self.run.integrate_to(t)
+    }
 
     fn state(&self) -> &State {
-        &self.cur
+        &self.run.cur
     }
 
     fn stats(&self) -> &Stats {
-        &self.problem.stats
+        &self.run.problem.stats
     }
 
     fn trajectory(&self) -> &Trajectory {
-        &self.traj
+        &self.run.traj
     }
 }
 
@@ -742,11 +799,7 @@ fn validate<M: Model>(
 }
 
 /// t₀ and the given or declared q₀, qd₀ into `cur`, checked finite.
-fn initial_state<M: Model>(
-    problem: &mut Problem<M>,
-    options: &Options,
-    cur: &mut State,
-) -> Result<(), Failure> {
+fn initial_state(problem: &mut Problem, options: &Options, cur: &mut State) -> Result<(), Failure> {
     cur.t = options.t0;
     problem.model.initial_state(&mut cur.q, &mut cur.qd);
     if let Some(q0) = &options.q0 {
@@ -760,11 +813,10 @@ fn initial_state<M: Model>(
     // a rotation joint that starts near gimbal lock starts in a chart centred on it
     if options.chart_switch > 0.0 {
         let mut moved = Vec::new();
-        charts::recentre_below(
-            &mut problem.model,
+        charts::recentre_below_erased(
+            problem.model.erased_mut(),
             options.chart_switch,
-            &mut cur.q,
-            &mut cur.qd,
+            [&mut cur.q, &mut cur.qd],
             None,
             &mut moved,
         );
@@ -781,25 +833,25 @@ fn chart_quaternion(c: &[[f64; 3]; 3]) -> [f64; 4] {
 
 /// A constrained model: the constraint method, the assembly of q₀ and qd₀, the partition
 /// when partitioning; the model's constraints are then set in `problem`.
-fn consistent_start<M: Model>(
-    problem: &mut Problem<M>,
+fn consistent_start(
+    problem: &mut Problem,
     scheme: &Scheme,
     options: &Options,
     cur: &mut State,
 ) -> Result<Option<Assembly>, Failure> {
-    if M::NC == 0 {
+    if problem.model.nc() == 0 {
         return Ok(None);
     }
     let oc = &options.constraints;
     let adaptive = matches!(options.step, StepControl::Adaptive { .. });
     let mode = constraint_mode(oc.method, scheme, adaptive)?;
-    let a = assemble(&problem.model, cur.t, &mut cur.q, &mut cur.qd, oc)?;
+    let a = assemble_erased(problem.model.erased(), cur.t, &mut cur.q, &mut cur.qd, oc)?;
     problem
         .model
         .complete_start(cur.t, &mut cur.q, &mut cur.qd)?;
-    let mut c = Constrained::new(&problem.model, mode, oc);
+    let mut c = Constrained::new(problem.model.erased(), mode, oc);
     if mode == Mode::Partitioning {
-        c.eval_b(&problem.model, &mut problem.stats, cur.t, &cur.q);
+        c.eval_b(problem.model.erased(), &mut problem.stats, cur.t, &cur.q);
         let marks = problem.model.info().independent;
         let marked = marks.iter().any(|&m| m);
         c.choose_partition(marked.then_some(marks), &mut problem.stats);
@@ -810,14 +862,15 @@ fn consistent_start<M: Model>(
 
 /// The controllers' first sample on the consistent positions and velocities, then qdd₀
 /// (and λ₀) there; singular configurations are judged against the factor of M found now.
-fn first_sample<M: Model>(
-    problem: &mut Problem<M>,
+fn first_sample(
+    problem: &mut Problem,
     controllers: &mut [(f64, u64, Box<dyn Controller>)],
     singularity_tol: f64,
     implicit: bool,
     cur: &mut State,
 ) -> Result<(), Failure> {
-    let charts = charts::charts_of(&problem.model);
+    let mut charts = Vec::new();
+    charts::read_charts_erased(problem.model.erased(), &mut charts);
     for (_, count, c) in controllers.iter_mut() {
         c.sample_in_charts(cur.t, cur, &charts, &mut problem.held);
         *count = 1;

@@ -23,7 +23,6 @@
 use super::problem::Problem;
 use super::{Attempt, State, Step, Stepper};
 use crate::error::Failure;
-use crate::model::Model;
 
 #[derive(Clone, Copy, PartialEq)]
 enum Kind {
@@ -172,9 +171,9 @@ impl StabilityWatch {
     /// Before a step of size h from `cur`: every 16 steps, every 4 within a factor 2 of the
     /// limit and after a lurch, estimates ρ and refuses the step with `UnstableStep` when h·ρ
     /// exceeds `limit(oscillating)` (the scheme's stability radius for the kind of mode).
-    pub(crate) fn check<M: Model>(
+    pub(crate) fn check(
         &mut self,
-        p: &mut Problem<M>,
+        p: &mut Problem,
         cur: &State,
         h: f64,
         scheme: &'static str,
@@ -196,9 +195,9 @@ impl StabilityWatch {
     /// At the start (`settle`), and before refusing a step, the estimate is iterated until it
     /// settles: one iteration from the seed direction can be far below ρ, and the message
     /// advises a step from it. `at_end`: `s` is the end of the step (see [`Self::after`]).
-    fn judge<M: Model>(
+    fn judge(
         &mut self,
-        p: &mut Problem<M>,
+        p: &mut Problem,
         (s, h, scheme): (&State, f64, &'static str),
         limit: impl Fn(bool) -> f64,
         settle: bool,
@@ -237,9 +236,9 @@ impl StabilityWatch {
     /// step to catch it (the double pendulum started where gravity has no stiffness, one step
     /// of explicit Euler to t_end = 10 s: ρ ≈ 0 at the start, the energy 100 % off at the end,
     /// no word).
-    pub(crate) fn after<M: Model>(
+    pub(crate) fn after(
         &mut self,
-        p: &mut Problem<M>,
+        p: &mut Problem,
         steps: (&State, &State, f64),
         scheme: &'static str,
         limit: impl Fn(bool) -> f64,
@@ -269,9 +268,9 @@ impl StabilityWatch {
 
     /// Estimates ρ now: one power iteration, and with `settle` more until it changes by less
     /// than 0.1 %.
-    pub(crate) fn refresh<M: Model>(
+    pub(crate) fn refresh(
         &mut self,
-        p: &mut Problem<M>,
+        p: &mut Problem,
         cur: &State,
         settle: bool,
     ) -> Result<(), Failure> {
@@ -283,7 +282,7 @@ impl StabilityWatch {
     }
 
     /// Iterates the estimate until it changes by less than 0.1 % (at most 30 times).
-    fn settle<M: Model>(&mut self, p: &mut Problem<M>, cur: &State) -> Result<(), Failure> {
+    fn settle(&mut self, p: &mut Problem, cur: &State) -> Result<(), Failure> {
         for _ in 0..30 {
             let last = self.rho;
             self.rho = self.estimate_rho(p, cur)?;
@@ -301,7 +300,7 @@ impl StabilityWatch {
     }
 
     /// One power-iteration step on J²; returns the estimate of ρ(J).
-    fn estimate_rho<M: Model>(&mut self, p: &mut Problem<M>, s: &State) -> Result<f64, Failure> {
+    fn estimate_rho(&mut self, p: &mut Problem, s: &State) -> Result<f64, Failure> {
         let n0 = norm2(&self.dq, &self.dv);
         self.probe
             .apply_j(p, s, &self.dq, &self.dv, &mut self.jq, &mut self.jv)?;
@@ -357,9 +356,9 @@ impl Probe {
     }
 
     /// (oq, ov) = J·(iq, iv) at `s`, by a forward difference of the accelerations.
-    pub(crate) fn apply_j<M: Model>(
+    pub(crate) fn apply_j(
         &mut self,
-        p: &mut Problem<M>,
+        p: &mut Problem,
         s: &State,
         iq: &[f64],
         iv: &[f64],
@@ -387,8 +386,8 @@ impl Probe {
     }
 }
 
-impl<M: Model> Stepper<M> for Explicit {
-    fn attempt(&mut self, step: Step<'_, M>) -> Result<Attempt, Failure> {
+impl Stepper for Explicit {
+    fn attempt(&mut self, step: Step<'_>) -> Result<Attempt, Failure> {
         let Step(p, cur, h, ctl, next) = step;
         if ctl.stability_check {
             let kind = self.kind;

@@ -12,7 +12,6 @@ use super::problem::Problem;
 use super::{Attempt, Control, State, Step, Stepper};
 use crate::charts::Recentring;
 use crate::error::Failure;
-use crate::model::Model;
 
 pub(crate) struct Midpoint {
     n: usize,
@@ -35,19 +34,19 @@ impl Midpoint {
     }
 }
 
-impl<M: Model> Stepper<M> for Midpoint {
+impl Stepper for Midpoint {
     fn newton_largest(&self) -> Option<(usize, usize)> {
         self.newton.largest
     }
 
-    fn start(&mut self, _p: &mut Problem<M>, s: &State, _ctl: &Control) -> Result<(), Failure> {
+    fn start(&mut self, _p: &mut Problem, s: &State, _ctl: &Control) -> Result<(), Failure> {
         self.a.copy_from_slice(&s.qdd);
         Ok(())
     }
 
     fn rechart(
         &mut self,
-        p: &mut Problem<M>,
+        p: &mut Problem,
         s: &State,
         ctl: &Control,
         _moved: &[Recentring],
@@ -57,7 +56,7 @@ impl<M: Model> Stepper<M> for Midpoint {
         self.start(p, s, ctl)
     }
 
-    fn attempt(&mut self, step: Step<'_, M>) -> Result<Attempt, Failure> {
+    fn attempt(&mut self, step: Step<'_>) -> Result<Attempt, Failure> {
         let Step(p, cur, h, ctl, next) = step;
         for i in 0..self.n {
             self.qhat[i] = cur.q[i] + 0.5 * h * cur.qd[i];

@@ -219,7 +219,7 @@ impl AlphaFamily {
     }
 }
 
-impl<M: Model> Stepper<M> for AlphaFamily {
+impl Stepper for AlphaFamily {
     fn last_test(&self) -> ErrorNorm {
         self.test
     }
@@ -232,14 +232,14 @@ impl<M: Model> Stepper<M> for AlphaFamily {
         order_two_floored(rtol, TOL_FACTOR, FLOOR)
     }
 
-    fn error_test(&self, p: &Problem<M>) -> ErrorTest {
+    fn error_test(&self, p: &Problem) -> ErrorTest {
         match p.loops.closed() {
             Some(c) if c.mode == Mode::Index2 => ErrorTest::PositionsVelocities,
             _ => ErrorTest::Positions,
         }
     }
 
-    fn start(&mut self, p: &mut Problem<M>, s: &State, _ctl: &Control) -> Result<(), Failure> {
+    fn start(&mut self, p: &mut Problem, s: &State, _ctl: &Control) -> Result<(), Failure> {
         self.a.copy_from_slice(&s.qdd);
         self.h_prev = None;
         let solved = p
@@ -264,7 +264,7 @@ impl<M: Model> Stepper<M> for AlphaFamily {
     /// starts again (its last acceleration is of another configuration).
     fn rechart(
         &mut self,
-        _p: &mut Problem<M>,
+        _p: &mut Problem,
         s: &State,
         _ctl: &Control,
         moved: &[Recentring],
@@ -284,7 +284,7 @@ impl<M: Model> Stepper<M> for AlphaFamily {
         Ok(())
     }
 
-    fn attempt(&mut self, step: Step<'_, M>) -> Result<Attempt, Failure> {
+    fn attempt(&mut self, step: Step<'_>) -> Result<Attempt, Failure> {
         let Step(p, cur, h, ctl, next) = step;
         let (am, af, b, g) = (self.alpha_m, self.alpha_f, self.beta, self.gamma);
         // a₁ = c·qdd₁ + a_c, with a_c from the current state
@@ -400,7 +400,7 @@ impl<M: Model> Stepper<M> for AlphaFamily {
         }
     }
 
-    fn accepted(&mut self, _p: &mut Problem<M>, prev: &State, cur: &State) {
+    fn accepted(&mut self, _p: &mut Problem, prev: &State, cur: &State) {
         std::mem::swap(&mut self.a, &mut self.a_next);
         self.qdd_prev.copy_from_slice(&prev.qdd);
         self.h_prev = Some(cur.t - prev.t);
@@ -410,7 +410,7 @@ impl<M: Model> Stepper<M> for AlphaFamily {
 /// The iteration matrix of an index-3 generalized-α step of size `h` (N × N column-major,
 /// N = NQ + NC), evaluated at `state` (q, qd, qdd, λ), with the constraint rows scaled by
 /// 1/β' or not: the matrix the integrator factorises, exposed for condition studies.
-pub fn index3_iteration_matrix<M: Model>(
+pub fn index3_iteration_matrix<M: Model + 'static>(
     model: M,
     params: GenAlphaParams,
     h: f64,
@@ -421,8 +421,12 @@ pub fn index3_iteration_matrix<M: Model>(
         scaling: scaled,
         ..Default::default()
     };
-    let mut p = Problem::new(model, crate::options::IterationMatrix::Auto);
-    p.loops = Loops::Closed(Box::new(Constrained::new(&p.model, Mode::Index3, &options)));
+    let mut p = Problem::new(Box::new(model), crate::options::IterationMatrix::Auto);
+    p.loops = Loops::Closed(Box::new(Constrained::new(
+        p.model.erased(),
+        Mode::Index3,
+        &options,
+    )));
     let mut newton = AccelNewton::new(M::NQ);
     newton.enable_index3(M::NC, scaled, options.tolerance);
     let c = (1.0 - params.alpha_f) / (1.0 - params.alpha_m);

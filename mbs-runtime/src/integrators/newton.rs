@@ -48,7 +48,6 @@ use super::problem::Problem;
 use super::step_control::Argmax;
 use crate::error::Failure;
 use crate::linalg::Lu;
-use crate::model::Model;
 use crate::options::IterationMatrix;
 
 const INDEX3_MATRIX: &str = "the index-3 iteration matrix [M + γ'C + β'K, −Bᵀ; B, 0]";
@@ -193,9 +192,9 @@ impl AccelNewton {
 
     /// Stabilized index 2: B₀ = B(q₀) at the start (t₀, q₀) of the step to solve, along
     /// which the second multiplier moves the positions; ν starts from zero.
-    pub fn index2_start<M: Model>(&mut self, p: &mut Problem<M>, t0: f64, q0: &[f64]) {
+    pub fn index2_start(&mut self, p: &mut Problem, t0: f64, q0: &[f64]) {
         if let Some(c) = p.loops.closed_mut() {
-            c.eval_b(&p.model, &mut p.stats, t0, q0);
+            c.eval_b(p.model.erased(), &mut p.stats, t0, q0);
             self.b0.copy_from_slice(&c.b);
         }
         self.nu.fill(0.0);
@@ -204,9 +203,9 @@ impl AccelNewton {
     /// Solves τ(t, q̂ + β'a, v̂ + γ'a, a) = 0; `a` holds the guess and receives the solution.
     /// Returns the iterations used. `q` and `v` of the solution are then in [`AccelNewton::q`]
     /// and [`AccelNewton::v`].
-    pub fn solve<M: Model>(
+    pub fn solve(
         &mut self,
-        p: &mut Problem<M>,
+        p: &mut Problem,
         step: Affine,
         a: &mut [f64],
         tol: &NewtonTol,
@@ -216,9 +215,9 @@ impl AccelNewton {
 
     /// [`AccelNewton::solve`] with the multipliers λ as unknowns too (after
     /// [`AccelNewton::enable_index3`]; `lambda` empty otherwise).
-    pub fn solve_index3<M: Model>(
+    pub fn solve_index3(
         &mut self,
-        p: &mut Problem<M>,
+        p: &mut Problem,
         step: Affine,
         a: &mut [f64],
         lambda: &mut [f64],
@@ -377,9 +376,9 @@ impl AccelNewton {
 
     /// r[..n] −= Bᵀλ at the current q; r[n..n + nc] = Φ(q)/β' (scaled) or Φ(q); index 2:
     /// r[n + nc..] = (B(q)v + Φ_t)/γ' (scaled) or B(q)v + Φ_t.
-    fn index3_residual<M: Model>(
+    fn index3_residual(
         &mut self,
-        p: &mut Problem<M>,
+        p: &mut Problem,
         t: f64,
         lambda: &[f64],
         w: Weights,
@@ -388,8 +387,8 @@ impl AccelNewton {
         let (n, nc) = (self.n, self.nc);
         // open loops have no multipliers and no constraint rows
         if let Some(c) = p.loops.closed_mut() {
-            c.eval_b(&p.model, &mut p.stats, t, &self.q);
-            c.eval_phi(&p.model, &mut p.stats, t, &self.q);
+            c.eval_b(p.model.erased(), &mut p.stats, t, &self.q);
+            c.eval_phi(p.model.erased(), &mut p.stats, t, &self.q);
             for j in 0..n {
                 self.r[j] -= (0..nc).map(|k| c.b[k + nc * j] * lambda[k]).sum::<f64>();
             }
@@ -416,9 +415,9 @@ impl AccelNewton {
     }
 
     /// The index-3 iteration matrix at the current (q, v, a, λ), unfactorised, in `self.lu`.
-    fn index3_matrix<M: Model>(
+    fn index3_matrix(
         &mut self,
-        p: &mut Problem<M>,
+        p: &mut Problem,
         t: f64,
         a: &[f64],
         lambda: &[f64],
@@ -437,7 +436,7 @@ impl AccelNewton {
         // B borders the matrix (nothing for open loops)
         let b: &[f64] = match p.loops.closed_mut() {
             Some(c) => {
-                c.eval_b(&p.model, &mut p.stats, t, &self.q);
+                c.eval_b(p.model.erased(), &mut p.stats, t, &self.q);
                 &c.b
             }
             None => &[],
@@ -499,10 +498,10 @@ impl AccelNewton {
     }
 
     /// Index 2: Z = ∂(B v + Φ_t)/∂q at the current (q, v), with B(q) in `self.bq`.
-    fn rate_jacobian<M: Model>(&mut self, p: &mut Problem<M>, t: f64) {
+    fn rate_jacobian(&mut self, p: &mut Problem, t: f64) {
         if let Some(c) = p.loops.closed_mut() {
             c.rate_jacobian(
-                &p.model,
+                p.model.erased(),
                 &mut p.stats,
                 t,
                 &self.q,
@@ -515,9 +514,9 @@ impl AccelNewton {
 
     /// The index-3 iteration matrix (N × N, N = n + nc, column-major) at (t, q̂ + β'a,
     /// v̂ + γ'a, a, λ), unfactorised: for condition studies.
-    pub fn index3_matrix_at<M: Model>(
+    pub fn index3_matrix_at(
         &mut self,
-        p: &mut Problem<M>,
+        p: &mut Problem,
         at: At,
         a: &[f64],
         lambda: &[f64],

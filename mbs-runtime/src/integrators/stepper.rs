@@ -7,7 +7,6 @@ use super::problem::Problem;
 use super::step_control::{PiController, Tolerances};
 use crate::charts::Recentring;
 use crate::error::Failure;
-use crate::model::Model;
 use crate::stats::ErrorTest;
 
 /// What one attempted step gave.
@@ -61,8 +60,8 @@ pub(crate) struct Control {
 /// One attempted step, as the driver hands it to a scheme: the model, the state the step
 /// starts from, its size, the controls, and the state to fill when it is accepted.
 /// A scheme takes it apart as `let Step(p, cur, h, ctl, next) = step;`.
-pub(crate) struct Step<'a, M: Model>(
-    pub &'a mut Problem<M>,
+pub(crate) struct Step<'a>(
+    pub &'a mut Problem,
     pub &'a State,
     pub f64,
     pub &'a Control,
@@ -70,15 +69,15 @@ pub(crate) struct Step<'a, M: Model>(
 );
 
 /// A scheme, as the driver sees it.
-pub(crate) trait Stepper<M: Model> {
+pub(crate) trait Stepper {
     /// Called once with the consistent initial state.
-    fn start(&mut self, _p: &mut Problem<M>, _s: &State, _ctl: &Control) -> Result<(), Failure> {
+    fn start(&mut self, _p: &mut Problem, _s: &State, _ctl: &Control) -> Result<(), Failure> {
         Ok(())
     }
     /// Attempts a step of size `step.h` from `step.cur`; on acceptance fills `step.next`.
-    fn attempt(&mut self, step: Step<'_, M>) -> Result<Attempt, Failure>;
+    fn attempt(&mut self, step: Step<'_>) -> Result<Attempt, Failure>;
     /// The components the local error test measures with adaptive steps (after `start`).
-    fn error_test(&self, _p: &Problem<M>) -> ErrorTest {
+    fn error_test(&self, _p: &Problem) -> ErrorTest {
         ErrorTest::PositionsVelocities
     }
     /// The relative tolerance the local error test holds for the user's `rtol` when the
@@ -94,7 +93,7 @@ pub(crate) trait Stepper<M: Model> {
     /// that keeps matrices or history in the coordinates drops or maps them.
     fn rechart(
         &mut self,
-        p: &mut Problem<M>,
+        p: &mut Problem,
         s: &State,
         ctl: &Control,
         moved: &[Recentring],
@@ -116,7 +115,7 @@ pub(crate) trait Stepper<M: Model> {
         None
     }
     /// Called once the driver has accepted the step from `prev` to `cur`.
-    fn accepted(&mut self, _p: &mut Problem<M>, _prev: &State, _cur: &State) {}
+    fn accepted(&mut self, _p: &mut Problem, _prev: &State, _cur: &State) {}
     /// Dense output on [prev.t, cur.t]: by default the quintic Hermite interpolant of
     /// (q, qd, qdd) at both ends, accurate beyond every scheme's order here.
     fn interpolate(&self, prev: &State, cur: &State, t: f64, out: &mut State) {

@@ -7,10 +7,9 @@ use super::super::constrained::{Constrained, Mode};
 use super::Problem;
 use crate::error::Failure;
 use crate::linalg::Lu;
-use crate::model::Model;
 use crate::options::IterationMatrix;
 
-impl<M: Model> Problem<M> {
+impl Problem {
     /// qdd and λ (into `c.lambda`) of the index-1 equations of the closed loops `c`, after
     /// completing the dependent coordinates when partitioning; the last evaluation is cached.
     pub(super) fn closed_accel(
@@ -28,7 +27,7 @@ impl<M: Model> Problem<M> {
             return Ok(());
         }
         if c.mode == Mode::Partitioning {
-            c.complete(&self.model, &mut self.stats, t, q, qd)?;
+            c.complete(self.model.erased(), &mut self.stats, t, q, qd)?;
             self.qx.copy_from_slice(&c.qc);
             self.vx.copy_from_slice(&c.vc);
         } else {
@@ -44,7 +43,7 @@ impl<M: Model> Problem<M> {
         self.qx = qx;
         factorised?;
         c.kkt(
-            &self.model,
+            self.model.erased(),
             &mut self.stats,
             &self.chol,
             At::new(t, &self.qx, &self.vx),

@@ -3,12 +3,13 @@
 
 use super::super::at::{At, Weights};
 use super::Problem;
+use crate::erased::ErasedModel;
 use crate::error::Failure;
 use crate::linalg::Lu;
-use crate::model::{DifferenceBuffers, Model};
+use crate::model::DifferenceBuffers;
 use crate::options::IterationMatrix;
 
-impl<M: Model> Problem<M> {
+impl Problem {
     /// Fills and factorises the iteration matrix M + γ'·C_t + β'·K_t at (t, q, qd, qdd): the
     /// derivative of τ(q̂ + β'a, v̂ + γ'a, a) with respect to a.
     pub fn iteration_matrix(
@@ -84,7 +85,7 @@ impl<M: Model> Problem<M> {
     }
 
     /// The model, its inputs at the time `inputs_at` set, and the buffers its differences use.
-    fn differencing(&mut self) -> (&M, &[f64], DifferenceBuffers<'_>) {
+    fn differencing(&mut self) -> (&dyn ErasedModel, &[f64], DifferenceBuffers<'_>) {
         let work = DifferenceBuffers {
             tau0: &mut self.tau0,
             tau1: &mut self.tau1,
@@ -92,7 +93,7 @@ impl<M: Model> Problem<M> {
             vp: &mut self.vp,
             ap: &mut self.ap,
         };
-        (&self.model, &self.u, work)
+        (self.model.erased(), &self.u, work)
     }
 
     /// M, C_t and K_t (n × n, column-major) the last iteration matrix was made of, when it was

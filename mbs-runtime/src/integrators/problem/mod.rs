@@ -20,15 +20,15 @@ mod projection;
 mod watch;
 
 use super::constrained::{Constrained, Mode};
+use crate::erased::OwnedModel;
 use crate::error::Failure;
 use crate::linalg::{PIVOT_FLOOR, cholesky, cholesky_solve};
-use crate::model::Model;
 use crate::options::IterationMatrix;
 use crate::stats::Stats;
 use watch::{worst_pivot, worst_pivot_of};
 
-pub(crate) struct Problem<M: Model> {
-    pub model: M,
+pub(crate) struct Problem {
+    pub model: Box<dyn OwnedModel>,
     pub n: usize,
     /// inputs u at the time of the last evaluation: the time function's value plus the
     /// outputs the sampled controllers hold
@@ -116,9 +116,10 @@ impl Loops {
     }
 }
 
-impl<M: Model> Problem<M> {
-    pub fn new(model: M, iteration: IterationMatrix) -> Problem<M> {
-        let n = M::NQ;
+impl Problem {
+    pub fn new(model: Box<dyn OwnedModel>, iteration: IterationMatrix) -> Problem {
+        let (n, nu, nc) = (model.nq(), model.nu(), model.nc());
+        let forward = model.forward_dynamics_generated();
         let info = model.info();
         let labels = (0..n).map(|i| info.dof_label(i)).collect();
         let iteration = match iteration {
@@ -130,17 +131,17 @@ impl<M: Model> Problem<M> {
         Problem {
             model,
             n,
-            u: vec![0.0; M::NU],
+            u: vec![0.0; nu],
             input_fn: None,
-            held: vec![0.0; M::NU],
-            u_fn: vec![0.0; M::NU],
+            held: vec![0.0; nu],
+            u_fn: vec![0.0; nu],
             u_t: f64::NAN,
             stats: Stats::default(),
             iteration,
             singularity_tol: 0.0,
             start_pivots: z(),
             start_diagonal: z(),
-            forward: M::FORWARD_DYNAMICS_GENERATED,
+            forward,
             pivots: z(),
             start_forward: z(),
             mchk: vec![0.0; n * n],
@@ -166,7 +167,7 @@ impl<M: Model> Problem<M> {
             cache_q: z(),
             cache_v: z(),
             cache_a: z(),
-            cache_l: vec![0.0; M::NC],
+            cache_l: vec![0.0; nc],
         }
     }
 

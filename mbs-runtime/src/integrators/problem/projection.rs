@@ -7,9 +7,8 @@ use super::super::constrained::{Constrained, Mode};
 use super::{Loops, Problem};
 use crate::error::Failure;
 use crate::linalg::cholesky;
-use crate::model::Model;
 
-impl<M: Model> Problem<M> {
+impl Problem {
     /// Runs `f` on the constraints of closed loops, lent out of `self.loops` meanwhile
     /// (`open` without loops).
     fn with_closed<R>(&mut self, open: R, f: impl FnOnce(&mut Self, &mut Constrained) -> R) -> R {
@@ -42,11 +41,11 @@ impl<M: Model> Problem<M> {
         if let Err(s) = cholesky(&mut self.chol, self.n) {
             return Err(self.singular_mass(&self.chol, s));
         }
-        c.eval_b(&self.model, &mut self.stats, t, q);
+        c.eval_b(self.model.erased(), &mut self.stats, t, q);
         if c.tangent_part(&mut self.stats, &self.chol, e, &mut self.dx)
             .is_err()
         {
-            return Err(c.rank_failure(&self.model, &mut self.stats, t, q));
+            return Err(c.rank_failure(self.model.erased(), &mut self.stats, t, q));
         }
         Ok(())
     }
@@ -62,27 +61,35 @@ impl<M: Model> Problem<M> {
     fn closed_after_step(&mut self, c: &mut Constrained, next: &mut State) -> Result<(), Failure> {
         let t = next.t;
         match c.mode {
-            Mode::Index3 | Mode::Index2 => c.check_drift(&self.model, &mut self.stats, t, &next.q),
+            Mode::Index3 | Mode::Index2 => {
+                c.check_drift(self.model.erased(), &mut self.stats, t, &next.q)
+            }
             Mode::Baumgarte { .. } => {
                 let mut f = std::mem::take(&mut self.fa);
                 let r = self.closed_accel(c, t, &next.q, &next.qd, &mut f);
                 self.fa = f;
                 r?;
                 next.lambda.copy_from_slice(&c.lambda);
-                c.check_drift(&self.model, &mut self.stats, t, &next.q)
+                c.check_drift(self.model.erased(), &mut self.stats, t, &next.q)
             }
             Mode::Projection => {
                 self.model.mass_matrix(t, &next.q, &mut self.chol);
                 self.stats.mass_matrix += 1;
                 self.stats.factorizations += 1;
                 cholesky(&mut self.chol, self.n).map_err(|s| self.singular_mass(&self.chol, s))?;
-                c.project(&self.model, &mut self.stats, &self.chol, next, &mut self.dx)?;
+                c.project(
+                    self.model.erased(),
+                    &mut self.stats,
+                    &self.chol,
+                    next,
+                    &mut self.dx,
+                )?;
                 self.closed_accel(c, t, &next.q, &next.qd, &mut next.qdd)?;
                 next.lambda.copy_from_slice(&c.lambda);
                 Ok(())
             }
             Mode::Partitioning => {
-                c.complete(&self.model, &mut self.stats, t, &next.q, &next.qd)?;
+                c.complete(self.model.erased(), &mut self.stats, t, &next.q, &next.qd)?;
                 next.q.copy_from_slice(&c.qc);
                 next.qd.copy_from_slice(&c.vc);
                 self.closed_accel(c, t, &next.q, &next.qd, &mut next.qdd)?;

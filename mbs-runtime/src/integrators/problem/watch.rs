@@ -3,12 +3,12 @@
 //! coordinates involved.
 
 use super::Problem;
+use crate::erased::ErasedModel;
 use crate::error::Failure;
 use crate::linalg::{Singular, cholesky, cholesky_solve};
-use crate::model::Model;
 use crate::options::IterationMatrix;
 
-impl<M: Model> Problem<M> {
+impl Problem {
     /// The failure for a singular matrix whose pivot column `s.column` names a coordinate,
     /// or, past the coordinates (index-3 matrices), the multiplier of a constraint.
     pub(crate) fn singular(&self, matrix: &'static str, s: Singular) -> Failure {
@@ -158,7 +158,7 @@ impl<M: Model> Problem<M> {
     ) -> Failure {
         let n = self.n;
         let mut l = vec![0.0; n * n];
-        let log_det = |model: &M, q: &[f64], l: &mut [f64]| -> Option<f64> {
+        let log_det = |model: &dyn ErasedModel, q: &[f64], l: &mut [f64]| -> Option<f64> {
             model.mass_matrix(t, q, l);
             cholesky(l, n).ok()?;
             Some((0..n).map(|i| (l[i + n * i] * l[i + n * i]).ln()).sum())
@@ -201,9 +201,9 @@ impl<M: Model> Problem<M> {
         for j in 0..n {
             let dj = 1e-6 * q[j].abs().max(1.0);
             qp[j] = q[j] + dj;
-            let up = log_det(&self.model, &qp, &mut l);
+            let up = log_det(self.model.erased(), &qp, &mut l);
             qp[j] = q[j] - dj;
-            let down = log_det(&self.model, &qp, &mut l);
+            let down = log_det(self.model.erased(), &qp, &mut l);
             qp[j] = q[j];
             self.stats.mass_matrix += 2;
             self.stats.factorizations += 2;

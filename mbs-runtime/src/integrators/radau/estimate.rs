@@ -4,12 +4,11 @@
 use super::super::State;
 use super::super::problem::Problem;
 use super::{Radau, Tol};
-use crate::model::Model;
 
 impl Radau {
     /// err = (I − gJ)⁻¹ (r_q, r_v) in second-order form, into `err` = (e_q, e_v):
     /// (M + gC + g²K) e_v = M r_v − g K r_q, e_q = r_q + g e_v.
-    pub(super) fn filter<M: Model>(&mut self, p: &mut Problem<M>, g: f64) {
+    pub(super) fn filter(&mut self, p: &mut Problem, g: f64) {
         let n = self.n;
         for i in 0..n {
             let mut x = 0.0;
@@ -44,9 +43,9 @@ impl Radau {
     }
 
     /// RADAU5's error estimate of the converged step (`next` holds y₁), as a weighted norm.
-    pub(super) fn estimate<M: Model>(
+    pub(super) fn estimate(
         &mut self,
-        p: &mut Problem<M>,
+        p: &mut Problem,
         cur: &State,
         next: &State,
         h: f64,
@@ -100,7 +99,7 @@ impl Radau {
     /// Index 3: the filter (E − gJ)⁻¹ on y = (q, v, λ), E = diag(I, M, 0), in second-order
     /// form with the real block: [M + gC + g²K̃, −Bᵀ; B, 0] (e_v, g e_λ) =
     /// (b_v − gK̃ r_q, −(Φ + B r_q)/g), e_q = r_q + g e_v; into `err` as (e_q, h e_v, h² e_λ).
-    pub(super) fn filter3<M: Model>(&mut self, p: &mut Problem<M>, g: f64, h: f64) {
+    pub(super) fn filter3(&mut self, p: &mut Problem, g: f64, h: f64) {
         let (n, nc) = (self.n, self.nc);
         self.filter_rhs(g);
         self.lu_r.solve(&mut self.tmp);
@@ -146,9 +145,9 @@ impl Radau {
     /// Index 3: RADAU5's estimate for the DAE E y' = f(y), y = (q, v, λ), f = (v, h + Bᵀλ,
     /// Φ), with the velocity errors weighted by h and the multipliers' by h² (RADAU5's
     /// scaling of index-2 and index-3 components).
-    pub(super) fn estimate3<M: Model>(
+    pub(super) fn estimate3(
         &mut self,
-        p: &mut Problem<M>,
+        p: &mut Problem,
         cur: &State,
         next: &State,
         h: f64,
@@ -188,7 +187,7 @@ impl Radau {
 
     /// τ(t₀, qx, vx, qdd₀) − B(qx)ᵀ lx into `ax` and Φ(qx) into `phix`; false when an
     /// evaluation fails or is not finite.
-    pub(super) fn residual_at<M: Model>(&mut self, p: &mut Problem<M>, cur: &State) -> bool {
+    pub(super) fn residual_at(&mut self, p: &mut Problem, cur: &State) -> bool {
         let (n, nc) = (self.n, self.nc);
         let qdd0: &[f64] = if self.own_end_valid() {
             &self.own_end[..n]
@@ -201,8 +200,8 @@ impl Radau {
             return false;
         }
         if let Some(c) = p.loops.closed_mut() {
-            c.eval_b(&p.model, &mut p.stats, cur.t, &self.qx);
-            c.eval_phi(&p.model, &mut p.stats, cur.t, &self.qx);
+            c.eval_b(p.model.erased(), &mut p.stats, cur.t, &self.qx);
+            c.eval_phi(p.model.erased(), &mut p.stats, cur.t, &self.qx);
             for j in 0..n {
                 self.ax[j] -= (0..nc).map(|k| c.b[k + nc * j] * self.lx[k]).sum::<f64>();
             }

@@ -7,7 +7,6 @@ use super::super::problem::Problem;
 use super::{Radau, Tol};
 use crate::error::Failure;
 use crate::linalg::Field;
-use crate::model::Model;
 use crate::options::IterationMatrix;
 
 impl Radau {
@@ -43,12 +42,12 @@ impl Radau {
     /// with the accelerations as h²μ² against hμ for the velocities, so leaving it out costs
     /// Newton a contraction of about h·‖Z‖/‖B‖ per iteration, which limited the steps of fast
     /// loops.
-    pub(super) fn rate_jacobian<M: Model>(&mut self, p: &mut Problem<M>, cur: &State) {
+    pub(super) fn rate_jacobian(&mut self, p: &mut Problem, cur: &State) {
         if p.iteration == IterationMatrix::MassOnly {
             self.i2.z.fill(0.0);
         } else if let Some(c) = p.loops.closed_mut() {
             c.rate_jacobian(
-                &p.model,
+                p.model.erased(),
                 &mut p.stats,
                 cur.t,
                 &cur.q,
@@ -78,9 +77,9 @@ impl Radau {
     /// carried that error into the velocities between steps (Cash's pendulum at rtol 1e-8:
     /// 2e-9 between steps against 4e-11 at them). One evaluation of M and h and one solve
     /// of the bordered system per step.
-    pub(super) fn consistent_end<M: Model>(
+    pub(super) fn consistent_end(
         &mut self,
-        p: &mut Problem<M>,
+        p: &mut Problem,
         t: f64,
         next: &mut State,
     ) -> Result<(), Failure> {
@@ -95,13 +94,13 @@ impl Radau {
     }
 
     /// Index 2: the largest |Φ̇| = |B(Q_s)V_s + Φ_t| of the last stage (the new state), at t.
-    pub(super) fn final_rate<M: Model>(&mut self, p: &mut Problem<M>, t: f64) -> f64 {
+    pub(super) fn final_rate(&mut self, p: &mut Problem, t: f64) -> f64 {
         let (s, n, nc) = (self.k.s, self.n, self.nc);
         let (lo, hi) = ((s - 1) * n, s * n);
         let Some(c) = p.loops.closed_mut() else {
             return 0.0;
         };
-        c.eval_b(&p.model, &mut p.stats, t, &self.qs[lo..hi]);
+        c.eval_b(p.model.erased(), &mut p.stats, t, &self.qs[lo..hi]);
         p.model.constraint_rate(t, &self.qs[lo..hi], &mut self.phit);
         p.stats.constraints += 1;
         let v = &self.vs[lo..hi];
@@ -139,7 +138,7 @@ impl Radau {
     ///
     /// into `err` as (e_q, e_v, h e_λ); `phix` and `psix` hold Φ and Φ̇ (zero for the first
     /// estimate).
-    fn filter2<M: Model>(&mut self, p: &mut Problem<M>, g: f64, h: f64) {
+    fn filter2(&mut self, p: &mut Problem, g: f64, h: f64) {
         let (n, nc) = (self.n, self.nc);
         self.filter_rhs(g);
         for k in 0..nc {
@@ -162,9 +161,9 @@ impl Radau {
     /// Index 2: RADAU5's estimate for the index-2 DAE E y' = f(y); q and qd are differential
     /// components (unscaled), λ an index-2 one (weighted by h, RADAU5's scaling), μ (zero on
     /// the exact solution) left out.
-    pub(super) fn estimate2<M: Model>(
+    pub(super) fn estimate2(
         &mut self,
-        p: &mut Problem<M>,
+        p: &mut Problem,
         cur: &State,
         next: &State,
         h: f64,

@@ -7,7 +7,6 @@ use super::super::problem::Problem;
 use super::Radau;
 use crate::error::Failure;
 use crate::linalg::{C64, Field, Lu};
-use crate::model::Model;
 use crate::options::IterationMatrix;
 
 impl Radau {
@@ -70,9 +69,9 @@ impl Radau {
 
     /// Index 3: ∂(Bᵀλ)/∂q and B at the start of the step (with λ₀), frozen with M, C_t, K_t;
     /// K_t − ∂(Bᵀλ)/∂q replaces K_t in `km`.
-    pub(super) fn constraint_matrices<M: Model>(
+    pub(super) fn constraint_matrices(
         &mut self,
-        p: &mut Problem<M>,
+        p: &mut Problem,
         cur: &State,
     ) -> Result<(), Failure> {
         let (n, nc) = (self.n, self.nc);
@@ -86,7 +85,7 @@ impl Radau {
             }
         }
         if let Some(c) = p.loops.closed_mut() {
-            c.eval_b(&p.model, &mut p.stats, cur.t, &cur.q);
+            c.eval_b(p.model.erased(), &mut p.stats, cur.t, &cur.q);
             self.bm.copy_from_slice(&c.b);
         }
         Failure::non_finite("B = ∂Φ/∂q", &self.bm, |i| p.label((i / nc).min(n - 1)))?;
@@ -103,17 +102,17 @@ impl Radau {
     /// Index 3 and 2, stage i: r_i −= B(Q_i)ᵀΛ_i, Φ(Q_i, t) into `phis`, the largest |Φ_i|
     /// kept; at index 2 also Φ̇_i = B(Q_i)V_i + Φ_t(Q_i, t) into `psis` (its largest |Φ̇_i| in
     /// `psi_max`).
-    pub(super) fn constraint_residual<M: Model>(
+    pub(super) fn constraint_residual(
         &mut self,
-        p: &mut Problem<M>,
+        p: &mut Problem,
         i: usize,
         t: f64,
     ) -> Result<(), Failure> {
         let (n, nc) = (self.n, self.nc);
         let (lo, hi) = (i * n, (i + 1) * n);
         if let Some(c) = p.loops.closed_mut() {
-            c.eval_b(&p.model, &mut p.stats, t, &self.qs[lo..hi]);
-            c.eval_phi(&p.model, &mut p.stats, t, &self.qs[lo..hi]);
+            c.eval_b(p.model.erased(), &mut p.stats, t, &self.qs[lo..hi]);
+            c.eval_phi(p.model.erased(), &mut p.stats, t, &self.qs[lo..hi]);
             let lam = &self.lam[i * nc..(i + 1) * nc];
             for j in 0..n {
                 self.res[lo + j] -= (0..nc).map(|k| c.b[k + nc * j] * lam[k]).sum::<f64>();

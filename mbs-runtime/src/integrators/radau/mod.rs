@@ -333,7 +333,6 @@ use super::{Attempt, Control, State, Step, Stepper};
 use crate::charts::Recentring;
 use crate::error::Failure;
 use crate::linalg::{C64, Lu};
-use crate::model::Model;
 use crate::stats::ErrorTest;
 use tableau::Coefficients;
 
@@ -599,7 +598,7 @@ impl Radau {
 const NEWTON_RELAX: f64 = 1.2;
 const NEWTON_MARGIN: f64 = 0.9;
 
-impl<M: Model> Stepper<M> for Radau {
+impl Stepper for Radau {
     fn last_test(&self) -> ErrorNorm {
         self.test
     }
@@ -608,7 +607,7 @@ impl<M: Model> Stepper<M> for Radau {
         self.newton_largest.get()
     }
 
-    fn error_test(&self, p: &Problem<M>) -> ErrorTest {
+    fn error_test(&self, p: &Problem) -> ErrorTest {
         if p.loops.index3().is_some() {
             ErrorTest::PositionsScaledVelocities
         } else {
@@ -618,7 +617,7 @@ impl<M: Model> Stepper<M> for Radau {
         }
     }
 
-    fn start(&mut self, p: &mut Problem<M>, _s: &State, _ctl: &Control) -> Result<(), Failure> {
+    fn start(&mut self, p: &mut Problem, _s: &State, _ctl: &Control) -> Result<(), Failure> {
         if let Some(c) = p.loops.closed() {
             match c.mode {
                 Mode::Index3 => self.enable_constraints(c.nc, c.tol, false),
@@ -641,7 +640,7 @@ impl<M: Model> Stepper<M> for Radau {
     /// chart); the step-size controller keeps its history.
     fn rechart(
         &mut self,
-        _p: &mut Problem<M>,
+        _p: &mut Problem,
         _s: &State,
         _ctl: &Control,
         _moved: &[Recentring],
@@ -653,7 +652,7 @@ impl<M: Model> Stepper<M> for Radau {
         Ok(())
     }
 
-    fn attempt(&mut self, step: Step<'_, M>) -> Result<Attempt, Failure> {
+    fn attempt(&mut self, step: Step<'_>) -> Result<Attempt, Failure> {
         let Step(p, cur, h, ctl, next) = step;
         let (s, n) = (self.k.s, self.n);
         let tol = Tol::new(ctl, s);
@@ -813,7 +812,7 @@ impl<M: Model> Stepper<M> for Radau {
         }
     }
 
-    fn accepted(&mut self, _p: &mut Problem<M>, _prev: &State, _cur: &State) {
+    fn accepted(&mut self, _p: &mut Problem, _prev: &State, _cur: &State) {
         std::mem::swap(&mut self.acc, &mut self.acc_prev);
         std::mem::swap(&mut self.lam, &mut self.lam_prev);
         self.h_prev = self.h_try;

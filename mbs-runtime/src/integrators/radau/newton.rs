@@ -12,17 +12,11 @@ use super::{
 };
 use crate::error::Failure;
 use crate::linalg::{C64, Singular};
-use crate::model::Model;
 
 impl Radau {
     /// Factorises the complex block (and the real one when `real`) for step h, unless
     /// factorised for this h already. At index 3 the blocks are bordered by −Bᵀ and B.
-    pub(super) fn factor<M: Model>(
-        &mut self,
-        p: &mut Problem<M>,
-        h: f64,
-        real: bool,
-    ) -> Result<(), Failure> {
+    pub(super) fn factor(&mut self, p: &mut Problem, h: f64, real: bool) -> Result<(), Failure> {
         let close = |x: f64, y: f64| (x - y).abs() <= 1e-10 * x.abs().max(y.abs());
         let (n, nc) = (self.n, self.nc);
         let big = n + if self.index2 { 2 * nc } else { nc };
@@ -78,12 +72,7 @@ impl Radau {
 
     /// The failure for a singular iteration matrix (named plain, index 3, index 2): its pivot
     /// column names a coordinate, or (index 3, 2) a multiplier of a constraint.
-    pub(super) fn singular<M: Model>(
-        &self,
-        p: &Problem<M>,
-        e: Singular,
-        names: [&'static str; 3],
-    ) -> Failure {
+    pub(super) fn singular(&self, p: &Problem, e: Singular, names: [&'static str; 3]) -> Failure {
         let k = match (self.nc, self.index2) {
             (0, _) => 0,
             (_, false) => 1,
@@ -155,7 +144,7 @@ impl Radau {
     /// B W_μ = −[(T⁻¹ ⊗ I) Φ]_μ / (h²μ²); at index 2 also the μ corrections, whose unknowns in
     /// block μ are Z_μ/(hμ), with the rows B W_μ + BBᵀ Z_μ/(hμ) = −[(T⁻¹ ⊗ I) Φ]_μ / (h²μ²)
     /// and B W_μ = −[(T⁻¹ ⊗ I) Φ̇]_μ / (hμ).
-    pub(super) fn correction<M: Model>(&mut self, p: &mut Problem<M>, h: f64) {
+    pub(super) fn correction(&mut self, p: &mut Problem, h: f64) {
         let (s, n, nc) = (self.k.s, self.n, self.nc);
         let (t, ti, kc) = (&self.k.t, &self.k.ti, self.k.complex);
         let index2 = self.index2;
@@ -280,9 +269,9 @@ impl Radau {
     }
 
     /// Simplified Newton on the stage accelerations (RADAU5's iteration and stopping rules).
-    pub(super) fn newton<M: Model>(
+    pub(super) fn newton(
         &mut self,
-        p: &mut Problem<M>,
+        p: &mut Problem,
         cur: &State,
         h: f64,
         tol: &Tol,

@@ -4,8 +4,8 @@
 //! study.
 //!
 //! ```text
-//! cargo run --release --example tour                 # writes to target/tour
-//! cargo run --release --example tour -- --out DIR
+//! cargo run --release -p mbs-tour --example tour            # writes to target/tour
+//! cargo run --release -p mbs-tour --example tour -- --out DIR
 //! ```
 
 use clap::Parser;

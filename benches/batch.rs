@@ -94,7 +94,8 @@ fn main() {
     ];
     c.final_summary();
     // criterion's medians exist after a measuring run (`cargo bench`), not in test mode
-    println!("\nmedians, ns for {LANES} states   one state ×{LANES}    lanes   throughput   goal");
+    println!("\nprocessor: {}", common::processor());
+    println!("medians, ns for {LANES} states   one state ×{LANES}    lanes   throughput   goal");
     for name in names {
         let group = format!("batch_{name}");
         for (f, one, lanes) in [

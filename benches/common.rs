@@ -30,3 +30,27 @@ pub fn median_ns(group: &str, id: &str, since: SystemTime) -> Option<f64> {
     let v: serde_json::Value = serde_json::from_str(&text).ok()?;
     v["median"]["point_estimate"].as_f64()
 }
+
+/// The processor the figures were measured on, as Linux describes it (`/proc/cpuinfo`: its
+/// name, and its family and model, which tell its generation where a virtual machine names
+/// it only by its maker): timings, and the ratios between code of different shapes, depend
+/// on it. `unknown` elsewhere.
+#[allow(dead_code)] // the benchmarks that print a summary print it
+pub fn processor() -> String {
+    let Ok(info) = std::fs::read_to_string("/proc/cpuinfo") else {
+        return "unknown".into();
+    };
+    let field = |key: &str| {
+        info.lines()
+            .find(|l| l.split(':').next().is_some_and(|k| k.trim() == key))
+            .and_then(|l| l.split_once(':'))
+            .map(|(_, v)| v.trim().to_string())
+    };
+    match (field("model name"), field("cpu family"), field("model")) {
+        (Some(name), Some(family), Some(model)) => {
+            format!("{name} (family {family}, model {model})")
+        }
+        (Some(name), ..) => name,
+        _ => "unknown".into(),
+    }
+}

@@ -106,6 +106,11 @@ cd "$dir"
 export CARGO_TARGET_DIR="$dir/target"
 # for every build, the untimed ones too: a change of it rebuilds the path dependencies
 export CARGO_INCREMENTAL=0
+# the processor: build times, like run times, depend on it
+if [ -r /proc/cpuinfo ]; then
+    field() { grep -m1 "^$1[[:space:]]*:" /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//'; }
+    echo "processor: $(field 'model name') (family $(field 'cpu family'), model $(field model))"
+fi
 cases=("${@:-arm24 chain32 hexapod hexapod-radau chain200 arm24-dev arm24-batch}")
 for case in ${cases[@]}; do
     profile=release

@@ -117,7 +117,8 @@ fn main() {
     if medians.is_empty() {
         return;
     }
-    println!("\nmedians (ns per call)      dense   forward   ratio   goal");
+    println!("\nprocessor: {}", common::processor());
+    println!("medians (ns per call)      dense   forward   ratio   goal");
     for ((name, n, goal), d, f) in medians {
         let verdict = if f / d <= *goal { "met" } else { "MISSED" };
         println!(

@@ -145,6 +145,7 @@ fn main() {
     for path in &paths {
         let _ = std::fs::remove_file(path);
     }
+    println!("processor: {}", common::processor());
     println!(
         "ns per call: each of {copies} fresh copies of this binary (its {rounds} runs, taking turns with the others), then over the copies' best"
     );

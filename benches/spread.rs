@@ -1,8 +1,8 @@
 //! The spread of timings over fresh copies of one binary: the time of a large straight-line
 //! function depends on where its pages land in memory, so identical copies of a benchmark
 //! measure the same code at different speeds. This program copies itself to several fresh
-//! files, runs the copies in turns, twice (each run measures the medians of the 16-bar chain's M + h,
-//! forward dynamics and batch forward dynamics) and prints every copy's figures with their
+//! files, runs the copies in turns, twice (each run measures the medians of the 16-bar chain's and
+//! the 12-joint arm's M + h, forward dynamics and batch forward dynamics) and prints every copy's figures with their
 //! minimum, median, maximum and max/min over the copies (each copy by its better run).
 //!
 //! ```text
@@ -17,7 +17,7 @@ mod models;
 
 use common::test_state;
 use mbs::{F64x4, Model};
-use models::Chain16;
+use models::{Arm3d12, Chain16};
 use std::hint::black_box;
 use std::process::Command;
 use std::time::{Duration, Instant};
@@ -25,10 +25,19 @@ use std::time::{Duration, Instant};
 /// A case of the measurement: its name and one call.
 type Case = (&'static str, Box<dyn FnMut()>);
 
-/// What each copy measures.
+/// What each copy measures: M + h, forward dynamics and batch forward dynamics of the 16-bar
+/// chain and of the 12-joint arm (whose batch forward dynamics measured 2× apart from one file
+/// to a copy of it).
 fn cases() -> Vec<Case> {
-    let model: &'static Chain16 = Box::leak(Box::default());
-    let n = Chain16::NQ;
+    let mut v = model_cases("chain16", Chain16::default());
+    v.extend(model_cases("arm3d_12", Arm3d12::default()));
+    v
+}
+
+/// The three cases of one model.
+fn model_cases<M: Model + 'static>(name: &'static str, model: M) -> Vec<Case> {
+    let model: &'static M = Box::leak(Box::new(model));
+    let n = M::NQ;
     let (q, qd) = test_state(n);
     let (mut m, mut h) = (vec![0.0; n * n], vec![0.0; n]);
     let (mut a, mut p) = (vec![0.0; n], vec![0.0; n]);
@@ -38,21 +47,22 @@ fn cases() -> Vec<Case> {
     );
     let (mut a4, mut p4) = (vec![F64x4::ZERO; n], vec![F64x4::ZERO; n]);
     let (q1, qd1) = (q.clone(), qd.clone());
+    let label = |what: &str| -> &'static str { format!("{name} {what}").leak() };
     vec![
         (
-            "chain16 dynamics (M + h)",
+            label("dynamics (M + h)"),
             Box::new(move || {
                 model.dynamics(0.0, black_box(&q), black_box(&qd), &[], &mut m, &mut h)
             }),
         ),
         (
-            "chain16 forward_dynamics",
+            label("forward_dynamics"),
             Box::new(move || {
                 model.forward_dynamics(0.0, black_box(&q1), black_box(&qd1), &[], &mut a, &mut p)
             }),
         ),
         (
-            "chain16 forward_dynamics_x4",
+            label("forward_dynamics_x4"),
             Box::new(move || {
                 model.forward_dynamics_x4(
                     F64x4::ZERO,

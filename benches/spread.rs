@@ -1,9 +1,10 @@
 //! The spread of timings over fresh copies of one binary: the time of a large straight-line
 //! function depends on where its pages land in memory, so identical copies of a benchmark
 //! measure the same code at different speeds. This program copies itself to several fresh
-//! files, runs the copies in turns, twice (each run measures the medians of the 16-bar chain's and
-//! the 12-joint arm's M + h, forward dynamics and batch forward dynamics) and prints every copy's figures with their
-//! minimum, median, maximum and max/min over the copies (each copy by its better run).
+//! files, runs the copies in turns, twice (each run measures the medians of the 16-bar chain's
+//! and the 12-joint arm's M + h, forward dynamics and batch forward dynamics) and prints every
+//! copy's figures with their minimum, median, maximum and max/min over the copies (each copy by
+//! its better run).
 //!
 //! ```text
 //! cargo bench -p mbs-benches --bench spread
@@ -23,7 +24,7 @@ use std::process::Command;
 use std::time::{Duration, Instant};
 
 /// A case of the measurement: its name and one call.
-type Case = (&'static str, Box<dyn FnMut()>);
+type Case = (String, Box<dyn FnMut()>);
 
 /// What each copy measures: M + h, forward dynamics and batch forward dynamics of the 16-bar
 /// chain and of the 12-joint arm (whose batch forward dynamics measured 2× apart from one file
@@ -35,7 +36,7 @@ fn cases() -> Vec<Case> {
 }
 
 /// The three cases of one model.
-fn model_cases<M: Model + 'static>(name: &'static str, model: M) -> Vec<Case> {
+fn model_cases<M: Model + 'static>(name: &str, model: M) -> Vec<Case> {
     let model: &'static M = Box::leak(Box::new(model));
     let n = M::NQ;
     let (q, qd) = test_state(n);
@@ -47,7 +48,7 @@ fn model_cases<M: Model + 'static>(name: &'static str, model: M) -> Vec<Case> {
     );
     let (mut a4, mut p4) = (vec![F64x4::ZERO; n], vec![F64x4::ZERO; n]);
     let (q1, qd1) = (q.clone(), qd.clone());
-    let label = |what: &str| -> &'static str { format!("{name} {what}").leak() };
+    let label = |what: &str| format!("{name} {what}");
     vec![
         (
             label("dynamics (M + h)"),

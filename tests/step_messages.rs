@@ -228,12 +228,25 @@ fn an_rtol_beyond_a_schemes_floor_is_said() {
     }
 }
 
+/// At index 3 the Newmark family holds 0.07·rtol^1.5, floored at 10³ε: on a closed loop
+/// (fastlink, gen-α at index 3, its default) rtol 5e-8 is held, 1e-8 is not.
+#[test]
+fn an_rtol_beyond_the_index3_floor_is_said() {
+    let gen_alpha = Scheme::GenAlpha(GenAlphaParams::from_rho_inf(0.8));
+    for (rtol, floor) in [(5e-8, None), (1e-8, Some(1e3 * f64::EPSILON))] {
+        let o = quiet(Options::adaptive(2e-4, rtol));
+        let (_, stats) = simulate(FastLink::default(), gen_alpha, o).unwrap();
+        assert_eq!(stats.tolerance_floor, floor, "rtol {rtol:e}");
+    }
+}
+
 /// A component near zero beside large ones of its kind, under an atol below their rounding,
 /// is tested at that rounding (100ε times the largest of its kind), not at atol: fastlink's
 /// velocities (a crank at 1,100 rad/s, a coupler turning through zero) under atol = 1e-12.
 /// `Stats::floored_steps` counts such steps and the summary says so; at atol = 1e-9, above
 /// that rounding, there are none. (The Newmark family tests its positions against its own
-/// floor, 10⁴ε, on the tolerance: its weights never reach this one at atol 1e-12.)
+/// floor, 10⁴ε or 10³ε at index 3, on the tolerance: its weights never reach this one at
+/// atol 1e-12.)
 #[test]
 fn a_weight_held_at_its_rounding_is_said() {
     let bdf = Scheme::Bdf(BdfParams::default());

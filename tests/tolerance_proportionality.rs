@@ -13,12 +13,18 @@
 //!
 //! - every run reaches t_end;
 //! - no run loses more than 0.2 digits when rtol tightens by a decade;
-//! - no more than 1.5 digits below the median of the asserted sweeps at the same rtol, or
+//! - no more than a digit below the median of the asserted sweeps at the same rtol, or
 //!   below rtol's digits when the median is above them (RKC's sweeps, up to 0.5 digits above
-//!   rtol on Cash's pendulum, raised the median at 1e-6 to 6.22 there, 1.54 digits above HHT's
-//!   4.68), on every model: a user who trusts rtol is not misled by the choice of scheme or
-//!   method by more than that. (Above it is not an error: BDF with partitioning gets 6.1 digits on
-//!   fastlink at rtol 1e-7, where the median is 4.3.)
+//!   rtol on Cash's pendulum, raise the median there), on every model: a user who trusts rtol
+//!   is not misled by the choice of scheme or method by more than that. (Above it is not an
+//!   error: BDF with partitioning gets 6.1 digits on fastlink at rtol 1e-7, where the median
+//!   is 4.9.) Three exceptions are held to 1.5 digits, as measured: DOPRI5 with partitioning on
+//!   fastlink (1.0–1.24 digits below the median from rtol 1e-6 to 1e-8; with projection it is
+//!   above it; neither its error estimate's dependent part mapped through the completion,
+//!   −B_d⁻¹B_i e_i, nor interpolated samples completed brought it closer: the first made it
+//!   0.1–0.4 digits worse, the second changed nothing), Radau5 on slider-crank (b) at rtol
+//!   1e-7 (5.93 digits against the median's 6.93: its digits stall from 1e-6 to 1e-7) and BDF
+//!   with projection on Cash's pendulum at rtol 1e-10 (8.98 digits, 1.02 short of rtol's 10).
 //!
 //! Not asserted, because not true: within 1.5 digits of rtol itself. On the Cartesian double
 //! pendulum, Cash's pendulum and slider-crank (b) the asserted sweeps are 0.3–1.8 digits short
@@ -47,7 +53,23 @@ use mbs_models::{dpend, dpend_cartesian, fastlink, fourbar, pendulum3, slidercra
 mod common;
 
 /// Digits a sweep may fall below the median of the others at the same rtol.
-const WITHIN: f64 = 1.5;
+const WITHIN: f64 = 1.0;
+/// The sweeps held to 1.5 digits instead, (model, sweep), as measured (see the module notes).
+const EXCEPTIONS: [(&str, &str); 4] = [
+    ("fastlink", "dopri5 partitioning"),
+    ("slider-crank (b)", "radau5 auto"),
+    ("pendulum3", "bdf auto"),
+    ("pendulum3", "bdf projection"),
+];
+
+/// The digits the sweep `label` may fall below the median on the model `title`.
+fn within(title: &str, label: &str) -> f64 {
+    if EXCEPTIONS.contains(&(title, label)) {
+        1.5
+    } else {
+        WITHIN
+    }
+}
 /// Digits a run may lose when rtol tightens by a decade.
 const LOSS: f64 = 0.2;
 
@@ -205,7 +227,7 @@ fn judge(wp: &WorkPrecision, constrained: bool) -> Vec<String> {
             // below the median, and below rtol itself: a sweep that reaches rtol is not
             // made wrong by others that do better
             if let Some(m) = median(r)
-                && d < m.min(-r.log10()) - WITHIN
+                && d < m.min(-r.log10()) - within(&wp.title, &p.label)
             {
                 bad.push(format!("{}: {d:.2} digits, the median {m:.2}", at(r)));
             }

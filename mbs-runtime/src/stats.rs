@@ -69,7 +69,8 @@ pub struct Stats {
     /// `Some(rtol')` when the user's rtol asked of the local error test a tolerance below the
     /// scheme's floor, which it held instead: the run then gives fewer digits than rtol, where
     /// a tighter rtol would otherwise have taken more steps (the Newmark family from rtol ≈
-    /// 4e-8 on, its floor 10⁴ε; RKC from ≈ 2e-9, BDF from ≈ 8e-11, their floors 100ε)
+    /// 4e-8 on, its floor 10⁴ε, at index 3 from ≈ 2e-8, its floor 10³ε; RKC from ≈ 2e-9,
+    /// BDF from ≈ 8e-11, their floors 100ε)
     pub tolerance_floor: Option<f64>,
     /// accepted steps whose error test raised some component's weight atol' + rtol'·|y_i| to
     /// its rounding floor, 100ε times the largest entry of its kind (positions, velocities,
@@ -94,8 +95,8 @@ pub enum ErrorTest {
     /// positions and velocities (and extra states)
     PositionsVelocities,
     /// positions only: the Newmark family's estimate h²(β − ⅙)(a₁ − a₀) except at index 2
-    /// (at index 3 its part along the constraints), against rtol' = 0.3·rtol^1.5 so that the
-    /// global error follows rtol; velocities and multipliers are not tested (the velocities'
+    /// (at index 3 its part along the constraints), against rtol' = 0.3·rtol^1.5 (0.07·rtol^1.5
+    /// at index 3) so that the global error follows rtol; velocities and multipliers are not tested (the velocities'
     /// error follows the positions' by the scheme's order 2, the multipliers' does not)
     Positions,
 

@@ -2,7 +2,8 @@
 //! function depends on where its pages land in memory, so identical copies of a benchmark
 //! measure the same code at different speeds. This program copies itself to several fresh
 //! files, runs the copies in turns, twice (each run measures the medians of the 16-bar chain's
-//! and the 12-joint arm's M + h, forward dynamics and batch forward dynamics) and prints every
+//! and the 12-joint arm's M + h, dense path, forward dynamics and batch forward dynamics) and
+//! prints every
 //! copy's figures with their minimum, median, maximum and max/min over the copies (each copy by
 //! its better run).
 //!
@@ -10,7 +11,9 @@
 //! cargo bench -p mbs-benches --bench spread
 //! ```
 //!
-//! Under `cargo test` it runs two copies briefly, so that it cannot rot.
+//! Under `cargo test` it runs two copies briefly, so that it cannot rot. Copies share their
+//! layout (every function at the same address); `benches/layout.sh` measures the same cases
+//! over builds whose functions the linker placed in different orders.
 
 mod common;
 #[path = "scaling/models.rs"]
@@ -26,16 +29,17 @@ use std::time::{Duration, Instant};
 /// A case of the measurement: its name and one call.
 type Case = (String, Box<dyn FnMut()>);
 
-/// What each copy measures: M + h, forward dynamics and batch forward dynamics of the 16-bar
-/// chain and of the 12-joint arm (whose batch forward dynamics measured 2× apart from one file
-/// to a copy of it).
+/// What each copy measures: M + h, the dense path (M + h, Cholesky and two triangular
+/// solves), forward dynamics and batch forward dynamics of the 16-bar chain and of the
+/// 12-joint arm (whose batch forward dynamics measured 2× apart from one file to a copy of
+/// it).
 fn cases() -> Vec<Case> {
     let mut v = model_cases("chain16", Chain16::default());
     v.extend(model_cases("arm3d_12", Arm3d12::default()));
     v
 }
 
-/// The three cases of one model.
+/// The four cases of one model.
 fn model_cases<M: Model + 'static>(name: &str, model: M) -> Vec<Case> {
     let model: &'static M = Box::leak(Box::new(model));
     let n = M::NQ;
@@ -48,12 +52,22 @@ fn model_cases<M: Model + 'static>(name: &str, model: M) -> Vec<Case> {
     );
     let (mut a4, mut p4) = (vec![F64x4::ZERO; n], vec![F64x4::ZERO; n]);
     let (q1, qd1) = (q.clone(), qd.clone());
+    let (q2, qd2) = (q.clone(), qd.clone());
+    let (mut m2, mut h2) = (m.clone(), h.clone());
     let label = |what: &str| format!("{name} {what}");
     vec![
         (
             label("dynamics (M + h)"),
             Box::new(move || {
                 model.dynamics(0.0, black_box(&q), black_box(&qd), &[], &mut m, &mut h)
+            }),
+        ),
+        (
+            label("dense (M + h, Cholesky)"),
+            Box::new(move || {
+                model.dynamics(0.0, black_box(&q2), black_box(&qd2), &[], &mut m2, &mut h2);
+                mbs::linalg::cholesky(&mut m2, n).expect("M positive definite");
+                mbs::linalg::cholesky_solve(&m2, n, &mut h2);
             }),
         ),
         (
@@ -177,7 +191,7 @@ fn main() {
         v.sort_by(f64::total_cmp);
         let (min, med, max) = (v[0], v[v.len() / 2], v[v.len() - 1]);
         println!(
-            "{name:<28} {}  min {min:.0}  median {med:.0}  max {max:.0}  max/min {:.2}",
+            "{name:<32} {}  min {min:.0}  median {med:.0}  max {max:.0}  max/min {:.2}",
             each.join(" "),
             max / min
         );

@@ -19,7 +19,7 @@
 //!   is not misled by the choice of scheme or method by more than that. (Above it is not an
 //!   error: BDF with partitioning gets 6.1 digits on fastlink at rtol 1e-7, where the median
 //!   is 4.9.) Three exceptions are held to 1.5 digits, as measured: DOPRI5 with partitioning on
-//!   fastlink (1.0–1.24 digits below the median from rtol 1e-6 to 1e-8; with projection it is
+//!   fastlink (1.2–1.24 digits below the median from rtol 1e-6 to 1e-8; with projection it is
 //!   above it; neither its error estimate's dependent part mapped through the completion,
 //!   −B_d⁻¹B_i e_i, nor interpolated samples completed brought it closer: the first made it
 //!   0.1–0.4 digits worse, the second changed nothing), Radau5 on slider-crank (b) at rtol

@@ -31,8 +31,8 @@ for round in 1 2; do
         "$work/layout$k" --copy --bench | sed "s/^/$k\t$round\t/" >> "$work/runs"
     done
 done
-field() { grep -m1 "^$1[[:space:]]*:" /proc/cpuinfo | cut -d: -f2- | sed 's/^ //'; }
-echo "processor: $(field 'model name'), family $(field 'cpu family'), model $(field model)"
+field() { grep -m1 "^$1[[:space:]]*:" /proc/cpuinfo | cut -d: -f2- | sed "s/^ *//"; }
+echo "processor: $(field 'model name') (family $(field 'cpu family'), model $(field model))"
 echo "ns per call, the better of two runs per layout (layouts 0..$((layouts - 1)), 0 the default order)"
 awk -F'\t' -v L="$layouts" '
     { key = $3; v = $4 + 0
@@ -50,9 +50,11 @@ awk -F'\t' -v L="$layouts" '
         printf "%s  min %.0f  median %.0f  max %.0f  max/min %.2f\n", line, x[1], x[int(m / 2) + 1], x[m], x[m] / x[1]
       }
       print "forward / dense per layout:"
-      split("chain16 arm3d_12", models, " ")
-      for (j = 1; j <= 2; j++) {
-        md = models[j]; line = sprintf("%-34s", md)
+      # every model of the cases: the names before " forward_dynamics"
+      for (i = 1; i <= n; i++) {
+        if (order[i] !~ / forward_dynamics$/) continue
+        md = substr(order[i], 1, length(order[i]) - length(" forward_dynamics"))
+        line = sprintf("%-34s", md)
         for (k = 0; k < L; k++)
           line = line sprintf(" %7.2f", best[md " forward_dynamics", k] / best[md " dense (M + h, Cholesky)", k])
         print line

@@ -3,9 +3,8 @@
 //! measure the same code at different speeds. This program copies itself to several fresh
 //! files, runs the copies in turns, twice (each run measures the medians of the 16-bar chain's
 //! and the 12-joint arm's M + h, dense path, forward dynamics and batch forward dynamics) and
-//! prints every
-//! copy's figures with their minimum, median, maximum and max/min over the copies (each copy by
-//! its better run).
+//! prints every copy's figures with their minimum, median, maximum and max/min over the
+//! copies (each copy by its better run).
 //!
 //! ```text
 //! cargo bench -p mbs-benches --bench spread

@@ -96,8 +96,9 @@ pub enum ErrorTest {
     PositionsVelocities,
     /// positions only: the Newmark family's estimate h²(β − ⅙)(a₁ − a₀) except at index 2
     /// (at index 3 its part along the constraints), against rtol' = 0.3·rtol^1.5 (0.07·rtol^1.5
-    /// at index 3) so that the global error follows rtol; velocities and multipliers are not tested (the velocities'
-    /// error follows the positions' by the scheme's order 2, the multipliers' does not)
+    /// at index 3) so that the global error follows rtol; velocities and multipliers are not
+    /// tested (the velocities' error follows the positions' by the scheme's order 2, the
+    /// multipliers' does not)
     Positions,
 
     /// positions, with velocities weighted by h and multipliers by h² (Radau IIA at index 3,

@@ -58,9 +58,9 @@
 //! 0.5–2.4 short at index 3, the amplifying loops (four-bar, slider-crank, fastlink) the
 //! furthest. Below rtol 1e-7 (2e-8 at index 3) the local tolerance reaches its floor and the
 //! digits stall (6.3–7.5 on pendulum3, 4.6–6.5 on the loops); gen-α at index 2 stops with
-//! `StepTooSmall` on fastlink at rtol 1e-8. Before the transformation (the test per step at rtol itself, as at index 3 and
-//! with projection until then) the runs fell 2.9–5.5 digits short of rtol on average, gaining
-//! ⅔ of a digit per decade. The transformation costs what order 2 costs: dpend to 2 s at rtol
+//! `StepTooSmall` on fastlink at rtol 1e-8. Before the transformation (the test per step at
+//! rtol itself, as at index 3 and with projection until then) the runs fell 2.9–5.5 digits
+//! short of rtol on average, gaining ⅔ of a digit per decade. The transformation costs what order 2 costs: dpend to 2 s at rtol
 //! 1e-6 takes 14,957 steps where the per-step test took 1,001 (`tests/work_counters.rs`),
 //! and on stiff models the high frequencies a step load excites are resolved rather than
 //! damped away (`tests/hard_cases/chain16.rs`: HHT 34,839 steps where it took 341 and lost

@@ -1,23 +1,8 @@
 //! `for` loops and `part`s: the statements they expand to generate the same code as the
 //! statements written out, indexed names stay readable, and errors say which instance.
 
-use mbs_symbolic::expand::{Expansion, expand_models};
-
-/// The generated code of the single model in `src`, or its errors' messages.
-fn generate(src: &str) -> Result<String, Vec<String>> {
-    let tokens: proc_macro2::TokenStream = src.parse().expect("tokens");
-    let mut out = expand_models(tokens).map_err(|e| vec![e.to_string()])?;
-    assert_eq!(out.len(), 1);
-    match out.remove(0) {
-        Expansion::Ok { generated, .. } => Ok(generated
-            .code
-            .lines()
-            .filter(|l| !l.contains("GENERATED_HASH"))
-            .collect::<Vec<_>>()
-            .join("\n")),
-        Expansion::Err { error, .. } => Err(error.into_iter().map(|e| e.to_string()).collect()),
-    }
-}
+mod expansion;
+use expansion::{errors, generate};
 
 /// Equal code, or the first line that differs.
 fn same(a: &str, b: &str) {
@@ -25,13 +10,6 @@ fn same(a: &str, b: &str) {
         assert_eq!(x, y, "line {k} differs");
     }
     assert_eq!(a.lines().count(), b.lines().count());
-}
-
-fn errors(src: &str) -> Vec<String> {
-    match generate(src) {
-        Ok(_) => panic!("expected errors"),
-        Err(e) => e,
-    }
 }
 
 /// chain8 of MODELS.md written bar by bar, with `bars` naming bar k.
@@ -312,7 +290,19 @@ fn nested_parts_name_arguments_and_integer_arithmetic() {
     );
     assert!(
         e.iter().any(|m| m
-            == "part `P` is instantiated 16 parts deep: a part instantiates itself, directly or through another"),
+            == "part `P` instantiates itself: a part cannot be recursive; repeat its statements with `for` instead"),
+        "{e:?}"
+    );
+    // through another part instantiated twice: reported by each of B's instances, at once
+    // (a depth limit let it instantiate itself 16 parts deep first, its instances doubling)
+    let e = errors("model L { part A() { B(); B(); } part B() { A(); } A(); }");
+    let recursive: Vec<&String> = e
+        .iter()
+        .filter(|m| m.contains("instantiates itself"))
+        .collect();
+    assert_eq!(recursive.len(), 2, "{e:?}");
+    assert!(
+        recursive[0].starts_with("part `A` instantiates itself (through `B`)"),
         "{e:?}"
     );
 }

@@ -28,7 +28,8 @@ impl Naming for RustNames<'_> {
             Var::Qd(i) => format!("qd_{i}"),
             Var::Qdd(i) => format!("qdd_{i}"),
             Var::T => "t".into(),
-            Var::Param(i) => format!("p_{}", self.params[i as usize].name),
+            // a raw identifier (`r#type`) keeps its `r#` as the field, not in the local's name
+            Var::Param(i) => format!("p_{}", raw_stripped(&self.params[i as usize].name)),
             Var::Input(i) => format!("u_{i}"),
             Var::Lambda(i) => format!("lambda_{i}"),
             Var::Chart(i) => format!("r_{i}"),
@@ -44,7 +45,7 @@ impl Naming for RustNames<'_> {
             Var::T => String::new(),
             Var::Param(i) => {
                 let n = &self.params[i as usize].name;
-                format!("let p_{n} = {}.{n};", self.params_path)
+                format!("let p_{} = {}.{n};", raw_stripped(n), self.params_path)
             }
             Var::Input(i) => format!("let u_{i} = u[{i}];"),
             Var::Lambda(i) => format!("let lambda_{i} = lambda[{i}];"),
@@ -363,4 +364,9 @@ pub fn emit_fn(
         count: em.count,
         prefix: prefix_count,
     })
+}
+
+/// `name` without the `r#` of a raw identifier.
+fn raw_stripped(name: &str) -> &str {
+    name.strip_prefix("r#").unwrap_or(name)
 }

@@ -996,8 +996,9 @@ fn emit_scene(
         Formulation::VirtualPower => "virtual power",
     };
     let mut doc = String::new();
-    for d in &sys.docs {
-        let _ = writeln!(doc, "///{d}");
+    // a block comment `/** … */` is one doc attribute of several lines
+    for line in sys.docs.iter().flat_map(|d| d.split('\n')) {
+        let _ = writeln!(doc, "///{line}");
     }
     if !sys.docs.is_empty() {
         doc.push_str("///\n");

@@ -87,7 +87,7 @@ pub fn index_hint(name: &str, candidates: &[&str]) -> Option<String> {
     found.dedup();
     let (lo, hi) = (found[0], found[found.len() - 1]);
     let shown = display(base);
-    let which = if found.len() as u64 == hi - lo + 1 {
+    let which = if hi.checked_sub(lo).and_then(|d| d.checked_add(1)) == Some(found.len() as u64) {
         if lo == hi {
             format!("only the index {lo}")
         } else {
@@ -165,8 +165,9 @@ struct Expander {
     /// parts whose declaration has an error (reported): their instances are skipped
     broken: Vec<String>,
     errors: Vec<syn::Error>,
-    /// part instantiation depth, against a part that instantiates itself
-    depth: usize,
+    /// the parts being instantiated, outermost first: a part met again among them
+    /// instantiates itself
+    instantiating: Vec<String>,
 }
 
 /// Expands a model's statements (the tokens inside `model Name { … }`); `end` is the span of
@@ -176,7 +177,7 @@ pub fn expand(content: TokenStream, end: Span, errors: &mut Vec<syn::Error>) -> 
         parts: Vec::new(),
         broken: Vec::new(),
         errors: Vec::new(),
-        depth: 0,
+        instantiating: Vec::new(),
     };
     let stmts = split(content, end);
     // parts first: a part may be instantiated above its declaration
@@ -504,7 +505,7 @@ impl Expander {
             b
         };
         if b.saturating_sub(a) > MAX_ITERATIONS {
-            self.error(range_span, format!("`for {var} in {a}..{b}` repeats {} times: at most {MAX_ITERATIONS} instances per loop", b - a), origin);
+            self.error(range_span, format!("`for {var} in {a}..{b}` repeats {} times: at most {MAX_ITERATIONS} instances per loop", i128::from(b) - i128::from(a)), origin);
             return;
         }
         let stmts = split(body.stream(), body.span_close());
@@ -571,8 +572,15 @@ impl Expander {
             );
             return;
         }
-        if self.depth >= 16 {
-            self.error(id.span(), format!("part `{id}` is instantiated 16 parts deep: a part instantiates itself, directly or through another"), &None);
+        let name = id.to_string();
+        if let Some(k) = self.instantiating.iter().position(|p| *p == name) {
+            let through = &self.instantiating[k + 1..];
+            let how = if through.is_empty() {
+                String::new()
+            } else {
+                format!(" (through {})", quoted(through))
+            };
+            self.error(id.span(), format!("part `{id}` instantiates itself{how}: a part cannot be recursive; repeat its statements with `for` instead"), &None);
             return;
         }
         let n = part.instances.get() + 1;
@@ -599,9 +607,9 @@ impl Expander {
             format!("in part {id}, instance {n} ({})", shown.join(", ")),
         );
         let stmts = split(part.body.clone(), id.span());
-        self.depth += 1;
+        self.instantiating.push(name);
         self.statements(stmts, &inner_env, &o, out, in_effect);
-        self.depth -= 1;
+        self.instantiating.pop();
     }
 
     /// Replaces bound names only (no index folding): for loop ranges.
@@ -916,6 +924,16 @@ impl Expander {
                 None
             }
         }
+    }
+}
+
+/// `a`, `b` and `c`: names in backquotes.
+fn quoted(names: &[String]) -> String {
+    let q: Vec<String> = names.iter().map(|n| format!("`{n}`")).collect();
+    match q.split_last() {
+        Some((last, [])) => last.clone(),
+        Some((last, rest)) => format!("{} and {last}", rest.join(", ")),
+        None => String::new(),
     }
 }
 

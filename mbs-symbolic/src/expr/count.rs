@@ -43,7 +43,7 @@ pub fn latency(node: Node) -> u32 {
         Node::Num(_) | Node::Var(_) => 0,
         Node::Add(..) | Node::Sub(..) | Node::Neg(..) => 3,
         Node::Mul(..) => 4,
-        Node::Powi(_, k) => 4 * (k.unsigned_abs()).saturating_sub(1),
+        Node::Powi(_, k) => 4u32.saturating_mul(k.unsigned_abs().saturating_sub(1)),
         Node::Div(..) => 13,
         Node::Func(super::Func::Sqrt, _) => 15,
         _ => 40,

@@ -35,7 +35,8 @@ impl Ready {
                 }
                 if known {
                     let before = ch[..k].iter().map(|c| self.0[c.index()]).max().unwrap_or(0);
-                    self.0[n.index()] = before + latency(node);
+                    // saturated below the mark of a value not yet known
+                    self.0[n.index()] = before.saturating_add(latency(node)).min(UNKNOWN - 1);
                     stack.pop();
                 }
             }

@@ -320,7 +320,12 @@ impl Arena {
             return self.num(v.powi(n));
         }
         if n < 0 {
-            let p = self.powi(x, -n);
+            // -i32::MIN is not an i32: x^MIN = (x^(MIN/2))^2
+            let Some(m) = n.checked_neg() else {
+                let half = self.powi(x, n / 2);
+                return self.powi(half, 2);
+            };
+            let p = self.powi(x, m);
             let one = self.one();
             return self.div(one, p);
         }
@@ -329,7 +334,10 @@ impl Arena {
             return if n % 2 == 0 { p } else { self.neg(p) };
         }
         if let Node::Powi(y, m) = self.node(x) {
-            return self.powi(y, m * n);
+            // (y^m)^n = y^(mn), unless mn leaves i32 (the power then stays nested)
+            if let Some(k) = m.checked_mul(n) {
+                return self.powi(y, k);
+            }
         }
         self.intern(Node::Powi(x, n))
     }

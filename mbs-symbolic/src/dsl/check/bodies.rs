@@ -299,13 +299,17 @@ impl Checker {
             return;
         };
         if self.tog_defined[fi] {
-            self.error(
-                span,
+            let name = &self.sys.frames[fi].name;
+            let message = if self.lumped.contains(&fi) {
                 format!(
-                    "TOG[{}] is defined twice: each body and frame has one pose; remove one of the two",
-                    self.sys.frames[fi].name
-                ),
-            );
+                    "`{name}` is a point mass, placed by its `mass {name} on … at (…)` statement: it has no TOG; move it there"
+                )
+            } else {
+                format!(
+                    "TOG[{name}] is defined twice: each body and frame has one pose; remove one of the two"
+                )
+            };
+            self.error(span, message);
             return;
         }
         let mut leaves = Vec::new();

@@ -618,6 +618,10 @@ impl Checker {
                     self.error_at(args[1], format!("the exponent of `powi` is an integer literal, found `{}`: use `pow(x, y)` for a real exponent", text(args[1])));
                     return self.sys.arena.zero();
                 };
+                if n.unsigned_abs() > 64 {
+                    self.error_at(args[1], format!("the exponent of `powi` is at most 64 in magnitude, found {n}: use `pow(x, y)` for a larger one"));
+                    return self.sys.arena.zero();
+                }
                 return self.sys.arena.powi(x, n);
             }
             "spline" => {
@@ -650,12 +654,19 @@ impl Checker {
                 if !arity(self, params.len(), &usage) {
                     return self.sys.arena.zero();
                 }
-                if self.depth > 64 {
+                if let Some(k) = self.calling.iter().position(|f| *f == name) {
+                    let through: Vec<String> = self.calling[k + 1..]
+                        .iter()
+                        .map(|f| format!("`{f}`"))
+                        .collect();
+                    let how = if through.is_empty() {
+                        String::new()
+                    } else {
+                        format!(" (through {})", through.join(", "))
+                    };
                     self.error_at(
                         c,
-                        format!(
-                            "`{name}` calls itself without end: an inline `fn` cannot be recursive"
-                        ),
+                        format!("`{name}` calls itself{how}: an inline `fn` cannot be recursive"),
                     );
                     return self.sys.arena.zero();
                 }
@@ -670,9 +681,9 @@ impl Checker {
                         )
                     })
                     .collect();
-                self.depth += 1;
+                self.calling.push(name.clone());
                 let r = self.lower(&body, a);
-                self.depth -= 1;
+                self.calling.pop();
                 for (k, old) in saved {
                     match old {
                         Some(o) => self.scalars.insert(k, o),

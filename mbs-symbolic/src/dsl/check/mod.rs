@@ -162,8 +162,9 @@ struct Checker {
     tog_target_error: bool,
     /// a body or frame was named `ground` (reported; then TOG[ground] is a cascade)
     ground_declared: bool,
-    /// inline-function call depth, against runaway recursion
-    depth: usize,
+    /// the inline functions being expanded, outermost first: a function met again among
+    /// them calls itself
+    calling: Vec<String>,
     /// reserved names a declaration tried to take (reported there; their uses would only
     /// repeat it as "unknown name")
     taken_reserved: rustc_hash::FxHashSet<String>,
@@ -210,7 +211,7 @@ pub fn check(def: &ModelDef) -> Result<Checked, syn::Error> {
         kinds: FxHashMap::default(),
         tog_target_error: false,
         ground_declared: false,
-        depth: 0,
+        calling: Vec::new(),
         taken_reserved: Default::default(),
         tog_start: FxHashMap::default(),
         lumped: Default::default(),
@@ -453,6 +454,7 @@ impl Checker {
                     self.frame_names
                         .insert(name.to_string(), self.sys.frames.len());
                     self.frame_spans.push(name.span());
+                    self.frame_origins.push(origin.clone());
                     // its pose is the statement's
                     self.tog_defined.push(true);
                     self.sys.frames.push(FrameDef {

@@ -774,6 +774,15 @@ impl Tree {
         }
         for (k, j) in robot.joints.iter().enumerate() {
             if matches!(j.kind, JointKind::Fixed | JointKind::Floating) {
+                if let Some(m) = &j.mimic {
+                    return Err(UrdfError::Mimic {
+                        joint: j.name.clone(),
+                        leader: m.leader.clone(),
+                        problem: "but only revolute, continuous and prismatic joints can mimic; \
+                                  remove the `<mimic>`"
+                            .to_string(),
+                    });
+                }
                 continue;
             }
             if j.axis.iter().map(|x| x * x).sum::<f64>().sqrt() < 1e-12 {

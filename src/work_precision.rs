@@ -525,7 +525,8 @@ impl Study {
         o
     }
 
-    fn validate(&self, nq: usize, joints: usize) -> Result<(), StudyError> {
+    fn validate(&self, nq: usize, rotation_joints: &[RotationJoint]) -> Result<(), StudyError> {
+        let joints = rotation_joints.len();
         let r = &self.reference;
         if r.times.is_empty() {
             return Err(StudyError::NoTimes);
@@ -576,12 +577,24 @@ impl Study {
         if self.repeats == 0 {
             return invalid("repeats", 0.0, "must be at least 1");
         }
+        // the Euler angles named, with the model's own joints: coordinates, each in one joint
+        let mut angles: Vec<usize> = rotation_joints.iter().flat_map(|j| j.angles).collect();
+        let named = angles.len();
+        angles.sort_unstable();
+        angles.dedup();
+        if angles.len() < named || angles.last().is_some_and(|&k| k >= nq) {
+            return Err(StudyError::Invalid {
+                name: "euler_angles",
+                value: format!("{:?}", self.euler_angles),
+                reason: "must name coordinates of the model (below its number of coordinates), each in one triple only and none of a `Tball` or `Tfree` joint's",
+            });
+        }
         Ok(())
     }
 
     /// Runs every setting of every sweep on a clone of `model`, in order, one at a time.
     pub fn run<M: Model + Clone + 'static>(&self, model: &M) -> Result<WorkPrecision, StudyError> {
-        self.validate(M::NQ, self.joints(model).len())?;
+        self.validate(M::NQ, &self.joints(model))?;
         let mut rows = Vec::new();
         for sweep in &self.sweeps {
             for &setting in &sweep.settings {

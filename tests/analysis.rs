@@ -643,6 +643,46 @@ fn inverse_then_forward_dynamics_returns_qdd() {
     assert!(worst < 1e-12);
 }
 
+/// A measured motion built by hand that does not fit the model is a typed error naming the
+/// field, not an index out of range.
+#[test]
+fn a_trajectory_that_does_not_fit_the_model_is_named() {
+    use mbs::analysis::{inverse_dynamics_actuated_of, inverse_dynamics_of};
+    let model = seed2dof::Seed2dof::default();
+    let measured = mbs::Trajectory {
+        dof_names: vec!["x1".into(), "x2".into()],
+        t: vec![0.0, 0.1],
+        q_data: vec![0.0; 4],
+        qd_data: vec![0.0; 4],
+        // no accelerations
+        ..Default::default()
+    };
+    let name = |e: mbs::analysis::AnalysisError| match e {
+        mbs::analysis::AnalysisError::Failure(Failure::InvalidOption { name, .. }) => name,
+        other => panic!("{other}"),
+    };
+    let e = inverse_dynamics_of(&model, &measured, &[]).unwrap_err();
+    assert_eq!(name(e), "trajectory.qdd_data");
+    let e = inverse_dynamics_actuated_of(&model, &measured, &[], &[0, 1]).unwrap_err();
+    assert_eq!(name(e), "trajectory.qdd_data");
+    // rotation joints the model does not have
+    let joints = mbs::Trajectory {
+        qdd_data: vec![0.0; 4],
+        joint_names: vec!["base".into()],
+        charts: vec![vec![[0.0, 0.0, 0.0, 1.0]]],
+        chart_data: vec![0, 0],
+        ..measured.clone()
+    };
+    let e = inverse_dynamics_of(&model, &joints, &[]).unwrap_err();
+    assert_eq!(name(e), "trajectory.joint_names");
+    // once it fits, it runs
+    let fits = mbs::Trajectory {
+        qdd_data: vec![0.0; 4],
+        ..measured
+    };
+    assert_eq!(inverse_dynamics_of(&model, &fits, &[]).unwrap().t.len(), 2);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Velocity-dependent, rheonomic model
 

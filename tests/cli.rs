@@ -295,10 +295,11 @@ fn a_long_run_holds_a_bounded_number_of_outputs() {
 fn ctrl_c_stops_a_program_which_keeps_its_outputs() {
     let dir = scratch("sigint");
     let program = example("dpend");
-    // a million seconds at fixed steps of 1 ms (outputs every 10 ms): hours
+    // a million seconds at fixed steps of 1 ms, an output every second: hours (every 10 ms,
+    // the outputs would take 26 GB, which the run refuses up front)
     let mut child = Command::new(&program)
         .args([
-            "--scheme", "rk4", "--h", "1e-3", "--dt", "1e-2", "--t-end", "1e6",
+            "--scheme", "rk4", "--h", "1e-3", "--dt", "1", "--t-end", "1e6",
         ])
         .args(["--max-steps", "2000000000", "--out"])
         .arg(&dir)

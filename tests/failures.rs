@@ -275,3 +275,61 @@ fn newton_that_fails_names_its_largest_correction() {
         assert!(e.to_string().contains("largest in the velocity of q[1]"));
     }
 }
+
+/// Requests that cannot be met are refused before the run: outputs that would not fit in
+/// memory (the process once aborted reserving them), global control asked for more samples
+/// than a trajectory may hold, and an assembly given states of the wrong size.
+#[test]
+fn requests_beyond_memory_or_size_are_refused() {
+    // 9·10⁷ outputs with the poses of every frame: 23.8 GB
+    let opts = Options {
+        output: Output::Every { dt: 1e-8 },
+        frames: true,
+        ..Options::fixed(0.9, 1e-3)
+    };
+    let e = simulate(Seed2dof::default(), Scheme::Rk4, opts).unwrap_err();
+    println!("{e}");
+    match &e.kind {
+        Failure::InvalidOption { name, value, .. } => {
+            assert_eq!(*name, "output", "{e}");
+            assert!(value.starts_with("90000001 outputs of"), "{e}");
+        }
+        other => panic!("{other}"),
+    }
+    let control = mbs::GlobalControl {
+        samples: usize::MAX,
+        ..Default::default()
+    };
+    let e = mbs::simulate_global(
+        &Seed2dof::default(),
+        Scheme::Dopri5,
+        &Options::adaptive(1.0, 1e-6),
+        &control,
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("samples ≤ 10⁸"), "{e}");
+
+    let model = mbs_models::slidercrank::SliderCrank::default();
+    let (mut q, mut qd) = (vec![0.0; 3], vec![0.0; 2]);
+    let e = mbs::assemble(&model, 0.0, &mut q, &mut qd, &Default::default()).unwrap_err();
+    assert!(
+        matches!(e, Failure::InvalidOption { name: "qd", .. }),
+        "{e}"
+    );
+    let bad = mbs::ConstraintOptions {
+        max_iterations: 0,
+        ..Default::default()
+    };
+    let mut qd = vec![0.0; 3];
+    let e = mbs::assemble(&model, 0.0, &mut q, &mut qd, &bad).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            Failure::InvalidOption {
+                name: "constraints.max_iterations",
+                ..
+            }
+        ),
+        "{e}"
+    );
+}

@@ -321,6 +321,24 @@ fn shards_merge_into_the_table_of_the_whole_sweep() {
         without_cpu(&whole.join("results.csv"))
     );
     assert!(Shard::parse("3/3").is_err() && Shard::parse("1").is_err());
+    // a shard made by hand is checked too: 1-based task numbers, or no shards at all
+    for (index, count) in [(3, 3), (0, 0)] {
+        let e = make()
+            .run_shard(&parts, &runs, Shard { index, count })
+            .unwrap_err();
+        assert!(
+            matches!(&e, SweepError::Shard(s) if *s == format!("{index}/{count}")),
+            "{e}"
+        );
+    }
+    // an empty table is refused, not read as one without columns
+    let empty = parts.join("empty.csv");
+    std::fs::write(&empty, "").unwrap();
+    let e = mbs::sweep::parquet::write(&empty, &parts.join("empty.parquet")).unwrap_err();
+    assert!(
+        matches!(&e, SweepError::Table { .. }) && e.to_string().contains("no header"),
+        "{e}"
+    );
     let _ = std::fs::remove_dir_all(&whole);
     let _ = std::fs::remove_dir_all(&parts);
 }

@@ -443,6 +443,18 @@ fn bad_descriptions_are_typed_errors_naming_the_culprit() {
         matches!(&e, UrdfError::Mimic { joint, leader, .. } if joint == "j" && leader == "nowhere"),
         "{e}"
     );
+    // a fixed or floating joint cannot mimic (it once reached the mimic's lookup unchecked)
+    for kind in ["fixed", "floating"] {
+        let mimic = format!(
+            r#"<link name="c"><inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1"/></inertial></link><joint name="k" type="revolute"><parent link="a"/><child link="c"/><axis xyz="0 0 1"/></joint>
+            <joint name="j" type="{kind}"><parent link="a"/><child link="b"/><mimic joint="k"/></joint>"#
+        );
+        let e = error(&robot(&format!("{LINKS}{mimic}")));
+        assert!(
+            matches!(&e, UrdfError::Mimic { joint, problem, .. } if joint == "j" && problem.contains("only revolute")),
+            "{kind}: {e}"
+        );
+    }
 
     let massless = format!(
         "<link name=\"a\"/><link name=\"b\"/>{}",

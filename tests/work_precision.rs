@@ -192,4 +192,23 @@ fn computed_references_and_bad_references() {
         .run(&Seed2dof::default())
         .unwrap_err();
     assert!(matches!(e, StudyError::BadTimes { .. }), "{e}");
+    // Euler angles named beyond the model's coordinates (or twice) are refused, not indexed
+    for angles in [[0, 1, 5], [0, 1, 1]] {
+        let sized = Reference::data("one joint", vec![1.0], vec![vec![0.0; 10]]);
+        let study = Study {
+            euler_angles: vec![angles],
+            ..Study::new("bad", sized)
+        };
+        let e = study.run(&Seed2dof::default()).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                StudyError::Invalid {
+                    name: "euler_angles",
+                    ..
+                }
+            ),
+            "{angles:?}: {e}"
+        );
+    }
 }

@@ -437,6 +437,24 @@ pub struct ConstraintOptions {
     pub scaling: bool,
 }
 
+impl ConstraintOptions {
+    /// Checks the tolerances and the iteration count.
+    pub fn validate(&self) -> Result<(), Failure> {
+        for (name, v) in [
+            ("constraints.tolerance", self.tolerance),
+            ("constraints.drift_tol", self.drift_tol),
+        ] {
+            if !(v > 0.0) || !v.is_finite() {
+                return Err(invalid(name, v, "must be > 0 and finite"));
+            }
+        }
+        if self.max_iterations == 0 {
+            return Err(invalid("constraints.max_iterations", 0, "must be > 0"));
+        }
+        Ok(())
+    }
+}
+
 impl Default for ConstraintOptions {
     fn default() -> Self {
         ConstraintOptions {
@@ -777,17 +795,7 @@ impl Options {
             }
         }
         let c = &self.constraints;
-        for (name, v) in [
-            ("constraints.tolerance", c.tolerance),
-            ("constraints.drift_tol", c.drift_tol),
-        ] {
-            if !(v > 0.0) || !v.is_finite() {
-                return Err(invalid(name, v, "must be > 0 and finite"));
-            }
-        }
-        if c.max_iterations == 0 {
-            return Err(invalid("constraints.max_iterations", 0, "must be > 0"));
-        }
+        c.validate()?;
         if let ConstraintMethod::Baumgarte { alpha, beta } = c.method {
             if !(alpha >= 0.0 && beta >= 0.0 && alpha.is_finite() && beta.is_finite()) {
                 return Err(invalid(

@@ -166,13 +166,15 @@ impl<M: Model + 'static> Sensitivities<M> {
     }
 
     /// ∂q/∂p (NQ values) of parameter `p` (an index into `M::SENSITIVE`) at output `i` of a
-    /// trajectory of this model.
+    /// trajectory of this model. Panics, as slice indexing does, when `p` or `i` is out of
+    /// range or `tr` is not a trajectory of this wrapper (whose coordinates hold the
+    /// sensitivities).
     pub fn dq_dp(tr: &Trajectory, i: usize, p: usize) -> &[f64] {
         let n = M::NQ;
         &tr.q(i)[n * (1 + p)..n * (2 + p)]
     }
 
-    /// ∂qd/∂p at output `i`.
+    /// ∂qd/∂p at output `i` (panics as [`Sensitivities::dq_dp`] does).
     pub fn dqd_dp(tr: &Trajectory, i: usize, p: usize) -> &[f64] {
         let n = M::NQ;
         &tr.qd(i)[n * (1 + p)..n * (2 + p)]

@@ -105,8 +105,13 @@ pub fn natural_coefficients(points: &[(f64, f64)]) -> Result<Vec<[f64; 4]>, Spli
 /// Derivative number `order` (0: the value) at `x` of the spline with `knots` x₀ < … < xₙ and
 /// the `coefficients` of its n intervals from [`natural_coefficients`]. The third derivative
 /// is constant on each interval and the fourth is zero; outside the knots, the spline is the
-/// line of its end value and slope.
+/// line of its end value and slope. NaN when `knots` and `coefficients` are not such a table
+/// (no interval, or not one knot more than intervals).
 pub fn evaluate(knots: &[f64], coefficients: &[[f64; 4]], order: u8, x: f64) -> f64 {
+    if coefficients.is_empty() || knots.len() != coefficients.len() + 1 {
+        // not a table of `natural_coefficients`: no value
+        return f64::NAN;
+    }
     let last = coefficients.len() - 1;
     let (i, s) = if x < knots[0] {
         // the line through the first point with its slope

@@ -162,11 +162,26 @@ impl Ellipsoid<'static> {
     }
 }
 
+/// The vertical axis of a [`Terrain`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Vertical {
+    X,
+    Y,
+    Z,
+}
+
+impl Vertical {
+    /// The axis' number: 0, 1 or 2.
+    pub fn index(self) -> usize {
+        self as usize
+    }
+}
+
 /// The ground plane along `up` and boxes on it, and the law their contacts follow.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Terrain {
-    /// the vertical axis: 0, 1 or 2 (x, y, z)
-    pub up: usize,
+    /// the vertical axis
+    pub up: Vertical,
     /// whether the ground plane is part of the terrain (false: the boxes alone, for a model
     /// whose own generated contacts meet the ground)
     pub ground: bool,
@@ -178,7 +193,7 @@ impl Default for Terrain {
     /// Flat ground z = 0 with the default [`ContactLaw`].
     fn default() -> Self {
         Terrain {
-            up: 2,
+            up: Vertical::Z,
             ground: true,
             blocks: Vec::new(),
             law: ContactLaw::default(),
@@ -203,9 +218,9 @@ impl Terrain {
     /// The two horizontal axes, in increasing order.
     pub fn horizontal(&self) -> [usize; 2] {
         match self.up {
-            0 => [1, 2],
-            1 => [0, 2],
-            _ => [0, 1],
+            Vertical::X => [1, 2],
+            Vertical::Y => [0, 2],
+            Vertical::Z => [0, 1],
         }
     }
 
@@ -245,7 +260,7 @@ impl Terrain {
 
     /// Calls `touch` for the ground and each box the ellipsoid `e` overlaps (module docs).
     pub fn touches(&self, e: &Ellipsoid, mut touch: impl FnMut(Touch)) {
-        let up = self.up;
+        let up = self.up.index();
         let n = Self::axis(up, 1.0);
         let s = e.support(n);
         if self.ground && s[up] < 0.0 {

@@ -130,6 +130,71 @@ impl Trajectory {
         }
     }
 
+    /// Checks that the data fit a model of `nq` coordinates and `joints` rotation joints
+    /// before they are read as its motion (a trajectory built by hand from measurements, or
+    /// read from a file): `nq` names, q, qd and qdd one value per coordinate per output, and
+    /// the charts of at most `joints` rotation joints (none: each output is read in the
+    /// model's charts), each output's chart numbers among them.
+    pub fn check_fits(&self, nq: usize, joints: usize) -> Result<(), crate::error::Failure> {
+        use crate::error::Failure::InvalidOption;
+        let outputs = self.len();
+        if self.nq() != nq {
+            return Err(InvalidOption {
+                name: "trajectory.dof_names",
+                value: format!("{} names for a model of {nq} coordinates", self.nq()),
+                reason: "must name every coordinate of the model, in its order",
+            });
+        }
+        for (name, data) in [
+            ("trajectory.q_data", &self.q_data),
+            ("trajectory.qd_data", &self.qd_data),
+            ("trajectory.qdd_data", &self.qdd_data),
+        ] {
+            if data.len() != outputs * nq {
+                return Err(InvalidOption {
+                    name,
+                    value: format!(
+                        "{} values for {outputs} outputs (t) of {nq} coordinates",
+                        data.len()
+                    ),
+                    reason: "must hold one value per coordinate per output, output after output",
+                });
+            }
+        }
+        let tj = self.joint_names.len();
+        if tj > joints {
+            return Err(InvalidOption {
+                name: "trajectory.joint_names",
+                value: format!("{tj} rotation joints for a model of {joints}"),
+                reason: "must name at most the model's rotation joints (none: the model's charts)",
+            });
+        }
+        if self.charts.len() != tj || self.chart_data.len() != outputs * tj {
+            return Err(InvalidOption {
+                name: "trajectory.chart_data",
+                value: format!(
+                    "{} chart lists and {} chart numbers for {tj} joints over {outputs} outputs",
+                    self.charts.len(),
+                    self.chart_data.len()
+                ),
+                reason: "must hold one chart list per joint and one chart number per joint per output",
+            });
+        }
+        let out_of_range = self
+            .chart_data
+            .iter()
+            .enumerate()
+            .any(|(k, &c)| c as usize >= self.charts[k % tj].len());
+        if out_of_range {
+            return Err(InvalidOption {
+                name: "trajectory.chart_data",
+                value: "a chart number beyond its joint's list".into(),
+                reason: "each chart number must index its joint's list in `charts`",
+            });
+        }
+        Ok(())
+    }
+
     /// Number of outputs.
     pub fn len(&self) -> usize {
         self.t.len()
@@ -211,28 +276,55 @@ impl Trajectory {
         }
     }
 
-    /// Reserves room for `outputs` more outputs.
-    pub(crate) fn reserve(&mut self, outputs: usize, energy: bool, frames: bool) {
-        let n = self.nq();
-        self.t.reserve(outputs);
-        self.q_data.reserve(outputs * n);
-        self.qd_data.reserve(outputs * n);
-        self.qdd_data.reserve(outputs * n);
-        self.lambda_data
-            .reserve(outputs * self.constraint_names.len());
-        let joints = self.joint_names.len();
-        self.orientation_data.reserve(outputs * 4 * joints);
-        self.chart_data.reserve(outputs * joints);
-        for charts in self.charts.iter_mut() {
-            // re-centrings are rare: room for 16 before the list grows
-            charts.reserve(16);
-        }
+    /// The bytes one output takes (t, q, q̇, q̈, λ, the rotation joints' orientations and
+    /// charts, and energy and poses when recorded).
+    pub(crate) fn bytes_per_output(&self, energy: bool, frames: bool) -> usize {
+        let (n, nc, joints) = (
+            self.nq(),
+            self.constraint_names.len(),
+            self.joint_names.len(),
+        );
+        let f64s = 1 + 3 * n + nc + 4 * joints;
+        let mut bytes = 8 * f64s + 4 * joints;
         if energy {
-            self.energy.reserve(outputs);
+            bytes += std::mem::size_of::<Energy>();
         }
         if frames {
-            self.poses.reserve(outputs * self.frame_names.len());
+            bytes += self.frame_names.len() * std::mem::size_of::<Pose>();
         }
+        bytes
+    }
+
+    /// Reserves room for `outputs` more outputs; an error when the memory they need cannot
+    /// be had (nothing is reserved then beyond what was).
+    pub(crate) fn reserve(
+        &mut self,
+        outputs: usize,
+        energy: bool,
+        frames: bool,
+    ) -> Result<(), std::collections::TryReserveError> {
+        let n = self.nq();
+        let joints = self.joint_names.len();
+        let times = |k: usize| outputs.saturating_mul(k);
+        self.t.try_reserve(outputs)?;
+        self.q_data.try_reserve(times(n))?;
+        self.qd_data.try_reserve(times(n))?;
+        self.qdd_data.try_reserve(times(n))?;
+        self.lambda_data
+            .try_reserve(times(self.constraint_names.len()))?;
+        self.orientation_data.try_reserve(times(4 * joints))?;
+        self.chart_data.try_reserve(times(joints))?;
+        for charts in self.charts.iter_mut() {
+            // re-centrings are rare: room for 16 before the list grows
+            charts.try_reserve(16)?;
+        }
+        if energy {
+            self.energy.try_reserve(outputs)?;
+        }
+        if frames {
+            self.poses.try_reserve(times(self.frame_names.len()))?;
+        }
+        Ok(())
     }
 
     pub(crate) fn push(&mut self, t: f64, q: &[f64], qd: &[f64], qdd: &[f64], lambda: &[f64]) {

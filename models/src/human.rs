@@ -1917,7 +1917,7 @@ impl<E: Efforts> OnTerrain<E> {
             eps: p.eps_foot,
         };
         let terrain = Terrain {
-            up: 1,
+            up: mbs::terrain::Vertical::Y,
             ground: false,
             blocks,
             law,

@@ -469,6 +469,13 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
         runs: &RunList,
         shard: Shard,
     ) -> Result<Summary, SweepError> {
+        if shard.index >= shard.count {
+            // the fields are public: a shard made by hand (a 1-based array task number)
+            return Err(SweepError::Shard(format!(
+                "{}/{}",
+                shard.index, shard.count
+            )));
+        }
         self.prepare(dir, runs)?;
         let parts = dir.join("parts");
         std::fs::create_dir_all(&parts).map_err(|source| SweepError::Io {

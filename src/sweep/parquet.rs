@@ -41,6 +41,9 @@ pub fn write(csv: &Path, out: &Path) -> Result<usize, SweepError> {
         .iter()
         .map(String::from)
         .collect();
+    if names.is_empty() {
+        return Err(bad(csv, "no header: the table is empty".into()));
+    }
     // the failure's columns are text even when every run succeeded
     let mut kinds: Vec<Kind> = names
         .iter()

@@ -73,6 +73,7 @@ pub fn inverse_dynamics_of<M: Model + Clone>(
     trajectory: &Trajectory,
     u: &[f64],
 ) -> Result<Efforts, AnalysisError> {
+    fits(model, trajectory)?;
     let mut out = efforts(model, u, trajectory.len())?;
     let mut read = model.clone();
     let mut row = vec![0.0; M::NQ];
@@ -84,6 +85,12 @@ pub fn inverse_dynamics_of<M: Model + Clone>(
         out.tau.extend_from_slice(&row);
     }
     Ok(out)
+}
+
+/// Whether `trajectory`'s data fit `model` ([`Trajectory::check_fits`]).
+fn fits<M: Model>(model: &M, trajectory: &Trajectory) -> Result<(), AnalysisError> {
+    let joints = model.info().rotation_joints.len();
+    Ok(trajectory.check_fits(M::NQ, joints)?)
 }
 
 /// Output `i` of `trajectory`: [q, qd, qdd].
@@ -233,6 +240,7 @@ pub fn inverse_dynamics_actuated_of<M: Model + Clone>(
     u: &[f64],
     actuated: &[usize],
 ) -> Result<ActuatedEfforts, AnalysisError> {
+    fits(model, trajectory)?;
     let (mut solver, mut out) = Actuation::new(model, u, actuated, trajectory.len())?;
     let mut read = model.clone();
     for i in 0..trajectory.len() {

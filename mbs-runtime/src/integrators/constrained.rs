@@ -724,6 +724,23 @@ pub fn assemble<M: crate::model::Model + 'static>(
     qd: &mut [f64],
     o: &ConstraintOptions,
 ) -> Result<Assembly, Failure> {
+    o.validate()?;
+    for (name, v) in [("q", &*q), ("qd", &*qd)] {
+        if v.len() != M::NQ {
+            return Err(Failure::InvalidOption {
+                name,
+                value: v.len().to_string(),
+                reason: "must have one value per coordinate",
+            });
+        }
+    }
+    if !t.is_finite() {
+        return Err(Failure::InvalidOption {
+            name: "t",
+            value: t.to_string(),
+            reason: "must be finite",
+        });
+    }
     assemble_erased(model, t, q, qd, o)
 }
 

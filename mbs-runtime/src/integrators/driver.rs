@@ -237,7 +237,6 @@ impl Run {
                 |t, q, qd, qdd| problem.accel(t, q, qd, qdd).is_ok(),
             ),
         };
-        let out_times = output_times(&options);
         let mut traj = names.trajectory();
         let joints = problem.model.info().rotation_joints;
         traj.charts = (0..joints.len())
@@ -246,9 +245,23 @@ impl Run {
         let expected = match &options.output {
             Output::Steps => 1024,
             Output::Last => 1,
-            _ => out_times.len(),
+            Output::Times(ts) => ts.len(),
+            Output::Every { dt } => every_count(&options, *dt) + 1,
         };
-        traj.reserve(expected, options.energy, options.frames);
+        let bytes = expected.saturating_mul(traj.bytes_per_output(options.energy, options.frames));
+        if bytes > MAX_OUTPUT_BYTES
+            || traj
+                .reserve(expected, options.energy, options.frames)
+                .is_err()
+        {
+            let e = Failure::InvalidOption {
+                name: "output",
+                value: format!("{expected} outputs of {:.1} GB", bytes as f64 * 1e-9),
+                reason: "take more memory than a trajectory may (8 GB): ask fewer (a larger `dt`, `Output::Times`), or `Output::Last` and read the motion with an observer",
+            };
+            return Err(early(e, problem.stats.clone()));
+        }
+        let out_times = output_times(&options);
         let held_counts = vec![0; n + cur.lambda.len()];
         let largest = |v: &[f64]| v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
         let start_scale = [largest(&cur.q), largest(&cur.qd)];
@@ -914,11 +927,20 @@ fn control(options: &Options) -> Control {
 }
 
 /// The output instants of `Output::Every` and `Output::Times` (none for the others).
+/// The most memory the outputs asked for may take, 8 GB: beyond it the request is refused
+/// before the run rather than ending it without a word when memory runs out.
+const MAX_OUTPUT_BYTES: usize = 8_000_000_000;
+
+/// The whole intervals `dt` from t0 to t_end (the outputs of `Output::Every` less one).
+fn every_count(options: &Options, dt: f64) -> usize {
+    ((options.t_end - options.t0) / dt + 1e-9).floor() as usize
+}
+
 fn output_times(options: &Options) -> Vec<f64> {
     match &options.output {
         Output::Times(ts) => ts.clone(),
         Output::Every { dt } => {
-            let k = ((options.t_end - options.t0) / dt + 1e-9).floor() as usize;
+            let k = every_count(options, *dt);
             (0..=k).map(|i| options.t0 + i as f64 * dt).collect()
         }
         Output::Steps | Output::Last => Vec::new(),

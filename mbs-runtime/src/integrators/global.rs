@@ -157,13 +157,17 @@ pub fn simulate_global<M: Model + Clone + 'static>(
             options.t0,
         ));
     };
-    if control.max_runs < 2 || control.samples == 0 || control.min_rtol.is_nan() {
+    if control.max_runs < 2
+        || control.samples == 0
+        || control.samples > 100_000_000
+        || control.min_rtol.is_nan()
+    {
         return Err(refused(
             model,
             Failure::InvalidOption {
                 name: "global control",
                 value: format!("{control:?}"),
-                reason: "needs max_runs ≥ 2 and samples ≥ 1",
+                reason: "needs max_runs ≥ 2 and 1 ≤ samples ≤ 10⁸",
             },
             options.t0,
         ));

@@ -125,6 +125,27 @@ fn main() {
 }
 
 fn run(args: &Args) -> Result<(), String> {
+    // the shared run arguments this program does not act on are refused, not ignored
+    let r = &args.run;
+    let unsupported = [
+        ("--global-error", r.global_error),
+        ("--scene", r.scene.is_some()),
+        ("--sweep", r.sweep.is_some()),
+        ("--shard", r.shard.is_some()),
+        ("--slurm", r.slurm),
+        ("--merge", r.merge),
+        ("--threads", r.threads.is_some()),
+    ];
+    if let Some((flag, _)) = unsupported.iter().find(|(_, given)| *given) {
+        return Err(format!(
+            "{flag} is not taken by this program (one walk, or `--compare`): run the `hexapod` example for sweeps and scenes"
+        ));
+    }
+    for (flag, v) in [("--speed", args.speed), ("--turn", args.turn)] {
+        if !v.is_finite() {
+            return Err(format!("{flag} must be a finite number, found {v}"));
+        }
+    }
     let walker = walker(args)?;
     let scheme = Scheme::from_name(&args.run.scheme)
         .ok_or_else(|| format!("unknown scheme `{}`", args.run.scheme))?;

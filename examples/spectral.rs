@@ -43,9 +43,9 @@ struct Args {
     /// write every table into this CSV file
     #[arg(long)]
     csv: Option<PathBuf>,
-    /// points of ωh, log-spaced from 0.01 to 100
-    #[arg(long, default_value_t = 41)]
-    points: usize,
+    /// points of ωh, log-spaced from 0.01 to 100 (2 to 100,000)
+    #[arg(long, default_value_t = 41, value_parser = clap::value_parser!(u32).range(2..=100_000))]
+    points: u32,
     /// print every point, not only ωh = 0.1, 1, 10, 100
     #[arg(long)]
     full: bool,
@@ -86,7 +86,7 @@ fn main() {
 
 fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let model = Oscillator::default();
-    let grid = log_grid(0.01, 100.0, args.points.max(2));
+    let grid = log_grid(0.01, 100.0, args.points as usize);
     let groups = [alpha_family(), implicit(), explicit()];
     let start = Instant::now();
     let mut tables: Vec<Vec<SpectralTable>> = Vec::new();

@@ -101,8 +101,20 @@ fn main() {
         || std::env::temp_dir().join(format!("mbs-sweep-example-{}", std::process::id())),
         std::path::PathBuf::from,
     );
+    // the folder is emptied before each round: only a new one or one of this program's
+    // (with its runs.csv), never a folder of other files
+    let ours = out.join("runs.csv").is_file();
+    let empty = std::fs::read_dir(&out).is_ok_and(|mut d| d.next().is_none());
+    if out.exists() && !ours && !empty {
+        fail(&format!(
+            "{} exists and is not a sweep's folder: the program empties its --out folder, so name a new one",
+            out.display()
+        ));
+    }
     let plan = plan(runs);
-    let list = plan.runs(std::path::Path::new(".")).expect("runs");
+    let list = plan
+        .runs(std::path::Path::new("."))
+        .unwrap_or_else(|e| fail(&format!("--runs: {e}")));
     let base = Options {
         step: StepControl::Adaptive {
             rtol: 1e-8,
@@ -139,11 +151,8 @@ fn main() {
         for _ in 0..repeat {
             let _ = std::fs::remove_dir_all(&out);
             let s = Sweep::new(DoublePendulum::default, &plan, Scheme::Dopri5, base.clone())
-                .expect("sweep")
-                .metrics(metrics())
-                .threads(threads)
-                .run(&out, &list)
-                .expect("sweep");
+                .and_then(|s| s.metrics(metrics()).threads(threads).run(&out, &list))
+                .unwrap_or_else(|e| fail(&e.to_string()));
             assert_eq!(s.ran, runs);
             if s.wall < best.0 {
                 best = (s.wall, s.cpu);

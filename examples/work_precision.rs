@@ -567,10 +567,27 @@ fn main() {
     } else {
         vec![args.model.as_str()]
     };
+    fn fail(path: &std::path::Path, e: impl std::fmt::Display) -> ! {
+        eprintln!("error: cannot write {}: {e}", path.display());
+        std::process::exit(1);
+    }
     if let Some(dir) = &args.out {
         if let Err(e) = std::fs::create_dir_all(dir) {
             eprintln!("error: cannot create {}: {e}", dir.display());
             std::process::exit(1);
+        }
+        // every file writable before the studies run, not after
+        for name in &names {
+            for file in [format!("wp_{name}.csv"), format!("wp_{name}.svg")] {
+                let path = dir.join(file);
+                let open = std::fs::OpenOptions::new()
+                    .append(true)
+                    .create(true)
+                    .open(&path);
+                if let Err(e) = open {
+                    fail(&path, e);
+                }
+            }
         }
     }
     for name in names {
@@ -583,10 +600,9 @@ fn main() {
         }
         if let Some(dir) = &args.out {
             let csv = dir.join(format!("wp_{name}.csv"));
-            std::fs::write(&csv, wp.to_csv()).unwrap_or_else(|e| panic!("{}: {e}", csv.display()));
+            std::fs::write(&csv, wp.to_csv()).unwrap_or_else(|e| fail(&csv, e));
             let svg = dir.join(format!("wp_{name}.svg"));
-            wp.write_svg(&svg)
-                .unwrap_or_else(|e| panic!("{}: {e}", svg.display()));
+            wp.write_svg(&svg).unwrap_or_else(|e| fail(&svg, e));
             println!("wrote {} and {}", csv.display(), svg.display());
         }
         println!(

@@ -785,7 +785,7 @@ impl Tree {
                 }
                 continue;
             }
-            if j.axis.iter().map(|x| x * x).sum::<f64>().sqrt() < 1e-12 {
+            if !(norm(j.axis) >= 1e-12 && norm(j.axis).is_finite()) {
                 return Err(UrdfError::ZeroAxis {
                     joint: j.name.clone(),
                     x: j.axis[0],
@@ -1764,8 +1764,16 @@ fn plane_basis(a: V3) -> (V3, V3) {
 }
 
 fn unit(a: V3) -> V3 {
-    let norm = a.iter().map(|x| x * x).sum::<f64>().sqrt();
-    scale(a, 1.0 / norm)
+    scale(a, 1.0 / norm(a))
+}
+
+/// |a|, without overflow for entries near ±f64::MAX (scaled by the largest first).
+fn norm(a: V3) -> f64 {
+    let big = a.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    if big == 0.0 || !big.is_finite() {
+        return big;
+    }
+    big * a.iter().map(|x| (x / big) * (x / big)).sum::<f64>().sqrt()
 }
 
 /// `ur5_robot` → `Ur5Robot`.
@@ -1784,7 +1792,8 @@ fn camel(name: &str) -> String {
             up = true;
         }
     }
-    if s.is_empty() || s.starts_with(|c: char| c.is_ascii_digit()) {
+    // `Self` is a keyword, not a type name a model may take
+    if s.is_empty() || s.starts_with(|c: char| c.is_ascii_digit()) || s == "Self" {
         s.insert_str(0, "Robot");
     }
     s

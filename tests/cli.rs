@@ -485,3 +485,34 @@ fn global_error_control_from_the_command_line() {
     assert!(matches!(e, RunError::Simulation(_)), "{e}");
     assert!(!dir.exists());
 }
+
+/// Programs refuse what they would get wrong: the sweep benchmark a folder of other files (it
+/// empties its folder before each round: it once deleted them), the walker options it does
+/// not act on and a speed that is not a number.
+#[test]
+fn programs_refuse_folders_and_options_they_would_get_wrong() {
+    let dir = scratch("foreign");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("thesis.txt"), "keep").unwrap();
+    let out = Command::new(example("sweep"))
+        .args(["--runs", "2", "--repeat", "1", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("is not a sweep's folder"), "{stderr}");
+    assert_eq!(
+        std::fs::read_to_string(dir.join("thesis.txt")).unwrap(),
+        "keep"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+
+    let walk = example("hexapod_walk");
+    for args in [&["--threads", "2"][..], &["--speed", "nan"]] {
+        let out = Command::new(&walk).args(args).output().unwrap();
+        assert!(!out.status.success(), "{args:?}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.contains(args[0]), "{args:?}: {stderr}");
+    }
+}

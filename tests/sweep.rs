@@ -191,6 +191,16 @@ fn a_sweep_started_again_makes_only_the_missing_runs() {
         .run(&dir, &other.runs(Path::new(".")).unwrap())
         .unwrap_err();
     assert!(matches!(err, SweepError::OtherSweep { .. }), "{err}");
+    // the same runs with other settings are refused too: the table would mix two sweeps
+    let longer = Options {
+        t_end: 3.0,
+        ..base()
+    };
+    let err = Sweep::new(DoublePendulum::default, &plan, Scheme::Dopri5, longer)
+        .unwrap()
+        .run(&dir, &runs)
+        .unwrap_err();
+    assert!(matches!(err, SweepError::OtherSettings { .. }), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -278,6 +288,67 @@ fn unknown_variables_are_refused_before_any_run() {
         Plan::from_toml("[sweep]\ndesign = \"grid\"\n[[vary]]\nname = \"q0[2]\"\nvalues = [1]\n")
             .unwrap();
     assert!(Sweep::new(DoublePendulum::default, &plan, Scheme::Dopri5, base()).is_err());
+}
+
+/// Plans and settings at the edges: refused up front, or values the plan wrote, never NaN.
+#[test]
+fn settings_at_the_edges_are_refused_or_kept_finite() {
+    // bounds near ±f64::MAX: their difference overflows, the values must not
+    for vary in [
+        "uniform = [-1e308, 1e308]",
+        "range = [-1e308, 1e308]\ncount = 3",
+    ] {
+        let design = if vary.starts_with("range") {
+            "\"grid\""
+        } else {
+            "\"monte-carlo\"\nruns = 5"
+        };
+        let plan = Plan::from_toml(&format!(
+            "[sweep]\ndesign = {design}\n[[vary]]\nname = \"l\"\n{vary}\n"
+        ))
+        .unwrap();
+        let runs = plan.runs(Path::new(".")).unwrap();
+        for row in &runs.rows {
+            let mbs::sweep::Value::Num(v) = row[0] else {
+                panic!("{vary}: not a number")
+            };
+            assert!(v.is_finite() && v.abs() <= 1e308, "{vary}: {v}");
+        }
+    }
+    // settings every run starts from, invalid: refused once, not a failed row per run
+    let plan =
+        Plan::from_toml("[sweep]\ndesign = \"grid\"\n[[vary]]\nname = \"l\"\nvalues = [1]\n[simulation]\nt_end = -1.0\n")
+            .unwrap();
+    let Err(e) = Sweep::new(DoublePendulum::default, &plan, Scheme::Dopri5, base()) else {
+        panic!("t_end = -1 accepted")
+    };
+    assert!(e.to_string().contains("t_end"), "{e}");
+    // more job-array tasks than runs
+    let plan = Plan::from_toml(
+        "[sweep]\ndesign = \"grid\"\n[[vary]]\nname = \"l\"\nvalues = [1, 2]\n[slurm]\ntasks = 3\n",
+    )
+    .unwrap();
+    let runs = plan.runs(Path::new(".")).unwrap();
+    let dir = scratch("edges");
+    let e = Sweep::new(DoublePendulum::default, &plan, Scheme::Dopri5, base())
+        .unwrap()
+        .write_slurm(&dir, &runs, &["program".to_string()])
+        .unwrap_err();
+    assert!(e.to_string().contains("tasks = 3 is more than"), "{e}");
+    // far more threads than runs: as many as there are runs
+    let s = Sweep::new(DoublePendulum::default, &plan, Scheme::Dopri5, base())
+        .unwrap()
+        .threads(1_000_000)
+        .run(&dir, &runs)
+        .unwrap();
+    assert_eq!((s.ran, s.threads), (2, 2));
+    // shards of a count near usize::MAX: index·n would wrap
+    let last = Shard {
+        index: usize::MAX - 1,
+        count: usize::MAX,
+    };
+    assert_eq!(last.range(4), 3..4);
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]

@@ -443,6 +443,20 @@ fn bad_descriptions_are_typed_errors_naming_the_culprit() {
         matches!(&e, UrdfError::Mimic { joint, leader, .. } if joint == "j" && leader == "nowhere"),
         "{e}"
     );
+    // an axis of huge entries is a direction (its length once overflowed to infinity)
+    let huge = r#"<joint name="j" type="revolute"><parent link="a"/><child link="b"/>
+        <axis xyz="1e308 1e308 0"/></joint>"#;
+    let text = import(&robot(&format!("{LINKS}{huge}"))).unwrap().model;
+    assert!(
+        text.contains("Trotn(0.7071067811865475, 0.7071067811865475, 0"),
+        "{text}"
+    );
+    // a robot named `self` is not a model named `Self`, a keyword
+    let named = format!(
+        "<robot name=\"self\">{LINKS}{}</robot>",
+        joint("j", "continuous", "a", "b")
+    );
+    assert!(import(&named).unwrap().model.contains("model RobotSelf"));
     // a fixed or floating joint cannot mimic (it once reached the mimic's lookup unchecked)
     for kind in ["fixed", "floating"] {
         let mimic = format!(

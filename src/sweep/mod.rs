@@ -94,6 +94,11 @@ pub enum SweepError {
         dir.display()
     )]
     OtherSweep { dir: PathBuf },
+    #[error(
+        "{} holds this sweep's runs made with other settings (its plan.toml differs in [simulation]: scheme, t_end, h, rtol, atol or dt): run it with the settings of plan.toml to resume, or choose another folder",
+        dir.display()
+    )]
+    OtherSettings { dir: PathBuf },
     #[error("shard `{0}`: write INDEX/COUNT with INDEX < COUNT, such as 0/3")]
     Shard(String),
     #[error(
@@ -267,7 +272,9 @@ impl Shard {
 
     /// The runs of this shard among `n`.
     pub fn range(self, n: usize) -> std::ops::Range<usize> {
-        self.index * n / self.count..(self.index + 1) * n / self.count
+        // in u128: index·n wraps usize for counts near its largest value
+        let at = |k: usize| (k as u128 * n as u128 / self.count.max(1) as u128) as usize;
+        at(self.index)..at(self.index + 1)
     }
 
     /// Its table's file name in `parts/`.
@@ -337,6 +344,25 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
         if plan.sweep.design != DesignKind::List {
             let names: Vec<String> = plan.vary.iter().map(|v| v.name.clone()).collect();
             sweep.targets = targets(&model, &names)?;
+            // the settings every run starts from, checked once rather than failing every row
+            // (unless the runs set them: a varied setting replaces the base's)
+            let settings = [
+                Target::Scheme,
+                Target::TEnd,
+                Target::H,
+                Target::Rtol,
+                Target::Atol,
+            ];
+            if !sweep.targets.iter().any(|t| settings.contains(t)) {
+                let b = &sweep.base;
+                let mut start = b.options.clone();
+                start.step = StepControl::from_settings(b.h, b.rtol, b.atol);
+                start
+                    .validate(&b.scheme, M::NQ, model.info().has_tangents)
+                    .map_err(|e| {
+                        SweepError::Plan(format!("the settings every run starts from: {e}"))
+                    })?;
+            }
         }
         Ok(sweep)
     }
@@ -406,19 +432,29 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
         })?;
         let list = dir.join("runs.csv");
         let text = runs.to_csv();
-        match std::fs::read_to_string(&list) {
-            Ok(old) if old == text => {}
+        let resumed = match std::fs::read_to_string(&list) {
+            Ok(old) if old == text => true,
             Ok(_) => {
                 return Err(SweepError::OtherSweep {
                     dir: dir.to_path_buf(),
                 });
             }
-            Err(_) => replace(&list, &text)?,
-        }
+            Err(_) => {
+                replace(&list, &text)?;
+                false
+            }
+        };
         let plan = dir.join("plan.toml");
         let text = self.effective_plan().to_toml();
-        if std::fs::read_to_string(&plan).ok().as_deref() != Some(text.as_str()) {
-            replace(&plan, &text)?;
+        match std::fs::read_to_string(&plan) {
+            Ok(old) if old == text => {}
+            // the same runs with other settings would mix two sweeps in one table
+            Ok(_) if resumed => {
+                return Err(SweepError::OtherSettings {
+                    dir: dir.to_path_buf(),
+                });
+            }
+            _ => replace(&plan, &text)?,
         }
         Ok(())
     }
@@ -507,7 +543,9 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
         let pool = {
             let mut b = rayon::ThreadPoolBuilder::new();
             if let Some(n) = self.threads {
-                b = b.num_threads(n);
+                // no more threads than runs to make (a thread per run at most; tens of
+                // thousands asked were started, each with its stack, for four runs)
+                b = b.num_threads(n.min(pending.len().max(1)));
             }
             b.build().map_err(|e| SweepError::Threads(e.to_string()))?
         };

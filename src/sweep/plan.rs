@@ -385,7 +385,7 @@ impl Dist {
     /// The value at u ∈ [0, 1) of the uniform or log-uniform distribution (its inverse CDF).
     fn at(self, u: f64) -> f64 {
         match self {
-            Dist::Uniform(lo, hi) => lo + u * (hi - lo),
+            Dist::Uniform(lo, hi) => between(lo, hi, u),
             Dist::LogUniform(lo, hi) => (lo.ln() + u * (hi.ln() - lo.ln())).exp(),
             Dist::Normal(..) => unreachable!("a Latin hypercube refuses normal variables"),
         }
@@ -441,7 +441,7 @@ impl Variable {
                         } else {
                             i as f64 / (n - 1) as f64
                         };
-                        Value::Num(if i + 1 == n { b } else { a + s * (b - a) })
+                        Value::Num(if i + 1 == n { b } else { between(a, b, s) })
                     })
                     .collect())
             }
@@ -481,6 +481,17 @@ impl Variable {
             (_, _, Some(_)) if design == DesignKind::Lhs => Err(bad(" (not `normal`)")),
             _ => Err(bad(" with a finite mean and sd ≥ 0")),
         }
+    }
+}
+
+/// a + s (b − a), or weighted, a (1 − s) + b s, where b − a overflows (bounds near
+/// ±f64::MAX, which gave NaN and infinities no one wrote).
+fn between(a: f64, b: f64, s: f64) -> f64 {
+    let d = b - a;
+    if d.is_finite() {
+        a + s * d
+    } else {
+        a * (1.0 - s) + b * s
     }
 }
 

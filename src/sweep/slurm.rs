@@ -132,6 +132,14 @@ impl<M: Model + 'static> Sweep<'_, M> {
                 "[slurm] tasks and cpus_per_task must be at least 1".into(),
             ));
         }
+        if self.plan.slurm.tasks > runs.len().max(1) {
+            return Err(SweepError::Plan(format!(
+                "[slurm] tasks = {} is more than the sweep's {} runs: a task would have none; take at most {}",
+                self.plan.slurm.tasks,
+                runs.len(),
+                runs.len().max(1)
+            )));
+        }
         self.prepare(dir, runs)?;
         let io = |path: PathBuf| move |source| SweepError::Io { path, source };
         let dir = std::path::absolute(dir).map_err(io(dir.to_path_buf()))?;

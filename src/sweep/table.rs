@@ -127,6 +127,15 @@ pub fn merge(dir: &Path) -> Result<MergeReport, SweepError> {
     let manifest = slurm::Manifest::read(dir)?;
     let n = manifest.runs;
     let tasks = manifest.tasks;
+    if tasks == 0 || tasks > n.max(1) {
+        return Err(SweepError::Table {
+            path: dir.join("manifest.json"),
+            reason: format!(
+                "tasks = {tasks} for {n} runs: a job array has 1 to {} tasks (write the array again with `--slurm`)",
+                n.max(1)
+            ),
+        });
+    }
     let table = dir.join("results.csv");
     let tmp = dir.join("results.csv.partial");
     let io = |path: &Path| {

@@ -1767,8 +1767,12 @@ fn unit(a: V3) -> V3 {
     scale(a, 1.0 / norm(a))
 }
 
-/// |a|, without overflow for entries near ±f64::MAX (scaled by the largest first).
+/// |a|, without overflow for entries near ±f64::MAX (then scaled by the largest first).
 fn norm(a: V3) -> f64 {
+    let plain = a.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if plain.is_finite() && plain > 1e-150 {
+        return plain;
+    }
     let big = a.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
     if big == 0.0 || !big.is_finite() {
         return big;

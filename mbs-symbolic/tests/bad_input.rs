@@ -127,3 +127,16 @@ fn block_doc_comments_and_raw_identifiers_give_code_that_parses() {
     let line = code.lines().find(|l| l.contains("described on two lines"));
     assert!(line.is_some_and(|l| l.starts_with("///")), "{code}");
 }
+
+#[test]
+fn a_coordinate_index_that_is_not_a_whole_number_says_what_it_takes() {
+    for index in ["-1", "1.5", "x"] {
+        let e = errors(&format!(
+            "model M {{ dof q[{index}]; body b {{ mass = 1.0; inertia = (1, 1, 1); }} TOG[b] = Trotz(q[0]); }}"
+        ));
+        one_with(
+            &e,
+            "the index of a coordinate `q[i]` is a whole number from 0",
+        );
+    }
+}

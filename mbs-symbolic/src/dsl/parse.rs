@@ -280,8 +280,14 @@ fn parse_item(input: ParseStream) -> syn::Result<Item> {
             let name = if id == "q" && input.peek(syn::token::Bracket) {
                 let idx;
                 bracketed!(idx in input);
-                let l: syn::LitInt = idx.parse()?;
-                DofName::Indexed(l.base10_parse()?, l.span())
+                let whole = |span| {
+                    syn::Error::new(
+                        span,
+                        "the index of a coordinate `q[i]` is a whole number from 0, such as `dof q[0]`",
+                    )
+                };
+                let l: syn::LitInt = idx.parse().map_err(|e| whole(e.span()))?;
+                DofName::Indexed(l.base10_parse().map_err(|_| whole(l.span()))?, l.span())
             } else {
                 DofName::Named(id)
             };

@@ -773,16 +773,20 @@ impl Tree {
             });
         }
         for (k, j) in robot.joints.iter().enumerate() {
+            let moves_by_one = matches!(
+                j.kind,
+                JointKind::Revolute | JointKind::Continuous | JointKind::Prismatic
+            );
+            if let (Some(m), false) = (&j.mimic, moves_by_one) {
+                return Err(UrdfError::Mimic {
+                    joint: j.name.clone(),
+                    leader: m.leader.clone(),
+                    problem: "but only revolute, continuous and prismatic joints can mimic; \
+                              remove the `<mimic>`"
+                        .to_string(),
+                });
+            }
             if matches!(j.kind, JointKind::Fixed | JointKind::Floating) {
-                if let Some(m) = &j.mimic {
-                    return Err(UrdfError::Mimic {
-                        joint: j.name.clone(),
-                        leader: m.leader.clone(),
-                        problem: "but only revolute, continuous and prismatic joints can mimic; \
-                                  remove the `<mimic>`"
-                            .to_string(),
-                    });
-                }
                 continue;
             }
             if !(norm(j.axis) >= 1e-12 && norm(j.axis).is_finite()) {
@@ -816,18 +820,6 @@ impl Tree {
                         }
                     }
                 };
-                if !matches!(
-                    j.kind,
-                    JointKind::Revolute | JointKind::Continuous | JointKind::Prismatic
-                ) {
-                    return Err(UrdfError::Mimic {
-                        joint: j.name.clone(),
-                        leader: m.leader.clone(),
-                        problem: "but only revolute, continuous and prismatic joints can mimic; \
-                                  remove the `<mimic>`"
-                            .to_string(),
-                    });
-                }
                 if let Some(problem) = problem {
                     return Err(UrdfError::Mimic {
                         joint: j.name.clone(),

@@ -12,31 +12,30 @@ fn one_with<'a>(e: &'a [String], part: &str) -> &'a str {
     found[0]
 }
 
-#[test]
-fn a_body_without_pose_after_a_point_mass_is_named() {
-    let e = errors(
-        "model M {
+/// An arm with a point mass `tip`, then `extra`.
+fn arm_with_tip(extra: &str) -> String {
+    format!(
+        "model M {{
             dof x = 0.0;
-            body arm { mass = 1.0; inertia = (1, 1, 1); }
+            body arm {{ mass = 1.0; inertia = (1, 1, 1); }}
             TOG[arm] = Trotz(x);
             mass tip on arm at (1, 0, 0) = 1.0;
-            body bar { mass = 1.0; inertia = (1, 1, 1); }
-        }",
-    );
+            {extra}
+        }}"
+    )
+}
+
+#[test]
+fn a_body_without_pose_after_a_point_mass_is_named() {
+    let e = errors(&arm_with_tip(
+        "body bar { mass = 1.0; inertia = (1, 1, 1); }",
+    ));
     one_with(&e, "body `bar` has no pose");
 }
 
 #[test]
 fn a_point_mass_given_a_tog_is_told_where_its_pose_is() {
-    let e = errors(
-        "model M {
-            dof x = 0.0;
-            body arm { mass = 1.0; inertia = (1, 1, 1); }
-            TOG[arm] = Trotz(x);
-            mass tip on arm at (1, 0, 0) = 1.0;
-            TOG[tip] = Tdisp(1, 0, 0);
-        }",
-    );
+    let e = errors(&arm_with_tip("TOG[tip] = Tdisp(1, 0, 0);"));
     let m = one_with(&e, "point mass");
     assert!(
         m.starts_with("`tip` is a point mass, placed by its `mass tip on"),

@@ -565,9 +565,16 @@ fn default_chart_switch() -> f64 {
 }
 
 fn invalid(name: &'static str, value: impl ToString, reason: &'static str) -> Failure {
+    let mut value = value.to_string();
+    // a number written out by `f64`'s Display (1e-300 as 0.000…1, 302 characters): short
+    if value.len() > 15 && value.parse::<u64>().is_err() {
+        if let Ok(x) = value.parse::<f64>() {
+            value = short(x);
+        }
+    }
     Failure::InvalidOption {
         name,
-        value: value.to_string(),
+        value,
         reason,
     }
 }
@@ -911,6 +918,14 @@ mod tests {
             .validate(&Scheme::Dopri5, 2, false)
             .unwrap_err();
         assert!(matches!(e, Failure::InvalidOption { name: "rtol", .. }));
+        // tiny and huge values read as written, not as 300 digits
+        let e = Options::adaptive(1.0, 1e-300)
+            .validate(&Scheme::Dopri5, 2, false)
+            .unwrap_err();
+        assert!(
+            matches!(&e, Failure::InvalidOption { value, .. } if value == "1e-300"),
+            "{e}"
+        );
         let e = Options::adaptive(1.0, 1e-6)
             .validate(&Scheme::Rk4, 2, false)
             .unwrap_err();

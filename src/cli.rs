@@ -567,6 +567,7 @@ impl RunArgs {
         use crate::sweep::{Plan, Shard, Sweep, merge};
         let plan_path = self.sweep.as_deref().ok_or(RunError::SweepWithoutOut)?;
         let dir = self.out.as_deref().ok_or(RunError::SweepWithoutOut)?;
+        self.check_scene(model.info().scene)?;
         if self.merge {
             let m = merge(dir)?;
             if !self.quiet {
@@ -676,17 +677,7 @@ impl RunArgs {
         let scheme = Scheme::from_name(&self.scheme)
             .ok_or_else(|| RunError::UnknownScheme(self.scheme.clone()))?;
         let info = model.info();
-        // a program with several scenes picks the model by --scene; any other must refuse it
-        if let Some(scene) = &self.scene {
-            if *scene != info.scene {
-                let known: &[&str] = if info.scene.is_empty() {
-                    &[]
-                } else {
-                    &[info.scene]
-                };
-                return Err(self.unknown_scene(known));
-            }
-        }
+        self.check_scene(info.scene)?;
         let name = info.name;
         let running = Running::start();
         let start = Instant::now();
@@ -959,6 +950,18 @@ impl RunArgs {
         crate::gltf::write_gltf(&path, info, tr).map_err(|e| export(path.clone(), e))?;
         written.push(path);
         Ok(written)
+    }
+
+    /// A program with several scenes picks the model by `--scene`; any other must refuse
+    /// it: the `--scene` asked, if any, must be the model's `scene`.
+    fn check_scene(&self, scene: &str) -> Result<(), RunError> {
+        match &self.scene {
+            Some(asked) if asked != scene => {
+                let known: &[&str] = if scene.is_empty() { &[] } else { &[scene] };
+                Err(self.unknown_scene(known))
+            }
+            _ => Ok(()),
+        }
     }
 
     /// The error for a `--scene` this program does not have.

@@ -88,6 +88,19 @@ fn bad_arguments_are_refused_with_what_is_known() {
         e.to_string().contains("`Damped`") && e.to_string().contains("Free"),
         "{e}"
     );
+    // in a sweep too (it once ran the model it was given, whatever the scene asked)
+    let e = args(&[
+        "--scene",
+        "Damped",
+        "--sweep",
+        "plan.toml",
+        "--out",
+        "sweep",
+    ])
+    .sweep(SwingFree::default(), 1.0)
+    .err()
+    .unwrap();
+    assert!(matches!(e, RunError::UnknownScene { .. }), "{e}");
     // the right one runs
     assert!(
         args(&["--scene", "Damped", "--t-end", "0.1"])

@@ -139,3 +139,21 @@ fn a_coordinate_index_that_is_not_a_whole_number_says_what_it_takes() {
         );
     }
 }
+
+#[test]
+fn the_separator_of_indexed_names_is_not_a_users() {
+    let e = errors(
+        "model M {
+            dof x = 0.0;
+            body b·0 { mass = 1.0; inertia = (1, 1, 1); }
+            TOG[b·0] = Trotz(x);
+        }",
+    );
+    assert_eq!(
+        e.iter()
+            .filter(|m| m.contains("is reserved for the instances of indexed names"))
+            .count(),
+        2,
+        "{e:?}"
+    );
+}

@@ -179,6 +179,7 @@ pub fn expand(content: TokenStream, end: Span, errors: &mut Vec<syn::Error>) -> 
         errors: Vec::new(),
         instantiating: Vec::new(),
     };
+    separator_written(content.clone(), errors);
     let stmts = split(content, end);
     // parts first: a part may be instantiated above its declaration
     let mut rest = Vec::new();
@@ -193,6 +194,21 @@ pub fn expand(content: TokenStream, end: Span, errors: &mut Vec<syn::Error>) -> 
     ex.statements(rest, &[], &None, &mut out, false);
     errors.append(&mut ex.errors);
     out
+}
+
+/// An error for each name written with [`SEP`], which only the expansion writes (`b[0]`
+/// becomes `b·0`): written by hand it would name an instance, or collide with one.
+fn separator_written(tokens: TokenStream, errors: &mut Vec<syn::Error>) {
+    for t in tokens {
+        match t {
+            TokenTree::Ident(i) if i.to_string().contains(SEP) => errors.push(syn::Error::new(
+                i.span(),
+                format!("`{SEP}` is reserved for the instances of indexed names: write `b[0]`, not `{i}`"),
+            )),
+            TokenTree::Group(g) => separator_written(g.stream(), errors),
+            _ => {}
+        }
+    }
 }
 
 fn starts_with(s: &[TokenTree], kw: &str) -> bool {

@@ -789,7 +789,8 @@ impl Tree {
             if matches!(j.kind, JointKind::Fixed | JointKind::Floating) {
                 continue;
             }
-            if !(norm(j.axis) >= 1e-12 && norm(j.axis).is_finite()) {
+            let length = norm(j.axis);
+            if !(length >= 1e-12 && length.is_finite()) {
                 return Err(UrdfError::ZeroAxis {
                     joint: j.name.clone(),
                     x: j.axis[0],
@@ -1759,17 +1760,15 @@ fn unit(a: V3) -> V3 {
     scale(a, 1.0 / norm(a))
 }
 
-/// |a|, without overflow for entries near ±f64::MAX (then scaled by the largest first).
+/// |a|: the plain root of the sum of squares, or `hypot`'s where that sum overflows or
+/// underflows (entries near ±f64::MAX or below 1e-150).
 fn norm(a: V3) -> f64 {
     let plain = a.iter().map(|x| x * x).sum::<f64>().sqrt();
     if plain.is_finite() && plain > 1e-150 {
-        return plain;
+        plain
+    } else {
+        a[0].hypot(a[1]).hypot(a[2])
     }
-    let big = a.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
-    if big == 0.0 || !big.is_finite() {
-        return big;
-    }
-    big * a.iter().map(|x| (x / big) * (x / big)).sum::<f64>().sqrt()
 }
 
 /// `ur5_robot` → `Ur5Robot`.

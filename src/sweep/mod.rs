@@ -264,10 +264,17 @@ impl Shard {
         let (i, n) = s.split_once('/').ok_or_else(bad)?;
         let index: usize = i.trim().parse().map_err(|_| bad())?;
         let count: usize = n.trim().parse().map_err(|_| bad())?;
-        if index >= count {
-            return Err(bad());
+        Shard { index, count }.checked()
+    }
+
+    /// The shard if its index is below its count (the fields are public: a shard made by
+    /// hand, with a 1-based array task number, is checked too).
+    pub fn checked(self) -> Result<Shard, SweepError> {
+        if self.index < self.count {
+            Ok(self)
+        } else {
+            Err(SweepError::Shard(format!("{}/{}", self.index, self.count)))
         }
-        Ok(Shard { index, count })
     }
 
     /// The runs of this shard among `n`.
@@ -505,13 +512,7 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
         runs: &RunList,
         shard: Shard,
     ) -> Result<Summary, SweepError> {
-        if shard.index >= shard.count {
-            // the fields are public: a shard made by hand (a 1-based array task number)
-            return Err(SweepError::Shard(format!(
-                "{}/{}",
-                shard.index, shard.count
-            )));
-        }
+        let shard = shard.checked()?;
         self.prepare(dir, runs)?;
         let parts = dir.join("parts");
         std::fs::create_dir_all(&parts).map_err(|source| SweepError::Io {

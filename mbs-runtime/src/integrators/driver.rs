@@ -926,7 +926,6 @@ fn control(options: &Options) -> Control {
     }
 }
 
-/// The output instants of `Output::Every` and `Output::Times` (none for the others).
 /// The most memory the outputs asked for may take, 8 GB: beyond it the request is refused
 /// before the run rather than ending it without a word when memory runs out.
 const MAX_OUTPUT_BYTES: usize = 8_000_000_000;
@@ -936,6 +935,7 @@ fn every_count(options: &Options, dt: f64) -> usize {
     ((options.t_end - options.t0) / dt + 1e-9).floor() as usize
 }
 
+/// The output instants of `Output::Every` and `Output::Times` (none for the others).
 fn output_times(options: &Options) -> Vec<f64> {
     match &options.output {
         Output::Times(ts) => ts.clone(),

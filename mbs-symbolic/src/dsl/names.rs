@@ -40,6 +40,17 @@ pub fn did_you_mean<'a>(
     }
 }
 
+/// " (through `g` and `h`)" for the names a recursion passed through, or "" when it called
+/// itself directly: how a recursive `fn` or `part` is reported.
+pub fn through(names: &[String]) -> String {
+    let q: Vec<String> = names.iter().map(|n| format!("`{n}`")).collect();
+    match q.split_last() {
+        None => String::new(),
+        Some((last, [])) => format!(" (through {last})"),
+        Some((last, rest)) => format!(" (through {} and {last})", rest.join(", ")),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

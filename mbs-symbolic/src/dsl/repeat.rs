@@ -590,12 +590,7 @@ impl Expander {
         }
         let name = id.to_string();
         if let Some(k) = self.instantiating.iter().position(|p| *p == name) {
-            let through = &self.instantiating[k + 1..];
-            let how = if through.is_empty() {
-                String::new()
-            } else {
-                format!(" (through {})", quoted(through))
-            };
+            let how = super::names::through(&self.instantiating[k + 1..]);
             self.error(id.span(), format!("part `{id}` instantiates itself{how}: a part cannot be recursive; repeat its statements with `for` instead"), &None);
             return;
         }
@@ -940,16 +935,6 @@ impl Expander {
                 None
             }
         }
-    }
-}
-
-/// `a`, `b` and `c`: names in backquotes.
-fn quoted(names: &[String]) -> String {
-    let q: Vec<String> = names.iter().map(|n| format!("`{n}`")).collect();
-    match q.split_last() {
-        Some((last, [])) => last.clone(),
-        Some((last, rest)) => format!("{} and {last}", rest.join(", ")),
-        None => String::new(),
     }
 }
 

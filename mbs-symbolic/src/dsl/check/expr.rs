@@ -655,15 +655,7 @@ impl Checker {
                     return self.sys.arena.zero();
                 }
                 if let Some(k) = self.calling.iter().position(|f| *f == name) {
-                    let through: Vec<String> = self.calling[k + 1..]
-                        .iter()
-                        .map(|f| format!("`{f}`"))
-                        .collect();
-                    let how = if through.is_empty() {
-                        String::new()
-                    } else {
-                        format!(" (through {})", through.join(", "))
-                    };
+                    let how = crate::dsl::names::through(&self.calling[k + 1..]);
                     self.error_at(
                         c,
                         format!("`{name}` calls itself{how}: an inline `fn` cannot be recursive"),

@@ -29,6 +29,17 @@ pub enum ExportError {
     },
     #[error("cannot serialise the document: {0}")]
     Json(String),
+    /// A value beyond what the file's 32-bit floats hold (about 3.4e38).
+    #[error(
+        "{what} at output {output} (t = {t}) is {value:e}, beyond the 32-bit floats of a glTF file: \
+         export the outputs before it (a copy with `Trajectory::clear_outputs` and `push_output`)"
+    )]
+    BeyondSinglePrecision {
+        what: String,
+        output: usize,
+        t: f64,
+        value: f64,
+    },
 }
 
 /// Which world axis points up in the views.
@@ -106,6 +117,29 @@ impl<'a> Frames<'a> {
             let m = self.keep.len() - 1;
             self.keep = (0..n).map(|k| self.keep[k * m / (n - 1)]).collect();
         }
+    }
+
+    /// Skips the outputs whose time, less the first's, rounds to the same 32-bit float as
+    /// the previous kept output's (glTF's times are 32-bit and strictly increasing: at
+    /// t − t₀ = 10⁴ s they are about a millisecond apart).
+    #[cfg(feature = "gltf")]
+    pub(crate) fn keep_single_precision_times(&mut self) {
+        let t0 = self.time(0);
+        let t = &self.trajectory.t;
+        let mut last = f32::NEG_INFINITY;
+        self.keep.retain(|&i| {
+            let ti = (t[i] - t0) as f32;
+            let keep = ti > last;
+            if keep {
+                last = ti;
+            }
+            keep
+        });
+    }
+
+    /// The index in the trajectory of kept output `k`.
+    pub(crate) fn output(&self, k: usize) -> usize {
+        self.keep[k]
     }
 
     pub(crate) fn len(&self) -> usize {

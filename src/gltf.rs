@@ -19,7 +19,9 @@
 //! The file is self-contained: its one buffer is a base64 `data:` URI. Lengths are the model's
 //! (metres); glTF's up axis is +y, so a model whose up axis is z (see
 //! [`Up`]) hangs below a root node turned by −90° about x, and the body
-//! nodes keep the model's world coordinates. Animation times are `t − t₀`.
+//! nodes keep the model's world coordinates. Animation times are `t − t₀`, as 32-bit floats:
+//! outputs closer together than their resolution (a millisecond at 10⁴ s) are skipped, and a
+//! time or position beyond their range (3.4e38) is an [`ExportError`].
 
 use crate::export::{ExportError, Frames, Up, palette};
 use crate::model::ModelInfo;
@@ -65,13 +67,38 @@ pub fn write_gltf_with(
     })
 }
 
+/// Refuses a time or a frame's position beyond f32 (which glTF's JSON would write as `null`).
+fn check_single_precision(info: &ModelInfo, frames: &Frames) -> Result<(), ExportError> {
+    let t0 = frames.time(0);
+    for k in 0..frames.len() {
+        let t = frames.time(k);
+        let beyond = |what: String, value: f64| ExportError::BeyondSinglePrecision {
+            what,
+            output: frames.output(k),
+            t,
+            value,
+        };
+        if !((t - t0) as f32).is_finite() {
+            return Err(beyond("the time less the first output's".into(), t - t0));
+        }
+        for (i, p) in frames.pose(k).iter().enumerate() {
+            if let Some(&x) = p.position.iter().find(|x| !(**x as f32).is_finite()) {
+                return Err(beyond(format!("the position of `{}`", info.frames[i]), x));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// The glTF document of [`write_gltf`], its buffer embedded as a `data:` URI.
 pub fn document(
     info: &ModelInfo,
     trajectory: &Trajectory,
     options: &GltfOptions,
 ) -> Result<json::Root, ExportError> {
-    let frames = Frames::new(info, trajectory)?;
+    let mut frames = Frames::new(info, trajectory)?;
+    frames.keep_single_precision_times();
+    check_single_precision(info, &frames)?;
     let up = options.up.resolve(&frames);
     let mut b = Builder::default();
     let nf = info.frames.len();

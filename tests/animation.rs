@@ -330,6 +330,55 @@ fn exports_without_poses_say_how_to_record_them() {
     assert!(matches!(e, ExportError::Frames { .. }), "{e}");
 }
 
+/// glTF's times and positions are 32-bit: outputs that its times cannot tell apart are
+/// skipped (strictly increasing times, as the format asks), and a value beyond f32 is a typed
+/// error naming the output, not a `null` in the file.
+#[test]
+fn the_gltf_keeps_its_32_bit_times_increasing_and_refuses_what_f32_cannot_hold() {
+    let info = dpend::DoublePendulum::default().info();
+    let mut tr = dpend_run(5.0);
+    let n = tr.len();
+    assert!(n > 100, "{n} outputs");
+    // the first output at 0, the others 10⁴ s later, 1e-5 s apart: at 10⁴ s f32 times are
+    // 2^-10 s apart, so about one output in 98 keeps a time of its own
+    for (k, t) in tr.t.iter_mut().enumerate().skip(1) {
+        *t = 1e4 + k as f64 * 1e-5;
+    }
+    let root = mbs::gltf::document(info, &tr, &GltfOptions::default()).unwrap();
+    let anim = &root.animations[0];
+    let input = &root.accessors[anim.samplers[0].input.value()];
+    let kept = input.count.0 as usize;
+    assert!(kept >= 2 && kept < n, "{kept} of {n} outputs kept");
+    let min = input.min.as_ref().unwrap()[0].as_f64().unwrap();
+    let max = input.max.as_ref().unwrap()[0].as_f64().unwrap();
+    assert_eq!(min, 0.0);
+    assert!((max - 1e4).abs() < 0.01, "{max}");
+
+    // a position beyond f32 (3.4e38): refused, naming the frame and the output
+    let mut far = dpend_run(0.1);
+    let nf = info.frames.len();
+    far.poses[5 * nf + 1].position[0] = 1e39;
+    let e = mbs::gltf::document(info, &far, &GltfOptions::default()).unwrap_err();
+    assert!(
+        matches!(e, ExportError::BeyondSinglePrecision { output: 5, .. }),
+        "{e}"
+    );
+    let message = e.to_string();
+    assert!(
+        message.contains(info.frames[1]) && message.contains("1e39"),
+        "{message}"
+    );
+    // and so is a time 1e39 s after the first
+    let mut late = dpend_run(0.1);
+    let last = late.len() - 1;
+    late.t[last] = 1e39;
+    let e = mbs::gltf::document(info, &late, &GltfOptions::default()).unwrap_err();
+    assert!(
+        matches!(e, ExportError::BeyondSinglePrecision { output, .. } if output == last),
+        "{e}"
+    );
+}
+
 fn base64_decode(s: &str) -> Vec<u8> {
     let val = |c: u8| match c {
         b'A'..=b'Z' => c - b'A',

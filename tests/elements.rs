@@ -335,3 +335,24 @@ fn negative_rotational_coefficients_from_parameters_are_typed_errors() {
         );
     }
 }
+
+/// `Path::through` finds a path's points by name, and refuses a name the model does not
+/// declare, or a path of fewer than two points, with a typed error that says so.
+#[test]
+fn a_path_is_built_from_declared_point_names() {
+    use mbs::elements::{Path, PathError};
+    let info = RigBare::default().info();
+    let path = Path::through(info, &["hook", "tip"]).unwrap();
+    assert_eq!(
+        path.points,
+        [
+            info.point_index("hook").unwrap(),
+            info.point_index("tip").unwrap()
+        ]
+    );
+    let e = Path::through(info, &["hook", "tipp"]).unwrap_err();
+    assert!(matches!(&e, PathError::NoPoint { name, .. } if name == "tipp"));
+    assert!(e.to_string().contains("has no point `tipp`"), "{e}");
+    let e = Path::through(info, &["hook"]).unwrap_err();
+    assert!(matches!(e, PathError::TooShort { found: 1 }), "{e}");
+}

@@ -276,6 +276,59 @@ fn expand_follows_modules_and_reports_every_error_with_its_place() {
     );
 }
 
+/// A module file that is not a regular file (here a FIFO named by `#[path]`, which nothing
+/// writes to: reading it would block for ever) is an error where it is named, not a hang.
+#[cfg(unix)]
+#[test]
+fn expand_refuses_a_module_that_is_not_a_regular_file() {
+    let dir = fixture(
+        "expand_fifo",
+        &[(
+            "main.rs",
+            &format!(
+                "mbs::multibody! {{ model Alone {{ {GOOD} }} }}\n#[path = \"pipe.rs\"]\nmod pipe;\n"
+            ),
+        )],
+    );
+    let made = Command::new("mkfifo")
+        .arg(dir.join("pipe.rs"))
+        .status()
+        .unwrap();
+    assert!(made.success());
+    let mut child = Command::new(env!("CARGO_BIN_EXE_mbs"))
+        .args([
+            "expand",
+            dir.join("main.rs").to_str().unwrap(),
+            "--counts-only",
+        ])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > std::time::Duration::from_secs(60) {
+            child.kill().unwrap();
+            panic!("`mbs expand` still reads the FIFO after 60 s");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let out = child.wait_with_output().unwrap();
+    let (stdout, stderr) = (
+        String::from_utf8(out.stdout).unwrap(),
+        String::from_utf8(out.stderr).unwrap(),
+    );
+    assert!(
+        !out.status.success() && stdout.contains("model Alone:"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.starts_with(&format!("error: {}:3:5", dir.join("main.rs").display()))
+            && stderr.contains("not a regular file"),
+        "{stderr}"
+    );
+}
+
 /// The examples keep their models in `mbs-models`: `mbs expand examples/hexapod.rs` finds the
 /// model through `use mbs_models::hexapod`.
 #[test]

@@ -66,6 +66,11 @@ pub trait Efforts: 'static {
 }
 
 /// The state handed to the user part, and where it adds its efforts.
+///
+/// Frames, points and coordinates are named by their indices in the wrapped model
+/// (`ModelInfo::frame_index`, `ModelInfo::point_index`, found once when the user part is
+/// built, where a missing name is an error the user part can report). An index the model
+/// does not have is a bug in the user part: the accessors panic on it, as a slice does.
 pub struct Effort<'a> {
     pub t: f64,
     /// coordinates and velocities of the wrapped model

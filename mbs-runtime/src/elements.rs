@@ -16,7 +16,7 @@
 //!   speed and ∂l/∂q from the points' kinematics, a tension applied along it.
 
 use crate::efforts::Effort;
-use crate::model::Kinematics;
+use crate::model::{Kinematics, ModelInfo};
 
 type V3 = [f64; 3];
 
@@ -273,6 +273,17 @@ impl Bushing {
     }
 }
 
+/// Why [`Path::through`] could not build a path.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum PathError {
+    #[error(
+        "model `{model}` has no point `{name}`: declare it in the multibody! block, `point {name} on BODY at (x, y, z);`"
+    )]
+    NoPoint { model: &'static str, name: String },
+    #[error("a path needs at least two points, its origin and its insertion; {found} given")]
+    TooShort { found: usize },
+}
+
 /// A path through declared points (origin, via points, insertion) along which a cable or a
 /// muscle pulls: its length l = Σ |p_{i+1} − p_i|, lengthening speed l̇ and gradient ∂l/∂q
 /// from the generated kinematics of the points (exact: the gradient is Σ u_iᵀ (J_{i+1} − J_i)
@@ -280,6 +291,10 @@ impl Bushing {
 /// −∂l/∂q are those of the kinematics, not of differences. A tension T acts at each point
 /// along its segments, pulling consecutive points together; its generalised force is
 /// −T ∂l/∂q.
+///
+/// Build it with [`Path::through`], which checks the names. Its methods index the
+/// kinematics' points by `points`, and panic on an index the model does not have (a path
+/// built by hand for another model).
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Path {
     /// the declared points (`ModelInfo::point_index`), from origin to insertion
@@ -287,6 +302,24 @@ pub struct Path {
 }
 
 impl Path {
+    /// The path through the declared points named `names` of the model `info`, from origin
+    /// to insertion: a typed error for a name the model does not declare, or fewer than two.
+    pub fn through(info: &ModelInfo, names: &[&str]) -> Result<Path, PathError> {
+        if names.len() < 2 {
+            return Err(PathError::TooShort { found: names.len() });
+        }
+        let points = names
+            .iter()
+            .map(|&name| {
+                info.point_index(name).ok_or_else(|| PathError::NoPoint {
+                    model: info.name,
+                    name: name.to_string(),
+                })
+            })
+            .collect::<Result<_, _>>()?;
+        Ok(Path { points })
+    }
+
     fn segments<'a>(&'a self, kin: &'a Kinematics) -> impl Iterator<Item = (V3, V3, f64)> + 'a {
         self.points.windows(2).map(|w| {
             let (a, b) = (&kin.points[w[0]], &kin.points[w[1]]);

@@ -72,7 +72,16 @@ impl Reader {
             return;
         }
         self.seen.push(key);
-        let text = match std::fs::read_to_string(&path) {
+        // a FIFO or a device would block the read or never end it: only regular files
+        let text = match std::fs::metadata(&path).and_then(|m| {
+            if m.is_file() {
+                std::fs::read_to_string(&path)
+            } else {
+                Err(std::io::Error::other(
+                    "it is not a regular file (a folder, a FIFO or a device): name a Rust source file",
+                ))
+            }
+        }) {
             Ok(t) => t,
             Err(e) => {
                 let (file, span) = match from {

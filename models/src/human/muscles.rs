@@ -133,16 +133,10 @@ impl Muscles {
                     m.pennation,
                 );
                 unit.activation_times = [0.01, 0.04];
-                let points = m
-                    .path
-                    .iter()
-                    .map(|p| {
-                        let name = format!("{p}[{k}]");
-                        info.point_index(&name)
-                            .ok_or_else(|| format!("the model has no point `{name}`"))
-                    })
-                    .collect::<Result<Vec<usize>, String>>()?;
-                units.push((unit, Path { points }));
+                let names: Vec<String> = m.path.iter().map(|p| format!("{p}[{k}]")).collect();
+                let names: Vec<&str> = names.iter().map(String::as_str).collect();
+                let path = Path::through(info, &names).map_err(|e| e.to_string())?;
+                units.push((unit, path));
             }
         }
         Ok(Muscles {

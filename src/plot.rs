@@ -85,18 +85,24 @@ pub enum PlotError {
     Empty,
     #[error("drawing the chart failed: {0}")]
     Draw(String),
+    #[error(
+        "values from {lo:e} to {hi:e} span more than an axis can draw (its range, widened, leaves f64): scale them"
+    )]
+    Range { lo: f64, hi: f64 },
 }
 
 fn kept(c: &Chart, p: (f64, f64)) -> bool {
     p.0.is_finite() && p.1.is_finite() && (!c.log_x || p.0 > 0.0) && (!c.log_y || p.1 > 0.0)
 }
 
-/// The range of the kept values along one axis, widened a little (by a factor on a log axis).
-fn range(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
+/// The range of the kept values along one axis, widened a little (by a factor on a log axis),
+/// or an error when it cannot be drawn: bounds beyond f64 once widened (plotting code then
+/// looks for tick marks without end).
+fn range(values: impl Iterator<Item = f64>, log: bool) -> Result<(f64, f64), PlotError> {
     let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
         (a.min(v), b.max(v))
     });
-    if log {
+    let (a, b) = if log {
         let (lo, hi) = if lo == hi {
             (lo / 2.0, hi * 2.0)
         } else {
@@ -104,8 +110,20 @@ fn range(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
         };
         (lo / 1.5, hi * 1.5)
     } else {
-        let pad = if lo == hi { 1.0 } else { 0.05 * (hi - lo) };
+        // a width below the values' resolution is no width: pad by their size
+        let size = lo.abs().max(hi.abs());
+        let width = hi - lo;
+        let pad = if width > 1e-12 * size {
+            0.05 * width
+        } else {
+            (0.05 * size).max(1.0)
+        };
         (lo - pad, hi + pad)
+    };
+    if a.is_finite() && b.is_finite() && a < b && (b - a).is_finite() && (!log || a > 0.0) {
+        Ok((a, b))
+    } else {
+        Err(PlotError::Range { lo, hi })
     }
 }
 
@@ -139,8 +157,8 @@ pub fn line_chart_svg(chart: &Chart, series: &[Series]) -> Result<String, PlotEr
     if pts().next().is_none() {
         return Err(PlotError::Empty);
     }
-    let (x0, x1) = range(pts().map(|p| p.0), chart.log_x);
-    let (y0, y1) = range(pts().map(|p| p.1), chart.log_y);
+    let (x0, x1) = range(pts().map(|p| p.0), chart.log_x)?;
+    let (y0, y1) = range(pts().map(|p| p.1), chart.log_y)?;
     let mut out = String::new();
     {
         let root = SVGBackend::with_string(&mut out, chart.size).into_drawing_area();
@@ -307,5 +325,36 @@ mod tests {
             points: vec![(0.0, 1.0)],
         }];
         assert!(matches!(line_chart_svg(&c, &empty), Err(PlotError::Empty)));
+    }
+
+    /// Values whose widened range leaves f64 are a typed error (the plotting code looked for
+    /// tick marks without end on them); values of one size far from 1, or a span below
+    /// their resolution, still draw.
+    #[test]
+    fn ranges_beyond_f64_are_refused_and_narrow_ones_drawn() {
+        let lin = Chart::linear("t", "x", "y");
+        let series = |points: Vec<(f64, f64)>| {
+            [Series {
+                name: "a".into(),
+                points,
+            }]
+        };
+        for (chart, points) in [
+            (&lin, vec![(0.0, 0.0), (1.0, 1.75e308)]),
+            (&lin, vec![(0.0, -1e308), (1.0, 1e308)]),
+            (&Chart::default(), vec![(1.0, 1.0), (2.0, 1.5e308)]),
+            (&Chart::default(), vec![(1.0, 7e307)]),
+        ] {
+            let e = line_chart_svg(chart, &series(points.clone())).unwrap_err();
+            assert!(matches!(e, PlotError::Range { .. }), "{points:?}: {e}");
+        }
+        for points in [
+            vec![(0.0, 1e300), (1.0, 1e300)],
+            vec![(0.0, 1.0), (1.0, 1.0 + 1e-15)],
+            vec![(0.0, 3e-320), (1.0, 5e-320)],
+        ] {
+            let svg = line_chart_svg(&lin, &series(points.clone()));
+            assert!(svg.is_ok(), "{points:?}: {svg:?}");
+        }
     }
 }

@@ -415,11 +415,22 @@ impl Reference {
 pub use mbs_runtime::state_size;
 
 /// max_i |y_i − r_i| / (a + |r_i|): the Test Set's mixed error with absolute floor `a`.
+/// NaN when a component is not comparable (NaN or infinite) or the lengths differ: a state
+/// that cannot be measured is never taken for an exact one.
 pub fn mixed_error(y: &[f64], reference: &[f64], floor: f64) -> f64 {
+    if y.len() != reference.len() {
+        return f64::NAN;
+    }
     y.iter()
         .zip(reference)
         .map(|(y, r)| (y - r).abs() / (floor + r.abs()))
-        .fold(0.0, f64::max)
+        .fold(0.0, |m, e| {
+            if e.is_nan() || m.is_nan() {
+                f64::NAN
+            } else {
+                m.max(e)
+            }
+        })
 }
 
 /// Significant correct digits of a mixed error: −log10 e (+∞ for an exact result).
@@ -477,6 +488,22 @@ pub enum StudyError {
         value: String,
         reason: &'static str,
     },
+    #[error(
+        "reference state {index} has component {component} = {value}: a reference must be finite (a run that failed, or a function outside its domain?)"
+    )]
+    NonFiniteReference {
+        index: usize,
+        component: usize,
+        value: f64,
+    },
+    #[error("the study has no sweep: add one with `Study::sweep`")]
+    NoSweeps,
+    #[error("sweep `{label}` has no setting: give it tolerances or steps")]
+    EmptySweep { label: String },
+    #[error(
+        "sweep `{label}` asks for global error control on fixed steps: global control needs tolerances (`Sweep::adaptive`)"
+    )]
+    GlobalNeedsRtol { label: String },
 }
 
 impl Study {
@@ -556,6 +583,15 @@ impl Study {
                     expected,
                 });
             }
+            for (index, y) in states.iter().enumerate() {
+                if let Some(component) = y.iter().position(|v| !v.is_finite()) {
+                    return Err(StudyError::NonFiniteReference {
+                        index,
+                        component,
+                        value: y[component],
+                    });
+                }
+            }
         }
         let invalid = |name, value: f64, reason| {
             Err(StudyError::Invalid {
@@ -588,6 +624,23 @@ impl Study {
                 value: format!("{:?}", self.euler_angles),
                 reason: "must name coordinates of the model (below its number of coordinates), each in one triple only and none of a `Tball` or `Tfree` joint's",
             });
+        }
+        if self.sweeps.is_empty() {
+            return Err(StudyError::NoSweeps);
+        }
+        for sweep in &self.sweeps {
+            if sweep.settings.is_empty() {
+                return Err(StudyError::EmptySweep {
+                    label: sweep.label.clone(),
+                });
+            }
+            if sweep.global.is_some()
+                && sweep.settings.iter().any(|s| matches!(s, Setting::Step(_)))
+            {
+                return Err(StudyError::GlobalNeedsRtol {
+                    label: sweep.label.clone(),
+                });
+            }
         }
         Ok(())
     }
@@ -1081,19 +1134,28 @@ impl Proportionality {
     }
 
     /// The largest number of digits lost from one rtol to the next, tighter, one (0 when every
-    /// tightening gained); failed runs are skipped.
+    /// tightening gained); failed runs, and exact ones (infinitely many digits), are skipped.
     pub fn largest_loss(&self) -> f64 {
-        let ok: Vec<f64> = self.digits.iter().flatten().copied().collect();
+        let ok: Vec<f64> = self
+            .digits
+            .iter()
+            .flatten()
+            .copied()
+            .filter(|d| d.is_finite())
+            .collect();
         ok.windows(2).map(|w| w[0] - w[1]).fold(0.0, f64::max)
     }
 
-    /// Least-squares slope of the digits against −log10 rtol (1 for a proportional sweep).
-    pub fn slope(&self) -> f64 {
+    /// Least-squares slope of the digits against −log10 rtol (1 for a proportional sweep);
+    /// `None` below two successful runs at different tolerances (failed and exact runs do not
+    /// count).
+    pub fn slope(&self) -> Option<f64> {
         let pts: Vec<(f64, f64)> = self
             .rtols
             .iter()
             .zip(&self.digits)
             .filter_map(|(r, d)| d.map(|d| (-r.log10(), d)))
+            .filter(|(x, y)| x.is_finite() && y.is_finite())
             .collect();
         let n = pts.len() as f64;
         let (mx, my) = pts
@@ -1101,7 +1163,7 @@ impl Proportionality {
             .fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n, b + y / n));
         let sxy: f64 = pts.iter().map(|(x, y)| (x - mx) * (y - my)).sum();
         let sxx: f64 = pts.iter().map(|(x, _)| (x - mx) * (x - mx)).sum();
-        sxy / sxx
+        (sxx > 0.0).then(|| sxy / sxx)
     }
 }
 
@@ -1159,13 +1221,22 @@ impl WorkPrecision {
                     }
                 }
             }
-            let offsets: Vec<f64> = p.offsets().map(|(_, o)| o).collect();
-            let mean = offsets.iter().sum::<f64>() / offsets.len().max(1) as f64;
+            let offsets: Vec<f64> = p
+                .offsets()
+                .map(|(_, o)| o)
+                .filter(|o| o.is_finite())
+                .collect();
+            let mean =
+                (!offsets.is_empty()).then(|| offsets.iter().sum::<f64>() / offsets.len() as f64);
+            let shown = |x: Option<f64>, w: usize| match x {
+                Some(x) => format!("{x:>w$.2}"),
+                None => format!("{:>w$}", "—"),
+            };
             let _ = writeln!(
                 s,
-                " {:>6.2} {:>7.2} {:>6.2}",
-                p.slope(),
-                mean,
+                " {} {} {:>6.2}",
+                shown(p.slope(), 6),
+                shown(mean, 7),
                 p.largest_loss()
             );
         }

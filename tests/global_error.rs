@@ -123,6 +123,56 @@ fn fixed_steps_are_refused() {
     assert_eq!(err.stats.steps, 0);
 }
 
+/// Runs with nothing to compare (no output after t0, or t_end = t0), and a floor on the local
+/// tolerance that leaves no tighter run, are refused by name: before, two runs that agreed at
+/// t0 alone "met" any tolerance.
+#[test]
+fn nothing_to_compare_and_a_floor_above_rtol_are_refused() {
+    let model = fourbar::FourBar::default();
+    let control = GlobalControl::default();
+    for o in [
+        Options {
+            output: Output::Times(vec![]),
+            ..options(1.0, 1e-6, 1)
+        },
+        Options {
+            output: Output::Times(vec![0.0]),
+            ..options(1.0, 1e-6, 1)
+        },
+        Options {
+            output: Output::Steps,
+            ..options(0.0, 1e-6, 1)
+        },
+    ] {
+        let err = simulate_global(&model, Scheme::Dopri5, &o, &control).expect_err("refused");
+        assert!(
+            matches!(err.kind, Failure::InvalidOption { name: "output", .. }),
+            "{:?}: {}",
+            o.output,
+            err.kind
+        );
+    }
+    for min_rtol in [1e-6, 1.0, f64::INFINITY, 0.0, -1e-9, f64::NAN] {
+        let control = GlobalControl {
+            min_rtol,
+            ..GlobalControl::default()
+        };
+        let err = simulate_global(&model, Scheme::Dopri5, &options(1.0, 1e-6, 10), &control)
+            .expect_err("refused");
+        assert!(
+            matches!(
+                err.kind,
+                Failure::InvalidOption {
+                    name: "global control",
+                    ..
+                }
+            ) && err.kind.to_string().contains("min_rtol < rtol"),
+            "min_rtol {min_rtol}: {}",
+            err.kind
+        );
+    }
+}
+
 /// A body on a spherical joint tumbling through its flips: each run re-centres its chart at
 /// its own times, so the runs are compared by rotation and angular velocity, not angles. The
 /// control converges over 10 s (the first flip), and the result is within rtol of a run at rtol

@@ -212,3 +212,64 @@ fn computed_references_and_bad_references() {
         );
     }
 }
+
+/// A study that would measure nothing, or not what its label says, is refused by name; a
+/// reference that is not finite is refused (its NaN made every run look exact: the mixed
+/// error dropped it); a sweep with one tolerance has no slope rather than a NaN one.
+#[test]
+fn studies_that_measure_nothing_and_references_that_are_not_finite_are_refused() {
+    use mbs::work_precision::Proportionality;
+    let model = Seed2dof::default();
+    let reference = || Reference::exact("modal solution", times(), exact);
+    let one = |s: Study| Study { repeats: 1, ..s };
+    let e = one(Study::new("none", reference()))
+        .run(&model)
+        .unwrap_err();
+    assert!(matches!(e, StudyError::NoSweeps), "{e}");
+    let e = one(Study::new("empty", reference()))
+        .sweep(Sweep::adaptive(Scheme::Dopri5, &[]))
+        .run(&model)
+        .unwrap_err();
+    assert!(
+        matches!(&e, StudyError::EmptySweep { label } if label == "dopri5"),
+        "{e}"
+    );
+    let e = one(Study::new("fixed", reference()))
+        .sweep(Sweep::fixed(Scheme::Rk4, &[1e-3]).global())
+        .run(&model)
+        .unwrap_err();
+    assert!(matches!(e, StudyError::GlobalNeedsRtol { .. }), "{e}");
+    for bad in [f64::NAN, f64::INFINITY] {
+        let r = Reference::data("bad", vec![1.0], vec![vec![0.0, bad, 0.0, 0.0]]);
+        let e = one(Study::new("bad", r))
+            .sweep(Sweep::adaptive(Scheme::Dopri5, &[1e-6]))
+            .run(&model)
+            .unwrap_err();
+        assert!(
+            matches!(
+                e,
+                StudyError::NonFiniteReference {
+                    index: 0,
+                    component: 1,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+    }
+    // the mixed error of a state it cannot compare is NaN, never 0
+    assert!(mixed_error(&[1.0, 2.0], &[1.0, f64::NAN], 0.01).is_nan());
+    assert!(mixed_error(&[f64::NAN, 2.0], &[1.0, 2.0], 0.01).is_nan());
+    assert!(mixed_error(&[1.0], &[1.0, 2.0], 0.01).is_nan());
+    assert_eq!(mixed_error(&[1.0, 2.0], &[1.0, 2.0], 0.01), 0.0);
+    // slopes: none from one run, or from a failed and an exact one
+    let p = |digits: Vec<Option<f64>>| Proportionality {
+        label: "x".into(),
+        rtols: vec![1e-4, 1e-6][..digits.len()].to_vec(),
+        digits,
+    };
+    assert_eq!(p(vec![Some(4.0)]).slope(), None);
+    assert_eq!(p(vec![None, Some(f64::INFINITY)]).slope(), None);
+    assert_eq!(p(vec![Some(3.0), Some(5.0)]).slope(), Some(1.0));
+    assert_eq!(p(vec![Some(3.0), Some(f64::INFINITY)]).largest_loss(), 0.0);
+}

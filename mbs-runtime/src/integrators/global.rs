@@ -160,14 +160,14 @@ pub fn simulate_global<M: Model + Clone + 'static>(
     if control.max_runs < 2
         || control.samples == 0
         || control.samples > 100_000_000
-        || control.min_rtol.is_nan()
+        || !(control.min_rtol > 0.0 && control.min_rtol < rtol)
     {
         return Err(refused(
             model,
             Failure::InvalidOption {
                 name: "global control",
                 value: format!("{control:?}"),
-                reason: "needs max_runs ≥ 2 and 1 ≤ samples ≤ 10⁸",
+                reason: "needs max_runs ≥ 2, 1 ≤ samples ≤ 10⁸ and 0 < min_rtol < rtol",
             },
             options.t0,
         ));
@@ -197,6 +197,18 @@ pub fn simulate_global<M: Model + Clone + 'static>(
         }
     };
     let (first, first_stats) = run(output, rtol, atol)?;
+    if !first.t.iter().any(|&t| t > options.t0) {
+        // nothing to compare: two runs would agree at t0 alone and "meet" any tolerance
+        return Err(refused(
+            model,
+            Failure::InvalidOption {
+                name: "output",
+                value: format!("{:?}", options.output),
+                reason: "global control compares its runs at outputs after t0, and this gives none: give output times after t0 (and t_end > t0)",
+            },
+            options.t0,
+        ));
+    }
     let times = Output::Times(first.t.clone());
     let mut work = first_stats.clone();
     let mut runs = vec![GlobalRun {

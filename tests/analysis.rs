@@ -796,6 +796,21 @@ fn invalid_options_are_typed_errors() {
         }),
         "tolerance"
     );
+    // each option by its own name
+    assert_eq!(
+        invalid(StaticsOptions {
+            max_iterations: 0,
+            ..Default::default()
+        }),
+        "max_iterations"
+    );
+    assert_eq!(
+        invalid(StaticsOptions {
+            t: f64::NAN,
+            ..Default::default()
+        }),
+        "t"
+    );
     // linearize: wrong lengths, and exact tangents of a model without them
     let lin_err = |r: Result<mbs::Linearization, AnalysisError>| match r {
         Err(AnalysisError::Failure(Failure::InvalidOption { name, .. })) => name,

@@ -92,6 +92,21 @@ mbs::multibody! {
 }
 
 mbs::multibody! {
+    /// The bar pendulum pinned, and held by a second constraint that nearly repeats the first
+    /// (rows [1, 1, 0] and [1, 1 + e, 0] of B): full rank by its singular values, too nearly
+    /// dependent for the normal equations and for pivoting.
+    pub model BarNearlyTwice {
+        param m = 1.2; param l = 0.8; param g = 9.81; param e = 2e-9;
+        dof px = 0.0; dof py = -0.4; dof theta = 0.0;
+        body bar { mass = m; inertia = (m * l * l / 12, 0, m * l * l / 12); }
+        TOG[bar] = Tdisp(px, py, 0) * Trotz(theta);
+        gravity(0, -g, 0);
+        constraint sum = px + py + 0.4;
+        constraint near = px + (1 + e) * py + 0.4 * (1 + e);
+    }
+}
+
+mbs::multibody! {
     /// fourbar (`tests/reference/MODELS.md`): ground 0.4 m, crank 0.1, coupler 0.35, rocker
     /// 0.3, uniform bars of 1 kg/m, gravity; absolute angles a, b, c; crank marked
     /// independent; a torque input on the crank.
@@ -1028,6 +1043,49 @@ fn constrained_analyses_fail_with_typed_errors() {
         })
         .unwrap_err(),
     );
+    // constraints full rank by their singular values but too nearly dependent for statics'
+    // normal equations or linearize's pivoting: a typed error, never a panic
+    let near = BarNearlyTwice::default();
+    let q = [0.0, -0.4, 0.0];
+    for (what, e) in [
+        (
+            "statics",
+            static_equilibrium(
+                &near,
+                &StaticsOptions {
+                    q0: Some(q.to_vec()),
+                    ..Default::default()
+                },
+            )
+            .map(|_| ()),
+        ),
+        (
+            "linearize",
+            linearize(&near, 0.0, &q, &[0.0; 3], &[], IterationMatrix::Auto).map(|_| ()),
+        ),
+    ] {
+        println!("nearly pinned twice, {what}: {e:?}");
+        assert!(
+            matches!(
+                e,
+                Ok(())
+                    | Err(AnalysisError::Failure(
+                        Failure::SingularMatrix { .. } | Failure::RankDeficientConstraints { .. }
+                    ))
+            ),
+            "{what}: {e:?}"
+        );
+    }
+    // statics meets it in its multipliers' first fit (where it panicked on an `unwrap_err`)
+    let e = static_equilibrium(
+        &near,
+        &StaticsOptions {
+            q0: Some(q.to_vec()),
+            ..Default::default()
+        },
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("nearly dependent"), "{e}");
 
     // statics with every coordinate locked but one: the pin cannot be closed
     let e = static_equilibrium(

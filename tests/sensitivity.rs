@@ -569,6 +569,26 @@ fn closed_loop_equilibria_move_with_the_parameters_as_differences_say() {
     let other = static_equilibrium(&SprungArm::default(), &options).unwrap();
     let err = static_sensitivity(&model, &other, &options).unwrap_err();
     assert!(err.to_string().contains("not one of this model"), "{err}");
+    // so is one with charts of rotation joints the model does not have, and inputs it does
+    // not take (they were handed to the generated code, which indexes them)
+    let mut charted = eq.clone();
+    charted
+        .charts
+        .push([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
+    let err = static_sensitivity(&model, &charted, &options).unwrap_err();
+    assert!(err.to_string().contains("not one of this model"), "{err}");
+    let with_u = StaticsOptions {
+        u: Some(vec![1.0, 2.0]),
+        ..options.clone()
+    };
+    let err = static_sensitivity(&model, &eq, &with_u).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            mbs::AnalysisError::Failure(mbs::Failure::InvalidOption { name: "u", .. })
+        ),
+        "{err}"
+    );
     assert_eq!(s.dlambda_dp.len(), 2 * 4);
     for (j, name) in s.params.iter().enumerate() {
         let p0 = fourbar_param(j);

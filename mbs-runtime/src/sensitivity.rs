@@ -293,7 +293,8 @@ impl<M: Model + 'static> Sensitivities<M> {
     /// leaves the wrapper in them); None when `tr` has no output `i` of this model's size.
     pub fn residuals(&mut self, tr: &Trajectory, i: usize) -> Option<(f64, f64)> {
         let (n, nc) = (M::NQ, M::NC);
-        if i >= tr.len() || tr.q(i).len() != <Self as Model>::NQ {
+        let joints = self.model.info().rotation_joints.len();
+        if i >= tr.len() || tr.check_fits(<Self as Model>::NQ, joints).is_err() {
             return None;
         }
         if nc == 0 {

@@ -391,7 +391,16 @@ impl<'a> Actuation<'a> {
             model.constraint_bias(t, q, qd, gamma);
         }
         let row = |i: usize, v: &[f64]| (0..n).map(|j| b[(i, j)] * v[j]).sum::<f64>();
-        let worst = |f: &dyn Fn(usize) -> f64| (0..nc).map(f).fold(0.0, |m: f64, v| m.max(v.abs()));
+        // a NaN violation stays NaN (f64::max would drop it and report 0)
+        let worst = |f: &dyn Fn(usize) -> f64| {
+            (0..nc).map(f).fold(0.0, |m: f64, v| {
+                if m.is_nan() || v.is_nan() {
+                    f64::NAN
+                } else {
+                    m.max(v.abs())
+                }
+            })
+        };
         out.phi.push(worst(&|i| phi[i]));
         out.phi_dot.push(worst(&|i| row(i, qd) + phi_t[i]));
         out.phi_ddot.push(worst(&|i| row(i, qdd) - gamma[i]));

@@ -33,7 +33,7 @@
 //! linearisation of the reduced ODE z̈ = f(z, ż) (the dependent coordinates completed from
 //! Φ = 0, Φ̇ = 0): `tests/analysis_constrained.rs` checks A against its central differences.
 
-use super::{AnalysisError, check, reduce};
+use super::{AnalysisError, check, check_named, reduce};
 use crate::error::Failure;
 use crate::linalg::{cholesky, cholesky_solve};
 use crate::model::Model;
@@ -213,7 +213,15 @@ pub fn linearize<M: Model + Clone>(
             }
             .into());
         }
-        check(model, name, v)?;
+        if name == "u" {
+            let inputs = model.info().inputs;
+            check_named(name, v, |i| match inputs.get(i) {
+                Some(input) => format!("input {i} (`{input}`)"),
+                None => format!("input {i}"),
+            })?;
+        } else {
+            check(model, name, v)?;
+        }
     }
     if model.info().rotation_joints.is_empty() {
         return linearize_in_chart(model, t, q, qd, u, how);
@@ -345,7 +353,7 @@ fn linearize_in_chart<M: Model>(
     reduce::check_constraints(model, "γ", &gamma)?;
     let (qdd, lambda) = reduce::index1(&l, &h, &b, &gamma, names)?;
     let part = reduce::partition(&b, info.independent)
-        .ok_or_else(|| AnalysisError::from(reduce::rank_check(&b, names).unwrap_err()))?;
+        .ok_or_else(|| AnalysisError::from(reduce::nearly_dependent(&b, names)))?;
     let (nb, e) = reduce::basis(&b, &part).ok_or_else(|| {
         AnalysisError::from(Failure::SingularMatrix {
             matrix: "B over the dependent coordinates",

@@ -60,5 +60,24 @@ pub enum AnalysisError {
 /// The first non-finite entry of `v` (NQ-periodic, named by its coordinate) as an error.
 fn check<M: Model>(model: &M, quantity: &'static str, v: &[f64]) -> Result<(), AnalysisError> {
     let info = model.info();
-    Failure::non_finite(quantity, v, |i| info.dof_label(i % M::NQ)).map_err(AnalysisError::from)
+    check_named(quantity, v, |i| info.dof_label(i % M::NQ.max(1)))
+}
+
+/// The first non-finite entry of `v` as an error, entry i named by `name(i)` (for quantities
+/// not laid out by coordinate: inputs, constraints, modes).
+fn check_named(
+    quantity: &'static str,
+    v: &[f64],
+    name: impl FnOnce(usize) -> String,
+) -> Result<(), AnalysisError> {
+    Failure::non_finite(quantity, v, name).map_err(AnalysisError::from)
+}
+
+/// Names entry i of a quantity with one value per constraint (NC-periodic).
+fn constraint_label(info: &crate::model::ModelInfo, nc: usize, i: usize) -> String {
+    let k = i % nc.max(1);
+    match info.constraints.get(k) {
+        Some(name) => format!("constraint {k} (`{name}`)"),
+        None => format!("constraint {k}"),
+    }
 }

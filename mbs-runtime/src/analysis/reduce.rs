@@ -6,7 +6,7 @@
 //! an orthonormal null-space basis, the Hessians of the constraints and the index-1
 //! accelerations. Dense nalgebra matrices throughout: the analyses are not in a time loop.
 
-use super::{AnalysisError, check};
+use super::{AnalysisError, check, check_named};
 use crate::error::Failure;
 use crate::linalg::{cholesky, cholesky_solve};
 use crate::model::Model;
@@ -37,7 +37,9 @@ pub(super) fn jacobian<M: Model>(
 ) -> Result<DMatrix<f64>, AnalysisError> {
     let mut b = vec![0.0; M::NC * M::NQ];
     model.constraint_jacobian(t, q, &mut b);
-    check(model, "B = ∂Φ/∂q", &b)?;
+    // column-major NC × NQ: entry i is in the column of coordinate i / NC
+    let info = model.info();
+    check_named("B = ∂Φ/∂q", &b, |i| info.dof_label(i / M::NC.max(1)))?;
     Ok(DMatrix::from_column_slice(M::NC, M::NQ, &b))
 }
 
@@ -92,6 +94,31 @@ pub(super) fn rank_check(b: &DMatrix<f64>, names: &[&str]) -> Result<(), Failure
         });
     }
     Ok(())
+}
+
+/// Why B failed a factorisation it needs full rank for: `RankDeficientConstraints` when its
+/// singular values say so, and otherwise (full rank by them, but too nearly dependent for the
+/// normal equations or for pivoting) a singular matrix that names the constraints involved.
+pub(super) fn nearly_dependent(b: &DMatrix<f64>, names: &[&str]) -> Failure {
+    match rank_check(b, names) {
+        Err(f) => f,
+        Ok(()) => {
+            let (_, sigma_min, involved) = rank_of(b);
+            let sigma_max = b.singular_values().max();
+            Failure::SingularMatrix {
+                matrix: "B (its constraints nearly dependent)",
+                rcond: if sigma_max > 0.0 {
+                    sigma_min / sigma_max
+                } else {
+                    0.0
+                },
+                coordinates: involved
+                    .iter()
+                    .map(|&i| format!("constraint `{}`", names.get(i).copied().unwrap_or("?")))
+                    .collect(),
+            }
+        }
+    }
 }
 
 /// The columns of B (nc × n) complete pivoting picks, in pivot order: the coordinates best

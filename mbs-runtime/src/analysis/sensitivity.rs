@@ -16,7 +16,7 @@
 //! (K_λ = ∂(Bᵀλ)/∂q; rows and columns of the free coordinates), which gives dλ/dp as well.
 
 use super::statics::{Equilibrium, StaticsOptions, stiffness};
-use super::{AnalysisError, check};
+use super::{AnalysisError, check, check_named, constraint_label};
 use crate::error::Failure;
 use crate::linalg::Lu;
 use crate::model::Model;
@@ -69,17 +69,20 @@ pub fn static_sensitivity<M: Model + Clone>(
             "it has no sensitive parameters: mark them, `param k = 1e4 sensitive;`",
         ));
     }
-    if eq.q.len() != n || eq.lambda.len() != M::NC {
+    if eq.q.len() != n
+        || eq.lambda.len() != M::NC
+        || eq.charts.len() != model.info().rotation_joints.len()
+    {
         return Err(refuse(
-            "the equilibrium is not one of this model (its coordinates or multipliers have other sizes): find it with static_equilibrium on this model",
+            "the equilibrium is not one of this model (its coordinates, multipliers or charts have other sizes): find it with static_equilibrium on this model",
         ));
     }
+    let u = super::statics::checked_inputs::<M>(options)?;
     // q is read in the equilibrium's charts
     let mut m = model.clone();
     for (j, r) in eq.charts.iter().enumerate() {
         m.set_chart(j, *r);
     }
-    let u = options.u.clone().unwrap_or_else(|| vec![0.0; M::NU]);
     let zero = vec![0.0; n];
     let mut dtau = vec![0.0; n * ns];
     m.parameter_tangents(options.t, &eq.q, &zero, &zero, &u, &mut dtau)
@@ -98,7 +101,9 @@ pub fn static_sensitivity<M: Model + Clone>(
         m.constraint_tangent(options.t, &eq.q, &eq.lambda, &mut k_lambda);
         m.constraint_parameter_tangents(options.t, &eq.q, &zero, &zero, &eq.lambda, &mut ct)
             .map_err(|e| refuse(crate::integrators::model_error_reason(&e)))?;
-        check(&m, "∂Φ/∂p", &ct.dphi_dp)?;
+        check_named("∂Φ/∂p", &ct.dphi_dp, |i| {
+            constraint_label(m.info(), nc, i)
+        })?;
         check(&m, "∂(Bᵀλ)/∂p", &ct.dforce_dp)?;
         for (x, g) in k.iter_mut().zip(&k_lambda) {
             *x -= g;
@@ -146,7 +151,9 @@ pub fn static_sensitivity<M: Model + Clone>(
         dlambda_dp[nc * p..nc * (p + 1)].copy_from_slice(&x[nf..]);
     }
     check(&m, "∂q/∂p", &dq_dp)?;
-    check(&m, "∂λ/∂p", &dlambda_dp)?;
+    check_named("∂λ/∂p", &dlambda_dp, |i| {
+        constraint_label(m.info(), nc, i)
+    })?;
     let info = m.info();
     Ok(StaticSensitivity {
         params: M::SENSITIVE.to_vec(),
@@ -398,13 +405,14 @@ pub fn pole_sensitivity<M: Model + Clone>(
             dpole_dp.push((d.re, im));
         }
     }
-    check(
-        &m,
+    let per_mode = 2 * M::SENSITIVE.len();
+    check_named(
         "dλ/dp",
         &dpole_dp
             .iter()
             .flat_map(|&(a, b)| [a, b])
             .collect::<Vec<_>>(),
+        |i| format!("mode {}", i / per_mode.max(1)),
     )?;
     Ok(PoleSensitivity {
         params: M::SENSITIVE.to_vec(),

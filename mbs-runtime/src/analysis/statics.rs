@@ -191,6 +191,58 @@ pub(super) fn stiffness<M: Model>(
     Ok(())
 }
 
+/// The inputs of `options` (zero when not given), after checking what statics and its
+/// sensitivities read of them: t and u finite, u of the model's size, locked coordinates of
+/// the model, tolerances > 0 and iterations > 0, each by its own name.
+pub(super) fn checked_inputs<M: Model>(
+    options: &StaticsOptions,
+) -> Result<Vec<f64>, AnalysisError> {
+    let invalid = |name: &'static str, value: String, reason: &'static str| {
+        Err(AnalysisError::from(Failure::InvalidOption {
+            name,
+            value,
+            reason,
+        }))
+    };
+    let u = options.u.clone().unwrap_or_else(|| vec![0.0; M::NU]);
+    if u.len() != M::NU {
+        return invalid(
+            "u",
+            format!("{} values", u.len()),
+            "must have one value per input",
+        );
+    }
+    if let Some(v) = u.iter().find(|v| !v.is_finite()) {
+        return invalid("u", v.to_string(), "must be finite");
+    }
+    if !options.t.is_finite() {
+        return invalid("t", options.t.to_string(), "must be finite");
+    }
+    if let Some(&i) = options.locked.iter().find(|&&i| i >= M::NQ) {
+        return invalid("locked", i.to_string(), "is not a coordinate index");
+    }
+    if !(options.tolerance > 0.0 && options.tolerance.is_finite()) {
+        return invalid(
+            "tolerance",
+            options.tolerance.to_string(),
+            "must be > 0 and finite",
+        );
+    }
+    if M::NC > 0
+        && !(options.constraint_tolerance > 0.0 && options.constraint_tolerance.is_finite())
+    {
+        return invalid(
+            "constraint_tolerance",
+            options.constraint_tolerance.to_string(),
+            "must be > 0 and finite",
+        );
+    }
+    if options.max_iterations == 0 {
+        return invalid("max_iterations", "0".into(), "must be at least 1");
+    }
+    Ok(u)
+}
+
 /// Finds q with h(q, 0, t, u) = 0 on the free coordinates, from `options.q0`; with
 /// constraints, q and λ with h(q, 0, t, u) + Bᵀλ = 0 on the free coordinates and Φ(q, t) = 0.
 /// Rotation joints (`Tball`, `Tfree`) whose angles are free are solved for in charts centred
@@ -224,31 +276,7 @@ pub fn static_equilibrium<M: Model + Clone>(
             q
         }
     };
-    let u = options.u.clone().unwrap_or_else(|| vec![0.0; M::NU]);
-    if u.len() != M::NU {
-        return Err(invalid(
-            "u",
-            u.len().to_string(),
-            "must have one value per input",
-        ));
-    }
-    if let Some(&i) = options.locked.iter().find(|&&i| i >= n) {
-        return Err(invalid(
-            "locked",
-            i.to_string(),
-            "is not a coordinate index",
-        ));
-    }
-    if !(options.tolerance > 0.0)
-        || options.max_iterations == 0
-        || (M::NC > 0 && !(options.constraint_tolerance > 0.0))
-    {
-        return Err(invalid(
-            "tolerance",
-            options.tolerance.to_string(),
-            "must be > 0, with constraint_tolerance > 0 and max_iterations > 0",
-        ));
-    }
+    let u = checked_inputs::<M>(options)?;
     check(model, "q0", &q)?;
     let free: Vec<usize> = (0..n).filter(|i| !options.locked.contains(i)).collect();
     let solve = |model: &M, q: Vec<f64>| {
@@ -266,15 +294,26 @@ pub fn static_equilibrium<M: Model + Clone>(
     crate::charts::recentre(&mut centred, &mut q, &mut zero, &options.locked);
     let mut eq = solve(&centred, q)?;
     // a restart or two, each from a chart centred on where Newton went
+    // a restart or two, each from a chart centred on where Newton went; a restart that fails
+    // leaves the equilibrium found (converged, in a chart far from its centre)
     for _ in 0..3 {
         if !crate::charts::below(&centred, &eq.q, 0.5) {
             break;
         }
         let mut q = eq.q.clone();
+        let before = centred.clone();
         crate::charts::recentre(&mut centred, &mut q, &mut zero, &options.locked);
-        let done = eq.iterations;
-        eq = solve(&centred, q)?;
-        eq.iterations += done;
+        match solve(&centred, q) {
+            Ok(restarted) => {
+                let done = eq.iterations;
+                eq = restarted;
+                eq.iterations += done;
+            }
+            Err(_) => {
+                centred = before;
+                break;
+            }
+        }
     }
     eq.charts = crate::charts::charts_of(&centred);
     Ok(eq)
@@ -484,7 +523,7 @@ fn constrained<M: Model>(
         (&bf * bf.transpose())
             .cholesky()
             .map(|c| c.solve(&rhs))
-            .ok_or_else(|| AnalysisError::from(reduce::rank_check(&st.b, names).unwrap_err()))?
+            .ok_or_else(|| AnalysisError::from(reduce::nearly_dependent(&st.b, names)))?
     }
     .as_slice()
     .to_vec();

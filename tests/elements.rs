@@ -356,3 +356,44 @@ fn a_path_is_built_from_declared_point_names() {
     let e = Path::through(info, &["hook"]).unwrap_err();
     assert!(matches!(e, PathError::TooShort { found: 1 }), "{e}");
 }
+
+/// Degenerate inputs give forces, not NaN: friction with no regularisation (ε = 0, exact
+/// Coulomb) at rest, and a path whose two points coincide (no direction: it pulls nothing).
+#[test]
+fn exact_coulomb_at_rest_and_coincident_points_are_finite() {
+    use mbs::elements::Path;
+    use mbs::terrain::ContactLaw;
+    let exact = PlaneContact {
+        eps: 0.0,
+        ..PlaneContact::default()
+    };
+    // 1 mm into the ground z = 0, at rest
+    let f = exact.force([0.0, 0.0, -1e-3], [0.0; 3], [0.0; 3]);
+    assert_eq!(f.force, [0.0, 0.0, 100.0]);
+    // sliding, it is Coulomb's μ f_n against the motion
+    let f = exact.force([0.0, 0.0, -1e-3], [0.5, 0.0, 0.0], [0.0; 3]);
+    assert!((f.force[0] + 0.8 * 100.0).abs() < 1e-12, "{:?}", f.force);
+    let law = ContactLaw {
+        eps: 0.0,
+        ..ContactLaw::default()
+    };
+    let f = law.force(1e-3, [0.0, 0.0, 1.0], [0.0, 0.0, -0.1]);
+    assert!(
+        f.iter().all(|x| x.is_finite()) && f[0] == 0.0 && f[2] > 0.0,
+        "{f:?}"
+    );
+
+    let info = RigBare::default().info();
+    let path = Path::through(info, &["hook", "tip"]).unwrap();
+    let mut kin = mbs::Kinematics::new::<RigBare>();
+    for p in &mut kin.points {
+        p.position = [0.5, 0.2, 1.0];
+        p.velocity = [0.0, 0.0, 1.0];
+        p.jv.iter_mut().enumerate().for_each(|(k, x)| *x = k as f64);
+    }
+    kin.points[info.point_index("tip").unwrap()].velocity = [0.3, 0.0, 0.0];
+    assert_eq!(path.length(&kin), (0.0, 0.0));
+    let mut grad = vec![f64::NAN; RigBare::NQ];
+    path.gradient(&kin, &mut grad);
+    assert!(grad.iter().all(|&g| g == 0.0), "{grad:?}");
+}

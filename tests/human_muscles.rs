@@ -14,7 +14,8 @@
 //! - a fibre at rest from `equilibrium` has zero length rate; the tension applied along a
 //!   path is the generalised force −T ∂l/∂q;
 //! - a muscle stretched beyond its fibre's range stops a run with a typed failure, the
-//!   trajectory kept;
+//!   trajectory kept; a unit's invalid parameters, non-finite inputs and a tendon no fibre
+//!   speed balances are typed errors;
 //! - standing on the muscles (mode 2): excitations from the statics of the held body and a
 //!   static optimisation (co-contraction about 0.5), the equilibrium under them by statics
 //!   with the fibres at rest; the body stands 2 s on constant excitations within 1e-6 of it.
@@ -493,4 +494,60 @@ fn the_quadriceps_insert_where_opensims_moving_points_are() {
         1e3 * worst
     );
     assert!(worst < 1.5e-3, "{worst}");
+}
+
+/// A unit's invalid parameters, a non-finite input, and a tendon pulling more than any fibre
+/// speed balances are typed errors (before: a NaN path length gave the fibre range's lower
+/// end as an equilibrium, and a stretched tendon at low activation an infinite rate).
+#[test]
+fn a_units_bad_parameters_and_inputs_are_typed_errors() {
+    let unit = Musculotendon::new("soleus", 5137.0, 0.05, 0.25, 0.43633);
+    let e = unit.equilibrium(f64::NAN, 0.5).unwrap_err();
+    assert!(matches!(e, MuscleError::NotFinite { .. }), "{e}");
+    let e = unit.fibre(0.3, f64::INFINITY, 1.0).unwrap_err();
+    assert!(matches!(e, MuscleError::NotFinite { .. }), "{e}");
+    for (bad, name) in [
+        (
+            Musculotendon {
+                tendon_slack_length: 0.0,
+                ..unit.clone()
+            },
+            "tendon_slack_length",
+        ),
+        (
+            Musculotendon {
+                pennation_angle: f64::NAN,
+                ..unit.clone()
+            },
+            "pennation_angle",
+        ),
+        (
+            Musculotendon {
+                activation_times: [0.0, 0.06],
+                ..unit.clone()
+            },
+            "activation_times[0]",
+        ),
+        (
+            Musculotendon {
+                fibre_range: [0.4, f64::NAN],
+                ..unit.clone()
+            },
+            "fibre_range[1]",
+        ),
+    ] {
+        for e in [
+            bad.fibre(0.3, 0.5, 1.0).unwrap_err(),
+            bad.equilibrium(0.3, 0.5).unwrap_err(),
+        ] {
+            assert!(
+                matches!(&e, MuscleError::InvalidParameter { name: n, .. } if *n == name),
+                "{name}: {e}"
+            );
+        }
+    }
+    // at the lowest activation, a tendon stretched by 8 %: its pull is beyond any fibre speed
+    let e = unit.fibre(0.3153, 0.0, 1.0).unwrap_err();
+    assert!(matches!(e, MuscleError::NoFibreSpeed { .. }), "{e}");
+    assert!(unit.fibre(0.3153, 1.0, 1.0).is_ok());
 }

@@ -292,6 +292,33 @@ fn a_tilted_ellipsoid_at_an_edge_takes_the_shortest_way_out() {
 }
 
 /// R = Rx(θ) (columns: the body's axes in world axes).
+/// An ellipsoid with a NaN semi-axis or centre is not silently let through the terrain: it
+/// touches at a NaN depth, so its force is NaN and a run stops on it; a negative semi-axis
+/// counts by its size (it fell outside the boxes' broad phase).
+#[test]
+fn a_nan_ellipsoid_is_not_let_through_and_a_negative_axis_counts_by_its_size() {
+    const I: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    let t = Terrain::step(0.6, 0.05);
+    let forces = |axes: [f64; 3], centre: [f64; 3]| {
+        let mut out = Vec::new();
+        t.ellipsoid_forces(&I, [0.0; 3], (centre, [0.0; 3]), axes, |_, f| out.push(f));
+        out
+    };
+    let nan = forces([0.02, f64::NAN, 0.02], [0.2, 0.0, 0.01]);
+    assert!(
+        nan.len() == 1 && nan[0].iter().all(|f| f.is_nan()),
+        "{nan:?}"
+    );
+    // a sphere of 2 cm centred 1 cm before the riser, 3 cm up: one semi-axis written
+    // negative touches the riser as the sphere does
+    let sphere = forces([0.02, 0.02, 0.02], [0.59, 0.0, 0.03]);
+    let negative = forces([-0.02, 0.02, 0.02], [0.59, 0.0, 0.03]);
+    assert!(
+        !sphere.is_empty() && sphere == negative,
+        "{sphere:?} {negative:?}"
+    );
+}
+
 fn rx(theta: f64) -> [[f64; 3]; 3] {
     let (s, c) = theta.sin_cos();
     [[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]]

@@ -24,7 +24,8 @@ pub fn array(m: &Matrix3<f64>) -> [[f64; 3]; 3] {
 }
 
 /// The rotation matrix (rows) of a unit quaternion `[x, y, z, w]` (the order of
-/// [`crate::Pose::quaternion`] and of the trajectory's orientations).
+/// [`crate::Pose::quaternion`] and of the trajectory's orientations); a quaternion is
+/// normalised first, and one of zero norm gives NaN.
 pub fn matrix_of(q: [f64; 4]) -> [[f64; 3]; 3] {
     let [x, y, z, w] = q;
     let u = UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(w, x, y, z));
@@ -35,7 +36,7 @@ pub fn matrix_of(q: [f64; 4]) -> [[f64; 3]; 3] {
 /// trajectory's [`orientation`](crate::Trajectory::orientation)), `R = Rz(a) · Ry(b) · Rx(c)`
 /// with b in [−π/2, π/2] and a, c in (−π, π]: the yaw, pitch and roll of the rotation
 /// whatever chart its coordinates were read in (singular where cos b = 0, where a and c
-/// share one angle).
+/// share one angle); NaN for a quaternion of zero norm.
 pub fn zyx_angles_of(q: [f64; 4]) -> [f64; 3] {
     let [x, y, z, w] = q;
     let u = UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(w, x, y, z));
@@ -99,7 +100,7 @@ pub fn chart_quality(joint: &RotationJoint, q: &[f64]) -> f64 {
 }
 
 /// The rotation of the joint relative to the frame before it, `C · Rz(a) · Ry(b) · Rx(c)`,
-/// as a unit quaternion.
+/// as a unit quaternion (NaN when an angle or the chart is not finite).
 pub fn joint_rotation(
     chart: &[[f64; 3]; 3],
     joint: &RotationJoint,
@@ -107,7 +108,23 @@ pub fn joint_rotation(
 ) -> UnitQuaternion<f64> {
     let c = Matrix3::from_fn(|r, k| chart[r][k]);
     let r = c * zyx(angles_of(joint, q));
-    UnitQuaternion::from_matrix(&r)
+    rotation_of(&r)
+}
+
+/// The rotation nearest `m` as a unit quaternion (nalgebra's iterative extraction), or NaN
+/// when `m` is not finite: with a NaN the extraction never meets its tolerance and would
+/// iterate without end.
+pub(crate) fn rotation_of(m: &Matrix3<f64>) -> UnitQuaternion<f64> {
+    if m.iter().all(|x| x.is_finite()) {
+        UnitQuaternion::from_matrix(m)
+    } else {
+        UnitQuaternion::new_unchecked(nalgebra::Quaternion::new(
+            f64::NAN,
+            f64::NAN,
+            f64::NAN,
+            f64::NAN,
+        ))
+    }
 }
 
 /// The joint's rotation as `[x, y, z, w]` (the order of [`crate::Pose::quaternion`]), of the
@@ -318,6 +335,19 @@ mod tests {
             angles: [0, 1, 2],
             translation: None,
         }
+    }
+
+    /// A NaN or infinite angle gives a NaN rotation at once (nalgebra's extraction of the
+    /// rotation, unbounded, never met its tolerance on it and did not return).
+    #[test]
+    fn angles_that_are_not_finite_give_nan_not_a_hang() {
+        let eye = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        for bad in [f64::NAN, f64::INFINITY] {
+            let u = joint_rotation(&eye, &joint(), &[bad, 0.0, 0.0]);
+            assert!(u.as_ref().coords.iter().all(|x| x.is_nan()));
+        }
+        let u = joint_rotation(&eye, &joint(), &[0.3, 0.0, 0.0]);
+        assert!((u.angle() - 0.3).abs() < 1e-15);
     }
 
     fn rot(q: &[f64], chart: &[[f64; 3]; 3]) -> Matrix3<f64> {

@@ -60,6 +60,14 @@ fn rx(r: &[[f64; 3]; 3], x: V3) -> V3 {
     [dot(r[0], x), dot(r[1], x), dot(r[2], x)]
 }
 
+/// Regularised Coulomb friction μ f_n / √(|v_t|² + ε²), the force per unit of sliding
+/// speed: 0 at rest when ε = 0 (exact Coulomb, whose direction at rest is undefined; 0/0
+/// before).
+pub(crate) fn friction_per_speed(mu: f64, f_n: f64, vt2: f64, eps: f64) -> f64 {
+    let speed = (vt2 + eps * eps).sqrt();
+    if speed > 0.0 { mu * f_n / speed } else { 0.0 }
+}
+
 /// Contact of a point or a sphere with a fixed plane (penalty, non-adhesive damping,
 /// regularised Coulomb friction).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -69,7 +77,8 @@ pub struct PlaneContact {
     pub offset: f64,
     /// sphere radius (0: a point)
     pub radius: f64,
-    /// stiffness (N/m), damping (N s/m), friction coefficient, regularising speed (m/s)
+    /// stiffness (N/m), damping (N s/m), friction coefficient, regularising speed (m/s; 0:
+    /// exact Coulomb, no friction at rest and a discontinuous force, stiff for a scheme)
     pub k: f64,
     pub c: f64,
     pub mu: f64,
@@ -118,7 +127,7 @@ impl PlaneContact {
             let arm = scale(-self.radius, n);
             let vc = add(v, cross(w, arm));
             let vt = sub(vc, scale(nv, n));
-            let coef = -self.mu * f_n / (dot(vt, vt) + self.eps * self.eps).sqrt();
+            let coef = -friction_per_speed(self.mu, f_n, dot(vt, vt), self.eps);
             let ft = scale(coef, vt);
             force = add(force, ft);
             torque = cross(arm, ft);
@@ -174,7 +183,14 @@ impl Anchor {
     }
 }
 
-/// A spring–damper with preload between two anchors: tension F0 + k(l − l0) + c l̇.
+/// `d / l` (l = |d|), or zero where the two ends coincide and the direction is undefined
+/// (1/0 times 0 was NaN).
+fn unit_or_zero(d: V3, l: f64) -> V3 {
+    if l > 0.0 { scale(1.0 / l, d) } else { [0.0; 3] }
+}
+
+/// A spring–damper with preload between two anchors: tension F0 + k(l − l0) + c l̇. Where
+/// the anchors coincide its line, and so its force, is undefined: it pulls nothing.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SpringDamper {
     pub k: f64,
@@ -189,7 +205,7 @@ impl SpringDamper {
         let ((pa, va), (pb, vb)) = (a.state(e), b.state(e));
         let d = sub(pb, pa);
         let l = dot(d, d).sqrt();
-        let u = scale(1.0 / l, d);
+        let u = unit_or_zero(d, l);
         let ldot = dot(u, sub(vb, va));
         let tension = self.preload + self.k * (l - self.l0) + self.c * ldot;
         // tension pulls b towards a and a towards b
@@ -290,7 +306,8 @@ pub enum PathError {
 /// with u_i the unit vector of segment i and J the points' Jacobians), so the moment arms
 /// −∂l/∂q are those of the kinematics, not of differences. A tension T acts at each point
 /// along its segments, pulling consecutive points together; its generalised force is
-/// −T ∂l/∂q.
+/// −T ∂l/∂q. A segment whose two points coincide has no direction: it adds its length (0)
+/// and nothing to l̇, ∂l/∂q or the forces.
 ///
 /// Build it with [`Path::through`], which checks the names. Its methods index the
 /// kinematics' points by `points`, and panic on an index the model does not have (a path
@@ -325,7 +342,7 @@ impl Path {
             let (a, b) = (&kin.points[w[0]], &kin.points[w[1]]);
             let d = sub(b.position, a.position);
             let l = dot(d, d).sqrt();
-            (scale(1.0 / l, d), sub(b.velocity, a.velocity), l)
+            (unit_or_zero(d, l), sub(b.velocity, a.velocity), l)
         })
     }
 

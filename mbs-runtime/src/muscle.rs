@@ -153,6 +153,23 @@ pub enum MuscleError {
         "muscle `{muscle}`: no fibre length in its range balances the tendon at musculotendon length {length:.4} m"
     )]
     NoEquilibrium { muscle: String, length: f64 },
+    #[error("muscle `{muscle}`: {name} = {value} is invalid: {reason}")]
+    InvalidParameter {
+        muscle: String,
+        name: &'static str,
+        value: f64,
+        reason: &'static str,
+    },
+    #[error("muscle `{muscle}`: {quantity} = {value} is not finite")]
+    NotFinite {
+        muscle: String,
+        quantity: &'static str,
+        value: f64,
+    },
+    #[error(
+        "muscle `{muscle}`: the tendon pulls {ratio:.3e} times what the fibre holds at rest at this length and activation: no fibre speed balances it (a state far from equilibrium: start the fibre at `Musculotendon::equilibrium`)"
+    )]
+    NoFibreSpeed { muscle: String, ratio: f64 },
 }
 
 /// One musculotendon unit's parameters (OpenSim's names and units).
@@ -206,6 +223,61 @@ impl Musculotendon {
         }
     }
 
+    /// Checks the parameters: force, lengths, v_max and activation times > 0 and finite,
+    /// pennation in [0, π/2), the fibre range within (0, ∞) and increasing.
+    /// [`Musculotendon::fibre`] and [`Musculotendon::equilibrium`] call it.
+    pub fn validate(&self) -> Result<(), MuscleError> {
+        let invalid = |name, value, reason| {
+            Err(MuscleError::InvalidParameter {
+                muscle: self.name.clone(),
+                name,
+                value,
+                reason,
+            })
+        };
+        let positive = "must be > 0 and finite";
+        for (name, value) in [
+            ("max_isometric_force", self.max_isometric_force),
+            ("optimal_fiber_length", self.optimal_fiber_length),
+            ("tendon_slack_length", self.tendon_slack_length),
+            ("max_contraction_velocity", self.max_contraction_velocity),
+            ("activation_times[0]", self.activation_times[0]),
+            ("activation_times[1]", self.activation_times[1]),
+        ] {
+            if !(value > 0.0 && value.is_finite()) {
+                return invalid(name, value, positive);
+            }
+        }
+        let alpha = self.pennation_angle;
+        if !(0.0..std::f64::consts::FRAC_PI_2).contains(&alpha) {
+            return invalid("pennation_angle", alpha, "must be in [0, π/2) rad");
+        }
+        let [lo, hi] = self.fibre_range;
+        if !(lo > 0.0 && lo.is_finite()) {
+            return invalid("fibre_range[0]", lo, positive);
+        }
+        if !(hi > lo && hi.is_finite()) {
+            return invalid(
+                "fibre_range[1]",
+                hi,
+                "must be finite and above fibre_range[0]",
+            );
+        }
+        Ok(())
+    }
+
+    fn finite(&self, quantity: &'static str, value: f64) -> Result<(), MuscleError> {
+        if value.is_finite() {
+            Ok(())
+        } else {
+            Err(MuscleError::NotFinite {
+                muscle: self.name.clone(),
+                quantity,
+                value,
+            })
+        }
+    }
+
     /// ȧ at excitation `e` and activation `a`.
     pub fn activation_rate(&self, e: f64, a: f64) -> f64 {
         activation_rate(e, a, self.activation_times)
@@ -251,11 +323,20 @@ impl Musculotendon {
     /// The tendon force and the fibre's length rate at path length `l_mt`, activation `a`
     /// and normalised fibre length `lm`.
     pub fn fibre(&self, l_mt: f64, a: f64, lm: f64) -> Result<Fibre, MuscleError> {
+        self.validate()?;
+        self.finite("musculotendon length", l_mt)?;
+        self.finite("activation", a)?;
         self.check_range(lm)?;
         let (lt, cos) = self.geometry(l_mt, lm)?;
         let ft = tendon_force(lt);
         let fv = (ft / cos - passive_force(lm)) / (a.max(MIN_ACTIVATION) * active_force(lm));
         let v = force_velocity_inverse(fv);
+        if !v.is_finite() {
+            return Err(MuscleError::NoFibreSpeed {
+                muscle: self.name.clone(),
+                ratio: fv,
+            });
+        }
         Ok(Fibre {
             tendon_force: self.max_isometric_force * ft,
             length_rate: self.max_contraction_velocity * v,
@@ -269,6 +350,9 @@ impl Musculotendon {
     /// `l_mt` and activation `a`: the start of a run in equilibrium. Found by bisection of
     /// the force balance over the fibre's range.
     pub fn equilibrium(&self, l_mt: f64, a: f64) -> Result<f64, MuscleError> {
+        self.validate()?;
+        self.finite("musculotendon length", l_mt)?;
+        self.finite("activation", a)?;
         let f0 = force_velocity(0.0);
         let a = a.max(MIN_ACTIVATION);
         // tendon force along the fibre minus the fibre's force at rest: decreasing in lm
@@ -283,7 +367,8 @@ impl Musculotendon {
             muscle: self.name.clone(),
             length: l_mt,
         };
-        if residual(lo)? < 0.0 || residual(hi)? > 0.0 {
+        // NaN on either side (a tendon force beyond f64) is no bracket either
+        if !(residual(lo)? >= 0.0 && residual(hi)? <= 0.0) {
             return Err(none());
         }
         for _ in 0..100 {

@@ -76,9 +76,14 @@ impl Default for ContactLaw {
 
 impl ContactLaw {
     /// The force (world axes) on a body at depth `depth` behind a face of outward unit
-    /// normal `n`, its material point there moving at `v`; zero out of contact.
+    /// normal `n`, its material point there moving at `v`; zero out of contact, NaN at a
+    /// NaN depth.
     #[inline]
     pub fn force(&self, depth: f64, n: V3, v: V3) -> V3 {
+        // a NaN depth gives a NaN force (the clamp of f_n below would make it 0)
+        if depth.is_nan() {
+            return [f64::NAN; 3];
+        }
         if depth <= 0.0 {
             return [0.0; 3];
         }
@@ -93,7 +98,7 @@ impl ContactLaw {
         let scale = if self.mu == 0.0 {
             0.0
         } else {
-            self.mu * f_n / (dot(vt, vt) + self.eps * self.eps).sqrt()
+            crate::elements::friction_per_speed(self.mu, f_n, dot(vt, vt), self.eps)
         };
         [0, 1, 2].map(|j| f_n * n[j] - scale * vt[j])
     }
@@ -259,9 +264,20 @@ impl Terrain {
     }
 
     /// Calls `touch` for the ground and each box the ellipsoid `e` overlaps (module docs).
+    /// Semi-axes count by their size; an ellipsoid whose centre or a semi-axis is not finite
+    /// touches once, at a NaN depth (its force NaN: a run stops on it, naming the
+    /// coordinate, where it would have fallen through the terrain unseen).
     pub fn touches(&self, e: &Ellipsoid, mut touch: impl FnMut(Touch)) {
         let up = self.up.index();
         let n = Self::axis(up, 1.0);
+        if !e.axes.iter().chain(&e.centre).all(|v| v.is_finite()) {
+            touch(Touch {
+                point: e.centre,
+                depth: f64::NAN,
+                normal: n,
+            });
+            return;
+        }
         let s = e.support(n);
         if self.ground && s[up] < 0.0 {
             touch(Touch {
@@ -272,7 +288,7 @@ impl Terrain {
         }
         let [u, w] = self.horizontal();
         // the box around the ellipsoid: no face of a box beyond it can be reached
-        let reach = e.axes.iter().copied().fold(0.0, f64::max);
+        let reach = e.axes.iter().map(|a| a.abs()).fold(0.0, f64::max);
         let x = e.centre;
         for b in &self.blocks {
             if x[up] - reach >= b.height

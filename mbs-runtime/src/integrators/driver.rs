@@ -841,7 +841,7 @@ fn initial_state(problem: &mut Problem, options: &Options, cur: &mut State) -> R
 /// A chart (rows of a rotation matrix) as a quaternion `[x, y, z, w]`, w ≥ 0.
 fn chart_quaternion(c: &[[f64; 3]; 3]) -> [f64; 4] {
     let m = nalgebra::Matrix3::from_fn(|r, k| c[r][k]);
-    charts::quaternion_near(&nalgebra::UnitQuaternion::from_matrix(&m), None)
+    charts::quaternion_near(&charts::rotation_of(&m), None)
 }
 
 /// A constrained model: the constraint method, the assembly of q₀ and qd₀, the partition

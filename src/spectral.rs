@@ -142,21 +142,32 @@ pub struct SpectralTable {
 pub enum SpectralError {
     #[error("not an undamped linear oscillator: {0}")]
     NotAnOscillator(String),
+    /// A run failed at one ωh; `computed` holds the points of the ωh before it.
     #[error("{label} at ωh = {omega_h}: {error}")]
     Simulation {
         label: String,
         omega_h: f64,
         error: Box<SimError>,
+        computed: Vec<Point>,
     },
+    /// No recurrence fits the motion at one ωh; `computed` holds the points before it.
     #[error("{label} at ωh = {omega_h}: no recurrence of order ≤ {order} fits the motion")]
     Fit {
         label: String,
         omega_h: f64,
         order: usize,
+        computed: Vec<Point>,
     },
+    #[error("ωh = {omega_h} is invalid: {reason}")]
+    Invalid { omega_h: f64, reason: &'static str },
 }
 
-/// `n` values from `lo` to `hi`, equally spaced in log.
+/// The largest recurrence order [`Method::Recurrence`] may fit (its runs take 3·order + 6
+/// steps beyond `skip`, and the fit a system of that size).
+pub const MAX_RECURRENCE_ORDER: usize = 64;
+
+/// `n` values from `lo` to `hi`, equally spaced in log (`lo` and `hi` > 0 and finite: other
+/// bounds give NaN values, which [`analyse`] refuses).
 pub fn log_grid(lo: f64, hi: f64, n: usize) -> Vec<f64> {
     if n < 2 {
         return vec![lo];
@@ -296,6 +307,24 @@ pub fn analyse_with<M: Model + Clone + 'static>(
     omega_h: &[f64],
     method: Method,
 ) -> Result<SpectralTable, SpectralError> {
+    let invalid = |omega_h, reason| Err(SpectralError::Invalid { omega_h, reason });
+    if omega_h.is_empty() {
+        return invalid(
+            f64::NAN,
+            "give at least one ωh (an empty grid measures nothing)",
+        );
+    }
+    if let Some(&wh) = omega_h.iter().find(|w| !(**w > 0.0 && w.is_finite())) {
+        return invalid(wh, "every ωh must be > 0 and finite");
+    }
+    if let Method::Recurrence { order, skip } = method
+        && (order == 0 || order > MAX_RECURRENCE_ORDER || skip > 1_000_000)
+    {
+        return invalid(
+            f64::NAN,
+            "a recurrence's order must be in 1..=64 and its skip at most 10⁶ steps",
+        );
+    }
     let omega = oscillator_omega(model)?;
     let label = label(&scheme);
     let mut points = Vec::with_capacity(omega_h.len());
@@ -305,6 +334,7 @@ pub fn analyse_with<M: Model + Clone + 'static>(
             label: label.clone(),
             omega_h: wh,
             error,
+            computed: points.clone(),
         };
         let point = match method {
             Method::OneStep => {
@@ -335,6 +365,7 @@ pub fn analyse_with<M: Model + Clone + 'static>(
                         label: label.clone(),
                         omega_h: wh,
                         order,
+                        computed: points.clone(),
                     })?;
                 fit.point(wh)
             }
@@ -402,7 +433,7 @@ pub fn fit_recurrence(sequences: &[&[f64]], k: usize) -> Option<Recurrence> {
         for n in 0..diffs[k].len() {
             let row: Vec<f64> = (0..=k).map(|j| diffs[j][n]).collect();
             let s = row.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            if s > 0.0 && s.is_finite() {
+            if s > 0.0 && row.iter().all(|v| v.is_finite()) {
                 rows.push(row.iter().map(|v| v / s).collect());
             }
         }
@@ -454,6 +485,9 @@ pub fn fit_recurrence(sequences: &[&[f64]], k: usize) -> Option<Recurrence> {
     }
     for j in 0..k {
         d[j] /= cs[j];
+    }
+    if !d.iter().all(|x| x.is_finite()) {
+        return None;
     }
     let residual = rows
         .iter()
@@ -632,8 +666,11 @@ fn measure(us: &[C], omega_h: f64, order: usize, residual: f64) -> Point {
 pub const CSV_HEADER: &str = "scheme,omega_h,rho,period_error,spurious_rho,order,residual";
 
 impl SpectralTable {
-    /// The point nearest to `omega_h` (in log).
+    /// The point nearest to `omega_h` (in log); `None` for an ωh that is not > 0 and finite.
     pub fn at(&self, omega_h: f64) -> Option<&Point> {
+        if !(omega_h > 0.0 && omega_h.is_finite()) {
+            return None;
+        }
         self.points.iter().min_by(|a, b| {
             (a.omega_h / omega_h)
                 .ln()

@@ -442,6 +442,61 @@ fn methods_agree_and_residuals_tell() {
     assert!(matches!(err, SpectralError::NotAnOscillator(_)), "{err}");
 }
 
+/// Grids that measure nothing or are not numbers are refused by name; a run that fails at one
+/// ωh keeps the points before it in its error; a fit never takes NaN rows for data.
+#[test]
+fn bad_grids_are_refused_and_a_failure_keeps_the_points_before_it() {
+    let model = Unit::default();
+    for grid in [
+        vec![],
+        log_grid(0.0, 10.0, 5),
+        vec![1.0, -1.0],
+        vec![f64::INFINITY],
+    ] {
+        let err = analyse(&model, Scheme::Rk4, &grid).unwrap_err();
+        assert!(
+            matches!(err, SpectralError::Invalid { .. }),
+            "{grid:?}: {err}"
+        );
+    }
+    let err = analyse_with(
+        &model,
+        Scheme::Rk4,
+        &[1.0],
+        Method::Recurrence {
+            order: 10_000_000,
+            skip: 0,
+        },
+    )
+    .unwrap_err();
+    assert!(matches!(err, SpectralError::Invalid { .. }), "{err}");
+    // a step beyond f64 at the last ωh: that run is refused
+    let err = analyse(&model, Scheme::Rk4, &[0.01, 0.1, 1e308]).unwrap_err();
+    match err {
+        SpectralError::Simulation {
+            omega_h, computed, ..
+        } => {
+            assert_eq!(omega_h, 1e308);
+            let at: Vec<f64> = computed.iter().map(|p| p.omega_h).collect();
+            assert_eq!(at, [0.01, 0.1]);
+        }
+        other => panic!("{other}"),
+    }
+    let table = analyse(&model, Scheme::Rk4, &[0.1, 1.0]).unwrap();
+    assert!(table.at(0.0).is_none() && table.at(f64::NAN).is_none());
+    assert_eq!(table.at(0.9).unwrap().omega_h, 1.0);
+    // a NaN in the data is no row of the fit: the others fit x_{n+1} = 0.5 x_n
+    let x: Vec<f64> = (0..12)
+        .map(|n| if n == 5 { f64::NAN } else { 0.5f64.powi(n) })
+        .collect();
+    let fit = fit_recurrence(&[&x], 1);
+    assert!(
+        fit.as_ref()
+            .is_none_or(|f| f.shifted.iter().all(|d| d.is_finite())),
+        "{fit:?}"
+    );
+}
+
 /// Measured (ρ, period error) of mode `k` of a seed2dof trajectory sampled at every step.
 fn measured(tr: &mbs::Trajectory, k: usize, skip: usize, wh: f64) -> (f64, f64) {
     let (_, v) = seed2dof_modes();

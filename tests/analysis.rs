@@ -371,6 +371,19 @@ fn seed2dof_poles_match_the_reference_and_are_undamped() {
     let low = mbs::analysis::modes(&lin, Some((0.0, 5.0))).unwrap();
     assert_eq!(low.modes.len(), 1);
     assert!((low.modes[0].frequency_hz - want[0]).abs() < 1e-6);
+    // a window upside down or with a NaN bound is refused, not an empty answer
+    for w in [(5.0, 0.0), (f64::NAN, 5.0), (0.0, f64::NAN)] {
+        let e = mbs::analysis::modes(&lin, Some(w)).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                mbs::AnalysisError::Failure(mbs::Failure::InvalidOption { name: "window", .. })
+            ),
+            "{w:?}: {e}"
+        );
+    }
+    let all = mbs::analysis::modes(&lin, Some((0.0, f64::INFINITY))).unwrap();
+    assert_eq!(all.modes.len(), want.len());
 }
 
 #[test]

@@ -352,8 +352,9 @@ impl Path {
             .fold((0.0, 0.0), |(l, ld), (u, dv, s)| (l + s, ld + dot(u, dv)))
     }
 
-    /// ∂l/∂q into `out` (one entry per coordinate of the model); the moment arm about
-    /// coordinate i is `−out[i]`.
+    /// ∂l/∂q into `out` (one entry per coordinate of the model whose kinematics `kin` are:
+    /// the wrapped model's, without a `WithEfforts` model's extra states); the moment arm
+    /// about coordinate i is `−out[i]`. Panics when `out` is longer than that.
     pub fn gradient(&self, kin: &Kinematics, out: &mut [f64]) {
         out.fill(0.0);
         for (w, (u, _, _)) in self.points.windows(2).zip(self.segments(kin)) {

@@ -158,8 +158,12 @@ pub struct Spline {
 }
 
 impl Spline {
-    /// The spline of `knots` and the `coefficients` [`natural_coefficients`] gives for them
-    /// (`knots.len() == coefficients.len() + 1`).
+    /// The spline of `knots` and the `coefficients` [`natural_coefficients`] gives for them.
+    ///
+    /// # Panics
+    ///
+    /// When the table is empty or `knots.len() != coefficients.len() + 1` (in a `const`, at
+    /// compile time: the generator writes these tables).
     pub const fn from_table(knots: &'static [f64], coefficients: &'static [[f64; 4]]) -> Spline {
         assert!(!coefficients.is_empty() && knots.len() == coefficients.len() + 1);
         Spline {

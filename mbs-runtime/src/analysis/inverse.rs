@@ -27,7 +27,7 @@ pub struct Efforts {
 }
 
 impl Efforts {
-    /// τ at time index `i`.
+    /// τ at time index `i` (panics beyond `t.len()`, as a slice does).
     pub fn at(&self, i: usize) -> &[f64] {
         let n = self.dof_names.len();
         &self.tau[i * n..(i + 1) * n]
@@ -172,13 +172,13 @@ pub struct ActuatedEfforts {
 }
 
 impl ActuatedEfforts {
-    /// τ_a at time index `i`.
+    /// τ_a at time index `i` (panics beyond `t.len()`, as a slice does).
     pub fn tau_at(&self, i: usize) -> &[f64] {
         let n = self.actuated.len();
         &self.tau[i * n..(i + 1) * n]
     }
 
-    /// λ at time index `i`.
+    /// λ at time index `i` (panics beyond `t.len()`, as a slice does).
     pub fn lambda_at(&self, i: usize) -> &[f64] {
         let n = self.constraint_names.len();
         &self.lambda[i * n..(i + 1) * n]

@@ -72,6 +72,16 @@ fn eigenvalues(a: &DMatrix<f64>) -> Result<Vec<nalgebra::Complex<f64>>, Analysis
 
 /// Computes the modes of `lin` whose frequency is within `window` (Hz, inclusive), or all.
 pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, AnalysisError> {
+    if let Some((lo, hi)) = window
+        && !(lo <= hi && !lo.is_nan() && !hi.is_nan())
+    {
+        return Err(Failure::InvalidOption {
+            name: "window",
+            value: format!("({lo}, {hi}) Hz"),
+            reason: "must be (low, high) with low ≤ high, neither NaN (an infinite bound: no limit)",
+        }
+        .into());
+    }
     let n2 = lin.a.nrows();
     let n = n2 / 2;
     if lin.a.iter().any(|x| !x.is_finite()) {

@@ -43,8 +43,9 @@ pub struct StaticsOptions {
     pub constraint_tolerance: f64,
     /// Newton iterations before `NotConverged` (default 50)
     pub max_iterations: usize,
-    /// how the stiffness is obtained: exact tangents (`Auto` when generated), or central
-    /// differences of the static forces
+    /// how the stiffness is obtained: exact tangents (`Exact`, or `Auto` when generated), or
+    /// central differences of the static forces (`FiniteDifferences`, `Auto` without
+    /// tangents, and `MassOnly`: statics has no use for M alone)
     pub stiffness: IterationMatrix,
 }
 

@@ -45,7 +45,7 @@
 //! | `frame sensor;` | a massless frame (a secondary frame) |
 //! | `point tip on arm at (0, -l/2, 0);` | a point fixed on a body, frame or `ground`, in its axes |
 //! | `TOG[arm] = …;` | the body's pose: a product of transforms (below) |
-//! | `fn g5(x) = 0.1*sin(x);` | an inline function, differentiated symbolically |
+//! | `fn g5(x) = 0.1*sin(x);` | an inline function, differentiated symbolically; its arguments hide the model's names of the same spelling in its own body only (a `let` or another `fn` it uses sees the model's) |
 //! | `extern fn g6 = [knee::g6, knee::g6_d, knee::g6_dd];` | a Rust function `f64 -> f64` and its successive derivatives |
 //! | `effect name { … }` | a named group of effect statements |
 //! | `gravity(0, -g, 0);` … outside an `effect` | an effect that is always on |
@@ -147,7 +147,8 @@
 //! Rust syntax and precedence: numbers, names, `+ - * /`, unary `-`, parentheses, `q[i]`,
 //! `qd[i]`, `qdd[i]`, `u[k]`, `t`, the constants `PI`, `E`, `TAU`, and the functions `sin cos
 //! tan asin acos atan atan2(y, x) sinh cosh tanh exp ln sqrt abs sign pos step powi(x, n)
-//! pow(x, y)` (also as methods: `x.sin()`). `^` is not a power; write `powi(x, 2)`.
+//! pow(x, y)` (also as methods: `x.sin()`; `x.signum()` is `sign(x)`, the mathematical sign,
+//! 0 at 0 where Rust's `f64::signum` gives 1). `^` is not a power; write `powi(x, 2)`.
 //! `pos(x)` = max(x, 0) is the positive part (derivative `step(x)`) and `step(x)` is 1 for
 //! x > 0, 0 otherwise (derivative 0): one-sided forces, such as a stop that only pushes,
 //! `generalized_force(q[0], -k * pos(q[0] - 0.1))`. Exact tangents see their derivatives

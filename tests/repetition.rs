@@ -2,6 +2,8 @@
 //! `for` loops in 13 lines of `multibody!`, against the same chain written out link by link
 //! (absolute products from the ground, generalised forces instead of joint torques) and
 //! evaluated on the generator's expression DAG: M and h agree to 1e-13 at random states.
+//! Inline `fn`s are scoped lexically: an argument named like a model's name hides it in that
+//! body alone, not in a `let` or another `fn` the body uses.
 
 use mbs::{Model, Options, Scheme, simulate};
 use mbs_symbolic::expr::SliceEnv;
@@ -39,6 +41,38 @@ mbs::multibody! {
         Leg(1, -0.2);
         gravity(0, 0, -9.81);
     }
+}
+
+mbs::multibody! {
+    /// A slider pushed by a generalised force written with functions whose arguments are
+    /// named like the model's parameter `l` and coordinate `x`.
+    model Scoped {
+        param l = 2.0;
+        dof x = 0.0;
+        body b { mass = 1.0; inertia = (1, 1, 1); }
+        TOG[b] = Tdisp(x, 0, 0);
+        let half = l / 2;
+        fn f(l) = l * half;
+        fn g(a) = a * x;
+        fn k(x) = g(2.0) + x;
+        generalized_force(q[x], f(3.0) + 10 * k(5.0));
+        // functions of a number and a coordinate (a method on a bare number did not compile)
+        generalized_force(q[x], pow(2.0, x) + atan2(1.0, x));
+    }
+}
+
+/// `half` is the model's l/2 = 1 even when first used inside `f(l)`, and `g` reads the
+/// coordinate x even when called from `k(x)`: f(3) + 10 k(5) = 3·1 + 10 (2x + 5). Names
+/// were bound for the whole of a call (dynamic scope): `half` became 3/2 for every use and
+/// `g(2.0)` read k's argument, 4.5 + 10 (2·5 + 5) = 154.5 at any x.
+#[test]
+fn inline_functions_see_their_own_arguments_and_the_models_names() {
+    let model = Scoped::default();
+    let (mut m, mut h) = ([0.0], [0.0]);
+    model.dynamics(0.0, &[0.7], &[0.0], &[], &mut m, &mut h);
+    assert_eq!(m[0], 1.0);
+    let want = 3.0 + 10.0 * (2.0 * 0.7 + 5.0) + 2f64.powf(0.7) + 1f64.atan2(0.7);
+    assert!((h[0] - want).abs() < 1e-12, "{} against {want}", h[0]);
 }
 
 #[test]

@@ -137,6 +137,13 @@ impl Writer<'_> {
     }
 
     /// Precedence of `n` where it is used.
+    /// Whether `n` is written as a bare number: a method called on it (`2.0.powf(x)`) does
+    /// not compile (E0689, an ambiguous float type), so such calls are written `f64::powf(2.0,
+    /// x)`.
+    fn is_literal(&self, n: ExprId) -> bool {
+        !self.sch.is_let(n) && matches!(self.arena.node(n), Node::Num(_))
+    }
+
     fn prec(&self, n: ExprId) -> Prec {
         if self.sch.is_let(n) {
             return Prec::Atom;
@@ -230,13 +237,24 @@ impl Writer<'_> {
                 self.expr(b, Prec::Add, out);
                 out.push(')');
             }
+            Node::Powi(a, k) if self.is_literal(a) => {
+                out.push_str("f64::powi(");
+                self.expr(a, Prec::Add, out);
+                let _ = write!(out, ", {k})");
+            }
             Node::Powi(a, k) => {
                 self.expr(a, Prec::Atom, out);
                 let _ = write!(out, ".powi({k})");
             }
             Node::Pow(a, b) => {
-                self.expr(a, Prec::Atom, out);
-                out.push_str(".powf(");
+                if self.is_literal(a) {
+                    out.push_str("f64::powf(");
+                    self.expr(a, Prec::Add, out);
+                    out.push_str(", ");
+                } else {
+                    self.expr(a, Prec::Atom, out);
+                    out.push_str(".powf(");
+                }
                 self.expr(b, Prec::Add, out);
                 out.push(')');
             }
@@ -259,8 +277,14 @@ impl Writer<'_> {
                 let _ = write!(out, ".{}()", f.name());
             }
             Node::Atan2(y, x) => {
-                self.expr(y, Prec::Atom, out);
-                out.push_str(".atan2(");
+                if self.is_literal(y) {
+                    out.push_str("f64::atan2(");
+                    self.expr(y, Prec::Add, out);
+                    out.push_str(", ");
+                } else {
+                    self.expr(y, Prec::Atom, out);
+                    out.push_str(".atan2(");
+                }
                 self.expr(x, Prec::Add, out);
                 out.push(')');
             }

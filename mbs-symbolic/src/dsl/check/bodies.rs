@@ -486,8 +486,8 @@ impl Checker {
 
     /// The coordinate `e` names (`q[2]`, `knee`, `q[knee]`), without reporting anything.
     fn coordinate_silent(&self, e: &Expr) -> Option<usize> {
-        let named = |id: &Ident| match self.scalars.get(&id.to_string()) {
-            Some(Scalar::Dof(i)) => Some(*i),
+        let named = |id: &Ident| match self.scalar(&id.to_string()) {
+            Some(Scalar::Dof(i)) => Some(i),
             _ => None,
         };
         match e {

@@ -16,10 +16,10 @@ impl Checker {
             }
             Expr::Path(p) if p.path.get_ident().is_some() => {
                 let id = p.path.get_ident().unwrap();
-                match self.scalars.get(&id.to_string()) {
-                    Some(Scalar::Dof(i)) => Some(*i),
+                match self.scalar(&id.to_string()) {
+                    Some(Scalar::Dof(i)) => Some(i),
                     other => {
-                        let is = self.describe(id, other);
+                        let is = self.describe(id, other.as_ref());
                         self.error(
                             id.span(),
                             format!("{is}, not a coordinate: write `q[i]` or a coordinate's name"),
@@ -38,6 +38,15 @@ impl Checker {
                 );
                 None
             }
+        }
+    }
+
+    /// What `name` stands for here: an argument of the inline `fn` being lowered, else the
+    /// model's name.
+    pub(super) fn scalar(&self, name: &str) -> Option<Scalar> {
+        match self.args.iter().rev().find(|(n, _)| n == name) {
+            Some(&(_, e)) => Some(Scalar::Bound(e)),
+            None => self.scalars.get(name).cloned(),
         }
     }
 
@@ -92,12 +101,12 @@ impl Checker {
             }
             Expr::Path(p) if p.path.get_ident().is_some() => {
                 let id = p.path.get_ident().unwrap();
-                match (self.scalars.get(&id.to_string()), v) {
-                    (Some(Scalar::Input(i)), "u") => Some(*i),
-                    (Some(Scalar::Dof(i)), "q" | "qd" | "qdd") => Some(*i),
+                match (self.scalar(&id.to_string()), v) {
+                    (Some(Scalar::Input(i)), "u") => Some(i),
+                    (Some(Scalar::Dof(i)), "q" | "qd" | "qdd") => Some(i),
                     (None, _) if self.taken_reserved.contains(&id.to_string()) => None,
                     (other, _) => {
-                        let is = self.describe(id, other);
+                        let is = self.describe(id, other.as_ref());
                         self.error(
                             id.span(),
                             format!(
@@ -378,7 +387,7 @@ impl Checker {
             "TAU" => return self.sys.arena.num(std::f64::consts::TAU),
             _ => {}
         }
-        match self.scalars.get(&s).cloned() {
+        match self.scalar(&s) {
             Some(Scalar::Bound(e)) => e,
             Some(Scalar::Param(i)) => {
                 if !a.params {
@@ -424,7 +433,11 @@ impl Checker {
                     return self.sys.arena.zero();
                 }
                 self.let_busy.push(s.clone());
+                // a `let` is the model's: lowered without the arguments of a call it is
+                // first used in (and then cached for every use)
+                let outer = std::mem::take(&mut self.args);
                 let e = self.lower(&body, ANY);
+                self.args = outer;
                 self.let_busy.pop();
                 self.let_done.insert(s, e);
                 self.check_allowed(e, id, a)
@@ -663,25 +676,14 @@ impl Checker {
                     return self.sys.arena.zero();
                 }
                 let vals: Vec<ExprId> = args.iter().map(|e| self.lower(e, a)).collect();
-                let saved: Vec<(String, Option<Scalar>)> = params
-                    .iter()
-                    .zip(&vals)
-                    .map(|(p, &v)| {
-                        (
-                            p.to_string(),
-                            self.scalars.insert(p.to_string(), Scalar::Bound(v)),
-                        )
-                    })
-                    .collect();
+                // the body sees its own arguments and the model's names, not the caller's
+                // arguments (lexical, not dynamic, scope)
+                let own = params.iter().map(|p| p.to_string()).zip(vals).collect();
+                let outer = std::mem::replace(&mut self.args, own);
                 self.calling.push(name.clone());
                 let r = self.lower(&body, a);
                 self.calling.pop();
-                for (k, old) in saved {
-                    match old {
-                        Some(o) => self.scalars.insert(k, o),
-                        None => self.scalars.remove(&k),
-                    };
-                }
+                self.args = outer;
                 r
             }
             Some(FnSym::Extern { id: fid }) => {

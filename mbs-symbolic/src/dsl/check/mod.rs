@@ -125,7 +125,8 @@ enum Scalar {
     Let(Box<Expr>),
     Dof(usize),
     Input(usize),
-    /// inline-function argument, bound to an expression
+    /// inline-function argument, bound to an expression (only in [`Checker::args`], the
+    /// innermost call's: never in `scalars`)
     Bound(ExprId),
 }
 
@@ -139,6 +140,9 @@ struct Checker {
     sys: System,
     errors: Vec<syn::Error>,
     scalars: FxHashMap<String, Scalar>,
+    /// the arguments of the inline `fn` whose body is being lowered: its own only (names are
+    /// lexical: a `let` or another `fn` it uses sees the model's names, not these)
+    args: Vec<(String, ExprId)>,
     fns: FxHashMap<String, FnSym>,
     /// lets being lowered (cycle detection) and lowered lets
     let_busy: Vec<String>,
@@ -196,6 +200,7 @@ pub fn check(def: &ModelDef) -> Result<Checked, syn::Error> {
         sys: System::new(&def.name.to_string()),
         errors: Vec::new(),
         scalars: FxHashMap::default(),
+        args: Vec::new(),
         fns: FxHashMap::default(),
         let_busy: Vec::new(),
         let_done: FxHashMap::default(),

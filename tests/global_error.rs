@@ -191,3 +191,24 @@ fn rotation_joints_are_compared_without_their_charts() {
     assert!(stats.chart_switches > 0, "the charts were re-centred");
     assert!(e <= 1.0, "{e}");
 }
+
+/// Global control's own sample times stay within [t0, t_end] where their last rounds past it
+/// (0.3 + 0.6 = 0.9000000000000001 > 0.9: the first run was refused, naming times the user
+/// never gave).
+#[test]
+fn its_sample_times_end_on_t_end() {
+    let o = Options {
+        t0: 0.3,
+        output: Output::Steps,
+        energy: false,
+        ..Options::adaptive(0.9, 1e-5)
+    };
+    let (tr, _, report) = simulate_global(
+        &fourbar::FourBar::default(),
+        Scheme::Dopri5,
+        &o,
+        &GlobalControl::default(),
+    )
+    .unwrap();
+    assert_eq!(*tr.t.last().unwrap(), 0.9, "{report}");
+}

@@ -418,3 +418,77 @@ fn a_tolerance_of_a_hundred_percent_and_outputs_beyond_memory_are_refused() {
     };
     assert!(simulate(Seed2dof::default(), Scheme::Radau5, o).is_ok());
 }
+
+/// Options that passed and then misled: an h_min or h_max below the resolution of time (t + h
+/// would not move t), an h_max below a fixed step (it was cut silently), a Newton iteration
+/// limit no iteration needs, and output times named by the first offending entry.
+#[test]
+fn steps_that_would_not_move_time_and_caps_on_fixed_steps_are_refused() {
+    let adaptive_at = |t0: f64| Options {
+        t0,
+        ..quiet(Options::adaptive(t0 + 1.0, 1e-6))
+    };
+    let (name, msg) = invalid(
+        Scheme::Dopri5,
+        Options {
+            h_min: Some(1e-13),
+            ..adaptive_at(1e6)
+        },
+    );
+    assert_eq!(name, "h_min", "{msg}");
+    assert!(msg.contains("resolution of time"), "{msg}");
+    let (name, _) = invalid(
+        Scheme::Dopri5,
+        Options {
+            h_max: 1e-300,
+            ..adaptive_at(0.0)
+        },
+    );
+    assert_eq!(name, "h_max");
+    let (name, msg) = invalid(
+        Scheme::Rk4,
+        Options {
+            h_max: 1e-3,
+            ..quiet(Options::fixed(1.0, 1e-2))
+        },
+    );
+    assert_eq!(name, "h_max", "{msg}");
+    let mut o = quiet(Options::adaptive(1.0, 1e-6));
+    o.newton.max_iterations = usize::MAX;
+    assert_eq!(invalid(Scheme::Radau5, o).0, "newton.max_iterations");
+    let (name, msg) = invalid(
+        Scheme::Dopri5,
+        Options {
+            output: Output::Times(vec![0.1, 0.2, 1.5, 0.3]),
+            ..adaptive_at(0.0)
+        },
+    );
+    assert_eq!(name, "output.times");
+    assert!(msg.contains("1.5 at index 2"), "{msg}");
+}
+
+/// `Output::Every` ends on t_end even where the last multiple of dt rounds past it (3 · 0.1 =
+/// 0.30000000000000004 > 0.3, whose output was lost), and a run that fails under
+/// `Output::Last` keeps its last accepted state (it kept nothing).
+#[test]
+fn every_dt_ends_on_t_end_and_a_failed_last_output_run_keeps_its_state() {
+    for (t_end, n) in [(0.3, 4), (0.7, 8), (1.2, 13)] {
+        let o = Options {
+            output: Output::Every { dt: 0.1 },
+            energy: false,
+            ..Options::adaptive(t_end, 1e-6)
+        };
+        let (tr, _) = simulate(Seed2dof::default(), Scheme::Dopri5, o).unwrap();
+        assert_eq!(tr.len(), n, "t_end {t_end}: {:?}", tr.t);
+        assert_eq!(*tr.t.last().unwrap(), t_end);
+    }
+    let o = Options {
+        max_steps: 50,
+        ..quiet(Options::adaptive(10.0, 1e-8))
+    };
+    let e = simulate(Seed2dof::default(), Scheme::Dopri5, o).unwrap_err();
+    assert!(matches!(e.kind, Failure::TooMuchWork { .. }), "{e}");
+    assert_eq!(e.trajectory.len(), 1, "the last accepted state");
+    assert_eq!(e.trajectory.t[0], e.t);
+    assert!(e.t > 0.0);
+}

@@ -727,6 +727,36 @@ impl Options {
         if !(self.h_max > 0.0) {
             return Err(invalid("h_max", self.h_max, "must be > 0"));
         }
+        // a step below 64 ε·|t| does not move t
+        let t_far = self.t0.abs().max(self.t_end.abs());
+        let resolution = 64.0 * f64::EPSILON * t_far;
+        match self.step {
+            StepControl::Fixed { h } if self.h_max < h => {
+                return Err(invalid(
+                    "h_max",
+                    format!(
+                        "{} (with the fixed step h = {})",
+                        short(self.h_max),
+                        short(h)
+                    ),
+                    "is below the fixed step, which is taken as given: drop h_max or take h ≤ h_max",
+                ));
+            }
+            StepControl::Adaptive { .. } => {
+                for (name, v) in [("h_max", Some(self.h_max)), ("h_min", self.h_min)] {
+                    if let Some(v) = v
+                        && v < resolution
+                    {
+                        return Err(invalid(
+                            name,
+                            format!("{} (with t = {})", short(v), short(t_far)),
+                            "is below the resolution of time there (64 ε·|t|): a step that small would not move t",
+                        ));
+                    }
+                }
+            }
+            _ => {}
+        }
         if let Some(h) = self.h_min {
             if !(h > 0.0) || !h.is_finite() {
                 return Err(invalid("h_min", h, "must be > 0 and finite"));
@@ -772,25 +802,44 @@ impl Options {
                 ));
             }
             Output::Times(ts) => {
-                if ts
+                // the first offending time by its index, not the whole list
+                if let Some(k) = ts
                     .iter()
-                    .any(|t| !t.is_finite() || *t < self.t0 || *t > self.t_end)
+                    .position(|t| !t.is_finite() || *t < self.t0 || *t > self.t_end)
                 {
                     return Err(invalid(
                         "output.times",
-                        format!("{ts:?}"),
+                        format!(
+                            "{} at index {k} (t0 = {}, t_end = {})",
+                            short(ts[k]),
+                            short(self.t0),
+                            short(self.t_end)
+                        ),
                         "must be finite and within [t0, t_end]",
                     ));
                 }
-                if ts.windows(2).any(|w| w[1] < w[0]) {
-                    return Err(invalid("output.times", format!("{ts:?}"), "must be sorted"));
+                if let Some(k) = ts.windows(2).position(|w| w[1] < w[0]) {
+                    return Err(invalid(
+                        "output.times",
+                        format!(
+                            "{} at index {} after {}",
+                            short(ts[k + 1]),
+                            k + 1,
+                            short(ts[k])
+                        ),
+                        "must be sorted",
+                    ));
                 }
             }
             _ => {}
         }
         let n = &self.newton;
-        if n.max_iterations == 0 {
-            return Err(invalid("newton.max_iterations", 0, "must be > 0"));
+        if n.max_iterations == 0 || n.max_iterations > 1_000_000 {
+            return Err(invalid(
+                "newton.max_iterations",
+                n.max_iterations,
+                "must be from 1 to 10⁶ (a Newton iteration that has not converged in a few dozen will not)",
+            ));
         }
         for (name, v) in [
             ("newton.tolerance_factor", n.tolerance_factor),

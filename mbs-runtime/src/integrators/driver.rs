@@ -388,7 +388,11 @@ impl Run {
         })
     }
 
-    fn fail(&self, kind: Failure, h: f64) -> SimError {
+    fn fail(&mut self, kind: Failure, h: f64) -> SimError {
+        // `Output::Last` records at the end: a run that fails keeps its last accepted state
+        if self.options.output == Output::Last && self.traj.is_empty() {
+            self.record_cur();
+        }
         let mut stats = self.problem.stats.clone();
         stats.held_most = self.held_most();
         stats.user_efforts = self.problem.model.user_evaluations();
@@ -940,8 +944,12 @@ fn output_times(options: &Options) -> Vec<f64> {
     match &options.output {
         Output::Times(ts) => ts.clone(),
         Output::Every { dt } => {
+            // the last may round past t_end (0.1 · 3 = 0.30000000000000004 > 0.3): it is
+            // t_end's output, which the run reaches exactly
             let k = every_count(options, *dt);
-            (0..=k).map(|i| options.t0 + i as f64 * dt).collect()
+            (0..=k)
+                .map(|i| (options.t0 + i as f64 * dt).min(options.t_end))
+                .collect()
         }
         Output::Steps | Output::Last => Vec::new(),
     }

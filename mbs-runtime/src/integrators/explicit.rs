@@ -87,6 +87,10 @@ fn dot_states(a: (&[f64], &[f64]), b: (&[f64], &[f64])) -> f64 {
 /// projections of J²δ (r1 = δ·J²δ, r2 = Jδ·J²δ): J²δ ≈ c₀δ + c₁Jδ by least squares, whose
 /// λ² = c₁λ + c₀ has the Ritz values as roots; δ ∥ Jδ gives the Rayleigh quotient δ·Jδ/δ·δ.
 pub(crate) fn ritz(g11: f64, g12: f64, g22: f64, r1: f64, r2: f64) -> (f64, f64) {
+    if g11 == 0.0 {
+        // no direction (a model without coordinates): no mode
+        return (0.0, 0.0);
+    }
     let det = g11 * g22 - g12 * g12;
     if !(det > 1e-12 * g11 * g22) {
         return (g12 / g11, 0.0);

@@ -191,7 +191,7 @@ pub fn simulate_global<M: Model + Clone + 'static>(
             let (t0, t1, n) = (options.t0, options.t_end, control.samples);
             Output::Times(
                 (1..=n)
-                    .map(|k| t0 + (t1 - t0) * (k as f64 / n as f64))
+                    .map(|k| (t0 + (t1 - t0) * (k as f64 / n as f64)).min(t1))
                     .collect(),
             )
         }

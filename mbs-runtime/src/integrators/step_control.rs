@@ -425,7 +425,7 @@ pub(crate) fn initial_step(
     let v1: Vec<f64> = (0..n).map(|i| s.qd[i] + h0 * s.qdd[i]).collect();
     let mut a1 = vec![0.0; n];
     if !accel(s.t + h0, &q1, &v1, &mut a1) {
-        return h0;
+        return h0.max(b.h_min);
     }
     let dv: Vec<f64> = (0..n).map(|i| (v1[i] - s.qd[i]) / h0).collect();
     let da: Vec<f64> = (0..n).map(|i| (a1[i] - s.qdd[i]) / h0).collect();

@@ -76,7 +76,12 @@ impl Radau {
                 err = self.weighted_norm(tol);
             }
         }
-        err.max(1e-10)
+        // a NaN estimate (an overflowing filter) is a failed test, not a pass
+        if err.is_nan() {
+            f64::INFINITY
+        } else {
+            err.max(1e-10)
+        }
     }
 
     /// The right-hand side the index-3 and index-2 filters share, into `tmp`:
@@ -182,7 +187,12 @@ impl Radau {
                 err = self.weighted_norm(tol);
             }
         }
-        err.max(1e-10)
+        // a NaN estimate (an overflowing filter) is a failed test, not a pass
+        if err.is_nan() {
+            f64::INFINITY
+        } else {
+            err.max(1e-10)
+        }
     }
 
     /// τ(t₀, qx, vx, qdd₀) − B(qx)ᵀ lx into `ax` and Φ(qx) into `phix`; false when an

@@ -225,7 +225,12 @@ impl Radau {
                 }
             }
         }
-        err.max(1e-10)
+        // a NaN estimate (an overflowing filter) is a failed test, not a pass
+        if err.is_nan() {
+            f64::INFINITY
+        } else {
+            err.max(1e-10)
+        }
     }
 }
 

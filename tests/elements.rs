@@ -397,3 +397,44 @@ fn exact_coulomb_at_rest_and_coincident_points_are_finite() {
     path.gradient(&kin, &mut grad);
     assert!(grad.iter().all(|&g| g == 0.0), "{grad:?}");
 }
+
+mbs::multibody! {
+    /// One-sided forces whose derivatives are infinite at the kink of their positive part:
+    /// √pos(x), pos(x)^0.7 and pos(x)^n with the exponent n a sensitive parameter.
+    model Kinks {
+        param k = 100.0; param n = 1.5 sensitive;
+        dof x = 0.0;
+        body b { mass = 1.0; inertia = (1, 1, 1); }
+        TOG[b] = Tdisp(x, 0, 0);
+        generalized_force(q[x], -k * sqrt(pos(x)) - pow(pos(x), 0.7) - pow(pos(x), n));
+        option tangents;
+    }
+}
+
+/// Off contact (x ≤ 0) the tangent and the derivative by the exponent are 0, where the chain
+/// rule gave inf·0 = NaN; in contact they are the derivatives by hand.
+#[test]
+fn derivatives_at_the_kink_of_a_positive_part_are_zero_not_nan() {
+    let model = Kinks::default();
+    let k_at = |x: f64| {
+        let (mut k, mut c) = ([0.0], [0.0]);
+        model
+            .tangents(0.0, &[x], &[0.0], &[0.0], &[], &mut k, &mut c)
+            .unwrap();
+        let mut dp = [0.0];
+        model
+            .parameter_tangents(0.0, &[x], &[0.0], &[0.0], &[], &mut dp)
+            .unwrap();
+        (k[0], dp[0])
+    };
+    // K = ∂τ/∂q with τ = M qdd − h: the derivative of minus the force
+    for x in [-0.1, 0.0] {
+        assert_eq!(k_at(x), (0.0, 0.0), "x = {x}");
+    }
+    let x: f64 = 0.2;
+    let (k, dp) = k_at(x);
+    let want = 100.0 * 0.5 / x.sqrt() + 0.7 * x.powf(-0.3) + 1.5 * x.powf(0.5);
+    assert!((k - want).abs() < 1e-12 * want, "{k} against {want}");
+    let want = x.powf(1.5) * x.ln();
+    assert!((dp - want).abs() < 1e-14, "{dp} against {want}");
+}

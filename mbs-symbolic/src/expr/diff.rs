@@ -131,18 +131,25 @@ impl Arena {
                 let (da, db) = (d(self, a), d(self, b));
                 if db == self.zero() {
                     // (a^b)' = b a^(b−1) a' for an exponent constant in this direction: no
-                    // ln a and no division by a, so a = 0 (pos(δ)^1.5 out of contact) gives 0
+                    // ln a and no division by a, so a = 0 (pos(δ)^1.5 out of contact) gives 0;
+                    // below 1 the power is infinite there, so it is taken off the kink
                     let one = self.one();
                     let e = self.sub(b, one);
-                    let p = self.pow(a, e);
+                    let base = if self.as_num(b).is_some_and(|b| b >= 1.0) {
+                        a
+                    } else {
+                        self.off_the_kink(a)
+                    };
+                    let p = self.pow(base, e);
                     let p = self.mul(b, p);
                     return self.mul(p, da);
                 }
-                // (a^b)' = a^b (b' ln a + b a'/a)
-                let la = self.func(Func::Ln, a);
+                // (a^b)' = a^b (b' ln a + b a'/a), a taken off the kink of a positive part
+                let a_off = self.off_the_kink(a);
+                let la = self.func(Func::Ln, a_off);
                 let x = self.mul(db, la);
                 let y = self.mul(b, da);
-                let y = self.div(y, a);
+                let y = self.div(y, a_off);
                 let s = self.add(x, y);
                 self.mul(n, s)
             }
@@ -176,6 +183,31 @@ impl Arena {
     }
 
     /// f'(a) where `fa` = f(a).
+    /// `a`, or where `a` is a positive part pos(u) (or c·pos(u)), pos(u) + 1 − step(u): equal
+    /// to it where u > 0, 1 where u ≤ 0. The factor of a chain rule that is infinite at 0
+    /// (0.5/√a, a^(b−1) with b < 1, ln a, 1/a) then stays finite where pos(u) is 0, and is
+    /// multiplied there by the derivative of pos(u), step(u)·u' = 0: the derivative is 0, as
+    /// it is, where inf·0 gave NaN (√pos(x), pos(δ)^b with b < 1, and the second derivatives
+    /// of pos(δ)^1.5 out of contact).
+    fn off_the_kink(&mut self, a: ExprId) -> ExprId {
+        let (c, p) = match self.node(a) {
+            Node::Func(Func::Pos, _) => (None, a),
+            Node::Mul(c, p) if self.as_num(c).is_some() => (Some(c), p),
+            _ => return a,
+        };
+        let Node::Func(Func::Pos, u) = self.node(p) else {
+            return a;
+        };
+        let one = self.one();
+        let step = self.func(Func::Step, u);
+        let lift = self.sub(one, step);
+        let off = self.add(p, lift);
+        match c {
+            Some(c) => self.mul(c, off),
+            None => off,
+        }
+    }
+
     fn func_derivative(&mut self, f: Func, a: ExprId, fa: ExprId) -> ExprId {
         let one = self.one();
         match f {
@@ -210,7 +242,13 @@ impl Arena {
             Func::Ln => self.div(one, a),
             Func::Sqrt => {
                 let h = self.num(0.5);
-                self.div(h, fa)
+                let off = self.off_the_kink(a);
+                let root = if off == a {
+                    fa
+                } else {
+                    self.func(Func::Sqrt, off)
+                };
+                self.div(h, root)
             }
             Func::Abs => self.func(Func::Sign, a),
             Func::Pos => self.func(Func::Step, a),

@@ -326,7 +326,7 @@ impl Reference {
         primary: (Scheme, Setting),
         check: Option<(Scheme, Setting)>,
         options: &Options,
-    ) -> Result<Reference, Box<SimError>> {
+    ) -> Result<Reference, ReferenceError> {
         let t_end = times.last().copied().unwrap_or(options.t0);
         let opts = |setting: Setting| Options {
             t_end,
@@ -343,16 +343,15 @@ impl Reference {
             ..options.clone()
         };
         let start = Instant::now();
-        let (tr, st) = simulate(model.clone(), primary.0, opts(primary.1)).map_err(Box::new)?;
-        let cpu = start.elapsed();
-        let check_states = match check {
-            Some((scheme, setting)) => {
-                let (tc, _) = simulate(model.clone(), scheme, opts(setting)).map_err(Box::new)?;
-                Some(tc.measured_states(model.info().rotation_joints))
+        let (tr, st) = simulate(model.clone(), primary.0, opts(primary.1)).map_err(|e| {
+            ReferenceError::Run {
+                scheme: primary.0.name(),
+                error: Box::new(e),
             }
-            None => None,
-        };
-        Ok(Reference {
+        })?;
+        let cpu = start.elapsed();
+        let check_run = check.map(|(scheme, setting)| (scheme, opts(setting)));
+        let mut reference = Reference {
             source: Source::Computed {
                 scheme: primary.0,
                 setting: primary.1,
@@ -363,8 +362,27 @@ impl Reference {
             },
             states: tr.measured_states(model.info().rotation_joints),
             times,
-            check: check_states,
-        })
+            check: None,
+        };
+        if let Some((scheme, o)) = check_run {
+            match simulate(model.clone(), scheme, o) {
+                Ok((tc, _)) => {
+                    reference.check = Some(tc.measured_states(model.info().rotation_joints));
+                }
+                Err(e) => {
+                    // the reference itself is kept, without its check
+                    if let Source::Computed { check, .. } = &mut reference.source {
+                        *check = None;
+                    }
+                    return Err(ReferenceError::Check {
+                        scheme: scheme.name(),
+                        error: Box::new(e),
+                        reference: Box::new(reference),
+                    });
+                }
+            }
+        }
+        Ok(reference)
     }
 
     /// The same reference with every state (and check state) passed through `f(t, y)`: e.g.
@@ -413,6 +431,25 @@ impl Reference {
 }
 
 pub use mbs_runtime::state_size;
+
+/// Why [`Reference::compute`] gave no reference: its own run failed, or the run that checks
+/// it did (the reference, computed, is then kept without its check).
+#[derive(Debug, thiserror::Error)]
+pub enum ReferenceError {
+    #[error("the reference run ({scheme}) failed: {error}")]
+    Run {
+        scheme: &'static str,
+        error: Box<SimError>,
+    },
+    #[error(
+        "the run that checks the reference ({scheme}) failed: {error}; the reference itself was computed (kept in the error, without its check)"
+    )]
+    Check {
+        scheme: &'static str,
+        error: Box<SimError>,
+        reference: Box<Reference>,
+    },
+}
 
 /// max_i |y_i − r_i| / (a + |r_i|): the Test Set's mixed error with absolute floor `a`.
 /// NaN when a component is not comparable (NaN or infinite) or the lengths differ: a state

@@ -178,6 +178,40 @@ fn computed_references_and_bad_references() {
         .fold(0.0, f64::max);
     assert!(worst < 1e-8, "{worst:e}");
 
+    // a failed run says which: the reference's own (nothing to keep), or its check's (the
+    // reference computed is kept, without a check); RK4 at h = 0.05 is beyond its stability
+    // on seed2dof's fast mode
+    use mbs::work_precision::ReferenceError;
+    let unstable = (Scheme::Rk4, Setting::Step(0.05));
+    let e = Reference::compute(
+        &Seed2dof::default(),
+        times.clone(),
+        unstable,
+        None,
+        &mbs::Options::default(),
+    )
+    .unwrap_err();
+    assert!(
+        matches!(e, ReferenceError::Run { scheme: "rk4", .. }),
+        "{e}"
+    );
+    let e = Reference::compute(
+        &Seed2dof::default(),
+        times.clone(),
+        (Scheme::Dopri5, Setting::Rtol(1e-10)),
+        Some(unstable),
+        &mbs::Options::default(),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("checks the reference (rk4)"), "{e}");
+    match e {
+        ReferenceError::Check { reference, .. } => {
+            assert_eq!(reference.states.len(), times.len());
+            assert!(reference.check.is_none() && reference.estimated_error(0.01).is_none());
+        }
+        other => panic!("{other}"),
+    }
+
     // a reference that does not fit the model is refused before any run
     let bad = Reference::data("two components", vec![1.0], vec![vec![0.0, 1.0]]);
     let e = Study::new("bad", bad)

@@ -37,8 +37,9 @@ impl Dir {
     pub(super) fn key(self, n: ExprId) -> u64 {
         let d: u64 = match self {
             Dir::Partial(v) => var_code(v),
-            Dir::Time => 7 << 16,
-            Dir::TimeBias => 8 << 16,
+            // beyond every variable's code (kinds 0..=8 in bits 16..): no direction shares a key
+            Dir::Time => 9 << 16,
+            Dir::TimeBias => 10 << 16,
         };
         d << 32 | n.0 as u64
     }
@@ -302,4 +303,36 @@ fn node_hash(n: &Node) -> u64 {
     let h = (tag ^ a.wrapping_mul(0x9E3779B97F4A7C15)).wrapping_mul(0xff51afd7ed558ccd)
         ^ b.wrapping_mul(0xc4ceb9fe1a85ec53);
     h ^ (h >> 29)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every direction has its own memo key: the time directions' once equalled those of
+    /// ∂/∂chart(0) and ∂/∂force(0).
+    #[test]
+    fn directions_have_distinct_memo_keys() {
+        let n = ExprId(5);
+        let mut keys = vec![Dir::Time.key(n), Dir::TimeBias.key(n)];
+        for i in [0u16, 1, 300] {
+            for v in [
+                Var::Q(i),
+                Var::Qd(i),
+                Var::Qdd(i),
+                Var::Param(i),
+                Var::Input(i),
+                Var::Lambda(i),
+                Var::Chart(i),
+                Var::Force(i),
+            ] {
+                keys.push(Dir::Partial(v).key(n));
+            }
+        }
+        keys.push(Dir::Partial(Var::T).key(n));
+        let all = keys.len();
+        keys.sort_unstable();
+        keys.dedup();
+        assert_eq!(keys.len(), all);
+    }
 }

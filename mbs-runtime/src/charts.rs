@@ -242,6 +242,22 @@ pub fn recentre<M: Model>(model: &mut M, q: &mut [f64], qd: &mut [f64], keep: &[
     }
 }
 
+/// Rewrites the angles of every rotation joint in `q`, read in the charts of `from`, in the
+/// charts of `to`: the same orientations (a `Tfree`'s translation, in front of its chart, is
+/// unchanged), b in [−π/2, π/2].
+pub fn reread_angles<M: Model>(from: &M, to: &M, q: &mut [f64]) {
+    for (j, joint) in from.info().rotation_joints.iter().enumerate() {
+        let r = joint_rotation(&from.chart(j), joint, q).to_rotation_matrix();
+        let c = to.chart(j);
+        let c = Matrix3::from_fn(|a, b| c[a][b]);
+        let local = rotation_of(&(c.transpose() * r.matrix()));
+        let angles = zyx_angles_of(quaternion_near(&local, None));
+        for (i, &k) in joint.angles.iter().enumerate() {
+            q[k] = angles[i];
+        }
+    }
+}
+
 /// Sets the charts of `model` to those output `i` of `tr` was read in, so that the model's
 /// functions (kinematics, energies, M and h) evaluate that output's q and qd as the
 /// simulation did.

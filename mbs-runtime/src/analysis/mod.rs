@@ -53,6 +53,8 @@ pub enum AnalysisError {
         residual: f64,
         /// largest |Φ_i| (0 without constraints)
         constraint_residual: f64,
+        /// where Newton stopped, rotation joints' angles in the model's charts (a start to
+        /// retry from)
         q: Vec<f64>,
     },
 }

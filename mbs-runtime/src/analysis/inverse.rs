@@ -390,20 +390,16 @@ impl<'a> Actuation<'a> {
             model.constraint_rate(t, q, phi_t);
             model.constraint_bias(t, q, qd, gamma);
         }
+        // Φ̇ = B qd + ∂Φ/∂t and Φ̈ = B qdd − γ in place; `reduce::worst` takes a non-finite
+        // violation for an infinite one (f64::max would drop a NaN and report 0)
         let row = |i: usize, v: &[f64]| (0..n).map(|j| b[(i, j)] * v[j]).sum::<f64>();
-        // a NaN violation stays NaN (f64::max would drop it and report 0)
-        let worst = |f: &dyn Fn(usize) -> f64| {
-            (0..nc).map(f).fold(0.0, |m: f64, v| {
-                if m.is_nan() || v.is_nan() {
-                    f64::NAN
-                } else {
-                    m.max(v.abs())
-                }
-            })
-        };
-        out.phi.push(worst(&|i| phi[i]));
-        out.phi_dot.push(worst(&|i| row(i, qd) + phi_t[i]));
-        out.phi_ddot.push(worst(&|i| row(i, qdd) - gamma[i]));
+        for i in 0..nc {
+            phi_t[i] += row(i, qd);
+            gamma[i] = row(i, qdd) - gamma[i];
+        }
+        out.phi.push(reduce::worst(phi).0);
+        out.phi_dot.push(reduce::worst(phi_t).0);
+        out.phi_ddot.push(reduce::worst(gamma).0);
         Ok(())
     }
 }

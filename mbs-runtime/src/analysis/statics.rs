@@ -311,7 +311,6 @@ pub fn static_equilibrium<M: Model + Clone>(
         }
         other => other,
     })?;
-    // a restart or two, each from a chart centred on where Newton went
     // a restart or two, each from a chart centred on where Newton went; a restart that fails
     // leaves the equilibrium found (converged, in a chart far from its centre)
     for _ in 0..3 {

@@ -182,7 +182,6 @@ impl Arena {
         }
     }
 
-    /// f'(a) where `fa` = f(a).
     /// `a`, or where `a` is a positive part pos(u) (or c·pos(u)), pos(u) + 1 − step(u): equal
     /// to it where u > 0, 1 where u ≤ 0. The factor of a chain rule that is infinite at 0
     /// (0.5/√a, a^(b−1) with b < 1, ln a, 1/a) then stays finite where pos(u) is 0, and is
@@ -208,6 +207,7 @@ impl Arena {
         }
     }
 
+    /// f'(a) where `fa` = f(a).
     fn func_derivative(&mut self, f: Func, a: ExprId, fa: ExprId) -> ExprId {
         let one = self.one();
         match f {

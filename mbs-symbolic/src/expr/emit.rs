@@ -136,14 +136,21 @@ impl Writer<'_> {
         s
     }
 
-    /// Precedence of `n` where it is used.
-    /// Whether `n` is written as a bare number: a method called on it (`2.0.powf(x)`) does
-    /// not compile (E0689, an ambiguous float type), so such calls are written `f64::powf(2.0,
-    /// x)`.
-    fn is_literal(&self, n: ExprId) -> bool {
-        !self.sch.is_let(n) && matches!(self.arena.node(n), Node::Num(_))
+    /// Opens the call of method `f` on `a` with further arguments: `a.f(`, or `f64::f(a, `
+    /// where `a` is written as a bare number (`2.0.powf(x)` does not compile: E0689, an
+    /// ambiguous float type).
+    fn method_call(&mut self, a: ExprId, f: &str, out: &mut String) {
+        if !self.sch.is_let(a) && matches!(self.arena.node(a), Node::Num(_)) {
+            let _ = write!(out, "f64::{f}(");
+            self.expr(a, Prec::Add, out);
+            out.push_str(", ");
+        } else {
+            self.expr(a, Prec::Atom, out);
+            let _ = write!(out, ".{f}(");
+        }
     }
 
+    /// Precedence of `n` where it is used.
     fn prec(&self, n: ExprId) -> Prec {
         if self.sch.is_let(n) {
             return Prec::Atom;
@@ -237,24 +244,12 @@ impl Writer<'_> {
                 self.expr(b, Prec::Add, out);
                 out.push(')');
             }
-            Node::Powi(a, k) if self.is_literal(a) => {
-                out.push_str("f64::powi(");
-                self.expr(a, Prec::Add, out);
-                let _ = write!(out, ", {k})");
-            }
             Node::Powi(a, k) => {
-                self.expr(a, Prec::Atom, out);
-                let _ = write!(out, ".powi({k})");
+                self.method_call(a, "powi", out);
+                let _ = write!(out, "{k})");
             }
             Node::Pow(a, b) => {
-                if self.is_literal(a) {
-                    out.push_str("f64::powf(");
-                    self.expr(a, Prec::Add, out);
-                    out.push_str(", ");
-                } else {
-                    self.expr(a, Prec::Atom, out);
-                    out.push_str(".powf(");
-                }
+                self.method_call(a, "powf", out);
                 self.expr(b, Prec::Add, out);
                 out.push(')');
             }
@@ -277,14 +272,7 @@ impl Writer<'_> {
                 let _ = write!(out, ".{}()", f.name());
             }
             Node::Atan2(y, x) => {
-                if self.is_literal(y) {
-                    out.push_str("f64::atan2(");
-                    self.expr(y, Prec::Add, out);
-                    out.push_str(", ");
-                } else {
-                    self.expr(y, Prec::Atom, out);
-                    out.push_str(".atan2(");
-                }
+                self.method_call(y, "atan2", out);
                 self.expr(x, Prec::Add, out);
                 out.push(')');
             }

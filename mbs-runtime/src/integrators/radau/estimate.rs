@@ -76,12 +76,7 @@ impl Radau {
                 err = self.weighted_norm(tol);
             }
         }
-        // a NaN estimate (an overflowing filter) is a failed test, not a pass
-        if err.is_nan() {
-            f64::INFINITY
-        } else {
-            err.max(1e-10)
-        }
+        floored(err)
     }
 
     /// The right-hand side the index-3 and index-2 filters share, into `tmp`:
@@ -187,12 +182,7 @@ impl Radau {
                 err = self.weighted_norm(tol);
             }
         }
-        // a NaN estimate (an overflowing filter) is a failed test, not a pass
-        if err.is_nan() {
-            f64::INFINITY
-        } else {
-            err.max(1e-10)
-        }
+        floored(err)
     }
 
     /// τ(t₀, qx, vx, qdd₀) − B(qx)ᵀ lx into `ax` and Φ(qx) into `phix`; false when an
@@ -218,5 +208,15 @@ impl Radau {
             self.phix.copy_from_slice(&c.phi);
         }
         self.ax.iter().chain(&self.phix).all(|x| x.is_finite())
+    }
+}
+
+/// An error estimate as the step test reads it: at least 1e-10, and a NaN estimate (an
+/// overflowing filter) a failed test, not a pass.
+pub(super) fn floored(err: f64) -> f64 {
+    if err.is_nan() {
+        f64::INFINITY
+    } else {
+        err.max(1e-10)
     }
 }

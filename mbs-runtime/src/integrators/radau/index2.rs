@@ -4,6 +4,7 @@
 
 use super::super::State;
 use super::super::problem::Problem;
+use super::estimate::floored;
 use super::{Radau, Tol};
 use crate::error::Failure;
 use crate::linalg::Field;
@@ -225,12 +226,7 @@ impl Radau {
                 }
             }
         }
-        // a NaN estimate (an overflowing filter) is a failed test, not a pass
-        if err.is_nan() {
-            f64::INFINITY
-        } else {
-            err.max(1e-10)
-        }
+        floored(err)
     }
 }
 

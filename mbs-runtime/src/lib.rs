@@ -38,8 +38,9 @@ pub use analysis::{
 pub use efforts::{Effort, Efforts, WithEfforts};
 pub use error::{Failure, HeldBy, HeldMost, ModelError, ParamError, check_inertia};
 pub use integrators::{
-    Assembly, Controller, GlobalControl, GlobalReport, GlobalRun, Inputs, Integrator, SimError,
-    Simulation, State, assemble, simulate, simulate_global, simulate_with,
+    Assembly, Controller, EnsembleReport, GlobalControl, GlobalReport, GlobalRun, Inputs,
+    Integrator, Member, SimError, Simulation, State, assemble, simulate, simulate_ensemble,
+    simulate_global, simulate_with,
 };
 pub use lanes::{F64x4, LANES};
 pub use model::{

@@ -18,6 +18,7 @@
 use super::explicit::StabilityWatch;
 use super::problem::Problem;
 use super::step_control::{Decision, ErrorNorm, PiController};
+use super::stepper::{Control, Staged};
 use super::{Attempt, State, Step, Stepper};
 use crate::error::Failure;
 
@@ -140,31 +141,94 @@ impl Stepper for Dopri5 {
 
     fn attempt(&mut self, step: Step<'_>) -> Result<Attempt, Failure> {
         let Step(p, cur, h, ctl, next) = step;
-        let n = self.n;
         if ctl.adaptive.is_none() && ctl.stability_check {
             self.watch.check(p, cur, h, "DOPRI5", limit)?;
         }
-        self.kv[0].copy_from_slice(&cur.qd);
-        self.ka[0].copy_from_slice(&cur.qdd);
+        self.begin(cur);
         for s in 1..7 {
-            for i in 0..n {
-                let (mut dq, mut dv) = (0.0, 0.0);
-                for j in 0..s {
-                    dq += A[s][j] * self.kv[j][i];
-                    dv += A[s][j] * self.ka[j][i];
-                }
-                self.q[i] = cur.q[i] + h * dq;
-                self.v[i] = cur.qd[i] + h * dv;
-            }
-            self.kv[s].copy_from_slice(&self.v);
-            if s == 5 {
-                self.q6.copy_from_slice(&self.q);
-            }
-            let r = p.accel(cur.t + C[s] * h, &self.q, &self.v, &mut self.ka[s]);
+            let (c, _, _) = self.point(cur, h, s);
+            let r = p.accel(cur.t + c * h, &self.q, &self.v, &mut self.ka[s]);
             if let Err(e) = r {
-                return Attempt::after_stage_failure(e, ctl.adaptive.is_some(), h, &mut self.pi);
+                return self.stage_failed(e, ctl, h);
             }
         }
+        self.complete(Step(p, cur, h, ctl, next))
+    }
+
+    fn staged(&mut self) -> Option<&mut dyn Staged> {
+        Some(self)
+    }
+
+    fn interpolate(&self, prev: &State, cur: &State, t: f64, out: &mut State) {
+        let h = cur.t - prev.t;
+        let th = if h == 0.0 { 1.0 } else { (t - prev.t) / h };
+        let th1 = 1.0 - th;
+        out.t = t;
+        for i in 0..self.n {
+            let [c1, c2, c3, c4, c5] = &self.cont_q;
+            out.q[i] = c1[i] + th * (c2[i] + th1 * (c3[i] + th * (c4[i] + th1 * c5[i])));
+            let [d1, d2, d3, d4, d5] = &self.cont_v;
+            out.qd[i] = d1[i] + th * (d2[i] + th1 * (d3[i] + th * (d4[i] + th1 * d5[i])));
+            // qdd: derivative of the velocity polynomial in θ, divided by h
+            let dp = d2[i]
+                + (1.0 - 2.0 * th) * d3[i]
+                + (2.0 * th - 3.0 * th * th) * d4[i]
+                + (2.0 * th - 6.0 * th * th + 4.0 * th * th * th) * d5[i];
+            out.qdd[i] = if h == 0.0 { cur.qdd[i] } else { dp / h };
+        }
+        super::lerp_lambda(prev, cur, t, out);
+    }
+}
+
+impl Staged for Dopri5 {
+    fn stages(&self) -> usize {
+        6
+    }
+
+    fn begin(&mut self, cur: &State) {
+        self.kv[0].copy_from_slice(&cur.qd);
+        self.ka[0].copy_from_slice(&cur.qdd);
+    }
+
+    fn point(&mut self, cur: &State, h: f64, s: usize) -> (f64, &[f64], &[f64]) {
+        // Σⱼ A[s][j] kⱼ summed from 0 in the order of j for each component, as one loop over
+        // the components per stage (the same operations, in vector registers)
+        let (q, v) = (&mut self.q, &mut self.v);
+        q.fill(0.0);
+        v.fill(0.0);
+        for j in 0..s {
+            let a = A[s][j];
+            for (x, k) in q.iter_mut().zip(&self.kv[j]) {
+                *x += a * k;
+            }
+            for (x, k) in v.iter_mut().zip(&self.ka[j]) {
+                *x += a * k;
+            }
+        }
+        for (x, y) in q.iter_mut().zip(&cur.q) {
+            *x = y + h * *x;
+        }
+        for (x, y) in v.iter_mut().zip(&cur.qd) {
+            *x = y + h * *x;
+        }
+        self.kv[s].copy_from_slice(&self.v);
+        if s == 5 {
+            self.q6.copy_from_slice(&self.q);
+        }
+        (C[s], &self.q, &self.v)
+    }
+
+    fn accel_mut(&mut self, s: usize) -> &mut [f64] {
+        &mut self.ka[s]
+    }
+
+    fn stage_failed(&mut self, e: Failure, ctl: &Control, h: f64) -> Result<Attempt, Failure> {
+        Attempt::after_stage_failure(e, ctl.adaptive.is_some(), h, &mut self.pi)
+    }
+
+    fn complete(&mut self, step: Step<'_>) -> Result<Attempt, Failure> {
+        let Step(p, cur, h, ctl, next) = step;
+        let n = self.n;
         // stage 7 is at (q1, qd1): the new state, first same as last
         next.q.copy_from_slice(&self.q);
         next.qd.copy_from_slice(&self.v);
@@ -200,26 +264,6 @@ impl Stepper for Dopri5 {
             }
             Decision::Reject { h_next } => Ok(Attempt::RejectedError { h_next }),
         }
-    }
-
-    fn interpolate(&self, prev: &State, cur: &State, t: f64, out: &mut State) {
-        let h = cur.t - prev.t;
-        let th = if h == 0.0 { 1.0 } else { (t - prev.t) / h };
-        let th1 = 1.0 - th;
-        out.t = t;
-        for i in 0..self.n {
-            let [c1, c2, c3, c4, c5] = &self.cont_q;
-            out.q[i] = c1[i] + th * (c2[i] + th1 * (c3[i] + th * (c4[i] + th1 * c5[i])));
-            let [d1, d2, d3, d4, d5] = &self.cont_v;
-            out.qd[i] = d1[i] + th * (d2[i] + th1 * (d3[i] + th * (d4[i] + th1 * d5[i])));
-            // qdd: derivative of the velocity polynomial in θ, divided by h
-            let dp = d2[i]
-                + (1.0 - 2.0 * th) * d3[i]
-                + (2.0 * th - 3.0 * th * th) * d4[i]
-                + (2.0 * th - 6.0 * th * th + 4.0 * th * th * th) * d5[i];
-            out.qdd[i] = if h == 0.0 { cur.qdd[i] } else { dp / h };
-        }
-        super::lerp_lambda(prev, cur, t, out);
     }
 }
 

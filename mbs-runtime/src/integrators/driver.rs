@@ -51,14 +51,14 @@ pub struct Simulation<M: Model> {
 
 /// A simulation with its model's type erased: all of its work, compiled once whatever the
 /// model (`crate::erased`).
-struct Run {
-    problem: Problem,
-    stepper: Box<dyn Stepper>,
+pub(super) struct Run {
+    pub(super) problem: Problem,
+    pub(super) stepper: Box<dyn Stepper>,
     scheme: Scheme,
     options: Options,
-    ctl: Control,
-    cur: State,
-    next: State,
+    pub(super) ctl: Control,
+    pub(super) cur: State,
+    pub(super) next: State,
     prev: State,
     scratch: State,
     h: f64,
@@ -108,10 +108,7 @@ impl<M: Model + 'static> Simulation<M> {
         options: Options,
         inputs: Inputs,
     ) -> Result<Simulation<M>, SimError> {
-        let names = Names::of(&model);
-        validate(&model, &scheme, &options, &inputs)
-            .map_err(|e| names.failure_at_start(e, options.t0, Stats::default()))?;
-        let run = Run::start(Box::new(model), names, scheme, options, inputs)?;
+        let run = Run::new(model, scheme, options, inputs)?;
         Ok(Simulation {
             run,
             model: PhantomData,
@@ -181,6 +178,19 @@ impl<M: Model + 'static> Simulation<M> {
 }
 
 impl Run {
+    /// Validates everything, then starts (what [`Simulation::with_inputs`] does).
+    pub(super) fn new<M: Model + 'static>(
+        model: M,
+        scheme: Scheme,
+        options: Options,
+        inputs: Inputs,
+    ) -> Result<Run, SimError> {
+        let names = Names::of(&model);
+        validate(&model, &scheme, &options, &inputs)
+            .map_err(|e| names.failure_at_start(e, options.t0, Stats::default()))?;
+        Run::start(Box::new(model), names, scheme, options, inputs)
+    }
+
     /// From validated options: a consistent start, the scheme started on it, the outputs
     /// at t₀.
     fn start(
@@ -324,7 +334,7 @@ impl Run {
 
     /// The model, the trajectory and the work counters (the final state recorded for
     /// `Output::Last`).
-    fn finish(mut self) -> (Box<dyn OwnedModel>, Trajectory, Stats) {
+    pub(super) fn finish(mut self) -> (Box<dyn OwnedModel>, Trajectory, Stats) {
         if self.options.output == Output::Last && self.traj.is_empty() {
             self.record_cur();
         }
@@ -511,170 +521,211 @@ impl Run {
     }
 
     fn step_until(&mut self, t_stop: f64) -> Result<(), SimError> {
+        // controllers are sampled exactly at their instants
+        let t_stop = t_stop.min(self.next_sample());
+        loop {
+            let plan = self.plan(t_stop)?;
+            let step = Step(
+                &mut self.problem,
+                &self.cur,
+                plan.h,
+                &self.ctl,
+                &mut self.next,
+            );
+            let result = self.stepper.attempt(step);
+            if self.conclude(plan, result)? {
+                return Ok(());
+            }
+        }
+    }
+
+    /// The next attempt towards `t_stop`: its size, landing on t_stop exactly, counted; the
+    /// run's failure when it has no steps left or the step fell below h_min.
+    pub(super) fn plan(&mut self, t_stop: f64) -> Result<Planned, SimError> {
         // the floor of adaptive steps, at the time this step starts (a fixed step is never
         // judged by it: its size is the user's, checked against the resolution of t up front)
         let h_min = self.options.h_min_at(self.cur.t);
         let fixed = matches!(self.options.step, StepControl::Fixed { .. });
-        // controllers are sampled exactly at their instants
-        let t_stop = t_stop.min(self.next_sample());
-        loop {
-            if self.attempts >= self.options.max_steps {
-                let max_steps = self.options.max_steps;
-                // a scheme that found the problem stiff says so (DOPRI5's detection)
-                let kind = match self.problem.stats.stiff_from {
-                    Some(t) => Failure::LikelyStiff {
-                        scheme: self.scheme.name(),
-                        t,
-                        max_steps,
-                        held_most: self.held_most(),
-                    },
-                    None => Failure::TooMuchWork {
-                        max_steps,
-                        held_most: self.held_most(),
-                    },
-                };
-                return Err(self.fail(kind, self.h));
-            }
-            let remaining = t_stop - self.cur.t;
-            let mut h = self.h.min(self.options.h_max());
-            let t_next = if fixed {
-                // fixed steps stay on the grid t0 + k h, whatever the rounding of sums
-                let k = ((self.cur.t - self.options.t0) / h + 1e-9).floor();
-                self.options.t0 + (k + 1.0) * h
-            } else {
-                self.cur.t + h
+        if self.attempts >= self.options.max_steps {
+            let max_steps = self.options.max_steps;
+            // a scheme that found the problem stiff says so (DOPRI5's detection)
+            let kind = match self.problem.stats.stiff_from {
+                Some(t) => Failure::LikelyStiff {
+                    scheme: self.scheme.name(),
+                    t,
+                    max_steps,
+                    held_most: self.held_most(),
+                },
+                None => Failure::TooMuchWork {
+                    max_steps,
+                    held_most: self.held_most(),
+                },
             };
-            // land on t_stop exactly, without leaving a sliver of a step behind
-            let last = t_next >= t_stop - 1e-9 * h
-                || (!fixed && h > 0.5 * remaining && remaining - h < 0.1 * h);
-            if last {
-                h = remaining;
-            } else if fixed {
-                h = t_next - self.cur.t;
+            return Err(self.fail(kind, self.h));
+        }
+        let remaining = t_stop - self.cur.t;
+        let mut h = self.h.min(self.options.h_max());
+        let t_next = if fixed {
+            // fixed steps stay on the grid t0 + k h, whatever the rounding of sums
+            let k = ((self.cur.t - self.options.t0) / h + 1e-9).floor();
+            self.options.t0 + (k + 1.0) * h
+        } else {
+            self.cur.t + h
+        };
+        // land on t_stop exactly, without leaving a sliver of a step behind
+        let last = t_next >= t_stop - 1e-9 * h
+            || (!fixed && h > 0.5 * remaining && remaining - h < 0.1 * h);
+        if last {
+            h = remaining;
+        } else if fixed {
+            h = t_next - self.cur.t;
+        }
+        if h < h_min && !last && !fixed {
+            // the cause of the rejections that shrank the step, when there is one
+            let held_by = self
+                .held_by
+                .map(|b| b.held_by(|i| self.problem.label(i), self.start_scale));
+            let kind = self
+                .last_cause
+                .take()
+                .unwrap_or(Failure::StepTooSmall { h_min, held_by });
+            return Err(self.fail(kind, h));
+        }
+        self.attempts += 1;
+        Ok(Planned {
+            h,
+            last,
+            t_next,
+            t_stop,
+            h_min,
+            fixed,
+        })
+    }
+
+    /// What the attempt `plan` gave: true when accepted (the run moved on, outputs recorded),
+    /// false when rejected (the next attempt's size set), the run's failure otherwise.
+    pub(super) fn conclude(
+        &mut self,
+        plan: Planned,
+        result: Result<Attempt, Failure>,
+    ) -> Result<bool, SimError> {
+        let Planned {
+            h,
+            last,
+            t_next,
+            t_stop,
+            h_min,
+            fixed,
+        } = plan;
+        match result {
+            // a trial state the user's efforts rejected: retried smaller while it can be
+            Err(kind @ Failure::EffortRejected { .. }) if !fixed && h > h_min => {
+                self.problem.stats.rejected_effort += 1;
+                self.last_cause = Some(kind);
+                self.held_by = None;
+                self.h = (0.25 * h).max(h_min);
             }
-            if h < h_min && !last && !fixed {
-                // the cause of the rejections that shrank the step, when there is one
-                let held_by = self
-                    .held_by
-                    .map(|b| b.held_by(|i| self.problem.label(i), self.start_scale));
-                let kind = self
-                    .last_cause
-                    .take()
-                    .unwrap_or(Failure::StepTooSmall { h_min, held_by });
-                return Err(self.fail(kind, h));
-            }
-            self.attempts += 1;
-            let step = Step(&mut self.problem, &self.cur, h, &self.ctl, &mut self.next);
-            let result = self.stepper.attempt(step);
-            match result {
-                // a trial state the user's efforts rejected: retried smaller while it can be
-                Err(kind @ Failure::EffortRejected { .. }) if !fixed && h > h_min => {
-                    self.problem.stats.rejected_effort += 1;
-                    self.last_cause = Some(kind);
-                    self.held_by = None;
-                    self.h = (0.25 * h).max(h_min);
+            Err(kind) => return Err(self.fail(kind, h)),
+            Ok(Attempt::Accepted { h_next }) => {
+                let test = self.stepper.last_test();
+                if test.floored {
+                    self.problem.stats.floored_steps += 1;
                 }
-                Err(kind) => return Err(self.fail(kind, h)),
-                Ok(Attempt::Accepted { h_next }) => {
-                    let test = self.stepper.last_test();
-                    if test.floored {
-                        self.problem.stats.floored_steps += 1;
+                if let Some(b) = test.held_by {
+                    let n = self.problem.n;
+                    // a coordinate's position and velocity together, then the multipliers
+                    let i = if b.block < 2 { b.index } else { n + b.index };
+                    if let Some(c) = self.held_counts.get_mut(i) {
+                        *c += 1;
                     }
-                    if let Some(b) = test.held_by {
-                        let n = self.problem.n;
-                        // a coordinate's position and velocity together, then the multipliers
-                        let i = if b.block < 2 { b.index } else { n + b.index };
-                        if let Some(c) = self.held_counts.get_mut(i) {
-                            *c += 1;
-                        }
+                }
+                self.next.t = if last {
+                    t_stop
+                } else if fixed {
+                    t_next
+                } else {
+                    self.cur.t + h
+                };
+                if let Err(kind) = self
+                    .problem
+                    .after_step(&mut self.next)
+                    .and_then(|_| self.check_next())
+                {
+                    return Err(self.fail(kind, h));
+                }
+                self.problem.stats.record_step(h);
+                self.problem.stats.user_efforts = self.problem.model.user_evaluations();
+                self.last_cause = None;
+                self.held_by = None;
+                self.prev.copy_from(&self.cur);
+                std::mem::swap(&mut self.cur, &mut self.next);
+                self.stepper
+                    .accepted(&mut self.problem, &self.prev, &self.cur);
+                self.outputs_after_step();
+                if let Err(kind) = self.recentre() {
+                    return Err(self.fail(kind, h));
+                }
+                if self.cur.t == t_stop && !self.controllers.is_empty() {
+                    if let Err(kind) = self.sample() {
+                        return Err(self.fail(kind, h));
                     }
-                    self.next.t = if last {
-                        t_stop
-                    } else if fixed {
-                        t_next
+                }
+                if !fixed {
+                    // a shortened last step says nothing about the next one
+                    self.h = if last {
+                        self.h.max(h_next.min(self.h * 5.0))
                     } else {
-                        self.cur.t + h
+                        h_next
                     };
-                    if let Err(kind) = self
-                        .problem
-                        .after_step(&mut self.next)
-                        .and_then(|_| self.check_next())
-                    {
-                        return Err(self.fail(kind, h));
-                    }
-                    self.problem.stats.record_step(h);
-                    self.problem.stats.user_efforts = self.problem.model.user_evaluations();
-                    self.last_cause = None;
-                    self.held_by = None;
-                    self.prev.copy_from(&self.cur);
-                    std::mem::swap(&mut self.cur, &mut self.next);
-                    self.stepper
-                        .accepted(&mut self.problem, &self.prev, &self.cur);
-                    self.outputs_after_step();
-                    if let Err(kind) = self.recentre() {
-                        return Err(self.fail(kind, h));
-                    }
-                    if self.cur.t == t_stop && !self.controllers.is_empty() {
-                        if let Err(kind) = self.sample() {
-                            return Err(self.fail(kind, h));
-                        }
-                    }
-                    if !fixed {
-                        // a shortened last step says nothing about the next one
-                        self.h = if last {
-                            self.h.max(h_next.min(self.h * 5.0))
-                        } else {
-                            h_next
-                        };
-                    }
-                    return Ok(());
                 }
-                Ok(Attempt::RejectedError { h_next }) => {
-                    // only adaptive schemes test errors
-                    self.problem.stats.rejected_error += 1;
-                    self.held_by = self.stepper.last_test().held_by;
-                    self.h = h_next;
+                return Ok(true);
+            }
+            Ok(Attempt::RejectedError { h_next }) => {
+                // only adaptive schemes test errors
+                self.problem.stats.rejected_error += 1;
+                self.held_by = self.stepper.last_test().held_by;
+                self.h = h_next;
+            }
+            Ok(Attempt::RejectedNewton {
+                h_next,
+                iterations,
+                correction,
+                cause,
+            }) => {
+                self.problem.stats.rejected_newton += 1;
+                if matches!(cause, Some(Failure::EffortRejected { .. })) {
+                    self.problem.stats.rejected_effort += 1;
                 }
-                Ok(Attempt::RejectedNewton {
-                    h_next,
-                    iterations,
-                    correction,
+                // a user effort's own error does not go away with a smaller step (a
+                // singular configuration met by a trial iterate may, and so may a state
+                // the efforts rejected: the step shrinks, and the failure is reported if
+                // it collapses)
+                let fatal = matches!(
                     cause,
-                }) => {
-                    self.problem.stats.rejected_newton += 1;
-                    if matches!(cause, Some(Failure::EffortRejected { .. })) {
-                        self.problem.stats.rejected_effort += 1;
-                    }
-                    // a user effort's own error does not go away with a smaller step (a
-                    // singular configuration met by a trial iterate may, and so may a state
-                    // the efforts rejected: the step shrinks, and the failure is reported if
-                    // it collapses)
-                    let fatal = matches!(
-                        cause,
-                        Some(Failure::UserEffort { .. })
-                            | Some(Failure::NonFinite {
-                                quantity: "user effort",
-                                ..
-                            })
-                    );
-                    if fixed || h <= h_min || fatal {
-                        let largest = self
-                            .stepper
-                            .newton_largest()
-                            .map(|(block, i)| component_name(block, i, |j| self.problem.label(j)));
-                        let kind = cause.unwrap_or(Failure::NewtonDiverged {
-                            iterations,
-                            correction,
-                            largest,
-                        });
-                        return Err(self.fail(kind, h));
-                    }
-                    self.last_cause = cause;
-                    self.held_by = None;
-                    self.h = h_next.max(h_min);
+                    Some(Failure::UserEffort { .. })
+                        | Some(Failure::NonFinite {
+                            quantity: "user effort",
+                            ..
+                        })
+                );
+                if fixed || h <= h_min || fatal {
+                    let largest = self
+                        .stepper
+                        .newton_largest()
+                        .map(|(block, i)| component_name(block, i, |j| self.problem.label(j)));
+                    let kind = cause.unwrap_or(Failure::NewtonDiverged {
+                        iterations,
+                        correction,
+                        largest,
+                    });
+                    return Err(self.fail(kind, h));
                 }
+                self.last_cause = cause;
+                self.held_by = None;
+                self.h = h_next.max(h_min);
             }
         }
+        Ok(false)
     }
 
     fn check_next(&self) -> Result<(), Failure> {
@@ -928,6 +979,20 @@ fn control(options: &Options) -> Control {
         newton,
         stability_check: options.stability_check,
     }
+}
+
+/// One attempt as [`Run::plan`] made it.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Planned {
+    /// its size
+    pub h: f64,
+    /// whether it lands on `t_stop`
+    last: bool,
+    /// where a fixed step lands on its grid
+    t_next: f64,
+    t_stop: f64,
+    h_min: f64,
+    fixed: bool,
 }
 
 /// The most memory the outputs asked for may take, 8 GB: beyond it the request is refused

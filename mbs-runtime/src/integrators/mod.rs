@@ -30,6 +30,7 @@ mod dense;
 mod dispatch;
 mod dopri5;
 mod driver;
+mod ensemble;
 mod explicit;
 mod global;
 mod inputs;
@@ -44,6 +45,7 @@ mod stepper;
 
 pub use constrained::{Assembly, assemble};
 pub use driver::{Simulation, simulate, simulate_with};
+pub use ensemble::{EnsembleReport, Member, simulate_ensemble};
 pub use global::{GlobalControl, GlobalReport, GlobalRun, simulate_global};
 pub use inputs::{Controller, Inputs};
 pub use newmark::index3_iteration_matrix;

@@ -121,4 +121,30 @@ pub(crate) trait Stepper {
     fn interpolate(&self, prev: &State, cur: &State, t: f64, out: &mut State) {
         super::dense::hermite5(prev, cur, t, out);
     }
+    /// The scheme as explicit stages, when it is one ([`Staged`]): an ensemble evaluates the
+    /// stages of several runs together.
+    fn staged(&mut self) -> Option<&mut dyn Staged> {
+        None
+    }
+}
+
+/// An explicit scheme's step taken apart at its evaluations, so that the stages of several
+/// runs may be evaluated together ([`super::ensemble`]): [`Staged::begin`], then for each
+/// stage s = 1..=[`Staged::stages`] its point, whose accelerations go into
+/// [`Staged::accel_mut`], then [`Staged::complete`] — what [`Stepper::attempt`] does with one
+/// evaluation at a time.
+pub(crate) trait Staged {
+    /// The evaluations of a step after the first (the state's own accelerations).
+    fn stages(&self) -> usize;
+    /// Starts an attempt from `cur`.
+    fn begin(&mut self, cur: &State);
+    /// Stage `s`'s time as a fraction of h, and its positions and velocities, of a step of
+    /// size h from `cur` (the stages before it evaluated).
+    fn point(&mut self, cur: &State, h: f64, s: usize) -> (f64, &[f64], &[f64]);
+    /// Where stage `s`'s accelerations go.
+    fn accel_mut(&mut self, s: usize) -> &mut [f64];
+    /// The attempt, after the evaluation of a stage failed with `e`.
+    fn stage_failed(&mut self, e: Failure, ctl: &Control, h: f64) -> Result<Attempt, Failure>;
+    /// The attempt, every stage evaluated: error test, step size, dense output.
+    fn complete(&mut self, step: Step<'_>) -> Result<Attempt, Failure>;
 }

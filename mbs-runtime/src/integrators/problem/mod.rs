@@ -269,23 +269,42 @@ impl Problem {
         if self.forward {
             self.model
                 .forward_dynamics(t, q, qd, &self.u, qdd, &mut self.pivots);
-            self.stats.forward_dynamics += 1;
-            if let Some(f) = self.model.take_failure() {
-                return Err(f);
-            }
-            // the dense Cholesky's test, against the largest pivot
-            let scale = self.pivots.iter().fold(0.0f64, |m, p| m.max(*p));
-            let positive =
-                self.pivots.iter().all(|p| *p > PIVOT_FLOOR * scale) && scale.is_finite();
-            if positive && qdd.iter().all(|a| a.is_finite()) {
-                if self.watching() {
-                    let (ratio, j) =
-                        worst_pivot_of(self.pivots.iter().copied(), &self.start_forward);
-                    self.judge(ratio, j, t, q)?;
-                }
+            if self.forward_holds(t, q, qdd)? {
                 return Ok(());
             }
         }
+        self.dense_accel(t, q, qd, qdd)
+    }
+
+    /// Counts the forward dynamics just evaluated into `qdd` and `self.pivots` and judges
+    /// them: true when they stand (finite, every pivot above `PIVOT_FLOOR` of the largest,
+    /// the configuration watched against the start), false when the dense path must decide.
+    fn forward_holds(&mut self, t: f64, q: &[f64], qdd: &[f64]) -> Result<bool, Failure> {
+        self.stats.forward_dynamics += 1;
+        if let Some(f) = self.model.take_failure() {
+            return Err(f);
+        }
+        // the dense Cholesky's test, against the largest pivot
+        let scale = self.pivots.iter().fold(0.0f64, |m, p| m.max(*p));
+        let positive = self.pivots.iter().all(|p| *p > PIVOT_FLOOR * scale) && scale.is_finite();
+        if positive && qdd.iter().all(|a| a.is_finite()) {
+            if self.watching() {
+                let (ratio, j) = worst_pivot_of(self.pivots.iter().copied(), &self.start_forward);
+                self.judge(ratio, j, t, q)?;
+            }
+            return Ok(true);
+        }
+        Ok(false)
+    }
+
+    /// M, h and a dense Cholesky factorisation: qdd of an open-loop model, its failures named.
+    fn dense_accel(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &mut [f64],
+    ) -> Result<(), Failure> {
         self.model
             .dynamics(t, q, qd, &self.u, &mut self.m, &mut self.h);
         self.stats.dynamics += 1;
@@ -294,6 +313,36 @@ impl Problem {
         cholesky_solve(&self.chol, self.n, qdd);
         self.stats.solves += 1;
         self.check("qdd", qdd)
+    }
+
+    /// The inputs u at time t (a function's value and the held outputs), for an evaluation
+    /// made outside ([`Problem::accept_forward`]).
+    pub fn inputs(&mut self, t: f64) -> Result<&[f64], Failure> {
+        self.inputs_at(t)?;
+        Ok(&self.u)
+    }
+
+    /// What [`Problem::accel`] makes of forward dynamics evaluated outside, at (t, q, qd) with
+    /// [`Problem::inputs`] (`qdd` and `pivots` as the model's forward dynamics gave them: an
+    /// ensemble's lanes): counted, checked and watched the same way; where they do not
+    /// stand, or the model has no generated forward dynamics, `qdd` is computed here by the
+    /// dense path, which names the failure. An open-loop model only.
+    pub fn accept_forward(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &mut [f64],
+        pivots: &[f64],
+    ) -> Result<(), Failure> {
+        self.inputs_at(t)?;
+        if self.forward {
+            self.pivots.copy_from_slice(pivots);
+            if self.forward_holds(t, q, qdd)? {
+                return Ok(());
+            }
+        }
+        self.dense_accel(t, q, qd, qdd)
     }
 
     /// The residual τ(t, q, qd, qdd) = M qdd − h.

@@ -1,0 +1,130 @@
+//! Many runs at once: an ensemble of 16 members (starts spread about the test state) of the
+//! 16-bar chain and of the 12-joint arm, DOPRI5 at rtol 1e-6 over 0.5 s, run by
+//! `simulate_ensemble` (four members at a time on the lanes of `option batch;`) against the
+//! same 16 members run one after another by `simulate`, in the same run (criterion).
+//!
+//! ```text
+//! cargo bench -p mbs-benches --bench ensemble
+//! ```
+//!
+//! Prints criterion's figures, then a table of medians: ms for the 16 runs each way, the
+//! ensemble's throughput relative to the runs one by one, its steps and how busy its lanes
+//! were.
+
+mod common;
+#[path = "scaling/models.rs"]
+mod models;
+
+use common::{median_ns, test_state};
+use criterion::Criterion;
+use mbs::{Inputs, Member, Model, Options, Output, Scheme, simulate_ensemble, simulate_with};
+use std::hint::black_box;
+
+use models::{Arm3d12, Chain16};
+
+/// Members of each ensemble.
+const MEMBERS: usize = 16;
+
+/// The members' starts: the test state, its angles moved by up to 0.2 rad and its rates by
+/// up to 0.5 rad/s.
+fn starts(n: usize) -> Vec<(Vec<f64>, Vec<f64>)> {
+    (0..MEMBERS)
+        .map(|k| {
+            let (mut q, mut qd) = test_state(n);
+            for (i, (a, b)) in q.iter_mut().zip(qd.iter_mut()).enumerate() {
+                *a += 0.2 * ((i * 3 + 7 * k) as f64).sin();
+                *b += 0.5 * ((i * 5 + 11 * k) as f64).cos();
+            }
+            (q, qd)
+        })
+        .collect()
+}
+
+fn options() -> Options {
+    Options {
+        output: Output::Last,
+        ..Options::adaptive(0.5, 1e-6)
+    }
+}
+
+fn members(n: usize) -> Vec<Member> {
+    starts(n)
+        .into_iter()
+        .map(|(q, qd)| Member::at(q, qd))
+        .collect()
+}
+
+/// The runs one by one: total steps.
+fn one_by_one<M: Model + Clone + 'static>(model: &M) -> usize {
+    starts(M::NQ)
+        .into_iter()
+        .map(|(q, qd)| {
+            let o = Options {
+                q0: Some(q),
+                qd0: Some(qd),
+                ..options()
+            };
+            let (_, stats) = simulate_with(model.clone(), Scheme::Dopri5, o, Inputs::default())
+                .expect("the run ends");
+            stats.steps
+        })
+        .sum()
+}
+
+/// The ensemble: total steps and the occupancy of its lanes.
+fn ensemble<M: Model + Clone + 'static>(model: &M) -> (usize, f64) {
+    let r = simulate_ensemble(model, Scheme::Dopri5, &options(), members(M::NQ))
+        .expect("an ensemble it runs");
+    let steps = r
+        .runs
+        .iter()
+        .map(|x| x.as_ref().expect("the run ends").1.steps)
+        .sum();
+    (steps, r.occupancy())
+}
+
+fn bench_model<M: Model + Clone + 'static>(
+    c: &mut Criterion,
+    name: &'static str,
+    model: M,
+) -> (&'static str, usize, usize, f64) {
+    assert!(M::BATCH_GENERATED, "{name} has `option batch;`");
+    let steps_alone = one_by_one(&model);
+    let (steps, occupancy) = ensemble(&model);
+    let mut g = c.benchmark_group(format!("ensemble_{name}"));
+    g.sample_size(10);
+    g.bench_function("one_by_one", |b| b.iter(|| one_by_one(black_box(&model))));
+    g.bench_function("ensemble", |b| b.iter(|| ensemble(black_box(&model))));
+    g.finish();
+    (name, steps_alone, steps, occupancy)
+}
+
+fn main() {
+    let since = std::time::SystemTime::now();
+    let mut c = Criterion::default().configure_from_args();
+    let rows = [
+        bench_model(&mut c, "chain16", Chain16::default()),
+        bench_model(&mut c, "arm3d_12", Arm3d12::default()),
+    ];
+    c.final_summary();
+    println!("\nprocessor: {}", common::processor());
+    println!(
+        "{MEMBERS} runs, DOPRI5 rtol 1e-6, 0.5 s   steps alone / ensemble   lanes busy   ms one by one   ms ensemble   throughput"
+    );
+    for (name, alone, steps, occupancy) in rows {
+        let group = format!("ensemble_{name}");
+        let (Some(o), Some(e)) = (
+            median_ns(&group, "one_by_one", since),
+            median_ns(&group, "ensemble", since),
+        ) else {
+            println!("{name:<9} steps {alone} / {steps}, lanes busy {occupancy:.2}");
+            continue;
+        };
+        println!(
+            "{name:<36} {alone:>7} / {steps:<7}   {occupancy:>10.2}   {:>13.2}   {:>11.2}   {:>9.2}×",
+            o * 1e-6,
+            e * 1e-6,
+            o / e
+        );
+    }
+}

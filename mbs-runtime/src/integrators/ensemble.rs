@@ -1,0 +1,368 @@
+//! Many runs of one model at once: an ensemble of members (starts and inputs) integrated by
+//! one explicit adaptive scheme, four members at a time on the lanes of the model's batch
+//! functions ([`crate::lanes`], `option batch;`).
+//!
+//! Each lane is a whole run of its own, the driver's (`driver::Run`): its own step size, error
+//! test, rejections, outputs, failure and work counters, exactly those of
+//! [`super::simulate_with`] on that member. Only the evaluations are shared: the scheme's
+//! step is taken apart at its stages ([`super::stepper::Staged`]), every lane computes its
+//! stage point, one call of [`Model::forward_dynamics_x4`] evaluates the four, and each lane
+//! checks its own result as its run would ([`super::problem::Problem::accept_forward`]: a
+//! value that does not stand is computed again by the lane's dense path, which names the
+//! failure). A lane whose run ends, by reaching t_end or by failing, takes the next member
+//! at once, so the lanes stay busy while members need different numbers of steps.
+//!
+//! What an ensemble runs: DOPRI5 with adaptive steps, on models without constraints or
+//! rotation joints (whose charts are the model's own state, one per run). A model without
+//! `option batch;`, or a processor without AVX2, evaluates the lanes one by one: the same
+//! results, without the gain.
+
+use super::driver::{Planned, Run};
+use super::inputs::Inputs;
+use super::sim_error::SimError;
+use super::stepper::{Staged, Step, Stepper};
+use crate::error::Failure;
+use crate::lanes::{F64x4, LANES, pack, simd_available, unpack};
+use crate::model::Model;
+use crate::options::{Options, Scheme, StepControl};
+use crate::stats::Stats;
+use crate::trajectory::Trajectory;
+
+/// One run of an ensemble: its start (the model's declared one where `None`) and its inputs
+/// (a function of time; sampled controllers are refused: their instants would stop the lanes
+/// at different times).
+#[derive(Default)]
+pub struct Member {
+    pub q0: Option<Vec<f64>>,
+    pub qd0: Option<Vec<f64>>,
+    pub inputs: Inputs,
+}
+
+impl Member {
+    /// A member starting at (q0, qd0), without inputs.
+    pub fn at(q0: Vec<f64>, qd0: Vec<f64>) -> Member {
+        Member {
+            q0: Some(q0),
+            qd0: Some(qd0),
+            inputs: Inputs::default(),
+        }
+    }
+
+    /// The same member with inputs u(t).
+    pub fn with_inputs(mut self, inputs: Inputs) -> Member {
+        self.inputs = inputs;
+        self
+    }
+}
+
+/// What an ensemble gave: each member's run, in the order of the members (the trajectory and
+/// work counters, or the failure with the trajectory up to it), and the shared work.
+#[derive(Debug)]
+pub struct EnsembleReport {
+    pub runs: Vec<Result<(Trajectory, Stats), SimError>>,
+    /// calls of the batch forward dynamics (four lanes each)
+    pub batch_evaluations: usize,
+    /// the lanes those calls evaluated for a run (the others were idle: fewer than four runs
+    /// left)
+    pub lane_evaluations: usize,
+}
+
+impl EnsembleReport {
+    /// The share of the batch calls' lanes that evaluated a run (1 when all four always did).
+    pub fn occupancy(&self) -> f64 {
+        if self.batch_evaluations == 0 {
+            return 0.0;
+        }
+        self.lane_evaluations as f64 / (LANES * self.batch_evaluations) as f64
+    }
+}
+
+/// Runs every member of an ensemble of `model` with `scheme` and `options` (its `q0` and
+/// `qd0` are each member's, where given), four at a time. Each member's run is the one
+/// [`super::simulate_with`] makes of it, but for the rounding of the batch functions (they
+/// agree with the one-state functions to about 1e-15 relative); a member that fails keeps its
+/// trajectory up to the failure and does not stop the others.
+///
+/// Refused with an `InvalidOption` at t₀ (before any run): a scheme other than DOPRI5, fixed
+/// steps, a model with constraints or rotation joints. A member whose start is refused (its
+/// q0's length, a non-finite value, controllers) has that failure as its run.
+pub fn simulate_ensemble<M: Model + Clone + 'static>(
+    model: &M,
+    scheme: Scheme,
+    options: &Options,
+    members: Vec<Member>,
+) -> Result<EnsembleReport, SimError> {
+    supported(model, &scheme, options).map_err(|e| super::driver::refused(model, e, options.t0))?;
+    let t_end = options.t_end;
+    let start = |m: Member| -> Result<Run, SimError> {
+        if !m.inputs.controllers.is_empty() {
+            let e = Failure::InvalidOption {
+                name: "inputs",
+                value: format!("{} controllers", m.inputs.controllers.len()),
+                reason: "an ensemble's members take inputs as functions of time: run a member with sampled controllers by `simulate_with`",
+            };
+            return Err(super::driver::refused(model, e, options.t0));
+        }
+        let options = Options {
+            q0: m.q0.or_else(|| options.q0.clone()),
+            qd0: m.qd0.or_else(|| options.qd0.clone()),
+            ..options.clone()
+        };
+        Run::new(model.clone(), scheme, options, m.inputs)
+    };
+    let mut lanes = Lanes::new(M::NQ, M::NU);
+    let batched = M::BATCH_GENERATED && M::FORWARD_DYNAMICS_GENERATED && simd_available();
+    let mut runs: Vec<Option<Result<(Trajectory, Stats), SimError>>> =
+        (0..members.len()).map(|_| None).collect();
+    let mut queue = members.into_iter().enumerate();
+    let mut active: [Option<(usize, Run)>; LANES] = Default::default();
+    let mut report = EnsembleReport {
+        runs: Vec::new(),
+        batch_evaluations: 0,
+        lane_evaluations: 0,
+    };
+    loop {
+        // every lane's next attempt, a lane whose run ended taking the next member
+        let mut plans: [Option<Planned>; LANES] = [None; LANES];
+        for (slot, plan) in active.iter_mut().zip(plans.iter_mut()) {
+            *plan = loop {
+                if slot.is_none() {
+                    let Some((i, m)) = queue.next() else {
+                        break None;
+                    };
+                    match start(m) {
+                        Ok(run) => *slot = Some((i, run)),
+                        Err(e) => {
+                            runs[i] = Some(Err(e));
+                            continue;
+                        }
+                    }
+                }
+                let (i, run) = slot.as_mut().expect("filled above");
+                if run.cur.t >= t_end {
+                    let (i, run) = slot.take().expect("filled above");
+                    let (_, traj, stats) = run.finish();
+                    runs[i] = Some(Ok((traj, stats)));
+                    continue;
+                }
+                match run.plan(t_end) {
+                    Ok(p) => break Some(p),
+                    Err(e) => {
+                        runs[*i] = Some(Err(e));
+                        *slot = None;
+                    }
+                }
+            };
+        }
+        if plans.iter().all(Option::is_none) {
+            break;
+        }
+        let mut failed: [Option<Failure>; LANES] = Default::default();
+        for (slot, plan) in active.iter_mut().zip(&plans) {
+            if let (Some((_, run)), Some(_)) = (slot, plan) {
+                staged(&mut run.stepper).begin(&run.cur);
+            }
+        }
+        let stages = active
+            .iter_mut()
+            .flatten()
+            .next()
+            .map_or(0, |(_, run)| staged(&mut run.stepper).stages());
+        for s in 1..=stages {
+            let live: [bool; LANES] =
+                std::array::from_fn(|k| plans[k].is_some() && failed[k].is_none());
+            if !live.iter().any(|&l| l) {
+                break;
+            }
+            for k in 0..LANES {
+                if let (true, Some((_, run)), Some(p)) = (live[k], &mut active[k], plans[k]) {
+                    if let Err(e) = lanes.point(k, run, p.h, s) {
+                        failed[k] = Some(e);
+                    }
+                }
+            }
+            let live: [bool; LANES] =
+                std::array::from_fn(|k| plans[k].is_some() && failed[k].is_none());
+            if batched && live.iter().any(|&l| l) {
+                lanes.evaluate(model, &live);
+                report.batch_evaluations += 1;
+                report.lane_evaluations += live.iter().filter(|&&l| l).count();
+            }
+            // a failure of user code in the shared call: each lane evaluates alone, so that
+            // the lanes it belongs to report it
+            let alone = !batched || model.take_failure().is_some();
+            for k in 0..LANES {
+                if let (true, Some((_, run))) = (live[k], &mut active[k]) {
+                    if let Err(e) = lanes.accept(k, run, s, alone) {
+                        failed[k] = Some(e);
+                    }
+                }
+            }
+        }
+        for k in 0..LANES {
+            let (Some((i, run)), Some(plan)) = (&mut active[k], plans[k]) else {
+                continue;
+            };
+            let Run {
+                problem,
+                stepper,
+                ctl,
+                cur,
+                next,
+                ..
+            } = run;
+            let st = staged(stepper);
+            let result = match failed[k].take() {
+                Some(e) => st.stage_failed(e, ctl, plan.h),
+                None => st.complete(Step(problem, cur, plan.h, ctl, next)),
+            };
+            if let Err(e) = run.conclude(plan, result) {
+                runs[*i] = Some(Err(e));
+                active[k] = None;
+            }
+        }
+    }
+    report.runs = runs
+        .into_iter()
+        .map(|r| r.expect("every member ran"))
+        .collect();
+    Ok(report)
+}
+
+/// A run's scheme as explicit stages (checked by [`supported`]).
+fn staged(stepper: &mut Box<dyn Stepper>) -> &mut dyn Staged {
+    stepper.staged().expect("checked by `supported`")
+}
+
+/// What an ensemble runs: an explicit staged scheme with adaptive steps, on a model without
+/// constraints or rotation joints.
+fn supported<M: Model>(model: &M, scheme: &Scheme, options: &Options) -> Result<(), Failure> {
+    let refuse = |name, value: String, reason| {
+        Err(Failure::InvalidOption {
+            name,
+            value,
+            reason,
+        })
+    };
+    if super::dispatch::stepper_for(scheme, M::NQ)
+        .staged()
+        .is_none()
+    {
+        return refuse(
+            "scheme",
+            scheme.name().to_string(),
+            "an ensemble runs DOPRI5, whose stages it evaluates together: run other schemes one member at a time with `simulate`",
+        );
+    }
+    if let StepControl::Fixed { h } = options.step {
+        return refuse(
+            "step",
+            format!("fixed h = {h}"),
+            "an ensemble takes adaptive steps (`StepControl::Adaptive`), each member its own",
+        );
+    }
+    if M::NC > 0 {
+        return refuse(
+            "model",
+            format!("{} constraints", M::NC),
+            "an ensemble runs open loops: run a closed loop's members with `simulate`",
+        );
+    }
+    let joints = model.info().rotation_joints.len();
+    if joints > 0 {
+        return refuse(
+            "model",
+            format!("{joints} rotation joints"),
+            "a rotation joint's chart is the model's own state, one per run: run the members with `simulate`",
+        );
+    }
+    Ok(())
+}
+
+/// The four lanes' arguments and results of the batch forward dynamics, and one lane's
+/// point and accelerations unpacked.
+struct Lanes {
+    t: F64x4,
+    q: Vec<F64x4>,
+    qd: Vec<F64x4>,
+    u: Vec<F64x4>,
+    qdd: Vec<F64x4>,
+    pivots: Vec<F64x4>,
+    /// each lane's stage time, point and inputs as one-state slices
+    times: [f64; LANES],
+    points: [(Vec<f64>, Vec<f64>); LANES],
+    inputs: [Vec<f64>; LANES],
+    pivot: Vec<f64>,
+}
+
+impl Lanes {
+    fn new(n: usize, nu: usize) -> Lanes {
+        let z = |len| vec![F64x4::ZERO; len];
+        Lanes {
+            t: F64x4::ZERO,
+            q: z(n),
+            qd: z(n),
+            u: z(nu),
+            qdd: z(n),
+            pivots: z(n),
+            times: [0.0; LANES],
+            points: std::array::from_fn(|_| (vec![0.0; n], vec![0.0; n])),
+            inputs: std::array::from_fn(|_| vec![0.0; nu]),
+            pivot: vec![0.0; n],
+        }
+    }
+
+    /// Lane `k`'s stage `s` of a step of size h: its time, point and inputs.
+    fn point(&mut self, k: usize, run: &mut Run, h: f64, s: usize) -> Result<(), Failure> {
+        let t0 = run.cur.t;
+        let (c, q, qd) = staged(&mut run.stepper).point(&run.cur, h, s);
+        let (pq, pv) = &mut self.points[k];
+        pq.copy_from_slice(q);
+        pv.copy_from_slice(qd);
+        self.times[k] = t0 + c * h;
+        let u = run.problem.inputs(self.times[k])?;
+        self.inputs[k].copy_from_slice(u);
+        Ok(())
+    }
+
+    /// The batch forward dynamics at the live lanes' points (an idle lane repeats a live one).
+    fn evaluate<M: Model>(&mut self, model: &M, live: &[bool; LANES]) {
+        let first = live.iter().position(|&l| l).expect("a live lane");
+        let of = |k: usize| if live[k] { k } else { first };
+        let lane = |k| of(k);
+        let points = &self.points;
+        pack(std::array::from_fn(|k| &points[lane(k)].0[..]), &mut self.q);
+        pack(
+            std::array::from_fn(|k| &points[lane(k)].1[..]),
+            &mut self.qd,
+        );
+        let inputs = &self.inputs;
+        pack(std::array::from_fn(|k| &inputs[lane(k)][..]), &mut self.u);
+        self.t = F64x4::from(std::array::from_fn(|k| self.times[lane(k)]));
+        model.forward_dynamics_x4(
+            self.t,
+            &self.q,
+            &self.qd,
+            &self.u,
+            &mut self.qdd,
+            &mut self.pivots,
+        );
+    }
+
+    /// Lane `k`'s accelerations of stage `s` into its scheme, judged by its run; computed by
+    /// the run alone when `alone`.
+    fn accept(&mut self, k: usize, run: &mut Run, s: usize, alone: bool) -> Result<(), Failure> {
+        let t = self.times[k];
+        let (q, qd) = &self.points[k];
+        let Run {
+            problem, stepper, ..
+        } = run;
+        let a = staged(stepper).accel_mut(s);
+        if alone {
+            return problem.accel(t, q, qd, a);
+        }
+        unpack(&self.qdd, k, a);
+        unpack(&self.pivots, k, &mut self.pivot);
+        problem.accept_forward(t, q, qd, a, &self.pivot)
+    }
+}

@@ -1,0 +1,245 @@
+//! An ensemble (`mbs::simulate_ensemble`): many members of one model run four at a time on
+//! the lanes of its batch functions. Each member's run is the one `simulate_with` makes of it
+//! (its steps, rejections and outputs; its states to the rounding of the batch functions); a
+//! member that fails keeps its trajectory and its own failure while the others finish; the
+//! lanes did the stages' evaluations (work counters); what an ensemble cannot run is refused
+//! up front.
+
+#![allow(unused_macros)]
+
+use mbs::{
+    Failure, Inputs, Member, Model, Options, Output, Scheme, SimError, Stats, StepControl,
+    Trajectory, simulate_ensemble, simulate_with,
+};
+
+include!("../benches/scaling/shapes.rs");
+
+chain!(Chain8, 8, batch);
+
+mbs::multibody! {
+    /// A pendulum driven by a torque input, with a light spring to a wall.
+    model Driven {
+        param l = 0.8; param m = 1.2; param g = 9.81; param k = 3.0;
+        dof a = 0.4;
+        input torque;
+        body bob { mass = m; inertia = (0.005, 0.005, 0.01); }
+        TOG[bob] = Trotz(a) * Tdisp(l, 0, 0);
+        gravity(0, -g, 0);
+        generalized_force(a, torque - k * a);
+        option batch;
+    }
+}
+
+/// Starts spread about the model's declared one, deterministic.
+fn starts(n: usize, count: usize) -> Vec<(Vec<f64>, Vec<f64>)> {
+    (0..count)
+        .map(|k| {
+            let q = (0..n)
+                .map(|i| 0.3 + 0.2 * ((i * 3 + k * 7) as f64).sin())
+                .collect();
+            let qd = (0..n)
+                .map(|i| 0.8 * ((i * 5 + k * 11) as f64).cos())
+                .collect();
+            (q, qd)
+        })
+        .collect()
+}
+
+fn options(t_end: f64, rtol: f64) -> Options {
+    Options {
+        output: Output::Every { dt: 0.1 },
+        ..Options::adaptive(t_end, rtol)
+    }
+}
+
+/// The ensemble's run of a member against the member run alone: the same outputs at the
+/// same times, the same steps, its states within `tol` relative to their largest entry.
+fn same_run(ens: &(Trajectory, Stats), alone: &(Trajectory, Stats), tol: f64, what: &str) -> f64 {
+    let ((te, se), (ta, sa)) = (ens, alone);
+    assert_eq!(te.len(), ta.len(), "{what}: outputs");
+    assert_eq!(te.t, ta.t, "{what}: output times");
+    assert_eq!(
+        (se.steps, se.rejected_error),
+        (sa.steps, sa.rejected_error),
+        "{what}: steps and rejections"
+    );
+    let mut worst = 0.0f64;
+    for i in 0..te.len() {
+        for (a, b) in [(te.q(i), ta.q(i)), (te.qd(i), ta.qd(i))] {
+            let scale = b.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+            for (x, y) in a.iter().zip(b) {
+                worst = worst.max((x - y).abs() / scale);
+            }
+        }
+    }
+    assert!(
+        worst <= tol,
+        "{what}: differs by {worst:.2e} from the run alone"
+    );
+    worst
+}
+
+#[test]
+fn members_run_as_they_would_alone_four_at_a_time() {
+    let model = Chain8::default();
+    let opts = options(1.5, 1e-8);
+    // six members: the lanes take the fifth and sixth as the first runs end
+    let members: Vec<Member> = starts(8, 6)
+        .into_iter()
+        .map(|(q, qd)| Member::at(q, qd))
+        .collect();
+    let report = simulate_ensemble(&model, Scheme::Dopri5, &opts, members).unwrap();
+    let mut worst = 0.0f64;
+    let mut lane_stages = 0;
+    for (k, (q, qd)) in starts(8, 6).into_iter().enumerate() {
+        let o = Options {
+            q0: Some(q),
+            qd0: Some(qd),
+            ..opts.clone()
+        };
+        let alone = simulate_with(model.clone(), Scheme::Dopri5, o, Inputs::default()).unwrap();
+        let ens = report.runs[k].as_ref().unwrap();
+        worst = worst.max(same_run(ens, &alone, 1e-9, &format!("member {k}")));
+        // its start (qdd₀ and the first step's trial) evaluated alone, every stage on a lane
+        let s = &ens.1;
+        assert_eq!(s.dynamics, 0, "member {k}: no dense evaluation");
+        assert_eq!(
+            s.forward_dynamics, alone.1.forward_dynamics,
+            "member {k}: evaluations"
+        );
+        lane_stages += s.forward_dynamics - 2;
+    }
+    if mbs::lanes::simd_available() {
+        assert_eq!(report.lane_evaluations, lane_stages);
+        // four lanes busy but for the last members' tails
+        assert!(
+            report.occupancy() > 0.7,
+            "occupancy {:.2} ({} batch calls)",
+            report.occupancy(),
+            report.batch_evaluations
+        );
+    }
+    println!(
+        "6 members of an 8-bar chain: {} batch calls for {} stages, occupancy {:.2}, worst difference from the runs alone {worst:.1e}",
+        report.batch_evaluations,
+        lane_stages,
+        report.occupancy()
+    );
+}
+
+#[test]
+fn a_member_that_fails_keeps_its_trajectory_and_the_others_finish() {
+    let model = Driven::default();
+    let opts = options(2.0, 1e-7);
+    let torque = |k: usize| move |t: f64, u: &mut [f64]| u[0] = 0.5 * k as f64 * (3.0 * t).sin();
+    let member = |k: usize| Member::at(vec![0.1 * k as f64], vec![0.0]);
+    let mut members: Vec<Member> = (0..5)
+        .map(|k| member(k).with_inputs(Inputs::new().function(torque(k))))
+        .collect();
+    // member 2's input is not finite from t = 0.75 on
+    members[2] = member(2).with_inputs(
+        Inputs::new()
+            .function(|t: f64, u: &mut [f64]| u[0] = if t < 0.75 { 0.3 } else { f64::NAN }),
+    );
+    // member 4's start has two coordinates for one
+    members[4].q0 = Some(vec![0.1, 0.2]);
+    let report = simulate_ensemble(&model, Scheme::Dopri5, &opts, members).unwrap();
+    assert_eq!(report.runs.len(), 5);
+    for k in [0, 1, 3] {
+        let o = Options {
+            q0: Some(vec![0.1 * k as f64]),
+            qd0: Some(vec![0.0]),
+            ..opts.clone()
+        };
+        let alone = simulate_with(
+            model.clone(),
+            Scheme::Dopri5,
+            o,
+            Inputs::new().function(torque(k)),
+        )
+        .unwrap();
+        same_run(
+            report.runs[k].as_ref().unwrap(),
+            &alone,
+            1e-9,
+            &format!("member {k}"),
+        );
+    }
+    let SimError {
+        kind,
+        t,
+        trajectory,
+        ..
+    } = report.runs[2].as_ref().unwrap_err();
+    assert!(
+        matches!(
+            kind,
+            Failure::NonFinite {
+                quantity: "input",
+                ..
+            }
+        ),
+        "member 2: {kind}"
+    );
+    assert!(*t < 0.75 && *t > 0.6, "member 2 failed at t = {t}");
+    // its outputs up to the failure: 0, 0.1, …, 0.7
+    assert_eq!(
+        trajectory.len(),
+        8,
+        "member 2's outputs: {:?}",
+        trajectory.t
+    );
+    let e4 = report.runs[4].as_ref().unwrap_err();
+    assert!(
+        matches!(e4.kind, Failure::InvalidOption { name: "q0", .. }),
+        "member 4: {}",
+        e4.kind
+    );
+}
+
+#[test]
+fn what_an_ensemble_cannot_run_is_refused_up_front() {
+    let members = || vec![Member::default(), Member::default()];
+    let refused = |r: Result<mbs::EnsembleReport, SimError>| match r {
+        Err(SimError {
+            kind: Failure::InvalidOption { name, reason, .. },
+            ..
+        }) => (name, reason),
+        other => panic!("not refused: {other:?}"),
+    };
+    let model = Driven::default();
+    let opts = options(1.0, 1e-6);
+    let (name, reason) = refused(simulate_ensemble(&model, Scheme::Radau5, &opts, members()));
+    assert_eq!(name, "scheme");
+    assert!(reason.contains("DOPRI5"), "{reason}");
+    let fixed = Options {
+        step: StepControl::Fixed { h: 1e-3 },
+        ..opts.clone()
+    };
+    let (name, _) = refused(simulate_ensemble(&model, Scheme::Dopri5, &fixed, members()));
+    assert_eq!(name, "step");
+    let fourbar = mbs_models::fourbar::FourBar::default();
+    let (name, reason) = refused(simulate_ensemble(
+        &fourbar,
+        Scheme::Dopri5,
+        &opts,
+        members(),
+    ));
+    assert_eq!(name, "model");
+    assert!(reason.contains("closed loop"), "{reason}");
+    let ball = mbs_models::spherical_pendulum::SphericalPendulum::default();
+    let (name, reason) = refused(simulate_ensemble(&ball, Scheme::Dopri5, &opts, members()));
+    assert_eq!(name, "model");
+    assert!(reason.contains("chart"), "{reason}");
+    // a model without `option batch;` runs its lanes one by one: the same runs
+    let report = simulate_ensemble(
+        &mbs_models::dpend::DoublePendulum::default(),
+        Scheme::Dopri5,
+        &opts,
+        members(),
+    )
+    .unwrap();
+    assert_eq!(report.batch_evaluations, 0);
+    assert!(report.runs.iter().all(|r| r.is_ok()));
+    let _ = <Driven as Model>::NQ;
+}

@@ -866,12 +866,40 @@ fn invalid_options_are_typed_errors() {
     // inverse dynamics: a path of the wrong length
     let r = inverse_dynamics_along(&seed, &[0.0], &[], |_| (vec![0.0], vec![0.0], vec![0.0]));
     assert!(matches!(
-        r,
-        Err(AnalysisError::Failure(Failure::InvalidOption {
-            name: "path",
-            ..
-        }))
+        r.unwrap_err().cause(),
+        AnalysisError::Failure(Failure::InvalidOption { name: "path", .. })
     ));
+}
+
+/// Inverse dynamics along a motion that turns non-finite at its third time: the failure
+/// names the time and the value, and keeps the rows of the two times before it.
+#[test]
+fn inverse_dynamics_that_fail_along_a_motion_keep_the_rows_before() {
+    use mbs::analysis::Computed;
+    let seed = seed2dof::Seed2dof::default();
+    let times = [0.0, 0.1, 0.2, 0.3];
+    let path = |t: f64| {
+        let x = if t > 0.15 { f64::NAN } else { t };
+        (vec![x, 0.0], vec![0.0; 2], vec![1.0, 0.0])
+    };
+    let e = inverse_dynamics_along(&seed, &times, &[], path).unwrap_err();
+    println!("{e}");
+    let AnalysisError::AlongMotion {
+        index, t, computed, ..
+    } = &e
+    else {
+        panic!("{e:?}");
+    };
+    assert_eq!((*index, *t), (2, 0.2));
+    assert!(matches!(
+        e.cause(),
+        AnalysisError::Failure(Failure::NonFinite { .. })
+    ));
+    let Computed::Efforts(kept) = computed.as_ref() else {
+        panic!("{computed:?}");
+    };
+    let all = inverse_dynamics_along(&seed, &times[..2], &[], path).unwrap();
+    assert_eq!(kept, &all);
 }
 
 #[test]

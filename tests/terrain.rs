@@ -37,6 +37,20 @@ fn a_point_takes_its_nearest_face_and_a_sphere_touches_a_box_as_by_hand() {
     let t = Terrain::step(0.6, 0.05);
     assert_eq!(t.height([0.7, 0.0]), 0.05);
     assert_eq!(t.height([0.5, 0.0]), 0.0);
+    // a height to plan on: the edge rounded over 2 cm, half way up at the edge; no width,
+    // the edge as it is; a width or a position that is not a number, NaN (it was the
+    // ground's height, and a negative width turned the ramps inside out)
+    assert_eq!(t.planned_height([0.6, 0.0], 0.02), 0.025);
+    assert_eq!(t.planned_height([0.62, 0.0], 0.02), 0.05);
+    assert_eq!(t.planned_height([0.7, 0.0], 0.0), 0.05);
+    for (p, w) in [
+        ([0.7, 0.0], -0.02),
+        ([0.7, 0.0], f64::NAN),
+        ([f64::NAN, 0.0], 0.02),
+    ] {
+        assert!(t.planned_height(p, w).is_nan(), "{p:?}, width {w}");
+    }
+    assert!(t.height([f64::NAN, 0.0]).is_nan());
     // inside, 1 cm below the top: the top
     let (d, n) = t.penetration([0.7, 0.0, 0.04]).expect("inside the step");
     assert!(

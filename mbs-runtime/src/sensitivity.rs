@@ -133,6 +133,15 @@ impl<M: Model + 'static> Sensitivities<M> {
             return Err(ModelError::TangentsNotGenerated { model: info.name });
         }
         let n = M::NQ;
+        // generated with `has_tangents`; a model written by hand may say it has them and
+        // lack one, which `evaluate` would then read as zeros: asked once here
+        {
+            let (z, u) = (vec![0.0; n], vec![0.0; M::NU]);
+            let (mut k, mut c) = (vec![0.0; n * n], vec![0.0; n * n]);
+            model.tangents(0.0, &z, &z, &z, &u, &mut k, &mut c)?;
+            let mut dtau = vec![0.0; n * M::SENSITIVE.len()];
+            model.parameter_tangents(0.0, &z, &z, &z, &u, &mut dtau)?;
+        }
         if M::NC > 0 {
             // generated for models with constraints and sensitive parameters; a model written
             // by hand may lack it
@@ -199,7 +208,7 @@ impl<M: Model + 'static> Sensitivities<M> {
                 s.qdd.fill(f64::NAN);
             }
         }
-        // checked at construction: both are generated
+        // checked at construction (`new`): both answer for this model
         let _ = self.model.tangents(t, q, qd, &s.qdd, u, &mut s.k, &mut s.c);
         let _ = self
             .model

@@ -230,8 +230,11 @@ impl Terrain {
     }
 
     /// The height of the terrain's top above the horizontal position `p`: the highest box
-    /// there, or the ground.
+    /// there, or the ground; NaN where `p` is not a number (not the ground's height).
     pub fn height(&self, p: [f64; 2]) -> f64 {
+        if p.iter().any(|x| x.is_nan()) {
+            return f64::NAN;
+        }
         self.blocks
             .iter()
             .filter(|b| (0..2).all(|j| p[j] > b.min[j] && p[j] < b.max[j]))
@@ -241,8 +244,16 @@ impl Terrain {
 
     /// [`Terrain::height`] with every box edge rounded over `width` (m) by a smooth ramp: a
     /// height to plan footholds on, which a position moving by a millimetre near an edge
-    /// does not move by a box's height.
+    /// does not move by a box's height. A width of 0 rounds nothing ([`Terrain::height`]);
+    /// a negative or NaN width, or a NaN position, gives NaN (a negative width turned the
+    /// ramps inside out, and a NaN one gave the ground's height everywhere).
     pub fn planned_height(&self, p: [f64; 2], width: f64) -> f64 {
+        if !(width >= 0.0) || p.iter().any(|x| x.is_nan()) {
+            return f64::NAN;
+        }
+        if width == 0.0 {
+            return self.height(p);
+        }
         let ramp = |d: f64| {
             let u = (d / width + 0.5).clamp(0.0, 1.0);
             u * u * (3.0 - 2.0 * u)

@@ -10,7 +10,7 @@
 //! consistent (Φ = 0, Φ̇ = 0, B qdd = γ); the largest violations are reported per time, not
 //! refused.
 
-use super::{AnalysisError, check, reduce};
+use super::{AnalysisError, Computed, check, reduce};
 use crate::error::Failure;
 use crate::linalg::Lu;
 use crate::model::Model;
@@ -19,7 +19,7 @@ use serde::Serialize;
 use std::io::{self, Write};
 
 /// Generalised forces along a motion: `tau` holds one row of NQ values per time.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Efforts {
     pub dof_names: Vec<String>,
     pub t: Vec<f64>,
@@ -56,9 +56,11 @@ pub fn inverse_dynamics_along<M: Model>(
 ) -> Result<Efforts, AnalysisError> {
     let mut out = efforts(model, u, times.len())?;
     let mut row = vec![0.0; M::NQ];
-    for &t in times {
+    for (i, &t) in times.iter().enumerate() {
         let (q, qd, qdd) = path(t);
-        tau_at(model, t, [&q, &qd, &qdd], u, &mut row)?;
+        if let Err(e) = tau_at(model, t, [&q, &qd, &qdd], u, &mut row) {
+            return Err(stopped(i, t, e, Computed::Efforts(out)));
+        }
         out.t.push(t);
         out.tau.extend_from_slice(&row);
     }
@@ -80,11 +82,23 @@ pub fn inverse_dynamics_of<M: Model + Clone>(
     for i in 0..trajectory.len() {
         crate::charts::use_charts_of(&mut read, trajectory, i);
         let t = trajectory.t[i];
-        tau_at(&read, t, state(trajectory, i), u, &mut row)?;
+        if let Err(e) = tau_at(&read, t, state(trajectory, i), u, &mut row) {
+            return Err(stopped(i, t, e, Computed::Efforts(out)));
+        }
         out.t.push(t);
         out.tau.extend_from_slice(&row);
     }
     Ok(out)
+}
+
+/// The failure `cause` at time `index` (t) of a motion, with the rows computed before it.
+fn stopped(index: usize, t: f64, cause: AnalysisError, computed: Computed) -> AnalysisError {
+    AnalysisError::AlongMotion {
+        index,
+        t,
+        cause: Box::new(cause),
+        computed: Box::new(computed),
+    }
 }
 
 /// Whether `trajectory`'s data fit `model` ([`Trajectory::check_fits`]).
@@ -141,8 +155,11 @@ fn check_state<M: Model>(model: &M, t: f64, state: [&[f64]; 3]) -> Result<(), An
         }
         .into());
     }
-    for v in state {
-        check(model, "path", v)?;
+    for (name, v) in ["path's q", "path's qd", "path's qdd"]
+        .into_iter()
+        .zip(state)
+    {
+        check(model, name, v)?;
     }
     Ok(())
 }
@@ -150,7 +167,7 @@ fn check_state<M: Model>(model: &M, t: f64, state: [&[f64]; 3]) -> Result<(), An
 /// Actuator efforts and constraint reactions along a motion of a constrained model
 /// ([`inverse_dynamics_actuated_along`]): per time, τ_a (one per actuated coordinate) and λ
 /// (one per constraint) with `S τ_a + Bᵀλ = M qdd − h`.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 #[non_exhaustive]
 pub struct ActuatedEfforts {
     /// labels of the actuated coordinates, and their indices in q
@@ -225,9 +242,11 @@ pub fn inverse_dynamics_actuated_along<M: Model>(
     mut path: impl FnMut(f64) -> (Vec<f64>, Vec<f64>, Vec<f64>),
 ) -> Result<ActuatedEfforts, AnalysisError> {
     let (mut solver, mut out) = Actuation::new(model, u, actuated, times.len())?;
-    for &t in times {
+    for (i, &t) in times.iter().enumerate() {
         let (q, qd, qdd) = path(t);
-        solver.push(model, t, [&q, &qd, &qdd], u, &mut out)?;
+        if let Err(e) = solver.push(model, t, [&q, &qd, &qdd], u, &mut out) {
+            return Err(stopped(i, t, e, Computed::Actuated(out)));
+        }
     }
     Ok(out)
 }
@@ -245,7 +264,10 @@ pub fn inverse_dynamics_actuated_of<M: Model + Clone>(
     let mut read = model.clone();
     for i in 0..trajectory.len() {
         crate::charts::use_charts_of(&mut read, trajectory, i);
-        solver.push(&read, trajectory.t[i], state(trajectory, i), u, &mut out)?;
+        let t = trajectory.t[i];
+        if let Err(e) = solver.push(&read, t, state(trajectory, i), u, &mut out) {
+            return Err(stopped(i, t, e, Computed::Actuated(out)));
+        }
     }
     Ok(out)
 }

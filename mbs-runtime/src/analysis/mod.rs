@@ -57,6 +57,37 @@ pub enum AnalysisError {
         /// retry from)
         q: Vec<f64>,
     },
+    /// An analysis along a motion (inverse dynamics) failed at one of its times; what it
+    /// computed at the times before is kept.
+    #[error("at t = {t} (time {index} of the motion; the {index} before it computed): {cause}")]
+    AlongMotion {
+        /// the index of the time in the motion, and the time
+        index: usize,
+        t: f64,
+        /// the failure there
+        cause: Box<AnalysisError>,
+        /// the rows of the times before
+        computed: Box<Computed>,
+    },
+}
+
+/// What an analysis along a motion computed before a time it failed at
+/// ([`AnalysisError::AlongMotion`]).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Computed {
+    Efforts(Efforts),
+    Actuated(ActuatedEfforts),
+}
+
+impl AnalysisError {
+    /// The failure itself: for an analysis along a motion that stopped, its cause at that
+    /// time; otherwise the error.
+    pub fn cause(&self) -> &AnalysisError {
+        match self {
+            AnalysisError::AlongMotion { cause, .. } => cause.cause(),
+            other => other,
+        }
+    }
 }
 
 /// The first non-finite entry of `v` (NQ-periodic, named by its coordinate) as an error.

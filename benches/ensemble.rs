@@ -9,7 +9,9 @@
 //!
 //! Prints criterion's figures, then a table of medians: ms for the 16 runs each way, the
 //! ensemble's throughput relative to the runs one by one, its steps and how busy its lanes
-//! were.
+//! were. Then a sweep (`mbs::sweep`) of 256 runs of the 16-bar chain over starts drawn at
+//! random, on one thread, one run at a time and on lanes (`Sweep::ensembles`), the best of
+//! three rounds each way.
 
 mod common;
 #[path = "scaling/models.rs"]
@@ -17,6 +19,7 @@ mod models;
 
 use common::{median_ns, test_state};
 use criterion::Criterion;
+use mbs::sweep::{Plan, Sweep};
 use mbs::{Inputs, Member, Model, Options, Output, Scheme, simulate_ensemble, simulate_with};
 use std::hint::black_box;
 
@@ -99,6 +102,44 @@ fn bench_model<M: Model + Clone + 'static>(
     (name, steps_alone, steps, occupancy)
 }
 
+/// The sweep of 256 runs of chain16 over random starts on one thread, one run at a time and
+/// on lanes: the best wall time of three rounds each way, in s.
+fn sweep_rounds() -> (f64, f64) {
+    let plan = Plan::from_toml(
+        r#"
+        [sweep]
+        design = "monte-carlo"
+        runs = 256
+        seed = 7
+        [[vary]]
+        name = "q0[0]"
+        uniform = [0.0, 0.6]
+        [[vary]]
+        name = "qd0[5]"
+        uniform = [-1.0, 1.0]
+        "#,
+    )
+    .expect("the plan is valid");
+    let out = std::env::temp_dir().join(format!("mbs-bench-ensemble-{}", std::process::id()));
+    let list = plan.runs(&out).expect("its runs");
+    let mut best = [f64::INFINITY; 2];
+    for _ in 0..3 {
+        for (on, best) in [false, true].into_iter().zip(best.iter_mut()) {
+            let _ = std::fs::remove_dir_all(&out);
+            let s = Sweep::new(Chain16::default, &plan, Scheme::Dopri5, options())
+                .expect("the sweep is valid")
+                .ensembles(on)
+                .threads(1)
+                .run(&out, &list)
+                .expect("the sweep runs");
+            assert_eq!(s.on_lanes, if on { 256 } else { 0 });
+            *best = best.min(s.wall.as_secs_f64());
+        }
+    }
+    let _ = std::fs::remove_dir_all(&out);
+    (best[0], best[1])
+}
+
 fn main() {
     let since = std::time::SystemTime::now();
     let mut c = Criterion::default().configure_from_args();
@@ -127,4 +168,11 @@ fn main() {
             o / e
         );
     }
+    let (alone, lanes) = sweep_rounds();
+    println!(
+        "sweep of 256 runs of chain16 over starts, one thread, best of 3: one at a time {:.1} ms, on lanes {:.1} ms ({:.2}×)",
+        alone * 1e3,
+        lanes * 1e3,
+        alone / lanes
+    );
 }

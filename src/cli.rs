@@ -333,6 +333,12 @@ fn sweep_summary(s: &crate::sweep::Summary) -> String {
         s.threads,
         s.table.display()
     );
+    if s.on_lanes > 0 {
+        text.push_str(&format!(
+            "\n{} of them four at a time on the lanes of the model's batch functions",
+            s.on_lanes
+        ));
+    }
     if s.stopped {
         text.push_str("\nstopped before every run was made: the same command resumes it");
     }

@@ -494,3 +494,82 @@ fn a_metric_that_would_double_a_column_is_refused() {
     assert_eq!(column(&dir.join("results.csv"), "t_last"), ["1.0", "2.0"]);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+mod batch {
+    #![allow(unused_macros)]
+    include!("../benches/scaling/shapes.rs");
+    chain!(Chain4, 4, batch);
+}
+
+/// A sweep over starts alone of a model with `option batch;` runs its runs four at a time on
+/// the lanes (`Sweep::ensembles`, on by default): the same rows as one run at a time — status,
+/// failure, steps, evaluations, metrics to the rounding of the batch functions — a run that
+/// fails failing alike.
+#[test]
+fn a_sweep_over_starts_runs_on_lanes_and_gives_the_rows_of_runs_alone() {
+    use batch::Chain4;
+    let plan = Plan::from_toml(
+        r#"
+        [sweep]
+        design = "grid"
+        [[vary]]
+        name = "q0[0]"
+        values = [0.1, 0.4, 0.7, 1.0, 1.3]
+        [[vary]]
+        name = "qd0[2]"
+        values = [-1.0, 0.0, 2.0, 1e200]
+        "#,
+    )
+    .unwrap();
+    let dir = scratch("lanes");
+    let runs = plan.runs(&dir).unwrap();
+    let table = |ensembles: bool, name: &str| {
+        let d = dir.join(name);
+        let s = Sweep::new(Chain4::default, &plan, Scheme::Dopri5, base())
+            .unwrap()
+            .ensembles(ensembles)
+            .threads(2);
+        let summary = s.run(&d, &runs).unwrap();
+        assert_eq!(summary.ran, 20);
+        let on_lanes = if ensembles && mbs::lanes::simd_available() {
+            20
+        } else {
+            0
+        };
+        assert_eq!(summary.on_lanes, on_lanes);
+        d.join("results.csv")
+    };
+    let (lanes, alone) = (table(true, "lanes"), table(false, "alone"));
+    for name in [
+        "run",
+        "status",
+        "failure",
+        "steps",
+        "rejected",
+        "evaluations",
+    ] {
+        assert_eq!(column(&lanes, name), column(&alone, name), "{name}");
+    }
+    let status = column(&lanes, "status");
+    assert_eq!(status.iter().filter(|s| *s == "failed").count(), 5);
+    let mut worst = 0.0f64;
+    let headers: Vec<String> = csv::Reader::from_path(&lanes)
+        .unwrap()
+        .headers()
+        .unwrap()
+        .iter()
+        .filter(|h| h.starts_with("q_end") || h.starts_with("qd_end"))
+        .map(String::from)
+        .collect();
+    assert_eq!(headers.len(), 8, "{headers:?}");
+    for name in &headers {
+        for (a, b) in column(&lanes, name).iter().zip(column(&alone, name)) {
+            if let (Ok(a), Ok(b)) = (a.parse::<f64>(), b.parse::<f64>()) {
+                worst = worst.max((a - b).abs() / b.abs().max(1.0));
+            }
+        }
+    }
+    println!("a sweep of 20 runs on lanes against one at a time: metrics within {worst:.1e}");
+    assert!(worst < 1e-9, "{worst:e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

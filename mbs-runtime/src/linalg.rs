@@ -3,6 +3,13 @@
 //! and a complex LU for the complex eigen-blocks of Radau. nalgebra's dynamic LU allocates its
 //! permutation at every factorisation, and none reports which coordinate made a matrix
 //! singular; these do, with a condition estimate (Hager–Higham 1-norm estimator).
+//!
+//! # Panics
+//!
+//! Every function here indexes its slices as the sizes it is given say: a matrix shorter
+//! than n·n, or a vector shorter than n, panics as a slice indexed beyond its end does
+//! (the runtime sizes them from the model's constants once; these functions are its inner
+//! loops, which check nothing more).
 
 use std::ops::{Add, Div, Mul, Neg, Sub};
 

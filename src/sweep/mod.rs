@@ -307,6 +307,9 @@ pub struct Summary {
     /// CPU time of the runs made now, summed over threads
     pub cpu: Duration,
     pub threads: usize,
+    /// of the runs made, those made four at a time on the lanes of the batch functions
+    /// ([`Sweep::ensembles`])
+    pub on_lanes: usize,
     /// the table written
     pub table: PathBuf,
 }
@@ -322,7 +325,12 @@ pub struct Sweep<'a, M: Model> {
     threads: Option<usize>,
     progress: bool,
     stop: Option<&'a AtomicBool>,
+    ensembles: bool,
 }
+
+/// Runs per ensemble when a sweep's runs share the lanes of the batch functions
+/// ([`Sweep::ensembles`]): taken from the list together by one thread.
+const ENSEMBLE_RUNS: usize = 16;
 
 impl<'a, M: Model + 'static> Sweep<'a, M> {
     /// The sweep of `plan` over models made by `make`, each run starting from `scheme` and
@@ -347,6 +355,7 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
             threads: None,
             progress: false,
             stop: None,
+            ensembles: true,
         };
         if plan.sweep.design != DesignKind::List {
             let names: Vec<String> = plan.vary.iter().map(|v| v.name.clone()).collect();
@@ -397,6 +406,35 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
     pub fn stop_flag(mut self, stop: &'a AtomicBool) -> Self {
         self.stop = Some(stop);
         self
+    }
+
+    /// Whether runs that differ only in their start (`q0…`, `qd0…` varied, nothing else) of a
+    /// model with `option batch;` run four at a time on the lanes of its batch functions
+    /// ([`crate::simulate_ensemble`]: the same runs, each its own steps and failure) where an
+    /// ensemble runs the sweep's scheme and model (DOPRI5 with adaptive steps, open loops
+    /// without rotation joints); on by default. The `cpu_s` of such a run is its share of its
+    /// ensemble's CPU time (the ensemble's divided by its runs).
+    pub fn ensembles(mut self, on: bool) -> Self {
+        self.ensembles = on;
+        self
+    }
+
+    /// Whether this sweep's runs go through ensembles ([`Sweep::ensembles`]), with `targets`
+    /// the variables of its plan.
+    fn in_ensembles(&self, targets: &[Target]) -> bool {
+        if !(self.ensembles && M::BATCH_GENERATED && crate::lanes::simd_available()) {
+            return false;
+        }
+        if !targets
+            .iter()
+            .all(|t| matches!(t, Target::Q0(_) | Target::Qd0(_)))
+        {
+            return false;
+        }
+        let b = &self.base;
+        let mut options = b.options.clone();
+        options.step = StepControl::from_settings(b.h, b.rtol, b.atol);
+        crate::ensemble_supported(&(self.make)(), &b.scheme, &options).is_ok()
     }
 
     /// The table's columns: `run`, `status` (ok, failed), `failure` (the failure's kind),
@@ -554,6 +592,7 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
         let bar = self.progress_bar(pending.len(), skipped);
         let start = Instant::now();
         let next = AtomicUsize::new(0);
+        let ensembles = self.in_ensembles(&targets);
         let (tx, rx) = mpsc::channel::<(usize, Row)>();
         let mut failed = 0;
         let mut cpu = Duration::ZERO;
@@ -563,14 +602,24 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
             s.spawn(|| {
                 let tx = tx; // moved in: the channel closes when every worker is done
                 pool.broadcast(|_| {
+                    // a run at a time, or an ensemble's runs
+                    let chunk = if ensembles { ENSEMBLE_RUNS } else { 1 };
                     loop {
                         if self.stop.is_some_and(|f| f.load(Ordering::SeqCst)) {
                             break;
                         }
-                        let k = next.fetch_add(1, Ordering::SeqCst);
-                        let Some(&i) = pending.get(k) else { break };
-                        let row = self.run_one(i, &runs.rows[i], &runs.names, &targets);
-                        if tx.send((k, row)).is_err() {
+                        let k0 = next.fetch_add(chunk, Ordering::SeqCst);
+                        if k0 >= pending.len() {
+                            break;
+                        }
+                        let ks = k0..(k0 + chunk).min(pending.len());
+                        let rows = if ensembles {
+                            self.run_ensemble(&pending[ks.clone()], runs, &targets)
+                        } else {
+                            let i = pending[k0];
+                            vec![self.run_one(i, &runs.rows[i], &runs.names, &targets)]
+                        };
+                        if ks.zip(rows).any(|row| tx.send(row).is_err()) {
                             break;
                         }
                     }
@@ -609,6 +658,7 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
             wall: start.elapsed(),
             cpu,
             threads,
+            on_lanes: if ensembles { written } else { 0 },
             table: path.to_path_buf(),
         })
     }
@@ -637,22 +687,97 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
         let outcome = catch_unwind(AssertUnwindSafe(|| {
             self.simulate(i, values, names, targets)
         }))
-        .unwrap_or_else(|panic| {
-            let what = panic
-                .downcast_ref::<&str>()
-                .map(|s| s.to_string())
-                .or_else(|| panic.downcast_ref::<String>().cloned())
-                .unwrap_or_default();
-            Outcome::Failed {
-                kind: "Panic".into(),
-                message: format!("user code panicked: {what}"),
-                t: f64::NAN,
-                stats: None,
+        .unwrap_or_else(panicked);
+        row_of(
+            i,
+            values,
+            outcome,
+            clock.elapsed(),
+            self.metrics.names.len(),
+        )
+    }
+
+    /// The runs `indices` of `runs` as one ensemble ([`Sweep::ensembles`]), whatever happens
+    /// in them, as rows in their order.
+    fn run_ensemble(&self, indices: &[usize], runs: &RunList, targets: &[Target]) -> Vec<Row> {
+        let clock = cpu_time::ThreadTime::now();
+        let mut outcomes: Vec<Option<Outcome>> = Vec::with_capacity(indices.len());
+        let (mut members, mut shared, mut in_ensemble) = (Vec::new(), None, Vec::new());
+        for &i in indices {
+            let mut model = (self.make)();
+            match self.settings(&mut model, i, &runs.rows[i], &runs.names, targets) {
+                Ok((scheme, options)) => {
+                    let member = crate::Member {
+                        q0: options.q0.clone(),
+                        qd0: options.qd0.clone(),
+                        inputs: Default::default(),
+                    };
+                    members.push(member);
+                    shared.get_or_insert((scheme, options));
+                    in_ensemble.push(outcomes.len());
+                    outcomes.push(None);
+                }
+                Err(e) => outcomes.push(Some(invalid_run(e))),
             }
-        });
-        let cpu = clock.elapsed();
-        let mut fields = vec![i.to_string()];
+        }
+        if let Some((scheme, options)) = shared {
+            let made = catch_unwind(AssertUnwindSafe(|| {
+                let report = crate::simulate_ensemble_of(&self.make, scheme, &options, members)?;
+                let done = report.runs.into_iter().map(|r| match r {
+                    Ok((traj, stats)) => self.finished((self.make)(), traj, stats, options.t_end),
+                    Err(e) => failed_run(e, options.t0),
+                });
+                Ok::<Vec<Outcome>, SimError>(done.collect())
+            }));
+            let done = match made {
+                Ok(Ok(done)) => done,
+                Ok(Err(e)) => vec![failed_run(e, options.t0); in_ensemble.len()],
+                Err(panic) => vec![panicked(panic); in_ensemble.len()],
+            };
+            for (j, o) in in_ensemble.into_iter().zip(done) {
+                outcomes[j] = Some(o);
+            }
+        }
+        // each run its share of the ensemble's time
+        let cpu = clock.elapsed() / indices.len().max(1) as u32;
         let nm = self.metrics.names.len();
+        indices
+            .iter()
+            .zip(outcomes)
+            .map(|(&i, o)| {
+                let o = o.expect("every run has its outcome");
+                row_of(i, &runs.rows[i], o, cpu, nm)
+            })
+            .collect()
+    }
+
+    /// The outcome of a run that reached its end: its metrics, checked.
+    fn finished(&self, model: M, traj: Trajectory, stats: crate::Stats, t_end: f64) -> Outcome {
+        let metrics = (self.metrics.f)(&model, &traj);
+        if metrics.len() != self.metrics.names.len() {
+            return Outcome::Failed {
+                kind: "Metrics".into(),
+                message: format!(
+                    "the metrics closure returned {} values for {} names",
+                    metrics.len(),
+                    self.metrics.names.len()
+                ),
+                t: t_end,
+                stats: Some(stats),
+            };
+        }
+        Outcome::Done {
+            t: traj.t.last().copied().unwrap_or(t_end),
+            metrics,
+            stats,
+        }
+    }
+}
+
+/// A run's outcome as a row of the table, its CPU time `cpu`, with `nm` metrics.
+fn row_of(i: usize, values: &[Value], outcome: Outcome, cpu: Duration, nm: usize) -> Row {
+    {
+        let mut fields = vec![i.to_string()];
         let (failed, stats) = match outcome {
             Outcome::Done { t, metrics, stats } => {
                 fields.extend(["ok".into(), String::new(), String::new(), num(t)]);
@@ -688,7 +813,9 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
             cpu,
         }
     }
+}
 
+impl<'a, M: Model + 'static> Sweep<'a, M> {
     fn simulate(
         &self,
         i: usize,
@@ -699,23 +826,11 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
         let mut model = (self.make)();
         let (scheme, options) = match self.settings(&mut model, i, values, names, targets) {
             Ok(s) => s,
-            Err(e) => {
-                return Outcome::Failed {
-                    kind: "InvalidRun".into(),
-                    message: e.to_string(),
-                    t: f64::NAN,
-                    stats: None,
-                };
-            }
+            Err(e) => return invalid_run(e),
         };
         let t0 = options.t0;
         let t_end = options.t_end;
-        let failed = |e: SimError| Outcome::Failed {
-            kind: failure_kind(&e),
-            message: e.kind.to_string(),
-            t: if e.trajectory.is_empty() { t0 } else { e.t },
-            stats: Some(*e.stats),
-        };
+        let failed = |e: SimError| failed_run(e, t0);
         let mut sim = match Simulation::new(model, scheme, options) {
             Ok(sim) => sim,
             Err(e) => return failed(e),
@@ -724,24 +839,7 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
             return failed(e);
         }
         let (model, traj, stats) = sim.finish_with_model();
-        let metrics = (self.metrics.f)(&model, &traj);
-        if metrics.len() != self.metrics.names.len() {
-            return Outcome::Failed {
-                kind: "Metrics".into(),
-                message: format!(
-                    "the metrics closure returned {} values for {} names",
-                    metrics.len(),
-                    self.metrics.names.len()
-                ),
-                t: t_end,
-                stats: Some(stats),
-            };
-        }
-        Outcome::Done {
-            t: traj.t.last().copied().unwrap_or(t_end),
-            metrics,
-            stats,
-        }
+        self.finished(model, traj, stats, t_end)
     }
 
     /// The run's model parameters (set on `model`), scheme and options.
@@ -826,7 +924,43 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
     }
 }
 
+/// A run whose settings were refused.
+fn invalid_run(e: SweepError) -> Outcome {
+    Outcome::Failed {
+        kind: "InvalidRun".into(),
+        message: e.to_string(),
+        t: f64::NAN,
+        stats: None,
+    }
+}
+
+/// A run that failed: where, and the work done (t₀ when nothing was recorded).
+fn failed_run(e: SimError, t0: f64) -> Outcome {
+    Outcome::Failed {
+        kind: failure_kind(&e),
+        message: e.kind.to_string(),
+        t: if e.trajectory.is_empty() { t0 } else { e.t },
+        stats: Some(*e.stats),
+    }
+}
+
+/// A run whose user code panicked.
+fn panicked(panic: Box<dyn std::any::Any + Send>) -> Outcome {
+    let what = panic
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| panic.downcast_ref::<String>().cloned())
+        .unwrap_or_default();
+    Outcome::Failed {
+        kind: "Panic".into(),
+        message: format!("user code panicked: {what}"),
+        t: f64::NAN,
+        stats: None,
+    }
+}
+
 /// A run's result before it becomes a row.
+#[derive(Clone)]
 enum Outcome {
     Done {
         t: f64,

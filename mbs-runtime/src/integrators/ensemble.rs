@@ -92,6 +92,19 @@ pub fn simulate_ensemble<M: Model + Clone + 'static>(
     options: &Options,
     members: Vec<Member>,
 ) -> Result<EnsembleReport, SimError> {
+    simulate_ensemble_of(|| model.clone(), scheme, options, members)
+}
+
+/// [`simulate_ensemble`] of models made by `make` (one for the shared evaluations, one per
+/// member), for a model that is not `Clone`: every model it makes must be the same.
+pub fn simulate_ensemble_of<M: Model + 'static>(
+    make: impl Fn() -> M,
+    scheme: Scheme,
+    options: &Options,
+    members: Vec<Member>,
+) -> Result<EnsembleReport, SimError> {
+    let shared = make();
+    let model = &shared;
     supported(model, &scheme, options).map_err(|e| super::driver::refused(model, e, options.t0))?;
     let t_end = options.t_end;
     let start = |m: Member| -> Result<Run, SimError> {
@@ -108,7 +121,7 @@ pub fn simulate_ensemble<M: Model + Clone + 'static>(
             qd0: m.qd0.or_else(|| options.qd0.clone()),
             ..options.clone()
         };
-        Run::new(model.clone(), scheme, options, m.inputs)
+        Run::new(make(), scheme, options, m.inputs)
     };
     let mut lanes = Lanes::new(M::NQ, M::NU);
     let batched = M::BATCH_GENERATED && M::FORWARD_DYNAMICS_GENERATED && simd_available();
@@ -232,6 +245,16 @@ pub fn simulate_ensemble<M: Model + Clone + 'static>(
 /// A run's scheme as explicit stages (checked by [`supported`]).
 fn staged(stepper: &mut Box<dyn Stepper>) -> &mut dyn Staged {
     stepper.staged().expect("checked by `supported`")
+}
+
+/// Whether an ensemble runs `scheme` with `options` on `model` ([`simulate_ensemble`]
+/// refuses the others with this failure).
+pub fn ensemble_supported<M: Model>(
+    model: &M,
+    scheme: &Scheme,
+    options: &Options,
+) -> Result<(), Failure> {
+    supported(model, scheme, options)
 }
 
 /// What an ensemble runs: an explicit staged scheme with adaptive steps, on a model without

@@ -45,7 +45,9 @@ mod stepper;
 
 pub use constrained::{Assembly, assemble};
 pub use driver::{Simulation, simulate, simulate_with};
-pub use ensemble::{EnsembleReport, Member, simulate_ensemble};
+pub use ensemble::{
+    EnsembleReport, Member, ensemble_supported, simulate_ensemble, simulate_ensemble_of,
+};
 pub use global::{GlobalControl, GlobalReport, GlobalRun, simulate_global};
 pub use inputs::{Controller, Inputs};
 pub use newmark::index3_iteration_matrix;

@@ -82,49 +82,66 @@ fn same_run(ens: &(Trajectory, Stats), alone: &(Trajectory, Stats), tol: f64, wh
 #[test]
 fn members_run_as_they_would_alone_four_at_a_time() {
     let model = Chain8::default();
-    let opts = options(1.5, 1e-8);
-    // six members: the lanes take the fifth and sixth as the first runs end
-    let members: Vec<Member> = starts(8, 6)
-        .into_iter()
-        .map(|(q, qd)| Member::at(q, qd))
-        .collect();
-    let report = simulate_ensemble(&model, Scheme::Dopri5, &opts, members).unwrap();
-    let mut worst = 0.0f64;
-    let mut lane_stages = 0;
-    for (k, (q, qd)) in starts(8, 6).into_iter().enumerate() {
-        let o = Options {
-            q0: Some(q),
-            qd0: Some(qd),
-            ..opts.clone()
-        };
-        let alone = simulate_with(model.clone(), Scheme::Dopri5, o, Inputs::default()).unwrap();
-        let ens = report.runs[k].as_ref().unwrap();
-        worst = worst.max(same_run(ens, &alone, 1e-9, &format!("member {k}")));
-        // its start (qdd₀ and the first step's trial) evaluated alone, every stage on a lane
-        let s = &ens.1;
-        assert_eq!(s.dynamics, 0, "member {k}: no dense evaluation");
-        assert_eq!(
-            s.forward_dynamics, alone.1.forward_dynamics,
-            "member {k}: evaluations"
+    let fixed = Options {
+        step: StepControl::Fixed { h: 2e-3 },
+        ..options(1.5, 1e-8)
+    };
+    for (scheme, opts) in [
+        (Scheme::Dopri5, options(1.5, 1e-8)),
+        (Scheme::Rk4, fixed.clone()),
+        (Scheme::Dopri5, fixed),
+    ] {
+        // six members: the lanes take the fifth and sixth as the first runs end
+        let members: Vec<Member> = starts(8, 6)
+            .into_iter()
+            .map(|(q, qd)| Member::at(q, qd))
+            .collect();
+        let report = simulate_ensemble(&model, scheme, &opts, members).unwrap();
+        let mut worst = 0.0f64;
+        let mut lane_stages = 0;
+        // evaluations each run makes alone: its start (qdd₀, and the first step's trial when
+        // adaptive) and the stability watch's (fixed steps)
+        let mut alone_only = 0;
+        for (k, (q, qd)) in starts(8, 6).into_iter().enumerate() {
+            let o = Options {
+                q0: Some(q),
+                qd0: Some(qd),
+                ..opts.clone()
+            };
+            let alone = simulate_with(model.clone(), scheme, o, Inputs::default()).unwrap();
+            let ens = report.runs[k].as_ref().unwrap();
+            let what = format!("{} member {k}", scheme.name());
+            worst = worst.max(same_run(ens, &alone, 1e-9, &what));
+            let s = &ens.1;
+            assert_eq!(s.dynamics, 0, "{what}: no dense evaluation");
+            assert_eq!(
+                s.forward_dynamics, alone.1.forward_dynamics,
+                "{what}: evaluations"
+            );
+            let stages = if scheme == Scheme::Rk4 { 4 } else { 6 };
+            let on_lanes = stages * (s.steps + s.rejected_error);
+            alone_only += s.forward_dynamics - on_lanes;
+            lane_stages += on_lanes;
+        }
+        if mbs::lanes::simd_available() {
+            assert_eq!(report.lane_evaluations, lane_stages, "{}", scheme.name());
+            // four lanes busy but for the last members' tails
+            assert!(
+                report.occupancy() > 0.7,
+                "occupancy {:.2} ({} batch calls)",
+                report.occupancy(),
+                report.batch_evaluations
+            );
+        }
+        println!(
+            "{}, 6 members of an 8-bar chain: {} batch calls for {} stages ({} evaluations alone), occupancy {:.2}, worst difference from the runs alone {worst:.1e}",
+            scheme.name(),
+            report.batch_evaluations,
+            lane_stages,
+            alone_only,
+            report.occupancy()
         );
-        lane_stages += s.forward_dynamics - 2;
     }
-    if mbs::lanes::simd_available() {
-        assert_eq!(report.lane_evaluations, lane_stages);
-        // four lanes busy but for the last members' tails
-        assert!(
-            report.occupancy() > 0.7,
-            "occupancy {:.2} ({} batch calls)",
-            report.occupancy(),
-            report.batch_evaluations
-        );
-    }
-    println!(
-        "6 members of an 8-bar chain: {} batch calls for {} stages, occupancy {:.2}, worst difference from the runs alone {worst:.1e}",
-        report.batch_evaluations,
-        lane_stages,
-        report.occupancy()
-    );
 }
 
 #[test]
@@ -211,13 +228,14 @@ fn what_an_ensemble_cannot_run_is_refused_up_front() {
     let opts = options(1.0, 1e-6);
     let (name, reason) = refused(simulate_ensemble(&model, Scheme::Radau5, &opts, members()));
     assert_eq!(name, "scheme");
-    assert!(reason.contains("DOPRI5"), "{reason}");
-    let fixed = Options {
-        step: StepControl::Fixed { h: 1e-3 },
-        ..opts.clone()
-    };
-    let (name, _) = refused(simulate_ensemble(&model, Scheme::Dopri5, &fixed, members()));
-    assert_eq!(name, "step");
+    assert!(reason.contains("DOPRI5, RK4"), "{reason}");
+    let (name, _) = refused(simulate_ensemble(
+        &model,
+        Scheme::Bdf(Default::default()),
+        &opts,
+        members(),
+    ));
+    assert_eq!(name, "scheme");
     let fourbar = mbs_models::fourbar::FourBar::default();
     let (name, reason) = refused(simulate_ensemble(
         &fourbar,

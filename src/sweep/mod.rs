@@ -411,7 +411,7 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
     /// Whether runs that differ only in their start (`q0…`, `qd0…` varied, nothing else) of a
     /// model with `option batch;` run four at a time on the lanes of its batch functions
     /// ([`crate::simulate_ensemble`]: the same runs, each its own steps and failure) where an
-    /// ensemble runs the sweep's scheme and model (DOPRI5 with adaptive steps, open loops
+    /// ensemble runs the sweep's scheme and model (DOPRI5, RK4 or explicit Euler, open loops
     /// without rotation joints); on by default. The `cpu_s` of such a run is its share of its
     /// ensemble's CPU time (the ensemble's divided by its runs).
     pub fn ensembles(mut self, on: bool) -> Self {
@@ -431,10 +431,7 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
         {
             return false;
         }
-        let b = &self.base;
-        let mut options = b.options.clone();
-        options.step = StepControl::from_settings(b.h, b.rtol, b.atol);
-        crate::ensemble_supported(&(self.make)(), &b.scheme, &options).is_ok()
+        crate::ensemble_supported(&(self.make)(), &self.base.scheme).is_ok()
     }
 
     /// The table's columns: `run`, `status` (ok, failed), `failure` (the failure's kind),

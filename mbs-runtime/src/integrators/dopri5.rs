@@ -141,12 +141,9 @@ impl Stepper for Dopri5 {
 
     fn attempt(&mut self, step: Step<'_>) -> Result<Attempt, Failure> {
         let Step(p, cur, h, ctl, next) = step;
-        if ctl.adaptive.is_none() && ctl.stability_check {
-            self.watch.check(p, cur, h, "DOPRI5", limit)?;
-        }
-        self.begin(cur);
+        self.begin(p, cur, h, ctl)?;
         for s in 1..7 {
-            let (c, _, _) = self.point(cur, h, s);
+            let (c, _, _) = self.point(p, cur, h, s)?;
             let r = p.accel(cur.t + c * h, &self.q, &self.v, &mut self.ka[s]);
             if let Err(e) = r {
                 return self.stage_failed(e, ctl, h);
@@ -185,12 +182,28 @@ impl Staged for Dopri5 {
         6
     }
 
-    fn begin(&mut self, cur: &State) {
+    fn begin(
+        &mut self,
+        p: &mut Problem,
+        cur: &State,
+        h: f64,
+        ctl: &Control,
+    ) -> Result<(), Failure> {
+        if ctl.adaptive.is_none() && ctl.stability_check {
+            self.watch.check(p, cur, h, "DOPRI5", limit)?;
+        }
         self.kv[0].copy_from_slice(&cur.qd);
         self.ka[0].copy_from_slice(&cur.qdd);
+        Ok(())
     }
 
-    fn point(&mut self, cur: &State, h: f64, s: usize) -> (f64, &[f64], &[f64]) {
+    fn point(
+        &mut self,
+        _p: &Problem,
+        cur: &State,
+        h: f64,
+        s: usize,
+    ) -> Result<(f64, &[f64], &[f64]), Failure> {
         // Σⱼ A[s][j] kⱼ summed from 0 in the order of j for each component, as one loop over
         // the components per stage (the same operations, in vector registers)
         let (q, v) = (&mut self.q, &mut self.v);
@@ -215,7 +228,7 @@ impl Staged for Dopri5 {
         if s == 5 {
             self.q6.copy_from_slice(&self.q);
         }
-        (C[s], &self.q, &self.v)
+        Ok((C[s], &self.q, &self.v))
     }
 
     fn accel_mut(&mut self, s: usize) -> &mut [f64] {

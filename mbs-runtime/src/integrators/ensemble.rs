@@ -1,5 +1,5 @@
 //! Many runs of one model at once: an ensemble of members (starts and inputs) integrated by
-//! one explicit adaptive scheme, four members at a time on the lanes of the model's batch
+//! one explicit scheme, four members at a time on the lanes of the model's batch
 //! functions ([`crate::lanes`], `option batch;`).
 //!
 //! Each lane is a whole run of its own, the driver's (`driver::Run`): its own step size, error
@@ -12,8 +12,9 @@
 //! failure). A lane whose run ends, by reaching t_end or by failing, takes the next member
 //! at once, so the lanes stay busy while members need different numbers of steps.
 //!
-//! What an ensemble runs: DOPRI5 with adaptive steps, on models without constraints or
-//! rotation joints (whose charts are the model's own state, one per run). A model without
+//! What an ensemble runs: DOPRI5 (adaptive or fixed steps), RK4 and explicit Euler, on models
+//! without constraints or rotation joints (whose charts are the model's own state, one per
+//! run). A model without
 //! `option batch;`, or a processor without AVX2, evaluates the lanes one by one: the same
 //! results, without the gain.
 
@@ -24,7 +25,7 @@ use super::stepper::{Staged, Step, Stepper};
 use crate::error::Failure;
 use crate::lanes::{F64x4, LANES, pack, simd_available, unpack};
 use crate::model::Model;
-use crate::options::{Options, Scheme, StepControl};
+use crate::options::{Options, Scheme};
 use crate::stats::Stats;
 use crate::trajectory::Trajectory;
 
@@ -83,8 +84,8 @@ impl EnsembleReport {
 /// agree with the one-state functions to about 1e-15 relative); a member that fails keeps its
 /// trajectory up to the failure and does not stop the others.
 ///
-/// Refused with an `InvalidOption` at t₀ (before any run): a scheme other than DOPRI5, fixed
-/// steps, a model with constraints or rotation joints. A member whose start is refused (its
+/// Refused with an `InvalidOption` at t₀ (before any run): a scheme other than DOPRI5, RK4
+/// and explicit Euler, a model with constraints or rotation joints. A member whose start is refused (its
 /// q0's length, a non-finite value, controllers) has that failure as its run.
 pub fn simulate_ensemble<M: Model + Clone + 'static>(
     model: &M,
@@ -105,7 +106,7 @@ pub fn simulate_ensemble_of<M: Model + 'static>(
 ) -> Result<EnsembleReport, SimError> {
     let shared = make();
     let model = &shared;
-    supported(model, &scheme, options).map_err(|e| super::driver::refused(model, e, options.t0))?;
+    supported(model, &scheme).map_err(|e| super::driver::refused(model, e, options.t0))?;
     let t_end = options.t_end;
     let start = |m: Member| -> Result<Run, SimError> {
         if !m.inputs.controllers.is_empty() {
@@ -171,9 +172,16 @@ pub fn simulate_ensemble_of<M: Model + 'static>(
             break;
         }
         let mut failed: [Option<Failure>; LANES] = Default::default();
-        for (slot, plan) in active.iter_mut().zip(&plans) {
-            if let (Some((_, run)), Some(_)) = (slot, plan) {
-                staged(&mut run.stepper).begin(&run.cur);
+        for ((slot, plan), failed) in active.iter_mut().zip(&plans).zip(failed.iter_mut()) {
+            if let (Some((_, run)), Some(p)) = (slot, plan) {
+                let Run {
+                    problem,
+                    stepper,
+                    ctl,
+                    cur,
+                    ..
+                } = run;
+                *failed = staged(stepper).begin(problem, cur, p.h, ctl).err();
             }
         }
         let stages = active
@@ -247,19 +255,15 @@ fn staged(stepper: &mut Box<dyn Stepper>) -> &mut dyn Staged {
     stepper.staged().expect("checked by `supported`")
 }
 
-/// Whether an ensemble runs `scheme` with `options` on `model` ([`simulate_ensemble`]
-/// refuses the others with this failure).
-pub fn ensemble_supported<M: Model>(
-    model: &M,
-    scheme: &Scheme,
-    options: &Options,
-) -> Result<(), Failure> {
-    supported(model, scheme, options)
+/// Whether an ensemble runs `scheme` on `model` ([`simulate_ensemble`] refuses the others
+/// with this failure).
+pub fn ensemble_supported<M: Model>(model: &M, scheme: &Scheme) -> Result<(), Failure> {
+    supported(model, scheme)
 }
 
-/// What an ensemble runs: an explicit staged scheme with adaptive steps, on a model without
-/// constraints or rotation joints.
-fn supported<M: Model>(model: &M, scheme: &Scheme, options: &Options) -> Result<(), Failure> {
+/// What an ensemble runs: an explicit staged scheme, on a model without constraints or
+/// rotation joints.
+fn supported<M: Model>(model: &M, scheme: &Scheme) -> Result<(), Failure> {
     let refuse = |name, value: String, reason| {
         Err(Failure::InvalidOption {
             name,
@@ -274,14 +278,7 @@ fn supported<M: Model>(model: &M, scheme: &Scheme, options: &Options) -> Result<
         return refuse(
             "scheme",
             scheme.name().to_string(),
-            "an ensemble runs DOPRI5, whose stages it evaluates together: run other schemes one member at a time with `simulate`",
-        );
-    }
-    if let StepControl::Fixed { h } = options.step {
-        return refuse(
-            "step",
-            format!("fixed h = {h}"),
-            "an ensemble takes adaptive steps (`StepControl::Adaptive`), each member its own",
+            "an ensemble runs explicit schemes (DOPRI5, RK4, explicit Euler), whose stages it evaluates together: run other schemes one member at a time with `simulate`",
         );
     }
     if M::NC > 0 {
@@ -338,7 +335,7 @@ impl Lanes {
     /// Lane `k`'s stage `s` of a step of size h: its time, point and inputs.
     fn point(&mut self, k: usize, run: &mut Run, h: f64, s: usize) -> Result<(), Failure> {
         let t0 = run.cur.t;
-        let (c, q, qd) = staged(&mut run.stepper).point(&run.cur, h, s);
+        let (c, q, qd) = staged(&mut run.stepper).point(&run.problem, &run.cur, h, s)?;
         let (pq, pv) = &mut self.points[k];
         pq.copy_from_slice(q);
         pv.copy_from_slice(qd);

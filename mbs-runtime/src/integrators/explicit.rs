@@ -21,6 +21,7 @@
 //! (far past it, a mode grows by orders of magnitude in a step).
 
 use super::problem::Problem;
+use super::stepper::{Control, Staged};
 use super::{Attempt, State, Step, Stepper};
 use crate::error::Failure;
 
@@ -37,6 +38,10 @@ pub(crate) struct Explicit {
     qs: Vec<f64>,
     vs: [Vec<f64>; 3],
     acc: [Vec<f64>; 3],
+    /// the new state (positions, velocities, accelerations) before it is handed over
+    qn: Vec<f64>,
+    vn: Vec<f64>,
+    an: Vec<f64>,
     watch: StabilityWatch,
 }
 
@@ -120,6 +125,9 @@ impl Explicit {
             qs: z(),
             vs: [z(), z(), z()],
             acc: [z(), z(), z()],
+            qn: z(),
+            vn: z(),
+            an: z(),
             watch: StabilityWatch::new(n),
         }
     }
@@ -393,45 +401,95 @@ impl Probe {
 impl Stepper for Explicit {
     fn attempt(&mut self, step: Step<'_>) -> Result<Attempt, Failure> {
         let Step(p, cur, h, ctl, next) = step;
+        self.begin(p, cur, h, ctl)?;
+        for s in 1..=self.stages() {
+            let (c, _, _) = self.point(p, cur, h, s)?;
+            let (q, v, a) = self.stage(s);
+            p.accel(cur.t + c * h, q, v, a)?;
+        }
+        self.complete(Step(p, cur, h, ctl, next))
+    }
+
+    fn staged(&mut self) -> Option<&mut dyn Staged> {
+        Some(self)
+    }
+}
+
+impl Explicit {
+    /// Stage `s`'s positions and velocities, and where its accelerations go: RK4's inner
+    /// stages, then the new state (Euler's only one).
+    fn stage(&mut self, s: usize) -> (&[f64], &[f64], &mut [f64]) {
+        if s < self.stages() {
+            (&self.qs, &self.vs[s - 1], &mut self.acc[s - 1])
+        } else {
+            (&self.qn, &self.vn, &mut self.an)
+        }
+    }
+}
+
+impl Staged for Explicit {
+    fn stages(&self) -> usize {
+        match self.kind {
+            Kind::Euler => 1,
+            Kind::Rk4 => 4,
+        }
+    }
+
+    fn begin(
+        &mut self,
+        p: &mut Problem,
+        cur: &State,
+        h: f64,
+        ctl: &Control,
+    ) -> Result<(), Failure> {
         if ctl.stability_check {
             let kind = self.kind;
             self.watch
                 .check(p, cur, h, self.name(), |osc| limit(kind, osc))?;
         }
+        Ok(())
+    }
+
+    fn point(
+        &mut self,
+        p: &Problem,
+        cur: &State,
+        h: f64,
+        s: usize,
+    ) -> Result<(f64, &[f64], &[f64]), Failure> {
         let n = self.n;
-        let t = cur.t;
+        if s < self.stages() {
+            // RK4's stage s at t + c h from the previous stage's (v, a); stage 1 from (qd0, qdd0)
+            let k = s - 1;
+            let c = if k < 2 { 0.5 } else { 1.0 };
+            let (vdone, vrest) = self.vs.split_at_mut(k);
+            let (vprev, aprev): (&[f64], &[f64]) = if k == 0 {
+                (&cur.qd, &cur.qdd)
+            } else {
+                (&vdone[k - 1], &self.acc[k - 1])
+            };
+            for i in 0..n {
+                self.qs[i] = cur.q[i] + c * h * vprev[i];
+                vrest[0][i] = cur.qd[i] + c * h * aprev[i];
+            }
+            return Ok((c, &self.qs, &self.vs[k]));
+        }
         match self.kind {
             Kind::Euler => {
                 for i in 0..n {
-                    next.q[i] = cur.q[i] + h * cur.qd[i];
-                    next.qd[i] = cur.qd[i] + h * cur.qdd[i];
+                    self.qn[i] = cur.q[i] + h * cur.qd[i];
+                    self.vn[i] = cur.qd[i] + h * cur.qdd[i];
                 }
             }
             Kind::Rk4 => {
-                // stage k at t + c_k h from the previous stage's (v, a); stage 1 is (qd0, qdd0)
-                for k in 0..3 {
-                    let c = if k < 2 { 0.5 } else { 1.0 };
-                    let (vdone, vrest) = self.vs.split_at_mut(k);
-                    let (adone, arest) = self.acc.split_at_mut(k);
-                    let (vprev, aprev): (&[f64], &[f64]) = if k == 0 {
-                        (&cur.qd, &cur.qdd)
-                    } else {
-                        (&vdone[k - 1], &adone[k - 1])
-                    };
-                    for i in 0..n {
-                        self.qs[i] = cur.q[i] + c * h * vprev[i];
-                        vrest[0][i] = cur.qd[i] + c * h * aprev[i];
-                    }
-                    p.accel(t + c * h, &self.qs, &vrest[0], &mut arest[0])?;
-                }
                 for i in 0..n {
-                    next.q[i] = cur.q[i]
+                    self.qn[i] = cur.q[i]
                         + h / 6.0
                             * (cur.qd[i]
                                 + 2.0 * self.vs[0][i]
                                 + 2.0 * self.vs[1][i]
                                 + self.vs[2][i]);
-                    next.qd[i] = cur.qd[i]
+                    self.vn[i] = cur.qd[i]
                         + h / 6.0
                             * (cur.qdd[i]
                                 + 2.0 * self.acc[0][i]
@@ -440,9 +498,24 @@ impl Stepper for Explicit {
                 }
             }
         }
-        p.check("q", &next.q)?;
-        p.check("qd", &next.qd)?;
-        p.accel(t + h, &next.q, &next.qd, &mut next.qdd)?;
+        p.check("q", &self.qn)?;
+        p.check("qd", &self.vn)?;
+        Ok((1.0, &self.qn, &self.vn))
+    }
+
+    fn accel_mut(&mut self, s: usize) -> &mut [f64] {
+        self.stage(s).2
+    }
+
+    fn stage_failed(&mut self, e: Failure, _ctl: &Control, _h: f64) -> Result<Attempt, Failure> {
+        Err(e)
+    }
+
+    fn complete(&mut self, step: Step<'_>) -> Result<Attempt, Failure> {
+        let Step(p, cur, h, ctl, next) = step;
+        next.q.copy_from_slice(&self.qn);
+        next.qd.copy_from_slice(&self.vn);
+        next.qdd.copy_from_slice(&self.an);
         if ctl.stability_check {
             let kind = self.kind;
             self.watch

@@ -136,11 +136,20 @@ pub(crate) trait Stepper {
 pub(crate) trait Staged {
     /// The evaluations of a step after the first (the state's own accelerations).
     fn stages(&self) -> usize;
-    /// Starts an attempt from `cur`.
-    fn begin(&mut self, cur: &State);
+    /// Starts an attempt of size h from `cur` (with a fixed step, its check against the
+    /// scheme's stability region first).
+    fn begin(&mut self, p: &mut Problem, cur: &State, h: f64, ctl: &Control)
+    -> Result<(), Failure>;
     /// Stage `s`'s time as a fraction of h, and its positions and velocities, of a step of
-    /// size h from `cur` (the stages before it evaluated).
-    fn point(&mut self, cur: &State, h: f64, s: usize) -> (f64, &[f64], &[f64]);
+    /// size h from `cur` (the stages before it evaluated); a point that is not finite is the
+    /// failure `p` names.
+    fn point(
+        &mut self,
+        p: &Problem,
+        cur: &State,
+        h: f64,
+        s: usize,
+    ) -> Result<(f64, &[f64], &[f64]), Failure>;
     /// Where stage `s`'s accelerations go.
     fn accel_mut(&mut self, s: usize) -> &mut [f64];
     /// The attempt, after the evaluation of a stage failed with `e`.

@@ -1,5 +1,5 @@
 //! Many runs at once: an ensemble of 16 members (starts spread about the test state) of the
-//! 16-bar chain and of the 12-joint arm, DOPRI5 at rtol 1e-6 over 0.5 s, run by
+//! 16-bar chain and of the 12-joint arm, DOPRI5 at rtol 1e-6 and RK4 at h = 1 ms over 0.5 s, run by
 //! `simulate_ensemble` (four members at a time on the lanes of `option batch;`) against the
 //! same 16 members run one after another by `simulate`, in the same run (criterion).
 //!
@@ -50,6 +50,14 @@ fn options() -> Options {
     }
 }
 
+/// RK4 at a fixed step of 1 ms over the same 0.5 s.
+fn fixed() -> Options {
+    Options {
+        output: Output::Last,
+        ..Options::fixed(0.5, 1e-3)
+    }
+}
+
 fn members(n: usize) -> Vec<Member> {
     starts(n)
         .into_iter()
@@ -57,27 +65,34 @@ fn members(n: usize) -> Vec<Member> {
         .collect()
 }
 
+/// The schemes measured: DOPRI5 adaptive, RK4 at a fixed step.
+fn configurations() -> [(&'static str, Scheme, Options); 2] {
+    [
+        ("dopri5", Scheme::Dopri5, options()),
+        ("rk4", Scheme::Rk4, fixed()),
+    ]
+}
+
 /// The runs one by one: total steps.
-fn one_by_one<M: Model + Clone + 'static>(model: &M) -> usize {
+fn one_by_one<M: Model + Clone + 'static>(model: &M, scheme: Scheme, opts: &Options) -> usize {
     starts(M::NQ)
         .into_iter()
         .map(|(q, qd)| {
             let o = Options {
                 q0: Some(q),
                 qd0: Some(qd),
-                ..options()
+                ..opts.clone()
             };
-            let (_, stats) = simulate_with(model.clone(), Scheme::Dopri5, o, Inputs::default())
-                .expect("the run ends");
+            let (_, stats) =
+                simulate_with(model.clone(), scheme, o, Inputs::default()).expect("the run ends");
             stats.steps
         })
         .sum()
 }
 
 /// The ensemble: total steps and the occupancy of its lanes.
-fn ensemble<M: Model + Clone + 'static>(model: &M) -> (usize, f64) {
-    let r = simulate_ensemble(model, Scheme::Dopri5, &options(), members(M::NQ))
-        .expect("an ensemble it runs");
+fn ensemble<M: Model + Clone + 'static>(model: &M, scheme: Scheme, opts: &Options) -> (usize, f64) {
+    let r = simulate_ensemble(model, scheme, opts, members(M::NQ)).expect("an ensemble it runs");
     let steps = r
         .runs
         .iter()
@@ -86,20 +101,30 @@ fn ensemble<M: Model + Clone + 'static>(model: &M) -> (usize, f64) {
     (steps, r.occupancy())
 }
 
+/// Both ways, each configuration: (group, steps alone, steps in the ensemble, occupancy).
 fn bench_model<M: Model + Clone + 'static>(
     c: &mut Criterion,
     name: &'static str,
     model: M,
-) -> (&'static str, usize, usize, f64) {
+) -> Vec<(String, usize, usize, f64)> {
     assert!(M::BATCH_GENERATED, "{name} has `option batch;`");
-    let steps_alone = one_by_one(&model);
-    let (steps, occupancy) = ensemble(&model);
-    let mut g = c.benchmark_group(format!("ensemble_{name}"));
-    g.sample_size(10);
-    g.bench_function("one_by_one", |b| b.iter(|| one_by_one(black_box(&model))));
-    g.bench_function("ensemble", |b| b.iter(|| ensemble(black_box(&model))));
-    g.finish();
-    (name, steps_alone, steps, occupancy)
+    let mut rows = Vec::new();
+    for (label, scheme, opts) in configurations() {
+        let steps_alone = one_by_one(&model, scheme, &opts);
+        let (steps, occupancy) = ensemble(&model, scheme, &opts);
+        let group = format!("ensemble_{name}_{label}");
+        let mut g = c.benchmark_group(&group);
+        g.sample_size(10);
+        g.bench_function("one_by_one", |b| {
+            b.iter(|| one_by_one(black_box(&model), scheme, &opts))
+        });
+        g.bench_function("ensemble", |b| {
+            b.iter(|| ensemble(black_box(&model), scheme, &opts))
+        });
+        g.finish();
+        rows.push((group, steps_alone, steps, occupancy));
+    }
+    rows
 }
 
 /// The sweep of 256 runs of chain16 over random starts on one thread, one run at a time and
@@ -143,26 +168,24 @@ fn sweep_rounds() -> (f64, f64) {
 fn main() {
     let since = std::time::SystemTime::now();
     let mut c = Criterion::default().configure_from_args();
-    let rows = [
-        bench_model(&mut c, "chain16", Chain16::default()),
-        bench_model(&mut c, "arm3d_12", Arm3d12::default()),
-    ];
+    let mut rows = bench_model(&mut c, "chain16", Chain16::default());
+    rows.extend(bench_model(&mut c, "arm3d_12", Arm3d12::default()));
     c.final_summary();
     println!("\nprocessor: {}", common::processor());
     println!(
-        "{MEMBERS} runs, DOPRI5 rtol 1e-6, 0.5 s   steps alone / ensemble   lanes busy   ms one by one   ms ensemble   throughput"
+        "{MEMBERS} runs over 0.5 s (DOPRI5 rtol 1e-6; RK4 h = 1 ms)   steps alone / ensemble   lanes busy   ms one by one   ms ensemble   throughput"
     );
-    for (name, alone, steps, occupancy) in rows {
-        let group = format!("ensemble_{name}");
+    for (group, alone, steps, occupancy) in rows {
+        let name = group.trim_start_matches("ensemble_");
         let (Some(o), Some(e)) = (
             median_ns(&group, "one_by_one", since),
             median_ns(&group, "ensemble", since),
         ) else {
-            println!("{name:<9} steps {alone} / {steps}, lanes busy {occupancy:.2}");
+            println!("{name:<16} steps {alone} / {steps}, lanes busy {occupancy:.2}");
             continue;
         };
         println!(
-            "{name:<36} {alone:>7} / {steps:<7}   {occupancy:>10.2}   {:>13.2}   {:>11.2}   {:>9.2}×",
+            "{name:<48} {alone:>7} / {steps:<7}   {occupancy:>10.2}   {:>13.2}   {:>11.2}   {:>9.2}×",
             o * 1e-6,
             e * 1e-6,
             o / e

@@ -571,5 +571,23 @@ fn a_sweep_over_starts_runs_on_lanes_and_gives_the_rows_of_runs_alone() {
     }
     println!("a sweep of 20 runs on lanes against one at a time: metrics within {worst:.1e}");
     assert!(worst < 1e-9, "{worst:e}");
+    // a metric that panics for the runs started at q0[0] = 0.4 fails those rows alone
+    let d = dir.join("panics");
+    let metric = Metrics::new(["q0"], |_: &Chain4, tr: &mbs::Trajectory| {
+        assert!(tr.q(0)[0] != 0.4, "no metric here");
+        vec![tr.q(0)[0]]
+    });
+    let s = Sweep::new(Chain4::default, &plan, Scheme::Dopri5, base())
+        .unwrap()
+        .metrics(metric)
+        .threads(2);
+    let summary = s.run(&d, &runs).unwrap();
+    assert_eq!(summary.failed, 5 + 3);
+    let table = d.join("results.csv");
+    let kinds = column(&table, "failure");
+    for (q0, kind) in column(&table, "q0[0]").iter().zip(&kinds) {
+        assert!(kind != "Panic" || q0 == "0.4", "{q0}: {kind}");
+    }
+    assert_eq!(kinds.iter().filter(|k| *k == "Panic").count(), 3);
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -46,7 +46,7 @@ mod table;
 pub use plan::{Design, DesignKind, Plan, RunList, SimulationSpec, SlurmSpec, Value, Variable};
 pub use table::{MergeReport, merge};
 
-use crate::{ConstraintMethod, Integrator, Trajectory};
+use crate::{ConstraintMethod, Integrator, LANES, Trajectory};
 use crate::{Model, Options, Output, Parameters, Scheme, SimError, Simulation, StepControl};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
@@ -328,8 +328,9 @@ pub struct Sweep<'a, M: Model> {
     ensembles: bool,
 }
 
-/// Runs per ensemble when a sweep's runs share the lanes of the batch functions
-/// ([`Sweep::ensembles`]): taken from the list together by one thread.
+/// The most runs per ensemble when a sweep's runs share the lanes of the batch functions
+/// ([`Sweep::ensembles`]): taken from the list together by one thread (fewer when the
+/// threads would otherwise wait: a thread's share of the runs, at least four).
 const ENSEMBLE_RUNS: usize = 16;
 
 impl<'a, M: Model + 'static> Sweep<'a, M> {
@@ -410,7 +411,9 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
 
     /// Whether runs that differ only in their start (`q0…`, `qd0…` varied, nothing else) of a
     /// model with `option batch;` run four at a time on the lanes of its batch functions
-    /// ([`crate::simulate_ensemble`]: the same runs, each its own steps and failure) where an
+    /// ([`crate::simulate_ensemble`]: the same runs, each its own steps and failure, to the
+    /// rounding of the batch functions, which may rarely flip an adaptive step's acceptance
+    /// and so move a run's steps and final state by its tolerance) where an
     /// ensemble runs the sweep's scheme and model (DOPRI5, RK4 or explicit Euler, open loops
     /// without rotation joints); on by default. The `cpu_s` of such a run is its share of its
     /// ensemble's CPU time (the ensemble's divided by its runs).
@@ -594,13 +597,20 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
         let mut failed = 0;
         let mut cpu = Duration::ZERO;
         let mut written = 0;
+        let mut on_lanes = 0;
         let mut io_error = None;
         std::thread::scope(|s| {
             s.spawn(|| {
                 let tx = tx; // moved in: the channel closes when every worker is done
                 pool.broadcast(|_| {
-                    // a run at a time, or an ensemble's runs
-                    let chunk = if ensembles { ENSEMBLE_RUNS } else { 1 };
+                    // a run at a time, or an ensemble's runs: up to ENSEMBLE_RUNS, fewer
+                    // where that would leave threads without runs (at least a lane's four)
+                    let share = pending.len().div_ceil(threads);
+                    let chunk = if ensembles {
+                        share.clamp(LANES, ENSEMBLE_RUNS)
+                    } else {
+                        1
+                    };
                     loop {
                         if self.stop.is_some_and(|f| f.load(Ordering::SeqCst)) {
                             break;
@@ -628,6 +638,7 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
                 held.insert(k, row);
                 while let Some(row) = held.remove(&written) {
                     failed += usize::from(row.failed);
+                    on_lanes += usize::from(row.on_lanes);
                     cpu += row.cpu;
                     if io_error.is_none() {
                         io_error = table.append(&row.fields).err();
@@ -655,7 +666,7 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
             wall: start.elapsed(),
             cpu,
             threads,
-            on_lanes: if ensembles { written } else { 0 },
+            on_lanes,
             table: path.to_path_buf(),
         })
     }
@@ -697,55 +708,78 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
     /// The runs `indices` of `runs` as one ensemble ([`Sweep::ensembles`]), whatever happens
     /// in them, as rows in their order.
     fn run_ensemble(&self, indices: &[usize], runs: &RunList, targets: &[Target]) -> Vec<Row> {
-        let clock = cpu_time::ThreadTime::now();
-        let mut outcomes: Vec<Option<Outcome>> = Vec::with_capacity(indices.len());
-        let (mut members, mut shared, mut in_ensemble) = (Vec::new(), None, Vec::new());
+        let nm = self.metrics.names.len();
+        // each run's settings, as `run_one` makes them (a panic in the model's factory is
+        // that run's row); the runs whose settings stand become members
+        let (mut members, mut shared, mut in_ensemble, mut rows) =
+            (Vec::new(), None, Vec::new(), Vec::new());
         for &i in indices {
-            let mut model = (self.make)();
-            match self.settings(&mut model, i, &runs.rows[i], &runs.names, targets) {
-                Ok((scheme, options)) => {
-                    let member = crate::Member {
+            let clock = cpu_time::ThreadTime::now();
+            let settings = catch_unwind(AssertUnwindSafe(|| {
+                let mut model = (self.make)();
+                self.settings(&mut model, i, &runs.rows[i], &runs.names, targets)
+            }));
+            match settings {
+                Ok(Ok((scheme, options))) => {
+                    members.push(crate::Member {
                         q0: options.q0.clone(),
                         qd0: options.qd0.clone(),
                         inputs: Default::default(),
-                    };
-                    members.push(member);
+                    });
                     shared.get_or_insert((scheme, options));
-                    in_ensemble.push(outcomes.len());
-                    outcomes.push(None);
+                    in_ensemble.push(rows.len());
+                    rows.push(None);
                 }
-                Err(e) => outcomes.push(Some(invalid_run(e))),
+                Ok(Err(e)) => rows.push(Some(row_of(
+                    i,
+                    &runs.rows[i],
+                    invalid_run(e),
+                    clock.elapsed(),
+                    nm,
+                ))),
+                Err(panic) => rows.push(Some(row_of(
+                    i,
+                    &runs.rows[i],
+                    panicked(panic),
+                    clock.elapsed(),
+                    nm,
+                ))),
             }
         }
         if let Some((scheme, options)) = shared {
+            let clock = cpu_time::ThreadTime::now();
             let made = catch_unwind(AssertUnwindSafe(|| {
-                let report = crate::simulate_ensemble_of(&self.make, scheme, &options, members)?;
-                let done = report.runs.into_iter().map(|r| match r {
-                    Ok((traj, stats)) => self.finished((self.make)(), traj, stats, options.t_end),
-                    Err(e) => failed_run(e, options.t0),
-                });
-                Ok::<Vec<Outcome>, SimError>(done.collect())
+                crate::simulate_ensemble_of(&self.make, scheme, &options, members)
             }));
-            let done = match made {
-                Ok(Ok(done)) => done,
-                Ok(Err(e)) => vec![failed_run(e, options.t0); in_ensemble.len()],
-                Err(panic) => vec![panicked(panic); in_ensemble.len()],
+            let Ok(Ok(report)) = made else {
+                // the ensemble itself failed or user code panicked in it: each of its runs
+                // made one at a time, so that each row says what is its own
+                for j in in_ensemble {
+                    let i = indices[j];
+                    rows[j] = Some(self.run_one(i, &runs.rows[i], &runs.names, targets));
+                }
+                return rows.into_iter().flatten().collect();
             };
-            for (j, o) in in_ensemble.into_iter().zip(done) {
-                outcomes[j] = Some(o);
+            // each run's metrics, a panic in them that run's own
+            let outcomes: Vec<Outcome> = (report.runs.into_iter())
+                .map(|r| match r {
+                    Ok((traj, stats)) => catch_unwind(AssertUnwindSafe(|| {
+                        self.finished((self.make)(), traj, stats, options.t_end)
+                    }))
+                    .unwrap_or_else(panicked),
+                    Err(e) => failed_run(e, options.t0),
+                })
+                .collect();
+            // each run its share of the ensemble's time
+            let cpu = clock.elapsed() / outcomes.len().max(1) as u32;
+            for (j, o) in in_ensemble.into_iter().zip(outcomes) {
+                let i = indices[j];
+                let mut row = row_of(i, &runs.rows[i], o, cpu, nm);
+                row.on_lanes = true;
+                rows[j] = Some(row);
             }
         }
-        // each run its share of the ensemble's time
-        let cpu = clock.elapsed() / indices.len().max(1) as u32;
-        let nm = self.metrics.names.len();
-        indices
-            .iter()
-            .zip(outcomes)
-            .map(|(&i, o)| {
-                let o = o.expect("every run has its outcome");
-                row_of(i, &runs.rows[i], o, cpu, nm)
-            })
-            .collect()
+        rows.into_iter().flatten().collect()
     }
 
     /// The outcome of a run that reached its end: its metrics, checked.
@@ -808,6 +842,7 @@ fn row_of(i: usize, values: &[Value], outcome: Outcome, cpu: Duration, nm: usize
             fields,
             failed,
             cpu,
+            on_lanes: false,
         }
     }
 }
@@ -977,6 +1012,8 @@ struct Row {
     fields: Vec<String>,
     failed: bool,
     cpu: Duration,
+    /// made in an ensemble ([`Sweep::ensembles`])
+    on_lanes: bool,
 }
 
 /// Writes `text` to `path` through a file beside it renamed over it: array tasks preparing the

@@ -288,7 +288,12 @@ impl Problem {
         let scale = self.pivots.iter().fold(0.0f64, |m, p| m.max(*p));
         let positive = self.pivots.iter().all(|p| *p > PIVOT_FLOOR * scale) && scale.is_finite();
         if positive && qdd.iter().all(|a| a.is_finite()) {
-            if self.watching() {
+            // the watch's ratios p/p₀ only where some pivot is near its tolerance: clear of
+            // it by a margin above rounding, p ≥ tol·p₀ says so without a division per pivot
+            let tol = self.singularity_tol * (1.0 + 1e-12);
+            let clear = (self.pivots.iter().zip(&self.start_forward))
+                .fold(true, |ok, (p, p0)| ok & (*p >= tol * p0));
+            if self.watching() && !clear {
                 let (ratio, j) = worst_pivot_of(self.pivots.iter().copied(), &self.start_forward);
                 self.judge(ratio, j, t, q)?;
             }

@@ -960,3 +960,60 @@ fn sensitivities_cross_chart_switches_as_differences_say() {
         assert!(worst < 1e-5, "{}: {worst:e}", scheme.name());
     }
 }
+
+mbs::multibody! {
+    /// Three masses on springs along x, y, z; the springs along x and y equally stiff, so that
+    /// their poles are one repeated pole, which moving kx alone splits.
+    model Twins {
+        param kx = 100.0 sensitive; param ky = 100.0; param kz = 300.0 sensitive; param m = 1.0;
+        option tangents;
+        dof x = 0.0; dof y = 0.0; dof z = 0.0;
+        body a { mass = m; inertia = (0.01, 0.01, 0.01); }
+        body b { mass = m; inertia = (0.01, 0.01, 0.01); }
+        body c { mass = m; inertia = (0.01, 0.01, 0.01); }
+        TOG[a] = Tdisp(x, 0, 0);
+        TOG[b] = Tdisp(0, y, 0);
+        TOG[c] = Tdisp(0, 0, z);
+        generalized_force(x, -kx * x);
+        generalized_force(y, -ky * y);
+        generalized_force(z, -kz * z);
+    }
+}
+
+/// A repeated pole (a symmetric machine's twin modes) has no derivative: it is listed, gives
+/// none, and the simple pole beside it keeps its own (dλ/dkz = i/(2 m ω) at ω = √(kz/m),
+/// dλ/dkx = 0).
+#[test]
+fn a_repeated_pole_is_listed_and_the_others_keep_their_derivatives() {
+    use mbs::analysis::pole_sensitivity;
+    let model = Twins::default();
+    let options = StaticsOptions::default();
+    let eq = static_equilibrium(&model, &options).unwrap();
+    let s = pole_sensitivity(&model, &eq, &options).unwrap();
+    for (i, mode) in s.modes.modes.iter().enumerate() {
+        println!(
+            "mode {i}: λ = {:.6} + {:.6}i, dλ/dkx {:?}, dλ/dkz {:?}",
+            mode.re,
+            mode.im,
+            s.dpole(i, "kx"),
+            s.dpole(i, "kz")
+        );
+    }
+    assert_eq!(s.modes.modes.len(), 3);
+    let simple: Vec<usize> = (0..3).filter(|i| !s.repeated.contains(i)).collect();
+    assert_eq!(simple.len(), 1, "repeated: {:?}", s.repeated);
+    let z = simple[0];
+    let omega = 300.0f64.sqrt();
+    assert!((s.modes.modes[z].im - omega).abs() < 1e-9 * omega);
+    let (re, im) = s.dpole(z, "kz").unwrap();
+    assert!(
+        re.abs() < 1e-12 && (im - 1.0 / (2.0 * omega)).abs() < 1e-12,
+        "{re} {im}"
+    );
+    let (re, im) = s.dpole(z, "kx").unwrap();
+    assert!(re.abs() < 1e-12 && im.abs() < 1e-12, "{re} {im}");
+    for &i in &s.repeated {
+        assert_eq!(s.dpole(i, "kx"), None);
+        assert_eq!(s.dfrequency(i, "kz"), None);
+    }
+}

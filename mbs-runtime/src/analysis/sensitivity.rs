@@ -172,15 +172,20 @@ pub struct PoleSensitivity {
     /// pair or real pole, by frequency)
     pub modes: super::Modes,
     /// dλ/dp of each mode's pole (Im λ ≥ 0), `(re, im)`, mode-major: entry `i * NS + j` is
-    /// mode i and parameter j
+    /// mode i and parameter j; NaN for the modes of `repeated`
     pub dpole_dp: Vec<(f64, f64)>,
+    /// the modes whose pole is repeated (another mode's within 1e-8 of its magnitude; a
+    /// symmetric machine's twin legs) or defective: a repeated pole splits as the parameters
+    /// move, and has no derivative of its own ([`PoleSensitivity::dpole`] gives none)
+    pub repeated: Vec<usize>,
 }
 
 impl PoleSensitivity {
     /// dλ/dp of mode `i` and the parameter named `param`, `(re, im)` (1/s per unit of p).
     pub fn dpole(&self, i: usize, param: &str) -> Option<(f64, f64)> {
         let j = self.params.iter().position(|p| *p == param)?;
-        (i < self.modes.modes.len()).then(|| self.dpole_dp[i * self.params.len() + j])
+        (i < self.modes.modes.len() && !self.repeated.contains(&i))
+            .then(|| self.dpole_dp[i * self.params.len() + j])
     }
 
     /// d f/dp of mode `i`'s natural frequency f = |λ|/2π (Hz per unit of p).
@@ -216,8 +221,12 @@ impl PoleSensitivity {
 /// dλ/dp = −(yᴴ(λ²M' + λC' + K' − K_λ')x − yᴴB'ᵀℓ + mᴴB'x) / yᴴ(2λM + C)x, B' and K_λ' along
 /// the equilibria from [`Model::constraint_rest_derivatives`] and dλ_eq/dp.
 ///
-/// Exact to rounding for simple poles; a repeated pole has no derivative and is reported as
-/// an error. Needs `option tangents;`; equilibria with locked coordinates (not at rest on
+/// Exact to rounding for simple poles; a repeated pole (or a defective one) has no
+/// derivative: its modes are listed in [`PoleSensitivity::repeated`], the others' derivatives
+/// given as for simple poles (a symmetric machine's twin modes no longer stop the rest; before,
+/// a repeated pole that was not defective passed the test on yᴴ(2λM + C)x and got a
+/// derivative that depended on the eigenvectors inverse iteration happened to find). Needs
+/// `option tangents;`; equilibria with locked coordinates (not at rest on
 /// them) are refused.
 pub fn pole_sensitivity<M: Model + Clone>(
     model: &M,
@@ -320,9 +329,21 @@ pub fn pole_sensitivity<M: Model + Clone>(
         .fold(1.0f64, |s, x| s.max(x.abs()));
     let na = n + nc;
     let mut dpole_dp = Vec::with_capacity(modes.modes.len() * ns);
+    let mut repeated = Vec::new();
+    let magnitude = |m: &super::Mode| m.re.hypot(m.im);
+    let twin = |i: usize, m: &super::Mode| {
+        modes.modes.iter().enumerate().any(|(j, o)| {
+            j != i && (m.re - o.re).hypot(m.im - o.im) <= 1e-8 * magnitude(m).max(magnitude(o))
+        })
+    };
     let mut a_right = Lu::<C64>::new(na);
     let mut a_left = Lu::<C64>::new(na);
-    for mode in &modes.modes {
+    for (index, mode) in modes.modes.iter().enumerate() {
+        if twin(index, mode) {
+            repeated.push(index);
+            dpole_dp.extend(std::iter::repeat_n((f64::NAN, f64::NAN), ns));
+            continue;
+        }
         let lambda = C64::new(mode.re, mode.im);
         // A(μ) and A(μ)ᴴ with μ a hair off λ, for inverse iteration
         let mag = mode.re.hypot(mode.im);
@@ -383,9 +404,10 @@ pub fn pole_sensitivity<M: Model + Clone>(
         };
         let denom = form(&|ij| real(2.0) * lambda * real(mass[ij]) + real(c[ij]));
         if denom.abs() <= 1e-10 * scale {
-            return Err(refuse(
-                "a pole is repeated (or defective): it has no derivative by the parameters",
-            ));
+            // defective: no derivative either
+            repeated.push(index);
+            dpole_dp.extend(std::iter::repeat_n((f64::NAN, f64::NAN), ns));
+            continue;
         }
         for p in 0..ns {
             let [dmp, dcp, dkp, dbp] = [0, 1, 2, 3].map(|i| &along[4 * p + i]);
@@ -405,18 +427,21 @@ pub fn pole_sensitivity<M: Model + Clone>(
             dpole_dp.push((d.re, im));
         }
     }
+    // the simple poles' derivatives checked (the repeated ones are NaN by design)
     let per_mode = 2 * M::SENSITIVE.len();
-    check_named(
-        "dλ/dp",
-        &dpole_dp
-            .iter()
-            .flat_map(|&(a, b)| [a, b])
-            .collect::<Vec<_>>(),
-        |i| format!("mode {}", i / per_mode.max(1)),
-    )?;
+    let values: Vec<f64> = (dpole_dp.iter().enumerate())
+        .flat_map(|(k, &(a, b))| {
+            let own = !repeated.contains(&(k / ns.max(1)));
+            [a, b].map(|x| if own { x } else { 0.0 })
+        })
+        .collect();
+    check_named("dλ/dp", &values, |i| {
+        format!("mode {}", i / per_mode.max(1))
+    })?;
     Ok(PoleSensitivity {
         params: M::SENSITIVE.to_vec(),
         modes,
         dpole_dp,
+        repeated,
     })
 }

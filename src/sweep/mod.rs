@@ -413,10 +413,10 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
     /// model with `option batch;` run four at a time on the lanes of its batch functions
     /// ([`crate::simulate_ensemble`]: the same runs, each its own steps and failure, to the
     /// rounding of the batch functions, which may rarely flip an adaptive step's acceptance
-    /// and so move a run's steps and final state by its tolerance) where an
-    /// ensemble runs the sweep's scheme and model (DOPRI5, RK4 or explicit Euler, open loops
-    /// without rotation joints); on by default. The `cpu_s` of such a run is its share of its
-    /// ensemble's CPU time (the ensemble's divided by its runs).
+    /// and so move a run's steps and final state by its tolerance) where an ensemble runs the
+    /// sweep's scheme and model (DOPRI5, RK4 or explicit Euler, open loops, rotation joints
+    /// only with `chart_switch` at 0); on by default. The `cpu_s` of such a run is its share
+    /// of its ensemble's CPU time (the ensemble's divided by its runs).
     pub fn ensembles(mut self, on: bool) -> Self {
         self.ensembles = on;
         self
@@ -434,7 +434,7 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
         {
             return false;
         }
-        crate::ensemble_supported(&(self.make)(), &self.base.scheme).is_ok()
+        crate::ensemble_supported(&(self.make)(), &self.base.scheme, &self.base.options).is_ok()
     }
 
     /// The table's columns: `run`, `status` (ok, failed), `failure` (the failure's kind),

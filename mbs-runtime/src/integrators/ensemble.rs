@@ -13,8 +13,9 @@
 //! at once, so the lanes stay busy while members need different numbers of steps.
 //!
 //! What an ensemble runs: DOPRI5 (adaptive or fixed steps), RK4 and explicit Euler, on models
-//! without constraints or rotation joints (whose charts are the model's own state, one per
-//! run). A model without
+//! without constraints; rotation joints only with `Options::chart_switch` at 0 (a joint's
+//! chart is the model's own state, one per run, and the lanes share one model: without
+//! re-centring every run keeps the model's charts). A model without
 //! `option batch;`, or a processor without AVX2, evaluates the lanes one by one: the same
 //! results, without the gain.
 
@@ -85,7 +86,8 @@ impl EnsembleReport {
 /// trajectory up to the failure and does not stop the others.
 ///
 /// Refused with an `InvalidOption` at t₀ (before any run): a scheme other than DOPRI5, RK4
-/// and explicit Euler, a model with constraints or rotation joints. A member whose start is refused (its
+/// and explicit Euler, a model with constraints, and rotation joints whose charts would be
+/// re-centred (`chart_switch` ≠ 0). A member whose start is refused (its
 /// q0's length, a non-finite value, controllers) has that failure as its run.
 pub fn simulate_ensemble<M: Model + Clone + 'static>(
     model: &M,
@@ -106,7 +108,7 @@ pub fn simulate_ensemble_of<M: Model + 'static>(
 ) -> Result<EnsembleReport, SimError> {
     let shared = make();
     let model = &shared;
-    supported(model, &scheme).map_err(|e| super::driver::refused(model, e, options.t0))?;
+    supported(model, &scheme, options).map_err(|e| super::driver::refused(model, e, options.t0))?;
     let t_end = options.t_end;
     let start = |m: Member| -> Result<Run, SimError> {
         if !m.inputs.controllers.is_empty() {
@@ -255,15 +257,19 @@ fn staged(stepper: &mut Box<dyn Stepper>) -> &mut dyn Staged {
     stepper.staged().expect("checked by `supported`")
 }
 
-/// Whether an ensemble runs `scheme` on `model` ([`simulate_ensemble`] refuses the others
-/// with this failure).
-pub fn ensemble_supported<M: Model>(model: &M, scheme: &Scheme) -> Result<(), Failure> {
-    supported(model, scheme)
+/// Whether an ensemble runs `scheme` with `options` on `model` ([`simulate_ensemble`]
+/// refuses the others with this failure).
+pub fn ensemble_supported<M: Model>(
+    model: &M,
+    scheme: &Scheme,
+    options: &Options,
+) -> Result<(), Failure> {
+    supported(model, scheme, options)
 }
 
-/// What an ensemble runs: an explicit staged scheme, on a model without constraints or
-/// rotation joints.
-fn supported<M: Model>(model: &M, scheme: &Scheme) -> Result<(), Failure> {
+/// What an ensemble runs: an explicit staged scheme, on a model without constraints, whose
+/// rotation joints (if any) keep the model's charts.
+fn supported<M: Model>(model: &M, scheme: &Scheme, options: &Options) -> Result<(), Failure> {
     let refuse = |name, value: String, reason| {
         Err(Failure::InvalidOption {
             name,
@@ -289,11 +295,11 @@ fn supported<M: Model>(model: &M, scheme: &Scheme) -> Result<(), Failure> {
         );
     }
     let joints = model.info().rotation_joints.len();
-    if joints > 0 {
+    if joints > 0 && options.chart_switch != 0.0 {
         return refuse(
-            "model",
-            format!("{joints} rotation joints"),
-            "a rotation joint's chart is the model's own state, one per run: run the members with `simulate`",
+            "chart_switch",
+            format!("{} with {joints} rotation joints", options.chart_switch),
+            "a rotation joint's chart is the model's own state, one per run, and the lanes share one model: set `chart_switch` to 0 (the joints keep the model's charts and stop at gimbal lock, as Euler angles do), or run the members with `simulate`",
         );
     }
     Ok(())

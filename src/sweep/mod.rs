@@ -719,7 +719,7 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
                 let mut model = (self.make)();
                 self.settings(&mut model, i, &runs.rows[i], &runs.names, targets)
             }));
-            match settings {
+            let refused = match settings {
                 Ok(Ok((scheme, options))) => {
                     members.push(crate::Member {
                         q0: options.q0.clone(),
@@ -729,22 +729,12 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
                     shared.get_or_insert((scheme, options));
                     in_ensemble.push(rows.len());
                     rows.push(None);
+                    continue;
                 }
-                Ok(Err(e)) => rows.push(Some(row_of(
-                    i,
-                    &runs.rows[i],
-                    invalid_run(e),
-                    clock.elapsed(),
-                    nm,
-                ))),
-                Err(panic) => rows.push(Some(row_of(
-                    i,
-                    &runs.rows[i],
-                    panicked(panic),
-                    clock.elapsed(),
-                    nm,
-                ))),
-            }
+                Ok(Err(e)) => invalid_run(e),
+                Err(panic) => panicked(panic),
+            };
+            rows.push(Some(row_of(i, &runs.rows[i], refused, clock.elapsed(), nm)));
         }
         if let Some((scheme, options)) = shared {
             let clock = cpu_time::ThreadTime::now();

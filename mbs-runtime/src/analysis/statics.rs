@@ -294,22 +294,11 @@ pub fn static_equilibrium<M: Model + Clone>(
     let (mut q, mut zero) = (q, vec![0.0; n]);
     crate::charts::recentre(&mut centred, &mut q, &mut zero, &options.locked);
     // a failure's q is read in the model's charts, where a retry from it starts
-    let mut eq = solve(&centred, q).map_err(|e| match e {
-        AnalysisError::NotConverged {
-            iterations,
-            residual,
-            constraint_residual,
-            mut q,
-        } => {
-            crate::charts::reread_angles(&centred, model, &mut q);
-            AnalysisError::NotConverged {
-                iterations,
-                residual,
-                constraint_residual,
-                q,
-            }
+    let mut eq = solve(&centred, q).map_err(|mut e| {
+        if let AnalysisError::NotConverged { q, .. } = &mut e {
+            crate::charts::reread_angles(&centred, model, q);
         }
-        other => other,
+        e
     })?;
     // a restart or two, each from a chart centred on where Newton went; a restart that fails
     // leaves the equilibrium found (converged, in a chart far from its centre)

@@ -108,7 +108,8 @@ pub fn simulate_ensemble_of<M: Model + 'static>(
 ) -> Result<EnsembleReport, SimError> {
     let shared = make();
     let model = &shared;
-    supported(model, &scheme, options).map_err(|e| super::driver::refused(model, e, options.t0))?;
+    let stages = supported(model, &scheme, options)
+        .map_err(|e| super::driver::refused(model, e, options.t0))?;
     let t_end = options.t_end;
     let start = |m: Member| -> Result<Run, SimError> {
         if !m.inputs.controllers.is_empty() {
@@ -186,11 +187,6 @@ pub fn simulate_ensemble_of<M: Model + 'static>(
                 *failed = staged(stepper).begin(problem, cur, p.h, ctl).err();
             }
         }
-        let stages = active
-            .iter_mut()
-            .flatten()
-            .next()
-            .map_or(0, |(_, run)| staged(&mut run.stepper).stages());
         for s in 1..=stages {
             let live: [bool; LANES] =
                 std::array::from_fn(|k| plans[k].is_some() && failed[k].is_none());
@@ -264,12 +260,12 @@ pub fn ensemble_supported<M: Model>(
     scheme: &Scheme,
     options: &Options,
 ) -> Result<(), Failure> {
-    supported(model, scheme, options)
+    supported(model, scheme, options).map(|_| ())
 }
 
 /// What an ensemble runs: an explicit staged scheme, on a model without constraints, whose
-/// rotation joints (if any) keep the model's charts.
-fn supported<M: Model>(model: &M, scheme: &Scheme, options: &Options) -> Result<(), Failure> {
+/// rotation joints (if any) keep the model's charts; the scheme's evaluations per step.
+fn supported<M: Model>(model: &M, scheme: &Scheme, options: &Options) -> Result<usize, Failure> {
     let refuse = |name, value: String, reason| {
         Err(Failure::InvalidOption {
             name,
@@ -277,16 +273,16 @@ fn supported<M: Model>(model: &M, scheme: &Scheme, options: &Options) -> Result<
             reason,
         })
     };
-    if super::dispatch::stepper_for(scheme, M::NQ)
+    let Some(stages) = super::dispatch::stepper_for(scheme, M::NQ)
         .staged()
-        .is_none()
-    {
+        .map(|s| s.stages())
+    else {
         return refuse(
             "scheme",
             scheme.name().to_string(),
             "an ensemble runs explicit schemes (DOPRI5, RK4, explicit Euler), whose stages it evaluates together: run other schemes one member at a time with `simulate`",
         );
-    }
+    };
     if M::NC > 0 {
         return refuse(
             "model",
@@ -302,7 +298,7 @@ fn supported<M: Model>(model: &M, scheme: &Scheme, options: &Options) -> Result<
             "a rotation joint's chart is the model's own state, one per run, and the lanes share one model: set `chart_switch` to 0 (the joints keep the model's charts and stop at gimbal lock, as Euler angles do), or run the members with `simulate`",
         );
     }
-    Ok(())
+    Ok(stages)
 }
 
 /// The four lanes' arguments and results of the batch forward dynamics, and one lane's

@@ -6,7 +6,7 @@
 
 use crate::elements::cross;
 use crate::error::{ModelError, ParamError};
-use crate::lanes::{F64x4, lane_by_lane};
+use crate::lanes::{F64x4, LANES, lane_by_lane};
 use serde::{Deserialize, Serialize, de::DeserializeOwned};
 use std::fmt;
 
@@ -744,8 +744,44 @@ pub trait Model {
         m: &mut [F64x4],
         h: &mut [F64x4],
     ) {
-        lane_by_lane(t, [q, qd, u], [m, h], |t, [q, qd, u], [m, h]| {
+        lane_by_lane(t, [q, qd, u], [m, h], |_, t, [q, qd, u], [m, h]| {
             self.dynamics(t, q, qd, u, m, h)
+        });
+    }
+
+    /// [`Model::dynamics_x4`] of four models of this type, lane `k` of `each[k]` with its
+    /// parameters and charts (the members of an ensemble, [`crate::simulate_ensemble_each`]).
+    /// Generated on lanes like [`Model::dynamics_x4`], which is this function with the model
+    /// itself in every lane; the default calls [`Model::dynamics`] of each lane's model,
+    /// allocating.
+    #[allow(clippy::too_many_arguments)]
+    fn dynamics_lanes(
+        each: [&Self; LANES],
+        t: F64x4,
+        q: &[F64x4],
+        qd: &[F64x4],
+        u: &[F64x4],
+        m: &mut [F64x4],
+        h: &mut [F64x4],
+    ) {
+        lane_by_lane(t, [q, qd, u], [m, h], |k, t, [q, qd, u], [m, h]| {
+            each[k].dynamics(t, q, qd, u, m, h)
+        });
+    }
+
+    /// [`Model::forward_dynamics`] of four models of this type, as [`Model::dynamics_lanes`].
+    #[allow(clippy::too_many_arguments)]
+    fn forward_dynamics_lanes(
+        each: [&Self; LANES],
+        t: F64x4,
+        q: &[F64x4],
+        qd: &[F64x4],
+        u: &[F64x4],
+        qdd: &mut [F64x4],
+        pivots: &mut [F64x4],
+    ) {
+        lane_by_lane(t, [q, qd, u], [qdd, pivots], |k, t, [q, qd, u], [a, p]| {
+            each[k].forward_dynamics(t, q, qd, u, a, p)
         });
     }
 
@@ -760,7 +796,7 @@ pub trait Model {
         qdd: &mut [F64x4],
         pivots: &mut [F64x4],
     ) {
-        lane_by_lane(t, [q, qd, u], [qdd, pivots], |t, [q, qd, u], [a, p]| {
+        lane_by_lane(t, [q, qd, u], [qdd, pivots], |_, t, [q, qd, u], [a, p]| {
             self.forward_dynamics(t, q, qd, u, a, p)
         });
     }

@@ -10,7 +10,11 @@
 //! Inside the generated functions the values that differ between states are [`Simd`]: on
 //! x86-64 one AVX register each, every operation one AVX instruction (the functions are
 //! compiled for AVX2 and entered when [`simd_available`]; otherwise [`lane_by_lane`] calls
-//! the one-state functions). Parameters and constants stay `f64`; the functions of the
+//! the one-state functions). Each lane's parameters and charts are those of its model: the
+//! `_x4` functions give the model itself to the four lanes, the `_lanes` functions
+//! ([`Model::forward_dynamics_lanes`](crate::Model::forward_dynamics_lanes)) one model per
+//! lane, so that the members of an ensemble may differ in their parameters and re-centre
+//! their charts each on its own ([`gather`]). Constants stay `f64`; the functions of the
 //! language are [`Math`] and [`Math2`], on `f64` or `Simd` alike. sin and cos are
 //! polynomials on all four lanes ([`F64x4::sin_cos`], the same in AVX registers); tan, the
 //! inverse functions and exp are the `wide` crate's vector polynomials (within 2 ulp of
@@ -322,14 +326,27 @@ pub fn unpack(batch: &[F64x4], k: usize, out: &mut [f64]) {
     }
 }
 
-/// A batch function by its one-state form: each lane's inputs unpacked, `f` called, its
-/// outputs packed (allocates): the batch functions of models without `option batch;`, and of
-/// generated ones on a processor without the SIMD they are compiled for.
+/// One value of four models as lanes, the generated batch code's parameters and charts
+/// (`gather::<EACH, _>(each, |m| m.params.l)`): lane `k` that of `models[k]` when `EACH`,
+/// else the first model's in every lane (the models are one).
+#[inline(always)]
+pub fn gather<const EACH: bool, M>(models: [&M; LANES], value: impl Fn(&M) -> f64) -> F64x4 {
+    if EACH {
+        F64x4(models.map(value))
+    } else {
+        F64x4::from(value(models[0]))
+    }
+}
+
+/// A batch function by its one-state form: each lane's inputs unpacked, `f` called with the
+/// lane's number, its outputs packed (allocates): the batch functions of models without
+/// `option batch;`, and of generated ones on a processor without the SIMD they are compiled
+/// for.
 pub fn lane_by_lane(
     t: F64x4,
     inputs: [&[F64x4]; 3],
     outputs: [&mut [F64x4]; 2],
-    mut f: impl FnMut(f64, [&[f64]; 3], [&mut [f64]; 2]),
+    mut f: impl FnMut(usize, f64, [&[f64]; 3], [&mut [f64]; 2]),
 ) {
     let mut ins: Vec<Vec<f64>> = inputs.iter().map(|x| vec![0.0; x.len()]).collect();
     let [o0, o1] = outputs;
@@ -338,7 +355,7 @@ pub fn lane_by_lane(
         for (v, x) in ins.iter_mut().zip(inputs) {
             unpack(x, k, v);
         }
-        f(t.lane(k), [&ins[0], &ins[1], &ins[2]], [&mut a, &mut b]);
+        f(k, t.lane(k), [&ins[0], &ins[1], &ins[2]], [&mut a, &mut b]);
         for (o, v) in o0.iter_mut().zip(&a).chain(o1.iter_mut().zip(&b)) {
             let mut l = o.to_array();
             l[k] = *v;

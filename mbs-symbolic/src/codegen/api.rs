@@ -6,7 +6,7 @@
 /// A method of `mbs::Model`: `fn {name}({receiver}, {args}) -> {ret}`.
 pub struct Method {
     pub name: &'static str,
-    /// `&self` or `&mut self`
+    /// `&self` or `&mut self`, or the first argument of an associated function
     pub receiver: &'static str,
     /// parameters after `&self`; `{P}` stands for the model's parameter struct
     pub args: &'static str,
@@ -152,20 +152,28 @@ pub const CONSTRAINT_REST_DERIVATIVES: Method = method(
 /// field of `ConstraintTangents`.
 pub const CONSTRAINT_PARAMETER_TANGENTS_INNER: &str = "t: f64, q: &[f64], qd: &[f64], qdd: &[f64], lambda: &[f64], dphi_dp: &mut [f64], drate_dq: &mut [f64], drate_dp: &mut [f64], dacc_dq: &mut [f64], dacc_dqd: &mut [f64], dacc_dp: &mut [f64], dforce_dp: &mut [f64]";
 
+const DYNAMICS_LANES: &str = "t: ::mbs::F64x4, q: &[::mbs::F64x4], qd: &[::mbs::F64x4], u: &[::mbs::F64x4], m: &mut [::mbs::F64x4], h: &mut [::mbs::F64x4]";
+const FORWARD_DYNAMICS_LANES: &str = "t: ::mbs::F64x4, q: &[::mbs::F64x4], qd: &[::mbs::F64x4], u: &[::mbs::F64x4], qdd: &mut [::mbs::F64x4], pivots: &mut [::mbs::F64x4]";
+
 /// The batch methods (four states at once on `::mbs::F64x4` lanes), which have defaults in
 /// the trait (lane by lane) that models with `option batch;` override; the arguments are
-/// those of `dynamics` and `forward_dynamics` with lanes for `f64`.
-pub const BATCH: [Method; 2] = [
-    method(
-        "dynamics_x4",
-        "t: ::mbs::F64x4, q: &[::mbs::F64x4], qd: &[::mbs::F64x4], u: &[::mbs::F64x4], m: &mut [::mbs::F64x4], h: &mut [::mbs::F64x4]",
-        "",
-    ),
-    method(
-        "forward_dynamics_x4",
-        "t: ::mbs::F64x4, q: &[::mbs::F64x4], qd: &[::mbs::F64x4], u: &[::mbs::F64x4], qdd: &mut [::mbs::F64x4], pivots: &mut [::mbs::F64x4]",
-        "",
-    ),
+/// those of `dynamics` and `forward_dynamics` with lanes for `f64`, after the four models
+/// (`each`) of the `_lanes` methods, whose parameters and charts the lanes take.
+pub const BATCH: [Method; 4] = [
+    method("dynamics_x4", DYNAMICS_LANES, ""),
+    method("forward_dynamics_x4", FORWARD_DYNAMICS_LANES, ""),
+    Method {
+        name: "dynamics_lanes",
+        receiver: "each: [&Self; 4]",
+        args: DYNAMICS_LANES,
+        ret: "",
+    },
+    Method {
+        name: "forward_dynamics_lanes",
+        receiver: "each: [&Self; 4]",
+        args: FORWARD_DYNAMICS_LANES,
+        ret: "",
+    },
 ];
 
 /// The method `name` of the table.

@@ -56,10 +56,40 @@ impl Naming for RustNames<'_> {
             }
         }
     }
+    /// A parameter's or a chart's lanes from the models of the batch method's argument
+    /// `each` (batch code is a method of a scene type: `m.params`, `m.charts`): the first
+    /// model's value in every lane, or each lane's model's when they differ (`EACH`).
+    fn bind_lanes(&self, v: Var) -> String {
+        match v {
+            Var::Param(i) => {
+                let n = &self.params[i as usize].name;
+                format!(
+                    "let p_{} = ::mbs::lanes::gather::<EACH, _>(each, |m| m.params.{n});",
+                    raw_stripped(n)
+                )
+            }
+            Var::Chart(i) => {
+                let (j, r, c) = (i / 9, i % 9 / 3, i % 3);
+                format!(
+                    "let r_{i} = ::mbs::lanes::gather::<EACH, _>(each, |m| m.charts[{j}][{r}][{c}]);"
+                )
+            }
+            _ => self.bind(v),
+        }
+    }
     fn spline(&self, s: u16) -> String {
         format!("{}[{s}]", self.splines_path)
     }
 }
+
+/// The generic parameter of batch methods and their chunks: whether the models of their
+/// lanes (`each`) differ, so that each lane reads its own model's parameters and charts, or
+/// are one model, whose values the compiler then knows to be the same in every lane. One
+/// function body serves both: with values that might differ in every call, the 12-joint
+/// arm's batch `dynamics` took 5–20 % longer than with one model's, the two in one program
+/// (gathering the four models' values into an array beforehand did not help); the
+/// timings of such long functions also move by as much with where the linker places them.
+pub const LANES_GENERIC: &str = "<const EACH: bool>";
 
 /// A method to generate: `fn {name}(&self, {args})` computing `outputs`.
 pub struct FnSpec {
@@ -111,10 +141,11 @@ impl FnSpec {
         }
     }
 
-    /// A method on lanes of four states: its arguments' `f64` (but the charts') become
-    /// lanes.
+    /// A method on lanes of four states: its arguments' `f64` become lanes, and the first,
+    /// `each`, holds the four lanes' models, whose parameters and charts it reads.
     pub fn lanes(name: &str, args: &str) -> FnSpec {
-        let mut f = FnSpec::new(name, &args.replace("f64", LANES_TYPE));
+        let args = format!("each: [&Self; 4], {}", args.replace("f64", LANES_TYPE));
+        let mut f = FnSpec::new(name, &args);
         f.numbers = Numbers::Lanes;
         f
     }
@@ -224,7 +255,7 @@ impl Chunk {
     pub fn text(&self, self_ty: &str, items: &mut String, formulas: &mut Formulas) -> String {
         if !self.simd.is_empty() {
             return format!(
-                "#[inline(never)]\n{}fn {}(&self, {}, w: &mut [{}; {}]) {{\n{}}}\n",
+                "#[inline(never)]\n{}fn {}{LANES_GENERIC}(&self, {}, w: &mut [{}; {}]) {{\n{}}}\n",
                 self.simd, self.name, self.args, self.number, self.workspace, self.body
             );
         }
@@ -299,26 +330,35 @@ pub fn emit_fn(
             "#[cfg_attr(target_arch = \"x86_64\", target_feature(enable = \"avx2\"))]\n"
         }
     };
+    // batch code is generic over whether its lanes' models differ ([`LANES_GENERIC`])
+    let (generic, each) = match spec.numbers {
+        Numbers::Scalar => ("", ""),
+        Numbers::Lanes => (LANES_GENERIC, "::<EACH>"),
+    };
     let mut s = String::new();
     let mut chunks = Vec::new();
     let prelude: String = spec.prelude.iter().map(|p| format!("{p}\n")).collect();
     if em.chunks.len() == 1 {
         let _ = writeln!(
             s,
-            "#[inline]\n{simd}fn {}(&self, {}) {{\n{prelude}{}}}",
+            "#[inline]\n{simd}fn {}{generic}(&self, {}) {{\n{prelude}{}}}",
             spec.name, spec.args, em.chunks[0]
         );
     } else {
         let _ = write!(
             s,
-            "#[inline]\n{simd}fn {}(&self, {}) {{\n{prelude}let mut w = [{}; {}];\n",
+            "#[inline]\n{simd}fn {}{generic}(&self, {}) {{\n{prelude}let mut w = [{}; {}];\n",
             spec.name,
             spec.args,
             spec.numbers.zero(),
             em.workspace
         );
         for k in 0..em.chunks.len() {
-            let _ = writeln!(s, "self.{}_part{k}({}, &mut w);", spec.name, spec.call);
+            let _ = writeln!(
+                s,
+                "self.{}_part{k}{each}({}, &mut w);",
+                spec.name, spec.call
+            );
         }
         s.push_str("}\n");
         for (k, c) in em.chunks.iter().enumerate() {

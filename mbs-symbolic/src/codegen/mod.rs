@@ -1240,15 +1240,23 @@ fn emit_scene(
                 format!("self.__forward_dynamics(t, q, qd, u, &[0.0; {n}], qdd, pivots)")
             }
             "forward_dynamics_forced" => format!("self.__forward_dynamics({})", m.call()),
-            name @ ("dynamics_x4" | "forward_dynamics_x4") => {
-                let one = name.trim_end_matches("_x4");
+            // one batch function per output, whose lanes take their parameters and charts
+            // from `each`: four times the model itself, or the four models of `_lanes`
+            name @ ("dynamics_x4"
+            | "forward_dynamics_x4"
+            | "dynamics_lanes"
+            | "forward_dynamics_lanes") => {
+                let (one, this, each, model) = match name.strip_suffix("_x4") {
+                    Some(one) => (one, "self", "::<false>([self; 4]", "self"),
+                    None => (name.trim_end_matches("_lanes"), "each[0]", "::<true>(each", "each[k]"),
+                };
                 let (a, b) = if one == "dynamics" {
                     ("m", "h")
                 } else {
                     ("qdd", "pivots")
                 };
                 let call = if one == "dynamics" {
-                    m.call()
+                    "t, q, qd, u, m, h".to_string()
                 } else {
                     format!("t, q, qd, u, &[::mbs::F64x4::ZERO; {n}], qdd, pivots")
                 };
@@ -1256,9 +1264,9 @@ fn emit_scene(
                 "if ::mbs::lanes::simd_available() {{
 #[allow(unused_unsafe)]
 // SAFETY: the processor has the features the batch code is compiled for
-unsafe {{ self.__{name}({call}) }}
+unsafe {{ {this}.__{one}_x4{each}, {call}) }}
 }} else {{
-::mbs::lanes::lane_by_lane(t, [q, qd, u], [{a}, {b}], |t, [q, qd, u], [{a}, {b}]| ::mbs::Model::{one}(self, t, q, qd, u, {a}, {b}))
+::mbs::lanes::lane_by_lane(t, [q, qd, u], [{a}, {b}], |k, t, [q, qd, u], [{a}, {b}]| ::mbs::Model::{one}({model}, t, q, qd, u, {a}, {b}))
 }}"
             )
             }

@@ -12,6 +12,12 @@ pub trait Naming {
     fn var(&self, v: Var) -> String;
     /// Statement that binds the identifier of `v` from the function's arguments.
     fn bind(&self, v: Var) -> String;
+    /// The statement of [`Numbers::Lanes`] code binding `v` to its four lanes (an
+    /// [`F64x4`](../../../mbs_runtime/lanes/struct.F64x4.html)): parameters and charts too
+    /// are each lane's own, those of the lane's model.
+    fn bind_lanes(&self, v: Var) -> String {
+        self.bind(v)
+    }
     /// Path of spline number `s` of the arena, an [`mbs::Spline`](../../../mbs_runtime/spline/struct.Spline.html)
     /// (`eval(order, x)`).
     fn spline(&self, s: u16) -> String {
@@ -25,9 +31,9 @@ pub enum Numbers {
     /// `f64`
     Scalar,
     /// several states at once: arguments, outputs and workspace slots are [`LANES_TYPE`];
-    /// in the body every value that depends on the arguments is a `Simd` (a vector register),
-    /// parameters and constants stay `f64` and meet them through mixed operators and the
-    /// functions of `Math` (`Math::sin(x)`), which take either
+    /// in the body every leaf is a `Simd` (a vector register), the parameters and charts each
+    /// lane's own ([`Naming::bind_lanes`]); constants stay `f64` and meet them through mixed
+    /// operators and the functions of `Math` (`Math::sin(x)`), which take either
     Lanes,
 }
 
@@ -336,11 +342,6 @@ impl Writer<'_> {
             self.expr(n, Prec::Add, out);
         }
     }
-}
-
-/// Whether leaf `v` differs between the states of a batch (parameters and charts do not).
-fn varies(v: Var) -> bool {
-    !matches!(v, Var::Param(_) | Var::Chart(_))
 }
 
 /// Appends a non-negative integer without the formatting machinery (slow unoptimised).
@@ -653,10 +654,13 @@ pub fn emit(
         vars.sort_unstable();
         vars.dedup();
         for &v in vars.iter() {
-            let _ = writeln!(s, "{}", naming.bind(v));
-            if numbers == Numbers::Lanes && varies(v) {
+            if numbers == Numbers::Lanes {
+                // every leaf in registers, the parameters' and charts' lanes too
                 let name = w.var(v).to_string();
+                let _ = writeln!(s, "{}", naming.bind_lanes(v));
                 let _ = writeln!(s, "let {name} = {SIMD_TYPE}::new({name});");
+            } else {
+                let _ = writeln!(s, "{}", naming.bind(v));
             }
         }
         let loads = &mut chunk_loads[c];
@@ -858,13 +862,16 @@ mod tests {
         let targets: Vec<String> = (0..outs.len()).map(|i| format!("out[{i}]")).collect();
         let e = emit(&a, &sch, &targets, &[], false, &N, Numbers::Lanes).unwrap();
         let all = e.chunks.concat();
-        // the state in a register, the parameter as it is; functions through Math; outputs
-        // and the workspace as F64x4
+        // the state in a register, the parameter too (bound to its lanes by `bind_lanes`:
+        // each lane's model's); functions through Math; outputs and the workspace as F64x4
         assert!(
             all.contains("let q0 = ::mbs::lanes::Simd::new(q0);"),
             "{all}"
         );
-        assert!(!all.contains("Simd::new(p0)"), "{all}");
+        assert!(
+            all.contains("let p0 = ::mbs::lanes::Simd::new(p0);"),
+            "{all}"
+        );
         assert!(all.contains("::mbs::lanes::Math::sin("), "{all}");
         assert!(all.contains("::mbs::lanes::Math::pos("), "{all}");
         assert!(all.contains("out[0] = ::mbs::F64x4::from("), "{all}");

@@ -9,8 +9,9 @@
 //!
 //! Prints criterion's figures, then a table of medians: ms for the 16 runs each way, the
 //! ensemble's throughput relative to the runs one by one, its steps and how busy its lanes
-//! were. Then a sweep (`mbs::sweep`) of 256 runs of the 16-bar chain over starts drawn at
-//! random, on one thread, one run at a time and on lanes (`Sweep::ensembles`), the best of
+//! were. Then two sweeps (`mbs::sweep`) of 256 runs of the 16-bar chain, over starts and over
+//! its bars' length and mass drawn at random (each run its own model, its lanes' parameters
+//! its own), on one thread, one run at a time and on lanes (`Sweep::ensembles`), the best of
 //! three rounds each way.
 
 mod common;
@@ -127,23 +128,30 @@ fn bench_model<M: Model + Clone + 'static>(
     rows
 }
 
-/// The sweep of 256 runs of chain16 over random starts on one thread, one run at a time and
-/// on lanes: the best wall time of three rounds each way, in s.
-fn sweep_rounds() -> (f64, f64) {
-    let plan = Plan::from_toml(
-        r#"
-        [sweep]
-        design = "monte-carlo"
-        runs = 256
-        seed = 7
-        [[vary]]
-        name = "q0[0]"
-        uniform = [0.0, 0.6]
-        [[vary]]
-        name = "qd0[5]"
-        uniform = [-1.0, 1.0]
-        "#,
-    )
+/// The variables of the sweeps: two of the start, then the bars' length and mass.
+const OVER_STARTS: &str = r#"
+[[vary]]
+name = "q0[0]"
+uniform = [0.0, 0.6]
+[[vary]]
+name = "qd0[5]"
+uniform = [-1.0, 1.0]
+"#;
+const OVER_PARAMETERS: &str = r#"
+[[vary]]
+name = "l"
+uniform = [0.3, 0.7]
+[[vary]]
+name = "m"
+uniform = [0.5, 2.0]
+"#;
+
+/// A sweep of 256 runs of chain16 over `vary` drawn at random, on one thread, one run at a
+/// time and on lanes: the best wall time of three rounds each way, in s.
+fn sweep_rounds(vary: &str) -> (f64, f64) {
+    let plan = Plan::from_toml(&format!(
+        "[sweep]\ndesign = \"monte-carlo\"\nruns = 256\nseed = 7\n{vary}"
+    ))
     .expect("the plan is valid");
     let out = std::env::temp_dir().join(format!("mbs-bench-ensemble-{}", std::process::id()));
     let list = plan.runs(&out).expect("its runs");
@@ -191,11 +199,16 @@ fn main() {
             o / e
         );
     }
-    let (alone, lanes) = sweep_rounds();
-    println!(
-        "sweep of 256 runs of chain16 over starts, one thread, best of 3: one at a time {:.1} ms, on lanes {:.1} ms ({:.2}×)",
-        alone * 1e3,
-        lanes * 1e3,
-        alone / lanes
-    );
+    for (over, vary) in [
+        ("starts", OVER_STARTS),
+        ("length and mass", OVER_PARAMETERS),
+    ] {
+        let (alone, lanes) = sweep_rounds(vary);
+        println!(
+            "sweep of 256 runs of chain16 over {over}, one thread, best of 3: one at a time {:.1} ms, on lanes {:.1} ms ({:.2}×)",
+            alone * 1e3,
+            lanes * 1e3,
+            alone / lanes
+        );
+    }
 }

@@ -55,7 +55,7 @@
 //! | `constraint hinge: align(A, B, about = [x, y]);` | frame B keeps its orientation relative to A about A's axes: `hinge.rx`, `hinge.ry` |
 //! | `dof crank = PI/3, independent;` | kept at its value when a closed loop is assembled |
 //! | `option tangents;` | also generate exact K_t = ∂τ/∂q and C_t = ∂τ/∂qd |
-//! | `option batch;` | also generate `dynamics_x4` and `forward_dynamics_x4`: four states at once on SIMD lanes ([`crate::lanes`]; without the option they call the one-state functions lane by lane), which ensembles of runs ([`crate::simulate_ensemble`]) and sweeps over starts evaluate their stages on |
+//! | `option batch;` | also generate `dynamics_x4` and `forward_dynamics_x4`: four states at once on SIMD lanes ([`crate::lanes`]; without the option they call the one-state functions lane by lane), and `dynamics_lanes` and `forward_dynamics_lanes`, the same with four models, each lane its model's parameters and charts, which ensembles of runs ([`crate::simulate_ensemble`], [`crate::simulate_ensemble_each`]) and sweeps over starts and parameters evaluate their stages on |
 //! | `option formulation = recursive;` | force `recursive` or `virtual_power` (default: the cheaper by op count) |
 //! | `shape arm: box(0.3, 0.05, 0.05);` | what to draw with a body, a frame or the `ground` (below); no effect on the dynamics |
 //! | `for i in 0..n { … }`, `part Leg(k, x) { … }`, `Leg(0, 0.4);` | statements repeated with an index, templates instantiated with arguments; indexed names `bar[i]` ([below](#repetition-and-parts)) |

@@ -501,6 +501,34 @@ mod batch {
     chain!(Chain4, 4, batch);
 }
 
+/// The tables of `plan`'s runs of the 4-bar chain with DOPRI5 made on lanes and one at a
+/// time (with `metrics` where given), in `dir`, checked to have made `count` runs, all of them
+/// on lanes in the first where the processor has the lanes.
+fn on_lanes_and_alone(
+    plan: &Plan,
+    dir: &Path,
+    metrics: Option<&dyn Fn() -> Metrics<batch::Chain4>>,
+    count: usize,
+) -> (PathBuf, PathBuf) {
+    let runs = plan.runs(dir).unwrap();
+    let table = |ensembles: bool, name: &str| {
+        let d = dir.join(name);
+        let mut s = Sweep::new(batch::Chain4::default, plan, Scheme::Dopri5, base())
+            .unwrap()
+            .ensembles(ensembles)
+            .threads(2);
+        if let Some(m) = metrics {
+            s = s.metrics(m());
+        }
+        let summary = s.run(&d, &runs).unwrap();
+        assert_eq!(summary.ran, count);
+        let on_lanes = ensembles && mbs::lanes::simd_available();
+        assert_eq!(summary.on_lanes, if on_lanes { count } else { 0 });
+        d.join("results.csv")
+    };
+    (table(true, "lanes"), table(false, "alone"))
+}
+
 /// A sweep over starts alone of a model with `option batch;` runs its runs four at a time on
 /// the lanes (`Sweep::ensembles`, on by default): the same rows as one run at a time — status,
 /// failure, steps, evaluations, metrics to the rounding of the batch functions — a run that
@@ -523,23 +551,7 @@ fn a_sweep_over_starts_runs_on_lanes_and_gives_the_rows_of_runs_alone() {
     .unwrap();
     let dir = scratch("lanes");
     let runs = plan.runs(&dir).unwrap();
-    let table = |ensembles: bool, name: &str| {
-        let d = dir.join(name);
-        let s = Sweep::new(Chain4::default, &plan, Scheme::Dopri5, base())
-            .unwrap()
-            .ensembles(ensembles)
-            .threads(2);
-        let summary = s.run(&d, &runs).unwrap();
-        assert_eq!(summary.ran, 20);
-        let on_lanes = if ensembles && mbs::lanes::simd_available() {
-            20
-        } else {
-            0
-        };
-        assert_eq!(summary.on_lanes, on_lanes);
-        d.join("results.csv")
-    };
-    let (lanes, alone) = (table(true, "lanes"), table(false, "alone"));
+    let (lanes, alone) = on_lanes_and_alone(&plan, &dir, None, 20);
     for name in [
         "run",
         "status",
@@ -589,5 +601,69 @@ fn a_sweep_over_starts_runs_on_lanes_and_gives_the_rows_of_runs_alone() {
         assert!(kind != "Panic" || q0 == "0.4", "{q0}: {kind}");
     }
     assert_eq!(kinds.iter().filter(|k| *k == "Panic").count(), 3);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A sweep over parameters and starts of a model with `option batch;` runs on the lanes too,
+/// each run with its own model (`simulate_ensemble_each`): the rows of one run at a time, and
+/// the metrics see the run's own model.
+#[test]
+fn a_sweep_over_parameters_runs_on_lanes_each_run_with_its_model() {
+    use batch::Chain4;
+    let plan = Plan::from_toml(
+        r#"
+        [sweep]
+        design = "grid"
+        [[vary]]
+        name = "l"
+        values = [0.3, 0.5, 0.8]
+        [[vary]]
+        name = "m"
+        values = [0.5, 2.0]
+        [[vary]]
+        name = "q0[1]"
+        values = [0.2, 0.9]
+        "#,
+    )
+    .unwrap();
+    let dir = scratch("lanes-params");
+    let metrics = || {
+        Metrics::new(["model_l", "q1_end"], |m: &Chain4, tr: &mbs::Trajectory| {
+            vec![m.params().l, tr.q(tr.len() - 1)[1]]
+        })
+    };
+    let (lanes, alone) = on_lanes_and_alone(&plan, &dir, Some(&metrics), 12);
+    for name in [
+        "run",
+        "status",
+        "steps",
+        "rejected",
+        "evaluations",
+        "model_l",
+    ] {
+        assert_eq!(column(&lanes, name), column(&alone, name), "{name}");
+    }
+    assert!(column(&lanes, "status").iter().all(|s| s == "ok"));
+    // each run's metrics saw its own model
+    assert_eq!(column(&lanes, "model_l"), column(&lanes, "l"));
+    let mut worst = 0.0f64;
+    for (a, b) in column(&lanes, "q1_end")
+        .iter()
+        .zip(column(&alone, "q1_end"))
+    {
+        let (a, b): (f64, f64) = (a.parse().unwrap(), b.parse().unwrap());
+        worst = worst.max((a - b).abs());
+    }
+    let ends: Vec<f64> = column(&alone, "q1_end")
+        .iter()
+        .map(|x| x.parse().unwrap())
+        .collect();
+    let spread =
+        ends.iter().fold(f64::MIN, |m, &x| m.max(x)) - ends.iter().fold(f64::MAX, |m, &x| m.min(x));
+    println!(
+        "a sweep of 12 runs over l, m and q0[1] on lanes against one at a time: q1 at the end within {worst:.1e} (the runs' values spread over {spread:.2})"
+    );
+    assert!(worst < 1e-9, "{worst:e}");
+    assert!(spread > 0.1, "{ends:?}");
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -40,7 +40,8 @@ pub use error::{Failure, HeldBy, HeldMost, ModelError, ParamError, check_inertia
 pub use integrators::{
     Assembly, Controller, EnsembleReport, GlobalControl, GlobalReport, GlobalRun, Inputs,
     Integrator, Member, SimError, Simulation, State, assemble, ensemble_supported, simulate,
-    simulate_ensemble, simulate_ensemble_of, simulate_global, simulate_with,
+    simulate_ensemble, simulate_ensemble_each, simulate_ensemble_of, simulate_global,
+    simulate_with,
 };
 pub use lanes::{F64x4, LANES};
 pub use model::{

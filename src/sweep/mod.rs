@@ -409,13 +409,13 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
         self
     }
 
-    /// Whether runs that differ only in their start (`q0…`, `qd0…` varied, nothing else) of a
-    /// model with `option batch;` run four at a time on the lanes of its batch functions
-    /// ([`crate::simulate_ensemble`]: the same runs, each its own steps and failure, to the
-    /// rounding of the batch functions, which may rarely flip an adaptive step's acceptance
-    /// and so move a run's steps and final state by its tolerance) where an ensemble runs the
-    /// sweep's scheme and model (DOPRI5, RK4 or explicit Euler, open loops, rotation joints
-    /// only with `chart_switch` at 0); on by default. The `cpu_s` of such a run is its share
+    /// Whether runs that differ only in their start and parameters (`q0…`, `qd0…` and
+    /// parameters varied, no setting) of a model with `option batch;` run four at a time on
+    /// the lanes of its batch functions ([`crate::simulate_ensemble_each`]: the same runs,
+    /// each its own model, steps and failure, to the rounding of the batch functions, which
+    /// may rarely flip an adaptive step's acceptance and so move a run's steps and final
+    /// state by its tolerance) where an ensemble runs the sweep's scheme and model (DOPRI5,
+    /// RK4 or explicit Euler, open loops); on by default. The `cpu_s` of such a run is its share
     /// of its ensemble's CPU time (the ensemble's divided by its runs).
     pub fn ensembles(mut self, on: bool) -> Self {
         self.ensembles = on;
@@ -430,11 +430,11 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
         }
         if !targets
             .iter()
-            .all(|t| matches!(t, Target::Q0(_) | Target::Qd0(_)))
+            .all(|t| matches!(t, Target::Q0(_) | Target::Qd0(_) | Target::Param(_)))
         {
             return false;
         }
-        crate::ensemble_supported(&(self.make)(), &self.base.scheme, &self.base.options).is_ok()
+        crate::ensemble_supported::<M>(&self.base.scheme).is_ok()
     }
 
     /// The table's columns: `run`, `status` (ok, failed), `failure` (the failure's kind),
@@ -718,14 +718,16 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
             let settings = catch_unwind(AssertUnwindSafe(|| {
                 let mut model = (self.make)();
                 self.settings(&mut model, i, &runs.rows[i], &runs.names, targets)
+                    .map(|s| (model, s))
             }));
             let refused = match settings {
-                Ok(Ok((scheme, options))) => {
-                    members.push(crate::Member {
+                Ok(Ok((model, (scheme, options)))) => {
+                    let member = crate::Member {
                         q0: options.q0.clone(),
                         qd0: options.qd0.clone(),
                         inputs: Default::default(),
-                    });
+                    };
+                    members.push((model, member));
                     shared.get_or_insert((scheme, options));
                     in_ensemble.push(rows.len());
                     rows.push(None);
@@ -739,7 +741,7 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
         if let Some((scheme, options)) = shared {
             let clock = cpu_time::ThreadTime::now();
             let made = catch_unwind(AssertUnwindSafe(|| {
-                crate::simulate_ensemble_of(&self.make, scheme, &options, members)
+                crate::simulate_ensemble_each(scheme, &options, members)
             }));
             let Ok(Ok(report)) = made else {
                 // the ensemble itself failed or user code panicked in it: each of its runs
@@ -752,12 +754,15 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
             };
             // each run's metrics, a panic in them that run's own
             let outcomes: Vec<Outcome> = (report.runs.into_iter())
+                .zip(report.models)
                 .map(|r| match r {
-                    Ok((traj, stats)) => catch_unwind(AssertUnwindSafe(|| {
-                        self.finished((self.make)(), traj, stats, options.t_end)
+                    // (a run that reached its end has its model)
+                    (Ok((traj, stats)), model) => catch_unwind(AssertUnwindSafe(|| {
+                        let model = model.unwrap_or_else(|| (self.make)());
+                        self.finished(model, traj, stats, options.t_end)
                     }))
                     .unwrap_or_else(panicked),
-                    Err(e) => failed_run(e, options.t0),
+                    (Err(e), _) => failed_run(e, options.t0),
                 })
                 .collect();
             // each run its share of the ensemble's time

@@ -1,21 +1,22 @@
-//! Many runs of one model at once: an ensemble of members (starts and inputs) integrated by
-//! one explicit scheme, four members at a time on the lanes of the model's batch
-//! functions ([`crate::lanes`], `option batch;`).
+//! Many runs of one model at once: an ensemble of members (starts, inputs, and each its own
+//! model: its parameters and its charts) integrated by one explicit scheme, four members at
+//! a time on the lanes of the model's batch functions ([`crate::lanes`], `option batch;`).
 //!
 //! Each lane is a whole run of its own, the driver's (`driver::Run`): its own step size, error
 //! test, rejections, outputs, failure and work counters, exactly those of
 //! [`super::simulate_with`] on that member. Only the evaluations are shared: the scheme's
 //! step is taken apart at its stages ([`super::stepper::Staged`]), every lane computes its
-//! stage point, one call of [`Model::forward_dynamics_x4`] evaluates the four, and each lane
+//! stage point, one call of the batch forward dynamics evaluates the four (each lane with its
+//! run's model, [`Model::forward_dynamics_lanes`]; [`Model::forward_dynamics_x4`] of one of
+//! them when the four have the same parameters and charts), and each lane
 //! checks its own result as its run would ([`super::problem::Problem::accept_forward`]: a
 //! value that does not stand is computed again by the lane's dense path, which names the
 //! failure). A lane whose run ends, by reaching t_end or by failing, takes the next member
 //! at once, so the lanes stay busy while members need different numbers of steps.
 //!
 //! What an ensemble runs: DOPRI5 (adaptive or fixed steps), RK4 and explicit Euler, on models
-//! without constraints; rotation joints only with `Options::chart_switch` at 0 (a joint's
-//! chart is the model's own state, one per run, and the lanes share one model: without
-//! re-centring every run keeps the model's charts). A model without
+//! without constraints. A rotation joint's chart is its run's model's own, re-centred when
+//! that run's joint nears gimbal lock, as alone. A model without
 //! `option batch;`, or a processor without AVX2, evaluates the lanes one by one: the same
 //! results, without the gain.
 
@@ -60,8 +61,11 @@ impl Member {
 /// What an ensemble gave: each member's run, in the order of the members (the trajectory and
 /// work counters, or the failure with the trajectory up to it), and the shared work.
 #[derive(Debug)]
-pub struct EnsembleReport {
+pub struct EnsembleReport<M> {
     pub runs: Vec<Result<(Trajectory, Stats), SimError>>,
+    /// each member's model as its run left it (its charts re-centred), for a run that reached
+    /// its end; `None` for a run that failed
+    pub models: Vec<Option<M>>,
     /// calls of the batch forward dynamics (four lanes each)
     pub batch_evaluations: usize,
     /// the lanes those calls evaluated for a run (the others were idle: fewer than four runs
@@ -69,7 +73,7 @@ pub struct EnsembleReport {
     pub lane_evaluations: usize,
 }
 
-impl EnsembleReport {
+impl<M> EnsembleReport<M> {
     /// The share of the batch calls' lanes that evaluated a run (1 when all four always did).
     pub fn occupancy(&self) -> f64 {
         if self.batch_evaluations == 0 {
@@ -86,55 +90,82 @@ impl EnsembleReport {
 /// trajectory up to the failure and does not stop the others.
 ///
 /// Refused with an `InvalidOption` at t₀ (before any run): a scheme other than DOPRI5, RK4
-/// and explicit Euler, a model with constraints, and rotation joints whose charts would be
-/// re-centred (`chart_switch` ≠ 0). A member whose start is refused (its
+/// and explicit Euler, and a model with constraints. A member whose start is refused (its
 /// q0's length, a non-finite value, controllers) has that failure as its run.
 pub fn simulate_ensemble<M: Model + Clone + 'static>(
     model: &M,
     scheme: Scheme,
     options: &Options,
     members: Vec<Member>,
-) -> Result<EnsembleReport, SimError> {
-    simulate_ensemble_of(|| model.clone(), scheme, options, members)
+) -> Result<EnsembleReport<M>, SimError> {
+    supported::<M>(&scheme).map_err(|e| super::driver::refused(model, e, options.t0))?;
+    let members = members.into_iter().map(|m| (model.clone(), m));
+    simulate_ensemble_each(scheme, options, members)
 }
 
-/// [`simulate_ensemble`] of models made by `make` (one for the shared evaluations, one per
-/// member), for a model that is not `Clone`: every model it makes must be the same.
+/// [`simulate_ensemble`] of models made by `make`, one per member, for a model that is not
+/// `Clone`.
 pub fn simulate_ensemble_of<M: Model + 'static>(
     make: impl Fn() -> M,
     scheme: Scheme,
     options: &Options,
     members: Vec<Member>,
-) -> Result<EnsembleReport, SimError> {
-    let shared = make();
-    let model = &shared;
-    let stages = supported(model, &scheme, options)
-        .map_err(|e| super::driver::refused(model, e, options.t0))?;
+) -> Result<EnsembleReport<M>, SimError> {
+    let model = make();
+    supported::<M>(&scheme).map_err(|e| super::driver::refused(&model, e, options.t0))?;
+    let members = members.into_iter().map(|m| (make(), m));
+    simulate_ensemble_each(scheme, options, members)
+}
+
+/// [`simulate_ensemble`] of members that each bring their model: models of one type with
+/// their own parameters (a Monte-Carlo study of a mass, a stiffness) and charts, each lane of
+/// the batch functions reading its member's ([`Model::forward_dynamics_lanes`]). The members
+/// are taken from `members` as lanes free up, so a long list of them is never all in memory
+/// at once. Refused as [`simulate_ensemble`], checked on the first member's model (nothing
+/// is checked when there are none).
+pub fn simulate_ensemble_each<M: Model + 'static>(
+    scheme: Scheme,
+    options: &Options,
+    members: impl IntoIterator<Item = (M, Member)>,
+) -> Result<EnsembleReport<M>, SimError> {
+    let mut members = members.into_iter().peekable();
+    let stages = match members.peek() {
+        Some((model, _)) => {
+            supported::<M>(&scheme).map_err(|e| super::driver::refused(model, e, options.t0))?
+        }
+        None => 0,
+    };
     let t_end = options.t_end;
-    let start = |m: Member| -> Result<Run, SimError> {
+    let start = |model: M, m: Member| -> Result<Run, SimError> {
         if !m.inputs.controllers.is_empty() {
             let e = Failure::InvalidOption {
                 name: "inputs",
                 value: format!("{} controllers", m.inputs.controllers.len()),
                 reason: "an ensemble's members take inputs as functions of time: run a member with sampled controllers by `simulate_with`",
             };
-            return Err(super::driver::refused(model, e, options.t0));
+            return Err(super::driver::refused(&model, e, options.t0));
         }
         let options = Options {
             q0: m.q0.or_else(|| options.q0.clone()),
             qd0: m.qd0.or_else(|| options.qd0.clone()),
             ..options.clone()
         };
-        Run::new(make(), scheme, options, m.inputs)
+        Run::new(model, scheme, options, m.inputs)
     };
-    let mut lanes = Lanes::new(M::NQ, M::NU);
+    let joints = members
+        .peek()
+        .map_or(0, |(m, _)| m.info().rotation_joints.len());
+    let mut lanes = Lanes::new(M::NQ, M::NU, joints);
     let batched = M::BATCH_GENERATED && M::FORWARD_DYNAMICS_GENERATED && simd_available();
-    let mut runs: Vec<Option<Result<(Trajectory, Stats), SimError>>> =
-        (0..members.len()).map(|_| None).collect();
-    let mut queue = members.into_iter().enumerate();
+    // each member's run and model, filled in as they end (a member taken from the list is
+    // given its places)
+    let mut runs: Vec<Option<Result<(Trajectory, Stats), SimError>>> = Vec::new();
+    let mut models: Vec<Option<M>> = Vec::new();
+    let mut queue = members.enumerate();
     let mut active: [Option<(usize, Run)>; LANES] = Default::default();
     let mut report = EnsembleReport {
         runs: Vec::new(),
+        models: Vec::new(),
         batch_evaluations: 0,
         lane_evaluations: 0,
     };
@@ -144,10 +175,12 @@ pub fn simulate_ensemble_of<M: Model + 'static>(
         for (slot, plan) in active.iter_mut().zip(plans.iter_mut()) {
             *plan = loop {
                 if slot.is_none() {
-                    let Some((i, m)) = queue.next() else {
+                    let Some((i, (model, m))) = queue.next() else {
                         break None;
                     };
-                    match start(m) {
+                    runs.push(None);
+                    models.push(None);
+                    match start(model, m) {
                         Ok(run) => *slot = Some((i, run)),
                         Err(e) => {
                             runs[i] = Some(Err(e));
@@ -158,8 +191,9 @@ pub fn simulate_ensemble_of<M: Model + 'static>(
                 let (i, run) = slot.as_mut().expect("filled above");
                 if run.cur.t >= t_end {
                     let (i, run) = slot.take().expect("filled above");
-                    let (_, traj, stats) = run.finish();
+                    let (model, traj, stats) = run.finish();
                     runs[i] = Some(Ok((traj, stats)));
+                    models[i] = model.into_any().downcast().ok().map(|m| *m);
                     continue;
                 }
                 match run.plan(t_end) {
@@ -202,17 +236,28 @@ pub fn simulate_ensemble_of<M: Model + 'static>(
             }
             let live: [bool; LANES] =
                 std::array::from_fn(|k| plans[k].is_some() && failed[k].is_none());
+            let mut alone = [!batched; LANES];
             if batched && live.iter().any(|&l| l) {
-                lanes.evaluate(model, &live);
+                let first = live.iter().position(|&l| l).expect("a live lane");
+                // an idle lane repeats a live one
+                let each: [&M; LANES] = std::array::from_fn(|k| {
+                    let (_, run) = active[if live[k] { k } else { first }]
+                        .as_ref()
+                        .expect("a live lane runs");
+                    model_of(run)
+                });
+                lanes.evaluate(each, &live);
                 report.batch_evaluations += 1;
                 report.lane_evaluations += live.iter().filter(|&&l| l).count();
+                // a failure of user code in a lane's model: that lane evaluates alone, so
+                // that its run reports it
+                for (k, alone) in alone.iter_mut().enumerate() {
+                    *alone = live[k] && each[k].take_failure().is_some();
+                }
             }
-            // a failure of user code in the shared call: each lane evaluates alone, so that
-            // the lanes it belongs to report it
-            let alone = !batched || model.take_failure().is_some();
             for k in 0..LANES {
                 if let (true, Some((_, run))) = (live[k], &mut active[k]) {
-                    if let Err(e) = lanes.accept(k, run, s, alone) {
+                    if let Err(e) = lanes.accept(k, run, s, alone[k]) {
                         failed[k] = Some(e);
                     }
                 }
@@ -245,7 +290,17 @@ pub fn simulate_ensemble_of<M: Model + 'static>(
         .into_iter()
         .map(|r| r.expect("every member ran"))
         .collect();
+    report.models = models;
     Ok(report)
+}
+
+/// A lane's model by its type (every run of an ensemble is of its model type).
+fn model_of<M: Model + 'static>(run: &Run) -> &M {
+    run.problem
+        .model
+        .as_any()
+        .downcast_ref()
+        .expect("an ensemble's runs are of its model type")
 }
 
 /// A run's scheme as explicit stages (checked by [`supported`]).
@@ -253,19 +308,15 @@ fn staged(stepper: &mut Box<dyn Stepper>) -> &mut dyn Staged {
     stepper.staged().expect("checked by `supported`")
 }
 
-/// Whether an ensemble runs `scheme` with `options` on `model` ([`simulate_ensemble`]
-/// refuses the others with this failure).
-pub fn ensemble_supported<M: Model>(
-    model: &M,
-    scheme: &Scheme,
-    options: &Options,
-) -> Result<(), Failure> {
-    supported(model, scheme, options).map(|_| ())
+/// Whether an ensemble runs `scheme` on models of type `M` ([`simulate_ensemble`] refuses
+/// the others with this failure).
+pub fn ensemble_supported<M: Model>(scheme: &Scheme) -> Result<(), Failure> {
+    supported::<M>(scheme).map(|_| ())
 }
 
-/// What an ensemble runs: an explicit staged scheme, on a model without constraints, whose
-/// rotation joints (if any) keep the model's charts; the scheme's evaluations per step.
-fn supported<M: Model>(model: &M, scheme: &Scheme, options: &Options) -> Result<usize, Failure> {
+/// What an ensemble runs: an explicit staged scheme, on a model without constraints; the
+/// scheme's evaluations per step.
+fn supported<M: Model>(scheme: &Scheme) -> Result<usize, Failure> {
     let refuse = |name, value: String, reason| {
         Err(Failure::InvalidOption {
             name,
@@ -290,20 +341,14 @@ fn supported<M: Model>(model: &M, scheme: &Scheme, options: &Options) -> Result<
             "an ensemble runs open loops: run a closed loop's members with `simulate`",
         );
     }
-    let joints = model.info().rotation_joints.len();
-    if joints > 0 && options.chart_switch != 0.0 {
-        return refuse(
-            "chart_switch",
-            format!("{} with {joints} rotation joints", options.chart_switch),
-            "a rotation joint's chart is the model's own state, one per run, and the lanes share one model: set `chart_switch` to 0 (the joints keep the model's charts and stop at gimbal lock, as Euler angles do), or run the members with `simulate`",
-        );
-    }
     Ok(stages)
 }
 
 /// The four lanes' arguments and results of the batch forward dynamics, and one lane's
 /// point and accelerations unpacked.
 struct Lanes {
+    /// the model's rotation joints
+    joints: usize,
     t: F64x4,
     q: Vec<F64x4>,
     qd: Vec<F64x4>,
@@ -318,9 +363,10 @@ struct Lanes {
 }
 
 impl Lanes {
-    fn new(n: usize, nu: usize) -> Lanes {
+    fn new(n: usize, nu: usize, joints: usize) -> Lanes {
         let z = |len| vec![F64x4::ZERO; len];
         Lanes {
+            joints,
             t: F64x4::ZERO,
             q: z(n),
             qd: z(n),
@@ -347,8 +393,11 @@ impl Lanes {
         Ok(())
     }
 
-    /// The batch forward dynamics at the live lanes' points (an idle lane repeats a live one).
-    fn evaluate<M: Model>(&mut self, model: &M, live: &[bool; LANES]) {
+    /// The batch forward dynamics at the live lanes' points, each lane with its model (an
+    /// idle lane repeats a live one): [`Model::forward_dynamics_x4`] of the first when the
+    /// four have the same parameters and charts (its code then knows them equal in every
+    /// lane), else [`Model::forward_dynamics_lanes`].
+    fn evaluate<M: Model>(&mut self, each: [&M; LANES], live: &[bool; LANES]) {
         let first = live.iter().position(|&l| l).expect("a live lane");
         let of = |k: usize| if live[k] { k } else { first };
         let lane = |k| of(k);
@@ -361,14 +410,13 @@ impl Lanes {
         let inputs = &self.inputs;
         pack(std::array::from_fn(|k| &inputs[lane(k)][..]), &mut self.u);
         self.t = F64x4::from(std::array::from_fn(|k| self.times[lane(k)]));
-        model.forward_dynamics_x4(
-            self.t,
-            &self.q,
-            &self.qd,
-            &self.u,
-            &mut self.qdd,
-            &mut self.pivots,
-        );
+        let (q, qd, u) = (&self.q, &self.qd, &self.u);
+        let (qdd, pivots) = (&mut self.qdd, &mut self.pivots);
+        if each[1..].iter().all(|m| same(each[0], m, self.joints)) {
+            each[0].forward_dynamics_x4(self.t, q, qd, u, qdd, pivots);
+        } else {
+            M::forward_dynamics_lanes(each, self.t, q, qd, u, qdd, pivots);
+        }
     }
 
     /// Lane `k`'s accelerations of stage `s` into its scheme, judged by its run; computed by
@@ -387,4 +435,11 @@ impl Lanes {
         unpack(&self.pivots, k, &mut self.pivot);
         problem.accept_forward(t, q, qd, a, &self.pivot)
     }
+}
+
+/// Whether two models of one type have the same parameters and charts (`joints` rotation
+/// joints), so that one model's batch function computes the other's lanes too.
+fn same<M: Model>(a: &M, b: &M, joints: usize) -> bool {
+    std::ptr::eq(a, b)
+        || (a.params() == b.params() && (0..joints).all(|j| a.chart(j) == b.chart(j)))
 }

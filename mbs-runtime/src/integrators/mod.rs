@@ -46,7 +46,8 @@ mod stepper;
 pub use constrained::{Assembly, assemble};
 pub use driver::{Simulation, simulate, simulate_with};
 pub use ensemble::{
-    EnsembleReport, Member, ensemble_supported, simulate_ensemble, simulate_ensemble_of,
+    EnsembleReport, Member, ensemble_supported, simulate_ensemble, simulate_ensemble_each,
+    simulate_ensemble_of,
 };
 pub use global::{GlobalControl, GlobalReport, GlobalRun, simulate_global};
 pub use inputs::{Controller, Inputs};

@@ -1,7 +1,7 @@
 //! A tour of mbs: write a machine once in the words of CAGeM, read what the generator made of
 //! it, find its static equilibria and poles, integrate it with two schemes (CSV, plots, an
-//! HTML animation and a glTF file), and see what accuracy costs in a small work–precision
-//! study.
+//! HTML animation and a glTF file), see what accuracy costs in a small work–precision study,
+//! and run a Monte-Carlo study of uncertain parameters four runs at a time on SIMD lanes.
 //!
 //! ```text
 //! cargo run --release -p mbs-tour --example tour            # writes to target/tour
@@ -12,9 +12,13 @@ use clap::Parser;
 use mbs::analysis::{AnalysisError, StaticsOptions, linearize, modes, static_equilibrium};
 use mbs::cli::{RunArgs, RunError};
 use mbs::work_precision::{Reference, Setting, Study, Sweep, decades};
-use mbs::{IterationMatrix, Kinematics, Model, Parameters, Scheme};
+use mbs::{
+    Inputs, IterationMatrix, Kinematics, Member, Model, Options, Output, Parameters, Scheme,
+    simulate_ensemble_each, simulate_with,
+};
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
+use std::time::Instant;
 
 /// The showcase of mbs on a double pendulum.
 #[derive(Parser, Debug)]
@@ -37,7 +41,7 @@ mbs::multibody! {
         effect gravity { gravity(0, -g, 0); }
         effect damping { torque(bar2, relative_to = bar1, axis = z, -c * qd[1]); }
         scene Free = []; scene Swing = [gravity]; scene Full = [gravity, damping];
-        option tangents;
+        option tangents; option batch;
     }
 }
 
@@ -143,6 +147,7 @@ fn main() {
         std::process::exit(1);
     }
     work_precision(&args.out);
+    many_runs();
     println!("\nread the generated code with: cargo run --bin mbs -- expand tour/examples/tour.rs");
 }
 
@@ -267,5 +272,86 @@ fn work_precision(out: &Path) {
         "\nopen {} in a browser (offline) to watch the motion; {} in Blender or any glTF viewer",
         out.join("dopri5").join("animation.html").display(),
         out.join("dopri5").join("motion.gltf").display()
+    );
+}
+
+/// A Monte-Carlo study: the damped pendulum (scene Full) whose damper and bar mass are known
+/// to ±20 %, 128 runs of 5 s from the horizontal, each member its own model
+/// (`simulate_ensemble_each`: four members at a time on the lanes of the batch functions of
+/// `option batch;`, each lane with its member's parameters), then the same runs one by one.
+fn many_runs() {
+    const RUNS: usize = 128;
+    println!(
+        "\nmany runs at once (scene Full, {RUNS} runs of 5 s, damper c and mass m drawn within ±20 %):"
+    );
+    let base = DoublePendulumFull::default();
+    // a low-discrepancy draw of (c, m): the additive sequences of the plastic number
+    let model = |k: usize| {
+        let (u, v) = (
+            (0.5 + k as f64 * 0.754_877_666_246_692_7) % 1.0,
+            (0.5 + k as f64 * 0.569_840_290_998_053_3) % 1.0,
+        );
+        let mut p = base.params().clone();
+        p.c *= 0.8 + 0.4 * u;
+        p.m *= 0.8 + 0.4 * v;
+        let mut model = base.clone();
+        model.set_params(p).expect("positive parameters");
+        model
+    };
+    // the start and the end
+    let options = Options {
+        output: Output::Every { dt: 5.0 },
+        ..Options::adaptive(5.0, 1e-8)
+    };
+    let clock = Instant::now();
+    let members = (0..RUNS).map(|k| (model(k), Member::default()));
+    let report = match simulate_ensemble_each(Scheme::Dopri5, &options, members) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("error: {e}");
+            std::process::exit(1);
+        }
+    };
+    let on_lanes = clock.elapsed();
+    let clock = Instant::now();
+    let alone: Vec<_> = (0..RUNS)
+        .map(|k| simulate_with(model(k), Scheme::Dopri5, options.clone(), Inputs::default()))
+        .collect();
+    let one_by_one = clock.elapsed();
+    // the energy each run's damper took, and how far the ensemble's runs are from the same
+    // runs one by one
+    let (mut lost, mut apart) = (Vec::new(), 0.0f64);
+    for (k, (run, alone)) in report.runs.iter().zip(&alone).enumerate() {
+        let (Ok((traj, _)), Ok((traj_alone, _)), Some(m)) = (run, alone, &report.models[k]) else {
+            eprintln!("error: run {k} failed");
+            std::process::exit(1);
+        };
+        let energy = |i: usize| {
+            let e = m.energy(traj.t[i], traj.q(i), traj.qd(i));
+            e.kinetic + e.potential
+        };
+        lost.push(energy(0) - energy(traj.len() - 1));
+        let last = traj.len() - 1;
+        for (a, b) in traj.q(last).iter().zip(traj_alone.q(traj_alone.len() - 1)) {
+            apart = apart.max((a - b).abs());
+        }
+    }
+    let mean = lost.iter().sum::<f64>() / RUNS as f64;
+    let (lo, hi) = lost
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(lo, hi), &x| (lo.min(x), hi.max(x)));
+    println!(
+        "  energy taken by the damper: mean {mean:.3} J, from {lo:.3} to {hi:.3} J over the runs"
+    );
+    println!(
+        "  {RUNS} runs on lanes in {:.1} ms ({} calls of the batch forward dynamics, lanes busy {:.0} %), one by one in {:.1} ms ({:.2}× the throughput), their final angles {apart:.1e} rad apart",
+        on_lanes.as_secs_f64() * 1e3,
+        report.batch_evaluations,
+        100.0 * report.occupancy(),
+        one_by_one.as_secs_f64() * 1e3,
+        one_by_one.as_secs_f64() / on_lanes.as_secs_f64()
+    );
+    println!(
+        "  (at 2 dof the lanes do not pay: each run's own scheme work outweighs its dynamics; on a 16-bar chain an ensemble has 1.6–1.9× the throughput of its runs one by one, `cargo bench -p mbs-benches --bench ensemble`)"
     );
 }

@@ -411,6 +411,50 @@ mbs::multibody! {
     }
 }
 
+mbs::multibody! {
+    /// Forces of the magnitude |x| whose derivatives are infinite at x = 0: √|x|, |x|^0.7 and
+    /// |x|^n with the exponent n a sensitive parameter (a damper growing with √|v|, say).
+    model AbsKinks {
+        param k = 100.0; param n = 1.5 sensitive;
+        dof x = 0.0;
+        body b { mass = 1.0; inertia = (1, 1, 1); }
+        TOG[b] = Tdisp(x, 0, 0);
+        generalized_force(q[x], -k * sqrt(abs(x)) - pow(abs(x), 0.7) - pow(abs(x), n));
+        option tangents;
+    }
+}
+
+/// At x = 0 the tangent and the derivative by the exponent of forces of |x| are 0, where the
+/// chain rule gave inf·0 = NaN; on both sides of it they are the derivatives by hand.
+#[test]
+fn derivatives_at_the_kink_of_a_magnitude_are_zero_not_nan() {
+    let model = AbsKinks::default();
+    let k_at = |x: f64| {
+        let (mut k, mut c) = ([0.0], [0.0]);
+        model
+            .tangents(0.0, &[x], &[0.0], &[0.0], &[], &mut k, &mut c)
+            .unwrap();
+        let mut dp = [0.0];
+        model
+            .parameter_tangents(0.0, &[x], &[0.0], &[0.0], &[], &mut dp)
+            .unwrap();
+        (k[0], dp[0])
+    };
+    assert_eq!(k_at(0.0), (0.0, 0.0));
+    for x in [0.2f64, -0.3] {
+        let (k, dp) = k_at(x);
+        let (m, s) = (x.abs(), x.signum());
+        // K = ∂τ/∂q, τ = M qdd − h: the derivative of minus the force
+        let want = s * (100.0 * 0.5 / m.sqrt() + 0.7 * m.powf(-0.3) + 1.5 * m.powf(0.5));
+        assert!(
+            (k - want).abs() < 1e-12 * want.abs(),
+            "x = {x}: {k} against {want}"
+        );
+        let want = m.powf(1.5) * m.ln();
+        assert!((dp - want).abs() < 1e-14, "x = {x}: {dp} against {want}");
+    }
+}
+
 /// Off contact (x ≤ 0) the tangent and the derivative by the exponent are 0, where the chain
 /// rule gave inf·0 = NaN; in contact they are the derivatives by hand.
 #[test]

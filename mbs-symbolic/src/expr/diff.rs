@@ -183,23 +183,32 @@ impl Arena {
     }
 
     /// `a`, or where `a` is a positive part pos(u) (or c·pos(u)), pos(u) + 1 − step(u): equal
-    /// to it where u > 0, 1 where u ≤ 0. The factor of a chain rule that is infinite at 0
-    /// (0.5/√a, a^(b−1) with b < 1, ln a, 1/a) then stays finite where pos(u) is 0, and is
-    /// multiplied there by the derivative of pos(u), step(u)·u' = 0: the derivative is 0, as
-    /// it is, where inf·0 gave NaN (√pos(x), pos(δ)^b with b < 1, and the second derivatives
-    /// of pos(δ)^1.5 out of contact).
+    /// to it where u > 0, 1 where u ≤ 0; where `a` is |u| (or c·|u|), |u| + 1 − sign(u)²:
+    /// equal to it where u ≠ 0, 1 where u = 0. The factor of a chain rule that is infinite at
+    /// 0 (0.5/√a, a^(b−1) with b < 1, ln a, 1/a) then stays finite where pos(u) or |u| is 0,
+    /// and is multiplied there by the derivative of pos(u), step(u)·u' = 0, or of |u|,
+    /// sign(u)·u' = 0: the derivative is 0 where inf·0 gave NaN (√pos(x), pos(δ)^b with
+    /// b < 1, the second derivatives of pos(δ)^1.5 out of contact, √|v|, |v|^b).
     fn off_the_kink(&mut self, a: ExprId) -> ExprId {
         let (c, p) = match self.node(a) {
-            Node::Func(Func::Pos, _) => (None, a),
+            Node::Func(Func::Pos | Func::Abs, _) => (None, a),
             Node::Mul(c, p) if self.as_num(c).is_some() => (Some(c), p),
             _ => return a,
         };
-        let Node::Func(Func::Pos, u) = self.node(p) else {
-            return a;
+        let (at_kink, u) = match self.node(p) {
+            Node::Func(Func::Pos, u) => (Func::Step, u),
+            Node::Func(Func::Abs, u) => (Func::Sign, u),
+            _ => return a,
         };
         let one = self.one();
-        let step = self.func(Func::Step, u);
-        let lift = self.sub(one, step);
+        // 1 − step(u), or 1 − sign(u)²: 1 at the kink (and below it, for pos)
+        let k = self.func(at_kink, u);
+        let k = if at_kink == Func::Sign {
+            self.powi(k, 2)
+        } else {
+            k
+        };
+        let lift = self.sub(one, k);
         let off = self.add(p, lift);
         match c {
             Some(c) => self.mul(c, off),

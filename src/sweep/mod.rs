@@ -3,7 +3,9 @@
 //!
 //! A [`Plan`] (TOML) says which runs to make: a grid, a Latin hypercube, Monte-Carlo draws
 //! with a seed, or a list from a CSV file, over parameters of the model, initial coordinates
-//! and velocities, and simulation settings (scheme, tolerances, step, end time). A
+//! and velocities (those a run does not vary start as its model starts them, its varied
+//! parameters set: a parameter may set the start), and simulation settings (scheme,
+//! tolerances, step, end time). A
 //! [`Sweep`] makes them in parallel (a rayon pool, one run per thread at a time, the next
 //! run taken as soon as a thread is free) and writes one row per run to a CSV table as the
 //! runs finish, in run order: the run's values, the [`Metrics`] the user chose (a closure
@@ -752,6 +754,13 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
                 }
                 return rows.into_iter().flatten().collect();
             };
+            // a run made on lanes: one that took a step (not one whose start was refused)
+            let on_lanes: Vec<bool> = (report.runs.iter())
+                .map(|r| match r {
+                    Ok(_) => true,
+                    Err(e) => e.stats.steps + e.stats.rejected_error + e.stats.rejected_newton > 0,
+                })
+                .collect();
             // each run's metrics, a panic in them that run's own
             let outcomes: Vec<Outcome> = (report.runs.into_iter())
                 .zip(report.models)
@@ -767,10 +776,10 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
                 .collect();
             // each run its share of the ensemble's time
             let cpu = clock.elapsed() / outcomes.len().max(1) as u32;
-            for (j, o) in in_ensemble.into_iter().zip(outcomes) {
+            for ((j, o), on_lanes) in in_ensemble.into_iter().zip(outcomes).zip(on_lanes) {
                 let i = indices[j];
                 let mut row = row_of(i, &runs.rows[i], o, cpu, nm);
-                row.on_lanes = true;
+                row.on_lanes = on_lanes;
                 rows[j] = Some(row);
             }
         }
@@ -882,7 +891,7 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
         let (mut scheme, mut options) = (b.scheme, b.options.clone());
         let (mut h, mut rtol, mut atol) = (b.h, b.rtol, b.atol);
         let mut params = model.params().clone();
-        let mut q0 = None::<(Vec<f64>, Vec<f64>)>;
+        let mut start = Vec::new();
         for (j, (target, value)) in targets.iter().zip(values).enumerate() {
             let bad = |reason: &str| SweepError::BadValue {
                 name: names[j].clone(),
@@ -902,21 +911,9 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
             };
             match target {
                 Target::Param(name) => params.set(name, x).map_err(|e| bad(&e.to_string()))?,
-                Target::Q0(k) | Target::Qd0(k) => {
-                    let (q, qd) = q0.get_or_insert_with(|| {
-                        let (mut q, mut qd) = (vec![0.0; M::NQ], vec![0.0; M::NQ]);
-                        model.initial_state(&mut q, &mut qd);
-                        if let Some(given) = &options.q0 {
-                            q.clone_from(given);
-                        }
-                        if let Some(given) = &options.qd0 {
-                            qd.clone_from(given);
-                        }
-                        (q, qd)
-                    });
-                    let v = if let Target::Q0(_) = target { q } else { qd };
-                    v[*k] = x;
-                }
+                // set on the start of the run's model, once its parameters are set
+                Target::Q0(k) => start.push((true, *k, x)),
+                Target::Qd0(k) => start.push((false, *k, x)),
                 Target::TEnd => options.t_end = x,
                 Target::H => h = Some(x),
                 Target::Rtol => {
@@ -942,7 +939,20 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
                     .join(", "),
                 reason: e.to_string(),
             })?;
-        if let Some((q, qd)) = q0 {
+        if !start.is_empty() {
+            // the coordinates not varied as the run's model starts them (its parameters may
+            // set its start) or as the base options give them
+            let (mut q, mut qd) = (vec![0.0; M::NQ], vec![0.0; M::NQ]);
+            model.initial_state(&mut q, &mut qd);
+            if let Some(given) = &options.q0 {
+                q.clone_from(given);
+            }
+            if let Some(given) = &options.qd0 {
+                qd.clone_from(given);
+            }
+            for (position, k, x) in start {
+                if position { q[k] = x } else { qd[k] = x }
+            }
             options.q0 = Some(q);
             options.qd0 = Some(qd);
         }

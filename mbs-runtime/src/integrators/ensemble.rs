@@ -246,13 +246,14 @@ pub fn simulate_ensemble_each<M: Model + 'static>(
                         .expect("a live lane runs");
                     model_of(run)
                 });
-                lanes.evaluate(each, &live);
+                let one = lanes.evaluate(each, &live);
                 report.batch_evaluations += 1;
                 report.lane_evaluations += live.iter().filter(|&&l| l).count();
                 // a failure of user code in a lane's model: that lane evaluates alone, so
-                // that its run reports it
+                // that its run reports it; every lane when one model evaluated them all
+                let failed = one.then(|| each[0].take_failure().is_some());
                 for (k, alone) in alone.iter_mut().enumerate() {
-                    *alone = live[k] && each[k].take_failure().is_some();
+                    *alone = live[k] && failed.unwrap_or_else(|| each[k].take_failure().is_some());
                 }
             }
             for k in 0..LANES {
@@ -396,8 +397,8 @@ impl Lanes {
     /// The batch forward dynamics at the live lanes' points, each lane with its model (an
     /// idle lane repeats a live one): [`Model::forward_dynamics_x4`] of the first when the
     /// four have the same parameters and charts (its code then knows them equal in every
-    /// lane), else [`Model::forward_dynamics_lanes`].
-    fn evaluate<M: Model>(&mut self, each: [&M; LANES], live: &[bool; LANES]) {
+    /// lane), else [`Model::forward_dynamics_lanes`]. Whether one model evaluated them.
+    fn evaluate<M: Model>(&mut self, each: [&M; LANES], live: &[bool; LANES]) -> bool {
         let first = live.iter().position(|&l| l).expect("a live lane");
         let of = |k: usize| if live[k] { k } else { first };
         let lane = |k| of(k);
@@ -412,11 +413,13 @@ impl Lanes {
         self.t = F64x4::from(std::array::from_fn(|k| self.times[lane(k)]));
         let (q, qd, u) = (&self.q, &self.qd, &self.u);
         let (qdd, pivots) = (&mut self.qdd, &mut self.pivots);
-        if each[1..].iter().all(|m| same(each[0], m, self.joints)) {
+        let one = each[1..].iter().all(|m| same(each[0], m, self.joints));
+        if one {
             each[0].forward_dynamics_x4(self.t, q, qd, u, qdd, pivots);
         } else {
             M::forward_dynamics_lanes(each, self.t, q, qd, u, qdd, pivots);
         }
+        one
     }
 
     /// Lane `k`'s accelerations of stage `s` into its scheme, judged by its run; computed by

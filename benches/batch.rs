@@ -7,7 +7,9 @@
 //! ```
 //!
 //! Prints criterion's figures, then a table of medians: ns for four states each way and the
-//! throughput of the batch relative to the one-state path (goal ≥ 3×).
+//! throughput of the batch relative to the one-state path (goal ≥ 3×); then the batch forward
+//! dynamics of four models, each lane its own model's parameters (`forward_dynamics_lanes`,
+//! an ensemble's members), against one model's in every lane.
 
 mod common;
 #[path = "scaling/models.rs"]
@@ -44,7 +46,7 @@ fn pack(states: &[&[f64]]) -> Vec<F64x4> {
 }
 
 /// Measures both functions both ways on `model`.
-fn bench_model<M: Model>(c: &mut Criterion, name: &'static str, model: M) -> &'static str {
+fn bench_model<M: Model + Clone>(c: &mut Criterion, name: &'static str, model: M) -> &'static str {
     assert!(M::BATCH_GENERATED, "{name} has `option batch;`");
     let n = M::NQ;
     let states = four_states(n);
@@ -81,6 +83,22 @@ fn bench_model<M: Model>(c: &mut Criterion, name: &'static str, model: M) -> &'s
             model.forward_dynamics_x4(t4, black_box(&q4), black_box(&qd4), &u4, &mut a4, &mut p4)
         })
     });
+    // four models (equal here, which the code does not know: it reads each lane's values)
+    let models = [model.clone(), model.clone(), model.clone(), model.clone()];
+    let each = [&models[0], &models[1], &models[2], &models[3]];
+    g.bench_function("forward_four_models", |b| {
+        b.iter(|| {
+            M::forward_dynamics_lanes(
+                black_box(each),
+                t4,
+                black_box(&q4),
+                black_box(&qd4),
+                &u4,
+                &mut a4,
+                &mut p4,
+            )
+        })
+    });
     g.finish();
     name
 }
@@ -113,6 +131,18 @@ fn main() {
                 "{name:<9} {f:<17} {o:>12.1} {l:>9.1}   {:>8.2}×   ≥ {GOAL:.0}× {verdict}",
                 o / l
             );
+        }
+    }
+    println!(
+        "batch forward dynamics, ns: one model in every lane / four models, each lane its own"
+    );
+    for name in names {
+        let group = format!("batch_{name}");
+        if let (Some(one), Some(four)) = (
+            median_ns(&group, "forward_lanes", since),
+            median_ns(&group, "forward_four_models", since),
+        ) {
+            println!("{name:<9} {one:>8.1} / {four:>8.1}   ({:.2}×)", four / one);
         }
     }
 }

@@ -204,25 +204,17 @@ impl Staged for Dopri5 {
         h: f64,
         s: usize,
     ) -> Result<(f64, &[f64], &[f64]), Failure> {
-        // Σⱼ A[s][j] kⱼ summed from 0 in the order of j for each component, as one loop over
-        // the components per stage (the same operations, in vector registers)
+        // y + h Σⱼ A[s][j] kⱼ, summed from 0 in the order of j for each component, in one pass
+        // over the components (the stage's terms unrolled, the components in vector registers)
+        let (kv, ka) = (&self.kv, &self.ka);
         let (q, v) = (&mut self.q, &mut self.v);
-        q.fill(0.0);
-        v.fill(0.0);
-        for j in 0..s {
-            let a = A[s][j];
-            for (x, k) in q.iter_mut().zip(&self.kv[j]) {
-                *x += a * k;
-            }
-            for (x, k) in v.iter_mut().zip(&self.ka[j]) {
-                *x += a * k;
-            }
-        }
-        for (x, y) in q.iter_mut().zip(&cur.q) {
-            *x = y + h * *x;
-        }
-        for (x, y) in v.iter_mut().zip(&cur.qd) {
-            *x = y + h * *x;
+        match s {
+            1 => combine::<1>(kv, ka, cur, h, q, v),
+            2 => combine::<2>(kv, ka, cur, h, q, v),
+            3 => combine::<3>(kv, ka, cur, h, q, v),
+            4 => combine::<4>(kv, ka, cur, h, q, v),
+            5 => combine::<5>(kv, ka, cur, h, q, v),
+            _ => combine::<6>(kv, ka, cur, h, q, v),
         }
         self.kv[s].copy_from_slice(&self.v);
         if s == 5 {
@@ -254,18 +246,28 @@ impl Staged for Dopri5 {
             self.watch.accepted(cur, next);
             return Ok(Attempt::Accepted { h_next: h });
         };
+        // the stages as slices of n, so that the loop over the components has no bounds to
+        // check and runs in vector registers
+        let kv: [&[f64]; 7] = std::array::from_fn(|s| &self.kv[s][..n]);
+        let ka: [&[f64]; 7] = std::array::from_fn(|s| &self.ka[s][..n]);
+        let (err, y0, y1) = (
+            &mut self.err[..2 * n],
+            &mut self.y0[..2 * n],
+            &mut self.y1[..2 * n],
+        );
+        let (q0, v0, q1, v1) = (&cur.q[..n], &cur.qd[..n], &next.q[..n], &next.qd[..n]);
         for i in 0..n {
             let (mut eq, mut ev) = (0.0, 0.0);
             for s in 0..7 {
-                eq += E[s] * self.kv[s][i];
-                ev += E[s] * self.ka[s][i];
+                eq += E[s] * kv[s][i];
+                ev += E[s] * ka[s][i];
             }
-            self.err[i] = h * eq;
-            self.err[n + i] = h * ev;
-            self.y0[i] = cur.q[i];
-            self.y0[n + i] = cur.qd[i];
-            self.y1[i] = next.q[i];
-            self.y1[n + i] = next.qd[i];
+            err[i] = h * eq;
+            err[n + i] = h * ev;
+            y0[i] = q0[i];
+            y0[n + i] = v0[i];
+            y1[i] = q1[i];
+            y1[n + i] = v1[i];
         }
         let norm = tol.norm(&self.err, &self.y0, &self.y1, self.y0.len() / 2);
         self.test = norm;
@@ -330,6 +332,31 @@ impl Dopri5 {
                 c[3][i] = diff - h * k[6][i] - bspl;
                 c[4][i] = h * (0..7).map(|s| D[s] * k[s][i]).sum::<f64>();
             }
+        }
+    }
+}
+
+/// Stage `S`'s point: q = q₀ + h Σⱼ A[S][j] kvⱼ and v = qd₀ + h Σⱼ A[S][j] kaⱼ over the first
+/// `S` stages, each sum from 0 in the order of j.
+#[inline(always)]
+fn combine<const S: usize>(
+    kv: &[Vec<f64>],
+    ka: &[Vec<f64>],
+    cur: &State,
+    h: f64,
+    q: &mut [f64],
+    v: &mut [f64],
+) {
+    let n = q.len();
+    let a = &A[S];
+    for (out, y, k) in [(q, &cur.q, kv), (v, &cur.qd, ka)] {
+        let (y, k): (&[f64], [&[f64]; S]) = (&y[..n], std::array::from_fn(|j| &k[j][..n]));
+        for (i, out) in out.iter_mut().enumerate() {
+            let mut x = 0.0;
+            for j in 0..S {
+                x += a[j] * k[j][i];
+            }
+            *out = y[i] + h * x;
         }
     }
 }

@@ -75,8 +75,10 @@ impl Tolerances {
         let (rtol, atol) = (self.rtol, self.atol);
         let n = e.len();
         let bounds = [0, kind.min(n), (2 * kind).min(n), n];
+        let (e, y0, y1) = (&e[..n], &y0[..n], &y1[..n]);
         let (mut s, mut floored) = (0.0, false);
-        let (mut top, mut held_by) = (Argmax::default(), None);
+        let mut top = Argmax::default();
+        let mut floors = [0.0; 3];
         for (block, b) in bounds.windows(2).enumerate() {
             let (start, end) = (b[0], b[1]);
             let largest = y0[start..end]
@@ -84,6 +86,7 @@ impl Tolerances {
                 .chain(&y1[start..end])
                 .fold(0.0f64, |m, y| m.max(y.abs()));
             let floor = Self::transformed_floor(rtol) * largest;
+            floors[block] = floor;
             for i in start..end {
                 let magnitude = y0[i].abs().max(y1[i].abs());
                 let w = atol + rtol * magnitude;
@@ -91,25 +94,30 @@ impl Tolerances {
                 let weight = w.max(floor);
                 let term = (e[i] / weight) * (e[i] / weight);
                 s += term;
-                if top.see(term, block, i - start) {
-                    let set_by = if w < floor {
-                        WeightBy::Rounding
-                    } else if atol >= rtol * magnitude {
-                        WeightBy::Atol
-                    } else {
-                        WeightBy::Rtol
-                    };
-                    held_by = Some(Largest {
-                        block,
-                        index: i - start,
-                        error: e[i],
-                        magnitude,
-                        weight,
-                        set_by,
-                    });
-                }
+                top.see(term, block, i - start);
             }
         }
+        // the component that weighed most, described once
+        let held_by = top.at.map(|(block, index)| {
+            let (floor, i) = (floors[block], bounds[block] + index);
+            let magnitude = y0[i].abs().max(y1[i].abs());
+            let w = atol + rtol * magnitude;
+            let set_by = if w < floor {
+                WeightBy::Rounding
+            } else if atol >= rtol * magnitude {
+                WeightBy::Atol
+            } else {
+                WeightBy::Rtol
+            };
+            Largest {
+                block,
+                index,
+                error: e[i],
+                magnitude,
+                weight: w.max(floor),
+                set_by,
+            }
+        });
         ErrorNorm {
             value: (s / e.len().max(1) as f64).sqrt(),
             floored,

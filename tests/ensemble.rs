@@ -490,3 +490,200 @@ fn a_free_body_runs_on_lanes_with_its_charts_held() {
         "a free body on two corners of the ground, 5 members: positions within {worst:.1e} of the runs alone"
     );
 }
+
+/// The 8-bar chain as a hand-written batch model whose user code fails at every evaluation
+/// past t = 0.6 s (a failure it records, as `WithEfforts` does, for `take_failure`): in a batch
+/// call, on the model that made the call.
+#[derive(Clone, Default)]
+struct FailsLate(Chain8, std::cell::Cell<Option<f64>>);
+
+impl FailsLate {
+    const AFTER: f64 = 0.6;
+    fn record(&self, t: f64) {
+        if t > Self::AFTER && self.1.get().is_none() {
+            self.1.set(Some(t));
+        }
+    }
+}
+
+impl Model for FailsLate {
+    type Params = <Chain8 as Model>::Params;
+    const NQ: usize = Chain8::NQ;
+    const NU: usize = Chain8::NU;
+    const NFRAMES: usize = Chain8::NFRAMES;
+    const NPOINTS: usize = Chain8::NPOINTS;
+    const NC: usize = Chain8::NC;
+    const FORWARD_DYNAMICS_GENERATED: bool = true;
+    const BATCH_GENERATED: bool = true;
+    fn info(&self) -> &'static mbs::ModelInfo {
+        self.0.info()
+    }
+    fn params(&self) -> &Self::Params {
+        self.0.params()
+    }
+    fn set_params(&mut self, p: Self::Params) -> Result<(), mbs::ParamError> {
+        self.0.set_params(p)
+    }
+    fn initial_state(&self, q: &mut [f64], qd: &mut [f64]) {
+        self.0.initial_state(q, qd)
+    }
+    fn mass_matrix(&self, t: f64, q: &[f64], m: &mut [f64]) {
+        self.0.mass_matrix(t, q, m)
+    }
+    fn dynamics(&self, t: f64, q: &[f64], qd: &[f64], u: &[f64], m: &mut [f64], h: &mut [f64]) {
+        self.record(t);
+        self.0.dynamics(t, q, qd, u, m, h)
+    }
+    fn forward_dynamics(
+        &self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        u: &[f64],
+        qdd: &mut [f64],
+        pivots: &mut [f64],
+    ) {
+        self.record(t);
+        self.0.forward_dynamics(t, q, qd, u, qdd, pivots)
+    }
+    fn forward_dynamics_x4(
+        &self,
+        t: mbs::F64x4,
+        q: &[mbs::F64x4],
+        qd: &[mbs::F64x4],
+        u: &[mbs::F64x4],
+        qdd: &mut [mbs::F64x4],
+        pivots: &mut [mbs::F64x4],
+    ) {
+        // any lane past the time: the failure is this model's
+        (0..mbs::LANES).for_each(|k| self.record(t.lane(k)));
+        self.0.forward_dynamics_x4(t, q, qd, u, qdd, pivots)
+    }
+    fn forward_dynamics_lanes(
+        each: [&Self; mbs::LANES],
+        t: mbs::F64x4,
+        q: &[mbs::F64x4],
+        qd: &[mbs::F64x4],
+        u: &[mbs::F64x4],
+        qdd: &mut [mbs::F64x4],
+        pivots: &mut [mbs::F64x4],
+    ) {
+        (0..mbs::LANES).for_each(|k| each[k].record(t.lane(k)));
+        Chain8::forward_dynamics_lanes(each.map(|m| &m.0), t, q, qd, u, qdd, pivots)
+    }
+    fn take_failure(&self) -> Option<Failure> {
+        self.1.take().map(|t| Failure::EffortRejected {
+            t,
+            message: "past t = 0.6 s".into(),
+        })
+    }
+    fn inverse_dynamics(
+        &self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        a: &[f64],
+        u: &[f64],
+        tau: &mut [f64],
+    ) {
+        self.0.inverse_dynamics(t, q, qd, a, u, tau)
+    }
+    #[allow(clippy::too_many_arguments)]
+    fn tangents(
+        &self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        a: &[f64],
+        u: &[f64],
+        k: &mut [f64],
+        c: &mut [f64],
+    ) -> Result<(), mbs::ModelError> {
+        self.0.tangents(t, q, qd, a, u, k, c)
+    }
+    fn static_forces(&self, t: f64, q: &[f64], u: &[f64], h: &mut [f64]) {
+        self.0.static_forces(t, q, u, h)
+    }
+    fn input_matrix(&self, t: f64, q: &[f64], qd: &[f64], u: &[f64], b: &mut [f64]) {
+        self.0.input_matrix(t, q, qd, u, b)
+    }
+    fn energy(&self, t: f64, q: &[f64], qd: &[f64]) -> mbs::Energy {
+        self.0.energy(t, q, qd)
+    }
+    fn power(&self, t: f64, q: &[f64], qd: &[f64], u: &[f64]) -> f64 {
+        self.0.power(t, q, qd, u)
+    }
+    fn constraints(&self, t: f64, q: &[f64], phi: &mut [f64]) {
+        self.0.constraints(t, q, phi)
+    }
+    fn constraint_jacobian(&self, t: f64, q: &[f64], b: &mut [f64]) {
+        self.0.constraint_jacobian(t, q, b)
+    }
+    fn constraint_rate(&self, t: f64, q: &[f64], phi_t: &mut [f64]) {
+        self.0.constraint_rate(t, q, phi_t)
+    }
+    fn constraint_bias(&self, t: f64, q: &[f64], qd: &[f64], gamma: &mut [f64]) {
+        self.0.constraint_bias(t, q, qd, gamma)
+    }
+    fn constraint_tangent(&self, t: f64, q: &[f64], lambda: &[f64], k: &mut [f64]) {
+        self.0.constraint_tangent(t, q, lambda, k)
+    }
+    fn frames(&self, t: f64, q: &[f64], out: &mut [mbs::Pose]) {
+        self.0.frames(t, q, out)
+    }
+    fn kinematics(&self, t: f64, q: &[f64], qd: &[f64], out: &mut mbs::Kinematics) {
+        self.0.kinematics(t, q, qd, out)
+    }
+}
+
+/// A failure of user code recorded in a batch call is its own lane's, whichever model made
+/// the call: every member of identical models (one model evaluates the four lanes) fails at
+/// the evaluation where it fails alone, none runs past it.
+#[test]
+fn a_failure_of_user_code_in_a_shared_batch_call_is_each_lane_s_own() {
+    let model = FailsLate::default();
+    let opts = options(1.0, 1e-8);
+    let starts = starts(8, 6);
+    let members: Vec<Member> = starts
+        .iter()
+        .map(|(q, qd)| Member::at(q.clone(), qd.clone()))
+        .collect();
+    let report = simulate_ensemble(&model, Scheme::Dopri5, &opts, members).unwrap();
+    for (k, (q, qd)) in starts.into_iter().enumerate() {
+        let o = Options {
+            q0: Some(q),
+            qd0: Some(qd),
+            ..opts.clone()
+        };
+        let alone = simulate_with(model.clone(), Scheme::Dopri5, o, Inputs::default()).unwrap_err();
+        let Err(e) = &report.runs[k] else {
+            panic!(
+                "member {k} ran past t = 0.6 s, where alone it failed at {}",
+                alone.t
+            )
+        };
+        assert!(
+            matches!(e.kind, Failure::EffortRejected { .. }),
+            "member {k}: {}",
+            e.kind
+        );
+        println!(
+            "member {k}: failed at {} after {} steps, alone at {} after {}",
+            e.t, e.stats.steps, alone.t, alone.stats.steps
+        );
+        // where alone it fails, to the rounding of the batch functions (the steps that close
+        // in on the wall of rejected states, 0–5 more or fewer than alone, follow the last
+        // bits), never past it
+        assert!(
+            e.t <= FailsLate::AFTER,
+            "member {k} ran past t = 0.6 s: {}",
+            e.t
+        );
+        assert!(
+            (e.t - alone.t).abs() < 1e-9,
+            "member {k}: {} against {}",
+            e.t,
+            alone.t
+        );
+    }
+}

@@ -424,22 +424,26 @@ mbs::multibody! {
     }
 }
 
+/// A one-coordinate model's tangent stiffness K and ∂τ/∂n (its one sensitive parameter) at
+/// rest at x.
+fn stiffness_and_exponent_derivative<M: Model>(model: &M, x: f64) -> (f64, f64) {
+    let (mut k, mut c) = ([0.0], [0.0]);
+    model
+        .tangents(0.0, &[x], &[0.0], &[0.0], &[], &mut k, &mut c)
+        .unwrap();
+    let mut dp = [0.0];
+    model
+        .parameter_tangents(0.0, &[x], &[0.0], &[0.0], &[], &mut dp)
+        .unwrap();
+    (k[0], dp[0])
+}
+
 /// At x = 0 the tangent and the derivative by the exponent of forces of |x| are 0, where the
 /// chain rule gave inf·0 = NaN; on both sides of it they are the derivatives by hand.
 #[test]
 fn derivatives_at_the_kink_of_a_magnitude_are_zero_not_nan() {
     let model = AbsKinks::default();
-    let k_at = |x: f64| {
-        let (mut k, mut c) = ([0.0], [0.0]);
-        model
-            .tangents(0.0, &[x], &[0.0], &[0.0], &[], &mut k, &mut c)
-            .unwrap();
-        let mut dp = [0.0];
-        model
-            .parameter_tangents(0.0, &[x], &[0.0], &[0.0], &[], &mut dp)
-            .unwrap();
-        (k[0], dp[0])
-    };
+    let k_at = |x: f64| stiffness_and_exponent_derivative(&model, x);
     assert_eq!(k_at(0.0), (0.0, 0.0));
     for x in [0.2f64, -0.3] {
         let (k, dp) = k_at(x);
@@ -460,17 +464,7 @@ fn derivatives_at_the_kink_of_a_magnitude_are_zero_not_nan() {
 #[test]
 fn derivatives_at_the_kink_of_a_positive_part_are_zero_not_nan() {
     let model = Kinks::default();
-    let k_at = |x: f64| {
-        let (mut k, mut c) = ([0.0], [0.0]);
-        model
-            .tangents(0.0, &[x], &[0.0], &[0.0], &[], &mut k, &mut c)
-            .unwrap();
-        let mut dp = [0.0];
-        model
-            .parameter_tangents(0.0, &[x], &[0.0], &[0.0], &[], &mut dp)
-            .unwrap();
-        (k[0], dp[0])
-    };
+    let k_at = |x: f64| stiffness_and_exponent_derivative(&model, x);
     // K = ∂τ/∂q with τ = M qdd − h: the derivative of minus the force
     for x in [-0.1, 0.0] {
         assert_eq!(k_at(x), (0.0, 0.0), "x = {x}");

@@ -30,6 +30,10 @@ mbs::multibody! {
     }
 }
 
+#[macro_use]
+#[path = "common/delegating.rs"]
+mod delegating;
+
 #[path = "common/free_box.rs"]
 mod free_box;
 use free_box::Mixed;
@@ -506,30 +510,9 @@ impl FailsLate {
     }
 }
 
-impl Model for FailsLate {
-    type Params = <Chain8 as Model>::Params;
-    const NQ: usize = Chain8::NQ;
-    const NU: usize = Chain8::NU;
-    const NFRAMES: usize = Chain8::NFRAMES;
-    const NPOINTS: usize = Chain8::NPOINTS;
-    const NC: usize = Chain8::NC;
+delegating_model!(FailsLate => Chain8 {
     const FORWARD_DYNAMICS_GENERATED: bool = true;
     const BATCH_GENERATED: bool = true;
-    fn info(&self) -> &'static mbs::ModelInfo {
-        self.0.info()
-    }
-    fn params(&self) -> &Self::Params {
-        self.0.params()
-    }
-    fn set_params(&mut self, p: Self::Params) -> Result<(), mbs::ParamError> {
-        self.0.set_params(p)
-    }
-    fn initial_state(&self, q: &mut [f64], qd: &mut [f64]) {
-        self.0.initial_state(q, qd)
-    }
-    fn mass_matrix(&self, t: f64, q: &[f64], m: &mut [f64]) {
-        self.0.mass_matrix(t, q, m)
-    }
     fn dynamics(&self, t: f64, q: &[f64], qd: &[f64], u: &[f64], m: &mut [f64], h: &mut [f64]) {
         self.record(t);
         self.0.dynamics(t, q, qd, u, m, h)
@@ -577,64 +560,7 @@ impl Model for FailsLate {
             message: "past t = 0.6 s".into(),
         })
     }
-    fn inverse_dynamics(
-        &self,
-        t: f64,
-        q: &[f64],
-        qd: &[f64],
-        a: &[f64],
-        u: &[f64],
-        tau: &mut [f64],
-    ) {
-        self.0.inverse_dynamics(t, q, qd, a, u, tau)
-    }
-    #[allow(clippy::too_many_arguments)]
-    fn tangents(
-        &self,
-        t: f64,
-        q: &[f64],
-        qd: &[f64],
-        a: &[f64],
-        u: &[f64],
-        k: &mut [f64],
-        c: &mut [f64],
-    ) -> Result<(), mbs::ModelError> {
-        self.0.tangents(t, q, qd, a, u, k, c)
-    }
-    fn static_forces(&self, t: f64, q: &[f64], u: &[f64], h: &mut [f64]) {
-        self.0.static_forces(t, q, u, h)
-    }
-    fn input_matrix(&self, t: f64, q: &[f64], qd: &[f64], u: &[f64], b: &mut [f64]) {
-        self.0.input_matrix(t, q, qd, u, b)
-    }
-    fn energy(&self, t: f64, q: &[f64], qd: &[f64]) -> mbs::Energy {
-        self.0.energy(t, q, qd)
-    }
-    fn power(&self, t: f64, q: &[f64], qd: &[f64], u: &[f64]) -> f64 {
-        self.0.power(t, q, qd, u)
-    }
-    fn constraints(&self, t: f64, q: &[f64], phi: &mut [f64]) {
-        self.0.constraints(t, q, phi)
-    }
-    fn constraint_jacobian(&self, t: f64, q: &[f64], b: &mut [f64]) {
-        self.0.constraint_jacobian(t, q, b)
-    }
-    fn constraint_rate(&self, t: f64, q: &[f64], phi_t: &mut [f64]) {
-        self.0.constraint_rate(t, q, phi_t)
-    }
-    fn constraint_bias(&self, t: f64, q: &[f64], qd: &[f64], gamma: &mut [f64]) {
-        self.0.constraint_bias(t, q, qd, gamma)
-    }
-    fn constraint_tangent(&self, t: f64, q: &[f64], lambda: &[f64], k: &mut [f64]) {
-        self.0.constraint_tangent(t, q, lambda, k)
-    }
-    fn frames(&self, t: f64, q: &[f64], out: &mut [mbs::Pose]) {
-        self.0.frames(t, q, out)
-    }
-    fn kinematics(&self, t: f64, q: &[f64], qd: &[f64], out: &mut mbs::Kinematics) {
-        self.0.kinematics(t, q, qd, out)
-    }
-}
+});
 
 /// A failure of user code recorded in a batch call is its own lane's, whichever model made
 /// the call: every member of identical models (one model evaluates the four lanes) fails at

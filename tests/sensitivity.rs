@@ -6,6 +6,10 @@ use mbs::{Model, ModelError, Parameters};
 use mbs_models::fourbar::SensitiveFourBar;
 use mbs_models::sprung_arm::SprungArm;
 
+#[macro_use]
+#[path = "common/delegating.rs"]
+mod delegating;
+
 mbs::multibody! {
     /// The same arm without sensitive parameters.
     pub model PlainArm {
@@ -194,90 +198,12 @@ fn generated_second_derivatives_at_rest_match_central_differences() {
 #[derive(Clone)]
 struct LacksParameterTangents(SprungArm);
 
-impl Model for LacksParameterTangents {
-    type Params = <SprungArm as Model>::Params;
-    const NQ: usize = SprungArm::NQ;
-    const NU: usize = SprungArm::NU;
-    const NFRAMES: usize = SprungArm::NFRAMES;
-    const NPOINTS: usize = SprungArm::NPOINTS;
-    const NC: usize = SprungArm::NC;
+delegating_model!(LacksParameterTangents => SprungArm {
     const SENSITIVE: &'static [&'static str] = SprungArm::SENSITIVE;
-    fn info(&self) -> &'static mbs::ModelInfo {
-        self.0.info()
-    }
-    fn params(&self) -> &Self::Params {
-        self.0.params()
-    }
-    fn set_params(&mut self, p: Self::Params) -> Result<(), mbs::ParamError> {
-        self.0.set_params(p)
-    }
-    fn initial_state(&self, q: &mut [f64], qd: &mut [f64]) {
-        self.0.initial_state(q, qd)
-    }
-    fn mass_matrix(&self, t: f64, q: &[f64], m: &mut [f64]) {
-        self.0.mass_matrix(t, q, m)
-    }
     fn dynamics(&self, t: f64, q: &[f64], qd: &[f64], u: &[f64], m: &mut [f64], h: &mut [f64]) {
         self.0.dynamics(t, q, qd, u, m, h)
     }
-    fn inverse_dynamics(
-        &self,
-        t: f64,
-        q: &[f64],
-        qd: &[f64],
-        a: &[f64],
-        u: &[f64],
-        tau: &mut [f64],
-    ) {
-        self.0.inverse_dynamics(t, q, qd, a, u, tau)
-    }
-    #[allow(clippy::too_many_arguments)]
-    fn tangents(
-        &self,
-        t: f64,
-        q: &[f64],
-        qd: &[f64],
-        a: &[f64],
-        u: &[f64],
-        k: &mut [f64],
-        c: &mut [f64],
-    ) -> Result<(), ModelError> {
-        self.0.tangents(t, q, qd, a, u, k, c)
-    }
-    fn static_forces(&self, t: f64, q: &[f64], u: &[f64], h: &mut [f64]) {
-        self.0.static_forces(t, q, u, h)
-    }
-    fn input_matrix(&self, t: f64, q: &[f64], qd: &[f64], u: &[f64], b: &mut [f64]) {
-        self.0.input_matrix(t, q, qd, u, b)
-    }
-    fn energy(&self, t: f64, q: &[f64], qd: &[f64]) -> mbs::Energy {
-        self.0.energy(t, q, qd)
-    }
-    fn power(&self, t: f64, q: &[f64], qd: &[f64], u: &[f64]) -> f64 {
-        self.0.power(t, q, qd, u)
-    }
-    fn constraints(&self, t: f64, q: &[f64], phi: &mut [f64]) {
-        self.0.constraints(t, q, phi)
-    }
-    fn constraint_jacobian(&self, t: f64, q: &[f64], b: &mut [f64]) {
-        self.0.constraint_jacobian(t, q, b)
-    }
-    fn constraint_rate(&self, t: f64, q: &[f64], phi_t: &mut [f64]) {
-        self.0.constraint_rate(t, q, phi_t)
-    }
-    fn constraint_bias(&self, t: f64, q: &[f64], qd: &[f64], gamma: &mut [f64]) {
-        self.0.constraint_bias(t, q, qd, gamma)
-    }
-    fn constraint_tangent(&self, t: f64, q: &[f64], lambda: &[f64], k: &mut [f64]) {
-        self.0.constraint_tangent(t, q, lambda, k)
-    }
-    fn frames(&self, t: f64, q: &[f64], out: &mut [mbs::Pose]) {
-        self.0.frames(t, q, out)
-    }
-    fn kinematics(&self, t: f64, q: &[f64], qd: &[f64], out: &mut mbs::Kinematics) {
-        self.0.kinematics(t, q, qd, out)
-    }
-}
+});
 
 /// The modes about the equilibrium of `model` found from `start`.
 fn poles_at<M: Model + Clone>(model: &M, start: &[f64], options: &StaticsOptions) -> mbs::Modes {

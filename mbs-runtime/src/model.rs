@@ -744,9 +744,7 @@ pub trait Model {
         m: &mut [F64x4],
         h: &mut [F64x4],
     ) {
-        lane_by_lane(t, [q, qd, u], [m, h], |_, t, [q, qd, u], [m, h]| {
-            self.dynamics(t, q, qd, u, m, h)
-        });
+        Self::dynamics_lanes([self; LANES], t, q, qd, u, m, h)
     }
 
     /// [`Model::dynamics_x4`] of four models of this type, lane `k` of `each[k]` with its
@@ -796,9 +794,7 @@ pub trait Model {
         qdd: &mut [F64x4],
         pivots: &mut [F64x4],
     ) {
-        lane_by_lane(t, [q, qd, u], [qdd, pivots], |_, t, [q, qd, u], [a, p]| {
-            self.forward_dynamics(t, q, qd, u, a, p)
-        });
+        Self::forward_dynamics_lanes([self; LANES], t, q, qd, u, qdd, pivots)
     }
 
     /// τ = M qdd − h (NQ): the generalised forces that produce qdd.

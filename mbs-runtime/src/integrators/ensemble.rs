@@ -400,8 +400,7 @@ impl Lanes {
     /// lane), else [`Model::forward_dynamics_lanes`]. Whether one model evaluated them.
     fn evaluate<M: Model>(&mut self, each: [&M; LANES], live: &[bool; LANES]) -> bool {
         let first = live.iter().position(|&l| l).expect("a live lane");
-        let of = |k: usize| if live[k] { k } else { first };
-        let lane = |k| of(k);
+        let lane = |k: usize| if live[k] { k } else { first };
         let points = &self.points;
         pack(std::array::from_fn(|k| &points[lane(k)].0[..]), &mut self.q);
         pack(

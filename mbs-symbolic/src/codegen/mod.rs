@@ -1246,9 +1246,10 @@ fn emit_scene(
             | "forward_dynamics_x4"
             | "dynamics_lanes"
             | "forward_dynamics_lanes") => {
-                let (one, this, each, model) = match name.strip_suffix("_x4") {
-                    Some(one) => (one, "self", "::<false>([self; 4]", "self"),
-                    None => (name.trim_end_matches("_lanes"), "each[0]", "::<true>(each", "each[k]"),
+                // (the batch body's `EACH`: whether the four lanes' models differ)
+                let (one, this, differ, each, model) = match name.strip_suffix("_x4") {
+                    Some(one) => (one, "self", false, "[self; 4]", "self"),
+                    None => (name.trim_end_matches("_lanes"), "each[0]", true, "each", "each[k]"),
                 };
                 let (a, b) = if one == "dynamics" {
                     ("m", "h")
@@ -1264,7 +1265,7 @@ fn emit_scene(
                 "if ::mbs::lanes::simd_available() {{
 #[allow(unused_unsafe)]
 // SAFETY: the processor has the features the batch code is compiled for
-unsafe {{ {this}.__{one}_x4{each}, {call}) }}
+unsafe {{ {this}.__{one}_x4::<{differ}>({each}, {call}) }}
 }} else {{
 ::mbs::lanes::lane_by_lane(t, [q, qd, u], [{a}, {b}], |k, t, [q, qd, u], [{a}, {b}]| ::mbs::Model::{one}({model}, t, q, qd, u, {a}, {b}))
 }}"

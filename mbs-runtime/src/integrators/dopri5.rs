@@ -1,7 +1,9 @@
 //! Dormand–Prince 5(4) (Dormand & Prince 1980) on y = (q, qd): seven stages, first same as
 //! last (six evaluations per step), error estimated by the embedded order-4 solution, step
 //! chosen by Hairer's PI controller (β = 0.04, `step_control::PiController`), dense output
-//! by the order-4 continuous extension of Shampine (1986), as in Hairer's DOPRI5. Stability
+//! by the order-4 continuous extension of Shampine (1986), as in Hairer's DOPRI5 (its
+//! coefficients computed at the first output inside a step, so that steps without one do
+//! not pay for them). Stability
 //! interval on the negative real axis ≈ 3.3; not for stiff problems. With a fixed step it
 //! checks h·ρ against its stability region every 16 steps, as RK4 does (`explicit.rs`),
 //! and stops with `UnstableStep` rather than amplify the fastest mode into garbage.
@@ -76,14 +78,13 @@ const D: [f64; 7] = [
 
 pub(crate) struct Dopri5 {
     n: usize,
-    /// stage derivatives (velocity part kv, acceleration part ka); stage 0 is qd0, qdd0
+    /// stage derivatives (velocity part kv, acceleration part ka); stage 0 is qd0, qdd0,
+    /// and stage s's velocities are kv[s] (stage 7's the new state's)
     kv: [Vec<f64>; 7],
     ka: [Vec<f64>; 7],
+    /// the last stage's positions (stage 7's: the new state's)
     q: Vec<f64>,
-    v: Vec<f64>,
     err: Vec<f64>,
-    y0: Vec<f64>,
-    y1: Vec<f64>,
     /// stage 6's positions (its velocities are kv[5]), for the stiffness test
     q6: Vec<f64>,
     /// accepted steps in a row with h·λ > 3.25, and without since the last such step
@@ -91,9 +92,12 @@ pub(crate) struct Dopri5 {
     nonstiff_run: usize,
     /// step control: Hairer's PI controller
     pi: PiController,
-    /// dense output of the last accepted step: 5 coefficient vectors for q and for qd
+    /// dense output of the last accepted step: 5 coefficient vectors for q and for qd,
+    /// computed at its first interpolation (`pending`: the step's size until then), so that
+    /// a run without outputs inside its steps never computes them
     cont_q: [Vec<f64>; 5],
     cont_v: [Vec<f64>; 5],
+    pending: Option<f64>,
     /// with a fixed step: the largest |λ| against the stability region (as RK4's)
     watch: StabilityWatch,
     /// the last error test
@@ -119,16 +123,14 @@ impl Dopri5 {
             kv: s7(),
             ka: s7(),
             q: z(),
-            v: z(),
             err: vec![0.0; 2 * n],
-            y0: vec![0.0; 2 * n],
-            y1: vec![0.0; 2 * n],
             q6: z(),
             stiff_run: 0,
             nonstiff_run: 0,
             pi: PiController::new(4, 0.04),
             cont_q: s5(),
             cont_v: s5(),
+            pending: None,
             watch: StabilityWatch::new(n),
         }
     }
@@ -144,7 +146,7 @@ impl Stepper for Dopri5 {
         self.begin(p, cur, h, ctl)?;
         for s in 1..7 {
             let (c, _, _) = self.point(p, cur, h, s)?;
-            let r = p.accel(cur.t + c * h, &self.q, &self.v, &mut self.ka[s]);
+            let r = p.accel(cur.t + c * h, &self.q, &self.kv[s], &mut self.ka[s]);
             if let Err(e) = r {
                 return self.stage_failed(e, ctl, h);
             }
@@ -156,7 +158,12 @@ impl Stepper for Dopri5 {
         Some(self)
     }
 
-    fn interpolate(&self, prev: &State, cur: &State, t: f64, out: &mut State) {
+    fn interpolate(&mut self, prev: &State, cur: &State, t: f64, out: &mut State) {
+        if let Some(h) = self.pending.take() {
+            // the step from `prev` just accepted, whose end the stages still hold (`cur` may
+            // have been moved since: a closed loop's projection)
+            self.dense(&prev.q, &prev.qd, h);
+        }
         let h = cur.t - prev.t;
         let th = if h == 0.0 { 1.0 } else { (t - prev.t) / h };
         let th1 = 1.0 - th;
@@ -192,6 +199,7 @@ impl Staged for Dopri5 {
         if ctl.adaptive.is_none() && ctl.stability_check {
             self.watch.check(p, cur, h, "DOPRI5", limit)?;
         }
+        self.pending = None;
         self.kv[0].copy_from_slice(&cur.qd);
         self.ka[0].copy_from_slice(&cur.qdd);
         Ok(())
@@ -205,9 +213,10 @@ impl Staged for Dopri5 {
         s: usize,
     ) -> Result<(f64, &[f64], &[f64]), Failure> {
         // y + h Σⱼ A[s][j] kⱼ, summed from 0 in the order of j for each component, in one pass
-        // over the components (the stage's terms unrolled, the components in vector registers)
-        let (kv, ka) = (&self.kv, &self.ka);
-        let (q, v) = (&mut self.q, &mut self.v);
+        // over the components (the stage's terms unrolled, the components in vector
+        // registers); the velocities go straight into kv[s]
+        let (kv, v) = self.kv.split_at_mut(s);
+        let (ka, q, v) = (&self.ka, &mut self.q, &mut v[0][..]);
         match s {
             1 => combine::<1>(kv, ka, cur, h, q, v),
             2 => combine::<2>(kv, ka, cur, h, q, v),
@@ -216,11 +225,10 @@ impl Staged for Dopri5 {
             5 => combine::<5>(kv, ka, cur, h, q, v),
             _ => combine::<6>(kv, ka, cur, h, q, v),
         }
-        self.kv[s].copy_from_slice(&self.v);
         if s == 5 {
             self.q6.copy_from_slice(&self.q);
         }
-        Ok((C[s], &self.q, &self.v))
+        Ok((C[s], &self.q, &self.kv[s]))
     }
 
     fn accel_mut(&mut self, s: usize) -> &mut [f64] {
@@ -236,13 +244,13 @@ impl Staged for Dopri5 {
         let n = self.n;
         // stage 7 is at (q1, qd1): the new state, first same as last
         next.q.copy_from_slice(&self.q);
-        next.qd.copy_from_slice(&self.v);
+        next.qd.copy_from_slice(&self.kv[6]);
         next.qdd.copy_from_slice(&self.ka[6]);
         let Some(tol) = ctl.adaptive else {
             if ctl.stability_check {
                 self.watch.after(p, (cur, next, h), "DOPRI5", limit)?;
             }
-            self.dense(cur, next, h);
+            self.pending = Some(h);
             self.watch.accepted(cur, next);
             return Ok(Attempt::Accepted { h_next: h });
         };
@@ -250,30 +258,26 @@ impl Staged for Dopri5 {
         // check and runs in vector registers
         let kv: [&[f64]; 7] = std::array::from_fn(|s| &self.kv[s][..n]);
         let ka: [&[f64]; 7] = std::array::from_fn(|s| &self.ka[s][..n]);
-        let (err, y0, y1) = (
-            &mut self.err[..2 * n],
-            &mut self.y0[..2 * n],
-            &mut self.y1[..2 * n],
-        );
-        let (q0, v0, q1, v1) = (&cur.q[..n], &cur.qd[..n], &next.q[..n], &next.qd[..n]);
+        let (eq, ev) = self.err[..2 * n].split_at_mut(n);
         for i in 0..n {
-            let (mut eq, mut ev) = (0.0, 0.0);
+            let (mut sq, mut sv) = (0.0, 0.0);
             for s in 0..7 {
-                eq += E[s] * kv[s][i];
-                ev += E[s] * ka[s][i];
+                sq += E[s] * kv[s][i];
+                sv += E[s] * ka[s][i];
             }
-            err[i] = h * eq;
-            err[n + i] = h * ev;
-            y0[i] = q0[i];
-            y0[n + i] = v0[i];
-            y1[i] = q1[i];
-            y1[n + i] = v1[i];
+            eq[i] = h * sq;
+            ev[i] = h * sv;
         }
-        let norm = tol.norm(&self.err, &self.y0, &self.y1, self.y0.len() / 2);
+        // the state's positions and velocities as the norm's blocks, where they are
+        let norm = tol.norm_of_blocks([
+            (eq, &cur.q[..n], &next.q[..n]),
+            (ev, &cur.qd[..n], &next.qd[..n]),
+            (&[], &[], &[]),
+        ]);
         self.test = norm;
         match self.pi.decide(h, norm.value) {
             Decision::Accept { h_next } => {
-                self.dense(cur, next, h);
+                self.pending = Some(h);
                 self.stiffness_test(p, cur.t, h);
                 Ok(Attempt::Accepted { h_next })
             }
@@ -317,12 +321,13 @@ impl Dopri5 {
         }
     }
 
-    /// Coefficients of the continuous extension of the step just accepted.
-    fn dense(&mut self, cur: &State, next: &State, h: f64) {
+    /// Coefficients of the continuous extension of the step of size h just accepted from
+    /// (q0, qd0), to the new state its last stage holds (q, kv[6]).
+    fn dense(&mut self, q0: &[f64], qd0: &[f64], h: f64) {
         for i in 0..self.n {
             for (y0, y1, k, c) in [
-                (cur.q[i], next.q[i], &self.kv, &mut self.cont_q),
-                (cur.qd[i], next.qd[i], &self.ka, &mut self.cont_v),
+                (q0[i], self.q[i], &self.kv, &mut self.cont_q),
+                (qd0[i], self.kv[6][i], &self.ka, &mut self.cont_v),
             ] {
                 let diff = y1 - y0;
                 let bspl = h * k[0][i] - diff;

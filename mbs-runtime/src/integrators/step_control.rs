@@ -72,35 +72,53 @@ impl Tolerances {
 
     /// [`Tolerances::error_norm`], and whether the floor set a weight (`Stats::floored_steps`).
     pub fn norm(&self, e: &[f64], y0: &[f64], y1: &[f64], kind: usize) -> ErrorNorm {
-        let (rtol, atol) = (self.rtol, self.atol);
         let n = e.len();
         let bounds = [0, kind.min(n), (2 * kind).min(n), n];
-        let (e, y0, y1) = (&e[..n], &y0[..n], &y1[..n]);
+        let block = |k: usize| {
+            let r = bounds[k]..bounds[k + 1];
+            (&e[r.clone()], &y0[r.clone()], &y1[r])
+        };
+        self.norm_of_blocks([block(0), block(1), block(2)])
+    }
+
+    /// [`Tolerances::norm`] of a vector given as its blocks (positions, velocities,
+    /// multipliers), each `(e, y0, y1)` a slice of its own: a scheme whose state is kept in
+    /// separate vectors does not copy it into one.
+    pub fn norm_of_blocks(&self, blocks: [(&[f64], &[f64], &[f64]); 3]) -> ErrorNorm {
+        let (rtol, atol) = (self.rtol, self.atol);
         let (mut s, mut floored) = (0.0, false);
         let mut top = Argmax::default();
         let mut floors = [0.0; 3];
-        for (block, b) in bounds.windows(2).enumerate() {
-            let (start, end) = (b[0], b[1]);
-            let largest = y0[start..end]
-                .iter()
-                .chain(&y1[start..end])
-                .fold(0.0f64, |m, y| m.max(y.abs()));
+        for (b, &(e, y0, y1)) in blocks.iter().enumerate() {
+            let len = e.len();
+            let (y0, y1) = (&y0[..len], &y1[..len]);
+            let largest = y0.iter().chain(y1).fold(0.0f64, |m, y| m.max(y.abs()));
             let floor = Self::transformed_floor(rtol) * largest;
-            floors[block] = floor;
-            for i in start..end {
+            floors[b] = floor;
+            // the block's largest term as `Argmax` takes it (the first NaN, else the first of
+            // the largest), chosen without a branch: the terms come in no order a branch
+            // predictor could learn
+            let (mut best, mut at) = (-1.0f64, 0);
+            for i in 0..len {
                 let magnitude = y0[i].abs().max(y1[i].abs());
                 let w = atol + rtol * magnitude;
                 floored |= w < floor;
                 let weight = w.max(floor);
                 let term = (e[i] / weight) * (e[i] / weight);
                 s += term;
-                top.see(term, block, i - start);
+                let new = !(term <= best) & !best.is_nan();
+                best = if new { term } else { best };
+                at = if new { i } else { at };
+            }
+            if len > 0 {
+                top.see(best, b, at);
             }
         }
         // the component that weighed most, described once
         let held_by = top.at.map(|(block, index)| {
-            let (floor, i) = (floors[block], bounds[block] + index);
-            let magnitude = y0[i].abs().max(y1[i].abs());
+            let (e, y0, y1) = blocks[block];
+            let floor = floors[block];
+            let magnitude = y0[index].abs().max(y1[index].abs());
             let w = atol + rtol * magnitude;
             let set_by = if w < floor {
                 WeightBy::Rounding
@@ -112,14 +130,15 @@ impl Tolerances {
             Largest {
                 block,
                 index,
-                error: e[i],
+                error: e[index],
                 magnitude,
                 weight: w.max(floor),
                 set_by,
             }
         });
+        let n: usize = blocks.iter().map(|b| b.0.len()).sum();
         ErrorNorm {
-            value: (s / e.len().max(1) as f64).sqrt(),
+            value: (s / n.max(1) as f64).sqrt(),
             floored,
             held_by,
         }

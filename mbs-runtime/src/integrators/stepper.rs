@@ -118,7 +118,7 @@ pub(crate) trait Stepper {
     fn accepted(&mut self, _p: &mut Problem, _prev: &State, _cur: &State) {}
     /// Dense output on [prev.t, cur.t]: by default the quintic Hermite interpolant of
     /// (q, qd, qdd) at both ends, accurate beyond every scheme's order here.
-    fn interpolate(&self, prev: &State, cur: &State, t: f64, out: &mut State) {
+    fn interpolate(&mut self, prev: &State, cur: &State, t: f64, out: &mut State) {
         super::dense::hermite5(prev, cur, t, out);
     }
     /// The scheme as explicit stages, when it is one ([`Staged`]): an ensemble evaluates the

@@ -3,12 +3,14 @@
 # and not timed: release builds of a 24-joint spatial arm, a 32-bar planar chain, the
 # hexapod with exact tangents (its forward dynamics called, then a program that runs it with
 # Radau5) and a 200-bar chain, then a debug build of the arm, and the arm with the batch
-# functions of `option batch;`.
+# functions of `option batch;` (its program calling them, then running an ensemble).
 #
 #   benches/compile_time.sh            # all cases
 #   benches/compile_time.sh chain32    # one case (arm24, chain32, hexapod, hexapod-radau,
 #                                      # chain200, arm24-dev, arm24-batch: the arm with
-#                                      # `option batch;`)
+#                                      # `option batch;`, arm24-ensemble: the same, its
+#                                      # program running an ensemble, which compiles the
+#                                      # batch code's two instances)
 #   benches/compile_time.sh --generator-unoptimised [cases]
 #
 # The model crate's Cargo.toml has the profile lines the README recommends: the generator
@@ -82,6 +84,24 @@ pub fn run() {
 RS
 }
 
+# (arm24-ensemble) an ensemble of four members, whose lanes read one model's parameters
+# (`forward_dynamics_x4`) or each member's (`forward_dynamics_lanes`): both instances of the
+# batch code
+ensemble_run() {
+    cat <<'RS'
+pub fn run() {
+    let options = mbs::Options {
+        output: mbs::Output::Last,
+        ..mbs::Options::adaptive(0.05, 1e-6)
+    };
+    let members = (0..4).map(|_| (Model::default(), mbs::Member::default()));
+    let report = mbs::simulate_ensemble_each(mbs::Scheme::Dopri5, &options, members)
+        .expect("an ensemble of the arm");
+    println!("ensemble of {} runs", report.runs.len());
+}
+RS
+}
+
 cat > "$dir/src/main.rs" <<'RS'
 #[allow(unused_macros, dead_code)]
 mod model;
@@ -111,7 +131,7 @@ if [ -r /proc/cpuinfo ]; then
     field() { grep -m1 "^$1[[:space:]]*:" /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//'; }
     echo "processor: $(field 'model name') (family $(field 'cpu family'), model $(field model))"
 fi
-cases=("${@:-arm24 chain32 hexapod hexapod-radau chain200 arm24-dev arm24-batch}")
+cases=("${@:-arm24 chain32 hexapod hexapod-radau chain200 arm24-dev arm24-batch arm24-ensemble}")
 for case in ${cases[@]}; do
     profile=release
     case "$case" in
@@ -122,6 +142,7 @@ for case in ${cases[@]}; do
         hexapod-radau) { hexapod; radau_run; } > src/model.rs ;;
         arm24-dev) { arm 24; no_run; } > src/model.rs; profile=dev ;;
         arm24-batch) { arm 24 batch; no_run; } > src/model.rs ;;
+        arm24-ensemble) { arm 24 batch; ensemble_run; } > src/model.rs ;;
         *) echo "unknown case $case" >&2; exit 2 ;;
     esac
     flag=$([ "$profile" = release ] && echo --release || true)

@@ -124,8 +124,8 @@ fn main() {
 fn print_poles(poles: &mbs::analysis::PoleSensitivity) {
     for (i, mode) in poles.modes.modes.iter().enumerate() {
         println!(
-            "  mode {i}: f = {:.4} Hz, ζ = {:.4}",
-            mode.frequency_hz, mode.damping_ratio
+            "  mode {i}: f = {:.4} Hz, ζ = {:.4}, nearest other pole {:.2e} of its size away",
+            mode.frequency_hz, mode.damping_ratio, poles.separation[i]
         );
         for p in &poles.params {
             let (dre, dim) = poles.dpole(i, p).unwrap_or((f64::NAN, f64::NAN));

@@ -98,6 +98,8 @@ pub(crate) struct Dopri5 {
     cont_q: [Vec<f64>; 5],
     cont_v: [Vec<f64>; 5],
     pending: Option<f64>,
+    /// the time the step of those coefficients started from
+    cont_from: f64,
     /// with a fixed step: the largest |λ| against the stability region (as RK4's)
     watch: StabilityWatch,
     /// the last error test
@@ -131,6 +133,7 @@ impl Dopri5 {
             cont_q: s5(),
             cont_v: s5(),
             pending: None,
+            cont_from: f64::NAN,
             watch: StabilityWatch::new(n),
         }
     }
@@ -159,6 +162,8 @@ impl Stepper for Dopri5 {
     }
 
     fn interpolate(&mut self, prev: &State, cur: &State, t: f64, out: &mut State) {
+        // only between the acceptance of a step and the next attempt, from that step's start
+        debug_assert_eq!(prev.t.to_bits(), self.cont_from.to_bits());
         if let Some(h) = self.pending.take() {
             // the step from `prev` just accepted, whose end the stages still hold (`cur` may
             // have been moved since: a closed loop's projection)
@@ -250,7 +255,7 @@ impl Staged for Dopri5 {
             if ctl.stability_check {
                 self.watch.after(p, (cur, next, h), "DOPRI5", limit)?;
             }
-            self.pending = Some(h);
+            (self.pending, self.cont_from) = (Some(h), cur.t);
             self.watch.accepted(cur, next);
             return Ok(Attempt::Accepted { h_next: h });
         };
@@ -277,7 +282,7 @@ impl Staged for Dopri5 {
         self.test = norm;
         match self.pi.decide(h, norm.value) {
             Decision::Accept { h_next } => {
-                self.pending = Some(h);
+                (self.pending, self.cont_from) = (Some(h), cur.t);
                 self.stiffness_test(p, cur.t, h);
                 Ok(Attempt::Accepted { h_next })
             }

@@ -469,6 +469,55 @@ pub(crate) fn initial_step(
 mod tests {
     use super::*;
 
+    /// The component that held the norm, as `Argmax::see` takes it term by term over the
+    /// whole vector: the first NaN, else the first of the largest.
+    fn held_by_term_by_term(tol: Tolerances, e: &[f64], y0: &[f64], y1: &[f64], kind: usize) {
+        let n = e.len();
+        let bounds = [0, kind.min(n), (2 * kind).min(n), n];
+        let mut top = Argmax::default();
+        for b in 0..3 {
+            let (start, end) = (bounds[b], bounds[b + 1]);
+            let largest = (y0[start..end].iter())
+                .chain(&y1[start..end])
+                .fold(0.0f64, |m, y| m.max(y.abs()));
+            let floor = Tolerances::transformed_floor(tol.rtol) * largest;
+            for i in start..end {
+                let w = (tol.atol + tol.rtol * y0[i].abs().max(y1[i].abs())).max(floor);
+                top.see((e[i] / w) * (e[i] / w), b, i - start);
+            }
+        }
+        let got = tol
+            .norm(e, y0, y1, kind)
+            .held_by
+            .map(|l| (l.block, l.index));
+        assert_eq!(got, top.at, "e = {e:?}");
+    }
+
+    #[test]
+    fn the_norm_s_largest_term_is_the_first_nan_else_the_first_of_the_largest() {
+        let tol = Tolerances {
+            rtol: 1e-3,
+            atol: 1e-6,
+        };
+        let (y0, y1) = ([1.0; 5], [1.0; 5]);
+        let nan = f64::NAN;
+        for e in [
+            [1.0, 3.0, 3.0, 2.0, 0.5], // a tie within the positions
+            [1.0, 3.0, 1.0, 3.0, 0.5], // a tie across blocks: the positions' one
+            [1.0, 3.0, 1.0, 4.0, 0.5], // the largest among the velocities
+            [9.0, 3.0, nan, 4.0, 0.5], // a NaN after a larger finite term
+            [1.0, nan, 1.0, nan, 0.5], // NaNs in two blocks: the first
+            [0.0, 0.0, 0.0, 0.0, 0.0], // all zero: the first
+            [1.0, 1.0, 1.0, 1.0, nan], // a NaN among the multipliers
+        ] {
+            held_by_term_by_term(tol, &e, &y0, &y1, 2);
+            // an empty velocity block and no multipliers
+            held_by_term_by_term(tol, &e[..2], &y0[..2], &y1[..2], 2);
+            // one block only
+            held_by_term_by_term(tol, &e, &y0, &y1, 5);
+        }
+    }
+
     fn close(a: f64, b: f64) -> bool {
         (a - b).abs() <= 1e-14 * a.abs().max(b.abs())
     }

@@ -34,6 +34,26 @@ const C1: f64 = 0.8;
 const C2: f64 = 3.0;
 
 mbs::multibody! {
+    /// Three masses on springs along x, y and z, two soft (ω = 1 and 1.2 rad/s) beside a
+    /// stiff one (ω = 1e5 rad/s, a gear's stiffness on a small inertia), and, with `option
+    /// tangents;`, exact stiffnesses for statics.
+    model SoftBesideStiff {
+        param kx = 1.0; param ky = 1.44; param kz = 1e10; param m = 1.0;
+        option tangents;
+        dof x = 0.0; dof y = 0.0; dof z = 0.0;
+        body a { mass = m; inertia = (0.01, 0.01, 0.01); }
+        body b { mass = m; inertia = (0.01, 0.01, 0.01); }
+        body c { mass = m; inertia = (0.01, 0.01, 0.01); }
+        TOG[a] = Tdisp(x, 0, 0);
+        TOG[b] = Tdisp(0, y, 0);
+        TOG[c] = Tdisp(0, 0, z);
+        generalized_force(x, -kx * x);
+        generalized_force(y, -ky * y);
+        generalized_force(z, -kz * z);
+    }
+}
+
+mbs::multibody! {
     /// seed2dof with dampers in parallel with both springs, named coordinates.
     model Seed2dofDamped {
         param m1 = 1.0; param m2 = 1.0;
@@ -956,4 +976,64 @@ fn modes_table_and_csv_have_one_row_per_mode() {
         assert_eq!(v[0], mode.frequency_hz);
         assert_eq!(v[1], mode.damping_ratio);
     }
+}
+
+/// Mode shapes beside a stiff mode: each of three uncoupled oscillators moves its own
+/// coordinate alone. The shapes come from inverse iteration a hair off each pole; that hair
+/// was a part in 10⁹ of the state matrix's largest entry (here 1e10/s², so 10/s), and the
+/// 1 rad/s mode's shape came out a mix of all three coordinates (its neighbour at 1.2 rad/s
+/// nearer the shifted pole than itself).
+#[test]
+fn mode_shapes_beside_a_stiff_mode_are_their_own() {
+    let model = SoftBesideStiff::default();
+    let lin = linearize(
+        &model,
+        0.0,
+        &[0.0; 3],
+        &[0.0; 3],
+        &[],
+        IterationMatrix::Auto,
+    )
+    .unwrap();
+    let modes = modes(&lin, None).unwrap();
+    assert_eq!(modes.modes.len(), 3);
+    for (own, (mode, omega)) in modes.modes.iter().zip([1.0, 1.2, 1e5]).enumerate() {
+        let off = (mode.shape.iter().enumerate())
+            .filter(|&(i, _)| i != own)
+            .fold(0.0f64, |m, (_, &(re, im))| m.max(re.hypot(im)));
+        let (re, im) = mode.shape[own];
+        println!(
+            "{:.6} rad/s: shape on its own coordinate {re:.3e} + {im:.3e}i, largest elsewhere {off:.1e}, modal mass {:.12}",
+            2.0 * PI * mode.frequency_hz,
+            mode.modal_mass
+        );
+        assert!(
+            (2.0 * PI * mode.frequency_hz - omega).abs() < 1e-9 * omega,
+            "{}",
+            mode.frequency_hz
+        );
+        assert!(off < 1e-10, "{off:e}");
+        assert!((re - 1.0).abs() < 1e-12 && im.abs() < 1e-12, "{re} {im}");
+        assert!((mode.modal_mass - 1.0).abs() < 1e-9, "{}", mode.modal_mass);
+    }
+}
+
+/// An unstable equilibrium beside a stiff spring is unstable: K = diag(1, 1.44, 1e10) with
+/// its first spring reversed (−0.49) has a negative eigenvalue five orders below 1e-9 of the
+/// largest, which the verdict's threshold (a part in 10⁹ of the largest, for stiffnesses
+/// from differences) called neutral; with exact tangents the threshold is a part in 10¹².
+#[test]
+fn an_unstable_direction_beside_a_stiff_spring_is_unstable() {
+    let mut model = SoftBesideStiff::default();
+    model.params.kx = -0.49;
+    let eq = static_equilibrium(&model, &StaticsOptions::default()).unwrap();
+    println!(
+        "stiffness eigenvalues {:?}: {:?}",
+        eq.stiffness_eigenvalues, eq.stability
+    );
+    assert_eq!(eq.stability, Stability::Unstable);
+    // the same, stable
+    model.params.kx = 0.49;
+    let eq = static_equilibrium(&model, &StaticsOptions::default()).unwrap();
+    assert_eq!(eq.stability, Stability::Stable);
 }

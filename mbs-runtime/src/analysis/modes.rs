@@ -102,7 +102,7 @@ pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, A
     let scale = lin.a.iter().fold(1.0f64, |m, x| m.max(x.abs()));
     let mut out = Vec::new();
     let mut lu = Lu::<C64>::new(n2);
-    for lambda in eig.iter() {
+    for (k, lambda) in eig.iter().enumerate() {
         // one mode per conjugate pair
         if lambda.im < -1e-12 * scale {
             continue;
@@ -123,26 +123,62 @@ pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, A
                 continue;
             }
         }
-        // inverse iteration on A − μI, μ a hair off λ
-        let shift = 1e-9 * scale.max(mag);
-        let mu = C64::new(re + shift, im + shift);
-        let a = lu.matrix_mut();
-        for j in 0..n2 {
-            for i in 0..n2 {
-                let d = if i == j { mu } else { C64::default() };
-                a[i + n2 * j] = C64::new(lin.a[(i, j)], 0.0) - d;
-            }
-        }
-        let mut v: Vec<C64> = (0..n2)
-            .map(|i| C64::new(1.0 + 0.1 * i as f64, 0.05 * i as f64))
-            .collect();
-        if lu.factor().is_ok() {
-            for _ in 0..3 {
-                lu.solve(&mut v);
-                let nv = v.iter().map(|z| z.abs()).fold(0.0, f64::max);
-                for z in v.iter_mut() {
-                    *z = *z / C64::new(nv, 0.0);
+        // inverse iteration on A − μI, μ a hair off λ: by a part in 10⁹ of λ, or by what the
+        // rounding of λ may be (1000 ε of A's largest entry), not by a part in 10⁹ of that
+        // entry: beside a stiff mode (a gear of 1e10/s²) that shift was 10/s, and a mode at
+        // 1/s converged to its neighbour at 1.2/s, or to neither
+        let shift = (1e-9 * mag).max(1e3 * f64::EPSILON * scale);
+        let mut mu = C64::new(re + shift, im + shift);
+        // each iteration leaves r = |λ − μ| / |λ' − μ| of the nearest other eigenvalue λ':
+        // iterated until r^k is below rounding (at least three, at most 100: a repeated
+        // eigenvalue, r ≈ 1, keeps the start's mix of its eigenvectors, a valid one)
+        let nearest = (eig.iter().enumerate())
+            .filter(|&(j, _)| j != k)
+            .map(|(_, o)| (C64::new(o.re, o.im) - mu).abs())
+            .fold(f64::INFINITY, f64::min);
+        let r = (C64::new(re, im) - mu).abs() / nearest;
+        let iterations = if r > 0.0 && r < 1.0 {
+            ((f64::EPSILON.ln() / r.ln()).ceil() as usize).clamp(3, 100)
+        } else {
+            100
+        };
+        let mut factored = false;
+        for _ in 0..4 {
+            let a = lu.matrix_mut();
+            for j in 0..n2 {
+                for i in 0..n2 {
+                    let d = if i == j { mu } else { C64::default() };
+                    a[i + n2 * j] = C64::new(lin.a[(i, j)], 0.0) - d;
                 }
+            }
+            if lu.factor().is_ok() {
+                factored = true;
+                break;
+            }
+            // μ on an eigenvalue to rounding: a little further off
+            mu = C64::new(mu.re + 1e3 * shift, mu.im + 1e3 * shift);
+        }
+        if !factored {
+            return Err(Failure::SingularMatrix {
+                matrix: "A − μI (a mode's shape by inverse iteration)",
+                rcond: 0.0,
+                coordinates: Vec::new(),
+            }
+            .into());
+        }
+        // the start differs from mode to mode, so that two modes of one repeated eigenvalue
+        // get two of its eigenvectors, not one twice
+        let mut v: Vec<C64> = (0..n2)
+            .map(|i| {
+                let turn = 0.7 * ((i + 1) * (k + 1)) as f64;
+                C64::new(1.0 + 0.1 * i as f64 + 0.3 * turn.sin(), 0.05 * i as f64)
+            })
+            .collect();
+        for _ in 0..iterations {
+            lu.solve(&mut v);
+            let nv = v.iter().map(|z| z.abs()).fold(0.0, f64::max);
+            for z in v.iter_mut() {
+                *z = *z / C64::new(nv, 0.0);
             }
         }
         // the q part, scaled to a largest component of 1 (real, positive)

@@ -355,17 +355,29 @@ pub fn pole_sensitivity<M: Model + Clone>(
         // A(μ) and A(μ)ᴴ with μ a hair off λ, for inverse iteration
         let mag = mode.re.hypot(mode.im);
         let mu = lambda + C64::new(1e-9 * mag.max(1.0), 1e-9 * mag.max(1.0));
+        // the constraints' rows and columns scaled by s to the size of Q(μ)'s entries, so
+        // that the factorisation does not take the small pivots a stiff loop's Schur
+        // complement B Q⁻¹ Bᵀ leaves for singular (a four-bar with a 2e6 N·m/rad spring, its
+        // pole at 30,553 rad/s: Q ~ 1e9, B ~ 1); the multipliers' parts are then ℓ/s and m/s
+        let qb = |i: usize, j: usize| {
+            mu * mu * real(mass[i + n * j]) + mu * real(c[i + n * j]) + real(k[i + n * j])
+        };
+        let q_size = (0..n * n).fold(0.0f64, |m, ij| m.max(qb(ij % n, ij / n).abs()));
+        let b_size = b.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let s = if b_size > 0.0 && q_size > 0.0 {
+            q_size / b_size
+        } else {
+            1.0
+        };
         {
             let (ar, al) = (a_right.matrix_mut(), a_left.matrix_mut());
             ar.fill(C64::default());
             for j in 0..n {
                 for i in 0..n {
-                    ar[i + na * j] = mu * mu * real(mass[i + n * j])
-                        + mu * real(c[i + n * j])
-                        + real(k[i + n * j]);
+                    ar[i + na * j] = qb(i, j);
                 }
                 for i in 0..nc {
-                    let bij = b[i + nc * j];
+                    let bij = s * b[i + nc * j];
                     ar[(n + i) + na * j] = real(bij);
                     ar[j + na * (n + i)] = real(-bij);
                 }
@@ -425,7 +437,10 @@ pub fn pole_sensitivity<M: Model + Clone>(
             s
         };
         let denom = form(&|ij| real(2.0) * lambda * real(mass[ij]) + real(c[ij]));
-        if denom.abs() <= 1e-10 * scale {
+        // against the sizes of the vectors' coordinate parts: on a closed loop they are
+        // scaled with their multipliers' parts, forces that may be far larger
+        let size = |v: &[C64]| v[..n].iter().map(|z| z.abs()).fold(0.0, f64::max);
+        if denom.abs() <= 1e-10 * scale * size(&x) * size(&y) {
             // defective: no derivative either
             repeated.push(index);
             dpole_dp.extend(std::iter::repeat_n((f64::NAN, f64::NAN), ns));
@@ -436,10 +451,10 @@ pub fn pole_sensitivity<M: Model + Clone>(
             let mut num = form(&|ij| {
                 lambda * lambda * real(dmp[ij]) + lambda * real(dcp[ij]) + real(dkp[ij])
             });
-            // − yᴴB'ᵀℓ + mᴴB'x
+            // − yᴴB'ᵀℓ + mᴴB'x, ℓ and m s times the vectors' parts
             for i in 0..nc {
                 for j in 0..n {
-                    let bij = real(dbp[i + nc * j]);
+                    let bij = real(s * dbp[i + nc * j]);
                     num = num - conj(y[j]) * bij * x[n + i] + conj(y[n + i]) * bij * x[j];
                 }
             }

@@ -71,7 +71,8 @@ pub enum Stability {
     Stable,
     /// some eigenvalue negative: a small push grows
     Unstable,
-    /// no negative eigenvalue but some zero (within 1e-9 of the largest): neutral directions
+    /// no negative eigenvalue but some zero (within 1e-12 of the largest with exact
+    /// tangents, 1e-9 with differences): neutral directions
     Neutral,
 }
 
@@ -160,12 +161,7 @@ pub(super) fn stiffness<M: Model>(
 ) -> Result<(), AnalysisError> {
     let n = M::NQ;
     let zero = vec![0.0; n];
-    let exact = match how {
-        IterationMatrix::Exact => true,
-        IterationMatrix::Auto => model.info().has_tangents,
-        _ => false,
-    };
-    if exact {
+    if exact_stiffness(model, how) {
         let mut c = vec![0.0; n * n];
         model
             .tangents(t, q, &zero, &zero, u, k, &mut c)
@@ -190,6 +186,15 @@ pub(super) fn stiffness<M: Model>(
         }
     }
     Ok(())
+}
+
+/// Whether [`stiffness`] takes K from the exact tangents (else from differences).
+fn exact_stiffness<M: Model>(model: &M, how: IterationMatrix) -> bool {
+    match how {
+        IterationMatrix::Exact => true,
+        IterationMatrix::Auto => model.info().has_tangents,
+        _ => false,
+    }
 }
 
 /// The inputs of `options` (zero when not given), after checking what statics and its
@@ -397,7 +402,8 @@ fn unconstrained<M: Model>(
     let ks = nalgebra::DMatrix::from_fn(nf, nf, |r, c| {
         0.5 * (k[free[r] + n * free[c]] + k[free[c] + n * free[r]])
     });
-    let (stiffness_eigenvalues, stability) = classify(&ks);
+    let exact = exact_stiffness(model, options.stiffness);
+    let (stiffness_eigenvalues, stability) = classify(&ks, exact);
     Ok(Equilibrium {
         q,
         residual,
@@ -413,17 +419,22 @@ fn unconstrained<M: Model>(
 }
 
 /// Eigenvalues (ascending) of a symmetric stiffness and the stability they mean (`Stable`
-/// with no eigenvalue: nothing left free to move).
-fn classify(ks: &DMatrix<f64>) -> (Vec<f64>, Stability) {
+/// with no eigenvalue: nothing left free to move). An eigenvalue counts as zero within the
+/// stiffness' own error times its largest eigenvalue: a part in 10¹² for exact tangents
+/// (rounding), a part in 10⁹ for central differences (their truncation and rounding, about
+/// ε^⅔ ≈ 4e-11 of it). Beside a stiff spring the threshold was a part in 10⁹ for both: with
+/// a 1e10 N/m spring, an inverted pendulum's −0.49 N·m/rad was called neutral.
+fn classify(ks: &DMatrix<f64>, exact: bool) -> (Vec<f64>, Stability) {
     if ks.nrows() == 0 {
         return (Vec::new(), Stability::Stable);
     }
     let mut eig: Vec<f64> = ks.symmetric_eigenvalues().iter().copied().collect();
     eig.sort_by(f64::total_cmp);
     let scale = eig.iter().fold(0.0f64, |m, e| m.max(e.abs()));
-    let stability = if eig.iter().any(|&e| e < -1e-9 * scale) {
+    let zero = if exact { 1e-12 } else { 1e-9 } * scale;
+    let stability = if eig.iter().any(|&e| e < -zero) {
         Stability::Unstable
-    } else if eig.iter().any(|&e| e <= 1e-9 * scale) {
+    } else if eig.iter().any(|&e| e <= zero) {
         Stability::Neutral
     } else {
         Stability::Stable
@@ -631,7 +642,8 @@ fn constrained<M: Model>(
         lambda: &lambda,
     };
     let kr = reduced_stiffness(model, at, options, free, &st.b)?;
-    let (stiffness_eigenvalues, stability) = classify(&kr.0);
+    let exact = exact_stiffness(model, options.stiffness);
+    let (stiffness_eigenvalues, stability) = classify(&kr.0, exact);
     Ok(Equilibrium {
         residual: st.force_residual(),
         constraint_residual: st.constraint_residual(),

@@ -3,14 +3,15 @@
 # and not timed: release builds of a 24-joint spatial arm, a 32-bar planar chain, the
 # hexapod with exact tangents (its forward dynamics called, then a program that runs it with
 # Radau5) and a 200-bar chain, then a debug build of the arm, and the arm with the batch
-# functions of `option batch;` (its program calling them, then running an ensemble).
+# functions of `option batch;` (its program calling them, and a program running an ensemble
+# of it and nothing else).
 #
 #   benches/compile_time.sh            # all cases
 #   benches/compile_time.sh chain32    # one case (arm24, chain32, hexapod, hexapod-radau,
 #                                      # chain200, arm24-dev, arm24-batch: the arm with
 #                                      # `option batch;`, arm24-ensemble: the same, its
-#                                      # program running an ensemble, which compiles the
-#                                      # batch code's two instances)
+#                                      # program running an ensemble and nothing else, which
+#                                      # compiles the batch code's two instances)
 #   benches/compile_time.sh --generator-unoptimised [cases]
 #
 # The model crate's Cargo.toml has the profile lines the README recommends: the generator
@@ -67,12 +68,31 @@ hexapod() { # the hexapod of models/src with `option tangents;` before its closi
     echo 'pub type Model = Hexapod;'
 }
 
-# what `main` does besides forward dynamics: nothing, or (hexapod-radau) a Radau5 run of the
-# standing hexapod with its tangents, so that every function a run calls is compiled
+# the batch forward dynamics of one model in every lane (lane by lane without `option
+# batch;`), which `main` calls beside the one-state forward dynamics
+x4_call() {
+    cat <<'RS'
+pub fn batch(m: &Model) -> Option<f64> {
+    use mbs::{F64x4, Model as _};
+    let n = <Model as mbs::Model>::NQ;
+    let (q4, z4) = (vec![F64x4::splat(0.1); n], vec![F64x4::ZERO; n]);
+    let (mut a4, mut p4) = (z4.clone(), z4.clone());
+    let u4 = vec![F64x4::ZERO; <Model as mbs::Model>::NU];
+    m.forward_dynamics_x4(F64x4::ZERO, &q4, &z4, &u4, &mut a4, &mut p4);
+    Some(a4[0].lane(0))
+}
+RS
+}
+
+# what `main` does besides forward dynamics: the batch call and nothing else, or
+# (hexapod-radau) also a Radau5 run of the standing hexapod with its tangents, so that every
+# function a run calls is compiled
 no_run() {
+    x4_call
     echo 'pub fn run() {}'
 }
 radau_run() {
+    x4_call
     cat <<'RS'
 pub fn run() {
     let mut options = mbs::Options::default();
@@ -84,10 +104,11 @@ pub fn run() {
 RS
 }
 
-# (arm24-ensemble) an ensemble of four members, whose lanes read one model's parameters
-# (`forward_dynamics_x4`) or each member's (`forward_dynamics_lanes`): both instances of the
-# batch code
+# (arm24-ensemble) no batch call of its own but an ensemble of four members, whose lanes
+# read their models' parameters (`forward_dynamics_lanes`), as a program that runs ensembles
+# and nothing else
 ensemble_run() {
+    echo 'pub fn batch(_: &Model) -> Option<f64> { None }'
     cat <<'RS'
 pub fn run() {
     let options = mbs::Options {
@@ -105,19 +126,15 @@ RS
 cat > "$dir/src/main.rs" <<'RS'
 #[allow(unused_macros, dead_code)]
 mod model;
-use mbs::{F64x4, Model};
+use mbs::Model;
 fn main() {
     let m = model::Model::default();
     let n = model::Model::NQ;
     let (q, z) = (vec![0.1; n], vec![0.0; n]);
     let (mut qdd, mut p) = (vec![0.0; n], vec![0.0; n]);
     m.forward_dynamics(0.0, &q, &z, &vec![0.0; model::Model::NU], &mut qdd, &mut p);
-    // the batch function too (lane by lane without `option batch;`)
-    let (q4, z4) = (vec![F64x4::splat(0.1); n], vec![F64x4::ZERO; n]);
-    let (mut a4, mut p4) = (z4.clone(), z4.clone());
-    let u4 = vec![F64x4::ZERO; model::Model::NU];
-    m.forward_dynamics_x4(F64x4::ZERO, &q4, &z4, &u4, &mut a4, &mut p4);
-    println!("{} dof, qdd[0] = {:.6} ({:.6} in a batch)", n, qdd[0], a4[0].lane(0));
+    let batch = model::batch(&m).map_or(String::new(), |a| format!(" ({a:.6} in a batch)"));
+    println!("{} dof, qdd[0] = {:.6}{batch}", n, qdd[0]);
     model::run();
 }
 RS

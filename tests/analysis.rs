@@ -1018,6 +1018,32 @@ fn mode_shapes_beside_a_stiff_mode_are_their_own() {
     }
 }
 
+/// A repeated pole's two modes get two independent shapes of its plane, not one twice: the
+/// inverse iteration starts differently for each (both started from one vector, and a
+/// repeated eigenvalue keeps the start's mix of its eigenvectors).
+#[test]
+fn a_repeated_pole_has_two_independent_shapes() {
+    let mut model = SoftBesideStiff::default();
+    model.params.ky = model.params.kx;
+    let lin = linearize(
+        &model,
+        0.0,
+        &[0.0; 3],
+        &[0.0; 3],
+        &[],
+        IterationMatrix::Auto,
+    )
+    .unwrap();
+    let modes = modes(&lin, None).unwrap();
+    let (a, b) = (&modes.modes[0].shape, &modes.modes[1].shape);
+    // |a × b| / (|a| |b|) over (x, y), the shapes real up to rounding
+    let cross = a[0].0 * b[1].0 - a[1].0 * b[0].0;
+    let sine = cross.abs() / (a[0].0.hypot(a[1].0) * b[0].0.hypot(b[1].0));
+    println!("repeated pole's shapes {a:?} and {b:?}: sine of their angle {sine:.3}");
+    assert!(sine > 0.1, "{sine}");
+    assert!(a[2].0.abs() < 1e-10 && b[2].0.abs() < 1e-10);
+}
+
 /// An unstable equilibrium beside a stiff spring is unstable: K = diag(1, 1.44, 1e10) with
 /// its first spring reversed (−0.49) has a negative eigenvalue five orders below 1e-9 of the
 /// largest, which the verdict's threshold (a part in 10⁹ of the largest, for stiffnesses

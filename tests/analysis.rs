@@ -978,6 +978,12 @@ fn modes_table_and_csv_have_one_row_per_mode() {
     }
 }
 
+/// The modes of the three oscillators about their rest.
+fn modes_at_rest(model: &SoftBesideStiff) -> mbs::Modes {
+    let lin = linearize(model, 0.0, &[0.0; 3], &[0.0; 3], &[], IterationMatrix::Auto).unwrap();
+    modes(&lin, None).unwrap()
+}
+
 /// Mode shapes beside a stiff mode: each of three uncoupled oscillators moves its own
 /// coordinate alone. The shapes come from inverse iteration a hair off each pole; that hair
 /// was a part in 10⁹ of the state matrix's largest entry (here 1e10/s², so 10/s), and the
@@ -986,16 +992,7 @@ fn modes_table_and_csv_have_one_row_per_mode() {
 #[test]
 fn mode_shapes_beside_a_stiff_mode_are_their_own() {
     let model = SoftBesideStiff::default();
-    let lin = linearize(
-        &model,
-        0.0,
-        &[0.0; 3],
-        &[0.0; 3],
-        &[],
-        IterationMatrix::Auto,
-    )
-    .unwrap();
-    let modes = modes(&lin, None).unwrap();
+    let modes = modes_at_rest(&model);
     assert_eq!(modes.modes.len(), 3);
     for (own, (mode, omega)) in modes.modes.iter().zip([1.0, 1.2, 1e5]).enumerate() {
         let off = (mode.shape.iter().enumerate())
@@ -1025,16 +1022,7 @@ fn mode_shapes_beside_a_stiff_mode_are_their_own() {
 fn a_repeated_pole_has_two_independent_shapes() {
     let mut model = SoftBesideStiff::default();
     model.params.ky = model.params.kx;
-    let lin = linearize(
-        &model,
-        0.0,
-        &[0.0; 3],
-        &[0.0; 3],
-        &[],
-        IterationMatrix::Auto,
-    )
-    .unwrap();
-    let modes = modes(&lin, None).unwrap();
+    let modes = modes_at_rest(&model);
     let (a, b) = (&modes.modes[0].shape, &modes.modes[1].shape);
     // |a × b| / (|a| |b|) over (x, y), the shapes real up to rounding
     let cross = a[0].0 * b[1].0 - a[1].0 * b[0].0;

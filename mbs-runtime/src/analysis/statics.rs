@@ -564,26 +564,39 @@ fn constrained<M: Model>(
         iterations += 1;
         stiffness(model, t, &q, u, options.stiffness, &mut k)?;
         let g = reduce::constraint_tangent(model, t, &q, &lambda)?;
-        // J = [−K + G, B_fᵀ; B_f, 0] over the free coordinates
+        // J = [−K + G, s B_fᵀ; s B_f, 0] over the free coordinates, the constraints' rows and
+        // columns scaled by s to the size of the stiffness (and their unknowns δλ/s): a
+        // stiff loop's Schur complement B K⁻¹ Bᵀ leaves pivots the factorisation takes for
+        // singular otherwise (a four-bar with a 2e8 N·m/rad spring was refused as a singular
+        // reduced stiffness)
         let m = nf + nc;
+        let mut kg_norm = 0.0f64;
+        for &i in free {
+            let row = free
+                .iter()
+                .map(|&j| (-k[i + n * j] + g[(i, j)]).abs())
+                .sum();
+            kg_norm = kg_norm.max(row);
+        }
+        let b_norm = (0..nc)
+            .map(|p| free.iter().map(|&j| st.b[(p, j)].abs()).sum::<f64>())
+            .fold(0.0f64, f64::max);
+        let scale = kg_norm / b_norm;
+        let scale = if scale.is_finite() && scale > 0.0 {
+            scale
+        } else {
+            1.0
+        };
         let a = lu.matrix_mut();
         a.fill(0.0);
-        let (mut kg_norm, mut b_norm) = (0.0f64, 0.0f64);
         for (r, &i) in free.iter().enumerate() {
-            let mut row = 0.0;
             for (c, &j) in free.iter().enumerate() {
-                let v = -k[i + n * j] + g[(i, j)];
-                a[r + m * c] = v;
-                row += v.abs();
+                a[r + m * c] = -k[i + n * j] + g[(i, j)];
             }
-            kg_norm = kg_norm.max(row);
             for p in 0..nc {
-                a[r + m * (nf + p)] = st.b[(p, i)];
-                a[(nf + p) + m * r] = st.b[(p, i)];
+                a[r + m * (nf + p)] = scale * st.b[(p, i)];
+                a[(nf + p) + m * r] = scale * st.b[(p, i)];
             }
-        }
-        for p in 0..nc {
-            b_norm = b_norm.max(free.iter().map(|&j| st.b[(p, j)].abs()).sum::<f64>());
         }
         if let Err(s) = lu.factor() {
             let at = Rest {
@@ -594,8 +607,13 @@ fn constrained<M: Model>(
             };
             return Err(singular_reduced(model, at, options, free, &st.b, s.rcond)?);
         }
-        let mut delta: Vec<f64> = st.f.iter().chain(&st.phi).map(|v| -v).collect();
+        let mut delta: Vec<f64> = (st.f.iter().map(|v| -v))
+            .chain(st.phi.iter().map(|v| -scale * v))
+            .collect();
         lu.solve(&mut delta);
+        for d in &mut delta[nf..] {
+            *d *= scale;
+        }
         // backtracking on ‖F‖∞ + μ‖Φ‖∞
         let mu = if kg_norm > 0.0 && b_norm > 0.0 && (kg_norm / b_norm).is_finite() {
             kg_norm / b_norm

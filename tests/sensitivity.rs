@@ -1016,3 +1016,34 @@ fn nearly_repeated_poles_have_exact_derivatives_and_their_separation() {
     }
     assert!(worst < 1e-10, "{worst:e}");
 }
+
+/// The equilibrium's sensitivities of a loop held by a spring of 2e6 to 2e14 N·m/rad: the
+/// crank the spring holds moves with the link lengths as 1/k1, the others as the loop's
+/// geometry says, whatever k1. At 2e14 the factorisation of [K, −Bᵀ; B, 0] took the pivots
+/// of B K⁻¹ Bᵀ for singular and the loop was refused as having a neutral direction.
+#[test]
+fn a_stiff_loop_s_equilibrium_sensitivities_scale_with_its_spring() {
+    let at = |k1: f64| {
+        let mut model = SensitiveFourBar::default();
+        let mut p = model.params().clone();
+        p.set("k1", k1).unwrap();
+        model.set_params(p).unwrap();
+        let options = StaticsOptions {
+            tolerance: 1e-13 * k1,
+            ..StaticsOptions::default()
+        };
+        let eq = static_equilibrium(&model, &options).unwrap();
+        static_sensitivity(&model, &eq, &options).unwrap().dq_dp
+    };
+    let (soft, stiff) = (at(2e6), at(2e14));
+    println!(
+        "dq/dl1 at k1 = 2e6: {:?}; at 2e14: {:?}",
+        &soft[..3],
+        &stiff[..3]
+    );
+    let crank = (stiff[0] * 1e8 - soft[0]).abs() / soft[0].abs();
+    assert!(crank < 1e-6, "{crank:e}");
+    for i in 1..3 {
+        assert!((stiff[i] - soft[i]).abs() < 1e-6 * soft[i].abs(), "{i}");
+    }
+}

@@ -114,6 +114,18 @@ pub fn static_sensitivity<M: Model + Clone>(
     }
     let na = nf + nc;
     let mut lu = Lu::<f64>::new(na);
+    // the constraints' rows and columns scaled by s to the stiffness' size (their unknowns
+    // dλ/s): a stiff loop's B K⁻¹ Bᵀ leaves pivots the factorisation takes for singular
+    // otherwise (a four-bar held by a 2e14 N·m/rad spring was refused as neutral)
+    let k_size = (free.iter())
+        .flat_map(|&j| free.iter().map(move |&i| i + n * j))
+        .fold(0.0f64, |m, ij| m.max(k[ij].abs()));
+    let b_size = b.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let s = if k_size > 0.0 && b_size > 0.0 && (k_size / b_size).is_finite() {
+        k_size / b_size
+    } else {
+        1.0
+    };
     {
         let a = lu.matrix_mut();
         a.fill(0.0);
@@ -122,8 +134,8 @@ pub fn static_sensitivity<M: Model + Clone>(
                 a[r + na * c] = k[i + n * j];
             }
             for i in 0..nc {
-                a[(nf + i) + na * c] = b[i + nc * j];
-                a[c + na * (nf + i)] = -b[i + nc * j];
+                a[(nf + i) + na * c] = s * b[i + nc * j];
+                a[c + na * (nf + i)] = -s * b[i + nc * j];
             }
         }
     }
@@ -142,9 +154,12 @@ pub fn static_sensitivity<M: Model + Clone>(
             x[r] = -dtau[i + n * p];
         }
         for i in 0..nc {
-            x[nf + i] = -ct.dphi_dp[i + nc * p];
+            x[nf + i] = -s * ct.dphi_dp[i + nc * p];
         }
         lu.solve(&mut x);
+        for v in &mut x[nf..] {
+            *v *= s;
+        }
         for (r, &i) in free.iter().enumerate() {
             dq_dp[i + n * p] = x[r];
         }

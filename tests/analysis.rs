@@ -33,24 +33,22 @@ const G: f64 = 9.81;
 const C1: f64 = 0.8;
 const C2: f64 = 3.0;
 
-mbs::multibody! {
-    /// Three masses on springs along x, y and z, two soft (ω = 1 and 1.2 rad/s) beside a
-    /// stiff one (ω = 1e5 rad/s, a gear's stiffness on a small inertia), and, with `option
-    /// tangents;`, exact stiffnesses for statics.
-    model SoftBesideStiff {
-        param kx = 1.0; param ky = 1.44; param kz = 1e10; param m = 1.0;
-        option tangents;
-        dof x = 0.0; dof y = 0.0; dof z = 0.0;
-        body a { mass = m; inertia = (0.01, 0.01, 0.01); }
-        body b { mass = m; inertia = (0.01, 0.01, 0.01); }
-        body c { mass = m; inertia = (0.01, 0.01, 0.01); }
-        TOG[a] = Tdisp(x, 0, 0);
-        TOG[b] = Tdisp(0, y, 0);
-        TOG[c] = Tdisp(0, 0, z);
-        generalized_force(x, -kx * x);
-        generalized_force(y, -ky * y);
-        generalized_force(z, -kz * z);
-    }
+#[path = "common/oscillators.rs"]
+mod oscillators;
+
+/// Three masses on springs along x, y and z, two soft (ω = 1 and 1.2 rad/s) beside a stiff
+/// one (ω = 1e5 rad/s, a gear's stiffness on a small inertia), with exact tangents.
+fn soft_beside_stiff() -> oscillators::Oscillators {
+    oscillators_of(1.0, 1.44, 1e10)
+}
+
+/// The oscillators with springs of stiffness kx, ky and kz.
+fn oscillators_of(kx: f64, ky: f64, kz: f64) -> oscillators::Oscillators {
+    let mut model = oscillators::Oscillators::default();
+    let mut p = model.params().clone();
+    (p.kx, p.ky, p.kz) = (kx, ky, kz);
+    model.set_params(p).unwrap();
+    model
 }
 
 mbs::multibody! {
@@ -979,7 +977,7 @@ fn modes_table_and_csv_have_one_row_per_mode() {
 }
 
 /// The modes of the three oscillators about their rest.
-fn modes_at_rest(model: &SoftBesideStiff) -> mbs::Modes {
+fn modes_at_rest(model: &oscillators::Oscillators) -> mbs::Modes {
     let lin = linearize(model, 0.0, &[0.0; 3], &[0.0; 3], &[], IterationMatrix::Auto).unwrap();
     modes(&lin, None).unwrap()
 }
@@ -991,7 +989,7 @@ fn modes_at_rest(model: &SoftBesideStiff) -> mbs::Modes {
 /// nearer the shifted pole than itself).
 #[test]
 fn mode_shapes_beside_a_stiff_mode_are_their_own() {
-    let model = SoftBesideStiff::default();
+    let model = soft_beside_stiff();
     let modes = modes_at_rest(&model);
     assert_eq!(modes.modes.len(), 3);
     for (own, (mode, omega)) in modes.modes.iter().zip([1.0, 1.2, 1e5]).enumerate() {
@@ -1020,8 +1018,7 @@ fn mode_shapes_beside_a_stiff_mode_are_their_own() {
 /// repeated eigenvalue keeps the start's mix of its eigenvectors).
 #[test]
 fn a_repeated_pole_has_two_independent_shapes() {
-    let mut model = SoftBesideStiff::default();
-    model.params.ky = model.params.kx;
+    let model = oscillators_of(1.0, 1.0, 1e10);
     let modes = modes_at_rest(&model);
     let (a, b) = (&modes.modes[0].shape, &modes.modes[1].shape);
     // |a × b| / (|a| |b|) over (x, y), the shapes real up to rounding
@@ -1038,8 +1035,7 @@ fn a_repeated_pole_has_two_independent_shapes() {
 /// from differences) called neutral; with exact tangents the threshold is a part in 10¹².
 #[test]
 fn an_unstable_direction_beside_a_stiff_spring_is_unstable() {
-    let mut model = SoftBesideStiff::default();
-    model.params.kx = -0.49;
+    let model = oscillators_of(-0.49, 1.44, 1e10);
     let eq = static_equilibrium(&model, &StaticsOptions::default()).unwrap();
     println!(
         "stiffness eigenvalues {:?}: {:?}",
@@ -1047,7 +1043,7 @@ fn an_unstable_direction_beside_a_stiff_spring_is_unstable() {
     );
     assert_eq!(eq.stability, Stability::Unstable);
     // the same, stable
-    model.params.kx = 0.49;
+    let model = oscillators_of(0.49, 1.44, 1e10);
     let eq = static_equilibrium(&model, &StaticsOptions::default()).unwrap();
     assert_eq!(eq.stability, Stability::Stable);
 }

@@ -9,6 +9,9 @@ use mbs_models::sprung_arm::SprungArm;
 #[macro_use]
 #[path = "common/delegating.rs"]
 mod delegating;
+#[path = "common/oscillators.rs"]
+mod oscillators;
+use oscillators::Oscillators;
 
 mbs::multibody! {
     /// The same arm without sensitive parameters.
@@ -907,32 +910,13 @@ fn sensitivities_cross_chart_switches_as_differences_say() {
     }
 }
 
-mbs::multibody! {
-    /// Three masses on springs along x, y, z; the springs along x and y equally stiff, so that
-    /// their poles are one repeated pole, which moving kx alone splits.
-    model Twins {
-        param kx = 100.0 sensitive; param ky = 100.0; param kz = 300.0 sensitive; param m = 1.0;
-        option tangents;
-        dof x = 0.0; dof y = 0.0; dof z = 0.0;
-        body a { mass = m; inertia = (0.01, 0.01, 0.01); }
-        body b { mass = m; inertia = (0.01, 0.01, 0.01); }
-        body c { mass = m; inertia = (0.01, 0.01, 0.01); }
-        TOG[a] = Tdisp(x, 0, 0);
-        TOG[b] = Tdisp(0, y, 0);
-        TOG[c] = Tdisp(0, 0, z);
-        generalized_force(x, -kx * x);
-        generalized_force(y, -ky * y);
-        generalized_force(z, -kz * z);
-    }
-}
-
 /// A repeated pole (a symmetric machine's twin modes) has no derivative: it is listed, gives
 /// none, and the simple pole beside it keeps its own (dλ/dkz = i/(2 m ω) at ω = √(kz/m),
 /// dλ/dkx = 0).
 #[test]
 fn a_repeated_pole_is_listed_and_the_others_keep_their_derivatives() {
     use mbs::analysis::pole_sensitivity;
-    let model = Twins::default();
+    let model = Oscillators::default();
     let options = StaticsOptions::default();
     let eq = static_equilibrium(&model, &options).unwrap();
     let s = pole_sensitivity(&model, &eq, &options).unwrap();

@@ -127,23 +127,15 @@ pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, A
         // rounding of λ may be (1000 ε of A's largest entry), not by a part in 10⁹ of that
         // entry: beside a stiff mode (a gear of 1e10/s²) that shift was 10/s, and a mode at
         // 1/s converged to its neighbour at 1.2/s, or to neither
-        let shift = (1e-9 * mag).max(1e3 * f64::EPSILON * scale);
+        let first = (1e-9 * mag).max(1e3 * f64::EPSILON * scale);
+        let mut shift = first;
         let mut mu = C64::new(re + shift, im + shift);
-        // each iteration leaves r = |λ − μ| / |λ' − μ| of the nearest other eigenvalue λ':
-        // iterated until r^k is below rounding (at least three, at most 100: a repeated
-        // eigenvalue, r ≈ 1, keeps the start's mix of its eigenvectors, a valid one)
-        let nearest = (eig.iter().enumerate())
-            .filter(|&(j, _)| j != k)
-            .map(|(_, o)| (C64::new(o.re, o.im) - mu).abs())
-            .fold(f64::INFINITY, f64::min);
-        let r = (C64::new(re, im) - mu).abs() / nearest;
-        let iterations = if r > 0.0 && r < 1.0 {
-            ((f64::EPSILON.ln() / r.ln()).ceil() as usize).clamp(3, 100)
-        } else {
-            100
-        };
+        // the factorisation refuses pivots below nε‖A − μI‖, which a fast mode's pivot near its
+        // eigenvalue can be (1e5 rad/s beside 1 rad/s: about 1e-5 of ‖A‖ at a shift of 2e-3):
+        // μ moves off by ten times more each time, and the iterations are counted at the μ
+        // factorised
         let mut factored = false;
-        for _ in 0..4 {
+        for _ in 0..10 {
             let a = lu.matrix_mut();
             for j in 0..n2 {
                 for i in 0..n2 {
@@ -155,8 +147,8 @@ pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, A
                 factored = true;
                 break;
             }
-            // μ on an eigenvalue to rounding: a little further off
-            mu = C64::new(mu.re + 1e3 * shift, mu.im + 1e3 * shift);
+            shift *= 10.0;
+            mu = C64::new(re + shift, im + shift);
         }
         if !factored {
             return Err(Failure::SingularMatrix {
@@ -166,6 +158,31 @@ pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, A
             }
             .into());
         }
+        // each iteration leaves r = |λ − μ| / |λ' − μ| of the nearest other eigenvalue λ' (at
+        // the μ factorised): iterated until r^k is below rounding (at least three, at most
+        // 100: a repeated eigenvalue, r ≈ 1, keeps the start's mix of its eigenvectors, a
+        // valid one)
+        let nearest = (eig.iter().enumerate())
+            .filter(|&(j, _)| j != k)
+            .map(|(_, o)| (C64::new(o.re, o.im) - mu).abs())
+            .fold(f64::INFINITY, f64::min);
+        let r = (C64::new(re, im) - mu).abs() / nearest;
+        if shift > first && r >= 0.5 {
+            // moved so far off that another eigenvalue is about as near: its shape would be
+            // this mode's (at the first shift, r ≈ 1 is a repeated eigenvalue's, whose
+            // vectors are all its own)
+            return Err(Failure::SingularMatrix {
+                matrix: "A − μI (a mode's shape by inverse iteration: no shift both factorisable and nearer this eigenvalue than the others)",
+                rcond: 0.0,
+                coordinates: Vec::new(),
+            }
+            .into());
+        }
+        let iterations = if r > 0.0 && r < 1.0 {
+            ((f64::EPSILON.ln() / r.ln()).ceil() as usize).clamp(3, 100)
+        } else {
+            100
+        };
         // the start differs from mode to mode, so that two modes of one repeated eigenvalue
         // get two of its eigenvectors, not one twice
         let mut v: Vec<C64> = (0..n2)

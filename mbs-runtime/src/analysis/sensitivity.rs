@@ -197,8 +197,10 @@ pub struct PoleSensitivity {
     /// or its own conjugate), relative to the larger of their magnitudes (infinite for a
     /// system of one real pole): how far its derivative reaches. Two simple poles s apart
     /// (relative) veer or cross as a parameter moves them by about that much, so dλ/dp
-    /// predicts a pole's motion only over changes of p that move it by much less than s·|λ|;
-    /// at s ≤ 1e-8 the pole counts as repeated
+    /// predicts a pole's motion only over changes of p that move it by much less than s·|λ|.
+    /// A pole within 1e-8 of another mode's counts as repeated; one within 1e-8 of its own
+    /// conjugate only (a nearly critically damped pair) keeps its derivative, which its
+    /// separation then says reaches little
     pub separation: Vec<f64>,
 }
 
@@ -369,7 +371,10 @@ pub fn pole_sensitivity<M: Model + Clone>(
         let lambda = C64::new(mode.re, mode.im);
         // A(μ) and A(μ)ᴴ with μ a hair off λ, for inverse iteration
         let mag = mode.re.hypot(mode.im);
-        let mu = lambda + C64::new(1e-9 * mag.max(1.0), 1e-9 * mag.max(1.0));
+        // by a part in 10⁹ of the pole (of 1/s at the origin), well inside the separation of
+        // 1e-8 from which a pole counts as simple, so that λ stays the nearest pole to μ
+        let off = if mag > 0.0 { 1e-9 * mag } else { 1e-9 };
+        let mu = lambda + C64::new(off, off);
         // the constraints' rows and columns scaled by s to the size of Q(μ)'s entries, so
         // that the factorisation does not take the small pivots a stiff loop's Schur
         // complement B Q⁻¹ Bᵀ leaves for singular (a four-bar with a 2e6 N·m/rad spring, its
@@ -379,7 +384,7 @@ pub fn pole_sensitivity<M: Model + Clone>(
         };
         let q_size = (0..n * n).fold(0.0f64, |m, ij| m.max(qb(ij % n, ij / n).abs()));
         let b_size = b.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        let s = if b_size > 0.0 && q_size > 0.0 {
+        let s = if b_size > 0.0 && q_size > 0.0 && (q_size / b_size).is_finite() {
             q_size / b_size
         } else {
             1.0

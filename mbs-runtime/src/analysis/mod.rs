@@ -90,6 +90,27 @@ impl AnalysisError {
     }
 }
 
+/// The factor s by which the constraints' rows and columns of an augmented matrix
+/// [K, ±Bᵀ; B, 0] are scaled to the size of the block beside them (`block` and `constraints`
+/// the two blocks' sizes; their unknowns are then λ/s): a stiff loop's Schur complement
+/// B K⁻¹ Bᵀ otherwise leaves pivots the factorisation takes for singular. 1 when either size
+/// is 0 or their ratio is not finite.
+fn constraint_scale(block: f64, constraints: f64) -> f64 {
+    let s = block / constraints;
+    if s.is_finite() && s > 0.0 { s } else { 1.0 }
+}
+
+/// Steps of inverse iteration at a shift μ that leaves r = |λ − μ| / |λ' − μ| of the nearest
+/// other eigenvalue λ' in the vector at each step: until r^k is below rounding, at least
+/// three and at most 100; `otherwise` where r is not in (0, 1).
+fn inverse_iterations(r: f64, otherwise: usize) -> usize {
+    if r > 0.0 && r < 1.0 {
+        ((f64::EPSILON.ln() / r.ln()).ceil() as usize).clamp(3, 100)
+    } else {
+        otherwise
+    }
+}
+
 /// The first non-finite entry of `v` (NQ-periodic, named by its coordinate) as an error.
 fn check<M: Model>(model: &M, quantity: &'static str, v: &[f64]) -> Result<(), AnalysisError> {
     let info = model.info();

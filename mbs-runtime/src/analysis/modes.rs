@@ -134,6 +134,14 @@ pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, A
         // eigenvalue can be (1e5 rad/s beside 1 rad/s: about 1e-5 of ‖A‖ at a shift of 2e-3):
         // μ moves off by ten times more each time, and the iterations are counted at the μ
         // factorised
+        let singular = |matrix| -> AnalysisError {
+            Failure::SingularMatrix {
+                matrix,
+                rcond: 0.0,
+                coordinates: Vec::new(),
+            }
+            .into()
+        };
         let mut factored = false;
         for _ in 0..10 {
             let a = lu.matrix_mut();
@@ -151,12 +159,7 @@ pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, A
             mu = C64::new(re + shift, im + shift);
         }
         if !factored {
-            return Err(Failure::SingularMatrix {
-                matrix: "A − μI (a mode's shape by inverse iteration)",
-                rcond: 0.0,
-                coordinates: Vec::new(),
-            }
-            .into());
+            return Err(singular("A − μI (a mode's shape by inverse iteration)"));
         }
         // each iteration leaves r = |λ − μ| / |λ' − μ| of the nearest other eigenvalue λ' (at
         // the μ factorised): iterated until r^k is below rounding (at least three, at most
@@ -171,18 +174,11 @@ pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, A
             // moved so far off that another eigenvalue is about as near: its shape would be
             // this mode's (at the first shift, r ≈ 1 is a repeated eigenvalue's, whose
             // vectors are all its own)
-            return Err(Failure::SingularMatrix {
-                matrix: "A − μI (a mode's shape by inverse iteration: no shift both factorisable and nearer this eigenvalue than the others)",
-                rcond: 0.0,
-                coordinates: Vec::new(),
-            }
-            .into());
+            return Err(singular(
+                "A − μI (a mode's shape by inverse iteration: no shift both factorisable and nearer this eigenvalue than the others)",
+            ));
         }
-        let iterations = if r > 0.0 && r < 1.0 {
-            ((f64::EPSILON.ln() / r.ln()).ceil() as usize).clamp(3, 100)
-        } else {
-            100
-        };
+        let iterations = super::inverse_iterations(r, 100);
         // the start differs from mode to mode, so that two modes of one repeated eigenvalue
         // get two of its eigenvectors, not one twice
         let mut v: Vec<C64> = (0..n2)

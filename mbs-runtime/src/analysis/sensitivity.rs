@@ -121,11 +121,7 @@ pub fn static_sensitivity<M: Model + Clone>(
         .flat_map(|&j| free.iter().map(move |&i| i + n * j))
         .fold(0.0f64, |m, ij| m.max(k[ij].abs()));
     let b_size = b.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-    let s = if k_size > 0.0 && b_size > 0.0 && (k_size / b_size).is_finite() {
-        k_size / b_size
-    } else {
-        1.0
-    };
+    let s = super::constraint_scale(k_size, b_size);
     {
         let a = lu.matrix_mut();
         a.fill(0.0);
@@ -384,11 +380,7 @@ pub fn pole_sensitivity<M: Model + Clone>(
         };
         let q_size = (0..n * n).fold(0.0f64, |m, ij| m.max(qb(ij % n, ij / n).abs()));
         let b_size = b.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        let s = if b_size > 0.0 && q_size > 0.0 && (q_size / b_size).is_finite() {
-            q_size / b_size
-        } else {
-            1.0
-        };
+        let s = super::constraint_scale(q_size, b_size);
         {
             let (ar, al) = (a_right.matrix_mut(), a_left.matrix_mut());
             ar.fill(C64::default());
@@ -431,11 +423,7 @@ pub fn pole_sensitivity<M: Model + Clone>(
             .map(|p| (p - mu).abs())
             .fold(f64::INFINITY, f64::min);
         let r = (lambda - mu).abs() / nearest;
-        let iterations = if r > 0.0 && r < 1.0 {
-            ((f64::EPSILON.ln() / r.ln()).ceil() as usize).clamp(3, 100)
-        } else {
-            3
-        };
+        let iterations = super::inverse_iterations(r, 3);
         for _ in 0..iterations {
             a_right.solve(&mut x);
             a_left.solve(&mut y);

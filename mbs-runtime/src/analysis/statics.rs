@@ -581,12 +581,7 @@ fn constrained<M: Model>(
         let b_norm = (0..nc)
             .map(|p| free.iter().map(|&j| st.b[(p, j)].abs()).sum::<f64>())
             .fold(0.0f64, f64::max);
-        let scale = kg_norm / b_norm;
-        let scale = if scale.is_finite() && scale > 0.0 {
-            scale
-        } else {
-            1.0
-        };
+        let scale = super::constraint_scale(kg_norm, b_norm);
         let a = lu.matrix_mut();
         a.fill(0.0);
         for (r, &i) in free.iter().enumerate() {
@@ -614,13 +609,8 @@ fn constrained<M: Model>(
         for d in &mut delta[nf..] {
             *d *= scale;
         }
-        // backtracking on ‖F‖∞ + μ‖Φ‖∞
-        let mu = if kg_norm > 0.0 && b_norm > 0.0 && (kg_norm / b_norm).is_finite() {
-            kg_norm / b_norm
-        } else {
-            1.0
-        };
-        let merit = |st: &ConstrainedState| st.force_residual() + mu * st.constraint_residual();
+        // backtracking on ‖F‖∞ + μ‖Φ‖∞, μ the same ratio of the blocks' sizes
+        let merit = |st: &ConstrainedState| st.force_residual() + scale * st.constraint_residual();
         let current = merit(&st);
         let mut alpha = 1.0;
         let (mut trial, mut trial_lambda) = (q.clone(), lambda.clone());

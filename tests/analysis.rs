@@ -793,6 +793,40 @@ fn statics_without_equilibrium_does_not_converge() {
     }
 }
 
+/// A force within the tolerance is no equilibrium where the stiffness is as small: a spring
+/// of 5e-7 N/m started 1 mm off pulls with 5e-10 N, below the default force tolerance of
+/// 1e-9 N, and the start was returned as the equilibrium after no iteration.
+#[test]
+fn a_soft_spring_s_equilibrium_is_found_not_its_start() {
+    let model = oscillators_of(5e-7, 1.0, 1.0);
+    let eq = static_equilibrium(
+        &model,
+        &StaticsOptions {
+            q0: Some(vec![1e-3, 0.0, 0.0]),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    println!("{eq}");
+    assert!(eq.q[0].abs() < 1e-12, "x = {} m", eq.q[0]);
+    assert!(eq.iterations >= 1);
+    assert!(eq.correction.is_some_and(|c| c <= 1e-10));
+    assert_eq!(eq.stability, Stability::Stable);
+
+    // a free mass at rest (no force, no stiffness): neutral, its start, no correction
+    let free = oscillators_of(0.0, 1.0, 1.0);
+    let eq = static_equilibrium(
+        &free,
+        &StaticsOptions {
+            q0: Some(vec![0.3, 0.0, 0.0]),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    assert_eq!((eq.q[0], eq.iterations, eq.correction), (0.3, 0, None));
+    assert_eq!(eq.stability, Stability::Neutral);
+}
+
 #[test]
 fn invalid_options_are_typed_errors() {
     let model = CartPole::default();

@@ -763,6 +763,38 @@ fn four_bar_statics_match_its_potential_energy() {
     }
 }
 
+/// A four-bar of light bars (1e-9 kg/m) rests where the one of 1 kg/m does: gravity's
+/// moments scale with the mass and their equilibria do not. Its forces at a start 0.15 rad
+/// off are below the force tolerance, which the start alone passed as an equilibrium.
+#[test]
+fn a_light_four_bar_rests_where_a_heavy_one_does() {
+    let mut model = FourBar::default();
+    let a_star = fourbar_equilibria(&model, 0.0)
+        .into_iter()
+        .find(|&a| derivatives(|x| fourbar_v(&model, x), a, 1e-3).1 > 0.0)
+        .unwrap();
+    let mut p = model.params().clone();
+    p.rho = 1e-9;
+    model.set_params(p).unwrap();
+    let eq = static_equilibrium(
+        &model,
+        &StaticsOptions {
+            q0: Some(fourbar_q(a_star + 0.15)),
+            u: Some(vec![0.0]),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    println!("{eq}");
+    assert!(
+        (eq.q[0] - a_star).abs() < 1e-7,
+        "a = {} vs {a_star}",
+        eq.q[0]
+    );
+    assert!(eq.correction.is_some_and(|c| c <= 1e-10));
+    assert_eq!(eq.stability, Stability::Stable);
+}
+
 #[test]
 fn four_bar_frequency_matches_the_energy_method() {
     let model = FourBar::default();

@@ -41,6 +41,11 @@ pub struct StaticsOptions {
     pub tolerance: f64,
     /// constrained models: and every |Φ_i| below this (m or rad), default 1e-11
     pub constraint_tolerance: f64,
+    /// and Newton's correction at `q` moves no free coordinate by more than this (m or rad),
+    /// or than 100 ε of its value, default 1e-10: a small force does not mean a near
+    /// equilibrium where the stiffness is small too (a hairspring of 5e-7 N·m/rad started
+    /// 1 mrad off has a force of 5e-10 N·m, which the force test alone accepted as converged)
+    pub step_tolerance: f64,
     /// Newton iterations before `NotConverged` (default 50)
     pub max_iterations: usize,
     /// how the stiffness is obtained: exact tangents (`Exact`, or `Auto` when generated), or
@@ -58,6 +63,7 @@ impl Default for StaticsOptions {
             locked: Vec::new(),
             tolerance: 1e-9,
             constraint_tolerance: 1e-11,
+            step_tolerance: 1e-10,
             max_iterations: 50,
             stiffness: IterationMatrix::Auto,
         }
@@ -84,6 +90,10 @@ pub struct Equilibrium {
     /// largest |h| over the free coordinates at `q` (|h + Bᵀλ| with constraints)
     pub residual: f64,
     pub iterations: usize,
+    /// the largest move of a free coordinate (m or rad) in Newton's correction at `q`: how far
+    /// `q` may be from the equilibrium; `None` where the stiffness at `q` does not factor
+    /// (a neutral direction, its forces within the tolerance)
+    pub correction: Option<f64>,
     /// names of the free coordinates
     pub free: Vec<String>,
     /// eigenvalues of the (symmetrised) stiffness on the free coordinates, ascending; with
@@ -116,8 +126,14 @@ impl fmt::Display for Equilibrium {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(
             f,
-            "static equilibrium ({:?}) after {} iterations, residual {:.2e}",
-            self.stability, self.iterations, self.residual
+            "static equilibrium ({:?}) after {} iterations, residual {:.2e}, {}",
+            self.stability,
+            self.iterations,
+            self.residual,
+            match self.correction {
+                Some(c) => format!("Newton's correction {c:.2e}"),
+                None => "no Newton correction (singular stiffness)".into(),
+            }
         )?;
         if !self.constraint_names.is_empty() {
             write!(f, "max |Φ| {:.2e}, λ:", self.constraint_residual)?;
@@ -234,6 +250,13 @@ pub(super) fn checked_inputs<M: Model>(
             "must be > 0 and finite",
         );
     }
+    if !(options.step_tolerance > 0.0 && options.step_tolerance.is_finite()) {
+        return invalid(
+            "step_tolerance",
+            options.step_tolerance.to_string(),
+            "must be > 0 and finite",
+        );
+    }
     if M::NC > 0
         && !(options.constraint_tolerance > 0.0 && options.constraint_tolerance.is_finite())
     {
@@ -347,8 +370,11 @@ fn unconstrained<M: Model>(
     forces(model, options.t, &q, u, &mut h)?;
     let mut residual = norm(&h);
     let mut iterations = 0;
-    while residual > options.tolerance {
-        if iterations == options.max_iterations {
+    let mut delta = vec![0.0; nf];
+    // Newton's correction at the q returned (None where K does not factor there)
+    let correction = loop {
+        let small = residual <= options.tolerance;
+        if !small && iterations == options.max_iterations {
             return Err(AnalysisError::NotConverged {
                 iterations,
                 residual,
@@ -356,7 +382,6 @@ fn unconstrained<M: Model>(
                 q,
             });
         }
-        iterations += 1;
         stiffness(model, options.t, &q, u, options.stiffness, &mut k)?;
         let a = lu.matrix_mut();
         for (c, &j) in free.iter().enumerate() {
@@ -364,41 +389,63 @@ fn unconstrained<M: Model>(
                 a[r + nf * c] = k[i + n * j];
             }
         }
-        lu.factor().map_err(|s| Failure::SingularMatrix {
-            matrix: "the stiffness K on the free coordinates",
-            rcond: s.rcond,
-            coordinates: vec![info.dof_label(free[s.column])],
-        })?;
+        if let Err(s) = lu.factor() {
+            // a neutral direction at a point whose forces are within the tolerance
+            if small {
+                break None;
+            }
+            return Err(Failure::SingularMatrix {
+                matrix: "the stiffness K on the free coordinates",
+                rcond: s.rcond,
+                coordinates: vec![info.dof_label(free[s.column])],
+            }
+            .into());
+        }
         // K δ = h (τ = −h at rest: h(q + δ) ≈ h − K δ)
-        let mut delta: Vec<f64> = free.iter().map(|&i| h[i]).collect();
+        for (d, &i) in delta.iter_mut().zip(free) {
+            *d = h[i];
+        }
         lu.solve(&mut delta);
+        let size = largest(&delta);
+        if small && (within_step(&delta, &q, free, options) || iterations == options.max_iterations)
+        {
+            break Some(size);
+        }
+        iterations += 1;
         // backtracking on ‖h‖∞
         let mut alpha = 1.0;
-        loop {
+        let accepted = loop {
             trial.copy_from_slice(&q);
             for (c, &i) in free.iter().enumerate() {
                 trial[i] += alpha * delta[c];
             }
             let ok = forces(model, options.t, &trial, u, &mut ht).is_ok();
             if ok && norm(&ht) < residual * (1.0 - 1e-4 * alpha) {
-                break;
+                break true;
             }
             alpha *= 0.5;
             if alpha < 1e-6 {
-                return Err(AnalysisError::NotConverged {
-                    iterations,
-                    residual,
-                    constraint_residual: 0.0,
-                    q,
-                });
+                break false;
             }
+        };
+        if !accepted {
+            // the forces cannot fall further: at their rounding when they are within the
+            // tolerance, the correction then saying how far q may be
+            if small {
+                break Some(size);
+            }
+            return Err(AnalysisError::NotConverged {
+                iterations,
+                residual,
+                constraint_residual: 0.0,
+                q,
+            });
         }
         q.copy_from_slice(&trial);
         h.copy_from_slice(&ht);
         residual = norm(&h);
-    }
-    // stability from the symmetrised stiffness on the free coordinates
-    stiffness(model, options.t, &q, u, options.stiffness, &mut k)?;
+    };
+    // stability from the symmetrised stiffness on the free coordinates (k is K at q)
     let ks = nalgebra::DMatrix::from_fn(nf, nf, |r, c| {
         0.5 * (k[free[r] + n * free[c]] + k[free[c] + n * free[r]])
     });
@@ -408,6 +455,7 @@ fn unconstrained<M: Model>(
         q,
         residual,
         iterations,
+        correction,
         free: free.iter().map(|&i| info.dof_label(i)).collect(),
         stiffness_eigenvalues,
         stability,
@@ -415,6 +463,22 @@ fn unconstrained<M: Model>(
         lambda: Vec::new(),
         constraint_residual: 0.0,
         charts: Vec::new(),
+    })
+}
+
+/// The largest |x_i|.
+fn largest(x: &[f64]) -> f64 {
+    x.iter().fold(0.0, |m, v| m.max(v.abs()))
+}
+
+/// Whether Newton's correction δ (over the free coordinates) moves none of them by more than
+/// the step tolerance or 100 ε of its value (its rounding).
+fn within_step(delta: &[f64], q: &[f64], free: &[usize], options: &StaticsOptions) -> bool {
+    delta.iter().zip(free).all(|(d, &i)| {
+        d.abs()
+            <= options
+                .step_tolerance
+                .max(100.0 * f64::EPSILON * q[i].abs())
     })
 }
 
@@ -552,8 +616,11 @@ fn constrained<M: Model>(
         st.force_residual() <= options.tolerance
             && st.constraint_residual() <= options.constraint_tolerance
     };
-    while !converged(&st) {
-        if iterations == options.max_iterations {
+    let mut delta = vec![0.0; nf + nc];
+    // Newton's correction at the q returned (None where the Jacobian does not factor there)
+    let correction = loop {
+        let small = converged(&st);
+        if !small && iterations == options.max_iterations {
             return Err(AnalysisError::NotConverged {
                 iterations,
                 residual: st.force_residual(),
@@ -561,7 +628,6 @@ fn constrained<M: Model>(
                 q,
             });
         }
-        iterations += 1;
         stiffness(model, t, &q, u, options.stiffness, &mut k)?;
         let g = reduce::constraint_tangent(model, t, &q, &lambda)?;
         // J = [−K + G, s B_fᵀ; s B_f, 0] over the free coordinates, the constraints' rows and
@@ -594,6 +660,9 @@ fn constrained<M: Model>(
             }
         }
         if let Err(s) = lu.factor() {
+            if small {
+                break None;
+            }
             let at = Rest {
                 t,
                 q: &q,
@@ -602,19 +671,30 @@ fn constrained<M: Model>(
             };
             return Err(singular_reduced(model, at, options, free, &st.b, s.rcond)?);
         }
-        let mut delta: Vec<f64> = (st.f.iter().map(|v| -v))
-            .chain(st.phi.iter().map(|v| -scale * v))
-            .collect();
+        for (d, v) in delta.iter_mut().zip(st.f.iter().chain(&st.phi)) {
+            *d = -v;
+        }
+        for d in &mut delta[nf..] {
+            *d *= scale;
+        }
         lu.solve(&mut delta);
         for d in &mut delta[nf..] {
             *d *= scale;
         }
+        let size = largest(&delta[..nf]);
+        if small
+            && (within_step(&delta[..nf], &q, free, options)
+                || iterations == options.max_iterations)
+        {
+            break Some(size);
+        }
+        iterations += 1;
         // backtracking on ‖F‖∞ + μ‖Φ‖∞, μ the same ratio of the blocks' sizes
         let merit = |st: &ConstrainedState| st.force_residual() + scale * st.constraint_residual();
         let current = merit(&st);
         let mut alpha = 1.0;
         let (mut trial, mut trial_lambda) = (q.clone(), lambda.clone());
-        loop {
+        let accepted = loop {
             trial.copy_from_slice(&q);
             for (c, &i) in free.iter().enumerate() {
                 trial[i] += alpha * delta[c];
@@ -625,22 +705,29 @@ fn constrained<M: Model>(
             if let Ok(next) = ConstrainedState::new(model, t, &trial, u, &trial_lambda, free) {
                 if merit(&next) < current * (1.0 - 1e-4 * alpha) {
                     st = next;
-                    break;
+                    break true;
                 }
             }
             alpha *= 0.5;
             if alpha < 1e-6 {
-                return Err(AnalysisError::NotConverged {
-                    iterations,
-                    residual: st.force_residual(),
-                    constraint_residual: st.constraint_residual(),
-                    q,
-                });
+                break false;
             }
+        };
+        if !accepted {
+            // the residuals cannot fall further: at their rounding when within the tolerances
+            if small {
+                break Some(size);
+            }
+            return Err(AnalysisError::NotConverged {
+                iterations,
+                residual: st.force_residual(),
+                constraint_residual: st.constraint_residual(),
+                q,
+            });
         }
         q.copy_from_slice(&trial);
         lambda.copy_from_slice(&trial_lambda);
-    }
+    };
     rank(&st.b)?;
     // stability from the reduced stiffness Nᵀ(K − G)N, N orthonormal over the free coordinates
     let at = Rest {
@@ -662,6 +749,7 @@ fn constrained<M: Model>(
         stability,
         constraint_names: names.iter().map(|s| s.to_string()).collect(),
         lambda,
+        correction,
         charts: Vec::new(),
     })
 }

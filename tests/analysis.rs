@@ -52,6 +52,20 @@ fn oscillators_of(kx: f64, ky: f64, kz: f64) -> oscillators::Oscillators {
 }
 
 mbs::multibody! {
+    /// A mass on a spring with forces that change on a micrometre scale: a regularised
+    /// Coulomb friction fc tanh(v/v_e) (v_e = 1 µm/s) and a detent fd tanh(x/x_e) (x_e = 1 µm);
+    /// at rest at x = 0 its stiffness is k + fd/x_e = 200 N/m and its damping fc/v_e = 2 N·s/m.
+    model Micro {
+        param k = 100.0; param fc = 2e-6; param fd = 1e-4;
+        option tangents;
+        dof x = 0.0;
+        body a { mass = 1.0; inertia = (0.01, 0.01, 0.01); }
+        TOG[a] = Tdisp(x, 0, 0);
+        generalized_force(x, -k * x - fd * tanh(x / 1e-6) - fc * tanh(qd[x] / 1e-6));
+    }
+}
+
+mbs::multibody! {
     /// seed2dof with dampers in parallel with both springs, named coordinates.
     model Seed2dofDamped {
         param m1 = 1.0; param m2 = 1.0;
@@ -757,6 +771,38 @@ fn rheonomic_damped_linearisation_matches_differences() {
 // ---------------------------------------------------------------------------------------------
 // Inputs
 
+/// Differences of forces that change on a micrometre scale: their step, ε^⅓ of a unit
+/// (6 µm, 6 µm/s), spanned the whole of the detent's and the friction's change and gave the
+/// state matrix a stiffness of 117 N/m and a damping of 0.33 N·s/m where the tangents say 200
+/// and 2; the step is now checked against its quarter.
+#[test]
+fn differences_see_forces_on_a_micrometre_scale() {
+    let model = Micro::default();
+    let at = |how| linearize(&model, 0.0, &[0.0], &[0.0], &[], how).unwrap().a;
+    let (exact, fd) = (
+        at(IterationMatrix::Exact),
+        at(IterationMatrix::FiniteDifferences),
+    );
+    println!("exact {exact}differences {fd}");
+    assert!((exact[(1, 0)] + 200.0).abs() < 1e-9 && (exact[(1, 1)] + 2.0).abs() < 1e-12);
+    let err = rel_diff(&fd, &exact);
+    println!("state matrix by differences, relative error {err:.1e}");
+    assert!(err < 1e-6, "{err:e}");
+    // the statics' stiffness by differences too: the detent's 100 N/m is seen
+    let eq = static_equilibrium(
+        &model,
+        &StaticsOptions {
+            q0: Some(vec![0.0]),
+            stiffness: IterationMatrix::FiniteDifferences,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let k = eq.stiffness_eigenvalues[0];
+    println!("stiffness at rest by differences {k}");
+    assert!((k - 200.0).abs() < 2e-4, "{k}");
+}
+
 #[test]
 fn input_matrix_matches_differences() {
     let model = Actuated::default();
@@ -1044,6 +1090,27 @@ fn mode_shapes_beside_a_stiff_mode_are_their_own() {
         assert!(off < 1e-10, "{off:e}");
         assert!((re - 1.0).abs() < 1e-12 && im.abs() < 1e-12, "{re} {im}");
         assert!((mode.modal_mass - 1.0).abs() < 1e-9, "{}", mode.modal_mass);
+    }
+}
+
+/// Slow modes beside a very stiff one oscillate: a pair counted as real when its imaginary
+/// part was below 1e-12 of the state matrix's largest entry, here 1e13/s², so 10 rad/s, and
+/// the modes of 1 and 1.2 rad/s were listed as real poles.
+#[test]
+fn slow_modes_beside_a_very_stiff_spring_oscillate() {
+    let model = oscillators_of(1.0, 1.44, 1e13);
+    let modes = modes_at_rest(&model);
+    assert_eq!(modes.modes.len(), 3);
+    for (mode, omega) in modes.modes.iter().zip([1.0, 1.2, 1e13f64.sqrt()]) {
+        let w = 2.0 * PI * mode.frequency_hz;
+        println!(
+            "{w:.9e} rad/s, real {}, damping ratio {:.1e}",
+            mode.is_real(),
+            mode.damping_ratio
+        );
+        assert!(!mode.is_real());
+        assert!((w - omega).abs() < 1e-9 * omega, "{w} rad/s");
+        assert!(mode.damping_ratio.abs() < 1e-9, "{}", mode.damping_ratio);
     }
 }
 

@@ -121,23 +121,17 @@ fn tangents<M: Model>(
             })?;
     } else {
         // central differences of τ in q and in qd
-        let (mut tp, mut tm) = (vec![0.0; n], vec![0.0; n]);
-        let (mut qp, mut vp) = (q.to_vec(), qd.to_vec());
+        let (mut qp, mut vp, mut column) = (q.to_vec(), qd.to_vec(), vec![0.0; n]);
         for j in 0..n {
             for (var, out) in [(0, &mut k), (1, &mut c)] {
                 let x = if var == 0 { q[j] } else { qd[j] };
-                let eps = f64::EPSILON.cbrt() * x.abs().max(1.0);
-                let target = if var == 0 { &mut qp } else { &mut vp };
-                target[j] = x + eps;
-                model.inverse_dynamics(t, &qp, &vp, qdd, u, &mut tp);
-                let target = if var == 0 { &mut qp } else { &mut vp };
-                target[j] = x - eps;
-                model.inverse_dynamics(t, &qp, &vp, qdd, u, &mut tm);
-                let target = if var == 0 { &mut qp } else { &mut vp };
-                target[j] = x;
-                for i in 0..n {
-                    out[i + n * j] = (tp[i] - tm[i]) / (2.0 * eps);
-                }
+                super::central_difference(x, &mut column, |x, tau| {
+                    (if var == 0 { &mut qp } else { &mut vp })[j] = x;
+                    model.inverse_dynamics(t, &qp, &vp, qdd, u, tau);
+                    Ok::<(), AnalysisError>(())
+                })?;
+                (if var == 0 { &mut qp } else { &mut vp })[j] = x;
+                out[n * j..n * (j + 1)].copy_from_slice(&column);
             }
         }
     }
@@ -376,25 +370,20 @@ fn linearize_in_chart<M: Model>(
     // ∂(∂Φ/∂t)/∂q and ∂γ/∂q (fixed qd) by central differences
     let (mut phi_tq, mut gamma_q) = (DMatrix::zeros(nc, n), DMatrix::zeros(nc, n));
     {
-        let (mut qp, mut fp, mut fm) = (q.to_vec(), vec![0.0; nc], vec![0.0; nc]);
+        let (mut qp, mut column) = (q.to_vec(), vec![0.0; nc]);
         for j in 0..n {
-            let eps = f64::EPSILON.cbrt() * q[j].abs().max(1.0);
             for (out, which) in [(&mut phi_tq, 0), (&mut gamma_q, 1)] {
-                let eval = |qq: &[f64], f: &mut [f64]| {
+                super::central_difference(q[j], &mut column, |x, f| {
+                    qp[j] = x;
                     if which == 0 {
-                        model.constraint_rate(t, qq, f)
+                        model.constraint_rate(t, &qp, f)
                     } else {
-                        model.constraint_bias(t, qq, qd, f)
+                        model.constraint_bias(t, &qp, qd, f)
                     }
-                };
-                qp[j] = q[j] + eps;
-                eval(&qp, &mut fp);
-                qp[j] = q[j] - eps;
-                eval(&qp, &mut fm);
+                    Ok::<(), AnalysisError>(())
+                })?;
                 qp[j] = q[j];
-                for i in 0..nc {
-                    out[(i, j)] = (fp[i] - fm[i]) / (2.0 * eps);
-                }
+                out.column_mut(j).copy_from_slice(&column);
             }
         }
     }

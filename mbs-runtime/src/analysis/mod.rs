@@ -8,6 +8,8 @@
 //! split M qdd − h into actuator efforts and constraint reactions. What is exact and what
 //! uses central differences is said in each module:
 //!
+//! Central differences check their step against its quarter (`central_difference`).
+//!
 //! | analysis | exact | central differences |
 //! |---|---|---|
 //! | statics | h, B, ∂(Bᵀλ)/∂q; K with tangents | K without tangents |
@@ -109,6 +111,66 @@ fn inverse_iterations(r: f64, otherwise: usize) -> usize {
     } else {
         otherwise
     }
+}
+
+/// Central differences of a vector function by one variable at x, into `out`
+/// (`f(x', values)` evaluates it with the variable at x'), with a step that is checked: from
+/// ε^⅓ max(|x|, 1) it is divided by 4 while the differences with a step and with its quarter
+/// disagree in some entry by more than 1e-6 of it (their truncation error) and more than its
+/// rounding (1000 ε of the values over the step), at most 12 times and while they come to
+/// agree better; where no two agree, the difference of the pair that disagrees least, its
+/// larger step's. The first step alone, a
+/// unit's part in 6·10⁶ of a coordinate of size 1 or less, misses nonlinearities on a smaller
+/// scale: a friction force μN tanh(v/v_ε) with v_ε = 1e-6 m/s gave a sixth of its damping at
+/// v = 0. Smooth functions keep the first step's difference, at twice its evaluations.
+fn central_difference<E>(
+    x: f64,
+    out: &mut [f64],
+    mut f: impl FnMut(f64, &mut [f64]) -> Result<(), E>,
+) -> Result<(), E> {
+    let m = out.len();
+    let (mut fp, mut fm) = (vec![0.0; m], vec![0.0; m]);
+    // the difference with step h into d, and the rounding of each entry into r
+    let mut difference = |h: f64, d: &mut [f64], r: &mut [f64]| -> Result<(), E> {
+        let (xp, xm) = (x + h, x - h);
+        f(xp, &mut fp)?;
+        f(xm, &mut fm)?;
+        let step = xp - xm;
+        for i in 0..m {
+            d[i] = (fp[i] - fm[i]) / step;
+            r[i] = 1e3 * f64::EPSILON * fp[i].abs().max(fm[i].abs()) / step;
+        }
+        Ok(())
+    };
+    let (mut next, mut r, mut r_next) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
+    let mut h = f64::EPSILON.cbrt() * x.abs().max(1.0);
+    difference(h, out, &mut r)?;
+    let (mut best, mut kept) = (f64::INFINITY, out.to_vec());
+    for _ in 0..12 {
+        h *= 0.25;
+        difference(h, &mut next, &mut r_next)?;
+        // the largest disagreement, in units of what each entry allows
+        let worst = (0..m)
+            .map(|i| {
+                let allowed = (1e-6 * out[i].abs()).max(r[i]).max(r_next[i]);
+                let gap = (out[i] - next[i]).abs();
+                if gap <= allowed { 0.0 } else { gap / allowed }
+            })
+            .fold(0.0, f64::max);
+        if worst == 0.0 {
+            return Ok(());
+        }
+        // past the least disagreement the smaller steps lose to rounding
+        if !(worst < best) {
+            break;
+        }
+        best = worst;
+        kept.copy_from_slice(out);
+        out.copy_from_slice(&next);
+        r.copy_from_slice(&r_next);
+    }
+    out.copy_from_slice(&kept);
+    Ok(())
 }
 
 /// The first non-finite entry of `v` (NQ-periodic, named by its coordinate) as an error.

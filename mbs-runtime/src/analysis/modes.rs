@@ -103,14 +103,19 @@ pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, A
     let mut out = Vec::new();
     let mut lu = Lu::<C64>::new(n2);
     for (k, lambda) in eig.iter().enumerate() {
+        // A pair is real where its imaginary part is within what rounding splits a double
+        // real eigenvalue into: ±√(δ γ) for a perturbation δ ≈ ε max|A| of a Jordan block
+        // of coupling γ ≈ |λ| (at least 1/s), here ten times that. The threshold was 1e-12
+        // of max|A|, which beside a stiff spring (max|A| = 1e13/s²) was 10 rad/s: a mode of
+        // 1 rad/s was listed as two real poles.
+        let real_within = 10.0 * (f64::EPSILON * scale * lambda.norm().max(1.0)).sqrt();
         // one mode per conjugate pair
-        if lambda.im < -1e-12 * scale {
+        if lambda.im < -real_within {
             continue;
         }
-        // a real eigenvalue has Im λ = 0 exactly, whatever the rounding of the Schur form
         let (re, im) = (
             lambda.re,
-            if lambda.im <= 1e-12 * scale {
+            if lambda.im <= real_within {
                 0.0
             } else {
                 lambda.im

@@ -188,17 +188,16 @@ pub(super) fn stiffness<M: Model>(
             })?;
         return check(model, "stiffness", k);
     }
-    let (mut qp, mut hp, mut hm) = (q.to_vec(), vec![0.0; n], vec![0.0; n]);
+    let (mut qp, mut column) = (q.to_vec(), vec![0.0; n]);
     for j in 0..n {
-        let eps = f64::EPSILON.cbrt() * q[j].abs().max(1.0);
-        qp[j] = q[j] + eps;
-        forces(model, t, &qp, u, &mut hp)?;
-        qp[j] = q[j] - eps;
-        forces(model, t, &qp, u, &mut hm)?;
+        super::central_difference(q[j], &mut column, |x, h| {
+            qp[j] = x;
+            forces(model, t, &qp, u, h)
+        })?;
         qp[j] = q[j];
         for i in 0..n {
             // τ = −h at rest
-            k[i + n * j] = -(hp[i] - hm[i]) / (2.0 * eps);
+            k[i + n * j] = -column[i];
         }
     }
     Ok(())

@@ -41,6 +41,64 @@ fn a_fixed_step_below_the_default_h_min_runs() {
     assert!((e.t - 0.2).abs() < 1e-9, "stopped at t = {}", e.t);
 }
 
+/// Fixed steps far from t = 0: from t0 = 1000 s at h = 1e-5 s the grid point reached after
+/// one step was counted as t0 + 0.99999999748 h, below the part in 10⁹ of a step the grid
+/// allowed, and every step after it planned for that same point had zero length, until the
+/// step budget ran out at t = 1000.00001 s.
+#[test]
+fn fixed_steps_far_from_zero_stay_on_their_grid() {
+    let o = Options {
+        t0: 1000.0,
+        output: Output::Every { dt: 1e-3 },
+        energy: false,
+        ..Options::fixed(1000.01, 1e-5)
+    };
+    let (tr, stats) = simulate(Seed2dof::default(), Scheme::Rk4, o).unwrap();
+    assert_eq!(stats.steps, 1000);
+    assert_eq!(tr.t.len(), 11);
+    assert_eq!(*tr.t.last().unwrap(), 1000.01);
+    assert!(stats.h_min > 0.99e-5, "a step of {} s", stats.h_min);
+}
+
+/// `Output::Every` keeps t_end's output where t_end − t0 rounds below its whole intervals:
+/// from t0 = 100000.3 s to 100000.31 s by 1 ms, (t_end − t0)/dt is 9.99999999476 in floating
+/// point, which the part in 10⁹ of an interval did not round up: the output at t_end was left
+/// out (and the fixed steps of 1 ms stuck at zero length after two).
+#[test]
+fn every_output_far_from_zero_ends_at_t_end() {
+    let o = Options {
+        t0: 100000.3,
+        output: Output::Every { dt: 1e-3 },
+        energy: false,
+        max_steps: 100,
+        ..Options::fixed(100000.31, 1e-3)
+    };
+    let (tr, stats) = simulate(Seed2dof::default(), Scheme::Rk4, o).unwrap();
+    assert_eq!(stats.steps, 10);
+    assert_eq!(tr.t.len(), 11);
+    assert_eq!(*tr.t.last().unwrap(), 100000.31);
+}
+
+/// A step stretched to land on a stop time is not longer than h_max: with h_max = 1 ms and
+/// t_end = 10.05 ms, the last step was 1.05 ms.
+#[test]
+fn the_step_onto_t_end_keeps_to_h_max() {
+    let o = Options {
+        h_max: 1e-3,
+        step: StepControl::Adaptive {
+            rtol: 1e-2,
+            atol: 1e-2,
+            h0: Some(1e-3),
+        },
+        output: Output::Last,
+        energy: false,
+        ..Options::adaptive(10.05e-3, 1e-2)
+    };
+    let (_, stats) = simulate(Seed2dof::default(), Scheme::Dopri5, o).unwrap();
+    println!("{} steps, the longest {} s", stats.steps, stats.h_max);
+    assert!(stats.h_max <= 1e-3, "a step of {} s", stats.h_max);
+}
+
 fn invalid(scheme: Scheme, o: Options) -> (&'static str, String) {
     let e = simulate(Seed2dof::default(), scheme, o).unwrap_err();
     assert_eq!(e.stats.steps, 0, "{e}");

@@ -564,17 +564,21 @@ impl Run {
             return Err(self.fail(kind, self.h));
         }
         let remaining = t_stop - self.cur.t;
-        let mut h = self.h.min(self.options.h_max());
+        let h_max = self.options.h_max();
+        let mut h = self.h.min(h_max);
+        // the rounding of t, in steps, beside a part in 10⁹ of a step
+        let slack = grid_slack(self.options.t0, self.cur.t.abs().max(t_stop.abs()), h);
         let t_next = if fixed {
             // fixed steps stay on the grid t0 + k h, whatever the rounding of sums
-            let k = ((self.cur.t - self.options.t0) / h + 1e-9).floor();
+            let k = ((self.cur.t - self.options.t0) / h + slack).floor();
             self.options.t0 + (k + 1.0) * h
         } else {
             self.cur.t + h
         };
-        // land on t_stop exactly, without leaving a sliver of a step behind
-        let last = t_next >= t_stop - 1e-9 * h
-            || (!fixed && h > 0.5 * remaining && remaining - h < 0.1 * h);
+        // land on t_stop exactly, without leaving a sliver of a step behind (nor a step
+        // longer than h_max)
+        let last = t_next >= t_stop - slack * h
+            || (!fixed && h > 0.5 * remaining && remaining - h < 0.1 * h && remaining <= h_max);
         if last {
             h = remaining;
         } else if fixed {
@@ -1001,7 +1005,17 @@ const MAX_OUTPUT_BYTES: usize = 8_000_000_000;
 
 /// The whole intervals `dt` from t0 to t_end (the outputs of `Output::Every` less one).
 fn every_count(options: &Options, dt: f64) -> usize {
-    ((options.t_end - options.t0) / dt + 1e-9).floor() as usize
+    let slack = grid_slack(options.t0, options.t_end.abs(), dt);
+    ((options.t_end - options.t0) / dt + slack).floor() as usize
+}
+
+/// How far (in steps of `h`) a time of size `t` computed on the grid t0 + k h may fall short
+/// of its grid point: a part in 10⁹ of a step, and the rounding of t and t0 in steps. The
+/// part in 10⁹ alone was below one rounding of t once t/h passed 10⁷: from t0 = 1000 at
+/// h = 1e-5, the step reached t0 + h, counted as t0 + 0.99999999748 h, and planned its next
+/// grid point there, a step of zero length, again and again.
+fn grid_slack(t0: f64, t: f64, h: f64) -> f64 {
+    1e-9 + 8.0 * f64::EPSILON * (t0.abs() + t) / h
 }
 
 /// The output instants of `Output::Every` and `Output::Times` (none for the others).

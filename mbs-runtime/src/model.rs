@@ -857,6 +857,15 @@ pub trait Model {
         differenced_iteration_matrix(self, t, state, u, weights, a, work)
     }
 
+    /// ∂q₀/∂p and ∂qd₀/∂p (NQ × NS each, column-major, NS = `SENSITIVE.len()`): how the
+    /// declared start moves with each sensitive parameter (`dof x = x0;` with `param x0
+    /// sensitive`), where the sensitivities start. Generated for the parameters marked
+    /// `sensitive`; zero by default.
+    fn start_sensitivities(&self, sq: &mut [f64], sqd: &mut [f64]) {
+        sq.fill(0.0);
+        sqd.fill(0.0);
+    }
+
     /// ∂τ/∂p (NQ × NS, column-major, NS = `SENSITIVE.len()`) at (t, q, qd, qdd, u): how the
     /// generalised forces that produce qdd change with each sensitive parameter, all else
     /// fixed; τ = M qdd − h, so it is ∂M/∂p·qdd − ∂h/∂p (∂h/∂p alone at qdd = 0). Generated

@@ -13,8 +13,10 @@
 //! (q, s₁, …, s_NS), block-diagonal mass matrix diag(M, …, M) and forces (h, h₁, …, h_NS), so
 //! every scheme integrates the motion and its sensitivities together, with its error control
 //! over both (as CVODES's "full" error control); its forward dynamics solves every block with
-//! one Cholesky factorisation of M. Starts at s = ṡ = 0 (initial conditions that
-//! do not depend on the parameters), except on closed loops (below). The wrapped model's
+//! one Cholesky factorisation of M. Starts at s = ∂q₀/∂p, ṡ = ∂qd₀/∂p of the declared
+//! start ([`Model::start_sensitivities`], zero where the start is free of the parameter; it
+//! was zero always, and `dof x = x0;` with `param x0 sensitive` gave dx/dx0 = 0 throughout),
+//! completed on closed loops (below). The wrapped model's
 //! iteration matrices come from finite differences (its tangents would need second
 //! derivatives).
 //!
@@ -401,11 +403,14 @@ impl<M: Model + 'static> Model for Sensitivities<M> {
         self.model.set_params(params)
     }
 
+    /// The wrapped model's start, then its sensitivities ∂q₀/∂p and ∂qd₀/∂p
+    /// ([`Model::start_sensitivities`]).
     fn initial_state(&self, q: &mut [f64], qd: &mut [f64]) {
         let n = M::NQ;
-        q.fill(0.0);
-        qd.fill(0.0);
-        self.model.initial_state(&mut q[..n], &mut qd[..n]);
+        let (q, sq) = q.split_at_mut(n);
+        let (qd, sqd) = qd.split_at_mut(n);
+        self.model.initial_state(q, qd);
+        self.model.start_sensitivities(sq, sqd);
     }
 
     /// qdd of every block with one factorisation of M (NQ × NQ of the wrapped model); the

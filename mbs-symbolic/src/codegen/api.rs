@@ -124,6 +124,11 @@ pub const PARAMETER_TANGENTS: Method = method(
     "::core::result::Result<(), ::mbs::ModelError>",
 );
 
+/// `start_sensitivities`, which has a default in the trait (zero: a start that no parameter
+/// moves) that models with parameters marked `sensitive` override.
+pub const START_SENSITIVITIES: Method =
+    method("start_sensitivities", "sq: &mut [f64], sqd: &mut [f64]", "");
+
 /// `rest_tangent_derivatives`, which has a default in the trait (an error) that models with
 /// parameters marked `sensitive` and `option tangents;` override.
 pub const REST_TANGENT_DERIVATIVES: Method = method(
@@ -219,7 +224,7 @@ pub struct Sizes {
     /// `option batch;`: the model overrides the methods of [`BATCH`]
     pub batch: bool,
     /// the parameters marked `sensitive` (field names): the model overrides
-    /// [`PARAMETER_TANGENTS`] and sets `SENSITIVE`
+    /// [`PARAMETER_TANGENTS`] and [`START_SENSITIVITIES`] and sets `SENSITIVE`
     pub sensitive: Vec<String>,
     /// the model overrides [`REST_TANGENT_DERIVATIVES`] (sensitive parameters and tangents)
     pub rest_derivatives: bool,
@@ -275,8 +280,12 @@ const BATCH_GENERATED: bool = {batch};
     let batch_methods = if *batch { &BATCH[..] } else { &[] };
     let sensitivity_methods = match (sensitive.is_empty(), rest_derivatives) {
         (true, _) => &[][..],
-        (false, false) => std::slice::from_ref(&PARAMETER_TANGENTS),
-        (false, true) => &[PARAMETER_TANGENTS, REST_TANGENT_DERIVATIVES][..],
+        (false, false) => &[PARAMETER_TANGENTS, START_SENSITIVITIES][..],
+        (false, true) => &[
+            PARAMETER_TANGENTS,
+            START_SENSITIVITIES,
+            REST_TANGENT_DERIVATIVES,
+        ][..],
     };
     let constraint_methods = match (constraint_sensitivity, constraint_rest_derivatives) {
         (false, _) => &[][..],

@@ -877,6 +877,12 @@ fn emit_scene(
         f.matrix(a, "dtau", dp);
         specs.push((f, Some("parameter_tangents (∂τ/∂p)")));
     }
+    if let Some((sq, sqd)) = &eq.start_sensitivities {
+        let mut f = FnSpec::new("__start_sensitivities", api::START_SENSITIVITIES.args);
+        f.matrix(a, "sq", sq);
+        f.matrix(a, "sqd", sqd);
+        specs.push((f, None));
+    }
     if let Some([dm, dc, dk]) = &eq.rest_tangent_derivatives {
         // the direction δq is passed as `qd`, the variables the matrices at rest are free of
         let mut f = FnSpec::new(
@@ -1189,6 +1195,7 @@ fn emit_scene(
             "rest_tangent_derivatives" => {
                 format!("self.__rest_tangent_derivatives({})", m.call()) + ";\nOk(())"
             }
+            "start_sensitivities" => format!("self.__start_sensitivities({})", m.call()),
             "constraint_parameter_tangents" => {
                 format!(
                     "self.params.__constraint_parameter_tangents(&self.charts, t, q, qd, qdd, lambda, {})",

@@ -74,6 +74,9 @@ pub struct SceneEquations {
     /// matrices at rest no longer contain) and block 1 + j the partial derivative by
     /// sensitive parameter j: what pole sensitivities need along the equilibria
     pub rest_tangent_derivatives: Option<[Matrix; 3]>,
+    /// ∂q₀/∂p and ∂qd₀/∂p (NQ × NS each) of the declared start, for the parameters marked
+    /// `sensitive`: where the sensitivities start
+    pub start_sensitivities: Option<(Matrix, Matrix)>,
     pub kinetic: ExprId,
     pub potential: ExprId,
     /// power of the non-conservative effects
@@ -173,6 +176,22 @@ impl SceneEquations {
                 })
                 .collect::<Matrix>()
         });
+        let start_sensitivities = (!sensitive.is_empty()).then(|| {
+            let of = |a: &mut crate::expr::Arena, start: &dyn Fn(usize) -> ExprId| {
+                (0..nd)
+                    .map(|d| {
+                        let e = start(d);
+                        sensitive
+                            .iter()
+                            .map(|&p| a.diff(e, Var::Param(p)))
+                            .collect()
+                    })
+                    .collect::<Matrix>()
+            };
+            let (q0, qd0): (Vec<ExprId>, Vec<ExprId>) =
+                sys.dofs.iter().map(|d| (d.q0, d.qd0)).unzip();
+            (of(a, &|d| q0[d]), of(a, &|d| qd0[d]))
+        });
         let rest_tangent_derivatives = match (&tangents, param_tangents.is_some()) {
             (Some((k, c)), true) => {
                 let rest = at_rest(a, nd);
@@ -212,6 +231,7 @@ impl SceneEquations {
             shared_parts: if shares { vec![0] } else { Vec::new() },
             param_tangents,
             rest_tangent_derivatives,
+            start_sensitivities,
             kinetic,
             potential,
             power,

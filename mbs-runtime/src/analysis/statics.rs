@@ -412,21 +412,14 @@ fn unconstrained<M: Model>(
         }
         iterations += 1;
         // backtracking on ‖h‖∞
-        let mut alpha = 1.0;
-        let accepted = loop {
+        let accepted = backtrack(|alpha| {
             trial.copy_from_slice(&q);
             for (c, &i) in free.iter().enumerate() {
                 trial[i] += alpha * delta[c];
             }
             let ok = forces(model, options.t, &trial, u, &mut ht).is_ok();
-            if ok && norm(&ht) < residual * (1.0 - 1e-4 * alpha) {
-                break true;
-            }
-            alpha *= 0.5;
-            if alpha < 1e-6 {
-                break false;
-            }
-        };
+            ok && norm(&ht) < residual * (1.0 - 1e-4 * alpha)
+        });
         if !accepted {
             // the forces cannot fall further: at their rounding when they are within the
             // tolerance, the correction then saying how far q may be
@@ -463,6 +456,18 @@ fn unconstrained<M: Model>(
         constraint_residual: 0.0,
         charts: Vec::new(),
     })
+}
+
+/// Newton's step scaled by α = 1, ½, ¼, … until `accept(α)` (false below α = 1e-6).
+fn backtrack(mut accept: impl FnMut(f64) -> bool) -> bool {
+    let mut alpha = 1.0;
+    while alpha >= 1e-6 {
+        if accept(alpha) {
+            return true;
+        }
+        alpha *= 0.5;
+    }
+    false
 }
 
 /// The largest |x_i|.
@@ -691,9 +696,8 @@ fn constrained<M: Model>(
         // backtracking on ‖F‖∞ + μ‖Φ‖∞, μ the same ratio of the blocks' sizes
         let merit = |st: &ConstrainedState| st.force_residual() + scale * st.constraint_residual();
         let current = merit(&st);
-        let mut alpha = 1.0;
         let (mut trial, mut trial_lambda) = (q.clone(), lambda.clone());
-        let accepted = loop {
+        let accepted = backtrack(|alpha| {
             trial.copy_from_slice(&q);
             for (c, &i) in free.iter().enumerate() {
                 trial[i] += alpha * delta[c];
@@ -701,17 +705,14 @@ fn constrained<M: Model>(
             for p in 0..nc {
                 trial_lambda[p] = lambda[p] + alpha * delta[nf + p];
             }
-            if let Ok(next) = ConstrainedState::new(model, t, &trial, u, &trial_lambda, free) {
-                if merit(&next) < current * (1.0 - 1e-4 * alpha) {
+            match ConstrainedState::new(model, t, &trial, u, &trial_lambda, free) {
+                Ok(next) if merit(&next) < current * (1.0 - 1e-4 * alpha) => {
                     st = next;
-                    break true;
+                    true
                 }
+                _ => false,
             }
-            alpha *= 0.5;
-            if alpha < 1e-6 {
-                break false;
-            }
-        };
+        });
         if !accepted {
             // the residuals cannot fall further: at their rounding when within the tolerances
             if small {

@@ -305,6 +305,81 @@ fn a_tilted_ellipsoid_at_an_edge_takes_the_shortest_way_out() {
     }
 }
 
+/// An ellipsoid elongated across a box's edge, pressed on it deeper than half its semi-axis
+/// across the edge: its shortest way out lies within the edge's cone at 26° from the top
+/// (15.3 mm), beside a largest separation over the whole circle that lies outside the cone.
+/// The edge was skipped and the top's depth taken (20 mm straight up), and 0.1 µm further
+/// out the edge's: a jump of the force in size and direction. Against the box's and the
+/// ellipsoid's support functions sampled over the normals across the edge (the best
+/// lies there: the centre is halfway along the edge and the axes are the box's).
+#[test]
+fn an_ellipsoid_pressed_deep_on_an_edge_leaves_by_its_shortest_way() {
+    let t = Terrain {
+        blocks: vec![Block {
+            min: [0.0, 0.0],
+            max: [1.0, 0.6],
+            height: 0.3,
+        }],
+        ground: false,
+        ..Terrain::default()
+    };
+    let r = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    let axes = [0.05, 0.03, 0.12];
+    // n = (0, cos θ, sin θ): s(θ) = n·(x − c) − h·|n| − √(nᵀQn), Q = diag(axes²)
+    let (c, h) = ([0.5, 0.3, 0.15], [0.5, 0.3, 0.15]);
+    let sep = |x: [f64; 3], th: f64| {
+        let (sn, cs) = th.sin_cos();
+        cs * (x[1] - c[1]) + sn * (x[2] - c[2])
+            - h[1] * cs.abs()
+            - h[2] * sn.abs()
+            - (axes[1] * axes[1] * cs * cs + axes[2] * axes[2] * sn * sn).sqrt()
+    };
+    let largest = |x: [f64; 3]| {
+        let k = 2_000_000;
+        let (mut best, mut arg) = (f64::NEG_INFINITY, 0.0);
+        for i in 0..k {
+            let th = 2.0 * std::f64::consts::PI * i as f64 / k as f64;
+            let s = sep(x, th);
+            if s > best {
+                (best, arg) = (s, th);
+            }
+        }
+        let mut step = 1e-5;
+        while step > 1e-13 {
+            let mut moved = false;
+            for d in [step, -step] {
+                if sep(x, arg + d) > best {
+                    (best, arg, moved) = (sep(x, arg + d), arg + d, true);
+                }
+            }
+            if !moved {
+                step *= 0.5;
+            }
+        }
+        (best, [0.0, arg.cos(), arg.sin()])
+    };
+    let mut depths = Vec::new();
+    for x in [[0.5, 0.6, 0.4], [0.5, 0.6000001, 0.4], [0.5, 0.59, 0.39]] {
+        let e = Ellipsoid {
+            centre: x,
+            rotation: &r,
+            axes,
+        };
+        let mut touches = Vec::new();
+        t.touches(&e, |x| touches.push(x));
+        let (s, n) = largest(x);
+        println!(
+            "centre {x:?}: largest separation {s:.6e} along {n:.4?}; the terrain's: {touches:.6?}"
+        );
+        assert_eq!(touches.len(), 1, "{touches:?}");
+        let got = touches[0];
+        assert!((got.depth + s).abs() < 1e-9, "{} against {}", got.depth, -s);
+        assert!(close(got.normal, n, 1e-6), "{:?} against {n:?}", got.normal);
+        depths.push(got.depth);
+    }
+    assert!((depths[0] - depths[1]).abs() < 1e-6, "{depths:?}");
+}
+
 /// R = Rx(θ) (columns: the body's axes in world axes).
 /// An ellipsoid with a NaN semi-axis or centre is not silently let through the terrain: it
 /// touches at a NaN depth, so its force is NaN and a run stops on it; a negative semi-axis

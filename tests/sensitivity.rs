@@ -26,15 +26,17 @@ mbs::multibody! {
 }
 
 mbs::multibody! {
-    /// A mass on a spring (ω = 10 rad/s) started at x0 with speed v0, both sensitive: x(t) =
+    /// A mass on a spring (ω = 10 rad/s) started at x0 with speed v0, both sensitive, and a
+    /// force input (zero unless a controller sets it): x(t) =
     /// x0 cos ωt + (v0/ω) sin ωt, so dx/dx0 = cos ωt and dx/dv0 = sin(ωt)/ω.
     pub model StartedSpring {
         param x0 = 0.1 sensitive; param v0 = 0.5 sensitive; param k = 100.0;
         option tangents;
         dof x = x0, qd = v0;
+        input push;
         body a { mass = 1.0; inertia = (0.01, 0.01, 0.01); }
         TOG[a] = Tdisp(x, 0, 0);
-        generalized_force(x, -k * x);
+        generalized_force(x, -k * x + push);
     }
 }
 
@@ -410,6 +412,41 @@ fn sensitivities_of_a_start_that_depends_on_the_parameters() {
             (sq - dq).abs() < 1e-8 && (sv - dv).abs() < 1e-7,
             "{sq} {sv}"
         );
+    }
+}
+
+/// A sampled controller's u depends on the parameters through the state, which the
+/// sensitivities do not differentiate: refused, where dq/dp came out without its feedback
+/// (3.5 times too large for u = −20 q on a spring).
+#[test]
+fn sensitivities_refuse_sampled_controllers() {
+    use mbs::{Inputs, Options, Scheme, Sensitivities, Simulation, State};
+    let model = Sensitivities::new(StartedSpring::default()).unwrap();
+    let inputs = Inputs::new().controller(0.01, |_: f64, _: &State, _: &mut [f64]| {});
+    let Err(e) = Simulation::with_inputs(model, Scheme::Dopri5, Options::default(), inputs) else {
+        panic!("a controller on sensitivities was accepted")
+    };
+    println!("{e}");
+    assert!(
+        matches!(
+            e.kind,
+            mbs::Failure::InvalidOption {
+                name: "controllers",
+                ..
+            }
+        ),
+        "{e}"
+    );
+    // the plain model takes it
+    let inputs = Inputs::new().controller(0.01, |_: f64, _: &State, _: &mut [f64]| {});
+    let plain = Simulation::with_inputs(
+        StartedSpring::default(),
+        Scheme::Dopri5,
+        Options::default(),
+        inputs,
+    );
+    if let Err(e) = plain {
+        panic!("{e}");
     }
 }
 

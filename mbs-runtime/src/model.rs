@@ -664,6 +664,10 @@ pub trait Model {
     /// the parameters marked `sensitive` in the model (`param k = 1e4 sensitive;`), in
     /// declaration order: the columns of [`Model::parameter_tangents`]
     const SENSITIVE: &'static [&'static str] = &[];
+    /// The parameters whose sensitivities are coordinates of this model: a
+    /// [`Sensitivities`](crate::Sensitivities) wrapper's, which treats the inputs as free of
+    /// them (a sampled controller's feedback would be left out of dq/dp); 0 otherwise.
+    const SENSITIVITY_BLOCKS: usize = 0;
 
     /// Names, sizes, formulation and op counts.
     fn info(&self) -> &'static ModelInfo;

@@ -16,7 +16,9 @@
 //! one Cholesky factorisation of M. Starts at s = ∂q₀/∂p, ṡ = ∂qd₀/∂p of the declared
 //! start ([`Model::start_sensitivities`], zero where the start is free of the parameter; it
 //! was zero always, and `dof x = x0;` with `param x0 sensitive` gave dx/dx0 = 0 throughout),
-//! completed on closed loops (below). The wrapped model's
+//! completed on closed loops (below). The inputs are taken as free of the parameters: u(t)
+//! given as a function of time is, a sampled controller's is not (its feedback through the
+//! state would be missing from dq/dp), and a simulation refuses controllers on a wrapper. The wrapped model's
 //! iteration matrices come from finite differences (its tangents would need second
 //! derivatives).
 //!
@@ -390,6 +392,7 @@ impl<M: Model + 'static> Model for Sensitivities<M> {
     const NC: usize = M::NC;
     /// block by block with one Cholesky factorisation of the wrapped M
     const FORWARD_DYNAMICS_GENERATED: bool = true;
+    const SENSITIVITY_BLOCKS: usize = M::SENSITIVE.len();
 
     fn info(&self) -> &'static ModelInfo {
         self.info

@@ -108,6 +108,18 @@ impl<M: Model + 'static> Simulation<M> {
         options: Options,
         inputs: Inputs,
     ) -> Result<Simulation<M>, SimError> {
+        if M::SENSITIVITY_BLOCKS > 0 && !inputs.controllers.is_empty() {
+            // u(t) alone is free of the parameters; a controller's u is not
+            return Err(refused(
+                &model,
+                Failure::InvalidOption {
+                    name: "controllers",
+                    value: format!("{} sampled controllers", inputs.controllers.len()),
+                    reason: "sensitivities take the inputs as free of the parameters, and a controller's feedback through the state would be left out of dq/dp: write the control law in the model (`generalized_force`), or differentiate whole runs",
+                },
+                options.t0,
+            ));
+        }
         let run = Run::new(model, scheme, options, inputs)?;
         Ok(Simulation {
             run,

@@ -71,6 +71,9 @@ fn curves_meet_their_anchor_points_and_sympy() {
     }
     assert_eq!(muscle::excitation_for_rate(0.5, 1e3, [0.015, 0.06]), 1.0);
     assert_eq!(muscle::excitation_for_rate(0.5, -1e3, [0.015, 0.06]), 0.0);
+    // a NaN asked is a NaN answered, not an excitation of 0
+    assert!(muscle::excitation_for_rate(f64::NAN, 1.0, [0.015, 0.06]).is_nan());
+    assert!(muscle::excitation_for_rate(0.5, f64::NAN, [0.015, 0.06]).is_nan());
     let soleus = Musculotendon::new("soleus", 5137.0, 0.05, 0.25, 0.43633231);
     let vasti = Musculotendon::new("vasti", 5000.0, 0.087, 0.136, 0.05235988);
     for (unit, l, a, lm, force, rate) in [

@@ -200,11 +200,15 @@ pub struct SpringDamper {
 }
 
 impl SpringDamper {
-    /// Applies the tension between `a` and `b`; returns it.
+    /// Applies the tension between `a` and `b`; returns it (0 where the anchors coincide:
+    /// it returned F0 − k l0 there, a tension it did not apply).
     pub fn apply(&self, e: &mut Effort, a: Anchor, b: Anchor) -> f64 {
         let ((pa, va), (pb, vb)) = (a.state(e), b.state(e));
         let d = sub(pb, pa);
         let l = dot(d, d).sqrt();
+        if l == 0.0 {
+            return 0.0;
+        }
         let u = unit_or_zero(d, l);
         let ldot = dot(u, sub(vb, va));
         let tension = self.preload + self.k * (l - self.l0) + self.c * ldot;

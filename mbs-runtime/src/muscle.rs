@@ -108,8 +108,13 @@ pub fn activation_rate(e: f64, a: f64, [tau_a, tau_d]: [f64; 2]) -> f64 {
 /// The excitation in [0, 1] under which activation `a` changes at `rate` (1/s): the
 /// activation dynamics of [`activation_rate`] inverted, as an excitation pattern that must
 /// make the activations follow a given course needs (ȧ rises with the excitation: found by
-/// bisection, to 1e-15). Where no excitation gives that rate, the nearest bound, 0 or 1.
+/// bisection, to 1e-15). Where no excitation gives that rate, the nearest bound, 0 or 1;
+/// NaN where `a` or `rate` is NaN (the bisection fell to an excitation of 0 there, a valid
+/// looking answer to a question that had none).
 pub fn excitation_for_rate(a: f64, rate: f64, times: [f64; 2]) -> f64 {
+    if a.is_nan() || rate.is_nan() {
+        return f64::NAN;
+    }
     let (mut low, mut high) = (0.0, 1.0);
     if activation_rate(low, a, times) >= rate {
         return low;

@@ -380,6 +380,50 @@ fn an_ellipsoid_pressed_deep_on_an_edge_leaves_by_its_shortest_way() {
     assert!((depths[0] - depths[1]).abs() < 1e-6, "{depths:?}");
 }
 
+/// A box entered with its corners swapped, or of no height, is not silently left out: the
+/// heights are NaN and a point touches it at a NaN depth (its force NaN, which stops a run),
+/// where a point inside the box meant was not touched at all.
+#[test]
+fn a_box_that_is_no_box_is_not_left_out_silently() {
+    for b in [
+        Block {
+            min: [1.0, 0.0],
+            max: [0.0, 0.6],
+            height: 0.3,
+        },
+        Block {
+            min: [0.0, 0.0],
+            max: [1.0, 0.6],
+            height: 0.0,
+        },
+    ] {
+        let t = Terrain {
+            blocks: vec![b],
+            ..Terrain::default()
+        };
+        assert!(t.height([0.5, 0.3]).is_nan(), "{b:?}");
+        assert!(t.planned_height([0.5, 0.3], 0.01).is_nan(), "{b:?}");
+        let (depth, _) = t.penetration([0.5, 0.3, 0.2]).unwrap();
+        assert!(depth.is_nan(), "{b:?}: {depth}");
+        let f = t.point_force([0.5, 0.3, 0.2], [0.0; 3]);
+        assert!(f.iter().any(|x| x.is_nan()), "{b:?}: {f:?}");
+    }
+    // the same box with its corners in order carries the point
+    let t = Terrain {
+        blocks: vec![Block {
+            min: [0.0, 0.0],
+            max: [1.0, 0.6],
+            height: 0.3,
+        }],
+        ..Terrain::default()
+    };
+    let (depth, n) = t.penetration([0.5, 0.3, 0.2]).unwrap();
+    assert!(
+        (depth - 0.1).abs() < 1e-15 && n == [0.0, 0.0, 1.0],
+        "{depth} {n:?}"
+    );
+}
+
 /// R = Rx(θ) (columns: the body's axes in world axes).
 /// An ellipsoid with a NaN semi-axis or centre is not silently let through the terrain: it
 /// touches at a NaN depth, so its force is NaN and a run stops on it; a negative semi-axis

@@ -37,12 +37,25 @@ use crate::elements::{cross, dot};
 type V3 = [f64; 3];
 
 /// A box standing on the ground: its footprint along the two horizontal axes (in increasing
-/// order of axis) and its height (m).
+/// order of axis) and its height (m). A box that is no box (min ≥ max along an axis, a
+/// height ≤ 0, or a bound not finite) makes the terrain's heights NaN and every ellipsoid
+/// and point touch it at a NaN depth, so that a run stops on its first contact force: it
+/// vanished silently, and what was meant to stand on it fell through.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Block {
     pub min: [f64; 2],
     pub max: [f64; 2],
     pub height: f64,
+}
+
+impl Block {
+    /// Whether the box is one: min < max along both axes, a height > 0, all finite.
+    pub fn is_box(&self) -> bool {
+        (0..2).all(|j| {
+            self.min[j] < self.max[j] && self.min[j].is_finite() && self.max[j].is_finite()
+        }) && self.height > 0.0
+            && self.height.is_finite()
+    }
 }
 
 /// The penalty law of a contact: F_n = pos(k δ^e (1 + d δ̇) + c δ̇) in contact (δ > 0) and
@@ -232,7 +245,7 @@ impl Terrain {
     /// The height of the terrain's top above the horizontal position `p`: the highest box
     /// there, or the ground; NaN where `p` is not a number (not the ground's height).
     pub fn height(&self, p: [f64; 2]) -> f64 {
-        if p.iter().any(|x| x.is_nan()) {
+        if p.iter().any(|x| x.is_nan()) || !self.blocks.iter().all(Block::is_box) {
             return f64::NAN;
         }
         self.blocks
@@ -248,7 +261,8 @@ impl Terrain {
     /// a negative or NaN width, or a NaN position, gives NaN (a negative width turned the
     /// ramps inside out, and a NaN one gave the ground's height everywhere).
     pub fn planned_height(&self, p: [f64; 2], width: f64) -> f64 {
-        if !(width >= 0.0) || p.iter().any(|x| x.is_nan()) {
+        if !(width >= 0.0) || p.iter().any(|x| x.is_nan()) || !self.blocks.iter().all(Block::is_box)
+        {
             return f64::NAN;
         }
         if width == 0.0 {
@@ -302,6 +316,14 @@ impl Terrain {
         let reach = e.axes.iter().map(|a| a.abs()).fold(0.0, f64::max);
         let x = e.centre;
         for b in &self.blocks {
+            if !b.is_box() {
+                touch(Touch {
+                    point: e.centre,
+                    depth: f64::NAN,
+                    normal: n,
+                });
+                continue;
+            }
             if x[up] - reach >= b.height
                 || x[u] + reach <= b.min[0]
                 || x[u] - reach >= b.max[0]
@@ -428,7 +450,8 @@ impl Terrain {
     pub fn penetration(&self, p: V3) -> Option<(f64, V3)> {
         let mut best: Option<(f64, V3)> = None;
         self.touches(&Ellipsoid::point(p), |t| {
-            if best.is_none_or(|(d, _)| t.depth > d) {
+            // the deepest, a NaN depth before any
+            if best.is_none_or(|(d, _)| !(t.depth <= d) && !d.is_nan()) {
                 best = Some((t.depth, t.normal));
             }
         });

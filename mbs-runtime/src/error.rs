@@ -400,7 +400,9 @@ pub enum Failure {
         if *floor { " (the last run took no more steps at a tenth of the tolerance: rtol does not set this scheme's step here, and the runs' difference says nothing of the error)" } else { "" }, cause.as_ref().map(|c| format!(" (the next run failed: {c})")).unwrap_or_default()
     )]
     GlobalToleranceNotMet {
-        /// the last estimate, in the user's tolerance (1 = met)
+        /// the last estimate, in the user's tolerance (1 = met): of the run before the one
+        /// kept, whose own error no tighter run checked (it read as the kept run's, which
+        /// at a tighter rtol is likely smaller)
         estimate: f64,
         /// the local rtol of the most accurate complete run (the trajectory kept)
         rtol: f64,
@@ -418,7 +420,9 @@ pub enum Failure {
 /// The estimate of a [`Failure::GlobalToleranceNotMet`], in words.
 fn estimated(estimate: f64) -> String {
     if estimate.is_finite() {
-        format!("the estimated error of the trajectory is still {estimate:.3} of the tolerance")
+        format!(
+            "the last error estimated, of the run before the most accurate (which no tighter run checked), was {estimate:.3} of the tolerance"
+        )
     } else {
         "the error of the trajectory could not be estimated".to_string()
     }

@@ -306,7 +306,7 @@ fn a_tilted_ellipsoid_at_an_edge_takes_the_shortest_way_out() {
 }
 
 /// An ellipsoid elongated across a box's edge, pressed on it deeper than half its semi-axis
-/// across the edge: its shortest way out lies within the edge's cone at 26° from the top
+/// across the edge: its shortest way out lies within the edge's cone, 26° above the side's normal
 /// (15.3 mm), beside a largest separation over the whole circle that lies outside the cone.
 /// The edge was skipped and the top's depth taken (20 mm straight up), and 0.1 µm further
 /// out the edge's: a jump of the force in size and direction. Against the box's and the

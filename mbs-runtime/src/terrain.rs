@@ -531,7 +531,7 @@ impl Terrain {
 /// is one of the maxima of s; where it lies outside the cone, another inside it may be the
 /// cone's largest (an ellipsoid elongated across the edge pressed on it deeper than half
 /// its semi-axis: the edge was skipped, and the top's depth taken, 20 mm where the
-/// shortest way out is 15.3 mm at 26° from it).
+/// shortest way out is 15.3 mm, 26° above the side's normal).
 fn cone_maxima(
     p: [f64; 2],
     [a, b, c]: [f64; 3],

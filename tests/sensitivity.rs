@@ -335,21 +335,26 @@ fn end_state_differences<M: Model + Default + 'static>(t_end: f64) -> Vec<(Vec<f
         .collect()
 }
 
-#[test]
-fn sensitivities_integrated_with_the_motion_match_central_differences() {
-    use mbs::{Options, Output, Scheme, Sensitivities, StepControl, simulate};
-    let t_end = 2.0;
-    let reference = end_state_differences::<SprungArm>(t_end);
-    let options = Options {
+/// Runs with sensitivities to `t_end` at rtol 1e-10, atol 1e-12, their last state only.
+fn last_state_at(t_end: f64) -> mbs::Options {
+    mbs::Options {
         t_end,
-        step: StepControl::Adaptive {
+        step: mbs::StepControl::Adaptive {
             rtol: 1e-10,
             atol: 1e-12,
             h0: None,
         },
-        output: Output::Last,
-        ..Options::default()
-    };
+        output: mbs::Output::Last,
+        ..mbs::Options::default()
+    }
+}
+
+#[test]
+fn sensitivities_integrated_with_the_motion_match_central_differences() {
+    use mbs::{Scheme, Sensitivities, simulate};
+    let t_end = 2.0;
+    let reference = end_state_differences::<SprungArm>(t_end);
+    let options = last_state_at(t_end);
     for scheme in [
         Scheme::Dopri5,
         Scheme::Radau5,
@@ -384,18 +389,9 @@ fn sensitivities_integrated_with_the_motion_match_central_differences() {
 /// 0.284 at t = 0.5 s).
 #[test]
 fn sensitivities_of_a_start_that_depends_on_the_parameters() {
-    use mbs::{Options, Output, Scheme, Sensitivities, StepControl, simulate};
+    use mbs::{Scheme, Sensitivities, simulate};
     let t_end = 0.5;
-    let options = Options {
-        t_end,
-        step: StepControl::Adaptive {
-            rtol: 1e-10,
-            atol: 1e-12,
-            h0: None,
-        },
-        output: Output::Last,
-        ..Options::default()
-    };
+    let options = last_state_at(t_end);
     let model = Sensitivities::new(StartedSpring::default()).unwrap();
     let (tr, _) = simulate(model, Scheme::Dopri5, options).unwrap();
     let last = tr.len() - 1;

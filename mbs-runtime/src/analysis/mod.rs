@@ -119,10 +119,10 @@ fn inverse_iterations(r: f64, otherwise: usize) -> usize {
 /// disagree in some entry by more than 1e-6 of it (their truncation error) and more than its
 /// rounding (1000 ε of the values over the step), at most 12 times and while they come to
 /// agree better; where no two agree, the difference of the pair that disagrees least, its
-/// larger step's. The first step alone, a
-/// unit's part in 6·10⁶ of a coordinate of size 1 or less, misses nonlinearities on a smaller
-/// scale: a friction force μN tanh(v/v_ε) with v_ε = 1e-6 m/s gave a sixth of its damping at
-/// v = 0. Smooth functions keep the first step's difference, at twice its evaluations.
+/// larger step's. The first step alone, a unit's part in 6·10⁶ of a coordinate of size 1 or
+/// less, misses nonlinearities on a smaller scale: a friction force μN tanh(v/v_ε) with
+/// v_ε = 1e-6 m/s gave a sixth of its damping at v = 0. Smooth functions keep the first
+/// step's difference, at twice its evaluations.
 fn central_difference<E>(
     x: f64,
     out: &mut [f64],

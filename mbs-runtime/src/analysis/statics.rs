@@ -43,8 +43,8 @@ pub struct StaticsOptions {
     pub constraint_tolerance: f64,
     /// and Newton's correction at `q` moves no free coordinate by more than this (m or rad),
     /// or than 100 ε of its value, default 1e-10: a small force does not mean a near
-    /// equilibrium where the stiffness is small too (a hairspring of 5e-7 N·m/rad started
-    /// 1 mrad off has a force of 5e-10 N·m, which the force test alone accepted as converged)
+    /// equilibrium where the stiffness is small too (a spring of 5e-7 N/m started 1 mm off
+    /// pulls with 5e-10 N, which the force test alone accepted as converged)
     pub step_tolerance: f64,
     /// Newton iterations before `NotConverged` (default 50)
     pub max_iterations: usize,
@@ -405,7 +405,7 @@ fn unconstrained<M: Model>(
             *d = h[i];
         }
         lu.solve(&mut delta);
-        let size = largest(&delta);
+        let size = reduce::worst(&delta).0;
         if small && (within_step(&delta, &q, free, options) || iterations == options.max_iterations)
         {
             break Some(size);
@@ -468,11 +468,6 @@ fn backtrack(mut accept: impl FnMut(f64) -> bool) -> bool {
         alpha *= 0.5;
     }
     false
-}
-
-/// The largest |x_i|.
-fn largest(x: &[f64]) -> f64 {
-    x.iter().fold(0.0, |m, v| m.max(v.abs()))
 }
 
 /// Whether Newton's correction δ (over the free coordinates) moves none of them by more than
@@ -613,7 +608,9 @@ fn constrained<M: Model>(
     .as_slice()
     .to_vec();
     st.set_lambda(&lambda, free);
+    // K and ∂(Bᵀλ)/∂q at the last (q, λ) Newton was at, which the stability reads
     let mut k = vec![0.0; n * n];
+    let mut g;
     let mut lu = Lu::<f64>::new(nf + nc);
     let mut iterations = 0;
     let converged = |st: &ConstrainedState| {
@@ -633,7 +630,7 @@ fn constrained<M: Model>(
             });
         }
         stiffness(model, t, &q, u, options.stiffness, &mut k)?;
-        let g = reduce::constraint_tangent(model, t, &q, &lambda)?;
+        g = reduce::constraint_tangent(model, t, &q, &lambda)?;
         // J = [−K + G, s B_fᵀ; s B_f, 0] over the free coordinates, the constraints' rows and
         // columns scaled by s to the size of the stiffness (and their unknowns δλ/s): a
         // stiff loop's Schur complement B K⁻¹ Bᵀ leaves pivots the factorisation takes for
@@ -667,13 +664,14 @@ fn constrained<M: Model>(
             if small {
                 break None;
             }
-            let at = Rest {
-                t,
-                q: &q,
-                u,
-                lambda: &lambda,
-            };
-            return Err(singular_reduced(model, at, options, free, &st.b, s.rcond)?);
+            return Err(singular_reduced(
+                model,
+                options,
+                free,
+                &st.b,
+                (&k, &g),
+                s.rcond,
+            )?);
         }
         for (d, v) in delta.iter_mut().zip(st.f.iter().chain(&st.phi)) {
             *d = -v;
@@ -685,7 +683,7 @@ fn constrained<M: Model>(
         for d in &mut delta[nf..] {
             *d *= scale;
         }
-        let size = largest(&delta[..nf]);
+        let size = reduce::worst(&delta[..nf]).0;
         if small
             && (within_step(&delta[..nf], &q, free, options)
                 || iterations == options.max_iterations)
@@ -730,13 +728,8 @@ fn constrained<M: Model>(
     };
     rank(&st.b)?;
     // stability from the reduced stiffness Nᵀ(K − G)N, N orthonormal over the free coordinates
-    let at = Rest {
-        t,
-        q: &q,
-        u,
-        lambda: &lambda,
-    };
-    let kr = reduced_stiffness(model, at, options, free, &st.b)?;
+    // (k and g are at q and λ)
+    let kr = reduced_stiffness(model, options, free, &st.b, (&k, &g))?;
     let exact = exact_stiffness(model, options.stiffness);
     let (stiffness_eigenvalues, stability) = classify(&kr.0, exact);
     Ok(Equilibrium {
@@ -754,29 +747,17 @@ fn constrained<M: Model>(
     })
 }
 
-/// A configuration at rest of a constrained model: time, positions, inputs, multipliers.
-#[derive(Clone, Copy)]
-struct Rest<'a> {
-    t: f64,
-    q: &'a [f64],
-    u: &'a [f64],
-    lambda: &'a [f64],
-}
-
-/// The symmetrised reduced stiffness Nᵀ(K − ∂(Bᵀλ)/∂q)N over the free coordinates, and N
-/// (free × dof, orthonormal).
+/// The symmetrised reduced stiffness Nᵀ(K − G)N over the free coordinates, and N (free ×
+/// dof, orthonormal), from K and G = ∂(Bᵀλ)/∂q (`k`, column-major NQ × NQ, and `g`) at the
+/// same q and λ.
 fn reduced_stiffness<M: Model>(
     model: &M,
-    at: Rest,
     options: &StaticsOptions,
     free: &[usize],
     b: &DMatrix<f64>,
+    (k, g): (&[f64], &DMatrix<f64>),
 ) -> Result<(DMatrix<f64>, DMatrix<f64>), AnalysisError> {
-    let Rest { t, q, u, lambda } = at;
     let n = M::NQ;
-    let mut k = vec![0.0; n * n];
-    stiffness(model, t, q, u, options.stiffness, &mut k)?;
-    let g = reduce::constraint_tangent(model, t, q, lambda)?;
     let kf = DMatrix::from_fn(free.len(), free.len(), |r, c| {
         let (i, j) = (free[r], free[c]);
         k[i + n * j] - g[(i, j)]
@@ -801,13 +782,13 @@ fn reduced_stiffness<M: Model>(
 /// named by the coordinates that move most along it.
 fn singular_reduced<M: Model>(
     model: &M,
-    at: Rest,
     options: &StaticsOptions,
     free: &[usize],
     b: &DMatrix<f64>,
+    kg: (&[f64], &DMatrix<f64>),
     rcond: f64,
 ) -> Result<AnalysisError, AnalysisError> {
-    let (kr, basis) = reduced_stiffness(model, at, options, free, b)?;
+    let (kr, basis) = reduced_stiffness(model, options, free, b, kg)?;
     let eig = nalgebra::SymmetricEigen::new(kr);
     let k = (0..eig.eigenvalues.len())
         .min_by(|&i, &j| {

@@ -166,31 +166,23 @@ impl SceneEquations {
             .filter(|&i| sys.params[i].sensitive)
             .map(|i| i as u16)
             .collect();
-        let param_tangents = (!sensitive.is_empty()).then(|| {
-            tau.iter()
-                .map(|&t| {
+        // ∂e/∂p of each expression e (a row each) by the sensitive parameters
+        let by_params = |a: &mut Arena, exprs: &[ExprId]| -> Matrix {
+            exprs
+                .iter()
+                .map(|&e| {
                     sensitive
                         .iter()
-                        .map(|&p| a.diff(t, Var::Param(p)))
+                        .map(|&p| a.diff(e, Var::Param(p)))
                         .collect()
                 })
-                .collect::<Matrix>()
-        });
+                .collect()
+        };
+        let param_tangents = (!sensitive.is_empty()).then(|| by_params(a, &tau));
         let start_sensitivities = (!sensitive.is_empty()).then(|| {
-            let of = |a: &mut crate::expr::Arena, start: &dyn Fn(usize) -> ExprId| {
-                (0..nd)
-                    .map(|d| {
-                        let e = start(d);
-                        sensitive
-                            .iter()
-                            .map(|&p| a.diff(e, Var::Param(p)))
-                            .collect()
-                    })
-                    .collect::<Matrix>()
-            };
             let (q0, qd0): (Vec<ExprId>, Vec<ExprId>) =
                 sys.dofs.iter().map(|d| (d.q0, d.qd0)).unzip();
-            (of(a, &|d| q0[d]), of(a, &|d| qd0[d]))
+            (by_params(a, &q0), by_params(a, &qd0))
         });
         let rest_tangent_derivatives = match (&tangents, param_tangents.is_some()) {
             (Some((k, c)), true) => {

@@ -415,7 +415,8 @@
 //! statements they produce are exactly those one would write out, so the generated code is
 //! the same. The range of a loop is made of integers, loop variables and integer part
 //! arguments (not parameters, which change at run time). A part's arguments may be integers
-//! (indices), scalar expressions (`0.4`, `-l / 2`), transform products (a mounting
+//! (indices; integer arithmetic that does not divide, `3 / 2`, is the number 1.5 where a
+//! number goes, as the statement written out would be), scalar expressions (`0.4`, `-l / 2`), transform products (a mounting
 //! transform, `TOG[base] * Trotz(PI)`, as the start of a product) and names (`Leg(0, base)`);
 //! an argument of several tokens is substituted in parentheses. Parts may instantiate other
 //! parts and contain loops.

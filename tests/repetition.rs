@@ -65,6 +65,32 @@ mbs::multibody! {
 /// coordinate x even when called from `k(x)`: f(3) + 10 k(5) = 3·1 + 10 (2x + 5). Names
 /// were bound for the whole of a call (dynamic scope): `half` became 3/2 for every use and
 /// `g(2.0)` read k's argument, 4.5 + 10 (2·5 + 5) = 154.5 at any x.
+mbs::multibody! {
+    /// Three sliders pushed by a part's argument: a number written as integer arithmetic
+    /// that does not divide (`3 / 2`, `i / 2`) is the real number the statement written out
+    /// would give.
+    model HalfPushes {
+        part Push(k, f) {
+            dof x[k] = 0.0;
+            body b[k] { mass = 1.0; inertia = (1, 1, 1); }
+            TOG[b[k]] = Tdisp(x[k], 0, 0);
+            generalized_force(x[k], f);
+        }
+        Push(0, 3 / 2);
+        for i in 1..3 { Push(i, i / 2 + 4 / 2); }
+    }
+}
+
+/// A part's integer arguments were evaluated in integers wherever they were pasted: `3 / 2`
+/// pushed with 1 N, where `generalized_force(x, 3 / 2)` pushes with 1.5.
+#[test]
+fn a_part_s_argument_that_does_not_divide_is_a_real_number() {
+    let model = HalfPushes::default();
+    let (mut m, mut h) = (vec![0.0; 9], vec![0.0; 3]);
+    model.dynamics(0.0, &[0.0; 3], &[0.0; 3], &[], &mut m, &mut h);
+    assert_eq!(h, [1.5, 2.5, 3.0]);
+}
+
 #[test]
 fn inline_functions_see_their_own_arguments_and_the_models_names() {
     let model = Scoped::default();

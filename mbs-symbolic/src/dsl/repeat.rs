@@ -602,7 +602,7 @@ impl Expander {
             let tokens = self.substitute(arg.into_iter().collect(), env, origin);
             let b = match syn::parse2::<syn::Expr>(tokens.clone())
                 .ok()
-                .and_then(|e| eval(&e).ok())
+                .and_then(|e| exact(&e))
             {
                 Some(v) => Binding::Int(v),
                 None => Binding::Tokens(tokens.clone()),
@@ -920,6 +920,39 @@ fn eval(e: &syn::Expr) -> Result<i64, (Span, String)> {
             ),
         )),
     }
+}
+
+/// The integer value of `e` when integer arithmetic and real arithmetic agree on it (a part's
+/// argument bound as a number); `None` when a division has a remainder (`3 / 2`): the
+/// argument is then pasted as its tokens, so that in a scalar position it is 1.5, as the
+/// statement written out would be, where an integer binding made it 1.
+fn exact(e: &syn::Expr) -> Option<i64> {
+    use syn::{BinOp, Expr, Lit};
+    fn real(e: &Expr) -> Option<f64> {
+        match e {
+            Expr::Lit(l) => match &l.lit {
+                Lit::Int(i) => i.base10_parse::<f64>().ok(),
+                _ => None,
+            },
+            Expr::Paren(p) => real(&p.expr),
+            Expr::Group(g) => real(&g.expr),
+            Expr::Unary(u) if matches!(u.op, syn::UnOp::Neg(_)) => real(&u.expr).map(|x| -x),
+            Expr::Binary(b) => {
+                let (x, y) = (real(&b.left)?, real(&b.right)?);
+                match b.op {
+                    BinOp::Add(_) => Some(x + y),
+                    BinOp::Sub(_) => Some(x - y),
+                    BinOp::Mul(_) => Some(x * y),
+                    BinOp::Div(_) => Some(x / y),
+                    BinOp::Rem(_) => Some(x % y),
+                    _ => None,
+                }
+            }
+            _ => None,
+        }
+    }
+    let v = eval(e).ok()?;
+    (real(e)? == v as f64).then_some(v)
 }
 
 impl Expander {

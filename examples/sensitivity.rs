@@ -160,7 +160,7 @@ fn motion<M: Model + Default + 'static>(t_end: f64) {
         reference.push(d);
     }
     println!(
-        "\n{}: dq(t = {t_end} s)/dp for {} at rtol 1e-8 (motion and sensitivities under one error control), best of 5:",
+        "\n{}: dq(t = {t_end} s)/dp for {} at rtol 1e-8 (the error test the largest of the motion's and each parameter's sensitivities' norms), best of 5:",
         M::default().info().name,
         M::SENSITIVE.join(", ")
     );

@@ -12,7 +12,10 @@
 //! and the generated ∂τ/∂p. [`Sensitivities`] wraps a model into one whose coordinates are
 //! (q, s₁, …, s_NS), block-diagonal mass matrix diag(M, …, M) and forces (h, h₁, …, h_NS), so
 //! every scheme integrates the motion and its sensitivities together, with its error control
-//! over both (as CVODES's "full" error control); its forward dynamics solves every block with
+//! over both (as CVODES's "full" error control: the error norm is the largest of the
+//! motion's and each parameter's sensitivities' own, so adding sensitivities never loosens
+//! the motion's control, which one RMS norm over them all did by √(1 + NS) where the
+//! sensitivities' errors were small); its forward dynamics solves every block with
 //! one Cholesky factorisation of M. Starts at s = ∂q₀/∂p, ṡ = ∂qd₀/∂p of the declared
 //! start ([`Model::start_sensitivities`], zero where the start is free of the parameter; it
 //! was zero always, and `dof x = x0;` with `param x0 sensitive` gave dx/dx0 = 0 throughout),

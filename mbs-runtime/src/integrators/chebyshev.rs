@@ -506,6 +506,7 @@ impl Stepper for Chebyshev {
         let tol = Tolerances {
             rtol: tol.rtol * f,
             atol: tol.atol * f,
+            groups: tol.groups,
         };
         let norm = tol.norm(&self.err, &self.y0, &self.y1, self.y0.len() / 2);
         self.test = norm;

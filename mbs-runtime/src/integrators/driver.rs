@@ -200,17 +200,19 @@ impl Run {
         let names = Names::of(&model);
         validate(&model, &scheme, &options, &inputs)
             .map_err(|e| names.failure_at_start(e, options.t0, Stats::default()))?;
-        Run::start(Box::new(model), names, scheme, options, inputs)
+        let groups = 1 + M::SENSITIVITY_BLOCKS;
+        Run::start(Box::new(model), names, scheme, options, inputs, groups)
     }
 
     /// From validated options: a consistent start, the scheme started on it, the outputs
-    /// at t₀.
+    /// at t₀; `groups` those of the error norm (`Tolerances::groups`).
     fn start(
         model: Box<dyn OwnedModel>,
         names: Names,
         scheme: Scheme,
         options: Options,
         inputs: Inputs,
+        groups: usize,
     ) -> Result<Run, SimError> {
         let early = |kind: Failure, stats: Stats| names.failure_at_start(kind, options.t0, stats);
         let (n, nc, nframes) = (model.nq(), model.nc(), model.nframes());
@@ -239,7 +241,7 @@ impl Run {
                 Ok(assembly)
             });
         let assembly = start.map_err(|e| early(e, problem.stats.clone()))?;
-        let ctl = control(&options);
+        let ctl = control(&options, groups);
         let mut stepper = stepper_for(&scheme, n);
         if let Err(e) = stepper.start(&mut problem, &cur, &ctl) {
             return Err(early(e, problem.stats.clone()));
@@ -253,7 +255,11 @@ impl Run {
             StepControl::Adaptive { h0: Some(h0), .. } => h0,
             StepControl::Adaptive { rtol, atol, .. } => initial_step(
                 &cur,
-                Tolerances { rtol, atol },
+                Tolerances {
+                    rtol,
+                    atol,
+                    groups: 1,
+                },
                 scheme.order(),
                 StepBounds::of(&options),
                 |t, q, qd, qdd| problem.accel(t, q, qd, qdd).is_ok(),
@@ -969,8 +975,9 @@ fn first_sample(
     Ok(())
 }
 
-/// Step control and Newton settings from the options.
-fn control(options: &Options) -> Control {
+/// Step control and Newton settings from the options; `groups` those of the error norm (the
+/// motion, and each parameter's sensitivities).
+fn control(options: &Options, groups: usize) -> Control {
     let newton = NewtonTol {
         atol: options.newton.atol,
         rtol: options.newton.rtol,
@@ -981,7 +988,7 @@ fn control(options: &Options) -> Control {
     let (adaptive, newton) = match options.step {
         StepControl::Fixed { .. } => (None, newton),
         StepControl::Adaptive { rtol, atol, .. } => (
-            Some(Tolerances { rtol, atol }),
+            Some(Tolerances { rtol, atol, groups }),
             NewtonTol {
                 atol,
                 rtol,

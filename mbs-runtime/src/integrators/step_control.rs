@@ -21,10 +21,18 @@ pub(crate) const ROUNDING: f64 = 100.0;
 
 /// Relative and absolute tolerance of the local error: a component y_i of error e_i counts as
 /// e_i / (atol + rtol·|y_i|).
+///
+/// `groups` > 1 splits the positions and the velocities into that many equal groups, each
+/// normed on its own, and the norm is the largest of theirs (as CVODES's error control with
+/// sensitivities): a model with forward sensitivities ([`crate::Sensitivities`]) is its motion
+/// and one group per parameter. One RMS norm over them all divided the motion's error by
+/// √(1 + NS) where the sensitivities' errors are small against their weights, so that adding
+/// sensitivities loosened the control of the motion itself.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Tolerances {
     pub rtol: f64,
     pub atol: f64,
+    pub groups: usize,
 }
 
 impl Tolerances {
@@ -39,7 +47,7 @@ impl Tolerances {
     pub fn transformed(self, c: f64, e: f64) -> Tolerances {
         Tolerances {
             rtol: (c * self.rtol.powf(e)).max(Self::transformed_floor(self.rtol)),
-            atol: self.atol,
+            ..self
         }
     }
 
@@ -86,38 +94,59 @@ impl Tolerances {
     /// separate vectors does not copy it into one.
     pub fn norm_of_blocks(&self, blocks: [(&[f64], &[f64], &[f64]); 3]) -> ErrorNorm {
         let (rtol, atol) = (self.rtol, self.atol);
-        let (mut s, mut floored) = (0.0, false);
+        let groups = self.groups.max(1);
+        // the part of block `b` that belongs to group `g`: positions and velocities split
+        // into `groups` equal parts when they divide; anything else is group 0's
+        let part = |b: usize, g: usize| {
+            let len = blocks[b].0.len();
+            if groups > 1 && b < 2 && len % groups == 0 {
+                let k = len / groups;
+                g * k..(g + 1) * k
+            } else if g == 0 {
+                0..len
+            } else {
+                0..0
+            }
+        };
+        let (mut value, mut nan, mut floored) = (0.0f64, false, false);
         let mut top = Argmax::default();
-        let mut floors = [0.0; 3];
-        for (b, &(e, y0, y1)) in blocks.iter().enumerate() {
-            let len = e.len();
-            let (y0, y1) = (&y0[..len], &y1[..len]);
-            let largest = y0.iter().chain(y1).fold(0.0f64, |m, y| m.max(y.abs()));
-            let floor = Self::transformed_floor(rtol) * largest;
-            floors[b] = floor;
-            // the block's largest term as `Argmax` takes it (the first NaN, else the first of
-            // the largest), chosen without a branch: the terms come in no order a branch
-            // predictor could learn
-            let (mut best, mut at) = (-1.0f64, 0);
-            for i in 0..len {
-                let magnitude = y0[i].abs().max(y1[i].abs());
-                let w = atol + rtol * magnitude;
-                floored |= w < floor;
-                let weight = w.max(floor);
-                let term = (e[i] / weight) * (e[i] / weight);
-                s += term;
-                let new = !(term <= best) & !best.is_nan();
-                best = if new { term } else { best };
-                at = if new { i } else { at };
+        let mut top_floor = 0.0;
+        for g in 0..groups {
+            let (mut s, mut n) = (0.0, 0usize);
+            for (b, &(e, y0, y1)) in blocks.iter().enumerate() {
+                let r = part(b, g);
+                let (e, y0, y1) = (&e[r.clone()], &y0[r.clone()], &y1[r.clone()]);
+                let len = e.len();
+                let largest = y0.iter().chain(y1).fold(0.0f64, |m, y| m.max(y.abs()));
+                let floor = Self::transformed_floor(rtol) * largest;
+                // the part's largest term as `Argmax` takes it (the first NaN, else the first
+                // of the largest), chosen without a branch: the terms come in no order a
+                // branch predictor could learn
+                let (mut best, mut at) = (-1.0f64, 0);
+                for i in 0..len {
+                    let magnitude = y0[i].abs().max(y1[i].abs());
+                    let w = atol + rtol * magnitude;
+                    floored |= w < floor;
+                    let weight = w.max(floor);
+                    let term = (e[i] / weight) * (e[i] / weight);
+                    s += term;
+                    let new = !(term <= best) & !best.is_nan();
+                    best = if new { term } else { best };
+                    at = if new { i } else { at };
+                }
+                n += len;
+                if len > 0 && top.see(best, b, r.start + at) {
+                    top_floor = floor;
+                }
             }
-            if len > 0 {
-                top.see(best, b, at);
-            }
+            let v = (s / n.max(1) as f64).sqrt();
+            nan |= v.is_nan();
+            value = value.max(v);
         }
         // the component that weighed most, described once
         let held_by = top.at.map(|(block, index)| {
             let (e, y0, y1) = blocks[block];
-            let floor = floors[block];
+            let floor = top_floor;
             let magnitude = y0[index].abs().max(y1[index].abs());
             let w = atol + rtol * magnitude;
             let set_by = if w < floor {
@@ -136,9 +165,8 @@ impl Tolerances {
                 set_by,
             }
         });
-        let n: usize = blocks.iter().map(|b| b.0.len()).sum();
         ErrorNorm {
-            value: (s / n.max(1) as f64).sqrt(),
+            value: if nan { f64::NAN } else { value },
             floored,
             held_by,
         }
@@ -431,7 +459,7 @@ pub(crate) fn initial_step(
     b: StepBounds,
     mut accel: impl FnMut(f64, &[f64], &[f64], &mut [f64]) -> bool,
 ) -> f64 {
-    let Tolerances { rtol, atol } = tol;
+    let Tolerances { rtol, atol, .. } = tol;
     let n = s.q.len();
     let w = |y: f64| atol + rtol * y.abs();
     let norm = |a: &[f64], b: &[f64], ya: &[f64], yb: &[f64]| {
@@ -498,6 +526,7 @@ mod tests {
         let tol = Tolerances {
             rtol: 1e-3,
             atol: 1e-6,
+            groups: 1,
         };
         let (y0, y1) = ([1.0; 5], [1.0; 5]);
         let nan = f64::NAN;
@@ -522,11 +551,37 @@ mod tests {
         (a - b).abs() <= 1e-14 * a.abs().max(b.abs())
     }
 
+    /// Groups (a motion and its sensitivities) are normed apart, the largest norm counts, and
+    /// a NaN in any group makes the norm NaN.
+    #[test]
+    fn the_norm_of_groups_is_their_largest() {
+        let tol = Tolerances {
+            rtol: 1e-3,
+            atol: 1.0,
+            groups: 2,
+        };
+        // positions (a, b) and velocities (c, d): group 0 is (a, c), group 1 (b, d)
+        let y = [0.0; 4];
+        let n = tol.error_norm(&[3.0, 0.0, 4.0, 0.0], &y, &y, 2);
+        assert!(close(n, (25.0f64 / 2.0).sqrt()), "{n}");
+        let n = tol.error_norm(&[3.0, 1.0, 4.0, 1.0], &y, &y, 2);
+        assert!(close(n, (25.0f64 / 2.0).sqrt()), "{n}");
+        let n = tol.error_norm(&[0.0, 1.0, 0.0, f64::NAN], &y, &y, 2);
+        assert!(n.is_nan());
+        let n = tol.error_norm(&[f64::NAN, 1.0, 0.0, 0.0], &y, &y, 2);
+        assert!(n.is_nan());
+        // one group: the RMS over all
+        let one = Tolerances { groups: 1, ..tol };
+        let n = one.error_norm(&[3.0, 1.0, 4.0, 1.0], &y, &y, 2);
+        assert!(close(n, (27.0f64 / 4.0).sqrt()), "{n}");
+    }
+
     #[test]
     fn error_norm_weighs_each_component_by_the_larger_state() {
         let tol = Tolerances {
             rtol: 1e-3,
             atol: 1e-6,
+            groups: 1,
         };
         // weights 1e-6 + 1e-3·2 and 1e-6 + 1e-3·0.5
         let e = [2.001e-3, -1.002e-3];
@@ -540,6 +595,7 @@ mod tests {
         let tol = Tolerances {
             rtol: 1e-11,
             atol: 1e-12,
+            groups: 1,
         };
         // a velocity through zero beside one of 1,000: its weight is 100ε·1,000, not
         // atol + rtol·0.002 ≈ 1.02e-12
@@ -558,6 +614,7 @@ mod tests {
         let tol = Tolerances {
             rtol: 1e-11,
             atol: 1e-12,
+            groups: 1,
         };
         // (q0, q1, qd0, qd1, λ): a position of 0.01 m beside a velocity of 1,000 and a
         // multiplier of 1e6; each weight's floor is 100ε times the largest of its kind
@@ -693,6 +750,7 @@ mod tests {
         let tol = Tolerances {
             rtol: 1e-3,
             atol: 1e-6,
+            groups: 1,
         };
         // y'' = −y from q = 1, qd = 0: y = (1, 0), f = (0, −1), weights (1.001e-3, 1e-6)
         let s = state(1.0, 0.0, -1.0);
@@ -721,6 +779,7 @@ mod tests {
         let tol = Tolerances {
             rtol: 1e-6,
             atol: 1e-8,
+            groups: 1,
         };
         let s = state(0.0, 0.0, 0.0);
         // a state at rest: the trial step is 1e-6, f does not change: h = max(1e-9, 1e-6)

@@ -366,7 +366,7 @@ struct Tol {
 impl Tol {
     fn new(ctl: &Control, s: usize) -> Tol {
         match ctl.adaptive {
-            Some(Tolerances { rtol, atol }) => {
+            Some(Tolerances { rtol, atol, groups }) => {
                 // Radau5: RADAU5's transformation 0.1·rtol^((s+1)/(2s)); Radau3: the global
                 // error's mapping c·rtol^((s+1)/(2s−1)), linear for s = 2 ("What rtol means")
                 let r = if s == 2 {
@@ -381,6 +381,7 @@ impl Tol {
                     weights: Tolerances {
                         rtol: r,
                         atol: r * atol / rtol,
+                        groups,
                     },
                     kappa: (10.0 * f64::EPSILON / r).max(ctl.newton.kappa.min(r.sqrt())),
                     max_iterations: ctl.newton.max_iterations,
@@ -391,6 +392,7 @@ impl Tol {
                 weights: Tolerances {
                     rtol: ctl.newton.rtol,
                     atol: ctl.newton.atol,
+                    groups: 1,
                 },
                 kappa: ctl.newton.kappa,
                 // a failure is final at a fixed step: twice the iterations before giving up

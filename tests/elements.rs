@@ -424,6 +424,41 @@ mbs::multibody! {
     }
 }
 
+mbs::multibody! {
+    /// The same kinks scaled by parameters: a damper √(|v|/v0), a spring pos(c·x/x0)^0.7 and
+    /// √(k·pos(x)) written with the parameter inside the root.
+    model ScaledKinks {
+        param k = 100.0; param v0 = 0.01; param c = 2.0; param x0 = 0.5;
+        dof x = 0.0;
+        body b { mass = 1.0; inertia = (1, 1, 1); }
+        TOG[b] = Tdisp(x, 0, 0);
+        generalized_force(q[x], -sqrt(abs(qd[x]) / v0) - pow(c * pos(x) / x0, 0.7) - sqrt(k * pos(x)));
+        option tangents;
+    }
+}
+
+/// At rest (x = 0, v = 0) the tangents of kinks scaled by parameters are 0, where only a
+/// numeric factor was taken off the kink and √(|v|/v0) gave ∂τ/∂v = inf·0 = NaN at every
+/// start from rest; beside the kink they are the derivatives by hand.
+#[test]
+fn derivatives_at_a_kink_scaled_by_parameters_are_zero_not_nan() {
+    let model = ScaledKinks::default();
+    let at = |x: f64, v: f64| {
+        let (mut k, mut c) = ([0.0], [0.0]);
+        model
+            .tangents(0.0, &[x], &[v], &[0.0], &[], &mut k, &mut c)
+            .unwrap();
+        (k[0], c[0])
+    };
+    assert_eq!(at(0.0, 0.0), (0.0, 0.0));
+    let (x, v) = (0.2f64, -0.3f64);
+    let (k, c) = at(x, v);
+    let want_k = 0.7 * 4.0f64.powf(0.7) * x.powf(-0.3) + 0.5 * 100.0f64.sqrt() / x.sqrt();
+    let want_c = -0.5 / (v.abs() / 0.01).sqrt() / 0.01;
+    assert!((k - want_k).abs() < 1e-12 * want_k, "{k} against {want_k}");
+    assert!((c - want_c).abs() < 1e-12 * want_c.abs(), "{c} against {want_c}");
+}
+
 /// A one-coordinate model's tangent stiffness K and ∂τ/∂n (its one sensitive parameter) at
 /// rest at x.
 fn stiffness_and_exponent_derivative<M: Model>(model: &M, x: f64) -> (f64, f64) {

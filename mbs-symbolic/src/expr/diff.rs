@@ -189,15 +189,26 @@ impl Arena {
     /// and is multiplied there by the derivative of pos(u), step(u)·u' = 0, or of |u|,
     /// sign(u)·u' = 0: the derivative is 0 where inf·0 gave NaN (√pos(x), pos(δ)^b with
     /// b < 1, the second derivatives of pos(δ)^1.5 out of contact, √|v|, |v|^b).
+    ///
+    /// A product or quotient with such a factor (`c·pos(u)`, `pos(u)/v0`, `k·c·|u|`, the
+    /// other factors numbers, parameters or anything else) is taken off the kink in that
+    /// factor: √(|v|/v0) with a parameter v0 gave NaN at v = 0 where √|v| gives 0.
     fn off_the_kink(&mut self, a: ExprId) -> ExprId {
-        let (c, p) = match self.node(a) {
-            Node::Func(Func::Pos | Func::Abs, _) => (None, a),
-            Node::Mul(c, p) if self.as_num(c).is_some() => (Some(c), p),
-            _ => return a,
-        };
-        let (at_kink, u) = match self.node(p) {
+        let (at_kink, u) = match self.node(a) {
             Node::Func(Func::Pos, u) => (Func::Step, u),
             Node::Func(Func::Abs, u) => (Func::Sign, u),
+            Node::Mul(x, y) => {
+                let y_off = self.off_the_kink(y);
+                if y_off != y {
+                    return self.mul(x, y_off);
+                }
+                let x_off = self.off_the_kink(x);
+                return if x_off != x { self.mul(x_off, y) } else { a };
+            }
+            Node::Div(x, y) => {
+                let x_off = self.off_the_kink(x);
+                return if x_off != x { self.div(x_off, y) } else { a };
+            }
             _ => return a,
         };
         let one = self.one();
@@ -209,11 +220,7 @@ impl Arena {
             k
         };
         let lift = self.sub(one, k);
-        let off = self.add(p, lift);
-        match c {
-            Some(c) => self.mul(c, off),
-            None => off,
-        }
+        self.add(a, lift)
     }
 
     /// f'(a) where `fa` = f(a).

@@ -154,8 +154,9 @@
 //! `generalized_force(q[0], -k * pos(q[0] - 0.1))`. Exact tangents see their derivatives
 //! away from the kink, not the jump. Where a power below 1 (`sqrt`, `pow(…, 0.7)`) or a
 //! power with a varying exponent meets the kink of `pos(u)` or `abs(u)` (`sqrt(pos(x))`,
-//! `pow(abs(v), 0.5)`), whose derivative is infinite there, the generated derivative is 0
-//! at the kink rather than NaN (and below it, for `pos`).
+//! `pow(abs(v), 0.5)`, also scaled by numbers or parameters: `sqrt(abs(v) / v0)`,
+//! `pow(c * pos(x), 0.7)`), whose derivative is infinite there, the generated derivative is
+//! 0 at the kink rather than NaN (and below it, for `pos`).
 //!
 //! `spline(x, [(x0, y0), (x1, y1), …])` is the natural cubic spline through the points
 //! (x0 < x1 < …, at least two; numbers known when the model is generated): cubic between

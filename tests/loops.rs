@@ -822,3 +822,45 @@ fn typed_errors_of_constrained_runs() {
     assert!(tr.constraint_residual(&FourBar::default()) <= drift_tol);
     assert_eq!(tr.lambda_data.len(), tr.len() * 2);
 }
+
+mbs::multibody! {
+    /// 66 beads on inclined wires y = x/2, in Cartesian coordinates: 66 scalar constraints,
+    /// more than a 64-bit mask holds.
+    model Beads {
+        for i in 0..66 {
+            dof x[i] = 0.0;
+            dof y[i] = 0.0;
+            body b[i] { mass = 1.0; inertia = (1, 1, 1); }
+            TOG[b[i]] = Tdisp(x[i], y[i], 0);
+            constraint wire[i] = y[i] - x[i] / 2;
+        }
+        gravity(0, -9.81, 0);
+    }
+}
+
+/// Coordinate partitioning picks one dependent coordinate per constraint by complete
+/// pivoting: its rows were kept in a 64-bit mask, whose bits 64 and up wrapped onto the
+/// first ones (and overflowed in a debug build). Each bead slides down its wire at
+/// g·(1/2)/(1 + 1/4) along x.
+#[test]
+fn partitioning_takes_more_than_64_constraints() {
+    let t_end = 0.5;
+    for method in [ConstraintMethod::Partitioning, ConstraintMethod::Projection] {
+        let (tr, _) = simulate(
+            Beads::default(),
+            Scheme::Dopri5,
+            options(t_end, adaptive(1e-8), method, Output::Last),
+        )
+        .unwrap_or_else(|e| panic!("{method:?}: {e}"));
+        let last = tr.len() - 1;
+        let x = -0.5 * 9.81 * 0.4 * t_end * t_end;
+        for i in 0..66 {
+            let (xi, yi) = (tr.q(last)[2 * i], tr.q(last)[2 * i + 1]);
+            assert!(
+                (xi - x).abs() < 1e-9 && (yi - x / 2.0).abs() < 1e-9,
+                "{method:?}: bead {i} at ({xi}, {yi}), not ({x}, {})",
+                x / 2.0
+            );
+        }
+    }
+}

@@ -79,6 +79,8 @@ pub(crate) struct Constrained {
     lu_d: Lu<f64>,
     pivot: Vec<f64>,
     used: Vec<bool>,
+    /// the rows complete pivoting has taken (one flag per constraint)
+    rows_used: Vec<bool>,
     best: Vec<usize>,
     pub qc: Vec<f64>,
     pub vc: Vec<f64>,
@@ -117,6 +119,7 @@ impl Constrained {
             lu_d: Lu::new(nc),
             pivot: z(nc * n),
             used: vec![false; n],
+            rows_used: vec![false; nc],
             best: Vec::with_capacity(nc),
             qc: z(n),
             vc: z(n),
@@ -474,8 +477,8 @@ impl Constrained {
         let (n, nc) = (self.n, self.nc);
         self.pivot.copy_from_slice(&self.b);
         self.used.fill(false);
+        self.rows_used.fill(false);
         self.best.clear();
-        let mut rows_left: u64 = if nc >= 64 { u64::MAX } else { (1u64 << nc) - 1 };
         for _ in 0..nc {
             let (mut bi, mut bj, mut bv) = (usize::MAX, usize::MAX, -1.0);
             for j in 0..n {
@@ -483,7 +486,7 @@ impl Constrained {
                     continue;
                 }
                 for i in 0..nc {
-                    if rows_left & (1 << i) == 0 {
+                    if self.rows_used[i] {
                         continue;
                     }
                     let v = self.pivot[i + nc * j].abs();
@@ -497,13 +500,13 @@ impl Constrained {
             }
             self.used[bj] = true;
             self.best.push(bj);
-            rows_left &= !(1 << bi);
+            self.rows_used[bi] = true;
             let p = self.pivot[bi + nc * bj];
             if p == 0.0 {
                 continue;
             }
             for i in 0..nc {
-                if rows_left & (1 << i) == 0 {
+                if self.rows_used[i] {
                     continue;
                 }
                 let f = self.pivot[i + nc * bj] / p;

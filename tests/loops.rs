@@ -864,3 +864,36 @@ fn partitioning_takes_more_than_64_constraints() {
         }
     }
 }
+
+mbs::multibody! {
+    /// Three beads each on a rod of length 1 from the origin, written as distances: at the
+    /// origin B = ∂Φ/∂q is 0/0.
+    model Rods {
+        for i in 0..3 {
+            dof x[i] = 0.0;
+            dof y[i] = 0.0;
+            body b[i] { mass = 1.0; inertia = (1, 1, 1); }
+            TOG[b[i]] = Tdisp(x[i], y[i], 0);
+            constraint rod[i] = sqrt(x[i] * x[i] + y[i] * y[i]) - 1;
+        }
+    }
+}
+
+/// A B that is not finite is named as such. With three constraints nalgebra's SVD, asked
+/// for B's rank, never returned (the assembly hung); with two it blamed redundant
+/// constraints, of rank 0.
+#[test]
+fn a_constraint_jacobian_that_is_not_finite_is_named() {
+    let err = simulate(
+        Rods::default(),
+        Scheme::Dopri5,
+        options(0.1, adaptive(1e-6), ConstraintMethod::Projection, Output::Last),
+    )
+    .unwrap_err();
+    let text = err.to_string();
+    assert!(
+        matches!(err.kind, Failure::NonFinite { .. }) && text.contains("B = ∂Φ/∂q"),
+        "{text}"
+    );
+    println!("{text}");
+}

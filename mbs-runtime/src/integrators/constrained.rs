@@ -241,7 +241,8 @@ impl Constrained {
         q: &[f64],
     ) -> Failure {
         self.eval_b(m, st, t, q);
-        rank_failure(&self.b, self.nc, self.n, &self.names)
+        let labels = &self.dof_labels;
+        rank_failure(&self.b, self.nc, self.n, &self.names, |j| labels[j].clone())
     }
 
     /// qdd and λ of the index-1 equations at (t, q, qd), with L the Cholesky factor of M(q)
@@ -610,7 +611,21 @@ pub(crate) fn worst(x: &[f64]) -> (f64, usize) {
 }
 
 /// Rank, smallest singular value and the constraints involved in B's deficiency.
-fn rank_failure(b: &[f64], nc: usize, n: usize, names: &[String]) -> Failure {
+fn rank_failure(
+    b: &[f64],
+    nc: usize,
+    n: usize,
+    names: &[String],
+    label: impl Fn(usize) -> String,
+) -> Failure {
+    // a B that is not finite has no rank: its own failure, naming the constraint and the
+    // coordinate (√(x² + y²) − l at x = y = 0 gives 0/0)
+    if let Some(i) = b.iter().position(|x| !x.is_finite()) {
+        return Failure::NonFinite {
+            quantity: "B = ∂Φ/∂q",
+            coordinate: format!("{} in constraint `{}`", label(i / nc), names[i % nc]),
+        };
+    }
     let (rank, sigma_min, involved) = rank_of(b, nc, n);
     Failure::RankDeficientConstraints {
         rank,
@@ -623,7 +638,12 @@ fn rank_failure(b: &[f64], nc: usize, n: usize, names: &[String]) -> Failure {
 /// Numerical rank of B (nc × n, column-major; σ ≤ 1e-10·σ_max counts as zero), its smallest
 /// singular value, and the constraints with large components in the left singular vectors
 /// of the vanishing singular values (the equations that repeat or cancel each other).
+/// A B with entries that are not finite has rank 0 here, σ_min NaN and every constraint
+/// involved: nalgebra's SVD does not return on such a matrix.
 pub(crate) fn rank_of(b: &[f64], nc: usize, n: usize) -> (usize, f64, Vec<usize>) {
+    if b.iter().any(|x| !x.is_finite()) {
+        return (0, f64::NAN, (0..nc).collect());
+    }
     // B padded with zero columns to at least nc × nc, so that U is square
     let cols = n.max(nc);
     let mat = nalgebra::DMatrix::from_fn(nc, cols, |i, j| if j < n { b[i + nc * j] } else { 0.0 });
@@ -792,7 +812,7 @@ pub(crate) fn assemble_erased(
         // redundant equations first: no marking would close them
         model.constraint_jacobian(t, q, &mut b);
         if rank_of(&b, nc, n).0 < nc {
-            return Err(rank_failure(&b, nc, n, &names));
+            return Err(rank_failure(&b, nc, n, &names, label));
         }
         return Err(fail(
             format!(
@@ -811,7 +831,7 @@ pub(crate) fn assemble_erased(
     let deficient = |b: &[f64], phi: &[f64], it: usize| -> Failure {
         let (rank, _, _) = rank_of(b, nc, n);
         if rank < nc {
-            rank_failure(b, nc, n, &names)
+            rank_failure(b, nc, n, &names, label)
         } else {
             fail(
                 format!(
@@ -919,7 +939,7 @@ pub(crate) fn assemble_erased(
     model.constraint_jacobian(t, q, &mut b);
     let (rank, _, _) = rank_of(&b, nc, n);
     if rank < nc {
-        return Err(rank_failure(&b, nc, n, &names));
+        return Err(rank_failure(&b, nc, n, &names, label));
     }
     let sign1 = det_sign(&b);
     if sign0 != 0.0 && sign1 != sign0 {

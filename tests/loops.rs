@@ -897,3 +897,32 @@ fn a_constraint_jacobian_that_is_not_finite_is_named() {
     );
     println!("{text}");
 }
+
+/// A first step far too large for the crank (h0 = 1 s and 2 s at 10 rad/s) makes stages
+/// whose dependent coordinates do not close (Newton stalled at |Φ| = 3.7e-10 after 50
+/// iterations): a step too large, rejected and retried smaller as a non-finite stage is,
+/// where it stopped the run at t = 0. Every first step ends where the small one does.
+#[test]
+fn partitioning_retries_a_stage_that_does_not_close() {
+    let end = |h0: f64| {
+        let o = options(
+            1.0,
+            StepControl::Adaptive {
+                rtol: 1e-6,
+                atol: 1e-8,
+                h0: Some(h0),
+            },
+            ConstraintMethod::Partitioning,
+            Output::Last,
+        );
+        let (tr, _) = simulate(SliderCrank::default(), Scheme::Dopri5, o)
+            .unwrap_or_else(|e| panic!("h0 = {h0}: {e}"));
+        tr.q(tr.len() - 1).to_vec()
+    };
+    let reference = end(1e-3);
+    for h0 in [0.2, 1.0, 2.0] {
+        let q = end(h0);
+        let gap = q.iter().zip(&reference).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        assert!(gap < 1e-4, "h0 = {h0}: {q:?} against {reference:?}");
+    }
+}

@@ -90,6 +90,11 @@ pub(crate) struct Constrained {
     phi_tp: Vec<f64>,
 }
 
+/// What a completion that does not close names ([`Failure::ClosureFailed`]).
+pub(crate) const PARTITION_CLOSURE: &str = "the dependent coordinates (partitioning)";
+/// The matrix a singular partition names ([`Failure::SingularMatrix`]).
+pub(crate) const PARTITION_MATRIX: &str = "B over the dependent coordinates (partitioning)";
+
 impl Constrained {
     pub fn new(model: &dyn ErasedModel, mode: Mode, o: &ConstraintOptions) -> Constrained {
         let (n, nc) = (model.nq(), model.nc());
@@ -393,7 +398,7 @@ impl Constrained {
             let converged = worst <= self.tol;
             if it == self.max_iterations && !converged || !worst.is_finite() {
                 break Err(Failure::ClosureFailed {
-                    what: "the dependent coordinates (partitioning)",
+                    what: PARTITION_CLOSURE,
                     constraint: self.name(at),
                     residual: worst,
                     iterations: it,
@@ -451,7 +456,7 @@ impl Constrained {
 
     fn singular_partition(&self, e: Singular) -> Failure {
         Failure::SingularMatrix {
-            matrix: "B over the dependent coordinates (partitioning)",
+            matrix: PARTITION_MATRIX,
             rcond: e.rcond,
             coordinates: vec![self.dof_labels[self.dep[e.column.min(self.dep.len() - 1)]].clone()],
         }

@@ -2,6 +2,7 @@
 //! (`Attempt`), and the settings every attempt is handed (`Control`).
 
 use super::State;
+use super::constrained::{PARTITION_CLOSURE, PARTITION_MATRIX};
 use super::newton::NewtonTol;
 use super::problem::Problem;
 use super::step_control::{PiController, Tolerances};
@@ -26,15 +27,24 @@ pub(crate) enum Attempt {
 
 impl Attempt {
     /// An evaluation inside an explicit step failed with `e`: with adaptive steps a
-    /// non-finite stage is a step too large, retried at a quarter of h (`pi` told, so that
-    /// the step does not grow right after); anything else, or with a fixed step, is fatal.
+    /// non-finite stage, or a stage whose dependent coordinates (partitioning) would not
+    /// close or whose B over them is singular, is a step too large, retried at a quarter of
+    /// h (`pi` told, so that the step does not grow right after; at h_min the failure is
+    /// reported as the cause); anything else, or with a fixed step, is fatal. The accepted
+    /// state's own completion is not a stage: its failures stay fatal.
     pub(crate) fn after_stage_failure(
         e: Failure,
         adaptive: bool,
         h: f64,
         pi: &mut PiController,
     ) -> Result<Attempt, Failure> {
-        if adaptive && matches!(e, Failure::NonFinite { .. }) {
+        let too_large = match &e {
+            Failure::NonFinite { .. } => true,
+            Failure::ClosureFailed { what, .. } => *what == PARTITION_CLOSURE,
+            Failure::SingularMatrix { matrix, .. } => *matrix == PARTITION_MATRIX,
+            _ => false,
+        };
+        if adaptive && too_large {
             pi.rejected_otherwise();
             return Ok(Attempt::RejectedNewton {
                 h_next: 0.25 * h,

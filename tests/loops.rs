@@ -926,3 +926,20 @@ fn partitioning_retries_a_stage_that_does_not_close() {
         assert!(gap < 1e-4, "h0 = {h0}: {q:?} against {reference:?}");
     }
 }
+
+/// `mbs::assemble` leaves the caller's start as it was when it fails: it left the last
+/// Newton iterate in q.
+#[test]
+fn a_failed_assembly_leaves_the_start_as_given() {
+    let (b, c) = fourbar::closed_loop(PI / 3.0);
+    let mut q = vec![PI / 3.0, b - 0.4, c + 0.3];
+    let mut qd = vec![1.0, 0.0, 0.0];
+    let (q0, qd0) = (q.clone(), qd.clone());
+    let o = ConstraintOptions {
+        max_iterations: 1,
+        ..ConstraintOptions::default()
+    };
+    let e = mbs::assemble(&FourBar::default(), 0.0, &mut q, &mut qd, &o).unwrap_err();
+    println!("{e}");
+    assert_eq!((q, qd), (q0, qd0));
+}

@@ -744,7 +744,8 @@ pub(crate) fn least_correction(
 /// than 0.5 per step, step halved until max |Φ| decreases), refusing a result on another
 /// assembly branch; then the velocities of those
 /// coordinates from B qd = −Φ_t. Typed errors: redundant constraints (rank of B), too many
-/// coordinates marked independent, no convergence, a change of branch.
+/// coordinates marked independent, no convergence, a change of branch; on any of them `q`
+/// and `qd` are left as they were given.
 pub fn assemble<M: crate::model::Model + 'static>(
     model: &M,
     t: f64,
@@ -769,7 +770,14 @@ pub fn assemble<M: crate::model::Model + 'static>(
             reason: "must be finite",
         });
     }
-    assemble_erased(model, t, q, qd, o)
+    let (q0, qd0) = (q.to_vec(), qd.to_vec());
+    let result = assemble_erased(model, t, q, qd, o);
+    if result.is_err() {
+        // the last Newton iterate is no start: the caller keeps the one it gave
+        q.copy_from_slice(&q0);
+        qd.copy_from_slice(&qd0);
+    }
+    result
 }
 
 /// [`assemble`] on the model behind the schemes.

@@ -742,3 +742,33 @@ fn coordinates_not_varied_start_from_the_run_s_own_model() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A list design's array tasks read the list from the sweep's folder: its plan.toml named
+/// the user's file, which lies beside the user's plan, so every task failed to read it (or,
+/// named runs.csv, read the folder's run list as a list with a variable `run`).
+#[test]
+fn a_list_design_s_folder_holds_its_runs_for_the_array_tasks() {
+    let plan = Plan::from_toml(
+        "[sweep]\ndesign = \"list\"\nfile = \"points.csv\"\n[simulation]\nt_end = 0.1\n\
+         [slurm]\ntasks = 2\n",
+    )
+    .unwrap();
+    let dir = scratch("list_slurm");
+    let study = dir.join("study");
+    std::fs::create_dir_all(&study).unwrap();
+    std::fs::write(study.join("points.csv"), "l,m\n1.0,1.0\n0.8,1.2\n1.1,0.9\n").unwrap();
+    let runs = plan.runs(&study).unwrap();
+    let out = dir.join("out");
+    let make = || Sweep::new(DoublePendulum::default, &plan, Scheme::Dopri5, base()).unwrap();
+    make()
+        .write_slurm(&out, &runs, &["program".to_string()])
+        .unwrap();
+    // what a task does: the plan of the folder, its runs from the folder
+    let task_plan = Plan::load(&out.join("plan.toml")).unwrap();
+    let task_runs = task_plan.runs(&out).unwrap();
+    assert_eq!(task_runs, runs);
+    let task = Sweep::new(DoublePendulum::default, &task_plan, Scheme::Dopri5, base()).unwrap();
+    task.run_shard(&out, &task_runs, Shard { index: 0, count: 2 })
+        .unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -16,7 +16,8 @@
 //! before them are written).
 //!
 //! The folder of a sweep holds `plan.toml` (the plan, with the simulation settings it ran
-//! with), `runs.csv` (the run list), `results.csv` (the table) and, for Slurm,
+//! with; a list design's reads its runs from the folder's `runs.csv`), `runs.csv` (the run
+//! list), `results.csv` (the table) and, for Slurm,
 //! `manifest.json`, `sweep.sbatch`, `parts/` and `logs/`. A sweep started again in the
 //! same folder skips the runs its table already has (a row cut short by a kill is dropped
 //! and run again); a folder that holds another sweep is refused.
@@ -522,6 +523,11 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
             _ => None,
         };
         s.max_steps = Some(b.options.max_steps);
+        if p.sweep.design == DesignKind::List {
+            // the list as the folder holds it: its runs.csv (the file named in the plan lies
+            // beside the plan, not in the folder the array tasks read)
+            p.sweep.file = Some(PathBuf::from("runs.csv"));
+        }
         s.constraints = Some(match b.options.constraints.method {
             ConstraintMethod::Baumgarte { alpha, beta } => format!("baumgarte:{alpha},{beta}"),
             m => m.name().to_string(),

@@ -532,7 +532,12 @@ fn latin_hypercube(dists: &[Dist], n: usize, rng: &mut ChaCha8Rng) -> Vec<Vec<Va
 }
 
 /// A list design's file: a header of variable names, one run per row.
+/// A list file's runs; a file whose first column is `run` is a sweep folder's run list
+/// ([`RunList::to_csv`]: a `run` column of the user's would double the table's own).
 fn list(text: &str, path: &Path) -> Result<RunList, SweepError> {
+    if text.split(['\n', ',']).next().map(str::trim) == Some("run") {
+        return RunList::from_csv(text, path);
+    }
     let bad = |reason: String| SweepError::Table {
         path: path.to_path_buf(),
         reason,

@@ -430,6 +430,7 @@ impl Recorder {
                 keep.dof_names.clone_from(&tr.dof_names);
                 keep.frame_names.clone_from(&tr.frame_names);
                 keep.constraint_names.clone_from(&tr.constraint_names);
+                keep.joint_names.clone_from(&tr.joint_names);
             }
         }
         self.peak_held = self

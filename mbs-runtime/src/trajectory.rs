@@ -411,7 +411,13 @@ impl Trajectory {
         );
         if !from.joint_names.is_empty() {
             self.push_joints(from.orientation(i), from.chart_numbers(i));
-            if self.charts.len() < from.charts.len() {
+            // the charts the output's numbers index: `from`'s, when it has more joints or
+            // more charts of a joint (a chart added since the last output pushed)
+            let fewer = self.charts.len() < from.charts.len()
+                || (self.charts.iter())
+                    .zip(&from.charts)
+                    .any(|(mine, theirs)| mine.len() < theirs.len());
+            if fewer {
                 self.charts = from.charts.clone();
             }
         }

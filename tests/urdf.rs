@@ -531,4 +531,16 @@ fn command_line_prints_the_block() {
         .expect("running mbs");
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("cannot read no-such-file.urdf"));
+
+    // a full disk is an error said as such (it panicked in `print!`), with exit status 1
+    if let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_mbs"))
+            .args(["import", "urdf", &urdf_path("arm2")])
+            .stdout(full)
+            .output()
+            .expect("running mbs");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        assert!(err.contains("cannot write the model") && !err.contains("panicked"), "{err}");
+    }
 }

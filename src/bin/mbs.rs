@@ -91,8 +91,15 @@ fn main() -> ExitCode {
         } => match mbs::urdf::import_file(&file, mbs::urdf::ImportOptions { floating_base }) {
             Ok(imported) => {
                 let source = file.file_name().unwrap_or(file.as_os_str());
-                print!("{}", imported.block(&source.to_string_lossy()));
-                ExitCode::SUCCESS
+                let block = imported.block(&source.to_string_lossy());
+                // a reader that stops early (`| head`) is not an error; a full disk is
+                match std::io::stdout().lock().write_all(block.as_bytes()) {
+                    Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+                        eprintln!("error: cannot write the model: {e}");
+                        ExitCode::FAILURE
+                    }
+                    _ => ExitCode::SUCCESS,
+                }
             }
             Err(e) => {
                 eprintln!("error: {}: {e}", file.display());

@@ -1241,20 +1241,29 @@ impl WorkPrecision {
             "tolerance proportionality: {} (digits = −log10 e_max)\n{:<w$}",
             self.title, "scheme"
         );
-        let rtols = props.first().map(|p| p.rtols.clone()).unwrap_or_default();
+        // every sweep's rtols, loosest first: a sweep over fewer leaves its other columns
+        // blank (the first sweep's headed every row, and a shorter row shifted its slope,
+        // offset and loss under the wrong headers)
+        let mut rtols: Vec<f64> = props.iter().flat_map(|p| p.rtols.iter().copied()).collect();
+        rtols.sort_by(|a, b| b.total_cmp(a));
+        rtols.dedup_by(|a, b| (*a - *b).abs() <= 1e-9 * b.abs());
         for r in &rtols {
             let _ = write!(s, " {:>6}", short(*r));
         }
         let _ = writeln!(s, " {:>6} {:>7} {:>6}", "slope", "offset", "loss");
         for p in &props {
             let _ = write!(s, "{:<w$}", p.label);
-            for d in &p.digits {
-                match d {
-                    Some(d) => {
+            for r in &rtols {
+                let at = p.rtols.iter().position(|x| (x - r).abs() <= 1e-9 * r.abs());
+                match at.map(|k| p.digits[k]) {
+                    Some(Some(d)) => {
                         let _ = write!(s, " {d:>6.2}");
                     }
-                    None => {
+                    Some(None) => {
                         let _ = write!(s, " {:>6}", "fail");
+                    }
+                    None => {
+                        let _ = write!(s, " {:>6}", "");
                     }
                 }
             }

@@ -307,3 +307,43 @@ fn studies_that_measure_nothing_and_references_that_are_not_finite_are_refused()
     assert_eq!(p(vec![Some(3.0), Some(5.0)]).slope(), Some(1.0));
     assert_eq!(p(vec![Some(3.0), Some(f64::INFINITY)]).largest_loss(), 0.0);
 }
+
+/// Sweeps over different tolerances share the proportionality table's columns: each digit
+/// under its own rtol, blanks elsewhere. The first sweep's rtols headed every row, so a
+/// sweep over others had its digits, slope, offset and loss under the wrong headers.
+#[test]
+fn the_proportionality_table_puts_each_digit_under_its_rtol() {
+    let reference = Reference::exact("modal solution", times(), exact);
+    let wp = Study {
+        repeats: 1,
+        ..Study::new("seed2dof", reference)
+    }
+    .sweep(Sweep::adaptive(Scheme::Dopri5, &[1e-3, 1e-4]))
+    .sweep(Sweep::adaptive(Scheme::Radau5, &[1e-4, 1e-5, 1e-6]))
+    .run(&Seed2dof::default())
+    .unwrap();
+    let table = wp.proportionality_table();
+    println!("{table}");
+    let lines: Vec<&str> = table.lines().collect();
+    let header = fields_of(lines[1]);
+    assert_eq!(
+        header,
+        ["scheme", "1e-3", "1e-4", "1e-5", "1e-6", "slope", "offset", "loss"]
+    );
+    // the columns are 7 characters wide after the label's: DOPRI5's row is blank under
+    // 1e-5 and 1e-6, Radau5's under 1e-3
+    let width = lines[1].find("   1e-3").unwrap();
+    let cell = |line: &str, k: usize| line[width + 7 * k..width + 7 * (k + 1)].trim().to_string();
+    let (dopri, radau) = (lines[2], lines[3]);
+    assert!(dopri.starts_with("dopri5") && radau.starts_with("radau5"));
+    assert!(!cell(dopri, 0).is_empty() && !cell(dopri, 1).is_empty());
+    assert!(cell(dopri, 2).is_empty() && cell(dopri, 3).is_empty(), "{dopri}");
+    assert!(cell(radau, 0).is_empty(), "{radau}");
+    for k in 1..4 {
+        assert!(cell(radau, k).parse::<f64>().is_ok(), "{radau}");
+    }
+}
+
+fn fields_of(line: &str) -> Vec<&str> {
+    line.split_whitespace().collect()
+}

@@ -772,3 +772,36 @@ fn a_list_design_s_folder_holds_its_runs_for_the_array_tasks() {
         .unwrap();
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A scheme's parameters are settings of the sweep: resumed with other ones, the folder is
+/// refused; read by a program whose scheme of that name has other ones (an array task), the
+/// plan is refused. Both mixed or ran the runs with other parameters silently: the plan
+/// recorded the scheme's name alone, and read back it meant the default parameters.
+#[test]
+fn a_scheme_s_parameters_are_settings_of_the_sweep() {
+    use mbs::BdfParams;
+    let plan = Plan::from_toml(
+        "[sweep]\ndesign = \"grid\"\n[[vary]]\nname = \"l\"\nvalues = [0.9, 1.0]\n[simulation]\nt_end = 0.2\n",
+    )
+    .unwrap();
+    let runs = plan.runs(Path::new(".")).unwrap();
+    let dir = scratch("scheme_parameters");
+    let order2 = Scheme::Bdf(BdfParams { max_order: 2 });
+    let sweep = |scheme: Scheme, plan: &Plan| Sweep::new(DoublePendulum::default, plan, scheme, base());
+    sweep(order2, &plan).unwrap().run(&dir, &runs).unwrap();
+    let err = sweep(Scheme::Bdf(BdfParams::default()), &plan)
+        .unwrap()
+        .run(&dir, &runs)
+        .unwrap_err();
+    assert!(matches!(err, SweepError::OtherSettings { .. }), "{err}");
+    // the folder's plan, as an array task reads it
+    let recorded = Plan::load(&dir.join("plan.toml")).unwrap();
+    let Err(err) = sweep(Scheme::Bdf(BdfParams::default()), &recorded) else {
+        panic!("the default BDF accepted a plan made with max_order 2");
+    };
+    assert!(err.to_string().contains("max_order: 2"), "{err}");
+    // with the scheme it was made with, the folder's plan resumes it: nothing left to run
+    let s = sweep(order2, &recorded).unwrap().run(&dir, &runs).unwrap();
+    assert_eq!((s.skipped, s.ran), (2, 0));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -98,7 +98,7 @@ pub enum SweepError {
     )]
     OtherSweep { dir: PathBuf },
     #[error(
-        "{} holds this sweep's runs made with other settings (its plan.toml differs in [simulation]: scheme, t_end, h, rtol, atol or dt): run it with the settings of plan.toml to resume, or choose another folder",
+        "{} holds this sweep's runs made with other settings (its plan.toml differs in [simulation]: scheme or its parameters, t_end, h, rtol, atol or dt): run it with the settings of plan.toml to resume, or choose another folder",
         dir.display()
     )]
     OtherSettings { dir: PathBuf },
@@ -204,7 +204,20 @@ impl Base {
         };
         let mut base_scheme = scheme;
         if let Some(name) = &spec.scheme {
-            base_scheme = scheme_named(name).map_err(SweepError::Plan)?;
+            // the caller's scheme of that name keeps its parameters
+            if name != scheme.name() {
+                base_scheme = scheme_named(name).map_err(SweepError::Plan)?;
+            }
+        }
+        if let Some(wanted) = &spec.scheme_parameters {
+            let have = scheme_parameters(&base_scheme);
+            if have.as_deref() != Some(wanted.as_str()) {
+                return Err(SweepError::Plan(format!(
+                    "the plan runs {} with the parameters {wanted}, this program with {}: run the sweep with the scheme it was made with",
+                    base_scheme.name(),
+                    have.unwrap_or_else(|| "none".into())
+                )));
+            }
         }
         let mut options = options;
         if let Some(t) = spec.t_end {
@@ -241,6 +254,17 @@ impl Base {
             atol,
             options,
         })
+    }
+}
+
+/// The parameters of a scheme that has some, as `plan.toml` records them.
+fn scheme_parameters(scheme: &Scheme) -> Option<String> {
+    match scheme {
+        Scheme::Newmark(p) => Some(format!("{p:?}")),
+        Scheme::Hht(p) => Some(format!("{p:?}")),
+        Scheme::GenAlpha(p) => Some(format!("{p:?}")),
+        Scheme::Bdf(p) => Some(format!("{p:?}")),
+        _ => None,
     }
 }
 
@@ -514,6 +538,7 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
         let b = &self.base;
         let s = &mut p.simulation;
         s.scheme = Some(b.scheme.name().to_string());
+        s.scheme_parameters = scheme_parameters(&b.scheme);
         s.t_end = Some(b.options.t_end);
         s.h = b.h;
         s.rtol = Some(b.rtol);

@@ -107,6 +107,11 @@ pub struct SimulationSpec {
     pub max_steps: Option<usize>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub constraints: Option<String>,
+    /// the parameters of `scheme` (Newmark's β and γ, HHT's α, generalized-α's, BDF's
+    /// highest order), as the sweep folder's `plan.toml` records them: a program whose scheme
+    /// of that name has others is refused, so that no run of the table is made with others
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scheme_parameters: Option<String>,
 }
 
 /// One varied quantity: a parameter of the model (its name), an initial coordinate or

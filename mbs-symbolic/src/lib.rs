@@ -27,3 +27,24 @@ pub fn systems_from_str(src: &str) -> Result<Vec<System>, String> {
     }
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    /// More parameters than the generator numbers (16 bits) is an error at the first one
+    /// beyond: `k[65536]` was read as `k[0]`, silently.
+    #[test]
+    fn more_parameters_than_the_generator_numbers_are_refused() {
+        let src = |n: usize| {
+            format!(
+                "model Many {{ for i in 0..{n} {{ param k[i] = 1.0; }} dof x; \
+                 body b {{ mass = 1.0; inertia = (1, 1, 1); }} TOG[b] = Tdisp(x, 0, 0); \
+                 generalized_force(x, -k[{last}] * x); }}",
+                last = n - 1
+            )
+        };
+        let err = super::systems_from_str(&src(65_537)).unwrap_err();
+        assert!(err.contains("more than 65536 parameters"), "{err}");
+        let systems = super::systems_from_str(&src(65_536)).unwrap();
+        assert_eq!(systems[0].params.len(), 65_536);
+    }
+}

@@ -140,6 +140,8 @@ struct Checker {
     sys: System,
     errors: Vec<syn::Error>,
     scalars: FxHashMap<String, Scalar>,
+    /// each parameter's field in the parameter struct, and the parameter's name
+    param_fields: FxHashMap<String, String>,
     /// the arguments of the inline `fn` whose body is being lowered: its own only (names are
     /// lexical: a `let` or another `fn` it uses sees the model's names, not these)
     args: Vec<(String, ExprId)>,
@@ -200,6 +202,7 @@ pub fn check(def: &ModelDef) -> Result<Checked, syn::Error> {
         sys: System::new(&def.name.to_string()),
         errors: Vec::new(),
         scalars: FxHashMap::default(),
+        param_fields: FxHashMap::default(),
         args: Vec::new(),
         fns: FxHashMap::default(),
         let_busy: Vec::new(),
@@ -359,14 +362,15 @@ impl Checker {
                     };
                     // an indexed parameter `k[3]` is the field `k_3`
                     let field = repeat::rust_ident(&name.to_string());
-                    if let Some(other) = self.scalars.iter().find_map(|(n, s)| match s {
-                        Scalar::Param(i) if self.sys.params[*i].name == field => Some(n.clone()),
-                        _ => None,
-                    }) {
+                    if let Some(other) = self.param_fields.get(&field) {
                         self.error(name.span(), format!("parameters `{other}` and `{name}` are both the field `{field}` of the parameter struct (an indexed parameter `k[3]` is the field `k_3`): rename one of them"));
                         continue;
                     }
+                    if self.too_many(name.span(), "parameters", self.sys.params.len()) {
+                        continue;
+                    }
                     self.bad_params.push(bad);
+                    self.param_fields.insert(field.clone(), name.to_string());
                     self.scalars
                         .insert(name.to_string(), Scalar::Param(self.sys.params.len()));
                     self.sys.params.push(ParamDef {
@@ -390,6 +394,9 @@ impl Checker {
                     ..
                 } => {
                     let i = self.sys.dofs.len();
+                    if self.too_many(*span, "coordinates", i) {
+                        continue;
+                    }
                     let display = match name {
                         DofName::Indexed(k, s) => {
                             if *k != i {
@@ -420,7 +427,9 @@ impl Checker {
                     self.dof_origins.push(origin.clone());
                 }
                 Item::Input { name } => {
-                    let ok = !self.reserved(name, "input") && !self.duplicate_scalar(name);
+                    let ok = !self.too_many(name.span(), "inputs", self.sys.inputs.len())
+                        && !self.reserved(name, "input")
+                        && !self.duplicate_scalar(name);
                     if ok {
                         self.scalars
                             .insert(name.to_string(), Scalar::Input(self.sys.inputs.len()));
@@ -540,6 +549,20 @@ impl Checker {
                 _ => {}
             }
         }
+    }
+
+    /// Whether one more of `what` (`count` declared) is beyond what the generator numbers
+    /// (65,536: its variables are numbered in 16 bits, and the 65,537th read as the first),
+    /// said once at the first one beyond.
+    fn too_many(&mut self, span: Span, what: &str, count: usize) -> bool {
+        const MAX: usize = u16::MAX as usize + 1;
+        if count == MAX {
+            self.error(
+                span,
+                format!("more than {MAX} {what}: the generator numbers at most {MAX}; split the model, or make some of them inputs or constants"),
+            );
+        }
+        count >= MAX
     }
 
     fn duplicate_scalar(&mut self, name: &Ident) -> bool {

@@ -48,3 +48,16 @@ mod tests {
         assert_eq!(systems[0].params.len(), 65_536);
     }
 }
+
+#[cfg(test)]
+mod powi_tests {
+    /// A loop variable below zero is an integer exponent of `powi` (pasted as `(-2)`, which
+    /// was refused as not an integer literal).
+    #[test]
+    fn a_negative_loop_variable_is_an_exponent_of_powi() {
+        let src = "model Powers { dof x = 1.0; body b { mass = 1.0; inertia = (1, 1, 1); } \
+                   TOG[b] = Tdisp(x, 0, 0); \
+                   for i in -2..0 { generalized_force(x, powi(x + 2, i)); } }";
+        super::systems_from_str(src).unwrap();
+    }
+}

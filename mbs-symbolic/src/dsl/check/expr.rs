@@ -613,20 +613,27 @@ impl Checker {
                     return self.sys.arena.zero();
                 }
                 let x = self.lower(args[0], a);
-                let n = match args[1] {
-                    Expr::Lit(syn::ExprLit {
-                        lit: syn::Lit::Int(l),
-                        ..
-                    }) => l.base10_parse::<i32>().ok(),
-                    Expr::Unary(u) if matches!(u.op, syn::UnOp::Neg(_)) => match &*u.expr {
+                // an integer literal, negated or not, in parentheses or not (a loop variable
+                // or a part's argument of −2 is pasted as `(-2)`)
+                fn literal(e: &Expr) -> Option<i32> {
+                    match e {
                         Expr::Lit(syn::ExprLit {
                             lit: syn::Lit::Int(l),
                             ..
-                        }) => l.base10_parse::<i32>().ok().map(|v| -v),
+                        }) => l.base10_parse::<i32>().ok(),
+                        Expr::Unary(u) if matches!(u.op, syn::UnOp::Neg(_)) => match &*u.expr {
+                            Expr::Lit(syn::ExprLit {
+                                lit: syn::Lit::Int(l),
+                                ..
+                            }) => l.base10_parse::<i32>().ok().map(|v| -v),
+                            _ => None,
+                        },
+                        Expr::Paren(p) => literal(&p.expr),
+                        Expr::Group(g) => literal(&g.expr),
                         _ => None,
-                    },
-                    _ => None,
-                };
+                    }
+                }
+                let n = literal(args[1]);
                 let Some(n) = n else {
                     self.error_at(args[1], format!("the exponent of `powi` is an integer literal, found `{}`: use `pow(x, y)` for a real exponent", text(args[1])));
                     return self.sys.arena.zero();

@@ -217,3 +217,19 @@ fn a_40_link_chain_in_a_loop_is_the_chain_written_out() {
     }
     println!("largest deviation, relative to the largest entry: M {dev_m:.1e}, h {dev_h:.1e}");
 }
+
+mbs::multibody! {
+    #[doc = "A doc attribute with a carriage return:\rits second line."]
+    model CarriageReturn {
+        dof x = 0.0;
+        body b { mass = 1.0; inertia = (1, 1, 1); }
+        TOG[b] = Tdisp(x, 0, 0);
+    }
+}
+
+/// A carriage return in a model's doc attribute ends a line of the generated docs: it was
+/// written inside a `///` comment, which rustc refuses ("generated code does not parse").
+#[test]
+fn a_carriage_return_in_a_doc_attribute_is_a_line_break() {
+    assert_eq!(CarriageReturn::NQ, 1);
+}

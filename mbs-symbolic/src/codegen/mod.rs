@@ -1002,8 +1002,9 @@ fn emit_scene(
         Formulation::VirtualPower => "virtual power",
     };
     let mut doc = String::new();
-    // a block comment `/** … */` is one doc attribute of several lines
-    for line in sys.docs.iter().flat_map(|d| d.split('\n')) {
+    // a block comment `/** … */` is one doc attribute of several lines; a carriage return
+    // (`#[doc = "a\rb"]`) ends a line too, which a `///` comment cannot hold
+    for line in sys.docs.iter().flat_map(|d| d.split(['\n', '\r'])) {
         let _ = writeln!(doc, "///{line}");
     }
     if !sys.docs.is_empty() {

@@ -61,10 +61,6 @@ mbs::multibody! {
     }
 }
 
-/// `half` is the model's l/2 = 1 even when first used inside `f(l)`, and `g` reads the
-/// coordinate x even when called from `k(x)`: f(3) + 10 k(5) = 3·1 + 10 (2x + 5). Names
-/// were bound for the whole of a call (dynamic scope): `half` became 3/2 for every use and
-/// `g(2.0)` read k's argument, 4.5 + 10 (2·5 + 5) = 154.5 at any x.
 mbs::multibody! {
     /// Three sliders pushed by a part's argument: a number written as integer arithmetic
     /// that does not divide (`3 / 2`, `i / 2`) is the real number the statement written out
@@ -91,6 +87,10 @@ fn a_part_s_argument_that_does_not_divide_is_a_real_number() {
     assert_eq!(h, [1.5, 2.5, 3.0]);
 }
 
+/// `half` is the model's l/2 = 1 even when first used inside `f(l)`, and `g` reads the
+/// coordinate x even when called from `k(x)`: f(3) + 10 k(5) = 3·1 + 10 (2x + 5). Names
+/// were bound for the whole of a call (dynamic scope): `half` became 3/2 for every use and
+/// `g(2.0)` read k's argument, 4.5 + 10 (2·5 + 5) = 154.5 at any x.
 #[test]
 fn inline_functions_see_their_own_arguments_and_the_models_names() {
     let model = Scoped::default();

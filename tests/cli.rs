@@ -536,11 +536,16 @@ fn programs_refuse_folders_and_options_they_would_get_wrong() {
 #[test]
 fn a_report_keeps_the_rotation_joints_of_its_trajectory() {
     let a = args(&["--t-end", "10", "--rtol", "1e-6"]);
-    let report = a.run(mbs_models::tumble::TumbleBall::default(), 10.0).unwrap();
+    let report = a
+        .run(mbs_models::tumble::TumbleBall::default(), 10.0)
+        .unwrap();
     let tr = &report.trajectory;
     assert_eq!(tr.joint_names.len(), 1);
     let last = tr.len() - 1;
     assert_eq!(tr.orientation(last).len(), 4);
-    assert!(tr.chart_numbers(last)[0] > 0, "the tumble re-centres its chart");
+    assert!(
+        tr.chart_numbers(last)[0] > 0,
+        "the tumble re-centres its chart"
+    );
     tr.check_fits(tr.q(0).len(), 1).unwrap();
 }

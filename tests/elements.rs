@@ -456,7 +456,10 @@ fn derivatives_at_a_kink_scaled_by_parameters_are_zero_not_nan() {
     let want_k = 0.7 * 4.0f64.powf(0.7) * x.powf(-0.3) + 0.5 * 100.0f64.sqrt() / x.sqrt();
     let want_c = -0.5 / (v.abs() / 0.01).sqrt() / 0.01;
     assert!((k - want_k).abs() < 1e-12 * want_k, "{k} against {want_k}");
-    assert!((c - want_c).abs() < 1e-12 * want_c.abs(), "{c} against {want_c}");
+    assert!(
+        (c - want_c).abs() < 1e-12 * want_c.abs(),
+        "{c} against {want_c}"
+    );
 }
 
 /// A one-coordinate model's tangent stiffness K and ∂τ/∂n (its one sensitive parameter) at

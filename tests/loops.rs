@@ -887,7 +887,12 @@ fn a_constraint_jacobian_that_is_not_finite_is_named() {
     let err = simulate(
         Rods::default(),
         Scheme::Dopri5,
-        options(0.1, adaptive(1e-6), ConstraintMethod::Projection, Output::Last),
+        options(
+            0.1,
+            adaptive(1e-6),
+            ConstraintMethod::Projection,
+            Output::Last,
+        ),
     )
     .unwrap_err();
     let text = err.to_string();
@@ -922,7 +927,10 @@ fn partitioning_retries_a_stage_that_does_not_close() {
     let reference = end(1e-3);
     for h0 in [0.2, 1.0, 2.0] {
         let q = end(h0);
-        let gap = q.iter().zip(&reference).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        let gap = q
+            .iter()
+            .zip(&reference)
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
         assert!(gap < 1e-4, "h0 = {h0}: {q:?} against {reference:?}");
     }
 }
@@ -941,5 +949,17 @@ fn a_failed_assembly_leaves_the_start_as_given() {
     };
     let e = mbs::assemble(&FourBar::default(), 0.0, &mut q, &mut qd, &o).unwrap_err();
     println!("{e}");
-    assert_eq!((q, qd), (q0, qd0));
+    assert_eq!((&q, &qd), (&q0, &qd0));
+    // velocities that are not finite do not make a start (they came back as Ok)
+    let mut qd = vec![f64::NAN, 0.0, 0.0];
+    let e = mbs::assemble(
+        &FourBar::default(),
+        0.0,
+        &mut q,
+        &mut qd,
+        &ConstraintOptions::default(),
+    )
+    .unwrap_err();
+    println!("{e}");
+    assert!(matches!(e, Failure::InconsistentStart { .. }), "{e:?}");
 }

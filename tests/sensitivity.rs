@@ -1174,7 +1174,11 @@ fn sensitivities_do_not_loosen_the_motion_s_control() {
                 scheme.name()
             );
             assert!(error <= 1.5 * plain_error, "{} at {rtol:e}", scheme.name());
-            assert!(s_error <= 20.0 * error.max(rtol), "{} at {rtol:e}", scheme.name());
+            assert!(
+                s_error <= 20.0 * error.max(rtol),
+                "{} at {rtol:e}",
+                scheme.name()
+            );
         }
     }
 }

@@ -787,7 +787,8 @@ fn a_scheme_s_parameters_are_settings_of_the_sweep() {
     let runs = plan.runs(Path::new(".")).unwrap();
     let dir = scratch("scheme_parameters");
     let order2 = Scheme::Bdf(BdfParams { max_order: 2 });
-    let sweep = |scheme: Scheme, plan: &Plan| Sweep::new(DoublePendulum::default, plan, scheme, base());
+    let sweep =
+        |scheme: Scheme, plan: &Plan| Sweep::new(DoublePendulum::default, plan, scheme, base());
     sweep(order2, &plan).unwrap().run(&dir, &runs).unwrap();
     let err = sweep(Scheme::Bdf(BdfParams::default()), &plan)
         .unwrap()

@@ -541,6 +541,9 @@ fn command_line_prints_the_block() {
             .expect("running mbs");
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(1), "{err}");
-        assert!(err.contains("cannot write the model") && !err.contains("panicked"), "{err}");
+        assert!(
+            err.contains("cannot write the model") && !err.contains("panicked"),
+            "{err}"
+        );
     }
 }

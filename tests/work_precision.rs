@@ -328,7 +328,9 @@ fn the_proportionality_table_puts_each_digit_under_its_rtol() {
     let header = fields_of(lines[1]);
     assert_eq!(
         header,
-        ["scheme", "1e-3", "1e-4", "1e-5", "1e-6", "slope", "offset", "loss"]
+        [
+            "scheme", "1e-3", "1e-4", "1e-5", "1e-6", "slope", "offset", "loss"
+        ]
     );
     // the columns are 7 characters wide after the label's: DOPRI5's row is blank under
     // 1e-5 and 1e-6, Radau5's under 1e-3
@@ -337,7 +339,10 @@ fn the_proportionality_table_puts_each_digit_under_its_rtol() {
     let (dopri, radau) = (lines[2], lines[3]);
     assert!(dopri.starts_with("dopri5") && radau.starts_with("radau5"));
     assert!(!cell(dopri, 0).is_empty() && !cell(dopri, 1).is_empty());
-    assert!(cell(dopri, 2).is_empty() && cell(dopri, 3).is_empty(), "{dopri}");
+    assert!(
+        cell(dopri, 2).is_empty() && cell(dopri, 3).is_empty(),
+        "{dopri}"
+    );
     assert!(cell(radau, 0).is_empty(), "{radau}");
     for k in 1..4 {
         assert!(cell(radau, k).parse::<f64>().is_ok(), "{radau}");

@@ -980,7 +980,37 @@ pub(crate) fn assemble_erased(
     for (k, &j) in free.iter().enumerate() {
         qd[j] -= dv[k];
     }
-    let (rate_after, _) = worst(&rate(qd));
+    // the correction solves through B W⁻¹ Bᵀ, whose condition is B's squared: a second one
+    // takes what rounding left, and what is left then is refused
+    let scale = (0..nc)
+        .map(|i| phi_t[i].abs() + (0..n).map(|j| (b[i + nc * j] * qd[j]).abs()).sum::<f64>())
+        .fold(0.0f64, f64::max);
+    let allowed = |r: f64| r <= 1e-9 * scale + o.tolerance;
+    let (mut rate_after, mut at) = worst(&rate(qd));
+    if !allowed(rate_after) && rate_after.is_finite() {
+        let r1 = rate(qd);
+        if let Some(dv) = least_correction(&b, &mm, &free, &r1) {
+            for (k, &j) in free.iter().enumerate() {
+                qd[j] -= dv[k];
+            }
+        }
+        (rate_after, at) = worst(&rate(qd));
+    }
+    if !allowed(rate_after) {
+        return Err(fail(
+            format!(
+                "the velocities do not satisfy constraint `{}`'s rate (|Φ̇| = {rate_after:.3e} after the correction{}): B over the coordinates not marked independent is ill-conditioned here, or the start's velocities are not finite; start elsewhere or mark other coordinates",
+                names[at],
+                if rate_before.is_finite() {
+                    ""
+                } else {
+                    ", not finite before it"
+                }
+            ),
+            &phi,
+            it,
+        ));
+    }
     let (change, moved) = (0..n)
         .map(|j| ((q[j] - q_start[j]).abs(), j))
         .fold((0.0, 0), |a, b| if b.0 > a.0 { b } else { a });

@@ -495,10 +495,11 @@
 //! | `<joint><origin xyz rpy>` | `Tdisp({joint}_dx, {joint}_dy, {joint}_dz) * Trotz(yaw) * Troty(pitch) * Trotx(roll)` (URDF's R = Rz·Ry·Rx) |
 //! | `revolute`, `continuous` | `dof {joint}` (limits, effort and velocity in a comment; starts at 0, or the nearer limit), then `Trotx/y/z({joint})` about a coordinate axis (`Trotz(-{joint})` for −z), `Trotn(nx, ny, nz, {joint})` about another |
 //! | `prismatic` | `Tdisp` along the axis |
-//! | `fixed` | the child's mass and inertia merged into its parent's (parallel axes); a massless child stays a `frame` |
+//! | `fixed` | the child's mass and inertia merged into its parent's (parallel axes), the joint's origin in numbers (the merge used them); a massless child stays a `frame` |
 //! | `floating` | `dof {joint}_x, _y, _z, _roll, _pitch, _yaw`: `Tdisp(x, y, z) * Trotz(yaw) * Troty(pitch) * Trotx(roll)` (singular at pitch = ±π/2) |
 //! | `planar` | `dof {joint}_x, _y, _theta`: two translations in the plane normal to the axis (the basis in a comment), then the rotation about it |
 //! | `<mimic joint multiplier offset>` | no coordinate: the joint turns by `multiplier * leader + offset` |
+//! | `<dynamics damping friction>` | `param {joint}_damping`, `{joint}_friction`; `generalized_force({joint}, -{joint}_damping * qd[{joint}])` in `effect joint_damping`, `generalized_force({joint}, -{joint}_friction * tanh(qd[{joint}] / joint_friction_eps))` in `effect joint_friction` (eps 0.01 rad/s or m/s); a mimic joint's on its leader, times the multiplier; not applied to floating and planar joints (a comment says so) |
 //! | `<visual>` box, cylinder, sphere | `shape` (`color` from its material); a mesh, or a box or cylinder turned off the link's axes, is a comment |
 //! | — | `param g = 9.81;` and `gravity(0, 0, -g);` (z up, as in ROS) |
 //!

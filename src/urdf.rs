@@ -12,12 +12,17 @@
 //!   roll–pitch–yaw, R = Rz·Ry·Rx) then its motion: `Trotx/y/z(q)` about a coordinate axis,
 //!   `Trotn(nx, ny, nz, q)` about another, `Tdisp` along the axis for a prismatic joint;
 //! - `fixed` joints merge the child's mass and inertia into its parent (a massless child
-//!   stays a `frame`); `floating` is `Tfree`: three translations and the Euler angles z, y, x
+//!   stays a `frame`), and the merged joint's origin stays numbers (the merged mass was
+//!   computed with it); `floating` is `Tfree`: three translations and the Euler angles z, y, x
 //!   in a chart the runtime re-centres before gimbal lock; `planar`
 //!   two translations in the plane and a rotation about its normal; a `mimic` joint follows
 //!   its leader (`multiplier * leader + offset`) without a coordinate of its own;
 //! - the root link is the ground (or, with [`ImportOptions::floating_base`], a body on a
 //!   floating joint); `gravity(0, 0, -g)` (z up, as in ROS);
+//! - a joint's `<dynamics damping friction>` is a `generalized_force` on its coordinate in
+//!   the effects `joint_damping` (−c q̇) and `joint_friction` (−f tanh(q̇ / eps), Coulomb
+//!   friction regularised below `joint_friction_eps` = 0.01 rad/s or m/s); a mimic joint's
+//!   acts on its leader, times the multiplier;
 //! - box, cylinder and sphere visuals become `shape` statements; meshes a comment.
 //!
 //! Masses, centres of mass, inertias and joint offsets (`{joint}_dx`, …) are parameters; angles
@@ -247,6 +252,8 @@ pub fn import_with(urdf: &str, options: ImportOptions) -> Result<Imported, UrdfE
                 axis: [1.0, 0.0, 0.0],
                 limit: None,
                 mimic: None,
+                damping: 0.0,
+                friction: 0.0,
             },
         );
         robot.links.push(Link {
@@ -406,6 +413,9 @@ struct Joint {
     /// lower, upper, effort, velocity (as given)
     limit: Option<[Option<f64>; 4]>,
     mimic: Option<Mimic>,
+    /// `<dynamics damping friction>` (each 0 when not given)
+    damping: f64,
+    friction: f64,
 }
 
 struct Robot {
@@ -651,6 +661,20 @@ fn read_robot(doc: &Document) -> Result<Robot, UrdfError> {
                 offset: optional_number(doc, m, "offset")?.unwrap_or(0.0),
             }),
         };
+        let (mut damping, mut friction) = (0.0, 0.0);
+        if let Some(d) = child(j, "dynamics") {
+            for (key, value) in [("damping", &mut damping), ("friction", &mut friction)] {
+                *value = optional_number(doc, d, key)?.unwrap_or(0.0);
+                if *value < 0.0 {
+                    return Err(UrdfError::BadValue {
+                        line: line(doc, d),
+                        what: format!("`{key}` of the `<dynamics>` of joint `{name}`"),
+                        value: num(*value),
+                        expected: format!("a {key} coefficient ≥ 0"),
+                    });
+                }
+            }
+        }
         joints.push(Joint {
             name,
             kind,
@@ -660,6 +684,8 @@ fn read_robot(doc: &Document) -> Result<Robot, UrdfError> {
             axis,
             limit,
             mimic,
+            damping,
+            friction,
         });
     }
     if links.is_empty() {
@@ -1096,6 +1122,11 @@ struct Writer<'a> {
     dofs: String,
     items: String,
     shapes: String,
+    /// the statements of the effects `joint_damping` and `joint_friction`
+    damping: String,
+    friction: String,
+    /// the parameter of friction's regularisation, once written
+    friction_eps: String,
 }
 
 impl<'a> Writer<'a> {
@@ -1116,6 +1147,9 @@ impl<'a> Writer<'a> {
             dofs: String::new(),
             items: String::new(),
             shapes: String::new(),
+            damping: String::new(),
+            friction: String::new(),
+            friction_eps: String::new(),
         }
     }
 
@@ -1265,6 +1299,11 @@ impl<'a> Writer<'a> {
                 self.pose(l, j);
             }
         }
+        for &(_, j) in &order {
+            if let Some(j) = j {
+                self.joint_dynamics(j);
+            }
+        }
         let ground: Vec<(usize, Rigid)> = self.on_ground.clone();
         for &(l, pose) in &ground {
             let link = &self.robot.links[l];
@@ -1298,7 +1337,19 @@ impl<'a> Writer<'a> {
         s.push_str(&self.dofs);
         s.push_str(&self.items);
         s.push_str(&self.shapes);
-        s.push_str("        gravity(0, 0, -g);\n    }\n");
+        s.push_str("        gravity(0, 0, -g);\n");
+        for (name, forces) in [
+            ("joint_damping", &self.damping),
+            ("joint_friction", &self.friction),
+        ] {
+            if !forces.is_empty() {
+                let name = self.names.fresh(name);
+                let _ = writeln!(s, "        effect {name} {{");
+                s.push_str(forces);
+                s.push_str("        }\n");
+            }
+        }
+        s.push_str("    }\n");
         Ok(Imported { name, model: s })
     }
 
@@ -1344,7 +1395,7 @@ impl<'a> Writer<'a> {
                     .collect();
                 let _ = writeln!(
                     self.dofs,
-                    "        // floating joint `{}`: position in the parent's axes, then Euler angles about \
+                    "        // floating joint `{}`: position in the axes of its `<origin>`, then Euler angles about \
                      z (yaw), y (pitch), x (roll)\n        // read in a chart the runtime re-centres \
                      before pitch reaches ±π/2 (`Tfree`)",
                     joint.name
@@ -1411,6 +1462,84 @@ impl<'a> Writer<'a> {
         );
         let bare = m.multiplier == 1.0 && m.offset == 0.0;
         self.motion[j] = vec![if bare { e } else { format!("({e})") }];
+    }
+
+    /// The damping and Coulomb friction of joint `j`'s `<dynamics>` as generalised forces on
+    /// its coordinate (for a mimic joint, on its leader's, times the multiplier: the power is
+    /// the same), in the effects `joint_damping` and `joint_friction`.
+    fn joint_dynamics(&mut self, j: usize) {
+        let joint = &self.robot.joints[j];
+        let (c, f) = (joint.damping, joint.friction);
+        if c == 0.0 && f == 0.0 || joint.kind == JointKind::Fixed {
+            return;
+        }
+        if matches!(joint.kind, JointKind::Floating | JointKind::Planar) {
+            let _ = writeln!(
+                self.shapes,
+                "        // joint `{}`: the damping and friction of its `<dynamics>` are not applied \
+                 to a floating or planar joint (add `generalized_force`s or a `bushing`)",
+                joint.name
+            );
+            return;
+        }
+        let (coordinate, speed, multiplier) = match &joint.mimic {
+            Some(m) => {
+                let leader = self.motion[self.tree.joint_index[&m.leader]][0].clone();
+                let speed = if m.multiplier == 1.0 {
+                    format!("qd[{leader}]")
+                } else {
+                    format!("{} * qd[{leader}]", lit(m.multiplier))
+                };
+                (leader, speed, (m.multiplier != 1.0).then_some(m.multiplier))
+            }
+            None => {
+                let q = self.motion[j][0].clone();
+                (q.clone(), format!("qd[{q}]"), None)
+            }
+        };
+        let units = if joint.kind == JointKind::Prismatic {
+            ("N·s/m", "N")
+        } else {
+            ("N·m·s/rad", "N·m")
+        };
+        let _ = writeln!(
+            self.params,
+            "        // joint `{}`: damping ({}) and Coulomb friction ({}) of its `<dynamics>`",
+            joint.name, units.0, units.1
+        );
+        let on = |force: String| match multiplier {
+            Some(m) => format!("{} * ({force})", lit(m)),
+            None => force,
+        };
+        let name = joint.name.clone();
+        if c > 0.0 {
+            let p = self.names.fresh(&format!("{name}_damping"));
+            let _ = writeln!(self.params, "        param {p} = {};", num(c));
+            let force = on(format!("-{p} * {speed}"));
+            let _ = writeln!(
+                self.damping,
+                "            generalized_force({coordinate}, {force});"
+            );
+        }
+        if f > 0.0 {
+            if self.friction_eps.is_empty() {
+                self.friction_eps = self.names.fresh("joint_friction_eps");
+                let _ = writeln!(
+                    self.params,
+                    "        // the speed (rad/s or m/s) below which joint friction is viscous: \
+                     f tanh(v / eps)\n        param {} = 0.01;",
+                    self.friction_eps
+                );
+            }
+            let p = self.names.fresh(&format!("{name}_friction"));
+            let _ = writeln!(self.params, "        param {p} = {};", num(f));
+            let eps = &self.friction_eps;
+            let force = on(format!("-{p} * tanh({speed} / {eps})"));
+            let _ = writeln!(
+                self.friction,
+                "            generalized_force({coordinate}, {force});"
+            );
+        }
     }
 
     fn declare_entity(&mut self, e: usize) {
@@ -1489,7 +1618,14 @@ impl<'a> Writer<'a> {
         let joint = &self.robot.joints[j];
         let mut f = Vec::new();
         let xyz = joint.origin.xyz;
-        if xyz != [0.0; 3] {
+        // the origin of a fixed joint whose link is merged into its parent's body stays a
+        // number: the merged mass, centre and inertia were computed with it
+        let child = &self.robot.links[self.tree.link_index[&joint.child]];
+        let merged = joint.kind == JointKind::Fixed && mass_of(child) > 0.0;
+        if xyz != [0.0; 3] && merged {
+            let parts = xyz.map(|x| if x == 0.0 { "0".to_string() } else { lit(x) });
+            f.push(format!("Tdisp({})", parts.join(", ")));
+        } else if xyz != [0.0; 3] {
             if !self.joint_params {
                 self.joint_params = true;
                 self.params

@@ -69,6 +69,8 @@ mbs::multibody! {
         TOG[fore_link] = TOG[upper_link] * Tdisp(0.5, 0, 0) * Troty(elbow);
         TOG[forearm] = TOG[fore_link] * Tdisp(0.2, 0, 0);
         gravity(0, 0, -9.81);
+        // the elbow's `<dynamics damping="0.5" friction="0.2">`
+        torque(forearm, relative_to = upper_arm, axis = y, -0.5 * qd[elbow] - 0.2 * tanh(qd[elbow] / 0.01));
     }
 
     /// tests/urdf/branched.urdf by hand: the battery and the right hand are bodies of their
@@ -117,6 +119,12 @@ mbs::multibody! {
         TOG[pin] = TOG[rotor_link] * Tdisp(0.1 + pin_slide / sqrt(3), pin_slide / sqrt(3), 0.1 + pin_slide / sqrt(3));
         TOG[wheel] = TOG[carriage_link] * Tdisp(0.15, 0, 0) * Trotx(PI / 2) * Trotn(0, 0, -1, 0.1 - 2 * tilt);
         gravity(0, 0, -9.81);
+        // the rail's `<dynamics damping="2">`, along x
+        force(carriage, (-2 * qd[rail_joint], 0, 0));
+        // the wheel's `<dynamics damping="0.05" friction="0.01">` about its −z, whose speed is
+        // −2 qd[tilt]: the torque τ about −z is −τ about z
+        torque(wheel, relative_to = carriage, axis = z,
+            0.05 * (-2 * qd[tilt]) + 0.01 * tanh(-2 * qd[tilt] / 0.01));
     }
 
     /// tests/urdf/floating.urdf by hand: the wall's plane is spanned by u = (0, −0.8, 0.6)
@@ -265,6 +273,22 @@ fn parameters_change_the_imported_model() {
 }
 
 #[test]
+fn merged_links_keep_the_origins_their_mass_was_computed_with() {
+    // the battery and the right hand are merged into the torso and the right arm: their
+    // joints' origins are numbers, not parameters that would move the children of a merged
+    // link but not its mass
+    let text = import_file(Path::new(&urdf_path("branched")), ImportOptions::default())
+        .unwrap()
+        .model;
+    for p in ["battery_mount_d", "wrist_mount_d", "mount_dz"] {
+        assert!(!text.contains(&format!("param {p}")), "{p}:\n{text}");
+    }
+    assert!(text.contains("TOG[right_arm_frame] * Tdisp(0, (-0.3), 0) * Troty(0.4)"));
+    // a massless link on a fixed joint stays a frame, its origin a parameter
+    assert!(text.contains("param neck_mount_dz = 0.65;"));
+}
+
+#[test]
 fn shapes_come_from_the_visuals() {
     let text = import_file(Path::new(&urdf_path("arm2")), ImportOptions::default())
         .unwrap()
@@ -314,6 +338,14 @@ fn bad_descriptions_are_typed_errors_naming_the_culprit() {
     );
     let e = error(&robot(&format!("{LINKS}{}", joint("j", "fixed", "a", "b"))));
     assert_eq!(e, UrdfError::NoMotion);
+    // a negative damping would feed energy in
+    let damped = r#"<joint name="j" type="revolute"><parent link="a"/><child link="b"/>
+        <dynamics damping="-0.1"/></joint>"#;
+    let e = error(&robot(&format!("{LINKS}{damped}")));
+    assert!(
+        matches!(&e, UrdfError::BadValue { what, .. } if what.contains("`damping`") && what.contains("joint `j`")),
+        "{e}"
+    );
     let e = error(&robot(&format!(
         "{LINKS}{}",
         joint("j", "revolute", "aa", "b")

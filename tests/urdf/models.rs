@@ -24,6 +24,11 @@ mbs::multibody! {
         // joint origins in the parent link frame (m)
         param shoulder_dz = 0.1;
         param elbow_dx = 0.5;
+        // joint `elbow`: damping (N·m·s/rad) and Coulomb friction (N·m) of its `<dynamics>`
+        param elbow_damping = 0.5;
+        // the speed (rad/s or m/s) below which joint friction is viscous: f tanh(v / eps)
+        param joint_friction_eps = 0.01;
+        param elbow_friction = 0.2;
         dof shoulder = 0.0; // revolute, limits [-3.14, 3.14] rad, effort 50.0 N·m, velocity 2.0 rad/s
         dof elbow = 0.0; // revolute, limits [-2.5, 2.5] rad, effort 30.0 N·m, velocity 3.0 rad/s
         body upper_arm { mass = upper_arm_m; inertia = (upper_arm_ixx, upper_arm_iyy, upper_arm_izz); }
@@ -37,6 +42,12 @@ mbs::multibody! {
         shape upper_arm: cylinder(0.03, 0.5, axis = x, color = "#3366cc");
         shape forearm: box(0.4, 0.04, 0.04);
         gravity(0, 0, -g);
+        effect joint_damping {
+            generalized_force(elbow, -elbow_damping * qd[elbow]);
+        }
+        effect joint_friction {
+            generalized_force(elbow, -elbow_friction * tanh(qd[elbow] / joint_friction_eps));
+        }
     }
 }
 }
@@ -97,18 +108,13 @@ mbs::multibody! {
         param finger_iyy = 5e-6;
         param finger_izz = 2e-5;
         // joint origins in the parent link frame (m)
-        param mount_dz = 0.5;
         param waist_dz = 0.05;
-        param battery_mount_dx = -0.1;
-        param battery_mount_dy = 0.05;
-        param battery_mount_dz = 0.2;
         param neck_mount_dz = 0.65;
         param neck_dz = 0.02;
         param left_shoulder_dy = 0.2;
         param left_shoulder_dz = 0.5;
         param right_shoulder_dy = -0.2;
         param right_shoulder_dz = 0.5;
-        param wrist_mount_dy = -0.3;
         param finger_joint_dx = 0.01;
         param finger_joint_dy = -0.08;
         dof waist = 0.0; // continuous
@@ -123,7 +129,7 @@ mbs::multibody! {
         body right_arm { mass = right_arm_m; inertia = (right_arm_ixx, right_arm_iyy, right_arm_izz, right_arm_ixy, right_arm_ixz, right_arm_iyz); }
         body finger { mass = finger_m; inertia = (finger_ixx, finger_iyy, finger_izz); }
         frame torso_frame;
-        TOG[torso_frame] = Tdisp(0, 0, mount_dz) * Trotz(0.3) * Tdisp(0, 0, waist_dz) * Trotz(waist);
+        TOG[torso_frame] = Tdisp(0, 0, 0.5) * Trotz(0.3) * Tdisp(0, 0, waist_dz) * Trotz(waist);
         TOG[torso] = TOG[torso_frame] * Tdisp(torso_cx, torso_cy, torso_cz);
         TOG[head_mount] = TOG[torso_frame] * Tdisp(0, 0, neck_mount_dz) * Troty(0.15);
         TOG[head] = TOG[head_mount] * Tdisp(0, 0, neck_dz) * Trotz(neck) * Tdisp(head_cx, 0, head_cz);
@@ -131,7 +137,7 @@ mbs::multibody! {
         frame right_arm_frame;
         TOG[right_arm_frame] = TOG[torso_frame] * Tdisp(0, right_shoulder_dy, right_shoulder_dz) * Trotz(-0.3) * Troty(0.2) * Trotx(-0.1) * Troty(-right_shoulder);
         TOG[right_arm] = TOG[right_arm_frame] * Tdisp(right_arm_cx, right_arm_cy, right_arm_cz);
-        TOG[finger] = TOG[right_arm_frame] * Tdisp(0, wrist_mount_dy, 0) * Troty(0.4) * Tdisp(finger_joint_dx, finger_joint_dy, 0) * Trotx(0.3) * Trotz(finger_joint) * Tdisp(0, finger_cy, 0);
+        TOG[finger] = TOG[right_arm_frame] * Tdisp(0, (-0.3), 0) * Troty(0.4) * Tdisp(finger_joint_dx, finger_joint_dy, 0) * Trotx(0.3) * Trotz(finger_joint) * Tdisp(0, finger_cy, 0);
         // link `base` is fixed to the ground: its mass (10.0 kg) does not move
         // link `base`: a visual turned off the link's axes is not drawn
         shape torso: box(0.2, 0.3, 0.6, at = (0.00887975174119749, (-0.01105229398850611), 0.02959600938488205));
@@ -182,6 +188,13 @@ mbs::multibody! {
         param pin_slide_dx = 0.1;
         param pin_slide_dz = 0.1;
         param wheel_joint_dx = 0.15;
+        // joint `rail_joint`: damping (N·s/m) and Coulomb friction (N) of its `<dynamics>`
+        param rail_joint_damping = 2.0;
+        // joint `wheel_joint`: damping (N·m·s/rad) and Coulomb friction (N·m) of its `<dynamics>`
+        param wheel_joint_damping = 0.05;
+        // the speed (rad/s or m/s) below which joint friction is viscous: f tanh(v / eps)
+        param joint_friction_eps = 0.01;
+        param wheel_joint_friction = 0.01;
         dof rail_joint = 0.0; // prismatic, limits [-1.0, 1.0] m, effort 100.0 N, velocity 1.0 m/s
         dof tilt = 0.0; // revolute, limits [-3.0, 3.0] rad, effort 10.0 N·m, velocity 5.0 rad/s
         dof pin_slide = 0.0; // prismatic, limits [-0.1, 0.2] m, effort 10.0 N, velocity 1.0 m/s
@@ -200,6 +213,13 @@ mbs::multibody! {
         TOG[wheel] = TOG[carriage_frame] * Tdisp(wheel_joint_dx, 0, 0) * Trotx(1.5707963267948966) * Trotz(-((-2.0) * tilt + 0.1));
         shape carriage: box(0.3, 0.2, 0.1, at = (0.0, 0.0, (-0.05)));
         gravity(0, 0, -g);
+        effect joint_damping {
+            generalized_force(rail_joint, -rail_joint_damping * qd[rail_joint]);
+            generalized_force(tilt, (-2.0) * (-wheel_joint_damping * (-2.0) * qd[tilt]));
+        }
+        effect joint_friction {
+            generalized_force(tilt, (-2.0) * (-wheel_joint_friction * tanh((-2.0) * qd[tilt] / joint_friction_eps)));
+        }
     }
 }
 }
@@ -237,7 +257,7 @@ mbs::multibody! {
         param free_dz = 1.0;
         param table_dx = 2.0;
         param wall_dy = 0.3;
-        // floating joint `free`: position in the parent's axes, then Euler angles about z (yaw), y (pitch), x (roll)
+        // floating joint `free`: position in the axes of its `<origin>`, then Euler angles about z (yaw), y (pitch), x (roll)
         // read in a chart the runtime re-centres before pitch reaches ±π/2 (`Tfree`)
         dof free_x = 0.0;
         dof free_y = 0.0;
@@ -292,7 +312,7 @@ mbs::multibody! {
         // joint origins in the parent link frame (m)
         param gimbal_dx = 0.1;
         param gimbal_dz = -0.05;
-        // floating joint `floating_base`: position in the parent's axes, then Euler angles about z (yaw), y (pitch), x (roll)
+        // floating joint `floating_base`: position in the axes of its `<origin>`, then Euler angles about z (yaw), y (pitch), x (roll)
         // read in a chart the runtime re-centres before pitch reaches ±π/2 (`Tfree`)
         dof floating_base_x = 0.0;
         dof floating_base_y = 0.0;

@@ -1,8 +1,9 @@
 //! Efforts written in Rust and extra first-order states ([`mbs::WithEfforts`]): the same
 //! force through the hook and in the DSL gives the same motion; extra states follow their
 //! exact solution with every scheme; the wrapper's tangents match differences of its τ; a
-//! failing user effort stops every scheme with its typed error and a trajectory free of NaN; a
-//! rejected trial state is retried with a smaller step.
+//! failing user effort stops every scheme with its typed error and a trajectory free of NaN (and
+//! an analysis with it; one before a run does not stop the run); a rejected trial state is
+//! retried with a smaller step.
 
 use mbs::{Effort, Efforts, Failure, Model, Options, Output, Scheme, Stats, WithEfforts, simulate};
 
@@ -374,6 +375,7 @@ fn failing_user_efforts_stop_every_scheme_with_a_typed_error() {
 
 /// A guard on the first bar's angle a little above the largest the motion reaches: the
 /// trial states of large steps can overshoot it where the motion never goes.
+#[derive(Clone)]
 struct Guard {
     limit: f64,
     reject: bool,
@@ -454,4 +456,41 @@ fn rejected_trial_states_are_retried_smaller() {
     .expect_err("the motion crosses the guard");
     assert!(matches!(e.kind, Failure::EffortRejected { .. }), "{e}");
     assert_eq!(e.stats.rejected_effort, 0);
+}
+
+#[test]
+fn a_user_failure_before_a_run_is_not_the_run_s() {
+    // the caller evaluates the model where its efforts fail (as a statics' trial state
+    // may), then runs it from a start where they do not: the run is not stopped at t0 by
+    // the earlier failure
+    let model = WithEfforts::new(
+        DpBare::default(),
+        Guard {
+            limit: 1.0,
+            reject: false,
+        },
+    );
+    let (mut m, mut h) = ([0.0; 4], [0.0; 2]);
+    model.dynamics(0.0, &[1.5, 0.0], &[0.0; 2], &[], &mut m, &mut h);
+    let (tr, _) = simulate(model, Scheme::Dopri5, Options::adaptive(0.3, 1e-6))
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(tr.t.last(), Some(&0.3));
+}
+
+#[test]
+fn an_analysis_reports_the_user_s_failure() {
+    // statics at a state where the efforts fail: the user's message, not a NaN it caused
+    let model = WithEfforts::new(
+        DpBare::default(),
+        Guard {
+            limit: 0.1,
+            reject: false,
+        },
+    );
+    let e = mbs::static_equilibrium(&model, &mbs::StaticsOptions::default())
+        .expect_err("the efforts fail at the start");
+    assert!(
+        matches!(&e, mbs::AnalysisError::Failure(Failure::UserEffort { message, .. }) if message.contains("beyond")),
+        "{e}"
+    );
 }

@@ -173,8 +173,14 @@ fn central_difference<E>(
     Ok(())
 }
 
-/// The first non-finite entry of `v` (NQ-periodic, named by its coordinate) as an error.
+/// The first non-finite entry of `v` (NQ-periodic, named by its coordinate) as an error; a
+/// failure of user code in the evaluations before it ([`crate::WithEfforts`]) first, as in
+/// simulations (a NaN it caused is only its symptom), which also leaves none behind for a
+/// later run once an analysis has probed a trial state that failed.
 fn check<M: Model>(model: &M, quantity: &'static str, v: &[f64]) -> Result<(), AnalysisError> {
+    if let Some(f) = model.take_failure() {
+        return Err(f.into());
+    }
     let info = model.info();
     check_named(quantity, v, |i| info.dof_label(i % M::NQ.max(1)))
 }

@@ -118,6 +118,9 @@ impl Loops {
 
 impl Problem {
     pub fn new(model: Box<dyn OwnedModel>, iteration: IterationMatrix) -> Problem {
+        // a failure of user code in evaluations before the run (an analysis's trial states,
+        // the caller's own calls) is not this run's
+        let _ = model.take_failure();
         let (n, nu, nc) = (model.nq(), model.nu(), model.nc());
         let forward = model.forward_dynamics_generated();
         let info = model.info();

@@ -29,6 +29,7 @@ mbs::multibody! {
 }
 
 /// The DSL's `extra` effect written in Rust.
+#[derive(Clone)]
 struct Extra {
     bar1: usize,
     bar2: usize,
@@ -493,4 +494,31 @@ fn an_analysis_reports_the_user_s_failure() {
         matches!(&e, mbs::AnalysisError::Failure(Failure::UserEffort { message, .. }) if message.contains("beyond")),
         "{e}"
     );
+}
+
+#[test]
+fn a_linearisation_with_efforts_in_rust_is_not_called_exact() {
+    // the wrapped model's tangents are generated, the efforts written in Rust differenced
+    let bare = DpBare::default();
+    let extra = Extra::new(bare.info());
+    let lin = mbs::linearize(
+        &DpFull::default(),
+        0.0,
+        &[0.2, 0.1],
+        &[0.0; 2],
+        &[],
+        mbs::IterationMatrix::Auto,
+    )
+    .unwrap();
+    assert!(lin.exact);
+    let lin = mbs::linearize(
+        &WithEfforts::new(bare, extra),
+        0.0,
+        &[0.2, 0.1],
+        &[0.0; 2],
+        &[],
+        mbs::IterationMatrix::Auto,
+    )
+    .unwrap();
+    assert!(!lin.exact);
 }

@@ -791,6 +791,11 @@ impl<M: Model, E: Efforts> Model for WithEfforts<M, E> {
         self.failure.borrow_mut().take()
     }
 
+    // the efforts written in Rust are differenced (forward) within `tangents`
+    fn tangents_exact(&self) -> bool {
+        false
+    }
+
     fn user_evaluations(&self) -> usize {
         self.evaluations.get()
     }

@@ -826,6 +826,13 @@ pub trait Model {
         c: &mut [f64],
     ) -> Result<(), ModelError>;
 
+    /// Whether [`Model::tangents`], where the model has them, are exact throughout: true for
+    /// generated tangents, false for a wrapper that differences a part of them
+    /// ([`crate::WithEfforts`]: its efforts written in Rust, by forward differences).
+    fn tangents_exact(&self) -> bool {
+        true
+    }
+
     /// K_t = ∂τ/∂q and C_t = ∂τ/∂qd (NQ × NQ each, column-major, into `out`) at
     /// `state` = (q, qd, qdd) by forward differences of [`Model::inverse_dynamics`], what the schemes use without generated tangents; returns
     /// how many evaluations of τ it made. The default differences τ along each coordinate's

@@ -67,7 +67,9 @@ pub struct Linearization {
     /// A (2nz × 2nz), B (2nz × nu)
     pub a: DMatrix<f64>,
     pub b: DMatrix<f64>,
-    /// whether C and K come from exact tangents (else central differences)
+    /// whether C and K are exact: from generated tangents throughout (false for central
+    /// differences, and for [`crate::WithEfforts`], whose efforts written in Rust are
+    /// differenced within its tangents)
     pub exact: bool,
     /// names of the coordinates z of `a`, `b` and the reduced matrices: every coordinate
     /// without constraints, the independent ones with constraints
@@ -292,7 +294,7 @@ fn linearize_in_chart<M: Model>(
             bu,
             a,
             b,
-            exact,
+            exact: exact && model.tangents_exact(),
             independent: (0..n).collect(),
             marks_used: false,
             basis: DMatrix::identity(n, n),
@@ -420,7 +422,7 @@ fn linearize_in_chart<M: Model>(
         bu,
         a,
         b: bs,
-        exact,
+        exact: exact && model.tangents_exact(),
         coordinates,
         independent: part.ind.clone(),
         marks_used: part.marked,

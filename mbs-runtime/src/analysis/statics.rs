@@ -78,7 +78,8 @@ pub enum Stability {
     /// some eigenvalue negative: a small push grows
     Unstable,
     /// no negative eigenvalue but some zero (within 1e-12 of the largest with exact
-    /// tangents, 1e-9 with differences): neutral directions
+    /// tangents, 1e-9 with central differences, 1e-7 when part of the tangents is forward
+    /// differences, as [`crate::WithEfforts`]' efforts written in Rust): neutral directions
     Neutral,
 }
 
@@ -201,6 +202,18 @@ pub(super) fn stiffness<M: Model>(
         }
     }
     Ok(())
+}
+
+/// The relative error of the K that [`stiffness`] takes: rounding (a part in 10¹²) for exact
+/// tangents; about √ε ≈ 1.5e-8 where a part is forward differences (a wrapper's efforts
+/// written in Rust, [`Model::tangents_exact`]), a part in 10⁷ with a margin; a part in 10⁹ for
+/// central differences (their truncation and rounding, about ε^⅔ ≈ 4e-11, with a margin).
+fn stiffness_error<M: Model>(model: &M, how: IterationMatrix) -> f64 {
+    match (exact_stiffness(model, how), model.tangents_exact()) {
+        (true, true) => 1e-12,
+        (true, false) => 1e-7,
+        (false, _) => 1e-9,
+    }
 }
 
 /// Whether [`stiffness`] takes K from the exact tangents (else from differences).
@@ -441,8 +454,8 @@ fn unconstrained<M: Model>(
     let ks = nalgebra::DMatrix::from_fn(nf, nf, |r, c| {
         0.5 * (k[free[r] + n * free[c]] + k[free[c] + n * free[r]])
     });
-    let exact = exact_stiffness(model, options.stiffness);
-    let (stiffness_eigenvalues, stability) = classify(&ks, exact);
+    let error = stiffness_error(model, options.stiffness);
+    let (stiffness_eigenvalues, stability) = classify(&ks, error);
     Ok(Equilibrium {
         q,
         residual,
@@ -483,18 +496,17 @@ fn within_step(delta: &[f64], q: &[f64], free: &[usize], options: &StaticsOption
 
 /// Eigenvalues (ascending) of a symmetric stiffness and the stability they mean (`Stable`
 /// with no eigenvalue: nothing left free to move). An eigenvalue counts as zero within the
-/// stiffness' own error times its largest eigenvalue: a part in 10¹² for exact tangents
-/// (rounding), a part in 10⁹ for central differences (their truncation and rounding, about
-/// ε^⅔ ≈ 4e-11 of it). Beside a stiff spring the threshold was a part in 10⁹ for both: with
-/// a 1e10 N/m spring, an inverted pendulum's −0.49 N·m/rad was called neutral.
-fn classify(ks: &DMatrix<f64>, exact: bool) -> (Vec<f64>, Stability) {
+/// stiffness' own relative error ([`stiffness_error`]) times its largest eigenvalue. Beside
+/// a stiff spring the threshold was a part in 10⁹ for exact tangents too: with a 1e10 N/m
+/// spring, an inverted pendulum's −0.49 N·m/rad was called neutral.
+fn classify(ks: &DMatrix<f64>, error: f64) -> (Vec<f64>, Stability) {
     if ks.nrows() == 0 {
         return (Vec::new(), Stability::Stable);
     }
     let mut eig: Vec<f64> = ks.symmetric_eigenvalues().iter().copied().collect();
     eig.sort_by(f64::total_cmp);
     let scale = eig.iter().fold(0.0f64, |m, e| m.max(e.abs()));
-    let zero = if exact { 1e-12 } else { 1e-9 } * scale;
+    let zero = error * scale;
     let stability = if eig.iter().any(|&e| e < -zero) {
         Stability::Unstable
     } else if eig.iter().any(|&e| e <= zero) {
@@ -730,8 +742,8 @@ fn constrained<M: Model>(
     // stability from the reduced stiffness Nᵀ(K − G)N, N orthonormal over the free coordinates
     // (k and g are at q and λ)
     let kr = reduced_stiffness(model, options, free, &st.b, (&k, &g))?;
-    let exact = exact_stiffness(model, options.stiffness);
-    let (stiffness_eigenvalues, stability) = classify(&kr.0, exact);
+    let error = stiffness_error(model, options.stiffness);
+    let (stiffness_eigenvalues, stability) = classify(&kr.0, error);
     Ok(Equilibrium {
         residual: st.force_residual(),
         constraint_residual: st.constraint_residual(),

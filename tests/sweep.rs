@@ -806,3 +806,72 @@ fn a_scheme_s_parameters_are_settings_of_the_sweep() {
     assert_eq!((s.skipped, s.ran), (2, 0));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+mbs::multibody! {
+    /// A spherical pendulum released 0.57 rad from hanging, where the ZYX chart it starts in
+    /// locks: its runs end in charts of their own.
+    model Swinging {
+        dof a = 0.0; dof b = 1.0; dof c = 0.0;
+        body bob { mass = 1.0; inertia = (0.01, 0.02, 0.02); }
+        TOG[bob] = Tball(a, b, c) * Tdisp(1.0, 0.0, 0.2);
+        gravity(0, 0, -9.81);
+    }
+}
+
+/// A rotation joint's final angles and rates in a sweep's table are read in the chart the
+/// start is given in, not the one each run happened to end in: the same orientation and
+/// angular velocity as the run's last output.
+#[test]
+fn final_angles_are_read_in_the_chart_of_the_start() {
+    use mbs::charts::{body_rates, zyx};
+    let plan = Plan::from_toml(
+        "[sweep]\ndesign = \"grid\"\n[[vary]]\nname = \"qd0.a\"\nvalues = [0.0, 0.7]\n",
+    )
+    .unwrap();
+    let runs = plan.runs(Path::new(".")).unwrap();
+    let dir = scratch("charts");
+    let sweep = Sweep::new(Swinging::default, &plan, Scheme::Dopri5, base())
+        .unwrap()
+        .metrics(Metrics::final_state(&Swinging::default()));
+    assert_eq!(sweep.run(&dir, &runs).unwrap().failed, 0);
+    let table = dir.join("results.csv");
+    let read = |name: &str| -> Vec<f64> {
+        column(&table, name)
+            .iter()
+            .map(|x| x.parse().unwrap())
+            .collect()
+    };
+    let (a, b, c) = (read("q_end.a"), read("q_end.b"), read("q_end.c"));
+    let (ad, bd, cd) = (read("qd_end.a"), read("qd_end.b"), read("qd_end.c"));
+    for (k, spin) in [0.0, 0.7].into_iter().enumerate() {
+        let model = Swinging::default();
+        let (mut q0, mut qd0) = (vec![0.0; 3], vec![0.0; 3]);
+        model.initial_state(&mut q0, &mut qd0);
+        qd0[0] = spin;
+        let o = Options {
+            q0: Some(q0),
+            qd0: Some(qd0),
+            ..base()
+        };
+        let (tr, _) = simulate(model, Scheme::Dopri5, o).unwrap();
+        let last = tr.len() - 1;
+        let chart = tr.chart(last, 0);
+        assert_ne!(chart, mbs::IDENTITY3, "run {k} ends in another chart");
+        let (q, qd) = (tr.q(last), tr.qd(last));
+        let r = nalgebra::Matrix3::from_fn(|i, j| chart[i][j]) * zyx([q[0], q[1], q[2]]);
+        let table_r = zyx([a[k], b[k], c[k]]);
+        assert!(
+            (r - table_r).amax() < 1e-9,
+            "run {k}: {r} against {table_r}"
+        );
+        let w = body_rates([q[0], q[1], q[2]], [qd[0], qd[1], qd[2]]);
+        let table_w = body_rates([a[k], b[k], c[k]], [ad[k], bd[k], cd[k]]);
+        for i in 0..3 {
+            assert!(
+                (w[i] - table_w[i]).abs() < 1e-9,
+                "run {k}: ω {w:?} against {table_w:?}"
+            );
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -258,6 +258,33 @@ pub fn reread_angles<M: Model>(from: &M, to: &M, q: &mut [f64]) {
     }
 }
 
+/// Reads a rotation joint's angles and rates at (q, qd), measured in `chart`, in the identity
+/// chart, the one a model starts with and initial states are given in: the same orientation
+/// (angles a and c in (−π, π], b in [−π/2, π/2]) and the same angular velocity. The rates are
+/// singular where the identity chart is, at b = ±π/2. A joint already in the identity chart
+/// is left as it is (its angles continuous, not wrapped).
+pub fn in_identity_chart(
+    joint: &RotationJoint,
+    chart: &[[f64; 3]; 3],
+    q: &mut [f64],
+    qd: &mut [f64],
+) {
+    if *chart == crate::model::IDENTITY3 {
+        return;
+    }
+    let w = body_rates(angles_of(joint, q), joint.angles.map(|k| qd[k]));
+    let angles = zyx_angles_of(quaternion_near(&joint_rotation(chart, joint, q), None));
+    let (sb, cb) = angles[1].sin_cos();
+    let (sc, cc) = angles[2].sin_cos();
+    // body_rates inverted: ω_y s_c + ω_z c_c = ȧ c_b, ω_y c_c − ω_z s_c = ḃ, ω_x = ċ − ȧ s_b
+    let ad = (w[1] * sc + w[2] * cc) / cb;
+    let rates = [ad, w[1] * cc - w[2] * sc, w[0] + ad * sb];
+    for (i, &k) in joint.angles.iter().enumerate() {
+        q[k] = angles[i];
+        qd[k] = rates[i];
+    }
+}
+
 /// Sets the charts of `model` to those output `i` of `tr` was read in, so that the model's
 /// functions (kinematics, energies, M and h) evaluate that output's q and qd as the
 /// simulation did.

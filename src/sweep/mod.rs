@@ -49,6 +49,7 @@ mod table;
 pub use plan::{Design, DesignKind, Plan, RunList, SimulationSpec, SlurmSpec, Value, Variable};
 pub use table::{MergeReport, merge};
 
+use crate::charts::in_identity_chart;
 use crate::{ConstraintMethod, Integrator, LANES, Trajectory};
 use crate::{Model, Options, Output, Parameters, Scheme, SimError, Simulation, StepControl};
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -144,22 +145,29 @@ impl<M: Model> Metrics<M> {
     /// vary, whose column it would have doubled), each coordinate and velocity there
     /// (`q_end.NAME`, `qd_end.NAME`) and the energy drift max |E(t) − E(0)| relative to max(|E(0)|, max
     /// kinetic energy) (`energy_drift`; NaN if energy was not recorded): the metrics of the
-    /// per-system programs' sweeps.
+    /// per-system programs' sweeps. A rotation joint's angles and their rates are read in the
+    /// identity chart, the one initial states are given in, whatever chart each run ended in
+    /// ([`crate::charts::in_identity_chart`]), so that runs compare.
     pub fn final_state(model: &M) -> Metrics<M> {
         let dofs = model.info().dofs;
         let mut names = vec!["t_last".to_string()];
         names.extend(dofs.iter().map(|d| format!("q_end.{d}")));
         names.extend(dofs.iter().map(|d| format!("qd_end.{d}")));
         names.push("energy_drift".into());
-        Metrics::new(names, |_: &M, tr: &Trajectory| {
+        Metrics::new(names, |model: &M, tr: &Trajectory| {
             let mut v = Vec::with_capacity(2 * tr.nq() + 2);
             let last = tr.len().saturating_sub(1);
             v.push(tr.t.last().copied().unwrap_or(f64::NAN));
             if tr.is_empty() {
                 v.extend(std::iter::repeat_n(f64::NAN, 2 * tr.nq()));
             } else {
-                v.extend_from_slice(tr.q(last));
-                v.extend_from_slice(tr.qd(last));
+                let (mut q, mut qd) = (tr.q(last).to_vec(), tr.qd(last).to_vec());
+                let joints = tr.joint_names.len();
+                for (j, joint) in model.info().rotation_joints.iter().enumerate().take(joints) {
+                    in_identity_chart(joint, &tr.chart(last, j), &mut q, &mut qd);
+                }
+                v.extend_from_slice(&q);
+                v.extend_from_slice(&qd);
             }
             v.push(tr.relative_energy_drift().unwrap_or(f64::NAN));
             v

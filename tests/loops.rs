@@ -963,3 +963,83 @@ fn a_failed_assembly_leaves_the_start_as_given() {
     println!("{e}");
     assert!(matches!(e, Failure::InconsistentStart { .. }), "{e:?}");
 }
+
+mbs::multibody! {
+    /// A parallelogram four-bar turning freely (no gravity, the crank at 5 rad/s): every half
+    /// turn it folds flat, a change point where B loses rank and the motion can go on as a
+    /// parallelogram (b = 0, c = a) or switch to the crossed, antiparallelogram branch.
+    model Parallelogram {
+        param l0 = 0.4; param l1 = 0.1; param l2 = 0.4; param l3 = 0.1;
+        dof a = PI / 3, qd = 5.0, independent;
+        dof b = 0.01;
+        dof c = 1.0;
+        body crank { mass = l1; inertia = (0, l1 * l1 * l1 / 12, l1 * l1 * l1 / 12); }
+        body coupler { mass = l2; inertia = (0, l2 * l2 * l2 / 12, l2 * l2 * l2 / 12); }
+        body rocker { mass = l3; inertia = (0, l3 * l3 * l3 / 12, l3 * l3 * l3 / 12); }
+        point coupler_end on coupler at (l2 / 2, 0, 0);
+        point rocker_tip on rocker at (l3 / 2, 0, 0);
+        TOG[crank] = Trotz(a) * Tdisp(l1 / 2, 0, 0);
+        TOG[coupler] = TOG[crank] * Tdisp(l1 / 2, 0, 0) * Trotz(b - a) * Tdisp(l2 / 2, 0, 0);
+        TOG[rocker] = Tdisp(l0, 0, 0) * Trotz(c) * Tdisp(l3 / 2, 0, 0);
+        constraint close: coincide(coupler_end, rocker_tip, along = [x, y]);
+    }
+}
+
+/// A scheme that comes close to a change point stops there with `SingularLoop`, naming the
+/// constraint that loses rank, its trajectory kept on the branch it was on; one whose steps
+/// pass over it stays on that branch. No run leaves it silently (Radau5 with projection
+/// went on as an antiparallelogram, the crank slowed from 5 to 3 rad/s).
+#[test]
+fn a_change_point_of_a_loop_stops_the_run_rather_than_switching_branch() {
+    // on the parallelogram branch b = 0 and c = a (mod 2π), the crank at 5 rad/s
+    let on_branch = |q: &[f64], qd: &[f64]| {
+        let wrap = |x: f64| (x + PI).rem_euclid(2.0 * PI) - PI;
+        wrap(q[1]).abs() < 1e-4 && wrap(q[2] - q[0]).abs() < 1e-4 && (qd[0] - 5.0).abs() < 1e-3
+    };
+    let mut stopped = Vec::new();
+    for scheme in [
+        Scheme::Dopri5,
+        Scheme::Radau5,
+        Scheme::Bdf(Default::default()),
+        gen_alpha(),
+    ] {
+        for method in [
+            ConstraintMethod::Index3,
+            ConstraintMethod::Index2,
+            ConstraintMethod::Projection,
+            ConstraintMethod::Partitioning,
+        ] {
+            let name = format!("{} {method:?}", scheme.name());
+            let o = options(2.0, adaptive(1e-6), method, Output::Steps);
+            let tr = match simulate(Parallelogram::default(), scheme, o) {
+                Ok((tr, _)) => tr,
+                Err(e) if matches!(e.kind, Failure::ConstraintsUnsupported { .. }) => continue,
+                Err(e) => {
+                    println!("{name}: {e}");
+                    let Failure::SingularLoop { constraints, .. } = &e.kind else {
+                        panic!("{name}: {e}");
+                    };
+                    assert_eq!(constraints, &["close.x"], "{name}");
+                    // stopped at a change point: a = π, 2π or 3π
+                    let a = e.trajectory.q(e.trajectory.len() - 1)[0];
+                    assert!((a / PI - (a / PI).round()).abs() < 0.01, "{name}: a = {a}");
+                    stopped.push(name.clone());
+                    *e.trajectory
+                }
+            };
+            for i in 0..tr.len() {
+                assert!(
+                    on_branch(tr.q(i), tr.qd(i)),
+                    "{name}: off the branch at t = {}: q {:?}, qd {:?}",
+                    tr.t[i],
+                    tr.q(i),
+                    tr.qd(i)
+                );
+            }
+        }
+    }
+    // Radau5 comes close with every method that iterates on the constraints
+    for method in ["Index3", "Index2", "Projection"] {
+        assert!(stopped.contains(&format!("radau5 {method}")), "{stopped:?}");
+    }
+}

@@ -246,6 +246,24 @@ impl HeldBy {
     }
 }
 
+/// The matrix a closed loop's watch factorises ([`Failure::SingularLoop`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum LoopMatrix {
+    /// S = B M⁻¹ Bᵀ, of every index-1 solve
+    Schur,
+    /// B Bᵀ, after every step of the index-3 and stabilized index-2 forms
+    Gram,
+}
+
+impl std::fmt::Display for LoopMatrix {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            LoopMatrix::Schur => "S = B M⁻¹ Bᵀ",
+            LoopMatrix::Gram => "B Bᵀ",
+        })
+    }
+}
+
 /// Why a simulation stopped early. Each variant carries what is needed to act on it; the
 /// time, step, work done and the trajectory so far travel with it in
 /// [`SimError`](crate::SimError).
@@ -307,6 +325,24 @@ pub enum Failure {
         dependent: Vec<String>,
         /// the pivot of M's factorisation (dense Cholesky, or the generated forward dynamics)
         /// that fell most, over its start value
+        ratio: f64,
+        /// `Options::singularity_tol`
+        tolerance: f64,
+    },
+    #[error(
+        "the closed loops reach a singular configuration at {coordinate} = {value:.6} (a change point or dead centre): B = ∂Φ/∂q nearly loses rank in the constraints {} (a pivot of {matrix} fell to {ratio:.1e} of its start value, below singularity_tol = {tolerance:.0e}), and the motion through it is not unique (the mechanism may switch branch): add what decides it (a constraint, a stop, a driving input) or end the run before it",
+        constraints.join(", ")
+    )]
+    SingularLoop {
+        /// the coordinate the singularity depends on: the largest |∂ log det (B Bᵀ)/∂q_j|
+        coordinate: String,
+        /// its value
+        value: f64,
+        /// the constraints of B's smallest singular value (its left singular vector)
+        constraints: Vec<String>,
+        /// the matrix whose factorisation was watched
+        matrix: LoopMatrix,
+        /// the pivot of its Cholesky factor that fell most, over its start value
         ratio: f64,
         /// `Options::singularity_tol`
         tolerance: f64,

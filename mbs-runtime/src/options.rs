@@ -513,7 +513,11 @@ pub struct Options {
     /// configurations the pivots stay above 1.5e-2 of their start values for chain16, chain24
     /// and arm3d_6, 8.9e-2 for the hexapod (pitch within ±1.3 rad), while a body on ZYX
     /// Euler angles crosses 1e-4 between 0.01 and 0.05 rad from gimbal lock (depending on
-    /// the spread of its inertia)
+    /// the spread of its inertia). Closed loops are watched alike for change points and dead
+    /// centres, where B = ∂Φ/∂q loses rank (`Failure::SingularLoop`): the Cholesky pivots of
+    /// S = B M⁻¹ Bᵀ at every index-1 solve, and of B Bᵀ after every step of the index-3 and
+    /// stabilized index-2 forms (one evaluation of B each, counted in `Stats::loop_checks`),
+    /// against their start values
     #[serde(default = "default_singularity_tol")]
     pub singularity_tol: f64,
     /// re-centre the chart of a rotation joint (`Tball`, `Tfree`: ZYX angles a, b, c read in a

@@ -52,6 +52,10 @@ pub struct Stats {
     /// τ: `Options::singularity_tol`), and once at the start of an implicit scheme when the
     /// generated forward dynamics solved for the start's accelerations (the reference)
     pub condition_checks: usize,
+    /// Cholesky factorisations of B Bᵀ made only to watch closed loops for a change point
+    /// (after each accepted step of the index-3 and stabilized index-2 forms, one evaluation
+    /// of B each, counted in `constraints`: `Options::singularity_tol`)
+    pub loop_checks: usize,
     /// Newton iterations, all steps together
     pub newton_iterations: usize,
     /// smallest and largest accepted step
@@ -161,6 +165,7 @@ impl Stats {
             (&mut self.factorizations, other.factorizations),
             (&mut self.solves, other.solves),
             (&mut self.condition_checks, other.condition_checks),
+            (&mut self.loop_checks, other.loop_checks),
             (&mut self.newton_iterations, other.newton_iterations),
             (&mut self.stiff_detections, other.stiff_detections),
         ];
@@ -243,6 +248,13 @@ impl fmt::Display for Stats {
                 f,
                 "; {} Cholesky factorisations of M to watch its conditioning",
                 self.condition_checks
+            )?;
+        }
+        if self.loop_checks > 0 {
+            write!(
+                f,
+                "; {} Cholesky factorisations of B Bᵀ to watch the loops",
+                self.loop_checks
             )?;
         }
         if self.error_test != ErrorTest::None {

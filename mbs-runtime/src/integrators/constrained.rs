@@ -22,7 +22,7 @@
 use super::State;
 use super::at::At;
 use crate::erased::ErasedModel;
-use crate::error::Failure;
+use crate::error::{Failure, LoopMatrix};
 use crate::linalg::{Lu, Singular, backward, cholesky, cholesky_solve, forward, norm1};
 use crate::options::ConstraintOptions;
 use crate::stats::Stats;
@@ -88,6 +88,14 @@ pub(crate) struct Constrained {
     qp: Vec<f64>,
     rate0: Vec<f64>,
     phi_tp: Vec<f64>,
+    /// the watch of the loops' conditioning (`Options::singularity_tol`, 0: none, until the
+    /// start is made): the Cholesky pivots of S at the start, against which every index-1
+    /// solve's are judged, and those of B Bᵀ (in `bbt`), against which the states after the
+    /// steps of index-3 and index-2 forms are judged
+    watch_tol: f64,
+    start_s: Vec<f64>,
+    start_bbt: Vec<f64>,
+    bbt: Vec<f64>,
 }
 
 /// What a completion that does not close names ([`Failure::ClosureFailed`]).
@@ -131,6 +139,133 @@ impl Constrained {
             qp: z(n),
             rate0: z(nc),
             phi_tp: z(nc),
+            watch_tol: 0.0,
+            start_s: z(nc),
+            start_bbt: z(nc),
+            bbt: z(nc * nc),
+        }
+    }
+
+    /// Watches the loops' conditioning from now on (`tolerance` > 0), against S's factor
+    /// (in `s`, of the index-1 solve just made at the start) and B Bᵀ at the B just
+    /// evaluated there. A change point (a parallelogram four-bar folding flat, an isosceles
+    /// slider-crank's slider reaching the crank's pivot) makes B lose rank; near it λ grows
+    /// as 1/σ and a scheme's small steps can leave the branch the motion was on, silently.
+    pub fn watch_from_start(&mut self, tolerance: f64) {
+        let nc = self.nc;
+        for i in 0..nc {
+            self.start_s[i] = self.s[i + nc * i].powi(2);
+        }
+        if self.gram().is_ok() {
+            for i in 0..nc {
+                self.start_bbt[i] = self.bbt[i + nc * i].powi(2);
+            }
+            self.watch_tol = tolerance;
+        }
+    }
+
+    /// The Cholesky factor of B Bᵀ (of `self.b`) into `bbt`.
+    fn gram(&mut self) -> Result<(), Singular> {
+        let (n, nc) = (self.n, self.nc);
+        for i in 0..nc {
+            for j in 0..=i {
+                let x = (0..n)
+                    .map(|k| self.b[i + nc * k] * self.b[j + nc * k])
+                    .sum();
+                self.bbt[i + nc * j] = x;
+                self.bbt[j + nc * i] = x;
+            }
+        }
+        cholesky(&mut self.bbt, nc)
+    }
+
+    /// The pivot of a Cholesky factor (nc × nc) that fell most against its start value.
+    fn fallen(factor: &[f64], start: &[f64], nc: usize) -> f64 {
+        (0..nc).fold(f64::INFINITY, |m, i| {
+            m.min(factor[i + nc * i].powi(2) / start[i])
+        })
+    }
+
+    /// Judges S's factor (just made by an index-1 solve at (t, q)) against the start.
+    fn judge_schur(
+        &mut self,
+        m: &dyn ErasedModel,
+        st: &mut Stats,
+        t: f64,
+        q: &[f64],
+    ) -> Result<(), Failure> {
+        let ratio = Self::fallen(&self.s, &self.start_s, self.nc);
+        if ratio < self.watch_tol {
+            return Err(self.singular_loop(m, st, t, q, LoopMatrix::Schur, ratio));
+        }
+        Ok(())
+    }
+
+    /// Judges B Bᵀ at the state (t, q) a step of an index-3 or index-2 form accepted.
+    fn judge_gram(
+        &mut self,
+        m: &dyn ErasedModel,
+        st: &mut Stats,
+        t: f64,
+        q: &[f64],
+    ) -> Result<(), Failure> {
+        self.eval_b(m, st, t, q);
+        st.loop_checks += 1;
+        if self.gram().is_err() {
+            return Err(self.rank_failure(m, st, t, q));
+        }
+        let ratio = Self::fallen(&self.bbt, &self.start_bbt, self.nc);
+        if ratio < self.watch_tol {
+            return Err(self.singular_loop(m, st, t, q, LoopMatrix::Gram, ratio));
+        }
+        Ok(())
+    }
+
+    /// What a singular loop at (t, q) is (a failure path: allocates, evaluates B 2n + 1
+    /// more times): the coordinate with the largest |∂ log det (B Bᵀ)/∂q_j| (central
+    /// differences), the one whose value makes B lose rank, and the constraints of B's
+    /// smallest singular value.
+    fn singular_loop(
+        &mut self,
+        m: &dyn ErasedModel,
+        st: &mut Stats,
+        t: f64,
+        q: &[f64],
+        matrix: LoopMatrix,
+        ratio: f64,
+    ) -> Failure {
+        let (n, nc) = (self.n, self.nc);
+        self.eval_b(m, st, t, q);
+        let (_, _, involved) = rank_of(&self.b, nc, n);
+        let mut log_det = |c: &mut Self, q: &[f64]| -> Option<f64> {
+            c.eval_b(m, st, t, q);
+            c.gram().ok()?;
+            Some((0..nc).map(|i| c.bbt[i + nc * i].powi(2).ln()).sum())
+        };
+        let mut qp = q.to_vec();
+        let mut best = (0, 0.0f64);
+        for j in 0..n {
+            let dj = 1e-6 * q[j].abs().max(1.0);
+            qp[j] = q[j] + dj;
+            let up = log_det(self, &qp);
+            qp[j] = q[j] - dj;
+            let down = log_det(self, &qp);
+            qp[j] = q[j];
+            if let (Some(a), Some(b)) = (up, down) {
+                let g = ((a - b) / (2.0 * dj)).abs();
+                if g > best.1 {
+                    best = (j, g);
+                }
+            }
+        }
+        self.eval_b(m, st, t, q);
+        Failure::SingularLoop {
+            coordinate: self.dof_labels[best.0].clone(),
+            value: q[best.0],
+            constraints: involved.iter().map(|&i| self.name(i)).collect(),
+            matrix,
+            ratio,
+            tolerance: self.watch_tol,
         }
     }
 
@@ -279,6 +414,9 @@ impl Constrained {
         }
         if self.schur(l, st).is_err() {
             return Err(self.rank_failure(m, st, t, q));
+        }
+        if self.watch_tol > 0.0 {
+            self.judge_schur(m, st, t, q)?;
         }
         self.w.copy_from_slice(h);
         forward(l, n, &mut self.w);
@@ -596,6 +734,9 @@ impl Constrained {
                 value: worst,
                 tolerance: self.drift_tol,
             });
+        }
+        if self.watch_tol > 0.0 && !self.mode.is_ode() {
+            self.judge_gram(m, st, t, q)?;
         }
         Ok(())
     }

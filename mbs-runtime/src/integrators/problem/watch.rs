@@ -105,6 +105,12 @@ impl Problem {
             self.start_diagonal[j] = (0..=j).map(|k| self.chol[j + n * k].powi(2)).sum();
         }
         self.singularity_tol = tolerance;
+        // closed loops: the index-1 solve at the start made S and evaluated B
+        if tolerance > 0.0
+            && let super::Loops::Closed(c) = &mut self.loops
+        {
+            c.watch_from_start(tolerance);
+        }
         Ok(())
     }
 

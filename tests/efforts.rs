@@ -522,3 +522,43 @@ fn a_linearisation_with_efforts_in_rust_is_not_called_exact() {
     .unwrap();
     assert!(!lin.exact);
 }
+
+mbs::multibody! {
+    /// The DC motor's arm held by a torsion spring of 2 N·m/rad: one static equilibrium per
+    /// voltage.
+    model SprungArm {
+        param l = 0.4; param m = 1.0; param ks = 2.0;
+        dof theta = 0.0;
+        input voltage;
+        option tangents;
+        body bar { mass = m; inertia = (0, m * l * l / 12, m * l * l / 12); }
+        TOG[bar] = Trotz(theta) * Tdisp(l / 2, 0, 0);
+        generalized_force(theta, -ks * theta - 0.01 * qd[0]);
+    }
+}
+
+#[test]
+fn statics_solves_for_the_extra_states() {
+    // at 1 V the current settles at V/R = 1 A (no back-emf at rest), and the spring holds the
+    // motor's torque N k i = 0.5 N·m at θ = 0.25 rad
+    use mbs_models::dc_motor::Motor;
+    for how in [
+        mbs::IterationMatrix::Auto,
+        mbs::IterationMatrix::FiniteDifferences,
+    ] {
+        let model = WithEfforts::new(SprungArm::default(), Motor::default());
+        let options = mbs::StaticsOptions {
+            u: Some(vec![1.0]),
+            stiffness: how,
+            ..Default::default()
+        };
+        let eq = mbs::static_equilibrium(&model, &options).unwrap_or_else(|e| panic!("{e}"));
+        println!("{how:?}: {eq}");
+        assert!((eq.q[0] - 0.25).abs() < 1e-9, "{how:?}: θ = {}", eq.q[0]);
+        assert!((eq.q[1] - 1.0).abs() < 1e-9, "{how:?}: i = {}", eq.q[1]);
+        // the spring's stiffness, the current settled
+        assert_eq!(eq.stability, mbs::Stability::Stable, "{how:?}");
+        assert_eq!(eq.stiffness_eigenvalues.len(), 1);
+        assert!((eq.stiffness_eigenvalues[0] - 2.0).abs() < 1e-6, "{how:?}");
+    }
+}

@@ -681,12 +681,15 @@ impl<M: Model, E: Efforts> Model for WithEfforts<M, E> {
         1 + n
     }
 
+    /// At rest: the wrapped model's velocities are zero and the extra states x are read from
+    /// their coordinates' positions `q[NQ_M + k]` ([`Model::first_order_states`]); their rows
+    /// are ẋ, which statics drives to zero with the forces.
     fn static_forces(&self, t: f64, q: &[f64], u: &[f64], h: &mut [f64]) {
         let n = M::NQ;
         let s = &mut *self.scratch.borrow_mut();
         self.model.static_forces(t, &q[..n], u, &mut s.h);
-        // at rest: qd = 0 and the extra states x = 0
         s.vp.fill(0.0);
+        s.vp[n..].copy_from_slice(&q[n..]);
         let vp = std::mem::take(&mut s.vp);
         let ok = self.user(s, t, q, &vp, u, false);
         s.vp = vp;
@@ -794,6 +797,10 @@ impl<M: Model, E: Efforts> Model for WithEfforts<M, E> {
     // the efforts written in Rust are differenced (forward) within `tangents`
     fn tangents_exact(&self) -> bool {
         false
+    }
+
+    fn first_order_states(&self) -> usize {
+        E::NX
     }
 
     fn user_evaluations(&self) -> usize {

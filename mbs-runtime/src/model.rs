@@ -1009,6 +1009,14 @@ pub trait Model {
     /// h(q, 0, t, u): forces at rest, for statics (NQ).
     fn static_forces(&self, t: f64, q: &[f64], u: &[f64], h: &mut [f64]);
 
+    /// How many of the last coordinates are first-order states riding as velocities (the
+    /// extra states of [`crate::WithEfforts`], `x:NAME`; none for generated models). Statics
+    /// reads each from its coordinate's position, where [`Model::static_forces`] takes it,
+    /// and solves ẋ = 0 for it (the state's integral means nothing at rest).
+    fn first_order_states(&self) -> usize {
+        0
+    }
+
     /// ∂h/∂u (NQ × NU, column-major): how the inputs enter the equations (linearisation).
     fn input_matrix(&self, t: f64, q: &[f64], qd: &[f64], u: &[f64], b: &mut [f64]);
 

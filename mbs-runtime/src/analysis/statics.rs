@@ -15,6 +15,14 @@
 //! degree of freedom of the mechanism): the Hessian of the potential on the constraint
 //! manifold, where the curvature of the constraints enters through λ. Everything is exact
 //! except K without tangents.
+//!
+//! First-order states riding as velocities (the extra states x of [`crate::WithEfforts`]: a
+//! motor's current, a muscle's activation; [`Model::first_order_states`]) are unknowns too:
+//! read from their coordinates' positions, with ẋ = 0 as their equations (their integrals
+//! mean nothing at rest), so `Equilibrium::q` holds them there; without `q0` they start from
+//! their initial values. Without constraints the stability is then read from the stiffness
+//! of the mechanical coordinates with the states condensed out (settled at each
+//! configuration); with constraints the states stay in the reduced stiffness.
 
 use super::{AnalysisError, check, reduce};
 use crate::error::Failure;
@@ -97,7 +105,8 @@ pub struct Equilibrium {
     pub correction: Option<f64>,
     /// names of the free coordinates
     pub free: Vec<String>,
-    /// eigenvalues of the (symmetrised) stiffness on the free coordinates, ascending; with
+    /// eigenvalues of the (symmetrised) stiffness on the free coordinates, ascending (free
+    /// first-order states condensed out, so one per free mechanical coordinate); with
     /// constraints, of the reduced stiffness Nᵀ(K − ∂(Bᵀλ)/∂q)N on the constraint manifold,
     /// one per degree of freedom left (free coordinates − constraints)
     pub stiffness_eigenvalues: Vec<f64>,
@@ -179,14 +188,20 @@ pub(super) fn stiffness<M: Model>(
     let n = M::NQ;
     let zero = vec![0.0; n];
     if exact_stiffness(model, how) {
+        // first-order states are read from their positions: their rates at the state, and
+        // their columns of K those of C
+        let f0 = n - model.first_order_states();
+        let mut qd = zero.clone();
+        qd[f0..].copy_from_slice(&q[f0..]);
         let mut c = vec![0.0; n * n];
         model
-            .tangents(t, q, &zero, &zero, u, k, &mut c)
+            .tangents(t, q, &qd, &zero, u, k, &mut c)
             .map_err(|e| Failure::InvalidOption {
                 name: "stiffness",
                 value: "Exact".into(),
                 reason: crate::integrators::model_error_reason(&e),
             })?;
+        k[n * f0..].copy_from_slice(&c[n * f0..]);
         return check(model, "stiffness", k);
     }
     let (mut qp, mut column) = (q.to_vec(), vec![0.0; n]);
@@ -202,6 +217,33 @@ pub(super) fn stiffness<M: Model>(
         }
     }
     Ok(())
+}
+
+/// The symmetrised stiffness over the free coordinates, the free first-order states
+/// ([`Model::first_order_states`]) condensed out: K_mm − K_ms K_ss⁻¹ K_sm, the stiffness of
+/// the mechanical coordinates when the states settle at each configuration (a motor's current
+/// at V/R, a muscle's activation at its excitation), which decides whether a small push
+/// grows; the whole K where K_ss is singular.
+fn condensed<M: Model>(model: &M, k: &[f64], free: &[usize]) -> DMatrix<f64> {
+    let n = M::NQ;
+    let f0 = n - model.first_order_states();
+    let full = DMatrix::from_fn(free.len(), free.len(), |r, c| k[free[r] + n * free[c]]);
+    let mech: Vec<usize> = (0..free.len()).filter(|&i| free[i] < f0).collect();
+    let states: Vec<usize> = (0..free.len()).filter(|&i| free[i] >= f0).collect();
+    let part = |rows: &[usize], cols: &[usize]| {
+        DMatrix::from_fn(rows.len(), cols.len(), |r, c| full[(rows[r], cols[c])])
+    };
+    let kept = if states.is_empty() {
+        full
+    } else {
+        match part(&states, &states).lu().solve(&part(&states, &mech)) {
+            Some(x) if x.iter().all(|v| v.is_finite()) => {
+                part(&mech, &mech) - part(&mech, &states) * x
+            }
+            _ => full,
+        }
+    };
+    (&kept + kept.transpose()) * 0.5
 }
 
 /// The relative error of the K that [`stiffness`] takes: rounding (a part in 10¹²) for exact
@@ -314,6 +356,9 @@ pub fn static_equilibrium<M: Model + Clone>(
         None => {
             let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
             model.initial_state(&mut q, &mut qd);
+            // first-order states start from their initial values
+            let f0 = n - model.first_order_states();
+            q[f0..].copy_from_slice(&qd[f0..]);
             q
         }
     };
@@ -450,10 +495,9 @@ fn unconstrained<M: Model>(
         h.copy_from_slice(&ht);
         residual = norm(&h);
     };
-    // stability from the symmetrised stiffness on the free coordinates (k is K at q)
-    let ks = nalgebra::DMatrix::from_fn(nf, nf, |r, c| {
-        0.5 * (k[free[r] + n * free[c]] + k[free[c] + n * free[r]])
-    });
+    // stability from the symmetrised stiffness on the free coordinates (k is K at q), the
+    // free first-order states condensed out (settled at each configuration)
+    let ks = condensed(model, &k, &free);
     let error = stiffness_error(model, options.stiffness);
     let (stiffness_eigenvalues, stability) = classify(&ks, error);
     Ok(Equilibrium {

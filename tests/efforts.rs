@@ -562,3 +562,53 @@ fn statics_solves_for_the_extra_states() {
         assert!((eq.stiffness_eigenvalues[0] - 2.0).abs() < 1e-6, "{how:?}");
     }
 }
+
+#[test]
+fn an_extra_state_adds_its_own_pole_and_no_zero_one() {
+    // the sprung arm on its motor, linearised at its equilibrium at 1 V: poles of the arm
+    // (J θ̈ = −ks θ − c θ̇ + N k i) and the circuit (L i̇ = V − R i − k N θ̇); the current's
+    // integral, read by nothing, is no pole
+    use mbs_models::dc_motor::Motor;
+    let model = WithEfforts::new(SprungArm::default(), Motor::default());
+    let options = mbs::StaticsOptions {
+        u: Some(vec![1.0]),
+        ..Default::default()
+    };
+    let eq = mbs::static_equilibrium(&model, &options).unwrap();
+    let qd = [0.0, eq.q[1]];
+    let lin = mbs::linearize(&model, 0.0, &eq.q, &qd, &[1.0], mbs::IterationMatrix::Auto).unwrap();
+    assert_eq!(lin.first_order, [1]);
+    let modes = mbs::modes(&lin, None).unwrap();
+    println!("{modes}");
+    let motor = Motor::default();
+    let (j, ks, c, nk) = (0.4f64.powi(2) / 3.0, 2.0, 0.01, motor.gear * motor.k);
+    let a = nalgebra::Matrix3::new(
+        0.0,
+        1.0,
+        0.0, //
+        -ks / j,
+        -c / j,
+        nk / j, //
+        0.0,
+        -nk / motor.l,
+        -motor.r / motor.l,
+    );
+    let mut expected: Vec<(f64, f64)> = a
+        .complex_eigenvalues()
+        .iter()
+        .filter(|l| l.im >= 0.0)
+        .map(|l| (l.re, l.im))
+        .collect();
+    let mut got: Vec<(f64, f64)> = modes.modes.iter().map(|m| (m.re, m.im)).collect();
+    let by_re = |a: &(f64, f64), b: &(f64, f64)| a.0.total_cmp(&b.0);
+    expected.sort_by(by_re);
+    got.sort_by(by_re);
+    assert_eq!(got.len(), expected.len(), "{got:?} against {expected:?}");
+    for (g, e) in got.iter().zip(&expected) {
+        let size = e.0.hypot(e.1);
+        assert!(
+            (g.0 - e.0).hypot(g.1 - e.1) < 1e-6 * size,
+            "{got:?} against {expected:?}"
+        );
+    }
+}

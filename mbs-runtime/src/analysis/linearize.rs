@@ -78,6 +78,11 @@ pub struct Linearization {
     pub independent: Vec<usize>,
     /// whether they are the model's `independent` marks (else chosen by pivoting on B)
     pub marks_used: bool,
+    /// the positions in z of first-order states ([`Model::first_order_states`]: the extra
+    /// states of [`crate::WithEfforts`], whose coordinates' positions are integrals nothing
+    /// reads): each adds an eigenvalue 0 to A that is no mode, which [`super::modes`] leaves
+    /// out
+    pub first_order: Vec<usize>,
     /// δq = N δz (n × nz; the identity without constraints)
     pub basis: DMatrix<f64>,
     /// the linearised equations in z: M_z δz̈ + C_z δż + K_z δz = B_u,z δu (equal to m, c,
@@ -182,6 +187,14 @@ fn state_space(
         }
     }
     Ok((a, b))
+}
+
+/// The positions in z (of coordinates `independent`) of the model's first-order states.
+fn first_order<M: Model>(model: &M, independent: &[usize]) -> Vec<usize> {
+    let f0 = M::NQ - model.first_order_states();
+    (0..independent.len())
+        .filter(|&i| independent[i] >= f0)
+        .collect()
 }
 
 /// Linearises `model` about (t, q, qd, u); K and C by `how` (Auto: exact tangents when
@@ -296,6 +309,7 @@ fn linearize_in_chart<M: Model>(
             b,
             exact: exact && model.tangents_exact(),
             independent: (0..n).collect(),
+            first_order: first_order(model, &(0..n).collect::<Vec<_>>()),
             marks_used: false,
             basis: DMatrix::identity(n, n),
             constraint_names: Vec::new(),
@@ -425,6 +439,7 @@ fn linearize_in_chart<M: Model>(
         exact: exact && model.tangents_exact(),
         coordinates,
         independent: part.ind.clone(),
+        first_order: first_order(model, &part.ind),
         marks_used: part.marked,
         basis: nb,
         mz,

@@ -5,6 +5,10 @@
 //! A real eigenvalue is no oscillation: [`Mode::time_constant`] gives 1/|λ|, and the table
 //! ([`Modes`]' Display) shows it as a real pole, unstable or decaying, with that time constant.
 //! Eigenvalues come from nalgebra's Schur decomposition, eigenvectors from inverse iteration.
+//! First-order states ([`crate::Model::first_order_states`], the extra states of
+//! [`crate::WithEfforts`]) ride as the velocities of coordinates whose positions, their
+//! integrals, nothing reads: each adds an eigenvalue 0 to A that is no mode, left out here,
+//! and a shape's entry for such a coordinate is the state's own amplitude.
 //! For a constrained model the shapes are in the independent coordinates z of the
 //! linearisation (named by [`Linearization::coordinates`], modal mass φᴴM_zφ), and also given
 //! in every coordinate as N φ.
@@ -98,10 +102,16 @@ pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, A
             modes: Vec::new(),
         });
     }
-    let eig = eigenvalues(&lin.a)?;
-    let scale = lin.a.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+    // the integrals of first-order states are read by nothing: their columns of A are zero
+    // and each adds an eigenvalue 0 that is no mode; A without them (`kept` of its states)
+    // has the others
+    let kept: Vec<usize> = (0..n2).filter(|i| !lin.first_order.contains(i)).collect();
+    let a = lin.a.select_rows(&kept).select_columns(&kept);
+    let m2 = kept.len();
+    let eig = eigenvalues(&a)?;
+    let scale = a.iter().fold(1.0f64, |m, x| m.max(x.abs()));
     let mut out = Vec::new();
-    let mut lu = Lu::<C64>::new(n2);
+    let mut lu = Lu::<C64>::new(m2);
     for (k, lambda) in eig.iter().enumerate() {
         // A pair is real where its imaginary part is within what rounding splits a double
         // real eigenvalue into: ±√(δ γ) for a perturbation δ ≈ ε max|A| of a Jordan block
@@ -149,11 +159,11 @@ pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, A
         };
         let mut factored = false;
         for _ in 0..10 {
-            let a = lu.matrix_mut();
-            for j in 0..n2 {
-                for i in 0..n2 {
+            let f = lu.matrix_mut();
+            for j in 0..m2 {
+                for i in 0..m2 {
                     let d = if i == j { mu } else { C64::default() };
-                    a[i + n2 * j] = C64::new(lin.a[(i, j)], 0.0) - d;
+                    f[i + m2 * j] = C64::new(a[(i, j)], 0.0) - d;
                 }
             }
             if lu.factor().is_ok() {
@@ -186,18 +196,27 @@ pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, A
         let iterations = super::inverse_iterations(r, 100);
         // the start differs from mode to mode, so that two modes of one repeated eigenvalue
         // get two of its eigenvectors, not one twice
-        let mut v: Vec<C64> = (0..n2)
+        let mut w: Vec<C64> = (0..m2)
             .map(|i| {
                 let turn = 0.7 * ((i + 1) * (k + 1)) as f64;
                 C64::new(1.0 + 0.1 * i as f64 + 0.3 * turn.sin(), 0.05 * i as f64)
             })
             .collect();
         for _ in 0..iterations {
-            lu.solve(&mut v);
-            let nv = v.iter().map(|z| z.abs()).fold(0.0, f64::max);
-            for z in v.iter_mut() {
+            lu.solve(&mut w);
+            let nv = w.iter().map(|z| z.abs()).fold(0.0, f64::max);
+            for z in w.iter_mut() {
                 *z = *z / C64::new(nv, 0.0);
             }
+        }
+        // the whole state, a first-order state's position entry its own amplitude δx (the
+        // velocity entry n + i) rather than its integral's
+        let mut v = vec![C64::default(); n2];
+        for (r, &i) in kept.iter().enumerate() {
+            v[i] = w[r];
+        }
+        for &i in &lin.first_order {
+            v[i] = v[n + i];
         }
         // the q part, scaled to a largest component of 1 (real, positive)
         let big = (0..n)

@@ -297,3 +297,44 @@ fn efforts_read_a_rotation_in_the_charts_they_are_handed() {
     assert!(st.chart_switches >= 1);
     assert!(worst < 1e-12, "{worst:e}");
 }
+
+#[test]
+fn a_row_at_a_sample_time_holds_the_new_inputs() {
+    // x'' = u, u = 1 − x sampled every 0.1 s: every row's qdd is the input of the latest
+    // sample at or before its time, as at the start (inputs hold from their sample on)
+    for (scheme, output) in [
+        (Scheme::Dopri5, Output::Steps),
+        (Scheme::Dopri5, Output::Every { dt: 0.05 }),
+        (Scheme::Rk4, Output::Every { dt: 0.05 }),
+        (Scheme::Radau5, Output::Steps),
+    ] {
+        let samples = Rc::new(RefCell::new(Vec::new()));
+        let record = samples.clone();
+        let controller = move |t: f64, s: &State, u: &mut [f64]| {
+            u[0] = 1.0 - s.q[0];
+            record.borrow_mut().push((t, u[0]));
+        };
+        let o = if scheme.is_adaptive() {
+            Options::adaptive(1.0, 1e-8)
+        } else {
+            Options::fixed(1.0, 1e-2)
+        };
+        let o = Options {
+            output: output.clone(),
+            ..o
+        };
+        let inputs = Inputs::new().controller(0.1, controller);
+        let (tr, _) = simulate_with(Pushed::default(), scheme, o, inputs).unwrap();
+        let samples = samples.borrow();
+        for i in 0..tr.len() {
+            let t = tr.t[i];
+            let held = samples.iter().rev().find(|(ts, _)| *ts <= t).unwrap().1;
+            let qdd = tr.qdd(i)[0];
+            assert!(
+                (qdd - held).abs() < 1e-12,
+                "{} {output:?}: qdd {qdd} at t = {t}, the input held there {held}",
+                scheme.name()
+            );
+        }
+    }
+}

@@ -433,14 +433,15 @@ impl Run {
         }
     }
 
-    /// Outputs in (prev.t, cur.t] after an accepted step.
-    fn outputs_after_step(&mut self) {
+    /// Outputs in (prev.t, cur.t] after an accepted step (at cur.t only `with_cur`).
+    fn outputs_after_step(&mut self, with_cur: bool) {
         match self.options.output {
-            Output::Steps => self.record_cur(),
-            Output::Last => {}
+            Output::Steps if with_cur => self.record_cur(),
+            Output::Steps | Output::Last => {}
             _ => {
                 while self.out_next < self.out_times.len()
-                    && self.out_times[self.out_next] <= self.cur.t
+                    && (self.out_times[self.out_next] < self.cur.t
+                        || with_cur && self.out_times[self.out_next] == self.cur.t)
                 {
                     let t = self.out_times[self.out_next];
                     self.out_next += 1;
@@ -450,6 +451,26 @@ impl Run {
                     } else {
                         self.stepper.interpolate(&self.prev, &self.cur, t, &mut s);
                     }
+                    self.record(&s);
+                    self.scratch = s;
+                }
+            }
+        }
+    }
+
+    /// The outputs at the current state's time, after a sample held them back
+    /// (`outputs_after_step` without them).
+    fn outputs_at_cur(&mut self) {
+        match self.options.output {
+            Output::Steps => self.record_cur(),
+            Output::Last => {}
+            _ => {
+                while self.out_next < self.out_times.len()
+                    && self.out_times[self.out_next] == self.cur.t
+                {
+                    self.out_next += 1;
+                    let mut s = std::mem::replace(&mut self.scratch, State::zeros(0, 0));
+                    s.copy_from(&self.cur);
                     self.record(&s);
                     self.scratch = s;
                 }
@@ -683,14 +704,23 @@ impl Run {
                 std::mem::swap(&mut self.cur, &mut self.next);
                 self.stepper
                     .accepted(&mut self.problem, &self.prev, &self.cur);
-                self.outputs_after_step();
+                // at a sample time the state's row waits for the new inputs: its qdd and λ
+                // are those of u_k, as at the start (inputs hold from their sample on)
+                let sampling = self.cur.t == t_stop && !self.controllers.is_empty();
+                self.outputs_after_step(!sampling);
                 if let Err(kind) = self.recentre() {
                     return Err(self.fail(kind, h));
                 }
-                if self.cur.t == t_stop && !self.controllers.is_empty() {
+                if sampling {
+                    // the accepted state as it was, kept in the attempt's buffer: a sample
+                    // that fails leaves the state's row as the step made it
+                    self.next.copy_from(&self.cur);
                     if let Err(kind) = self.sample() {
+                        self.cur.copy_from(&self.next);
+                        self.outputs_at_cur();
                         return Err(self.fail(kind, h));
                     }
+                    self.outputs_at_cur();
                 }
                 if !fixed {
                     // a shortened last step says nothing about the next one

@@ -514,3 +514,25 @@ fn derivatives_at_the_kink_of_a_positive_part_are_zero_not_nan() {
     let want = x.powf(1.5) * x.ln();
     assert!((dp - want).abs() < 1e-14, "{dp} against {want}");
 }
+
+/// A plane contact at a position, velocity or regularising speed that is not a number gives
+/// a force that is not one (which stops a run naming the effort), not a silent zero: the
+/// clamp of the normal force and the guard of friction's division made it 0.
+#[test]
+fn a_plane_contact_at_nan_is_nan_not_zero() {
+    let c = PlaneContact::default();
+    let nan = f64::NAN;
+    for (x, v) in [
+        ([0.0, 0.0, nan], [0.0; 3]),
+        ([0.0, 0.0, -0.01], [0.0, 0.0, nan]),
+        ([0.0, 0.0, -0.01], [nan, 0.0, 0.0]),
+    ] {
+        let f = c.force(x, v, [0.0; 3]);
+        assert!(f.force.iter().any(|x| x.is_nan()), "{x:?} {v:?}: {f:?}");
+    }
+    let slippery = PlaneContact { eps: nan, ..c };
+    let f = slippery.force([0.0, 0.0, -0.01], [0.1, 0.0, 0.0], [0.0; 3]);
+    assert!(f.force[0].is_nan(), "{f:?}");
+    // out of contact and at rest, a plain zero
+    assert_eq!(c.force([0.0, 0.0, 0.5], [0.0; 3], [0.0; 3]).force, [0.0; 3]);
+}

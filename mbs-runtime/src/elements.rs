@@ -65,7 +65,12 @@ fn rx(r: &[[f64; 3]; 3], x: V3) -> V3 {
 /// before).
 pub(crate) fn friction_per_speed(mu: f64, f_n: f64, vt2: f64, eps: f64) -> f64 {
     let speed = (vt2 + eps * eps).sqrt();
-    if speed > 0.0 { mu * f_n / speed } else { 0.0 }
+    // a NaN speed (a NaN velocity or ε) gives NaN, not a silent 0
+    if speed > 0.0 || speed.is_nan() {
+        mu * f_n / speed
+    } else {
+        0.0
+    }
 }
 
 /// Contact of a point or a sphere with a fixed plane (penalty, non-adhesive damping,
@@ -116,8 +121,12 @@ impl PlaneContact {
         let n = self.normal;
         let delta = self.offset + self.radius - dot(n, x);
         let nv = dot(n, v);
-        let f_n = if delta > 0.0 {
-            (self.k * delta - self.c * nv).max(0.0)
+        // never pulling; NaN stays NaN (a clamp by `max` would make it a silent 0)
+        let push = self.k * delta - self.c * nv;
+        let f_n = if delta.is_nan() || delta > 0.0 && push.is_nan() {
+            f64::NAN
+        } else if delta > 0.0 {
+            push.max(0.0)
         } else {
             0.0
         };
@@ -140,7 +149,10 @@ impl PlaneContact {
         }
     }
 
-    /// A contact at declared point `i` (a point: no rotation of its own).
+    /// A contact at declared point `i`. A point has no rotation of its own: with a radius,
+    /// the sphere centred there slides without turning, its friction applied at the centre
+    /// and the returned `torque` (about the centre) not applied; a sphere that rolls belongs
+    /// at a frame ([`PlaneContact::apply_to_frame`]).
     pub fn apply_to_point(&self, e: &mut Effort, i: usize) -> ContactForce {
         let p = e.point(i);
         let f = self.force(p.position, p.velocity, [0.0; 3]);

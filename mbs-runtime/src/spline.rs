@@ -117,6 +117,8 @@ pub fn evaluate(knots: &[f64], coefficients: &[[f64; 4]], order: u8, x: f64) -> 
         // the line through the first point with its slope
         let c = &coefficients[0];
         return match order {
+            // a level line stays level out to ±∞ (0·∞ would be NaN)
+            0 if c[1] == 0.0 => c[0],
             0 => c[0] + c[1] * (x - knots[0]),
             1 => c[1],
             _ => 0.0,
@@ -129,6 +131,7 @@ pub fn evaluate(knots: &[f64], coefficients: &[[f64; 4]], order: u8, x: f64) -> 
             c[1] + h * (2.0 * c[2] + 3.0 * h * c[3]),
         );
         return match order {
+            0 if dy == 0.0 => y,
             0 => y + dy * (x - knots[last + 1]),
             1 => dy,
             _ => 0.0,
@@ -187,6 +190,16 @@ impl Spline {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_level_end_stays_level_out_to_infinity() {
+        let c = natural_coefficients(&[(0.0, 1.0), (1.0, 1.0)]).unwrap();
+        let k = [0.0, 1.0];
+        for x in [f64::NEG_INFINITY, f64::INFINITY] {
+            assert_eq!(evaluate(&k, &c, 0, x), 1.0);
+            assert_eq!(evaluate(&k, &c, 1, x), 0.0);
+        }
+    }
 
     #[test]
     fn reproduces_a_line_and_interpolates() {

@@ -505,7 +505,12 @@ impl Terrain {
         let (rotation, w) = (k.pose.rotation, k.angular_velocity);
         let mut pressed = Pressed::default();
         self.ellipsoid_forces(&rotation, w, centre, axes, |t, f| {
-            pressed.depth = pressed.depth.max(t.depth);
+            // NaN stays NaN (`f64::max` would drop it and say "out of contact")
+            pressed.depth = if t.depth.is_nan() || pressed.depth.is_nan() {
+                f64::NAN
+            } else {
+                pressed.depth.max(t.depth)
+            };
             pressed.force = [0, 1, 2].map(|j| pressed.force[j] + f[j]);
             e.force_on_frame(frame, t.point, f);
         });

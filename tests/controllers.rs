@@ -338,3 +338,25 @@ fn a_row_at_a_sample_time_holds_the_new_inputs() {
         }
     }
 }
+
+#[test]
+fn a_controller_period_below_the_resolution_of_time_is_refused() {
+    // at t = 1e6 a period of 1e-11 s does not move t: the run took steps of zero length
+    let o = Options {
+        t0: 1e6,
+        ..Options::fixed(1e6 + 1e-3, 1e-4)
+    };
+    let inputs = Inputs::new().controller(1e-11, |_: f64, _: &State, u: &mut [f64]| u[0] = 1.0);
+    let e = simulate_with(Pushed::default(), Scheme::Rk4, o, inputs).unwrap_err();
+    assert!(
+        matches!(
+            e.kind,
+            mbs::Failure::InvalidOption {
+                name: "controller period",
+                ..
+            }
+        ),
+        "{e}"
+    );
+    assert!(e.to_string().contains("resolution of time"), "{e}");
+}

@@ -134,6 +134,17 @@ fn inconsistent_step_options_are_refused_naming_both() {
     for w in ["1e-9 (with t_end = 1e9)", "resolution of time", "larger h"] {
         assert!(msg.contains(w), "{w:?} missing in: {msg}");
     }
+    // outputs closer than the resolution of time (they repeated the same time)
+    let (name, msg) = invalid(
+        Scheme::Dopri5,
+        Options {
+            t0: 1e6,
+            output: Output::Every { dt: 1e-9 },
+            ..Options::adaptive(1e6 + 0.01, 1e-6)
+        },
+    );
+    assert_eq!(name, "output.dt");
+    assert!(msg.contains("resolution of time"), "{msg}");
     // a first step below h_min
     let adaptive_h0 = |h0| StepControl::Adaptive {
         rtol: 1e-6,

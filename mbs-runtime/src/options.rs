@@ -805,6 +805,15 @@ impl Options {
                     "gives more than 10⁸ outputs, more than the trajectory can hold: take a larger dt, or Output::Steps or Output::Last",
                 ));
             }
+            Output::Every { dt }
+                if *dt < 64.0 * f64::EPSILON * self.t0.abs().max(self.t_end.abs()) =>
+            {
+                return Err(invalid(
+                    "output.dt",
+                    format!("{} (with t_end = {})", short(*dt), short(self.t_end)),
+                    "is below the resolution of time there (64 ε·|t|): outputs that close would repeat the same time; take a larger dt",
+                ));
+            }
             Output::Times(ts) => {
                 // the first offending time by its index, not the whole list
                 if let Some(k) = ts

@@ -915,6 +915,16 @@ fn validate<M: Model>(
             reason: "must be > 0 and finite",
         });
     }
+    let t_far = options.t0.abs().max(options.t_end.abs());
+    if let Some((p, _)) =
+        (inputs.controllers.iter()).find(|(p, _)| *p < 64.0 * f64::EPSILON * t_far)
+    {
+        return Err(Failure::InvalidOption {
+            name: "controller period",
+            value: format!("{p} (with t_end = {})", options.t_end),
+            reason: "is below the resolution of time there (64 ε·|t|): samples that close would not move t; take a longer period",
+        });
+    }
     Ok(())
 }
 

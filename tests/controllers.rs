@@ -360,3 +360,41 @@ fn a_controller_period_below_the_resolution_of_time_is_refused() {
     );
     assert!(e.to_string().contains("resolution of time"), "{e}");
 }
+
+mbs::multibody! {
+    /// A unit mass on a spring of 10 N/m, pushed by u[0], released 0.1 m out.
+    model SprungBlock {
+        dof x = 0.1; input push;
+        body block { mass = 1.0; }
+        TOG[block] = Tdisp(x, 0, 0);
+        generalized_force(x, -10 * x + u[0]);
+    }
+}
+
+#[test]
+fn a_controller_sees_the_start_s_accelerations() {
+    // at t0 the state handed to a controller has the spring's −1 m/s² (it had qdd = 0), as
+    // a later sample sees the accelerations under the inputs held before it
+    let seen = Rc::new(RefCell::new(Vec::new()));
+    let record = seen.clone();
+    let controller = move |t: f64, s: &State, u: &mut [f64]| {
+        record.borrow_mut().push((t, s.q[0], s.qdd[0], u[0]));
+        u[0] = 0.5;
+    };
+    let inputs = Inputs::new().controller(0.1, controller);
+    simulate_with(
+        SprungBlock::default(),
+        Scheme::Rk4,
+        Options::fixed(0.3, 1e-3),
+        inputs,
+    )
+    .unwrap();
+    let seen = seen.borrow();
+    for &(t, x, qdd, held) in seen.iter() {
+        assert!(
+            (qdd - (-10.0 * x + held)).abs() < 1e-12,
+            "at t = {t}: qdd {qdd}, x {x}, held u {held}"
+        );
+    }
+    assert_eq!(seen[0].2, -1.0);
+}

@@ -990,8 +990,9 @@ fn consistent_start(
     Ok(Some(a))
 }
 
-/// The controllers' first sample on the consistent positions and velocities, then qdd₀
-/// (and λ₀) there; singular configurations are judged against the factor of M found now.
+/// The controllers' first sample on the consistent positions and velocities (with their qdd
+/// and λ under no inputs yet, as a later sample sees those under the inputs before it), then
+/// qdd₀ (and λ₀) there; singular configurations are judged against the factor of M found now.
 fn first_sample(
     problem: &mut Problem,
     controllers: &mut [(f64, u64, Box<dyn Controller>)],
@@ -1001,6 +1002,14 @@ fn first_sample(
 ) -> Result<(), Failure> {
     let mut charts = Vec::new();
     charts::read_charts_erased(problem.model.erased(), &mut charts);
+    if !controllers.is_empty() {
+        // the controllers see the state as at their later samples: its qdd and λ under the
+        // inputs held before them (none yet: u = 0, or the input function alone)
+        problem.accel(cur.t, &cur.q.clone(), &cur.qd.clone(), &mut cur.qdd)?;
+        if let Some(c) = problem.loops.closed() {
+            cur.lambda.copy_from_slice(&c.lambda);
+        }
+    }
     for (_, count, c) in controllers.iter_mut() {
         c.sample_in_charts(cur.t, cur, &charts, &mut problem.held);
         *count = 1;

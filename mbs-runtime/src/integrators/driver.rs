@@ -497,6 +497,11 @@ impl Run {
         if self.moved.is_empty() {
             return Ok(());
         }
+        // the state is in the new charts from here on, whatever follows: its rows say so
+        for r in &self.moved {
+            self.traj.charts[r.joint].push(chart_quaternion(&r.chart));
+            self.chart_numbers[r.joint] = (self.traj.charts[r.joint].len() - 1) as u32;
+        }
         if evaluate {
             // the model's own coordinates (a wrapper's) need their accelerations anew
             self.problem.chart_changed();
@@ -507,10 +512,6 @@ impl Run {
             if let Some(c) = self.problem.loops.closed() {
                 cur.lambda.copy_from_slice(&c.lambda);
             }
-        }
-        for r in &self.moved {
-            self.traj.charts[r.joint].push(chart_quaternion(&r.chart));
-            self.chart_numbers[r.joint] = (self.traj.charts[r.joint].len() - 1) as u32;
         }
         self.problem.stats.chart_switches += self.moved.len();
         self.problem.chart_changed();

@@ -497,7 +497,7 @@ fn unconstrained<M: Model>(
     };
     // stability from the symmetrised stiffness on the free coordinates (k is K at q), the
     // free first-order states condensed out (settled at each configuration)
-    let ks = condensed(model, &k, &free);
+    let ks = condensed(model, &k, free);
     let error = stiffness_error(model, options.stiffness);
     let (stiffness_eigenvalues, stability) = classify(&ks, error);
     Ok(Equilibrium {

@@ -499,28 +499,15 @@ fn an_analysis_reports_the_user_s_failure() {
 #[test]
 fn a_linearisation_with_efforts_in_rust_is_not_called_exact() {
     // the wrapped model's tangents are generated, the efforts written in Rust differenced
+    fn exact<M: Model + Clone>(model: &M) -> bool {
+        let how = mbs::IterationMatrix::Auto;
+        let lin = mbs::linearize(model, 0.0, &[0.2, 0.1], &[0.0; 2], &[], how);
+        lin.unwrap().exact
+    }
     let bare = DpBare::default();
     let extra = Extra::new(bare.info());
-    let lin = mbs::linearize(
-        &DpFull::default(),
-        0.0,
-        &[0.2, 0.1],
-        &[0.0; 2],
-        &[],
-        mbs::IterationMatrix::Auto,
-    )
-    .unwrap();
-    assert!(lin.exact);
-    let lin = mbs::linearize(
-        &WithEfforts::new(bare, extra),
-        0.0,
-        &[0.2, 0.1],
-        &[0.0; 2],
-        &[],
-        mbs::IterationMatrix::Auto,
-    )
-    .unwrap();
-    assert!(!lin.exact);
+    assert!(exact(&DpFull::default()));
+    assert!(!exact(&WithEfforts::new(bare, extra)));
 }
 
 mbs::multibody! {

@@ -186,17 +186,22 @@ impl Constrained {
         })
     }
 
-    /// Judges S's factor (just made by an index-1 solve at (t, q)) against the start.
-    fn judge_schur(
+    /// Judges the factor of `matrix` (S just made by an index-1 solve at (t, q), or B Bᵀ by
+    /// [`Constrained::judge_gram`]) against the start's.
+    fn judge(
         &mut self,
         m: &dyn ErasedModel,
         st: &mut Stats,
-        t: f64,
-        q: &[f64],
+        at: (f64, &[f64]),
+        matrix: LoopMatrix,
     ) -> Result<(), Failure> {
-        let ratio = Self::fallen(&self.s, &self.start_s, self.nc);
+        let (factor, start) = match matrix {
+            LoopMatrix::Schur => (&self.s, &self.start_s),
+            LoopMatrix::Gram => (&self.bbt, &self.start_bbt),
+        };
+        let ratio = Self::fallen(factor, start, self.nc);
         if ratio < self.watch_tol {
-            return Err(self.singular_loop(m, st, t, q, LoopMatrix::Schur, ratio));
+            return Err(self.singular_loop(m, st, at.0, at.1, matrix, ratio));
         }
         Ok(())
     }
@@ -214,11 +219,7 @@ impl Constrained {
         if self.gram().is_err() {
             return Err(self.rank_failure(m, st, t, q));
         }
-        let ratio = Self::fallen(&self.bbt, &self.start_bbt, self.nc);
-        if ratio < self.watch_tol {
-            return Err(self.singular_loop(m, st, t, q, LoopMatrix::Gram, ratio));
-        }
-        Ok(())
+        self.judge(m, st, (t, q), LoopMatrix::Gram)
     }
 
     /// What a singular loop at (t, q) is (a failure path: allocates, evaluates B 2n + 1
@@ -416,7 +417,7 @@ impl Constrained {
             return Err(self.rank_failure(m, st, t, q));
         }
         if self.watch_tol > 0.0 {
-            self.judge_schur(m, st, t, q)?;
+            self.judge(m, st, (t, q), LoopMatrix::Schur)?;
         }
         self.w.copy_from_slice(h);
         forward(l, n, &mut self.w);

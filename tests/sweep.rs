@@ -875,3 +875,50 @@ fn final_angles_are_read_in_the_chart_of_the_start() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A sweep whose start is set in Rust (t0, q0) records it in its folder's `plan.toml`, so that
+/// a program reading that plan with its own defaults (an array task) makes the same runs.
+#[test]
+fn the_folder_s_plan_records_the_start() {
+    let plan = Plan::from_toml(
+        "[sweep]\ndesign = \"grid\"\n[[vary]]\nname = \"qd0[1]\"\nvalues = [0.0, 0.5]\n",
+    )
+    .unwrap();
+    let runs = plan.runs(Path::new(".")).unwrap();
+    let dir = scratch("start");
+    let options = Options {
+        t0: 1.0,
+        q0: Some(vec![0.3, -0.2]),
+        ..base()
+    };
+    let sweep = Sweep::new(DoublePendulum::default, &plan, Scheme::Dopri5, options).unwrap();
+    sweep.run(&dir, &runs).unwrap();
+    let recorded = Plan::load(&dir.join("plan.toml")).unwrap();
+    assert_eq!(recorded.simulation.t0, Some(1.0));
+    assert_eq!(recorded.simulation.q0, Some(vec![0.3, -0.2]));
+    // the recorded plan with the defaults: the same table
+    let again = scratch("start-again");
+    let sweep = Sweep::new(DoublePendulum::default, &recorded, Scheme::Dopri5, base()).unwrap();
+    sweep.run(&again, &recorded.runs(&dir).unwrap()).unwrap();
+    let table = |d: &Path| {
+        let mut r = csv::Reader::from_path(d.join("results.csv")).unwrap();
+        let header: Vec<String> = r.headers().unwrap().iter().map(String::from).collect();
+        let kept: Vec<usize> = (0..header.len())
+            .filter(|&i| header[i] == "t_last" || header[i].starts_with("q_end."))
+            .collect();
+        let rows: Vec<Vec<String>> = r
+            .records()
+            .map(|rec| {
+                kept.iter()
+                    .map(|&i| rec.as_ref().unwrap()[i].to_string())
+                    .collect()
+            })
+            .collect();
+        rows
+    };
+    let (first, second) = (table(&dir), table(&again));
+    assert_eq!(first.len(), 2);
+    assert_eq!(first, second);
+    let _ = std::fs::remove_dir_all(&dir);
+    let _ = std::fs::remove_dir_all(&again);
+}

@@ -99,7 +99,7 @@ pub enum SweepError {
     )]
     OtherSweep { dir: PathBuf },
     #[error(
-        "{} holds this sweep's runs made with other settings (its plan.toml differs in [simulation]: scheme or its parameters, t_end, h, rtol, atol or dt): run it with the settings of plan.toml to resume, or choose another folder",
+        "{} holds this sweep's runs made with other settings (its plan.toml differs in [simulation]: scheme or its parameters, the start (t0, q0, qd0), t_end, h, rtol, atol or dt): run it with the settings of plan.toml to resume, or choose another folder",
         dir.display()
     )]
     OtherSettings { dir: PathBuf },
@@ -228,6 +228,15 @@ impl Base {
             }
         }
         let mut options = options;
+        if let Some(t) = spec.t0 {
+            options.t0 = t;
+        }
+        if spec.q0.is_some() {
+            options.q0.clone_from(&spec.q0);
+        }
+        if spec.qd0.is_some() {
+            options.qd0.clone_from(&spec.qd0);
+        }
         if let Some(t) = spec.t_end {
             options.t_end = t;
         }
@@ -547,6 +556,10 @@ impl<'a, M: Model + 'static> Sweep<'a, M> {
         let s = &mut p.simulation;
         s.scheme = Some(b.scheme.name().to_string());
         s.scheme_parameters = scheme_parameters(&b.scheme);
+        // the start, where the caller set one: array tasks read it from here too
+        s.t0 = Some(b.options.t0);
+        s.q0.clone_from(&b.options.q0);
+        s.qd0.clone_from(&b.options.qd0);
         s.t_end = Some(b.options.t_end);
         s.h = b.h;
         s.rtol = Some(b.rtol);

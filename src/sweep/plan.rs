@@ -86,13 +86,21 @@ impl DesignKind {
 }
 
 /// The simulation settings of every run, as the per-system programs' options (`scheme`,
-/// `t_end`, `h`, `rtol`, `atol`, `dt`, `max_steps`, `constraints`); a run's variables may
-/// override `scheme`, `t_end`, `h`, `rtol` and `atol`.
+/// `t_end`, `h`, `rtol`, `atol`, `dt`, `max_steps`, `constraints`) and the start (`t0`, and
+/// `q0`, `qd0` with one value per coordinate, where they differ from the model's); a run's
+/// variables may override `scheme`, `t_end`, `h`, `rtol` and `atol`, and its `q0…`, `qd0…`
+/// entries.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SimulationSpec {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub scheme: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub t0: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub q0: Option<Vec<f64>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub qd0: Option<Vec<f64>>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub t_end: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -431,6 +431,7 @@ impl Recorder {
                 keep.frame_names.clone_from(&tr.frame_names);
                 keep.constraint_names.clone_from(&tr.constraint_names);
                 keep.joint_names.clone_from(&tr.joint_names);
+                keep.input_names.clone_from(&tr.input_names);
             }
         }
         self.peak_held = self

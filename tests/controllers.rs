@@ -398,3 +398,110 @@ fn a_controller_sees_the_start_s_accelerations() {
     }
     assert_eq!(seen[0].2, -1.0);
 }
+
+/// A run records the inputs in force at every output (a time function plus a sampled
+/// controller), and inverse dynamics along it reads them: the motion needed no effort beyond
+/// them; under inputs held at zero it needed exactly them as τ, and a motion that records none
+/// must be given its inputs.
+#[test]
+fn a_run_records_its_inputs_and_inverse_dynamics_reads_them() {
+    use mbs::Model;
+    use mbs::analysis::{inverse_dynamics_actuated_of, inverse_dynamics_of};
+    let period = 0.01;
+    let wave = |t: f64| 0.05 * (7.0 * t).sin();
+    for scheme in [Scheme::Dopri5, Scheme::Radau5] {
+        // the PI controller's outputs, as it wrote them
+        let held = Rc::new(RefCell::new(Vec::new()));
+        let record = held.clone();
+        let mut pi = pi(period, Rc::new(RefCell::new(Vec::new())));
+        let controller = move |t: f64, s: &State, u: &mut [f64]| {
+            pi(t, s, u);
+            record.borrow_mut().push((t, u[0]));
+        };
+        let inputs = Inputs::new()
+            .function(move |t, u| u[0] = wave(t))
+            .controller(period, controller);
+        let o = Options {
+            output: Output::Steps,
+            ..Options::adaptive(0.5, 1e-8)
+        };
+        let (tr, _) = simulate_with(Rotor::default(), scheme, o, inputs).unwrap();
+        assert_eq!(tr.input_names, Rotor::default().info().inputs);
+        assert_eq!(tr.u_data.len(), tr.len());
+        let samples = held.borrow();
+        let mut largest = 0.0f64;
+        for i in 0..tr.len() {
+            let t = tr.t[i];
+            let h = samples.iter().rev().find(|(ts, _)| *ts <= t).unwrap().1;
+            let u = tr.u(i)[0];
+            assert!((u - (h + wave(t))).abs() < 1e-15, "u = {u} at t = {t}");
+            largest = largest.max(u.abs());
+        }
+        let model = Rotor::default();
+        let along = inverse_dynamics_of(&model, &tr, &[]).unwrap();
+        let unforced = inverse_dynamics_of(&model, &tr, &[0.0]).unwrap();
+        let actuated = inverse_dynamics_actuated_of(&model, &tr, &[], &[0]).unwrap();
+        let mut worst = [0.0f64; 3];
+        for i in 0..tr.len() {
+            worst[0] = worst[0].max(along.at(i)[0].abs());
+            worst[1] = worst[1].max((unforced.at(i)[0] - tr.u(i)[0]).abs());
+            worst[2] = worst[2].max((actuated.tau[i] - along.at(i)[0]).abs());
+        }
+        println!(
+            "{}: {} outputs, |u| up to {largest:.3} N m; |τ| beyond the recorded inputs {:.1e}, τ − u under u = 0 {:.1e}",
+            scheme.name(),
+            tr.len(),
+            worst[0],
+            worst[1]
+        );
+        assert!(worst[0] < 1e-12 * largest, "{}: {worst:?}", scheme.name());
+        assert!(worst[1] < 1e-12 * largest, "{}: {worst:?}", scheme.name());
+        assert!(worst[2] < 1e-12 * largest, "{}: {worst:?}", scheme.name());
+        // the columns of the CSV
+        let mut csv = Vec::new();
+        tr.write_csv(&mut csv).unwrap();
+        let header = String::from_utf8(csv).unwrap();
+        let header = header.lines().next().unwrap();
+        assert!(
+            header.split(',').any(|c| c == tr.input_names[0]),
+            "{header}"
+        );
+    }
+    // a measured motion records no inputs: they must be given
+    let measured = mbs::Trajectory {
+        dof_names: vec!["phi".into()],
+        t: vec![0.0],
+        q_data: vec![0.0],
+        qd_data: vec![0.0],
+        qdd_data: vec![0.0],
+        ..Default::default()
+    };
+    let e = inverse_dynamics_of(&Rotor::default(), &measured, &[]).unwrap_err();
+    assert!(e.to_string().contains("u"), "{e}");
+    assert!(inverse_dynamics_of(&Rotor::default(), &measured, &[0.3]).is_ok());
+}
+
+/// A sample that fails (its controller writes a non-finite input) ends the run with the
+/// accepted state's row as the step made it: its qdd and its recorded input those of the
+/// sample before, not the failed one's.
+#[test]
+fn a_failed_sample_leaves_the_row_and_the_inputs_of_the_step() {
+    let controller = move |t: f64, s: &State, u: &mut [f64]| {
+        u[0] = if t < 0.25 { 1.0 - s.q[0] } else { f64::NAN };
+    };
+    let o = Options {
+        output: Output::Steps,
+        ..Options::adaptive(1.0, 1e-8)
+    };
+    let inputs = Inputs::new().controller(0.1, controller);
+    let e = simulate_with(Pushed::default(), Scheme::Dopri5, o, inputs).unwrap_err();
+    let tr = &e.trajectory;
+    let last = tr.len() - 1;
+    assert!(
+        (tr.t[last] - 0.3).abs() < 1e-12,
+        "{e}: ends at {}",
+        tr.t[last]
+    );
+    let (u, qdd) = (tr.u(last)[0], tr.qdd(last)[0]);
+    assert!(u.is_finite() && (u - qdd).abs() < 1e-12, "u {u}, qdd {qdd}");
+}

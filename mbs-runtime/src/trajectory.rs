@@ -26,6 +26,15 @@ pub struct Trajectory {
     /// its gradient
     #[serde(default)]
     pub lambda_data: Vec<f64>,
+    /// input names (`u[k]` or the DSL's), as the model names them; empty for a model without
+    /// inputs and for a motion that records none (a measured one)
+    #[serde(default)]
+    pub input_names: Vec<String>,
+    /// the inputs u in force at each output, `input_names.len()` per output: the time
+    /// function's value there plus what the sampled controllers hold (at a sample instant,
+    /// what they wrote there), so that a run's qdd and λ are those of its q, qd and u
+    #[serde(default)]
+    pub u_data: Vec<f64>,
     /// the rotation joints (`Tball`, `Tfree`), each named by the frame it moves
     #[serde(default)]
     pub joint_names: Vec<String>,
@@ -169,6 +178,17 @@ impl Trajectory {
                 reason: "must name at most the model's rotation joints (none: the model's charts)",
             });
         }
+        let nu = self.input_names.len();
+        if self.u_data.len() != outputs * nu {
+            return Err(InvalidOption {
+                name: "trajectory.u_data",
+                value: format!(
+                    "{} values for {outputs} outputs of {nu} inputs",
+                    self.u_data.len()
+                ),
+                reason: "must hold one value per input named in `input_names` per output (none when it names none)",
+            });
+        }
         if self.charts.len() != tj || self.chart_data.len() != outputs * tj {
             return Err(InvalidOption {
                 name: "trajectory.chart_data",
@@ -233,6 +253,13 @@ impl Trajectory {
         &self.lambda_data[i * n..(i + 1) * n]
     }
 
+    /// The inputs u at output `i` (one per name of `input_names`: none when the motion
+    /// records no inputs).
+    pub fn u(&self, i: usize) -> &[f64] {
+        let n = self.input_names.len();
+        &self.u_data[i * n..(i + 1) * n]
+    }
+
     /// The multiplier of the constraint named `name` at every output (`None` if no such
     /// constraint).
     pub fn constraint_force(&self, name: &str) -> Option<Vec<f64>> {
@@ -276,15 +303,16 @@ impl Trajectory {
         }
     }
 
-    /// The bytes one output takes (t, q, q̇, q̈, λ, the rotation joints' orientations and
+    /// The bytes one output takes (t, q, q̇, q̈, λ, u, the rotation joints' orientations and
     /// charts, and energy and poses when recorded).
     pub(crate) fn bytes_per_output(&self, energy: bool, frames: bool) -> usize {
-        let (n, nc, joints) = (
+        let (n, nc, nu, joints) = (
             self.nq(),
             self.constraint_names.len(),
+            self.input_names.len(),
             self.joint_names.len(),
         );
-        let f64s = 1 + 3 * n + nc + 4 * joints;
+        let f64s = 1 + 3 * n + nc + nu + 4 * joints;
         let mut bytes = 8 * f64s + 4 * joints;
         if energy {
             bytes += std::mem::size_of::<Energy>();
@@ -312,6 +340,7 @@ impl Trajectory {
         self.qdd_data.try_reserve(times(n))?;
         self.lambda_data
             .try_reserve(times(self.constraint_names.len()))?;
+        self.u_data.try_reserve(times(self.input_names.len()))?;
         self.orientation_data.try_reserve(times(4 * joints))?;
         self.chart_data.try_reserve(times(joints))?;
         for charts in self.charts.iter_mut() {
@@ -376,7 +405,8 @@ impl Trajectory {
 
     /// CSV with a header of named columns: `t`, then per coordinate its name (`q[0]`, or the
     /// DSL name such as `knee`), then `qd[…]` and `qdd[…]` per coordinate as the DSL writes
-    /// them (`qd[0]`, `qd[knee]`), then `NAME.lambda` per constraint, then per rotation joint
+    /// them (`qd[0]`, `qd[knee]`), then `NAME.lambda` per constraint, then the inputs by
+    /// their names (`u[0]`, or the DSL's) when the run recorded them, then per rotation joint
     /// `FRAME.qx, FRAME.qy, FRAME.qz, FRAME.qw` (its rotation, a quaternion continuous
     /// across re-centrings) and `FRAME.chart` (the chart number), then `kinetic, potential,
     /// total` when energy was recorded. [`CsvWriter`] writes the same file as outputs come.
@@ -393,13 +423,14 @@ impl Trajectory {
         self.qd_data.clear();
         self.qdd_data.clear();
         self.lambda_data.clear();
+        self.u_data.clear();
         self.orientation_data.clear();
         self.chart_data.clear();
         self.energy.clear();
         self.poses.clear();
     }
 
-    /// Appends output `i` of `from` (a trajectory of the same model): t, q, qd, qdd, λ, and
+    /// Appends output `i` of `from` (a trajectory of the same model): t, q, qd, qdd, λ, u, and
     /// energy and poses when `from` recorded them.
     pub fn push_output(&mut self, from: &Trajectory, i: usize) {
         self.push(
@@ -409,6 +440,7 @@ impl Trajectory {
             from.qdd(i),
             from.lambda(i),
         );
+        self.u_data.extend_from_slice(from.u(i));
         if !from.joint_names.is_empty() {
             self.push_joints(from.orientation(i), from.chart_numbers(i));
             // the charts the output's numbers index: `from`'s, when it has more joints or
@@ -481,6 +513,7 @@ impl<W: Write> CsvWriter<W> {
                 .chain(tr.qd(i))
                 .chain(tr.qdd(i))
                 .chain(tr.lambda(i))
+                .chain(tr.u(i))
             {
                 write!(w, ",{v:e}")?;
             }
@@ -526,6 +559,7 @@ impl<W: Write> CsvWriter<W> {
         for name in &tr.constraint_names {
             header.push(format!("{name}.lambda"));
         }
+        header.extend(tr.input_names.iter().cloned());
         for name in &tr.joint_names {
             for c in ["qx", "qy", "qz", "qw", "chart"] {
                 header.push(format!("{name}.{c}"));

@@ -54,7 +54,8 @@ pub fn inverse_dynamics_along<M: Model>(
     u: &[f64],
     mut path: impl FnMut(f64) -> (Vec<f64>, Vec<f64>, Vec<f64>),
 ) -> Result<Efforts, AnalysisError> {
-    let mut out = efforts(model, u, times.len())?;
+    fixed_inputs::<M>(u)?;
+    let mut out = efforts(model, times.len());
     let mut row = vec![0.0; M::NQ];
     for (i, &t) in times.iter().enumerate() {
         let (q, qd, qdd) = path(t);
@@ -70,19 +71,24 @@ pub fn inverse_dynamics_along<M: Model>(
 /// τ along a recorded trajectory (its t, q, qd, qdd), e.g. to check that a simulation needed
 /// no actuation, or to drive a model along a measured motion. Each output is read in the
 /// charts the run read it in ([`crate::charts::use_charts_of`], on a copy of `model`).
+///
+/// `u`: one value per input, the inputs at every output; or none (`&[]`), the inputs the
+/// trajectory recorded at each output (a run records them: what its controllers and input
+/// function gave at that time), so that τ is what the motion needed beyond them.
 pub fn inverse_dynamics_of<M: Model + Clone>(
     model: &M,
     trajectory: &Trajectory,
     u: &[f64],
 ) -> Result<Efforts, AnalysisError> {
     fits(model, trajectory)?;
-    let mut out = efforts(model, u, trajectory.len())?;
+    let given = given_inputs::<M>(trajectory, u)?;
+    let mut out = efforts(model, trajectory.len());
     let mut read = model.clone();
     let mut row = vec![0.0; M::NQ];
     for i in 0..trajectory.len() {
         crate::charts::use_charts_of(&mut read, trajectory, i);
         let t = trajectory.t[i];
-        if let Err(e) = tau_at(&read, t, state(trajectory, i), u, &mut row) {
+        if let Err(e) = tau_at(&read, t, state(trajectory, i), given(i), &mut row) {
             return Err(stopped(i, t, e, Computed::Efforts(out)));
         }
         out.t.push(t);
@@ -107,14 +113,38 @@ fn fits<M: Model>(model: &M, trajectory: &Trajectory) -> Result<(), AnalysisErro
     Ok(trajectory.check_fits(M::NQ, joints)?)
 }
 
+/// The inputs at each output of `trajectory`: `u` when it gives one value per input, the
+/// trajectory's own when it gives none and the trajectory recorded the model's inputs.
+fn given_inputs<'a, M: Model>(
+    trajectory: &'a Trajectory,
+    u: &'a [f64],
+) -> Result<impl Fn(usize) -> &'a [f64], AnalysisError> {
+    let recorded = u.is_empty() && M::NU > 0;
+    if recorded && trajectory.input_names.len() != M::NU {
+        return Err(Failure::InvalidOption {
+            name: "u",
+            value: format!(
+                "none, and the trajectory records {} inputs for a model of {}",
+                trajectory.input_names.len(),
+                M::NU
+            ),
+            reason: "give the inputs, one value per input of the model, or a trajectory that records them (a run's)",
+        }
+        .into());
+    }
+    if !recorded {
+        fixed_inputs::<M>(u)?;
+    }
+    Ok(move |i: usize| if recorded { trajectory.u(i) } else { u })
+}
+
 /// Output `i` of `trajectory`: [q, qd, qdd].
 fn state(trajectory: &Trajectory, i: usize) -> [&[f64]; 3] {
     [trajectory.q(i), trajectory.qd(i), trajectory.qdd(i)]
 }
 
-/// No efforts yet, room for `times` times, once the inputs `u` are checked.
-fn efforts<M: Model>(model: &M, u: &[f64], times: usize) -> Result<Efforts, AnalysisError> {
-    let n = M::NQ;
+/// Inputs `u` given for every time: one value per input of the model.
+fn fixed_inputs<M: Model>(u: &[f64]) -> Result<(), AnalysisError> {
     if u.len() != M::NU {
         return Err(Failure::InvalidOption {
             name: "u",
@@ -123,12 +153,18 @@ fn efforts<M: Model>(model: &M, u: &[f64], times: usize) -> Result<Efforts, Anal
         }
         .into());
     }
+    Ok(())
+}
+
+/// No efforts yet, room for `times` times.
+fn efforts<M: Model>(model: &M, times: usize) -> Efforts {
+    let n = M::NQ;
     let info = model.info();
-    Ok(Efforts {
+    Efforts {
         dof_names: (0..n).map(|i| info.dof_label(i)).collect(),
         t: Vec::with_capacity(times),
         tau: Vec::with_capacity(n * times),
-    })
+    }
 }
 
 /// τ at one time of a motion into `row`, the state and τ checked.
@@ -241,7 +277,8 @@ pub fn inverse_dynamics_actuated_along<M: Model>(
     actuated: &[usize],
     mut path: impl FnMut(f64) -> (Vec<f64>, Vec<f64>, Vec<f64>),
 ) -> Result<ActuatedEfforts, AnalysisError> {
-    let (mut solver, mut out) = Actuation::new(model, u, actuated, times.len())?;
+    fixed_inputs::<M>(u)?;
+    let (mut solver, mut out) = Actuation::new(model, actuated, times.len())?;
     for (i, &t) in times.iter().enumerate() {
         let (q, qd, qdd) = path(t);
         if let Err(e) = solver.push(model, t, [&q, &qd, &qdd], u, &mut out) {
@@ -252,7 +289,8 @@ pub fn inverse_dynamics_actuated_along<M: Model>(
 }
 
 /// [`inverse_dynamics_actuated_along`] along a recorded trajectory (its t, q, qd, qdd), each
-/// output read in the charts the run read it in (on a copy of `model`).
+/// output read in the charts the run read it in (on a copy of `model`); `u` as in
+/// [`inverse_dynamics_of`]: the inputs at every output, or none for the trajectory's own.
 pub fn inverse_dynamics_actuated_of<M: Model + Clone>(
     model: &M,
     trajectory: &Trajectory,
@@ -260,12 +298,13 @@ pub fn inverse_dynamics_actuated_of<M: Model + Clone>(
     actuated: &[usize],
 ) -> Result<ActuatedEfforts, AnalysisError> {
     fits(model, trajectory)?;
-    let (mut solver, mut out) = Actuation::new(model, u, actuated, trajectory.len())?;
+    let given = given_inputs::<M>(trajectory, u)?;
+    let (mut solver, mut out) = Actuation::new(model, actuated, trajectory.len())?;
     let mut read = model.clone();
     for i in 0..trajectory.len() {
         crate::charts::use_charts_of(&mut read, trajectory, i);
         let t = trajectory.t[i];
-        if let Err(e) = solver.push(&read, t, state(trajectory, i), u, &mut out) {
+        if let Err(e) = solver.push(&read, t, state(trajectory, i), given(i), &mut out) {
             return Err(stopped(i, t, e, Computed::Actuated(out)));
         }
     }
@@ -284,11 +323,10 @@ struct Actuation<'a> {
 }
 
 impl<'a> Actuation<'a> {
-    /// Checks `u` and `actuated` against `model`; the solver and the efforts, none yet (room
-    /// for `times` times).
+    /// Checks `actuated` against `model`; the solver and the efforts, none yet (room for
+    /// `times` times).
     fn new<M: Model>(
         model: &M,
-        u: &[f64],
         actuated: &'a [usize],
         times: usize,
     ) -> Result<(Actuation<'a>, ActuatedEfforts), AnalysisError> {
@@ -301,13 +339,6 @@ impl<'a> Actuation<'a> {
                 reason,
             })
         };
-        if u.len() != M::NU {
-            return Err(invalid(
-                "u",
-                u.len().to_string(),
-                "must have one value per input",
-            ));
-        }
         if let Some(&i) = actuated.iter().find(|&&i| i >= n) {
             return Err(invalid(
                 "actuated",

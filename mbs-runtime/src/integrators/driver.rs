@@ -85,6 +85,8 @@ pub(super) struct Run {
     controllers: Vec<(f64, u64, Box<dyn Controller>)>,
     /// the charts of the rotation joints, handed to the controllers at each sample
     charts: Vec<[[f64; 3]; 3]>,
+    /// the controllers' outputs before a sample, restored when it fails
+    held_before: Vec<f64>,
     /// rotation joints: the re-centrings of the last accepted step, each joint's chart
     /// number and last recorded quaternion, and a buffer of orientations to record
     moved: Vec<Recentring>,
@@ -293,6 +295,7 @@ impl Run {
         let held_counts = vec![0; n + cur.lambda.len()];
         let largest = |v: &[f64]| v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
         let start_scale = [largest(&cur.q), largest(&cur.qd)];
+        let nu = problem.held.len();
         let mut sim = Run {
             start_scale,
             problem,
@@ -317,6 +320,7 @@ impl Run {
             assembly,
             controllers,
             charts: vec![[[0.0; 3]; 3]; joints.len()],
+            held_before: vec![0.0; nu],
             moved: Vec::with_capacity(joints.len()),
             chart_numbers: vec![0; joints.len()],
             last_quaternion: vec![None; joints.len()],
@@ -363,6 +367,10 @@ impl Run {
 
     fn record(&mut self, s: &State) {
         self.traj.push(s.t, &s.q, &s.qd, &s.qdd, &s.lambda);
+        // u in force at the output; a non-finite input is recorded as it is (the evaluation
+        // at that time stops the run with it)
+        let _ = self.problem.inputs(s.t);
+        self.traj.u_data.extend_from_slice(&self.problem.u);
         let model = &self.problem.model;
         let joints = model.info().rotation_joints;
         if !joints.is_empty() {
@@ -716,8 +724,12 @@ impl Run {
                     // the accepted state as it was, kept in the attempt's buffer: a sample
                     // that fails leaves the state's row as the step made it
                     self.next.copy_from(&self.cur);
+                    self.held_before.clone_from(&self.problem.held);
                     if let Err(kind) = self.sample() {
+                        // ... and with the inputs it was made under
                         self.cur.copy_from(&self.next);
+                        self.problem.held.clone_from(&self.held_before);
+                        self.problem.inputs_changed();
                         self.outputs_at_cur();
                         return Err(self.fail(kind, h));
                     }
@@ -845,6 +857,7 @@ struct Names {
     dofs: Vec<String>,
     frames: Vec<String>,
     constraints: Vec<String>,
+    inputs: Vec<String>,
     /// rotation joints, by the frame each moves
     joints: Vec<String>,
 }
@@ -857,6 +870,7 @@ impl Names {
             dofs: own(info.dofs),
             frames: own(info.frames),
             constraints: own(info.constraints),
+            inputs: own(info.inputs),
             joints: info
                 .rotation_joints
                 .iter()
@@ -872,6 +886,7 @@ impl Names {
             self.constraints.clone(),
         );
         t.joint_names = self.joints.clone();
+        t.input_names = self.inputs.clone();
         t
     }
 

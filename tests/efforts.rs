@@ -524,16 +524,15 @@ mbs::multibody! {
     }
 }
 
-#[test]
-fn statics_solves_for_the_extra_states() {
-    // at 1 V the current settles at V/R = 1 A (no back-emf at rest), and the spring holds the
-    // motor's torque N k i = 0.5 N·m at θ = 0.25 rad
+/// The equilibrium of `model` (an arm on the DC motor) at 1 V under either stiffness: its q
+/// (the current last) and its one stiffness eigenvalue, the current settled.
+fn motor_statics<M: mbs::Model + Clone + 'static>(model: M, q: &[f64], eigenvalue: f64) {
     use mbs_models::dc_motor::Motor;
     for how in [
         mbs::IterationMatrix::Auto,
         mbs::IterationMatrix::FiniteDifferences,
     ] {
-        let model = WithEfforts::new(SprungArm::default(), Motor::default());
+        let model = WithEfforts::new(model.clone(), Motor::default());
         let options = mbs::StaticsOptions {
             u: Some(vec![1.0]),
             stiffness: how,
@@ -541,13 +540,21 @@ fn statics_solves_for_the_extra_states() {
         };
         let eq = mbs::static_equilibrium(&model, &options).unwrap_or_else(|e| panic!("{e}"));
         println!("{how:?}: {eq}");
-        assert!((eq.q[0] - 0.25).abs() < 1e-9, "{how:?}: θ = {}", eq.q[0]);
-        assert!((eq.q[1] - 1.0).abs() < 1e-9, "{how:?}: i = {}", eq.q[1]);
-        // the spring's stiffness, the current settled
+        for (k, (&got, &want)) in eq.q.iter().zip(q).enumerate() {
+            assert!((got - want).abs() < 1e-9, "{how:?}: q[{k}] = {got}");
+        }
         assert_eq!(eq.stability, mbs::Stability::Stable, "{how:?}");
-        assert_eq!(eq.stiffness_eigenvalues.len(), 1);
-        assert!((eq.stiffness_eigenvalues[0] - 2.0).abs() < 1e-6, "{how:?}");
+        assert_eq!(eq.stiffness_eigenvalues.len(), 1, "{how:?}");
+        let e = eq.stiffness_eigenvalues[0];
+        assert!((e - eigenvalue).abs() < 1e-6, "{how:?}: {e}");
     }
+}
+
+#[test]
+fn statics_solves_for_the_extra_states() {
+    // at 1 V the current settles at V/R = 1 A (no back-emf at rest), and the spring holds the
+    // motor's torque N k i = 0.5 N·m at θ = 0.25 rad; its stiffness, the current settled
+    motor_statics(SprungArm::default(), &[0.25, 1.0], 2.0);
 }
 
 #[test]
@@ -598,4 +605,29 @@ fn an_extra_state_adds_its_own_pole_and_no_zero_one() {
             "{got:?} against {expected:?}"
         );
     }
+}
+
+mbs::multibody! {
+    /// The sprung arm in two coordinates tied by a constraint: the motor turns `theta`, the
+    /// spring (2 N·m/rad) holds `psi`, a light disk's angle, and `gear: psi − theta = 0`.
+    model SprungArmGeared {
+        param l = 0.4; param m = 1.0; param ks = 2.0;
+        dof theta = 0.0; dof psi = 0.0;
+        input voltage;
+        option tangents;
+        body bar { mass = m; inertia = (0, m * l * l / 12, m * l * l / 12); }
+        body disk { mass = 0.1; inertia = (1e-4, 1e-4, 1e-4); }
+        TOG[bar] = Trotz(theta) * Tdisp(l / 2, 0, 0);
+        TOG[disk] = Trotz(psi);
+        generalized_force(psi, -ks * psi - 0.01 * qd[1]);
+        constraint gear = psi - theta;
+    }
+}
+
+#[test]
+fn constrained_statics_judges_stability_with_the_extra_states_settled() {
+    // the same equilibrium through the constraint: θ = ψ = 0.25 rad, i = 1 A; on the
+    // constraint manifold, N = (1, 1)/√2 over (θ, ψ), the spring's stiffness is 2 / 2 = 1
+    // (with the current among the reduced coordinates: two eigenvalues, 0.99997 and 1000)
+    motor_statics(SprungArmGeared::default(), &[0.25, 0.25, 1.0], 1.0);
 }

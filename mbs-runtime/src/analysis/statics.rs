@@ -22,7 +22,8 @@
 //! mean nothing at rest), so `Equilibrium::q` holds them there; without `q0` they start from
 //! their initial values. Without constraints the stability is then read from the stiffness
 //! of the mechanical coordinates with the states condensed out (settled at each
-//! configuration); with constraints the states stay in the reduced stiffness.
+//! configuration), with constraints from the reduced stiffness of the mechanical coordinates
+//! with the states condensed out alike.
 
 use super::{AnalysisError, check, reduce};
 use crate::error::Failure;
@@ -108,7 +109,8 @@ pub struct Equilibrium {
     /// eigenvalues of the (symmetrised) stiffness on the free coordinates, ascending (free
     /// first-order states condensed out, so one per free mechanical coordinate); with
     /// constraints, of the reduced stiffness Nᵀ(K − ∂(Bᵀλ)/∂q)N on the constraint manifold,
-    /// one per degree of freedom left (free coordinates − constraints)
+    /// one per degree of freedom left (free mechanical coordinates − constraints, the states
+    /// condensed out likewise)
     pub stiffness_eigenvalues: Vec<f64>,
     pub stability: Stability,
     /// names of the constraints (empty without constraints)
@@ -784,10 +786,10 @@ fn constrained<M: Model>(
     };
     rank(&st.b)?;
     // stability from the reduced stiffness Nᵀ(K − G)N, N orthonormal over the free coordinates
-    // (k and g are at q and λ)
-    let kr = reduced_stiffness(model, options, free, &st.b, (&k, &g))?;
+    // (k and g are at q and λ), the free first-order states condensed out
+    let kr = settled_reduced_stiffness(model, options, free, &st.b, (&k, &g))?;
     let error = stiffness_error(model, options.stiffness);
-    let (stiffness_eigenvalues, stability) = classify(&kr.0, error);
+    let (stiffness_eigenvalues, stability) = classify(&kr, error);
     Ok(Equilibrium {
         residual: st.force_residual(),
         constraint_residual: st.constraint_residual(),
@@ -818,6 +820,18 @@ fn reduced_stiffness<M: Model>(
         let (i, j) = (free[r], free[c]);
         k[i + n * j] - g[(i, j)]
     });
+    reduced_stiffness_of(model, options, free, b, &kf)
+}
+
+/// The symmetrised Nᵀ kf N and N, N an orthonormal basis of the null space of B over the
+/// coordinates `free` (kf over them too).
+fn reduced_stiffness_of<M: Model>(
+    model: &M,
+    options: &StaticsOptions,
+    free: &[usize],
+    b: &DMatrix<f64>,
+    kf: &DMatrix<f64>,
+) -> Result<(DMatrix<f64>, DMatrix<f64>), AnalysisError> {
     let basis = reduce::orthonormal_null_basis(&b.select_columns(free)).ok_or_else(|| {
         AnalysisError::from(
             reduce::rank_check(b, model.info().constraints)
@@ -831,6 +845,34 @@ fn reduced_stiffness<M: Model>(
     })?;
     let kr = basis.transpose() * kf * &basis;
     Ok(((&kr + kr.transpose()) * 0.5, basis))
+}
+
+/// [`reduced_stiffness`] with the free first-order states ([`Model::first_order_states`])
+/// condensed out: the constraints do not read them (B's columns of the states are zero), so
+/// K − G is condensed over the free coordinates as without constraints ([`condensed`]) and
+/// reduced by N over the free mechanical coordinates; one eigenvalue per degree of freedom of
+/// the mechanism. The whole reduced stiffness where K_ss is singular.
+fn settled_reduced_stiffness<M: Model>(
+    model: &M,
+    options: &StaticsOptions,
+    free: &[usize],
+    b: &DMatrix<f64>,
+    (k, g): (&[f64], &DMatrix<f64>),
+) -> Result<DMatrix<f64>, AnalysisError> {
+    let n = M::NQ;
+    let f0 = n - model.first_order_states();
+    let mech: Vec<usize> = free.iter().copied().filter(|&i| i < f0).collect();
+    if mech.len() == free.len() {
+        return Ok(reduced_stiffness(model, options, free, b, (k, g))?.0);
+    }
+    let kg: Vec<f64> = (0..n * n).map(|c| k[c] - g[(c % n, c / n)]).collect();
+    let kc = condensed(model, &kg, free);
+    if kc.nrows() != mech.len() {
+        // K_ss singular: the states do not settle
+        return Ok(reduced_stiffness(model, options, free, b, (k, g))?.0);
+    }
+    let (kr, _) = reduced_stiffness_of(model, options, &mech, b, &kc)?;
+    Ok(kr)
 }
 
 /// Why the Newton matrix of the constrained statics is singular: redundant constraints, or

@@ -557,25 +557,26 @@ fn statics_solves_for_the_extra_states() {
     motor_statics(SprungArm::default(), &[0.25, 1.0], 2.0);
 }
 
-#[test]
-fn an_extra_state_adds_its_own_pole_and_no_zero_one() {
-    // the sprung arm on its motor, linearised at its equilibrium at 1 V: poles of the arm
-    // (J θ̈ = −ks θ − c θ̇ + N k i) and the circuit (L i̇ = V − R i − k N θ̇); the current's
-    // integral, read by nothing, is no pole
+/// The poles of `model` (an arm of inertia `j` on the DC motor, held by a spring of 2 N·m/rad)
+/// linearised at its equilibrium at 1 V: those of the arm (J θ̈ = −ks θ − c θ̇ + N k i) and the
+/// circuit (L i̇ = V − R i − k N θ̇); the current's integral, read by nothing, is no pole.
+fn motor_poles<M: mbs::Model + Clone + 'static>(model: M, j: f64) {
     use mbs_models::dc_motor::Motor;
-    let model = WithEfforts::new(SprungArm::default(), Motor::default());
+    let model = WithEfforts::new(model, Motor::default());
     let options = mbs::StaticsOptions {
         u: Some(vec![1.0]),
         ..Default::default()
     };
     let eq = mbs::static_equilibrium(&model, &options).unwrap();
-    let qd = [0.0, eq.q[1]];
+    let n = eq.q.len();
+    let mut qd = vec![0.0; n];
+    qd[n - 1] = eq.q[n - 1];
     let lin = mbs::linearize(&model, 0.0, &eq.q, &qd, &[1.0], mbs::IterationMatrix::Auto).unwrap();
-    assert_eq!(lin.first_order, [1]);
+    assert_eq!(lin.first_order.len(), 1);
     let modes = mbs::modes(&lin, None).unwrap();
     println!("{modes}");
     let motor = Motor::default();
-    let (j, ks, c, nk) = (0.4f64.powi(2) / 3.0, 2.0, 0.01, motor.gear * motor.k);
+    let (ks, c, nk) = (2.0, 0.01, motor.gear * motor.k);
     let a = nalgebra::Matrix3::new(
         0.0,
         1.0,
@@ -605,6 +606,17 @@ fn an_extra_state_adds_its_own_pole_and_no_zero_one() {
             "{got:?} against {expected:?}"
         );
     }
+}
+
+#[test]
+fn an_extra_state_adds_its_own_pole_and_no_zero_one() {
+    motor_poles(SprungArm::default(), 0.4f64.powi(2) / 3.0);
+}
+
+#[test]
+fn an_extra_state_of_a_closed_loop_adds_its_own_pole_and_no_zero_one() {
+    // the arm and the disk turn together: J = m l²/3 + 1e-4
+    motor_poles(SprungArmGeared::default(), 0.4f64.powi(2) / 3.0 + 1e-4);
 }
 
 mbs::multibody! {

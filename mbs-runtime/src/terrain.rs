@@ -345,7 +345,9 @@ impl Terrain {
     /// separation is its own (−depth behind it); within an edge's or a corner's cone s(n) =
     /// n·(x − f) − √(nᵀQn), f a point of the edge or the corner, whose largest value is the
     /// signed distance from f to the ellipsoid (`nearest_normal`): it counts when the normal
-    /// it is reached at lies in that cone.
+    /// it is reached at lies in that cone, and the maxima of s within the cone do too
+    /// ([`cone_maxima`], [`octant_maxima`]). An edge or a corner is skipped where one of its
+    /// faces provably beats it (`beaten`).
     fn block_touch(e: &Ellipsoid, b: &Block, up: usize, [u, w]: [usize; 2]) -> Option<Touch> {
         let (mut centre, mut half) = ([0.0; 3], [0.0; 3]);
         (centre[up], half[up]) = (0.5 * b.height, 0.5 * b.height);
@@ -363,29 +365,48 @@ impl Terrain {
         let support = |n: V3| dot(n, [0, 1, 2].map(|i| dot(qm[i], n))).sqrt();
         let separation =
             |n: V3| dot(n, q) - (0..3).map(|i| half[i] * n[i].abs()).sum::<f64>() - support(n);
-        // the ellipsoid within the plane of the face along axis i on side `sign`: it then
-        // reaches an edge or a corner on that plane from within, along a normal pointing
-        // back across the plane (outside the feature's cone), and the feature is skipped
-        let reach = [0, 1, 2].map(|i| qm[i][i].sqrt());
-        let within = |i: usize, sign: f64| sign * q[i] + reach[i] <= half[i];
         let mut best: Option<(f64, V3)> = None;
         let mut consider = |s: f64, n: V3| {
             if best.is_none_or(|(b, _)| s > b) {
                 best = Some((s, n));
             }
         };
-        // the top and the sides, each as its depth behind it
+        // the top and the sides, each as its depth behind it; per face (axis, side: 0 for
+        // −, 1 for +) its separation s_f and its support point
+        let mut faces = [[(f64::NAN, [f64::NAN; 3]); 2]; 3];
+        let mut clear = false;
         for (j, sign) in [(up, 1.0), (u, -1.0), (u, 1.0), (w, -1.0), (w, 1.0)] {
             let n = Self::axis(j, sign);
             let face = centre[j] * sign + half[j];
-            consider(dot(n, e.support(n)) - face, n);
+            let point = e.support(n);
+            let s = dot(n, point) - face;
+            faces[j][usize::from(sign > 0.0)] = (s, point);
+            clear |= s >= 0.0;
+            consider(s, n);
         }
+        if clear {
+            // clear of a face's plane: clear of the box
+            return None;
+        }
+        // An edge or a corner beats no face when a face f of it has its support point (the
+        // ellipsoid's deepest behind f) at least |s_f| inside the planes of the feature's other
+        // faces: over the feature's cone, n = Σ aᵢ uᵢ (its faces' normals, aᵢ ≥ 0, |n| = 1),
+        // s(n) ≤ n·(support − corner) ≤ a_f s_f − (Σ_{i≠f} aᵢ)|s_f| ≤ s_f, as
+        // Σ_{i≠f} aᵢ ≥ √(1 − a_f²) ≥ 1 − a_f. Otherwise it is searched (an ellipsoid may leave
+        // by an edge's or a corner's way even when it lies within the planes of its faces).
+        let beaten = |sides: &[(usize, f64)]| {
+            sides.iter().any(|&(f, sf)| {
+                let (s, point) = faces[f][usize::from(sf > 0.0)];
+                (sides.iter())
+                    .filter(|&&(i, _)| i != f)
+                    .all(|&(i, si)| half[i] - si * (point[i] - centre[i]) >= -s)
+            })
+        };
         // edges along axis i (not the bottom's), then the upper corners
         for i in 0..3 {
             let (j, k) = ((i + 1) % 3, (i + 2) % 3);
             for (sj, sk) in [(-1.0, -1.0), (-1.0, 1.0), (1.0, -1.0), (1.0, 1.0)] {
-                if (j == up && sj < 0.0) || (k == up && sk < 0.0) || within(j, sj) || within(k, sk)
-                {
+                if (j == up && sj < 0.0) || (k == up && sk < 0.0) || beaten(&[(j, sj), (k, sk)]) {
                     continue;
                 }
                 // the point of the edge's line in the plane of j and k, and the ellipse Q
@@ -424,18 +445,18 @@ impl Terrain {
             let mut sign = [1.0; 3];
             sign[u] = if corner & 1 == 0 { -1.0 } else { 1.0 };
             sign[w] = if corner & 2 == 0 { -1.0 } else { 1.0 };
-            if (0..3).any(|i| within(i, sign[i])) {
+            if beaten(&[(0, sign[0]), (1, sign[1]), (2, sign[2])]) {
                 continue;
             }
             let p = [0, 1, 2].map(|i| q[i] - sign[i] * half[i]);
             // in the ellipsoid's axes (the columns of R)
             let pp = [0, 1, 2].map(|k| (0..3).map(|i| r[i][k] * p[i]).sum::<f64>());
-            let Some(m) = nearest_normal(d2, pp) else {
-                continue;
-            };
-            let n = [0, 1, 2].map(|i| dot(r[i], m));
-            if (0..3).all(|i| sign[i] * n[i] >= 0.0) {
-                consider(separation(n), n);
+            let largest = nearest_normal(d2, pp).map(|m| [0, 1, 2].map(|i| dot(r[i], m)));
+            match largest {
+                Some(n) if (0..3).all(|i| sign[i] * n[i] >= 0.0) => consider(separation(n), n),
+                // the sphere's largest outside the corner's cone: the cone's largest is
+                // another of s's maxima, within it
+                _ => octant_maxima(p, &qm, sign, |n| consider(separation(n), n)),
             }
         }
         let (s, n) = best?;
@@ -578,6 +599,74 @@ fn cone_maxima(
             found(normal(0.5 * (lo + hi)));
         }
         before = after;
+    }
+}
+
+/// The unit normals n within a corner's cone (the octant sign_i n_i > 0) at which
+/// s(n) = n·p − √(nᵀQn) has a local maximum, each handed to `found`: the samples of a
+/// 17 × 17 grid of the octant (n = (sin θ cos φ, sin θ sin φ, cos θ) by sign, θ and φ in
+/// [0, π/2]) that no neighbour exceeds, each refined by ascent along s's gradient on the
+/// sphere, kept in the octant, until a step of 1e-12 gains nothing; those that end on the
+/// octant's boundary are left to the edges and faces. The 3D counterpart of
+/// [`cone_maxima`], for where the sphere's largest (`nearest_normal`) lies outside the
+/// corner's cone: an ellipsoid pressed on a corner took a face's or an edge's way out,
+/// 25.04 mm, where the corner's is 24.51 mm.
+fn octant_maxima(p: V3, q: &[[f64; 3]; 3], sign: V3, mut found: impl FnMut(V3)) {
+    let s = |n: V3| dot(n, p) - dot(n, [0, 1, 2].map(|i| dot(q[i], n))).max(0.0).sqrt();
+    const N: usize = 16;
+    let angle = |i: usize| std::f64::consts::FRAC_PI_2 * i as f64 / N as f64;
+    let normal = |a: usize, b: usize| {
+        let ((st, ct), (sp, cp)) = (angle(a).sin_cos(), angle(b).sin_cos());
+        [sign[0] * st * cp, sign[1] * st * sp, sign[2] * ct]
+    };
+    let mut grid = [[0.0; N + 1]; N + 1];
+    for (a, row) in grid.iter_mut().enumerate() {
+        for (b, v) in row.iter_mut().enumerate() {
+            *v = s(normal(a, b));
+        }
+    }
+    // onto the sphere, within the octant
+    let unit = |m: V3| {
+        let m = [0, 1, 2].map(|i| if sign[i] * m[i] < 0.0 { 0.0 } else { m[i] });
+        let norm = dot(m, m).sqrt();
+        (norm > 0.0).then(|| m.map(|x| x / norm))
+    };
+    for a in 0..=N {
+        for b in 0..=N {
+            let v = grid[a][b];
+            let peak = (a.saturating_sub(1)..=(a + 1).min(N))
+                .flat_map(|i| (b.saturating_sub(1)..=(b + 1).min(N)).map(move |j| (i, j)))
+                .all(|(i, j)| grid[i][j] <= v);
+            // at θ = 0 every φ is the same normal: one of them
+            if !peak || (a == 0 && b > 0) {
+                continue;
+            }
+            let (mut n, mut best, mut step) = (normal(a, b), v, angle(1));
+            while step > 1e-12 {
+                let qn = [0, 1, 2].map(|i| dot(q[i], n));
+                let support = dot(n, qn).sqrt();
+                let grad =
+                    [0, 1, 2].map(|i| p[i] - if support > 0.0 { qn[i] / support } else { 0.0 });
+                let along = dot(grad, n);
+                let g = [0, 1, 2].map(|i| grad[i] - along * n[i]);
+                let size = dot(g, g).sqrt();
+                let trial = (size > 0.0)
+                    .then(|| unit([0, 1, 2].map(|i| n[i] + step * g[i] / size)))
+                    .flatten();
+                match trial {
+                    Some(m) if s(m) > best => {
+                        (n, best) = (m, s(m));
+                        step *= 2.0;
+                    }
+                    _ => step *= 0.5,
+                }
+            }
+            // a maximum on the cone's boundary is an edge's or a face's, which they give
+            // exactly
+            if (0..3).all(|i| sign[i] * n[i] > 0.0) {
+                found(n);
+            }
+        }
     }
 }
 

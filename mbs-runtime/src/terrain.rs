@@ -605,9 +605,9 @@ fn cone_maxima(
 /// The unit normals n within a corner's cone (the octant sign_i n_i > 0) at which
 /// s(n) = n·p − √(nᵀQn) has a local maximum, each handed to `found`: the samples of a
 /// 17 × 17 grid of the octant (n = (sin θ cos φ, sin θ sin φ, cos θ) by sign, θ and φ in
-/// [0, π/2]) that no neighbour exceeds, each refined by ascent along s's gradient on the
-/// sphere, kept in the octant, until a step of 1e-12 gains nothing; those that end on the
-/// octant's boundary are left to the edges and faces. The 3D counterpart of
+/// [0, π/2]) that no neighbour exceeds, each refined by Newton's steps on the sphere (along
+/// the gradient where s is not concave), kept in the octant, until none gains; those that
+/// end on the octant's boundary are left to the edges and faces. The 3D counterpart of
 /// [`cone_maxima`], for where the sphere's largest (`nearest_normal`) lies outside the
 /// corner's cone: an ellipsoid pressed on a corner took a face's or an edge's way out,
 /// 25.04 mm, where the corner's is 24.51 mm.
@@ -641,29 +641,93 @@ fn octant_maxima(p: V3, q: &[[f64; 3]; 3], sign: V3, mut found: impl FnMut(V3)) 
             if !peak || (a == 0 && b > 0) {
                 continue;
             }
-            let (mut n, mut best, mut step) = (normal(a, b), v, angle(1));
-            while step > 1e-12 {
+            let (mut n, mut best) = (normal(a, b), v);
+            // Newton's steps on the sphere where s is concave there, else along its
+            // gradient by a grid spacing; each halved until it gains, and done when ten
+            // halvings gain nothing (at the maximum, to rounding)
+            for _ in 0..50 {
                 let qn = [0, 1, 2].map(|i| dot(q[i], n));
-                let support = dot(n, qn).sqrt();
-                let grad =
-                    [0, 1, 2].map(|i| p[i] - if support > 0.0 { qn[i] / support } else { 0.0 });
+                let sigma = dot(n, qn).sqrt();
+                if !(sigma > 0.0) {
+                    break;
+                }
+                let grad = [0, 1, 2].map(|i| p[i] - qn[i] / sigma);
                 let along = dot(grad, n);
                 let g = [0, 1, 2].map(|i| grad[i] - along * n[i]);
                 let size = dot(g, g).sqrt();
-                let trial = (size > 0.0)
-                    .then(|| unit([0, 1, 2].map(|i| n[i] + step * g[i] / size)))
-                    .flatten();
-                match trial {
-                    Some(m) if s(m) > best => {
-                        (n, best) = (m, s(m));
-                        step *= 2.0;
+                if !(size > 0.0) {
+                    break;
+                }
+                // tangent axes: along the gradient, and across it
+                let t1 = g.map(|x| x / size);
+                let t2 = cross(n, t1);
+                // s's Hessian on the sphere: tᵀ(−(Q − Qn nᵀQ/σ²)/σ)t' − (∇s·n) tᵀt'
+                let hess = |x: V3, y: V3| {
+                    let qy = [0, 1, 2].map(|i| dot(q[i], y));
+                    -(dot(x, qy) - dot(x, qn) * dot(qn, y) / (sigma * sigma)) / sigma
+                        - along * dot(x, y)
+                };
+                let (h11, h12, h22) = (hess(t1, t1), hess(t1, t2), hess(t2, t2));
+                // where s is not concave, H shifted to below zero by its spread of
+                // eigenvalues (a trust region's step); the step at most a grid spacing
+                let (mean, spread) = (
+                    0.5 * (h11 + h22),
+                    (0.25 * (h11 - h22).powi(2) + h12 * h12).sqrt(),
+                );
+                let shift = if mean + spread >= 0.0 {
+                    mean + 2.0 * spread
+                } else {
+                    0.0
+                };
+                let (h11, h22) = (h11 - shift, h22 - shift);
+                let det = h11 * h22 - h12 * h12;
+                // H d = −(size, 0)
+                let mut d = if det > 0.0 && h11 < 0.0 {
+                    [-size * h22 / det, size * h12 / det]
+                } else {
+                    [angle(1), 0.0]
+                };
+                let length = d[0].hypot(d[1]);
+                if !(length <= angle(1)) {
+                    d = [angle(1) * d[0] / length, angle(1) * d[1] / length];
+                }
+                let along_d = |scale: f64| {
+                    unit([0, 1, 2].map(|i| n[i] + scale * (d[0] * t1[i] + d[1] * t2[i])))
+                };
+                let mut scale = 1.0;
+                let mut gained = None;
+                for _ in 0..10 {
+                    if let Some(m) = along_d(scale)
+                        && s(m) > best
+                    {
+                        gained = Some((m, s(m)));
+                        break;
                     }
-                    _ => step *= 0.5,
+                    scale *= 0.5;
+                }
+                // a full step that gains: longer ones while they gain more (across a
+                // region where s is not concave)
+                if scale == 1.0 {
+                    for _ in 0..6 {
+                        scale *= 2.0;
+                        match (along_d(scale), gained) {
+                            (Some(m), Some((_, b))) if s(m) > b => gained = Some((m, s(m))),
+                            _ => break,
+                        }
+                    }
+                }
+                let Some((m, b)) = gained else {
+                    break;
+                };
+                (n, best) = (m, b);
+                // on the boundary, where the clamp holds it: an edge's or a face's
+                if (0..3).any(|i| n[i] == 0.0) {
+                    break;
                 }
             }
-            // a maximum on the cone's boundary is an edge's or a face's, which they give
-            // exactly
-            if (0..3).all(|i| sign[i] * n[i] > 0.0) {
+            // a maximum on the cone's boundary (or within rounding of it: cos(π/2) is not
+            // 0) is an edge's or a face's, which they give exactly
+            if (0..3).all(|i| sign[i] * n[i] > 1e-12) {
                 found(n);
             }
         }

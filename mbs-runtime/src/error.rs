@@ -101,9 +101,10 @@ pub const RAN_AWAY: f64 = 1e6;
 /// How [`Failure::UnstableStep`] starts when ρ was estimated at the end of the step.
 const LURCHED: &str = "the step changed the state by more than its own size: at its end ";
 
-/// The component that weighed most in the error test that last rejected a step, named when
-/// the step falls below h_min: a step held by one coordinate of a stiff or singular motion, or
-/// by a tolerance tighter than the arithmetic resolves.
+/// The component that weighed most in the last error test before the step fell below h_min
+/// (a test that rejected the step, or accepted it and chose a next step below h_min), named
+/// in the failure: a step held by one coordinate of a stiff or singular motion, or by a
+/// tolerance tighter than the arithmetic resolves.
 #[derive(Debug, Clone, PartialEq)]
 pub struct HeldBy {
     /// `q[7] (name)`, `the velocity of q[7] (name)` or `λ[2]`

@@ -65,8 +65,8 @@ pub(super) struct Run {
     attempts: usize,
     /// why the last attempt was rejected, when an evaluation failed (reported if h collapses)
     last_cause: Option<Failure>,
-    /// the component that weighed most in the error test, when that test rejected the last
-    /// attempt (`Failure::StepTooSmall` names it)
+    /// the component that weighed most in the last attempt's error test, which rejected the
+    /// attempt or accepted it and chose the next step (`Failure::StepTooSmall` names it)
     held_by: Option<Largest>,
     /// the largest position and velocity of the start, against which a component that held
     /// the step is judged to have run away (`HeldBy::ran_away`)
@@ -708,7 +708,8 @@ impl Run {
                 self.problem.stats.record_step(h);
                 self.problem.stats.user_efforts = self.problem.model.user_evaluations();
                 self.last_cause = None;
-                self.held_by = None;
+                // the test that chose the next step: named if that step falls below h_min
+                self.held_by = test.held_by;
                 self.prev.copy_from(&self.cur);
                 std::mem::swap(&mut self.cur, &mut self.next);
                 self.stepper

@@ -285,6 +285,19 @@ fn failure_text(e: &SimError) -> String {
                 ),
             }
         }
+        Failure::NewtonDiverged {
+            fixed: true,
+            iterations,
+            correction,
+            largest,
+        } => format!(
+            "Newton did not converge in {iterations} iterations at the fixed step (last correction {correction:.2e}{}) {at}: take a smaller step, e.g. --h {:.1e}, or an adaptive one (no --h)",
+            largest
+                .as_ref()
+                .map(|c| format!(", largest in {c}"))
+                .unwrap_or_default(),
+            shorten(0.25 * e.h)
+        ),
         Failure::UnstableStep {
             scheme,
             rho,
@@ -304,8 +317,17 @@ fn failure_text(e: &SimError) -> String {
         } => format!(
             "constraint `{constraint}` drifted to |Φ| = {value:.2e}, beyond {tolerance:.1e} {at}: use --constraints projection, index3 or partitioning, or larger baumgarte:ALPHA,BETA"
         ),
+        // an undamped member of the Newmark family asked to control its step at index 3
+        // or 2: a fixed step, or a member with damping (it is among the schemes that can)
+        Failure::ConstraintsUnsupported { scheme, method, .. }
+            if method.ends_with("with adaptive steps") =>
+        {
+            format!(
+                "{scheme} cannot integrate constraints by {method}: without numerical damping the multipliers and the accelerations oscillate from step to step, which defeats the error estimate; give a fixed step (--h 1e-3), use --constraints projection, or --scheme gen-alpha or hht"
+            )
+        }
         Failure::ConstraintsUnsupported { scheme, method, .. } => format!(
-            "{scheme} cannot integrate constraints by {method}: use --constraints projection (any scheme), or index 3 or index 2 with --scheme gen-alpha, hht, newmark, radau3 or radau5"
+            "{scheme} cannot integrate constraints by {method}: use --constraints projection (any scheme), or --constraints index3 or index2 with --scheme gen-alpha, hht, newmark, radau3 or radau5"
         ),
         _ => e.to_string(),
     }

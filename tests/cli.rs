@@ -191,12 +191,45 @@ fn advice_names_flags_not_rust_types() {
         text.contains("take --h ") && text.contains("--scheme radau5"),
         "{text}"
     );
+    // Newton failing at a fixed step: a smaller --h to type, not h_min (the double
+    // pendulum at h = 0.3 s under Radau5)
+    let e = args(&["--scheme", "radau5", "--h", "0.3"])
+        .run(mbs_models::dpend::DoublePendulum::default(), 10.0)
+        .err()
+        .unwrap();
+    let text = e.to_string();
+    assert!(
+        text.contains("at the fixed step") && text.contains("e.g. --h 7.5e-2"),
+        "{text}"
+    );
+    assert!(
+        !text.contains("h_min") && !text.contains("StepControl"),
+        "{text}"
+    );
     // an index-3 request of a scheme that cannot
     let e = args(&["--scheme", "dopri5", "--constraints", "index3"])
         .run(Pendulum3::default(), 1.0)
         .err()
         .unwrap();
     assert!(e.to_string().contains("--constraints projection"), "{e}");
+    assert!(
+        e.to_string().contains("--constraints index3 or index2"),
+        "{e}"
+    );
+    // trapezoidal Newmark (no numerical damping) asked to control its step at index 3 or 2:
+    // a fixed step or a damped member, not a list of schemes that names it as one that can
+    for method in ["index3", "index2"] {
+        let e = args(&["--scheme", "newmark", "--constraints", method])
+            .run(Pendulum3::default(), 1.0)
+            .err()
+            .unwrap();
+        let text = e.to_string();
+        assert!(
+            text.contains("--h 1e-3") && text.contains("--scheme gen-alpha or hht"),
+            "{text}"
+        );
+        assert!(!text.contains("newmark, radau3"), "{text}");
+    }
 }
 
 mbs::multibody! {

@@ -272,7 +272,15 @@ fn newton_that_fails_names_its_largest_correction() {
             panic!("{scheme:?}: {e}")
         };
         assert_eq!(c, "the velocity of q[1]", "{scheme:?}: {e}");
-        assert!(e.to_string().contains("largest in the velocity of q[1]"));
+        let text = e.to_string();
+        assert!(text.contains("largest in the velocity of q[1]"), "{text}");
+        // the step was the user's: said so, without h_min, which a fixed step never meets
+        assert!(
+            matches!(e.kind, Failure::NewtonDiverged { fixed: true, .. })
+                && text.contains("at the fixed step")
+                && !text.contains("h_min"),
+            "{text}"
+        );
     }
 }
 

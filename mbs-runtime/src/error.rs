@@ -297,14 +297,21 @@ pub enum Failure {
         held_most: Option<HeldMost>,
     },
     #[error(
-        "Newton did not converge in {iterations} iterations (last correction {correction:e}{}) at the smallest step allowed (h_min for adaptive steps; a fixed step is not reduced: take a smaller h)",
-        largest.as_ref().map(|c| format!(", largest in {c}")).unwrap_or_default()
+        "Newton did not converge in {iterations} iterations (last correction {correction:.2e}{}) {}",
+        largest.as_ref().map(|c| format!(", largest in {c}")).unwrap_or_default(),
+        if *fixed {
+            "at the fixed step, which is not reduced: take a smaller step (StepControl::Fixed)"
+        } else {
+            "at the smallest step allowed (h_min)"
+        }
     )]
     NewtonDiverged {
         iterations: usize,
         correction: f64,
         /// the component of the last correction with the largest weighted term
         largest: Option<String>,
+        /// whether the step was the user's fixed step (else the adaptive step at h_min)
+        fixed: bool,
     },
     #[error("{matrix} is singular (rcond ≈ {rcond:.1e}) near coordinates {}", coordinates.join(", "))]
     SingularMatrix {

@@ -783,6 +783,7 @@ impl Run {
                         iterations,
                         correction,
                         largest,
+                        fixed,
                     });
                     return Err(self.fail(kind, h));
                 }

@@ -44,7 +44,10 @@ fn main() {
     let angles = match mbs::simulate(dpend::DoublePendulum::default(), report.scheme, options) {
         Ok((angles, _)) => angles,
         Err(e) => {
-            eprintln!("error in the two-angle dpend: {e}");
+            eprintln!(
+                "error in the two-angle dpend: {}",
+                mbs::cli::RunError::Simulation(Box::new(e))
+            );
             std::process::exit(1);
         }
     };

@@ -48,7 +48,11 @@ fn main() {
     let (tb, sb) = match mbs::simulate(model::SliderCrankClosed::default(), scheme, options) {
         Ok(run) => run,
         Err(e) => {
-            eprintln!("error in form (b): {e}");
+            // in the command line's words (its flags, not the library's options)
+            eprintln!(
+                "error in form (b): {}",
+                mbs::cli::RunError::Simulation(Box::new(e))
+            );
             std::process::exit(1);
         }
     };

@@ -763,12 +763,12 @@ fn the_prescribed_cycle_gives_a_normal_double_hump_braking_then_propulsion_also_
     let alone = tracking
         .rms_over_last_cycle(info, &tr, &MUSCLE_JOINTS)
         .unwrap();
-    let share = cycle.shares.iter().sum::<f64>() / cycle.shares.len() as f64;
+    let share = cycle.share();
     let m = CycleForces::of(&model, &tracking, &tr_m, weight);
     let g = m.figures(0);
     println!(
         "on muscles: {} steps; reserves rms {reserves:.1} N·m against {alone:.1} N·m tracked alone; \
-         muscles at rest supply {:.0} % of the moments on average; right {g:.2?}",
+         muscles at rest supply {:.0} % of the moments (rms over the cycle); right {g:.2?}",
         stats_m.steps,
         100.0 * share
     );

@@ -649,12 +649,28 @@ pub struct MuscleCycle {
     /// the activations static optimisation found at each instant of the cycle (one row
     /// per instant, [`NM`] columns)
     pub activations: Vec<Vec<f64>>,
-    /// the share of the moments asked that the muscles produce at each instant: 1 − |r| /
-    /// |τ|, r the reserves' part
-    pub shares: Vec<f64>,
+    /// at each instant of the cycle, the size |τ| of the moments asked and |r| of the
+    /// reserves' part of them (N·m)
+    pub moments: Vec<[f64; 2]>,
 }
 
 impl MuscleCycle {
+    /// The share of the moments asked that the muscles produce over the cycle,
+    /// 1 − rms |r| / rms |τ|: instants where little is asked weigh little (a share per
+    /// instant, 1 − |r|/|τ|, averaged over a cycle whose moments pass near zero, came out
+    /// at −1888 %).
+    pub fn share(&self) -> f64 {
+        let (asked, left) = self
+            .moments
+            .iter()
+            .fold((0.0, 0.0), |(a, l), [t, r]| (a + t * t, l + r * r));
+        if asked > 0.0 {
+            1.0 - (left / asked).sqrt()
+        } else {
+            1.0
+        }
+    }
+
     /// The start of a run on the muscles: the tracked cycle's start ([`cycle_start`]) with
     /// the extra states of [`MuscleDriven::initial_states`] (the coordinates' part of them
     /// zero, their values after the velocities).
@@ -702,10 +718,12 @@ pub fn muscle_cycle(
             .enumerate()
             .all(|(k, i)| (tr.t[*i] - start - k as f64 * dt).abs() < 1e-6);
     if !uniform {
+        let end = tr.t.last().copied().unwrap_or(0.0);
         return Err(format!(
             "the run must cover a whole cycle of {period} s sampled uniformly (Output::Every), \
-             more than {} outputs over it",
-            2 * harmonics
+             more than {} outputs over it; it ends at t = {end} s, {} outputs in its last cycle",
+            2 * harmonics,
+            instants.len()
         ));
     }
     let mut driven = MuscleDriven {
@@ -714,7 +732,7 @@ pub fn muscle_cycle(
     };
     let mut kin = Kinematics::new::<Human>();
     let mut activations = Vec::with_capacity(instants.len());
-    let mut shares = Vec::with_capacity(instants.len());
+    let mut sizes = Vec::with_capacity(instants.len());
     let mut read = model.clone();
     for &s in &instants {
         let (t, q, qd) = (tr.t[s], &tr.q(s)[..n], &tr.qd(s)[..n]);
@@ -727,9 +745,8 @@ pub fn muscle_cycle(
             .excitations_with_reserves(&kin, &moments, baseline, RESERVE)?;
         let asked = moments.iter().map(|(_, v)| v * v).sum::<f64>().sqrt();
         let left = reserves.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let share = if asked > 0.0 { 1.0 - left / asked } else { 1.0 };
         activations.push(a);
-        shares.push(share);
+        sizes.push([asked, left]);
     }
     // the samples begin at `start`, a whole number of periods: the series are in the run's
     // time as they are
@@ -760,7 +777,7 @@ pub fn muscle_cycle(
     Ok(MuscleCycle {
         driven,
         activations,
-        shares,
+        moments: sizes,
     })
 }
 

@@ -269,11 +269,13 @@ fn failure_text(e: &SimError) -> String {
         Failure::TooMuchWork {
             max_steps,
             held_most,
+            cause,
         } => format!(
-            "more than {max_steps} steps {at}: raise --max-steps, take larger steps (a larger --h or a looser --rtol), or use a scheme suited to the stiffness (--scheme radau5 or bdf){}",
+            "more than {max_steps} steps {at}: {}{}",
+            cause.advice("--max-steps", "--rtol", "a larger --h", "--scheme "),
             HeldMost::clause(held_most)
         ),
-        Failure::StepTooSmall { h_min, held_by } => {
+        Failure::StepTooSmall { h_min, held_by, .. } => {
             match held_by.as_ref().and_then(|b| b.fix("--atol", "--rtol")) {
                 Some(fix) => format!("the step fell below {h_min:e} s {at}: {fix}"),
                 None => format!(

@@ -275,6 +275,10 @@ fn a_failing_run_writes_what_it_computed() {
     );
     assert!(e.to_string().contains("--max-steps"), "{e}");
     assert!(!e.to_string().contains("max_steps"), "{e}");
+    // a fixed step's run says how many steps it needs, not that it may be stiff
+    assert!(e.to_string().contains("needs 1000 steps"), "{e}");
+    assert!(e.to_string().contains("a larger --h"), "{e}");
+    assert!(!e.to_string().contains("stiff"), "{e}");
     assert_eq!(report.stats.steps, 100);
     assert_eq!(report.outputs, 101);
     let (last, rows) = csv_rows(&dir.join("trajectory.csv"));

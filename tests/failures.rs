@@ -4,8 +4,8 @@
 use mbs_models::seed2dof;
 
 use mbs::{
-    Failure, GenAlphaParams, HhtParams, Model, NewmarkParams, Options, Output, Scheme, Simulation,
-    simulate,
+    Failure, GenAlphaParams, HhtParams, Model, NewmarkParams, Options, OutOfSteps, Output, Scheme,
+    Simulation, simulate,
 };
 use mbs_models::undefined_force::LateForce;
 use seed2dof::Seed2dof;
@@ -199,7 +199,75 @@ fn work_limits_are_typed_errors() {
         ..Options::adaptive(10.0, 1e-10)
     };
     let e = simulate(Seed2dof::default(), Scheme::Dopri5, o).unwrap_err();
-    assert!(matches!(e.kind, Failure::StepTooSmall { .. }), "{e}");
+    assert!(
+        matches!(e.kind, Failure::StepTooSmall { given: true, .. }),
+        "{e}"
+    );
+    // a floor the user gave is the first thing to lower
+    assert!(e.to_string().contains("given in Options::h_min"), "{e}");
+    assert!(e.to_string().contains("lower h_min"), "{e}");
+}
+
+/// A run out of steps says what its kind of step and scheme can change: at a fixed step the
+/// steps it needs; an implicit scheme of high order is not told to use a scheme for stiff
+/// problems, an order-2 scheme is told of its order, DOPRI5 (its stiffness detection silent)
+/// that accuracy held its steps.
+#[test]
+fn a_run_out_of_steps_says_what_to_change_for_its_scheme() {
+    let run = |scheme: Scheme, o: Options| {
+        let e = simulate(Seed2dof::default(), scheme, o).unwrap_err();
+        println!("{}: {e}", scheme.name());
+        let Failure::TooMuchWork { cause, .. } = e.kind else {
+            panic!("{e}")
+        };
+        (cause, e.to_string())
+    };
+    let budget = |o: Options| Options { max_steps: 40, ..o };
+    let (cause, text) = run(Scheme::Rk4, budget(Options::fixed(1.0, 1e-3)));
+    assert_eq!(cause, OutOfSteps::Fixed(1000));
+    assert!(
+        text.contains("needs 1000 steps") && !text.contains("stiff"),
+        "{text}"
+    );
+    // 0.03 s at 0.01 s: three steps, whatever the rounding of 0.03/0.01
+    let e = simulate(
+        Seed2dof::default(),
+        Scheme::Rk4,
+        Options {
+            max_steps: 2,
+            ..Options::fixed(0.03, 0.01)
+        },
+    )
+    .unwrap_err();
+    assert!(
+        matches!(
+            e.kind,
+            Failure::TooMuchWork {
+                cause: OutOfSteps::Fixed(3),
+                ..
+            }
+        ),
+        "{e}"
+    );
+    for scheme in [Scheme::Radau5, Scheme::Bdf(Default::default())] {
+        let (cause, text) = run(scheme, budget(Options::adaptive(10.0, 1e-10)));
+        assert_eq!(cause, OutOfSteps::Implicit(scheme.name()));
+        assert!(
+            text.contains("already a scheme for stiff problems"),
+            "{text}"
+        );
+        assert!(!text.contains("use radau5"), "{text}");
+    }
+    let (_, text) = run(
+        Scheme::GenAlpha(Default::default()),
+        budget(Options::adaptive(10.0, 1e-8)),
+    );
+    assert!(
+        text.contains("of order 2") && text.contains("radau5"),
+        "{text}"
+    );
+    let (_, text) = run(Scheme::Dopri5, budget(Options::adaptive(10.0, 1e-10)));
+    assert!(text.contains("held by accuracy"), "{text}");
 }
 
 /// A run out of steps names the component whose error test held most of its steps: the

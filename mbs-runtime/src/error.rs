@@ -159,17 +159,79 @@ impl std::fmt::Display for HeldMost {
     }
 }
 
+/// Why a run ran out of steps, as far as its scheme and step control tell, and so what to
+/// change: the advice of [`Failure::TooMuchWork`] (a scheme that detected stiffness stops with
+/// [`Failure::LikelyStiff`] instead).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OutOfSteps {
+    /// a fixed step, whose run needs this many steps ((t_end − t0)/h rounded up)
+    Fixed(u64),
+    /// an adaptive scheme of order 2 (the Newmark family, the implicit midpoint rule), whose
+    /// steps shrink as the square root of the tolerance
+    OrderTwo(&'static str),
+    /// RKC: of order 2, and stable along the negative real axis (damped modes) only
+    Rkc,
+    /// an implicit scheme of high order (Radau IIA, BDF), made for stiff problems
+    Implicit(&'static str),
+    /// an explicit scheme of high order whose stiffness detection did not fire (DOPRI5)
+    Explicit(&'static str),
+}
+
+impl OutOfSteps {
+    /// The cause for the scheme named `scheme` ([`Scheme::name`](crate::Scheme::name)), with
+    /// `needed` steps at a fixed step.
+    pub fn of(scheme: &'static str, needed: Option<u64>) -> OutOfSteps {
+        match (needed, scheme) {
+            (Some(n), _) => OutOfSteps::Fixed(n),
+            (None, "rkc") => OutOfSteps::Rkc,
+            (None, "radau3" | "radau5" | "bdf") => OutOfSteps::Implicit(scheme),
+            (None, "dopri5" | "euler" | "rk4") => OutOfSteps::Explicit(scheme),
+            (None, _) => OutOfSteps::OrderTwo(scheme),
+        }
+    }
+
+    /// The advice, with the options named as the caller spells them: `max_steps`, `rtol`,
+    /// `larger_step` (what a larger fixed step is called) and `scheme` (the prefix of a
+    /// scheme's name: `--scheme ` on a command line).
+    pub fn advice(&self, max_steps: &str, rtol: &str, larger_step: &str, scheme: &str) -> String {
+        match self {
+            OutOfSteps::Fixed(n) => format!(
+                "at its fixed step the run needs {n} steps: raise {max_steps} to {n} or more, or take {larger_step}"
+            ),
+            OutOfSteps::OrderTwo(s) => format!(
+                "{s} is of order 2, whose steps shrink as the square root of the tolerance: loosen {rtol}, raise {max_steps}, or use a scheme of higher order ({scheme}radau5 or {scheme}bdf)"
+            ),
+            OutOfSteps::Rkc => format!(
+                "rkc is of order 2 and stable along the negative real axis only (damped modes): loosen {rtol} or raise {max_steps}; for accuracy on a problem that is not stiff use {scheme}dopri5, for stiff oscillation {scheme}radau5 or {scheme}bdf"
+            ),
+            OutOfSteps::Implicit(s) => format!(
+                "raise {max_steps} or loosen {rtol} ({s} is already a scheme for stiff problems: its steps were what its error test or its Newton iteration asked)"
+            ),
+            OutOfSteps::Explicit(s) => format!(
+                "raise {max_steps} or loosen {rtol} ({s}'s stiffness detection did not find its steps held by stability: they were held by accuracy)"
+            ),
+        }
+    }
+}
+
 impl HeldBy {
     /// What follows "the step fell below h_min": that the solution may be singular or too
     /// stiff, and the component the error test was held by; where the tolerance was atol's
     /// or the rounding floor, the fix instead (raise atol).
-    pub fn clause(held_by: &Option<HeldBy>) -> String {
-        const STIFF: &str = " (the solution may be singular or too stiff for the scheme)";
+    ///
+    /// With a floor the user `given`, the step may only have needed to be smaller than it:
+    /// the clause says to lower it before it speaks of stiffness.
+    pub fn clause(held_by: &Option<Box<HeldBy>>, given: bool) -> String {
+        let stiff = if given {
+            " (lower h_min if the motion may need smaller steps than that; otherwise the solution may be singular or too stiff for the scheme)"
+        } else {
+            " (the solution may be singular or too stiff for the scheme)"
+        };
         match held_by {
-            None => STIFF.into(),
+            None => stiff.into(),
             Some(b) => match b.fix("atol", "rtol") {
                 Some(fix) => format!(": {fix}"),
-                None => format!("{STIFF}; {}", b.held()),
+                None => format!("{stiff}; {}", b.held()),
             },
         }
     }
@@ -279,15 +341,23 @@ pub enum Failure {
     },
     #[error("invalid parameters: {0}")]
     InvalidParameters(ParamError),
-    #[error("the step fell below h_min = {h_min:e}{}", HeldBy::clause(held_by))]
+    #[error(
+        "the step fell below h_min = {h_min:e}{}{}",
+        if *given { ", the floor given in Options::h_min" } else { "" },
+        HeldBy::clause(held_by, *given)
+    )]
     StepTooSmall {
         h_min: f64,
         /// the component that weighed most in the last error test (none when the scheme has
         /// no error test, or rejected the step for another cause)
-        held_by: Option<HeldBy>,
+        held_by: Option<Box<HeldBy>>,
+        /// whether h_min is the user's ([`Options::h_min`](crate::Options::h_min)) rather than
+        /// the default 1e-12·|t|: then the step may simply have needed to be smaller
+        given: bool,
     },
     #[error(
-        "more than {max_steps} steps (raise Options::max_steps, loosen the tolerance, or use a scheme suited to the stiffness){}",
+        "more than {max_steps} steps: {}{}",
+        cause.advice("Options::max_steps", "rtol", "a larger fixed step", ""),
         HeldMost::clause(held_most)
     )]
     TooMuchWork {
@@ -295,6 +365,8 @@ pub enum Failure {
         /// the component whose error test held the most accepted steps (none without an
         /// error test)
         held_most: Option<HeldMost>,
+        /// what the kind of step and the scheme say of the cause, and so what to change
+        cause: OutOfSteps,
     },
     #[error(
         "Newton did not converge in {iterations} iterations (last correction {correction:.2e}{}) {}",

@@ -36,7 +36,9 @@ pub use analysis::{
     static_equilibrium,
 };
 pub use efforts::{Effort, Efforts, WithEfforts};
-pub use error::{Failure, HeldBy, HeldMost, LoopMatrix, ModelError, ParamError, check_inertia};
+pub use error::{
+    Failure, HeldBy, HeldMost, LoopMatrix, ModelError, OutOfSteps, ParamError, check_inertia,
+};
 pub use integrators::{
     Assembly, Controller, EnsembleReport, GlobalControl, GlobalReport, GlobalRun, Inputs,
     Integrator, Member, SimError, Simulation, State, assemble, ensemble_supported, simulate,

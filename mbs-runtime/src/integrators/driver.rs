@@ -13,7 +13,7 @@ use super::stepper::{Attempt, Control, Step, Stepper};
 use super::{Integrator, State};
 use crate::charts::{self, Recentring};
 use crate::erased::OwnedModel;
-use crate::error::{Failure, HeldMost};
+use crate::error::{Failure, HeldMost, OutOfSteps};
 use crate::model::{Model, Pose};
 use crate::options::{Options, Output, Scheme, StepControl};
 use crate::stats::Stats;
@@ -607,6 +607,16 @@ impl Run {
                 None => Failure::TooMuchWork {
                     max_steps,
                     held_most: self.held_most(),
+                    cause: OutOfSteps::of(
+                        self.scheme.name(),
+                        match self.options.step {
+                            StepControl::Fixed { h } => {
+                                let span = (self.options.t_end - self.options.t0).abs();
+                                Some((span / h - 1e-9).ceil().max(1.0) as u64)
+                            }
+                            _ => None,
+                        },
+                    ),
                 },
             };
             return Err(self.fail(kind, self.h));
@@ -636,11 +646,12 @@ impl Run {
             // the cause of the rejections that shrank the step, when there is one
             let held_by = self
                 .held_by
-                .map(|b| b.held_by(|i| self.problem.label(i), self.start_scale));
-            let kind = self
-                .last_cause
-                .take()
-                .unwrap_or(Failure::StepTooSmall { h_min, held_by });
+                .map(|b| Box::new(b.held_by(|i| self.problem.label(i), self.start_scale)));
+            let kind = self.last_cause.take().unwrap_or(Failure::StepTooSmall {
+                h_min,
+                held_by,
+                given: self.options.h_min.is_some(),
+            });
             return Err(self.fail(kind, h));
         }
         self.attempts += 1;

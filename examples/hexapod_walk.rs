@@ -103,9 +103,11 @@ fn print_figures(label: &str, f: &Figures) {
 /// A walk that started: an unreachable start, or options refused before the first output (a
 /// walk with no trajectory to read figures from), is the program's error.
 fn started(w: Result<Walk, Unreachable>) -> Result<Walk, String> {
-    let w = w.map_err(|e| e.to_string())?;
+    let w = w.map_err(|e| {
+        format!("{e}: the gait asks too long a stride of it; take a smaller --speed or --turn")
+    })?;
     match &w.failure {
-        Some(e) if w.trajectory.is_empty() => Err(e.to_string()),
+        Some(e) if w.trajectory.is_empty() => Err(mbs::cli::failure_text(e)),
         _ => Ok(w),
     }
 }
@@ -189,22 +191,28 @@ fn run(args: &Args) -> Result<(), String> {
         },
         scheme.name()
     );
-    print_figures(&label, &f);
-    println!(
-        "  {} steps, {} evaluations, {} samples",
-        w.stats.steps, w.stats.forward_dynamics, w.stats.samples
-    );
-    println!();
+    // --quiet: nothing but errors
+    let quiet = args.run.quiet;
+    if !quiet {
+        print_figures(&label, &f);
+        println!(
+            "  {} steps, {} evaluations, {} samples",
+            w.stats.steps, w.stats.forward_dynamics, w.stats.samples
+        );
+        println!();
+    }
     if let Some((t, e)) = &w.log.failure {
         println!();
         println!("  the controller held its voltages from t = {t:.3} s: {e}");
     }
     if let Some(out) = &args.run.out {
         write_outputs(out, &w, &f).map_err(|e| e.to_string())?;
-        println!("  outputs in {}", out.display());
+        if !quiet {
+            println!("  outputs in {}", out.display());
+        }
     }
     if let Some(e) = &w.failure {
-        return Err(format!("the walk stopped: {e}"));
+        return Err(format!("the walk stopped: {}", mbs::cli::failure_text(e)));
     }
     Ok(())
 }
@@ -259,7 +267,7 @@ fn compare(
             f.max_slip * 1e3
         );
         if let Some(e) = &r.failure {
-            println!("  ({name} stopped: {e})");
+            println!("  ({name} stopped: {})", mbs::cli::failure_text(e));
         }
     }
     if let Some(out) = out {

@@ -145,7 +145,9 @@ fn gait() -> Result<(), Box<dyn std::error::Error>> {
             Ok(x)
         } else {
             Err(format!(
-                "{name} {x} is out of range: take a number in [{low}, {high}]"
+                "{name} {x} is out of range: take a number in [{}, {}]",
+                mbs::error::short(low),
+                mbs::error::short(high)
             ))
         }
     };

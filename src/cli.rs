@@ -235,8 +235,9 @@ fn stopped_text(failure: Option<&SimError>, report: &RunReport) -> String {
 }
 
 /// The runtime's message of a failure, with advice in the command line's flags where the
-/// runtime names its Rust API (`StepControl::Fixed`, `max_steps`, …).
-fn failure_text(e: &SimError) -> String {
+/// runtime names its Rust API (`StepControl::Fixed`, `max_steps`, …): for programs that run
+/// with [`RunArgs`]' options but report a failure of their own runs.
+pub fn failure_text(e: &SimError) -> String {
     let flag = |name: &str| -> Option<&'static str> {
         Some(match name {
             "t_end" => "--t-end",

@@ -706,11 +706,14 @@ impl Options {
                         "must be at least 10 ε (2.2e-15): no scheme resolves below rounding",
                     ));
                 }
-                if !(atol > 0.0) || !atol.is_finite() {
+                if atol.is_infinite() {
+                    return Err(invalid("atol", atol, "must be finite"));
+                }
+                if !(atol > 0.0) {
                     return Err(invalid(
                         "atol",
                         atol,
-                        "must be > 0 and finite: under atol = 0 a component at zero (a start at rest) has no tolerance at all; take the magnitude below which a component need not be resolved (rtol/100 by default)",
+                        "must be > 0: under atol = 0 a component at zero (a start at rest) has no tolerance at all; take the magnitude below which a component need not be resolved (rtol/100 by default)",
                     ));
                 }
                 if let Some(h0) = h0 {
@@ -802,7 +805,7 @@ impl Options {
                         short(*dt),
                         short(self.t_end - self.t0)
                     ),
-                    "gives more than 10⁸ outputs, more than the trajectory can hold: take a larger dt, or Output::Steps or Output::Last",
+                    "gives more than 10⁸ outputs, more than the trajectory can hold: take a larger dt (or, in Rust, Output::Steps or Output::Last)",
                 ));
             }
             Output::Every { dt }

@@ -135,9 +135,11 @@ impl std::fmt::Display for Unreachable {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "leg {} cannot reach the foot target {:?} (m, base frame from its hip): the thigh and shank reach {:.2} to {:.2} m from the pitch axis",
+            "leg {} cannot reach the foot target [{:.3}, {:.3}, {:.3}] (m, base frame from its hip): the thigh and shank reach {:.2} to {:.2} m from the pitch axis",
             self.leg,
-            self.target,
+            self.target[0],
+            self.target[1],
+            self.target[2],
             SHANK - THIGH,
             THIGH + SHANK
         )

@@ -173,7 +173,8 @@ pub enum OutOfSteps {
     Rkc,
     /// an implicit scheme of high order (Radau IIA, BDF), made for stiff problems
     Implicit(&'static str),
-    /// an explicit scheme of high order whose stiffness detection did not fire (DOPRI5)
+    /// an explicit scheme of high order whose stiffness detection did not fire (DOPRI5): its
+    /// steps may still be held by stiff modes within its stability region
     Explicit(&'static str),
 }
 
@@ -208,7 +209,7 @@ impl OutOfSteps {
                 "raise {max_steps} or loosen {rtol} ({s} is already a scheme for stiff problems: its steps were what its error test or its Newton iteration asked)"
             ),
             OutOfSteps::Explicit(s) => format!(
-                "raise {max_steps} or loosen {rtol} ({s}'s stiffness detection did not find its steps held by stability: they were held by accuracy)"
+                "raise {max_steps} or loosen {rtol}; {s}'s stiffness detection did not find its steps held by its stability region, but a problem with fast decaying modes (a stiff spring or damper, large Baumgarte gains) is better run by {scheme}radau5 or {scheme}bdf"
             ),
         }
     }

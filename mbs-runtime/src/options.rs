@@ -872,7 +872,8 @@ impl Options {
             if !(alpha >= 0.0 && beta >= 0.0 && alpha.is_finite() && beta.is_finite()) {
                 return Err(invalid(
                     "constraints.method",
-                    format!("Baumgarte {{ alpha: {alpha}, beta: {beta} }}"),
+                    // as `ConstraintMethod::from_name` and the command line write it
+                    format!("baumgarte:{alpha},{beta}"),
                     "α and β must be finite and ≥ 0 (negative values destabilise the constraints)",
                 ));
             }

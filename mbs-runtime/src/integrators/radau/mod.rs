@@ -755,6 +755,12 @@ impl Stepper for Radau {
                     if f.cause.is_none() {
                         self.h_newton = self.h_newton.min(h);
                     }
+                    // the step shrank for Newton's sake, not its error's: the predictive
+                    // correction would read that shrinking as the error's trend and shrink
+                    // the step after the next acceptance by up to 5 more (the fast
+                    // mechanism at index 3, rtol 1e-9: from h_min to below it, which stopped
+                    // the run blaming an error test whose error was 6e-4 of its tolerance)
+                    self.control.restart();
                     return Ok(Attempt::RejectedNewton {
                         h_next: f.h_next,
                         iterations: f.iterations,

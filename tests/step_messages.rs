@@ -607,3 +607,22 @@ fn every_dt_ends_on_t_end_and_a_failed_last_output_run_keeps_its_state() {
     assert_eq!(e.trajectory.t[0], e.t);
     assert!(e.t > 0.0);
 }
+
+/// A step that shrank for Newton's sake is not blamed on the error test: fastlink at index 3
+/// under Radau3 at rtol 1e-9 fails its Newton iterations down to h_min, then accepts a step
+/// there with an error 6e-4 of its tolerance. The predictive correction took the shrinking
+/// for the error's trend and cut the next step by 5, below h_min, and the run stopped with
+/// "the step fell below h_min … raise atol"; it now says that Newton did not converge there.
+#[test]
+fn a_step_shrunk_by_newton_is_not_blamed_on_the_error_test() {
+    let mut o = quiet(Options::adaptive(0.03, 1e-9));
+    o.constraints.method = mbs::ConstraintMethod::Index3;
+    let e = simulate(FastLink::default(), Scheme::Radau3, o).unwrap_err();
+    println!("{e}\n{}", e.stats);
+    assert!(
+        matches!(e.kind, Failure::NewtonDiverged { fixed: false, .. }),
+        "{e}"
+    );
+    assert!(e.stats.rejected_newton > 10, "{}", e.stats);
+    assert_eq!(e.stats.rejected_error, 0, "{}", e.stats);
+}

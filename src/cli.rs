@@ -313,6 +313,15 @@ pub fn failure_text(e: &SimError) -> String {
             crate::error::unstable_text(scheme, *rho, *h_rho, *limit, *at_end),
             shorten(*h_stable)
         ),
+        Failure::ClosureFailed {
+            what,
+            constraint,
+            residual,
+            iterations,
+        } => format!(
+            "Newton could not close constraint `{constraint}` by moving {what} (|Φ| = {residual:.2e} after {iterations} iterations) {at}: the step left the constraints farther than Newton reaches from there; at a fixed step take a smaller one, e.g. --h {:.1e}, or adaptive steps (no --h), which retry it smaller (with adaptive steps it failed at h_min: near a singular configuration of the loop)",
+            shorten(0.25 * e.h)
+        ),
         Failure::ConstraintDrift {
             constraint,
             value,

@@ -412,3 +412,22 @@ fn requests_beyond_memory_or_size_are_refused() {
         "{e}"
     );
 }
+
+/// A loop that Newton cannot close after a fixed step too large for it says to take a smaller
+/// one: fastlink under BDF with partitioning at a fixed 0.1 s (its motion happens in 30 ms).
+#[test]
+fn a_loop_not_closed_after_a_large_fixed_step_advises_a_smaller_one() {
+    let mut o = Options::fixed(1.0, 0.1);
+    o.constraints.method = mbs::ConstraintMethod::Partitioning;
+    let e = simulate(
+        mbs_models::fastlink::FastLink::default(),
+        Scheme::Bdf(Default::default()),
+        o,
+    )
+    .unwrap_err();
+    println!("{e}");
+    assert!(matches!(e.kind, Failure::ClosureFailed { .. }), "{e}");
+    assert!(e.to_string().contains("take a smaller one"), "{e}");
+    assert_eq!(e.t, 0.0);
+    assert_eq!(e.trajectory.len(), 1);
+}

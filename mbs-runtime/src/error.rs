@@ -476,7 +476,7 @@ pub enum Failure {
         tolerance: f64,
     },
     #[error(
-        "Newton could not close constraint `{constraint}` by moving {what} (|Φ| = {residual:.2e} after {iterations} iterations)"
+        "Newton could not close constraint `{constraint}` by moving {what} (|Φ| = {residual:.2e} after {iterations} iterations): the step left the constraints farther than Newton reaches from there; at a fixed step take a smaller one, or adaptive steps, which retry it smaller (with adaptive steps it failed at h_min: near a singular configuration of the loop)"
     )]
     ClosureFailed {
         what: &'static str,

@@ -43,9 +43,9 @@
 
 use crate::plot::{Chart, Series, line_chart};
 use crate::{
-    ConstraintMethod, ConstraintOptions, CsvWriter, Failure, GlobalControl, GlobalReport, HeldMost,
-    Inputs, Model, Options, Output, Scheme, SimError, Simulation, Stats, StepControl, Trajectory,
-    error::short, simulate_global,
+    ConstraintMethod, ConstraintOptions, CsvWriter, Failure, GlobalControl, GlobalReport, HeldBy,
+    HeldMost, Inputs, Model, Options, Output, Scheme, SimError, Simulation, Stats, StepControl,
+    Trajectory, error::short, simulate_global,
 };
 /// `RunArgs::parse()` needs this trait in scope: programs can name it without depending on
 /// clap themselves (`use mbs::cli::Parser;`).
@@ -275,6 +275,19 @@ pub fn failure_text(e: &SimError) -> String {
             "more than {max_steps} steps {at}: {}{}",
             cause.advice("--max-steps", "--rtol", "a larger --h", "--scheme "),
             HeldMost::clause(held_most)
+        ),
+        Failure::StepTooSmall {
+            h_min,
+            held_by,
+            jump: Some(order),
+            ..
+        } if !held_by.as_ref().is_some_and(|b| b.ran_away()) => format!(
+            "the step fell below {h_min:e} s {at}: {}{}",
+            HeldBy::jump(*order, "--atol"),
+            held_by
+                .as_ref()
+                .map(|b| format!("; {}", b.held()))
+                .unwrap_or_default()
         ),
         Failure::StepTooSmall { h_min, held_by, .. } => {
             match held_by.as_ref().and_then(|b| b.fix("--atol", "--rtol")) {

@@ -222,7 +222,15 @@ impl HeldBy {
     ///
     /// With a floor the user `given`, the step may only have needed to be smaller than it:
     /// the clause says to lower it before it speaks of stiffness.
-    pub fn clause(held_by: &Option<Box<HeldBy>>, given: bool) -> String {
+    pub fn clause(held_by: &Option<Box<HeldBy>>, given: bool, jump: Option<f64>) -> String {
+        let ran_away = held_by.as_ref().is_some_and(|b| b.ran_away());
+        if let (Some(order), false) = (jump, ran_away) {
+            let held = held_by
+                .as_ref()
+                .map(|b| format!("; {}", b.held()))
+                .unwrap_or_default();
+            return format!(": {}{held}", HeldBy::jump(order, "atol"));
+        }
         let stiff = if given {
             " (lower h_min if the motion may need smaller steps than that; otherwise the solution may be singular or too stiff for the scheme)"
         } else {
@@ -265,6 +273,15 @@ impl HeldBy {
                 None => "unknown".to_string(),
             },
             self.held()
+        )
+    }
+
+    /// "the error fell in proportion to the step …": a jump in the forces within the step, by
+    /// the `order` at which the error fell with h over the last rejections (about 1, where a
+    /// smooth motion gives the scheme's order + 1), with the tolerance named `atol`.
+    pub fn jump(order: f64, atol: &str) -> String {
+        format!(
+            "the error fell only in proportion to the step as it shrank (order {order:.1}, where a smooth motion gives the scheme's order + 1): the forces likely jump within the step (a contact's damping force at touchdown, a switch, an input that steps), and a step across a jump Δa errs by about h·Δa whatever its size; make the force continuous there, stop and restart the run at the jump, or raise {atol} to what such a step can meet"
         )
     }
 
@@ -345,7 +362,7 @@ pub enum Failure {
     #[error(
         "the step fell below h_min = {h_min:e}{}{}",
         if *given { ", the floor given in Options::h_min" } else { "" },
-        HeldBy::clause(held_by, *given)
+        HeldBy::clause(held_by, *given, *jump)
     )]
     StepTooSmall {
         h_min: f64,
@@ -355,6 +372,9 @@ pub enum Failure {
         /// whether h_min is the user's ([`Options::h_min`](crate::Options::h_min)) rather than
         /// the default 1e-12·|t|: then the step may simply have needed to be smaller
         given: bool,
+        /// the order at which the error fell with the step over the last rejections, when
+        /// about 1 (below 1.5): the forces jump within the step ([`HeldBy::jump`])
+        jump: Option<f64>,
     },
     #[error(
         "more than {max_steps} steps: {}{}",

@@ -20,6 +20,12 @@ use crate::stats::Stats;
 use crate::trajectory::{Observer, Trajectory};
 use std::marker::PhantomData;
 
+/// Below this order of the error in h (and from 0.5), observed over two rejections from one
+/// t, the forces are taken to jump within the step: a step across a jump Δa in the
+/// acceleration errs by about h·Δa (order 1), where a smooth motion gives the schemes' orders
+/// of 2 to 6 (and a motion that runs away, an error that grows as h shrinks).
+const JUMP_ORDER: f64 = 1.5;
+
 /// Runs `scheme` on `model` with `options` to the end; on failure, the error keeps the
 /// trajectory up to the failure.
 pub fn simulate<M: Model + 'static>(
@@ -68,6 +74,11 @@ pub(super) struct Run {
     /// the component that weighed most in the last attempt's error test, which rejected the
     /// attempt or accepted it and chose the next step (`Failure::StepTooSmall` names it)
     held_by: Option<Largest>,
+    /// the last rejection by the error test: its start t, its h and its error norm
+    last_rejection: Option<(f64, f64, f64)>,
+    /// the order at which the error fell with the step over two rejections from one t
+    /// (ln(err₁/err₂)/ln(h₁/h₂)), and that t: about 1 where the forces jump within the step
+    observed_order: Option<(f64, f64)>,
     /// the largest position and velocity of the start, against which a component that held
     /// the step is judged to have run away (`HeldBy::ran_away`)
     start_scale: [f64; 2],
@@ -310,6 +321,8 @@ impl Run {
             attempts: 0,
             last_cause: None,
             held_by: None,
+            last_rejection: None,
+            observed_order: None,
             held_counts,
             traj,
             out_times,
@@ -647,10 +660,17 @@ impl Run {
             let held_by = self
                 .held_by
                 .map(|b| Box::new(b.held_by(|i| self.problem.label(i), self.start_scale)));
+            // an order of about 1 observed close by (t moved by less than a millionth of
+            // itself since): a jump in the forces, which no step resolves
+            let jump = self.observed_order.and_then(|(t, order)| {
+                let near = (self.cur.t - t).abs() <= 1e-6 * self.cur.t.abs().max(1.0);
+                (near && (0.5..JUMP_ORDER).contains(&order)).then_some(order)
+            });
             let kind = self.last_cause.take().unwrap_or(Failure::StepTooSmall {
                 h_min,
                 held_by,
                 given: self.options.h_min.is_some(),
+                jump,
             });
             return Err(self.fail(kind, h));
         }
@@ -760,7 +780,16 @@ impl Run {
             Ok(Attempt::RejectedError { h_next }) => {
                 // only adaptive schemes test errors
                 self.problem.stats.rejected_error += 1;
-                self.held_by = self.stepper.last_test().held_by;
+                let test = self.stepper.last_test();
+                self.held_by = test.held_by;
+                // two rejections from one t: the order at which the error fell with h
+                if let Some((t, h1, e1)) = self.last_rejection {
+                    let (h2, e2) = (h, test.value);
+                    if t == self.cur.t && h2 < 0.9 * h1 && e1 > 0.0 && e2 > 0.0 {
+                        self.observed_order = Some((t, (e1 / e2).ln() / (h1 / h2).ln()));
+                    }
+                }
+                self.last_rejection = Some((self.cur.t, h, test.value));
                 self.h = h_next;
             }
             Ok(Attempt::RejectedNewton {

@@ -631,10 +631,10 @@ fn a_step_shrunk_by_newton_is_not_blamed_on_the_error_test() {
 
 /// A step that collapses at a jump in the forces says so: the standing hexapod's feet touch
 /// the ground at t = 0.048 s, where the contact's damping force c·ż jumps from 0 to about
-/// 220 N; a step across that errs by about h·Δa, so that over the rejections from one t the
-/// error falls in proportion to h (order 1.0 under BDF and RKC, 1.4 under Radau3), and at
-/// tight tolerances the steps fall below h_min. Before, the message only said to raise atol,
-/// as for a component too small to resolve.
+/// 220 N; a step across that errs by about h·Δa, so that over the rejections from about one
+/// t the error falls in proportion to h (order 1.0 under BDF and RKC, 0.9 under Radau3), and
+/// at tight tolerances the steps fall below h_min. Before, the message only said to raise
+/// atol, as for a component too small to resolve.
 #[test]
 fn a_step_collapsing_at_a_jump_in_the_forces_says_so() {
     for (scheme, rtol) in [

@@ -276,12 +276,12 @@ impl HeldBy {
         )
     }
 
-    /// "the error fell in proportion to the step …": a jump in the forces within the step, by
-    /// the `order` at which the error fell with h over the last rejections (about 1, where a
-    /// smooth motion gives the scheme's order + 1), with the tolerance named `atol`.
+    /// "the error fell with the step at order …": forces that are not smooth within the step,
+    /// by the `order` at which the error fell with h over the last rejections (below 1.5,
+    /// where a smooth motion gives the scheme's order + 1), with the tolerance named `atol`.
     pub fn jump(order: f64, atol: &str) -> String {
         format!(
-            "the error fell only in proportion to the step as it shrank (order {order:.1}, where a smooth motion gives the scheme's order + 1): the forces likely jump within the step (a contact's damping force at touchdown, a switch, an input that steps), and a step across a jump Δa errs by about h·Δa whatever its size; make the force continuous there, stop and restart the run at the jump, or raise {atol} to what such a step can meet"
+            "the error fell with the step only at order {order:.1} as it shrank, where a smooth motion gives the scheme's order + 1: the forces are likely not smooth here (a jump, as a contact's damping force at touchdown or an input that steps, or a law that switches at a threshold of a coordinate or a rate), and a step across that errs by an amount that shrinking it hardly reduces (about h·Δa for a jump Δa); make the force continuous there (a regularisation over a small width), stop and restart the run at the event, or raise {atol} to what such a step can meet"
         )
     }
 
@@ -373,7 +373,8 @@ pub enum Failure {
         /// the default 1e-12·|t|: then the step may simply have needed to be smaller
         given: bool,
         /// the order at which the error fell with the step over the last rejections, when
-        /// about 1 (below 1.5): the forces jump within the step ([`HeldBy::jump`])
+        /// below 1.5: forces that are not smooth within the step, a jump (about 1) or a law
+        /// that switches with the state (about 0) ([`HeldBy::jump`])
         jump: Option<f64>,
     },
     #[error(

@@ -20,11 +20,17 @@ use crate::stats::Stats;
 use crate::trajectory::{Observer, Trajectory};
 use std::marker::PhantomData;
 
-/// Below this order of the error in h (and from 0.5), observed over two rejections from one
-/// t, the forces are taken to jump within the step: a step across a jump Δa in the
-/// acceleration errs by about h·Δa (order 1), where a smooth motion gives the schemes' orders
-/// of 2 to 6 (and a motion that runs away, an error that grows as h shrinks).
+/// Below this order of the error in h, observed over rejections from about one t, the forces
+/// are taken not to be smooth there: a step across a jump Δa in the acceleration errs by
+/// about h·Δa (order 1), a step across a law that switches with the state by a size that
+/// does not fall with h (order 0), where a smooth motion gives the schemes' orders of 2 to 6
+/// (and a motion that runs away an error that grows as h shrinks: below −0.5, not taken).
 const JUMP_ORDER: f64 = 1.5;
+
+/// Whether two times are about one: within a millionth of their size (or of 1 s).
+fn near(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 1e-6 * a.abs().max(b.abs()).max(1.0)
+}
 
 /// Runs `scheme` on `model` with `options` to the end; on failure, the error keeps the
 /// trajectory up to the failure.
@@ -74,10 +80,12 @@ pub(super) struct Run {
     /// the component that weighed most in the last attempt's error test, which rejected the
     /// attempt or accepted it and chose the next step (`Failure::StepTooSmall` names it)
     held_by: Option<Largest>,
-    /// the last rejection by the error test: its start t, its h and its error norm
-    last_rejection: Option<(f64, f64, f64)>,
-    /// the order at which the error fell with the step over two rejections from one t
-    /// (ln(err₁/err₂)/ln(h₁/h₂)), and that t: about 1 where the forces jump within the step
+    /// the first rejection by the error test of the current run of rejections from about
+    /// one t (t moving by less than a millionth of itself): its t, its h and its error norm
+    first_rejection: Option<(f64, f64, f64)>,
+    /// the order at which the error fell with the step over that run of rejections
+    /// (ln(err₁/err₂)/ln(h₁/h₂), h shrunk by 4 at least), and the t it was observed at:
+    /// about 1 where the forces jump within the step, about 0 where they switch with the state
     observed_order: Option<(f64, f64)>,
     /// the largest position and velocity of the start, against which a component that held
     /// the step is judged to have run away (`HeldBy::ran_away`)
@@ -321,7 +329,7 @@ impl Run {
             attempts: 0,
             last_cause: None,
             held_by: None,
-            last_rejection: None,
+            first_rejection: None,
             observed_order: None,
             held_counts,
             traj,
@@ -660,11 +668,10 @@ impl Run {
             let held_by = self
                 .held_by
                 .map(|b| Box::new(b.held_by(|i| self.problem.label(i), self.start_scale)));
-            // an order of about 1 observed close by (t moved by less than a millionth of
-            // itself since): a jump in the forces, which no step resolves
+            // an order below 1.5 observed close by: forces that jump, or switch with the
+            // state, which no step resolves
             let jump = self.observed_order.and_then(|(t, order)| {
-                let near = (self.cur.t - t).abs() <= 1e-6 * self.cur.t.abs().max(1.0);
-                (near && (0.5..JUMP_ORDER).contains(&order)).then_some(order)
+                (near(t, self.cur.t) && (-0.5..JUMP_ORDER).contains(&order)).then_some(order)
             });
             let kind = self.last_cause.take().unwrap_or(Failure::StepTooSmall {
                 h_min,
@@ -782,14 +789,17 @@ impl Run {
                 self.problem.stats.rejected_error += 1;
                 let test = self.stepper.last_test();
                 self.held_by = test.held_by;
-                // two rejections from one t: the order at which the error fell with h
-                if let Some((t, h1, e1)) = self.last_rejection {
-                    let (h2, e2) = (h, test.value);
-                    if t == self.cur.t && h2 < 0.9 * h1 && e1 > 0.0 && e2 > 0.0 {
-                        self.observed_order = Some((t, (e1 / e2).ln() / (h1 / h2).ln()));
+                // rejections from about one t: the order at which the error fell with h
+                let t = self.cur.t;
+                match self.first_rejection {
+                    Some((t1, h1, e1)) if near(t1, t) => {
+                        let e = test.value;
+                        if h * 4.0 <= h1 && e1 > 0.0 && e > 0.0 {
+                            self.observed_order = Some((t, (e1 / e).ln() / (h1 / h).ln()));
+                        }
                     }
+                    _ => self.first_rejection = Some((t, h, test.value)),
                 }
-                self.last_rejection = Some((self.cur.t, h, test.value));
                 self.h = h_next;
             }
             Ok(Attempt::RejectedNewton {

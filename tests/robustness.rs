@@ -12,20 +12,6 @@ use mbs::{ConstraintMethod, Failure, Model, Options, Output, Scheme, SimError, s
 use mbs_models::*;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
-const SCHEMES: [&str; 11] = [
-    "euler",
-    "rk4",
-    "rkc",
-    "dopri5",
-    "newmark",
-    "hht",
-    "gen-alpha",
-    "bdf",
-    "radau3",
-    "radau5",
-    "midpoint",
-];
-
 fn methods(closed: bool) -> Vec<ConstraintMethod> {
     if !closed {
         return vec![ConstraintMethod::Auto];
@@ -96,7 +82,7 @@ fn sweep<M: Model + Clone + 'static>(
     problems: &mut Vec<String>,
 ) -> usize {
     let mut runs = 0;
-    for scheme in SCHEMES.map(|s| Scheme::from_name(s).unwrap()) {
+    for scheme in Scheme::all() {
         for method in methods(closed) {
             for o in steps() {
                 let mut o = Options {

@@ -407,7 +407,10 @@ pub enum Failure {
         /// whether the step was the user's fixed step (else the adaptive step at h_min)
         fixed: bool,
     },
-    #[error("{matrix} is singular (rcond ≈ {rcond:.1e}) near coordinates {}", coordinates.join(", "))]
+    #[error(
+        "{matrix} is singular (rcond ≈ {rcond:.1e}){}",
+        if coordinates.is_empty() { String::new() } else { format!(" near coordinates {}", coordinates.join(", ")) }
+    )]
     SingularMatrix {
         matrix: &'static str,
         rcond: f64,

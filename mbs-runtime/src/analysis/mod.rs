@@ -59,6 +59,16 @@ pub enum AnalysisError {
         /// retry from)
         q: Vec<f64>,
     },
+    /// The QR iteration of a Schur decomposition did not converge, even where it set to zero
+    /// the subdiagonal entries below `deflation` of their neighbours.
+    #[error(
+        "the eigenvalues of {matrix} ({size} × {size}) were not found: the QR iteration of its Schur decomposition did not converge, even deflating at {deflation:.0e} of the neighbouring entries (a matrix of exactly repeated structure; perturb the state slightly, or linearise about another)"
+    )]
+    EigenvaluesNotFound {
+        matrix: &'static str,
+        size: usize,
+        deflation: f64,
+    },
     /// An analysis along a motion (inverse dynamics) failed at one of its times; what it
     /// computed at the times before is kept.
     #[error("at t = {t} (time {index} of the motion; the {index} before it computed): {cause}")]

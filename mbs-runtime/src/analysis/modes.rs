@@ -50,28 +50,49 @@ pub struct Modes {
     /// independent ones of a constrained model)
     pub dof_names: Vec<String>,
     pub modes: Vec<Mode>,
+    /// the threshold, relative to A's largest entry, below which the Schur decomposition set
+    /// a subdiagonal entry to zero: ε, or a looser one where its QR iteration could not
+    /// reach ε (several zero eigenvalues beside large ones: a free body's rigid motions); the
+    /// eigenvalues are those of a matrix within about this much of A's largest entry, and a
+    /// repeated eigenvalue is split by about the square root of it
+    pub deflation: f64,
 }
 
-/// The eigenvalues of A from its Schur form. nalgebra's QR iteration can cycle on matrices
-/// of exact structure (seen on the sleeping top's: zeros and equal entries where the
-/// exceptional shifts never break the tie) and `complex_eigenvalues` iterates without bound;
-/// here the iterations are bounded, and a matrix the iteration cannot reduce is tried again
-/// after a similarity by a fixed Householder reflection (same eigenvalues, no structure),
-/// then reported as an error rather than a hang.
-fn eigenvalues(a: &DMatrix<f64>) -> Result<Vec<nalgebra::Complex<f64>>, AnalysisError> {
+/// The deflation thresholds tried, in turn, relative to the largest entry of A (see
+/// [`eigenvalues`]).
+const DEFLATIONS: [f64; 6] = [f64::EPSILON, 1e-14, 1e-13, 1e-12, 1e-11, 1e-10];
+
+/// The eigenvalues of A from its Schur form, and the deflation threshold that found them.
+/// nalgebra's QR iteration can cycle on matrices of exact structure (seen on the sleeping
+/// top's: zeros and equal entries where the exceptional shifts never break the tie) and
+/// `complex_eigenvalues` iterates without bound; here the iterations are bounded, and a
+/// matrix the iteration cannot reduce is tried again after a similarity by a fixed
+/// Householder reflection (same eigenvalues, no structure). Its test deflates a subdiagonal
+/// entry below ε times its two diagonal neighbours, or below ε² of A's largest entry: beside
+/// several zero eigenvalues, whose diagonal entries are zero, only the second, which the
+/// rounding of a large A never reaches (the hexapod released above the ground: six rigid
+/// motions without stiffness or damping, twelve zero eigenvalues in Jordan blocks, beside
+/// contact and joint gains of 4·10⁴/s²). Both matrices are then tried at the looser
+/// thresholds of [`DEFLATIONS`]: an entry below one of them, relative to its neighbours, is
+/// set to zero, and the eigenvalues are those of a matrix within about that much of A's
+/// largest entry; the threshold used is returned ([`Modes::deflation`]). Past the last, an
+/// error rather than a hang.
+fn eigenvalues(a: &DMatrix<f64>) -> Result<(Vec<nalgebra::Complex<f64>>, f64), AnalysisError> {
     let n = a.nrows();
-    let schur = |m: DMatrix<f64>| nalgebra::linalg::Schur::try_new(m, f64::EPSILON, 200 * n);
-    let s = schur(a.clone()).or_else(|| {
-        let v = nalgebra::DVector::from_fn(n, |i, _| 1.0 + (i as f64 * 0.618_034).fract());
-        let h = DMatrix::identity(n, n) - (&v * v.transpose()) * (2.0 / v.norm_squared());
-        schur(&h * a * &h)
-    });
-    let s = s.ok_or(Failure::SingularMatrix {
-        matrix: "A (its Schur decomposition did not converge)",
-        rcond: 0.0,
-        coordinates: Vec::new(),
-    })?;
-    Ok(s.complex_eigenvalues().iter().copied().collect())
+    let schur = |m: &DMatrix<f64>, eps| nalgebra::linalg::Schur::try_new(m.clone(), eps, 200 * n);
+    let v = nalgebra::DVector::from_fn(n, |i, _| 1.0 + (i as f64 * 0.618_034).fract());
+    let h = DMatrix::identity(n, n) - (&v * v.transpose()) * (2.0 / v.norm_squared());
+    let reflected = &h * a * &h;
+    for eps in DEFLATIONS {
+        if let Some(s) = schur(a, eps).or_else(|| schur(&reflected, eps)) {
+            return Ok((s.complex_eigenvalues().iter().copied().collect(), eps));
+        }
+    }
+    Err(AnalysisError::EigenvaluesNotFound {
+        matrix: "A",
+        size: n,
+        deflation: DEFLATIONS[DEFLATIONS.len() - 1],
+    })
 }
 
 /// Computes the modes of `lin` whose frequency is within `window` (Hz, inclusive), or all.
@@ -100,6 +121,7 @@ pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, A
         return Ok(Modes {
             dof_names: lin.coordinates.clone(),
             modes: Vec::new(),
+            deflation: f64::EPSILON,
         });
     }
     // the integrals of first-order states are read by nothing: their columns of A are zero
@@ -108,8 +130,19 @@ pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, A
     let kept: Vec<usize> = (0..n2).filter(|i| !lin.first_order.contains(i)).collect();
     let a = lin.a.select_rows(&kept).select_columns(&kept);
     let m2 = kept.len();
-    let eig = eigenvalues(&a)?;
+    let (mut eig, deflation) = eigenvalues(&a)?;
     let scale = a.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+    // A repeated zero eigenvalue (a free body's rigid motions: Jordan blocks, no stiffness and
+    // no damping) comes out split by the rounding into a cluster of radius up to about
+    // √(deflation·max|A|), as real pairs ±x that the table would call unstable and decaying
+    // with time constants of months (the hexapod in the air: ±1.7e-7/s). Where two or more
+    // eigenvalues lie within ten times that of zero they are that zero, and are set to it.
+    let zero_within = 10.0 * (deflation * scale).sqrt();
+    if eig.iter().filter(|l| l.norm() <= zero_within).count() >= 2 {
+        for l in eig.iter_mut().filter(|l| l.norm() <= zero_within) {
+            *l = nalgebra::Complex::new(0.0, 0.0);
+        }
+    }
     let mut out = Vec::new();
     let mut lu = Lu::<C64>::new(m2);
     for (k, lambda) in eig.iter().enumerate() {
@@ -118,7 +151,9 @@ pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, A
         // of coupling γ ≈ |λ| (at least 1/s), here ten times that. The threshold was 1e-12
         // of max|A|, which beside a stiff spring (max|A| = 1e13/s²) was 10 rad/s: a mode of
         // 1 rad/s was listed as two real poles.
-        let real_within = 10.0 * (f64::EPSILON * scale * lambda.norm().max(1.0)).sqrt();
+        // (ε being the deflation threshold the eigenvalues were found with). Eigenvalues
+        // within this of each other are one repeated eigenvalue, split by the rounding.
+        let real_within = 10.0 * (deflation * scale * lambda.norm().max(1.0)).sqrt();
         // one mode per conjugate pair
         if lambda.im < -real_within {
             continue;
@@ -181,7 +216,7 @@ pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, A
         // 100: a repeated eigenvalue, r ≈ 1, keeps the start's mix of its eigenvectors, a
         // valid one)
         let nearest = (eig.iter().enumerate())
-            .filter(|&(j, _)| j != k)
+            .filter(|&(j, o)| j != k && (o - lambda).norm() > real_within)
             .map(|(_, o)| (C64::new(o.re, o.im) - mu).abs())
             .fold(f64::INFINITY, f64::min);
         let r = (C64::new(re, im) - mu).abs() / nearest;
@@ -263,6 +298,7 @@ pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, A
     Ok(Modes {
         dof_names: lin.coordinates.clone(),
         modes: out,
+        deflation,
     })
 }
 
@@ -409,6 +445,7 @@ mod tests {
                 mode(-2.0, 0.0),
                 mode(0.0, 0.0),
             ],
+            deflation: f64::EPSILON,
         };
         let table = modes.to_string();
         print!("{table}");

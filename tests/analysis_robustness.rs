@@ -319,3 +319,37 @@ fn the_modes_of_a_free_body_beside_stiff_joints_are_found() {
     println!("largest residual of (λ²M + λC + K)φ: {worst:.1e} of |K| + |λ||C| + |λ|²|M|");
     assert!(worst < 1e-11, "{worst:e}");
 }
+
+/// Statics from a start where the stiffness is singular but the forces are not zero: the
+/// double pendulum's default start, both bars horizontal (K = 0: gravity's moment is at its
+/// largest), and the 6-joint arm's, every joint at 0.2 rad about a first axis along gravity
+/// (no stiffness about it ever). Newton's step does not exist there; a step of Levenberg–Marquardt (K + μ diag M) takes it on, and Newton converges from
+/// where it leads (dpend in 6 iterations to hanging, the arm in 8). Before, both stopped with
+/// "the stiffness K is singular near q[0]".
+#[test]
+fn statics_start_where_the_stiffness_is_singular() {
+    use mbs::analysis::Stability;
+    let eq = static_equilibrium(
+        &dpend::DoublePendulum::default(),
+        &StaticsOptions::default(),
+    )
+    .unwrap();
+    println!(
+        "dpend: {:?} in {} iterations, {:?}",
+        eq.q, eq.iterations, eq.stability
+    );
+    assert!(eq.q.iter().all(|q| q.abs() < 1e-9), "{:?}", eq.q);
+    assert_eq!(eq.stability, Stability::Stable);
+    assert!(eq.residual <= 1e-9);
+    let arm = arm3d_6::Arm3d6::default();
+    let eq = static_equilibrium(&arm, &StaticsOptions::default()).unwrap();
+    println!(
+        "arm3d_6: {:?} in {} iterations, {:?} {:?}",
+        eq.q, eq.iterations, eq.stability, eq.stiffness_eigenvalues
+    );
+    assert!(eq.residual <= 1e-9);
+    // hanging straight down, the first joint left where it was: neutral about it
+    assert!((eq.q[0] - 0.2).abs() < 1e-9 && (eq.q[1] - std::f64::consts::FRAC_PI_2).abs() < 1e-9);
+    assert!(eq.q[2..].iter().all(|q| q.abs() < 1e-9));
+    assert_eq!(eq.stability, Stability::Neutral);
+}

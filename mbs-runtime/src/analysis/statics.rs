@@ -425,6 +425,7 @@ fn unconstrained<M: Model>(
     let (mut h, mut k, mut trial, mut ht) =
         (vec![0.0; n], vec![0.0; n * n], vec![0.0; n], vec![0.0; n]);
     let mut lu = Lu::<f64>::new(nf);
+    let mut mass = vec![0.0; n * n];
     let norm = |h: &[f64]| free.iter().map(|&i| h[i].abs()).fold(0.0, f64::max);
     forces(model, options.t, &q, u, &mut h)?;
     let mut residual = norm(&h);
@@ -442,6 +443,7 @@ fn unconstrained<M: Model>(
             });
         }
         stiffness(model, options.t, &q, u, options.stiffness, &mut k)?;
+        let mut singular = None;
         let a = lu.matrix_mut();
         for (c, &j) in free.iter().enumerate() {
             for (r, &i) in free.iter().enumerate() {
@@ -453,12 +455,37 @@ fn unconstrained<M: Model>(
             if small {
                 break None;
             }
-            return Err(Failure::SingularMatrix {
-                matrix: "the stiffness K on the free coordinates",
+            // a neutral direction at a point that is not yet an equilibrium (the double
+            // pendulum's default start, both bars horizontal, where K = 0; an arm whose first
+            // axis is vertical): a step of Levenberg–Marquardt instead
+            model.mass_matrix(options.t, &q, &mut mass);
+            let kk = &k;
+            let size_k = free
+                .iter()
+                .flat_map(|&j| free.iter().map(move |&i| kk[i + n * j].abs()))
+                .fold(0.0, f64::max);
+            let hf: Vec<f64> = free.iter().map(|&i| h[i]).collect();
+            let regular = damping(&mass, free, size_k, &hf).is_some_and(|(d, mu)| {
+                [1.0, 10.0, 100.0].into_iter().any(|f| {
+                    let a = lu.matrix_mut();
+                    for (c, &j) in free.iter().enumerate() {
+                        for (r, &i) in free.iter().enumerate() {
+                            a[r + nf * c] = k[i + n * j] + if r == c { f * mu * d[r] } else { 0.0 };
+                        }
+                    }
+                    lu.factor().is_ok()
+                })
+            });
+            let error = Failure::SingularMatrix {
+                matrix: "the stiffness K on the free coordinates (no restoring force along some direction, and a damped step along the forces lowers them no further: no equilibrium near this start, or one that needs a coordinate locked)",
                 rcond: s.rcond,
                 coordinates: vec![info.dof_label(free[s.column])],
+            };
+            if !regular {
+                return Err(error.into());
             }
-            .into());
+            // said if the damped step does not lower the forces either
+            singular = Some(error);
         }
         // K δ = h (τ = −h at rest: h(q + δ) ≈ h − K δ)
         for (d, &i) in delta.iter_mut().zip(free) {
@@ -485,6 +512,9 @@ fn unconstrained<M: Model>(
             // tolerance, the correction then saying how far q may be
             if small {
                 break Some(size);
+            }
+            if let Some(error) = singular {
+                return Err(error.into());
             }
             return Err(AnalysisError::NotConverged {
                 iterations,
@@ -515,6 +545,31 @@ fn unconstrained<M: Model>(
         constraint_residual: 0.0,
         charts: Vec::new(),
     })
+}
+
+/// The damping of a step of Levenberg–Marquardt, (K + μD) δ = h, where the stiffness K
+/// itself is singular: D the diagonal of M over the free coordinates (1 where it is not
+/// positive: a first-order state), and μ the larger of 1e-8 of K's size over D's and
+/// max |h_i/D_i| (so that where K = 0 the step moves no coordinate by more than a unit: a
+/// radian, a metre); ten and a hundred times that are tried after it. Along a direction with
+/// stiffness the step is Newton's damped by μ; along a neutral one it is the force over μD,
+/// which a neutral direction's forces, zero at an equilibrium, leave small; as the forces fall
+/// so does μ, and the steps become Newton's. `None` where μ is not positive and finite.
+fn damping(mass: &[f64], free: &[usize], size_k: f64, forces: &[f64]) -> Option<(Vec<f64>, f64)> {
+    let n = (mass.len() as f64).sqrt() as usize;
+    let d: Vec<f64> = free
+        .iter()
+        .map(|&i| mass[i + n * i])
+        .map(|m| if m > 0.0 && m.is_finite() { m } else { 1.0 })
+        .collect();
+    let size_d = d.iter().copied().fold(0.0, f64::max);
+    let pull = forces
+        .iter()
+        .zip(&d)
+        .map(|(f, d)| (f / d).abs())
+        .fold(0.0, f64::max);
+    let mu = (1e-8 * size_k / size_d).max(pull);
+    (mu > 0.0 && mu.is_finite()).then_some((d, mu))
 }
 
 /// Newton's step scaled by α = 1, ½, ¼, … until `accept(α)` (false below α = 1e-6).
@@ -670,6 +725,7 @@ fn constrained<M: Model>(
     let mut k = vec![0.0; n * n];
     let mut g;
     let mut lu = Lu::<f64>::new(nf + nc);
+    let mut mass = vec![0.0; n * n];
     let mut iterations = 0;
     let converged = |st: &ConstrainedState| {
         st.force_residual() <= options.tolerance
@@ -689,6 +745,7 @@ fn constrained<M: Model>(
         }
         stiffness(model, t, &q, u, options.stiffness, &mut k)?;
         g = reduce::constraint_tangent(model, t, &q, &lambda)?;
+        let mut singular = None;
         // J = [−K + G, s B_fᵀ; s B_f, 0] over the free coordinates, the constraints' rows and
         // columns scaled by s to the size of the stiffness (and their unknowns δλ/s): a
         // stiff loop's Schur complement B K⁻¹ Bᵀ leaves pivots the factorisation takes for
@@ -707,29 +764,41 @@ fn constrained<M: Model>(
             .map(|p| free.iter().map(|&j| st.b[(p, j)].abs()).sum::<f64>())
             .fold(0.0f64, f64::max);
         let scale = super::constraint_scale(kg_norm, b_norm);
-        let a = lu.matrix_mut();
-        a.fill(0.0);
-        for (r, &i) in free.iter().enumerate() {
-            for (c, &j) in free.iter().enumerate() {
-                a[r + m * c] = -k[i + n * j] + g[(i, j)];
+        // with −μD added to the stiffness block's diagonal (`extra`, μD)
+        let fill = |lu: &mut Lu<f64>, extra: &[f64]| {
+            let a = lu.matrix_mut();
+            a.fill(0.0);
+            for (r, &i) in free.iter().enumerate() {
+                for (c, &j) in free.iter().enumerate() {
+                    a[r + m * c] = -k[i + n * j] + g[(i, j)];
+                }
+                a[r + m * r] -= extra.get(r).copied().unwrap_or(0.0);
+                for p in 0..nc {
+                    a[r + m * (nf + p)] = scale * st.b[(p, i)];
+                    a[(nf + p) + m * r] = scale * st.b[(p, i)];
+                }
             }
-            for p in 0..nc {
-                a[r + m * (nf + p)] = scale * st.b[(p, i)];
-                a[(nf + p) + m * r] = scale * st.b[(p, i)];
-            }
-        }
-        if let Err(s) = lu.factor() {
+            lu.factor()
+        };
+        if let Err(s) = fill(&mut lu, &[]) {
             if small {
                 break None;
             }
-            return Err(singular_reduced(
-                model,
-                options,
-                free,
-                &st.b,
-                (&k, &g),
-                s.rcond,
-            )?);
+            // a neutral direction on the manifold at a point that is not yet an equilibrium
+            // (pendulum3's default start): a step of Levenberg–Marquardt instead
+            model.mass_matrix(t, &q, &mut mass);
+            let regular = damping(&mass, free, kg_norm, &st.f).is_some_and(|(d, mu)| {
+                [1.0, 10.0, 100.0].into_iter().any(|f| {
+                    let extra: Vec<f64> = d.iter().map(|d| f * mu * d).collect();
+                    fill(&mut lu, &extra).is_ok()
+                })
+            });
+            let error = singular_reduced(model, options, free, &st.b, (&k, &g), s.rcond)?;
+            if !regular {
+                return Err(error);
+            }
+            // said if the damped step does not lower the residuals either
+            singular = Some(error);
         }
         for (d, v) in delta.iter_mut().zip(st.f.iter().chain(&st.phi)) {
             *d = -v;
@@ -773,6 +842,9 @@ fn constrained<M: Model>(
             // the residuals cannot fall further: at their rounding when within the tolerances
             if small {
                 break Some(size);
+            }
+            if let Some(error) = singular {
+                return Err(error);
             }
             return Err(AnalysisError::NotConverged {
                 iterations,

@@ -5,8 +5,9 @@
 //!
 //! 2,145 runs of 1 s, at most 20,000 steps each, on 14 models. The sweep that first ran this found a
 //! message blaming an error test that had passed (Radau's predictive step correction after
-//! failed Newton iterations, `tests/step_messages.rs`) and a loop closure with no advice
-//! (`tests/failures.rs`).
+//! failed Newton iterations, `tests/step_messages.rs`), a loop closure with no advice
+//! (`tests/failures.rs`) and RKC's fixed steps going non-finite on fastlink's saddle
+//! (`tests/scheme_rkc.rs`).
 
 use mbs::{ConstraintMethod, Failure, Model, Options, Output, Scheme, SimError, simulate};
 use mbs_models::*;
@@ -149,6 +150,10 @@ fn every_run_ends_or_stops_typed_with_what_it_computed() {
     println!("{runs} runs: {kinds:?}");
     assert_eq!(runs, 2145);
     assert!(problems.is_empty(), "{}", problems.join("\n"));
+    // these models are finite wherever a step that is not refused takes them: a run that
+    // ends non-finite outgrew its motion unrefused (RKC at a fixed step on fastlink's saddle
+    // did, `tests/scheme_rkc.rs`)
+    assert!(!kinds.contains_key("NonFinite"), "{kinds:?}");
     // the sweep reaches every kind of ending it is meant to test
     for kind in [
         "finished",

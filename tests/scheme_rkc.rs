@@ -243,3 +243,44 @@ fn adaptive_steps_follow_rtol() {
     assert!(stats.steps * 2 < dopri.steps && stats.evaluations() * 2 < dopri.evaluations());
     assert_eq!(DampedChain::NQ, 6);
 }
+
+/// Fastlink released into its spring's push is a saddle (±806 1/s), whose sign the estimate
+/// of the fastest mode does not always read: at a fixed step of 30 ms or 0.1 s RKC's stages
+/// grew as Chebyshev polynomials do on the positive axis and went non-finite within the first
+/// step ("generalized force h of coordinate q[0] is not finite"). The step is now refused as
+/// outgrowing that mode, with the advised step, and the start kept. At the advised step the
+/// run takes two steps and is refused again, the spring's push having made a mode of about
+/// 1e9 1/s (an adaptive scheme is what this motion needs).
+#[test]
+fn a_step_that_outgrows_a_growing_mode_is_refused() {
+    use mbs::ConstraintMethod;
+    use mbs_models::fastlink::FastLink;
+    for method in [ConstraintMethod::Auto, ConstraintMethod::Projection] {
+        for h in [0.03, 0.1] {
+            let mut o = Options::fixed(0.1, h);
+            o.constraints.method = method;
+            let e = simulate(FastLink::default(), Scheme::Rkc, o).unwrap_err();
+            println!("{method:?}, h = {h}: {e}");
+            let Failure::UnstableStep { rho, h_rho, .. } = e.kind else {
+                panic!("{e}")
+            };
+            assert!((700.0..900.0).contains(&rho), "{rho}");
+            assert!((h_rho - h * rho).abs() < 1e-9 * h_rho);
+            assert_eq!(e.trajectory.len(), 1, "the start kept");
+            let advised = refused(&e);
+            let mut o = Options::fixed(0.03, advised);
+            o.constraints.method = method;
+            // it runs, or is refused again where the motion outgrows it (never non-finite)
+            match simulate(FastLink::default(), Scheme::Rkc, o) {
+                Ok((tr, _)) => println!(
+                    "  at the advised {advised:.3e} s: to t = {}",
+                    tr.t.last().unwrap()
+                ),
+                Err(e) => {
+                    println!("  at the advised {advised:.3e} s: {e}");
+                    assert!(matches!(e.kind, Failure::UnstableStep { .. }), "{e}");
+                }
+            }
+        }
+    }
+}

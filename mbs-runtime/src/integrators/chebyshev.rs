@@ -76,6 +76,12 @@ const FLOOR: f64 = 100.0 * f64::EPSILON;
 /// The growth of an undamped oscillation's amplitude a period that the stages accept.
 const GROWTH: f64 = 0.01;
 
+/// The largest h·ρ a step takes of a mode growing as e^(ρt), a choice (RK4's reach on the
+/// negative real axis, 2.785, rounded down): RKC's polynomials, which grow as T_s on the
+/// positive axis, hold such a mode by their bound |R| ≤ e^z at any h, but not to any
+/// accuracy.
+const GROWING: f64 = 2.67;
+
 /// Steps between two estimates of the fastest mode, and of the mode farthest off the axis.
 const EVERY: usize = 8;
 const OFF_AXIS_EVERY: usize = 16;
@@ -409,6 +415,35 @@ impl Chebyshev {
         Ok(())
     }
 
+    /// After a fixed step whose stages went non-finite from a finite state: the fastest mode
+    /// estimated to convergence, and `UnstableStep` where h·ρ exceeds [`GROWING`] (a step
+    /// that outgrew the motion rather than a model that is not finite there). The estimates
+    /// give |λ| and, from a Krylov space of rounding, not always its sign: fastlink released
+    /// into its spring's push is a saddle, ±806 1/s, and the estimate read −806, which 12
+    /// stages hold as a decaying mode at h = 30 ms; as a growing one the stages amplify it
+    /// as T_s, and went non-finite within the first step. A bound on growing modes checked
+    /// before every step refused the walking hexapod, whose Krylov space shows a ± pair of
+    /// 5–6·10³ 1/s that RKC follows at 0.5 ms to 0.1 mm of RK4: here it only names what
+    /// a step that has already blown up outgrew.
+    fn outgrown(
+        &mut self,
+        p: &mut Problem,
+        cur: &State,
+        h: f64,
+    ) -> Result<Option<Failure>, Failure> {
+        self.refresh(p, cur, true)?;
+        let rho = self.rho();
+        let h_rho = h * rho;
+        Ok((h_rho > GROWING).then(|| Failure::UnstableStep {
+            scheme: "RKC",
+            rho,
+            h_rho,
+            limit: GROWING,
+            h_stable: GROWING / rho,
+            at_end: false,
+        }))
+    }
+
     /// The stages for a step of size h, from the last estimates of the fastest mode and of
     /// the mode farthest off the axis (estimated anew first when due); when none up to MAX_STAGES hold
     /// them, estimated to convergence, then `Err(f)` with the largest fraction f of h some
@@ -487,6 +522,14 @@ impl Stepper for Chebyshev {
         }
         if let Err(e) = self.stage_loop(p, cur, h, next) {
             self.stale = true;
+            if ctl.adaptive.is_none()
+                && ctl.stability_check
+                && matches!(e, Failure::NonFinite { .. })
+            {
+                if let Some(unstable) = self.outgrown(p, cur, h)? {
+                    return Err(unstable);
+                }
+            }
             return Attempt::after_stage_failure(e, ctl.adaptive.is_some(), h, &mut self.pi);
         }
         let Some(tol) = ctl.adaptive else {

@@ -353,3 +353,21 @@ fn statics_start_where_the_stiffness_is_singular() {
     assert!(eq.q[2..].iter().all(|q| q.abs() < 1e-9));
     assert_eq!(eq.stability, Stability::Neutral);
 }
+
+/// The same on a closed loop: pendulum3 (a mass on a rod, Cartesian x, y and the rod's
+/// constraint) starts with the rod horizontal, where the reduced stiffness is zero. The damped
+/// step moves along the manifold's tangent and back onto it, and Newton converges to the
+/// mass hanging below the pivot, its λ the weight's pull along the rod.
+#[test]
+fn statics_of_a_loop_start_where_the_reduced_stiffness_is_singular() {
+    use mbs::analysis::Stability;
+    let model = pendulum3::Pendulum3::default();
+    let eq = static_equilibrium(&model, &StaticsOptions::default()).unwrap();
+    println!(
+        "pendulum3: {:?}, λ {:?} in {} iterations, {:?}",
+        eq.q, eq.lambda, eq.iterations, eq.stability
+    );
+    assert!(eq.q[0].abs() < 1e-9 && (eq.q[1] + 1.0).abs() < 1e-9, "{:?}", eq.q);
+    assert_eq!(eq.stability, Stability::Stable);
+    assert!(eq.residual <= 1e-9 && eq.constraint_residual <= 1e-11);
+}

@@ -709,17 +709,7 @@ fn constrained<M: Model>(
     };
     rank(&st.b)?;
     // λ₀: the least-squares fit of B_fᵀλ = −h_f
-    let mut lambda = {
-        let bf = restricted(&st.b);
-        let hf = DVector::from_iterator(nf, free.iter().map(|&i| st.h[i]));
-        let rhs = -(&bf * hf);
-        (&bf * bf.transpose())
-            .cholesky()
-            .map(|c| c.solve(&rhs))
-            .ok_or_else(|| AnalysisError::from(reduce::nearly_dependent(&st.b, names)))?
-    }
-    .as_slice()
-    .to_vec();
+    let mut lambda = fitted_lambda(&st, free, names)?;
     st.set_lambda(&lambda, free);
     // K and ∂(Bᵀλ)/∂q at the last (q, λ) Newton was at, which the stability reads
     let mut k = vec![0.0; n * n];
@@ -822,6 +812,7 @@ fn constrained<M: Model>(
         let merit = |st: &ConstrainedState| st.force_residual() + scale * st.constraint_residual();
         let current = merit(&st);
         let (mut trial, mut trial_lambda) = (q.clone(), lambda.clone());
+        let damped = singular.is_some();
         let accepted = backtrack(|alpha| {
             trial.copy_from_slice(&q);
             for (c, &i) in free.iter().enumerate() {
@@ -829,6 +820,20 @@ fn constrained<M: Model>(
             }
             for p in 0..nc {
                 trial_lambda[p] = lambda[p] + alpha * delta[nf + p];
+            }
+            // a damped step moves along the manifold's tangent, where the forces fall at
+            // second order, as the constraints' residual grows: back onto it, λ fitted
+            // there (pendulum3's default start, the rod horizontal, gravity's moment at its
+            // largest: the merit did not fall)
+            if damped {
+                let back = onto_manifold(model, t, &mut trial, free).and_then(|_| {
+                    let st = ConstrainedState::new(model, t, &trial, u, &trial_lambda, free)?;
+                    fitted_lambda(&st, free, names)
+                });
+                match back {
+                    Ok(fitted) => trial_lambda.copy_from_slice(&fitted),
+                    Err(_) => return false,
+                }
             }
             match ConstrainedState::new(model, t, &trial, u, &trial_lambda, free) {
                 Ok(next) if merit(&next) < current * (1.0 - 1e-4 * alpha) => {
@@ -875,6 +880,56 @@ fn constrained<M: Model>(
         correction,
         charts: Vec::new(),
     })
+}
+
+/// λ by the least-squares fit of B_fᵀλ = −h_f at `st` (B and h over the free coordinates).
+fn fitted_lambda(
+    st: &ConstrainedState,
+    free: &[usize],
+    names: &[&str],
+) -> Result<Vec<f64>, AnalysisError> {
+    let bf = st.b.select_columns(free);
+    let hf = DVector::from_iterator(free.len(), free.iter().map(|&i| st.h[i]));
+    let rhs = -(&bf * hf);
+    let lambda = (&bf * bf.transpose())
+        .cholesky()
+        .map(|c| c.solve(&rhs))
+        .ok_or_else(|| AnalysisError::from(reduce::nearly_dependent(&st.b, names)))?;
+    Ok(lambda.as_slice().to_vec())
+}
+
+/// Moves the free coordinates of q onto Φ(q, t) = 0 by Gauss–Newton with the least change,
+/// δ = −B_fᵀ(B_f B_fᵀ)⁻¹Φ, until |Φ| stops falling (at most 20 iterations); `Err` where it
+/// cannot (B_f losing rank, a non-finite Φ).
+fn onto_manifold<M: Model>(
+    model: &M,
+    t: f64,
+    q: &mut [f64],
+    free: &[usize],
+) -> Result<(), AnalysisError> {
+    let mut last = f64::INFINITY;
+    for _ in 0..20 {
+        let phi = reduce::constraints(model, t, q)?;
+        let size = phi.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        if size == 0.0 || size >= 0.5 * last {
+            return Ok(());
+        }
+        last = size;
+        let bf = reduce::jacobian(model, t, q)?.select_columns(free);
+        let y = (&bf * bf.transpose())
+            .cholesky()
+            .map(|c| c.solve(&DVector::from_column_slice(&phi)))
+            .ok_or(Failure::SingularMatrix {
+                matrix: "B Bᵀ over the free coordinates",
+                rcond: 0.0,
+                coordinates: Vec::new(),
+            })?;
+        let dq = bf.transpose() * y;
+        for (c, &i) in free.iter().enumerate() {
+            q[i] -= dq[c];
+        }
+    }
+    Ok(())
 }
 
 /// The symmetrised reduced stiffness Nᵀ(K − G)N over the free coordinates, and N (free ×

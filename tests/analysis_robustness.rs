@@ -367,7 +367,11 @@ fn statics_of_a_loop_start_where_the_reduced_stiffness_is_singular() {
         "pendulum3: {:?}, λ {:?} in {} iterations, {:?}",
         eq.q, eq.lambda, eq.iterations, eq.stability
     );
-    assert!(eq.q[0].abs() < 1e-9 && (eq.q[1] + 1.0).abs() < 1e-9, "{:?}", eq.q);
+    assert!(
+        eq.q[0].abs() < 1e-9 && (eq.q[1] + 1.0).abs() < 1e-9,
+        "{:?}",
+        eq.q
+    );
     assert_eq!(eq.stability, Stability::Stable);
     assert!(eq.residual <= 1e-9 && eq.constraint_residual <= 1e-11);
 }

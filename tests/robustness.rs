@@ -3,7 +3,8 @@
 //! failure that keeps what it computed. Never a panic, never a non-finite value in a
 //! trajectory (returned or kept), never a stop that loses the outputs before it.
 //!
-//! 2,145 runs of 1 s, at most 20,000 steps each, on 14 models. The sweep that first ran this found a
+//! 2,145 runs of 1 s, at most 20,000 steps each, on 14 models; 385 more with the sensitivities
+//! of two models' motion to their parameters, and 224 under global error control. The sweep that first ran this found a
 //! message blaming an error test that had passed (Radau's predictive step correction after
 //! failed Newton iterations, `tests/step_messages.rs`), a loop closure with no advice
 //! (`tests/failures.rs`) and RKC's fixed steps going non-finite on fastlink's saddle
@@ -74,10 +75,11 @@ fn check_failure(tag: &str, e: &SimError) -> Result<(), String> {
     Ok(())
 }
 
-/// Runs the sweep on one model; returns the runs, the failures by kind and the problems.
-fn sweep<M: Model + Clone + 'static>(
+/// Runs the sweep on one model (`make` makes a copy for each run); returns the runs, the
+/// failures by kind and the problems.
+fn sweep<M: Model + 'static>(
     name: &str,
-    model: M,
+    make: impl Fn() -> M,
     closed: bool,
     kinds: &mut std::collections::BTreeMap<String, usize>,
     problems: &mut Vec<String>,
@@ -94,7 +96,7 @@ fn sweep<M: Model + Clone + 'static>(
                 };
                 o.constraints.method = method;
                 let tag = format!("{name} {} {method:?} {:?}", scheme.name(), o.step);
-                let model = model.clone();
+                let model = make();
                 runs += 1;
                 match catch_unwind(AssertUnwindSafe(|| simulate(model, scheme, o))) {
                     Err(_) => problems.push(format!("{tag}: panicked")),
@@ -128,24 +130,24 @@ fn every_run_ends_or_stops_typed_with_what_it_computed() {
     let mut problems = Vec::new();
     let (k, p) = (&mut kinds, &mut problems);
     let mut runs = 0;
-    runs += sweep("dpend", dpend::DoublePendulum::default(), false, k, p);
-    runs += sweep("seed2dof", seed2dof::Seed2dof::default(), false, k, p);
-    runs += sweep("chain8", chain8::Chain8::default(), false, k, p);
-    runs += sweep("arm3d_6", arm3d_6::Arm3d6::default(), false, k, p);
-    runs += sweep("tumble", tumble::TumbleBall::default(), false, k, p);
-    runs += sweep("top", top::Top::default(), false, k, p);
+    runs += sweep("dpend", dpend::DoublePendulum::default, false, k, p);
+    runs += sweep("seed2dof", seed2dof::Seed2dof::default, false, k, p);
+    runs += sweep("chain8", chain8::Chain8::default, false, k, p);
+    runs += sweep("arm3d_6", arm3d_6::Arm3d6::default, false, k, p);
+    runs += sweep("tumble", tumble::TumbleBall::default, false, k, p);
+    runs += sweep("top", top::Top::default, false, k, p);
     let spherical = spherical_pendulum::SphericalPendulumZyx::default();
-    runs += sweep("spherical", spherical, false, k, p);
-    runs += sweep("springpend", springpend::SpringPend::default(), false, k, p);
-    runs += sweep("fourbar", fourbar::FourBar::default(), true, k, p);
+    runs += sweep("spherical", || spherical.clone(), false, k, p);
+    runs += sweep("springpend", springpend::SpringPend::default, false, k, p);
+    runs += sweep("fourbar", fourbar::FourBar::default, true, k, p);
     let slidercrank = slidercrank::SliderCrankClosed::default();
-    runs += sweep("slidercrank", slidercrank, true, k, p);
-    runs += sweep("pendulum3", pendulum3::Pendulum3::default(), true, k, p);
-    runs += sweep("fastlink", fastlink::FastLink::default(), true, k, p);
+    runs += sweep("slidercrank", || slidercrank.clone(), true, k, p);
+    runs += sweep("pendulum3", pendulum3::Pendulum3::default, true, k, p);
+    runs += sweep("fastlink", fastlink::FastLink::default, true, k, p);
     let cartesian = dpend_cartesian::DoublePendulumCartesian::default();
-    runs += sweep("dpend_cartesian", cartesian, true, k, p);
+    runs += sweep("dpend_cartesian", || cartesian.clone(), true, k, p);
     let standing = hexapod::HexapodStanding::default();
-    runs += sweep("hexapod_standing", standing, false, k, p);
+    runs += sweep("hexapod_standing", || standing.clone(), false, k, p);
     std::panic::set_hook(hook);
     println!("{runs} runs: {kinds:?}");
     assert_eq!(runs, 2145);
@@ -165,6 +167,110 @@ fn every_run_ends_or_stops_typed_with_what_it_computed() {
         "InvalidOption",
         "ConstraintsUnsupported",
     ] {
+        assert!(
+            kinds.contains_key(kind),
+            "no run ended in {kind}: {kinds:?}"
+        );
+    }
+}
+
+/// The same sweep on models wrapped with the sensitivities of their motion
+/// (`Sensitivities`: NQ·(1 + NS) coordinates, one error control over the motion and each
+/// parameter's), an open chain and a closed loop.
+#[test]
+fn every_run_with_sensitivities_ends_or_stops_typed() {
+    use mbs::Sensitivities;
+    let hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let mut kinds = std::collections::BTreeMap::new();
+    let mut problems = Vec::new();
+    let (k, p) = (&mut kinds, &mut problems);
+    let mut runs = 0;
+    let arm = || Sensitivities::new(sprung_arm::SprungArm::default()).unwrap();
+    runs += sweep("sprung_arm sensitivities", arm, false, k, p);
+    let fourbar = || Sensitivities::new(fourbar::SensitiveFourBar::default()).unwrap();
+    runs += sweep("fourbar sensitivities", fourbar, true, k, p);
+    std::panic::set_hook(hook);
+    println!("{runs} runs: {kinds:?}");
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+    assert!(!kinds.contains_key("NonFinite"), "{kinds:?}");
+    assert!(kinds.contains_key("finished"), "{kinds:?}");
+}
+
+/// Global error control (`simulate_global`) over every adaptive scheme and constraint method
+/// at a loose and a middling tolerance: it returns a finite run whose estimate is within the
+/// tolerance, or stops typed (`GlobalToleranceNotMet` keeping its most accurate complete
+/// trajectory, or the first run's own failure) — never a panic or a non-finite value.
+#[test]
+fn every_globally_controlled_run_ends_or_stops_typed() {
+    use mbs::{GlobalControl, simulate_global};
+    fn each<M: Model + Clone + 'static>(
+        name: &str,
+        model: M,
+        closed: bool,
+        kinds: &mut std::collections::BTreeMap<String, usize>,
+        problems: &mut Vec<String>,
+    ) -> usize {
+        let control = GlobalControl {
+            max_runs: 3,
+            ..GlobalControl::default()
+        };
+        let mut runs = 0;
+        for scheme in Scheme::all().into_iter().filter(|s| s.is_adaptive()) {
+            for method in methods(closed) {
+                for rtol in [1e-2, 1e-6] {
+                    let mut o = Options {
+                        max_steps: 20_000,
+                        output: Output::Every { dt: 0.05 },
+                        energy: false,
+                        ..Options::adaptive(0.5, rtol)
+                    };
+                    o.constraints.method = method;
+                    let tag = format!("{name} global {} {method:?} rtol {rtol:e}", scheme.name());
+                    runs += 1;
+                    let r = catch_unwind(AssertUnwindSafe(|| {
+                        simulate_global(&model, scheme, &o, &control)
+                    }));
+                    match r {
+                        Err(_) => problems.push(format!("{tag}: panicked")),
+                        Ok(Ok((tr, _, report))) => {
+                            if !finite(&tr) {
+                                problems.push(format!("{tag}: a non-finite value returned"));
+                            }
+                            if report.estimate.is_nan() || report.estimate > 1.0 {
+                                problems.push(format!("{tag}: returned at {}", report.estimate));
+                            }
+                            *kinds.entry("met".into()).or_default() += 1;
+                        }
+                        Ok(Err(e)) => {
+                            if let Err(p) = check_failure(&tag, &e) {
+                                problems.push(p);
+                            }
+                            let kind = format!("{:?}", e.kind);
+                            let kind = kind.split([' ', '(', '{']).next().unwrap_or("").to_string();
+                            *kinds.entry(kind).or_default() += 1;
+                        }
+                    }
+                }
+            }
+        }
+        runs
+    }
+    let hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let mut kinds = std::collections::BTreeMap::new();
+    let mut problems = Vec::new();
+    let (k, p) = (&mut kinds, &mut problems);
+    let mut runs = 0;
+    runs += each("dpend", dpend::DoublePendulum::default(), false, k, p);
+    runs += each("tumble", tumble::TumbleBall::default(), false, k, p);
+    runs += each("fourbar", fourbar::FourBar::default(), true, k, p);
+    runs += each("fastlink", fastlink::FastLink::default(), true, k, p);
+    std::panic::set_hook(hook);
+    println!("{runs} globally controlled runs: {kinds:?}");
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+    assert!(!kinds.contains_key("NonFinite"), "{kinds:?}");
+    for kind in ["met", "GlobalToleranceNotMet"] {
         assert!(
             kinds.contains_key(kind),
             "no run ended in {kind}: {kinds:?}"

@@ -67,6 +67,16 @@ impl Tally {
                 if text.trim().is_empty() {
                     self.problems.push(format!("{tag}: an empty message"));
                 }
+                // numbers read like the ones a user types, not the 17 digits of a round trip
+                let longest = text
+                    .split(|c: char| !c.is_ascii_digit())
+                    .map(|run| run.trim_start_matches('0').len())
+                    .max()
+                    .unwrap_or(0);
+                if longest > 12 {
+                    self.problems
+                        .push(format!("{tag}: a number of {longest} digits: {text}"));
+                }
                 let kind = match e.cause() {
                     AnalysisError::Failure(f) => format!("{f:?}"),
                     other => format!("{other:?}"),

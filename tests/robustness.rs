@@ -57,6 +57,15 @@ fn check_failure(tag: &str, e: &SimError) -> Result<(), String> {
     if text.trim().is_empty() {
         return Err(format!("{tag}: an empty message"));
     }
+    // numbers read like the ones a user types, not the 17 digits of a round trip
+    let longest = text
+        .split(|c: char| !c.is_ascii_digit())
+        .map(|run| run.trim_start_matches('0').len())
+        .max()
+        .unwrap_or(0);
+    if longest > 12 {
+        return Err(format!("{tag}: a number of {longest} digits: {text}"));
+    }
     if !refused {
         if e.trajectory.is_empty() {
             return Err(format!("{tag}: nothing kept: {text}"));

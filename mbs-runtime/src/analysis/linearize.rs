@@ -258,7 +258,7 @@ fn linearize_in_chart<M: Model>(
     let (mut m, mut h) = (vec![0.0; n * n], vec![0.0; n]);
     model.dynamics(t, q, qd, u, &mut m, &mut h);
     check(model, "M", &m)?;
-    check(model, "h", &h)?;
+    check(model, "generalized force h", &h)?;
     let mut l = m.clone();
     cholesky(&mut l, n).map_err(|s| Failure::SingularMatrix {
         matrix: "the mass matrix M",

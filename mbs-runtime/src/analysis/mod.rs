@@ -46,8 +46,9 @@ pub enum AnalysisError {
     #[error(transparent)]
     Failure(#[from] Failure),
     #[error(
-        "no static equilibrium found in {iterations} iterations: the largest free force is still {residual:e}{} at q = {q:?} (start closer, lock the coordinates that have no stiffness, or check that an equilibrium exists)",
-        if *constraint_residual > 0.0 { format!(" and the largest |Φ| {constraint_residual:e}") } else { String::new() }
+        "no static equilibrium found in {iterations} iterations: the largest free force is still {residual:.3e}{} at q = [{}] (start closer, lock the coordinates that have no stiffness, or check that an equilibrium exists)",
+        if *constraint_residual > 0.0 { format!(" and the largest |Φ| {constraint_residual:.3e}") } else { String::new() },
+        q.iter().map(|x| crate::error::short(*x)).collect::<Vec<_>>().join(", ")
     )]
     NotConverged {
         iterations: usize,

@@ -174,7 +174,7 @@ fn forces<M: Model>(
     h: &mut [f64],
 ) -> Result<(), AnalysisError> {
     model.static_forces(t, q, u, h);
-    check(model, "static forces", h)
+    check(model, "static generalized force", h)
 }
 
 /// The stiffness K = ∂τ/∂q at rest (column-major NQ × NQ): exact when the model has tangents

@@ -14,6 +14,9 @@ use mbs::{ConstraintMethod, Failure, Model, Options, Output, Scheme, SimError, s
 use mbs_models::*;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
+#[path = "common/sweeps.rs"]
+mod sweeps;
+
 fn methods(closed: bool) -> Vec<ConstraintMethod> {
     if !closed {
         return vec![ConstraintMethod::Auto];
@@ -57,12 +60,7 @@ fn check_failure(tag: &str, e: &SimError) -> Result<(), String> {
     if text.trim().is_empty() {
         return Err(format!("{tag}: an empty message"));
     }
-    // numbers read like the ones a user types, not the 17 digits of a round trip
-    let longest = text
-        .split(|c: char| !c.is_ascii_digit())
-        .map(|run| run.trim_start_matches('0').len())
-        .max()
-        .unwrap_or(0);
+    let longest = sweeps::longest_number(&text);
     if longest > 12 {
         return Err(format!("{tag}: a number of {longest} digits: {text}"));
     }
@@ -84,13 +82,41 @@ fn check_failure(tag: &str, e: &SimError) -> Result<(), String> {
     Ok(())
 }
 
+/// Counts a run's ending by kind (`ok` for a run that returned), and the problems with it:
+/// a panic, a non-finite value returned, or what [`check_failure`] finds in a failure.
+fn record(
+    tag: &str,
+    r: std::thread::Result<Result<mbs::Trajectory, SimError>>,
+    ok: &str,
+    kinds: &mut Kinds,
+    problems: &mut Vec<String>,
+) {
+    match r {
+        Err(_) => problems.push(format!("{tag}: panicked")),
+        Ok(Ok(tr)) => {
+            if !finite(&tr) {
+                problems.push(format!("{tag}: a non-finite value returned"));
+            }
+            *kinds.entry(ok.into()).or_default() += 1;
+        }
+        Ok(Err(e)) => {
+            if let Err(p) = check_failure(tag, &e) {
+                problems.push(p);
+            }
+            let kind = format!("{:?}", e.kind);
+            let kind = kind.split([' ', '(', '{']).next().unwrap_or("").to_string();
+            *kinds.entry(kind).or_default() += 1;
+        }
+    }
+}
+
 /// Runs the sweep on one model (`make` makes a copy for each run); returns the runs, the
 /// failures by kind and the problems.
 fn sweep<M: Model + 'static>(
     name: &str,
     make: impl Fn() -> M,
     closed: bool,
-    kinds: &mut std::collections::BTreeMap<String, usize>,
+    kinds: &mut Kinds,
     problems: &mut Vec<String>,
 ) -> usize {
     let mut runs = 0;
@@ -107,64 +133,62 @@ fn sweep<M: Model + 'static>(
                 let tag = format!("{name} {} {method:?} {:?}", scheme.name(), o.step);
                 let model = make();
                 runs += 1;
-                match catch_unwind(AssertUnwindSafe(|| simulate(model, scheme, o))) {
-                    Err(_) => problems.push(format!("{tag}: panicked")),
-                    Ok(Ok((tr, _))) => {
-                        if !finite(&tr) {
-                            problems.push(format!("{tag}: a non-finite value returned"));
-                        }
-                        *kinds.entry("finished".into()).or_default() += 1;
-                    }
-                    Ok(Err(e)) => {
-                        if let Err(p) = check_failure(&tag, &e) {
-                            problems.push(p);
-                        }
-                        let kind = format!("{:?}", e.kind);
-                        let kind = kind.split([' ', '(', '{']).next().unwrap_or("").to_string();
-                        *kinds.entry(kind).or_default() += 1;
-                    }
-                }
+                let r = catch_unwind(AssertUnwindSafe(|| simulate(model, scheme, o)));
+                record(
+                    &tag,
+                    r.map(|r| r.map(|(tr, _)| tr)),
+                    "finished",
+                    kinds,
+                    problems,
+                );
             }
         }
     }
     runs
 }
 
+/// Runs `sweeps` with the default panic report silenced on this thread (the panics they look
+/// for are caught; the report would only repeat them), then asserts that they found no problem and that no
+/// run ended non-finite: these models are finite wherever a step that is not refused takes
+/// them (a run that ends non-finite outgrew its motion unrefused, as RKC at a fixed step on
+/// fastlink's saddle did, `tests/scheme_rkc.rs`). Returns the runs and their endings by kind.
+fn quietly(sweeps: impl FnOnce(&mut Kinds, &mut Vec<String>) -> usize) -> (usize, Kinds) {
+    let (mut kinds, mut problems) = (Kinds::new(), Vec::new());
+    let runs = sweeps::silenced(|| sweeps(&mut kinds, &mut problems));
+    println!("{runs} runs: {kinds:?}");
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+    assert!(!kinds.contains_key("NonFinite"), "{kinds:?}");
+    (runs, kinds)
+}
+
+/// Endings by kind.
+type Kinds = std::collections::BTreeMap<String, usize>;
+
 #[test]
 fn every_run_ends_or_stops_typed_with_what_it_computed() {
-    // the panics this test looks for are caught; their default report would only repeat them
-    let hook = std::panic::take_hook();
-    std::panic::set_hook(Box::new(|_| {}));
-    let mut kinds = std::collections::BTreeMap::new();
-    let mut problems = Vec::new();
-    let (k, p) = (&mut kinds, &mut problems);
-    let mut runs = 0;
-    runs += sweep("dpend", dpend::DoublePendulum::default, false, k, p);
-    runs += sweep("seed2dof", seed2dof::Seed2dof::default, false, k, p);
-    runs += sweep("chain8", chain8::Chain8::default, false, k, p);
-    runs += sweep("arm3d_6", arm3d_6::Arm3d6::default, false, k, p);
-    runs += sweep("tumble", tumble::TumbleBall::default, false, k, p);
-    runs += sweep("top", top::Top::default, false, k, p);
-    let spherical = spherical_pendulum::SphericalPendulumZyx::default();
-    runs += sweep("spherical", || spherical.clone(), false, k, p);
-    runs += sweep("springpend", springpend::SpringPend::default, false, k, p);
-    runs += sweep("fourbar", fourbar::FourBar::default, true, k, p);
-    let slidercrank = slidercrank::SliderCrankClosed::default();
-    runs += sweep("slidercrank", || slidercrank.clone(), true, k, p);
-    runs += sweep("pendulum3", pendulum3::Pendulum3::default, true, k, p);
-    runs += sweep("fastlink", fastlink::FastLink::default, true, k, p);
-    let cartesian = dpend_cartesian::DoublePendulumCartesian::default();
-    runs += sweep("dpend_cartesian", || cartesian.clone(), true, k, p);
-    let standing = hexapod::HexapodStanding::default();
-    runs += sweep("hexapod_standing", || standing.clone(), false, k, p);
-    std::panic::set_hook(hook);
-    println!("{runs} runs: {kinds:?}");
+    let (runs, kinds) = quietly(|k, p| {
+        let mut runs = 0;
+        runs += sweep("dpend", dpend::DoublePendulum::default, false, k, p);
+        runs += sweep("seed2dof", seed2dof::Seed2dof::default, false, k, p);
+        runs += sweep("chain8", chain8::Chain8::default, false, k, p);
+        runs += sweep("arm3d_6", arm3d_6::Arm3d6::default, false, k, p);
+        runs += sweep("tumble", tumble::TumbleBall::default, false, k, p);
+        runs += sweep("top", top::Top::default, false, k, p);
+        let spherical = spherical_pendulum::SphericalPendulumZyx::default();
+        runs += sweep("spherical", || spherical.clone(), false, k, p);
+        runs += sweep("springpend", springpend::SpringPend::default, false, k, p);
+        runs += sweep("fourbar", fourbar::FourBar::default, true, k, p);
+        let slidercrank = slidercrank::SliderCrankClosed::default();
+        runs += sweep("slidercrank", || slidercrank.clone(), true, k, p);
+        runs += sweep("pendulum3", pendulum3::Pendulum3::default, true, k, p);
+        runs += sweep("fastlink", fastlink::FastLink::default, true, k, p);
+        let cartesian = dpend_cartesian::DoublePendulumCartesian::default();
+        runs += sweep("dpend_cartesian", || cartesian.clone(), true, k, p);
+        let standing = hexapod::HexapodStanding::default();
+        runs += sweep("hexapod_standing", || standing.clone(), false, k, p);
+        runs
+    });
     assert_eq!(runs, 2145);
-    assert!(problems.is_empty(), "{}", problems.join("\n"));
-    // these models are finite wherever a step that is not refused takes them: a run that
-    // ends non-finite outgrew its motion unrefused (RKC at a fixed step on fastlink's saddle
-    // did, `tests/scheme_rkc.rs`)
-    assert!(!kinds.contains_key("NonFinite"), "{kinds:?}");
     // the sweep reaches every kind of ending it is meant to test
     for kind in [
         "finished",
@@ -189,20 +213,12 @@ fn every_run_ends_or_stops_typed_with_what_it_computed() {
 #[test]
 fn every_run_with_sensitivities_ends_or_stops_typed() {
     use mbs::Sensitivities;
-    let hook = std::panic::take_hook();
-    std::panic::set_hook(Box::new(|_| {}));
-    let mut kinds = std::collections::BTreeMap::new();
-    let mut problems = Vec::new();
-    let (k, p) = (&mut kinds, &mut problems);
-    let mut runs = 0;
-    let arm = || Sensitivities::new(sprung_arm::SprungArm::default()).unwrap();
-    runs += sweep("sprung_arm sensitivities", arm, false, k, p);
-    let fourbar = || Sensitivities::new(fourbar::SensitiveFourBar::default()).unwrap();
-    runs += sweep("fourbar sensitivities", fourbar, true, k, p);
-    std::panic::set_hook(hook);
-    println!("{runs} runs: {kinds:?}");
-    assert!(problems.is_empty(), "{}", problems.join("\n"));
-    assert!(!kinds.contains_key("NonFinite"), "{kinds:?}");
+    let (_, kinds) = quietly(|k, p| {
+        let arm = || Sensitivities::new(sprung_arm::SprungArm::default()).unwrap();
+        let fourbar = || Sensitivities::new(fourbar::SensitiveFourBar::default()).unwrap();
+        sweep("sprung_arm sensitivities", arm, false, k, p)
+            + sweep("fourbar sensitivities", fourbar, true, k, p)
+    });
     assert!(kinds.contains_key("finished"), "{kinds:?}");
 }
 
@@ -217,7 +233,7 @@ fn every_globally_controlled_run_ends_or_stops_typed() {
         name: &str,
         model: M,
         closed: bool,
-        kinds: &mut std::collections::BTreeMap<String, usize>,
+        kinds: &mut Kinds,
         problems: &mut Vec<String>,
     ) -> usize {
         let control = GlobalControl {
@@ -240,45 +256,29 @@ fn every_globally_controlled_run_ends_or_stops_typed() {
                     let r = catch_unwind(AssertUnwindSafe(|| {
                         simulate_global(&model, scheme, &o, &control)
                     }));
-                    match r {
-                        Err(_) => problems.push(format!("{tag}: panicked")),
-                        Ok(Ok((tr, _, report))) => {
-                            if !finite(&tr) {
-                                problems.push(format!("{tag}: a non-finite value returned"));
-                            }
-                            if report.estimate.is_nan() || report.estimate > 1.0 {
-                                problems.push(format!("{tag}: returned at {}", report.estimate));
-                            }
-                            *kinds.entry("met".into()).or_default() += 1;
-                        }
-                        Ok(Err(e)) => {
-                            if let Err(p) = check_failure(&tag, &e) {
-                                problems.push(p);
-                            }
-                            let kind = format!("{:?}", e.kind);
-                            let kind = kind.split([' ', '(', '{']).next().unwrap_or("").to_string();
-                            *kinds.entry(kind).or_default() += 1;
-                        }
+                    if let Ok(Ok((_, _, report))) = &r
+                        && (report.estimate.is_nan() || report.estimate > 1.0)
+                    {
+                        problems.push(format!("{tag}: returned at {}", report.estimate));
                     }
+                    record(
+                        &tag,
+                        r.map(|r| r.map(|(tr, ..)| tr)),
+                        "met",
+                        kinds,
+                        problems,
+                    );
                 }
             }
         }
         runs
     }
-    let hook = std::panic::take_hook();
-    std::panic::set_hook(Box::new(|_| {}));
-    let mut kinds = std::collections::BTreeMap::new();
-    let mut problems = Vec::new();
-    let (k, p) = (&mut kinds, &mut problems);
-    let mut runs = 0;
-    runs += each("dpend", dpend::DoublePendulum::default(), false, k, p);
-    runs += each("tumble", tumble::TumbleBall::default(), false, k, p);
-    runs += each("fourbar", fourbar::FourBar::default(), true, k, p);
-    runs += each("fastlink", fastlink::FastLink::default(), true, k, p);
-    std::panic::set_hook(hook);
-    println!("{runs} globally controlled runs: {kinds:?}");
-    assert!(problems.is_empty(), "{}", problems.join("\n"));
-    assert!(!kinds.contains_key("NonFinite"), "{kinds:?}");
+    let (_, kinds) = quietly(|k, p| {
+        each("dpend", dpend::DoublePendulum::default(), false, k, p)
+            + each("tumble", tumble::TumbleBall::default(), false, k, p)
+            + each("fourbar", fourbar::FourBar::default(), true, k, p)
+            + each("fastlink", fastlink::FastLink::default(), true, k, p)
+    });
     for kind in ["met", "GlobalToleranceNotMet"] {
         assert!(
             kinds.contains_key(kind),

@@ -1,0 +1,34 @@
+//! What the sweeps of every scheme and every analysis share: a silent panic report, and the
+//! check of every failure's message.
+
+/// The most significant digits of any number in `text` (leading zeros not counted): a
+/// message's numbers should read like the ones a user types (`short`, ten digits at most),
+/// not like the 17 digits of a round trip.
+pub fn longest_number(text: &str) -> usize {
+    text.split(|c: char| !c.is_ascii_digit())
+        .map(|run| run.trim_start_matches('0').len())
+        .max()
+        .unwrap_or(0)
+}
+
+/// Runs `f` with the default panic report silenced on this thread (a sweep catches the
+/// panics it looks for; the report would only repeat them). One hook for the whole binary:
+/// the tests run in parallel, and a hook taken and restored by each could leave another's
+/// silent one behind, which would then swallow an assertion's message.
+pub fn silenced<T>(f: impl FnOnce() -> T) -> T {
+    use std::cell::Cell;
+    static HOOK: std::sync::Once = std::sync::Once::new();
+    thread_local!(static QUIET: Cell<bool> = const { Cell::new(false) });
+    HOOK.call_once(|| {
+        let default = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            if !QUIET.with(|q| q.get()) {
+                default(info)
+            }
+        }));
+    });
+    QUIET.with(|q| q.set(true));
+    let out = f();
+    QUIET.with(|q| q.set(false));
+    out
+}

@@ -300,6 +300,11 @@ fn the_modes_of_a_free_body_beside_stiff_joints_are_found() {
     let found = modes(&lin, None).unwrap();
     println!("deflation {:e}\n{found}", found.deflation);
     assert!(found.deflation > f64::EPSILON && found.deflation <= 1e-10);
+    assert!(
+        found
+            .to_string()
+            .contains("eigenvalues found deflating at 1e-12")
+    );
     assert_eq!(found.modes.len(), 2 * n);
     let zeros = found
         .modes

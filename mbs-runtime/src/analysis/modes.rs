@@ -414,6 +414,13 @@ impl fmt::Display for Modes {
                 .collect();
             writeln!(f, "     shape: {}", parts.join(", "))?;
         }
+        if self.deflation > f64::EPSILON {
+            writeln!(
+                f,
+                "(eigenvalues found deflating at {:.0e} of max|A|, where the QR iteration stalled at ε: they are those of a matrix within about that much of A)",
+                self.deflation
+            )?;
+        }
         Ok(())
     }
 }

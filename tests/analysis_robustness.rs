@@ -1,13 +1,15 @@
 //! Every analysis on the repository's models, from ordinary, perturbed, huge and non-finite
 //! states: statics (with and without locked coordinates, exact and differenced stiffness,
 //! one Newton iteration), linearisation and modes (each way of taking K and C), the
-//! sensitivities of the equilibria found, and inverse dynamics along a run and along a path
-//! that turns non-finite. Each returns finite results, or a typed error with a message; never a
-//! panic, never a NaN in a result it returns.
+//! sensitivities of the equilibria found, and inverse dynamics along a run (of every
+//! coordinate, and of actuated sets valid or not) and along a path that turns non-finite.
+//! Each returns finite results, or a typed error with a message; never a panic, never a NaN
+//! in a result it returns.
 
 use mbs::analysis::{
-    AnalysisError, StaticsOptions, inverse_dynamics_along, inverse_dynamics_of, linearize, modes,
-    pole_sensitivity, static_equilibrium, static_sensitivity,
+    AnalysisError, StaticsOptions, inverse_dynamics_actuated_of, inverse_dynamics_along,
+    inverse_dynamics_of, linearize, modes, pole_sensitivity, static_equilibrium,
+    static_sensitivity,
 };
 use mbs::{ConstraintMethod, IterationMatrix, Model, Options, Output, Scheme, simulate};
 use mbs_models::*;
@@ -210,6 +212,26 @@ fn sweep<M: Model + Clone + 'static>(name: &str, model: M, tally: &mut Tally) {
     tally.record(&tag, call(|| inverse_dynamics_of(&model, &tr, &[])), |e| {
         all_finite(&e.tau)
     });
+    // actuator efforts and reactions along the run: the first and the last NQ − NC
+    // coordinates actuated, and sets that are no such set (empty, repeated, out of range)
+    let free = M::NQ - M::NC;
+    let first: Vec<usize> = (0..free).collect();
+    let last: Vec<usize> = (M::NC..M::NQ).collect();
+    let repeated = vec![0; free.max(1)];
+    for (set, actuated) in [
+        ("first", first),
+        ("last", last),
+        ("empty", vec![]),
+        ("repeated", repeated),
+        ("beyond", vec![M::NQ + 3]),
+    ] {
+        let tag = format!("{name} inverse_dynamics_actuated {set}");
+        tally.record(
+            &tag,
+            call(|| inverse_dynamics_actuated_of(&model, &tr, &[], &actuated)),
+            |e| all_finite(&e.tau) && all_finite(&e.lambda),
+        );
+    }
     // a path that turns non-finite at its third time: the rows before it are kept
     let times = [0.0, 0.05, 0.1, 0.15];
     let tag = format!("{name} inverse_dynamics along");

@@ -6,6 +6,10 @@
 //! stability, inverse then forward dynamics, a rheonomic damped model, inputs, and the errors.
 #![allow(clippy::needless_range_loop)]
 
+#[path = "common/lcg.rs"]
+mod lcg;
+use lcg::Lcg;
+
 use mbs_models::arm3d_6;
 use mbs_models::dpend;
 use mbs_models::seed2dof;
@@ -344,19 +348,6 @@ fn undamped_state_matrix(m: &DMatrix<f64>, k: &DMatrix<f64>) -> DMatrix<f64> {
             0.0
         }
     })
-}
-
-/// Deterministic pseudo-random numbers in [−1, 1).
-struct Lcg(u64);
-
-impl Lcg {
-    fn next(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (self.0 >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-    }
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -6,6 +6,10 @@
 //! Each returns finite results, or a typed error with a message; never a panic, never a NaN
 //! in a result it returns.
 
+#[path = "common/lcg.rs"]
+mod lcg;
+use lcg::Lcg;
+
 use mbs::analysis::{
     AnalysisError, StaticsOptions, inverse_dynamics_actuated_of, inverse_dynamics_along,
     inverse_dynamics_of, linearize, modes, pole_sensitivity, static_equilibrium,
@@ -18,19 +22,6 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 
 #[path = "common/sweeps.rs"]
 mod sweeps;
-
-/// A deterministic sequence in [−1, 1) (no dependency for a few numbers).
-struct Lcg(u64);
-
-impl Lcg {
-    fn next(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        (self.0 >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-    }
-}
 
 fn all_finite<'a>(xs: impl IntoIterator<Item = &'a f64>) -> bool {
     xs.into_iter().all(|x| x.is_finite())

@@ -27,7 +27,7 @@
 
 use super::{AnalysisError, check, reduce};
 use crate::error::Failure;
-use crate::linalg::Lu;
+use crate::linalg::{Lu, Singular};
 use crate::model::Model;
 use crate::options::IterationMatrix;
 use nalgebra::{DMatrix, DVector};
@@ -444,13 +444,18 @@ fn unconstrained<M: Model>(
         }
         stiffness(model, options.t, &q, u, options.stiffness, &mut k)?;
         let mut singular = None;
-        let a = lu.matrix_mut();
-        for (c, &j) in free.iter().enumerate() {
-            for (r, &i) in free.iter().enumerate() {
-                a[r + nf * c] = k[i + n * j];
+        // K on the free coordinates, with μD added to its diagonal (`extra`)
+        let fill = |lu: &mut Lu<f64>, extra: &[f64]| {
+            let a = lu.matrix_mut();
+            for (c, &j) in free.iter().enumerate() {
+                for (r, &i) in free.iter().enumerate() {
+                    a[r + nf * c] = k[i + n * j];
+                }
+                a[c + nf * c] += extra.get(c).copied().unwrap_or(0.0);
             }
-        }
-        if let Err(s) = lu.factor() {
+            lu.factor()
+        };
+        if let Err(s) = fill(&mut lu, &[]) {
             // a neutral direction at a point whose forces are within the tolerance
             if small {
                 break None;
@@ -459,23 +464,12 @@ fn unconstrained<M: Model>(
             // pendulum's default start, both bars horizontal, where K = 0; an arm whose first
             // axis is vertical): a step of Levenberg–Marquardt instead
             model.mass_matrix(options.t, &q, &mut mass);
-            let kk = &k;
             let size_k = free
                 .iter()
-                .flat_map(|&j| free.iter().map(move |&i| kk[i + n * j].abs()))
-                .fold(0.0, f64::max);
+                .flat_map(|&j| free.iter().map(move |&i| (j, i)))
+                .fold(0.0, |m: f64, (j, i)| m.max(k[i + n * j].abs()));
             let hf: Vec<f64> = free.iter().map(|&i| h[i]).collect();
-            let regular = damping(&mass, free, size_k, &hf).is_some_and(|(d, mu)| {
-                [1.0, 10.0, 100.0].into_iter().any(|f| {
-                    let a = lu.matrix_mut();
-                    for (c, &j) in free.iter().enumerate() {
-                        for (r, &i) in free.iter().enumerate() {
-                            a[r + nf * c] = k[i + n * j] + if r == c { f * mu * d[r] } else { 0.0 };
-                        }
-                    }
-                    lu.factor().is_ok()
-                })
-            });
+            let regular = factor_damped(&mut lu, (&mass, n), free, size_k, &hf, fill);
             let error = Failure::SingularMatrix {
                 matrix: "the stiffness K on the free coordinates (no restoring force along some direction, and a damped step along the forces lowers them no further: no equilibrium near this start, or one that needs a coordinate locked)",
                 rcond: s.rcond,
@@ -547,16 +541,23 @@ fn unconstrained<M: Model>(
     })
 }
 
-/// The damping of a step of Levenberg–Marquardt, (K + μD) δ = h, where the stiffness K
-/// itself is singular: D the diagonal of M over the free coordinates (1 where it is not
-/// positive: a first-order state), and μ the larger of 1e-8 of K's size over D's and
-/// max |h_i/D_i| (so that where K = 0 the step moves no coordinate by more than a unit: a
-/// radian, a metre); ten and a hundred times that are tried after it. Along a direction with
-/// stiffness the step is Newton's damped by μ; along a neutral one it is the force over μD,
-/// which a neutral direction's forces, zero at an equilibrium, leave small; as the forces fall
-/// so does μ, and the steps become Newton's. `None` where μ is not positive and finite.
-fn damping(mass: &[f64], free: &[usize], size_k: f64, forces: &[f64]) -> Option<(Vec<f64>, f64)> {
-    let n = (mass.len() as f64).sqrt() as usize;
+/// Factors into `lu` Newton's matrix with a damping μD added to the stiffness by `fill`, for
+/// a step of Levenberg–Marquardt where the stiffness K itself is singular, (K + μD) δ = h;
+/// false where no μ tried makes it regular. D is the diagonal of M over the free coordinates
+/// (`mass`, NQ × NQ; 1 where it is not positive: a first-order state), μ the larger of 1e-8 of
+/// K's size over D's and max |h_i/D_i| (so that where K = 0 the step moves no coordinate by
+/// more than a unit: a radian, a metre), then ten and a hundred times that. Along a direction
+/// with stiffness the step is Newton's damped by μ; along a neutral one it is the force over
+/// μD, which a neutral direction's forces, zero at an equilibrium, leave small; as the forces
+/// fall so does μ, and the steps become Newton's.
+fn factor_damped(
+    lu: &mut Lu<f64>,
+    (mass, n): (&[f64], usize),
+    free: &[usize],
+    size_k: f64,
+    forces: &[f64],
+    mut fill: impl FnMut(&mut Lu<f64>, &[f64]) -> Result<(), Singular>,
+) -> bool {
     let d: Vec<f64> = free
         .iter()
         .map(|&i| mass[i + n * i])
@@ -569,7 +570,13 @@ fn damping(mass: &[f64], free: &[usize], size_k: f64, forces: &[f64]) -> Option<
         .map(|(f, d)| (f / d).abs())
         .fold(0.0, f64::max);
     let mu = (1e-8 * size_k / size_d).max(pull);
-    (mu > 0.0 && mu.is_finite()).then_some((d, mu))
+    if !(mu > 0.0 && mu.is_finite()) {
+        return false;
+    }
+    [1.0, 10.0, 100.0].into_iter().any(|f| {
+        let extra: Vec<f64> = d.iter().map(|d| f * mu * d).collect();
+        fill(lu, &extra).is_ok()
+    })
 }
 
 /// Newton's step scaled by α = 1, ½, ¼, … until `accept(α)` (false below α = 1e-6).
@@ -754,7 +761,7 @@ fn constrained<M: Model>(
             .map(|p| free.iter().map(|&j| st.b[(p, j)].abs()).sum::<f64>())
             .fold(0.0f64, f64::max);
         let scale = super::constraint_scale(kg_norm, b_norm);
-        // with −μD added to the stiffness block's diagonal (`extra`, μD)
+        // with μD added to the stiffness' diagonal (`extra`): −μD in the block −K + G
         let fill = |lu: &mut Lu<f64>, extra: &[f64]| {
             let a = lu.matrix_mut();
             a.fill(0.0);
@@ -777,12 +784,7 @@ fn constrained<M: Model>(
             // a neutral direction on the manifold at a point that is not yet an equilibrium
             // (pendulum3's default start): a step of Levenberg–Marquardt instead
             model.mass_matrix(t, &q, &mut mass);
-            let regular = damping(&mass, free, kg_norm, &st.f).is_some_and(|(d, mu)| {
-                [1.0, 10.0, 100.0].into_iter().any(|f| {
-                    let extra: Vec<f64> = d.iter().map(|d| f * mu * d).collect();
-                    fill(&mut lu, &extra).is_ok()
-                })
-            });
+            let regular = factor_damped(&mut lu, (&mass, n), free, kg_norm, &st.f, fill);
             let error = singular_reduced(model, options, free, &st.b, (&k, &g), s.rcond)?;
             if !regular {
                 return Err(error);

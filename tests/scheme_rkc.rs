@@ -244,7 +244,7 @@ fn adaptive_steps_follow_rtol() {
     assert_eq!(DampedChain::NQ, 6);
 }
 
-/// Fastlink released into its spring's push is a saddle (±806 1/s), whose sign the estimate
+/// Fastlink released into its spring's push is a saddle (ρ ≈ 807 1/s), whose sign the estimate
 /// of the fastest mode does not always read: at a fixed step of 30 ms or 0.1 s RKC's stages
 /// grew as Chebyshev polynomials do on the positive axis and went non-finite within the first
 /// step ("generalized force h of coordinate q[0] is not finite"). The step is now refused as

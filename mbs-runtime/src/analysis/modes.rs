@@ -72,7 +72,7 @@ const DEFLATIONS: [f64; 6] = [f64::EPSILON, 1e-14, 1e-13, 1e-12, 1e-11, 1e-10];
 /// several zero eigenvalues, whose diagonal entries are zero, only the second, which the
 /// rounding of a large A never reaches (the hexapod released above the ground: six rigid
 /// motions without stiffness or damping, twelve zero eigenvalues in Jordan blocks, beside
-/// contact and joint gains of 4·10⁴/s²). Both matrices are then tried at the looser
+/// entries of A up to 4.4·10⁴/s²). Both matrices are then tried at the looser
 /// thresholds of [`DEFLATIONS`]: an entry below one of them, relative to its neighbours, is
 /// set to zero, and the eigenvalues are those of a matrix within about that much of A's
 /// largest entry; the threshold used is returned ([`Modes::deflation`]). Past the last, an

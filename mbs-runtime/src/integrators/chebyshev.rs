@@ -419,7 +419,7 @@ impl Chebyshev {
     /// estimated to convergence, and `UnstableStep` where h·ρ exceeds [`GROWING`] (a step
     /// that outgrew the motion rather than a model that is not finite there). The estimates
     /// give |λ| and, from a Krylov space of rounding, not always its sign: fastlink released
-    /// into its spring's push is a saddle, ±806 1/s, and the estimate read −806, which 12
+    /// into its spring's push is a saddle, ρ ≈ 807 1/s, and the estimate read it as decaying, which 12
     /// stages hold as a decaying mode at h = 30 ms; as a growing one the stages amplify it
     /// as T_s, and went non-finite within the first step. A bound on growing modes checked
     /// before every step refused the walking hexapod, whose Krylov space shows a ± pair of

@@ -157,3 +157,42 @@ fn the_separator_of_indexed_names_is_not_a_users() {
         "{e:?}"
     );
 }
+
+#[test]
+fn a_parser_message_that_names_only_a_token_says_how_its_statement_is_written() {
+    let pendulum = |tog: &str, inertia: &str| {
+        format!(
+            "model M {{
+                dof x = 0.3;
+                body b {{ mass = 1.0; inertia = {inertia}; }}
+                TOG[b] = {tog};
+            }}"
+        )
+    };
+    // a comma slipped into a point: Rust's own "invalid digit found in string" before
+    let e = errors(&pendulum("Trotz(x) * Tdisp(0 . - 1, 0)", "(1, 1, 1)"));
+    let m = one_with(&e, "expected a number");
+    assert!(
+        m.contains("this statement is written `TOG[body] = Trotz(q[0]) * Tdisp(x, y, z);`"),
+        "{m}"
+    );
+    // syn's "expected an expression", and where
+    let e = errors(&pendulum("Trotz(x)", "(, 1, 1)"));
+    let m = one_with(&e, "expected an expression");
+    assert!(
+        m.contains(
+            "this statement is written `body name { mass = m; inertia = (Ixx, Iyy, Izz); }`"
+        ),
+        "{m}"
+    );
+    // a factor before parentheses, read as a call
+    let e = errors(&pendulum("Trotz(x * (1 - x)(2))", "(1, 1, 1)"));
+    let m = one_with(&e, "followed by parentheses");
+    assert!(m.contains("a product is written with `*`"), "{m}");
+    // the model's header
+    let e = errors("model { dof x = 0.1; }");
+    let m = one_with(&e, "the model's name");
+    assert!(m.contains("write `model Name { … }`"), "{m}");
+    let e = errors("model M dof x = 0.1;");
+    one_with(&e, "expected the statements of `model M` in braces");
+}

@@ -64,7 +64,17 @@ impl Parse for ModelDef {
                 format!("expected `model`, found `{kw}`: write `model Name {{ … }}`"),
             ));
         }
-        let name: Ident = input.parse()?;
+        let name: Ident = input.parse().map_err(|e| {
+            syn::Error::new(
+                e.span(),
+                "expected the model's name after `model`: write `model Name { … }`",
+            )
+        })?;
+        if !input.peek(syn::token::Brace) {
+            return Err(input.error(format!(
+                "expected the statements of `model {name}` in braces: write `model {name} {{ … }}`"
+            )));
+        }
         let content;
         let brace = braced!(content in input);
         let tokens: proc_macro2::TokenStream = content.parse()?;
@@ -73,6 +83,7 @@ impl Parse for ModelDef {
         let mut items = Vec::new();
         let mut origins = Vec::new();
         for s in stmts {
+            let word = first_word(&s.tokens);
             let parsed = match s.inner {
                 None => parse_in(s.tokens, s.end, parse_item),
                 Some(inner) => parse_in(s.tokens, s.end, |input| {
@@ -83,12 +94,13 @@ impl Parse for ModelDef {
                     let mut stmts = Vec::new();
                     let mut origins = Vec::new();
                     for e in inner {
+                        let word = first_word(&e.tokens);
                         match parse_in(e.tokens, e.end, parse_effect) {
                             Ok(stmt) => {
                                 stmts.push(stmt);
                                 origins.push(e.origin);
                             }
-                            Err(err) => errors.push(relabel(err, &e.origin)),
+                            Err(err) => errors.push(relabel(explained(err, &word), &e.origin)),
                         }
                     }
                     Item::EffectBlock {
@@ -112,7 +124,7 @@ impl Parse for ModelDef {
                     items.push(item);
                     origins.push(s.origin);
                 }
-                Err(e) => errors.push(relabel(e, &s.origin)),
+                Err(e) => errors.push(relabel(explained(e, &word), &s.origin)),
             }
         }
         Ok(ModelDef {
@@ -149,6 +161,83 @@ fn parse_in<T>(
         },
         wrapped,
     )
+}
+
+/// The first word of a statement's tokens (its keyword, or an effect's name), if it has one.
+fn first_word(tokens: &proc_macro2::TokenStream) -> Option<String> {
+    match tokens.clone().into_iter().next() {
+        Some(TokenTree::Ident(i)) => Some(i.to_string()),
+        _ => None,
+    }
+}
+
+/// How the statement that starts with `word` is written, for messages that say only what
+/// token the parser expected.
+fn statement_form(word: &str) -> String {
+    match word {
+        "let" => "`let name = expression;`".into(),
+        "fn" => "`fn name(x, y) = expression;`".into(),
+        "extern" => "`extern fn name = [path::to::function];`".into(),
+        "param" => "`param name = 1.0;`".into(),
+        "dof" => "`dof name = q0;` or `dof name = q0, qd = qd0;`".into(),
+        "input" => "`input name;`".into(),
+        "body" => "`body name { mass = m; inertia = (Ixx, Iyy, Izz); }`".into(),
+        "frame" => "`frame name;`".into(),
+        "point" => "`point name on body at (x, y, z);`".into(),
+        "mass" => "`mass name on body at (x, y, z) = m;`".into(),
+        "TOG" => "`TOG[body] = Trotz(q[0]) * Tdisp(x, y, z);`".into(),
+        "effect" => "`effect name { gravity(0, -9.81, 0); … }`".into(),
+        "scene" => "`scene name = [effect, …];`".into(),
+        "constraint" => {
+            "`constraint name = expression;` or `constraint name: coincide(a, b);`".into()
+        }
+        "shape" => "`shape body: box(lx, ly, lz);`".into(),
+        "option" => "`option name = value;`".into(),
+        "part" => "`part Name(a, b) { statements }`".into(),
+        "for" => "`for i in 0..n { statements }`".into(),
+        effect => format!("`{effect}(a, b, …);`, its arguments separated by commas"),
+    }
+}
+
+/// `e` with each message that names only the token the parser expected (syn's own, such as
+/// "expected an expression") completed by how its statement is written; a number that does
+/// not parse said so, where Rust's parser of integers said "invalid digit found in string".
+fn explained(e: syn::Error, word: &Option<String>) -> syn::Error {
+    let mut out: Option<syn::Error> = None;
+    for one in e {
+        let m = one.to_string();
+        let m = match m.as_str() {
+            "invalid digit found in string"
+            | "cannot parse integer from empty string"
+            | "number too large to fit in target type"
+            | "number too small to fit in target type"
+            | "invalid float literal" => "expected a number".to_string(),
+            _ => m,
+        };
+        let bare = (m.starts_with("expected ") || m.starts_with("unexpected "))
+            && !m.contains(": ")
+            && !m.contains("write")
+            && !m.contains('…')
+            && !m.contains("found `");
+        let new = match word {
+            Some(w) if bare => syn::Error::new(
+                one.span(),
+                format!("{m}: this statement is written {}", statement_form(w)),
+            ),
+            None if bare => syn::Error::new(
+                one.span(),
+                format!(
+                    "{m}: a statement starts with its keyword (param, let, dof, body, TOG, …) or with an effect's name, such as `gravity(…)`"
+                ),
+            ),
+            _ => syn::Error::new(one.span(), m),
+        };
+        match &mut out {
+            None => out = Some(new),
+            Some(o) => o.combine(new),
+        }
+    }
+    out.expect("an error has at least one message")
 }
 
 /// An error with its statement's origin appended and indexed names shown as written.

@@ -568,7 +568,10 @@ impl Checker {
         let Expr::Path(p) = &*c.func else {
             self.error_at(
                 &c.func,
-                format!("expected a function name, found `{}`", text(&c.func)),
+                format!(
+                    "`{}` is followed by parentheses as a function would be: a product is written with `*`, `a * (b)`, and a call `name(arguments)`",
+                    text(&c.func)
+                ),
             );
             return self.sys.arena.zero();
         };

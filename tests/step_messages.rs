@@ -223,6 +223,7 @@ fn a_non_finite_force_is_called_a_generalized_force() {
         Failure::NonFinite {
             quantity,
             coordinate,
+            ..
         } => {
             assert_eq!(*quantity, "generalized force h");
             assert!(coordinate.contains("theta"), "{coordinate}");
@@ -252,6 +253,50 @@ fn a_non_finite_force_is_called_a_generalized_force() {
             }
         ),
         "{e}"
+    );
+    // the parameters are at their defaults: the model's expression is to blame
+    let msg = e.kind.to_string();
+    assert!(
+        msg.contains("every parameter is at its default: an expression of the model is not defined at the start"),
+        "{msg}"
+    );
+}
+
+/// A parameter that makes the start, or the first step, not finite is named: each parameter
+/// set back to its default alone, the one that makes it finite.
+#[test]
+fn a_start_made_non_finite_by_a_parameter_names_it() {
+    use mbs::{Model, Parameters};
+    use mbs_models::{dpend::DoublePendulum, top::Top};
+    let run = |model: Top| simulate(model, Scheme::Radau5, Options::adaptive(0.1, 1e-6));
+    // the top's spin about its axis divides by sin²(theta0): its initial velocities
+    let mut top = Top::default();
+    let mut p = top.params().clone();
+    p.set("theta0", 0.0).unwrap();
+    p.set("m", 2.0).unwrap();
+    top.set_params(p).unwrap();
+    let e = run(top).unwrap_err();
+    let msg = e.kind.to_string();
+    println!("{msg}");
+    assert_eq!(e.stats.steps, 0);
+    assert!(
+        msg.contains("with `theta0` at its default 0.7 rather than 0 the start is finite: check that parameter"),
+        "{msg}"
+    );
+    assert!(!msg.contains("`m`"), "{msg}");
+    // gravity of 1e300: the start is finite, the first step overflows
+    let mut dpend = DoublePendulum::default();
+    let mut p = dpend.params().clone();
+    p.set("g", 1e300).unwrap();
+    dpend.set_params(p).unwrap();
+    let e = simulate(dpend, Scheme::Dopri5, Options::adaptive(0.1, 1e-6)).unwrap_err();
+    let msg = e.kind.to_string();
+    println!("{msg}");
+    assert!(
+        msg.contains(
+            "with `g` at its default 9.81 rather than 1e300 a first step of that size is finite"
+        ),
+        "{msg}"
     );
 }
 

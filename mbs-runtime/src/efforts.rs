@@ -346,6 +346,7 @@ impl<M: Model, E: Efforts> WithEfforts<M, E> {
             self.fail(Failure::NonFinite {
                 quantity: "user effort",
                 coordinate,
+                cause: String::new(),
             });
             return false;
         }

@@ -11,7 +11,7 @@ use std::any::Any;
 
 use crate::charts::Recentring;
 use crate::error::{Failure, ModelError};
-use crate::model::{DifferenceBuffers, Energy, Model, ModelInfo, Pose};
+use crate::model::{DifferenceBuffers, Energy, Model, ModelInfo, Parameters, Pose};
 
 /// [`Model`]'s run-time methods, callable on a trait object, with its constants as methods.
 #[allow(clippy::too_many_arguments)]
@@ -216,6 +216,14 @@ pub(crate) trait OwnedModel: ErasedModel {
     fn erased_mut(&mut self) -> &mut dyn ErasedModel;
     fn as_any(&self) -> &dyn Any;
     fn into_any(self: Box<Self>) -> Box<dyn Any>;
+    /// Each parameter whose value is not its default, set back to its default alone (where
+    /// the parameters stay valid), `holds` asked of the model so changed; the parameters
+    /// restored. The `(name, value, default)` of those for which it held, and whether every
+    /// parameter was at its default.
+    fn defaults_for_which(
+        &mut self,
+        holds: &mut dyn FnMut(&dyn ErasedModel) -> bool,
+    ) -> (Vec<(&'static str, f64, f64)>, bool);
 }
 
 impl<M: Model + 'static> OwnedModel for M {
@@ -230,5 +238,33 @@ impl<M: Model + 'static> OwnedModel for M {
     }
     fn into_any(self: Box<Self>) -> Box<dyn Any> {
         self
+    }
+    fn defaults_for_which(
+        &mut self,
+        holds: &mut dyn FnMut(&dyn ErasedModel) -> bool,
+    ) -> (Vec<(&'static str, f64, f64)>, bool) {
+        let given = self.params().clone();
+        let values = given.values();
+        let defaults = M::Params::default().values();
+        let mut found = Vec::new();
+        for (k, name) in M::Params::NAMES.iter().enumerate() {
+            if values[k].to_bits() == defaults[k].to_bits() {
+                continue;
+            }
+            let mut p = given.clone();
+            if p.set(name, defaults[k]).is_err() || self.set_params(p).is_err() {
+                continue;
+            }
+            if holds(&*self) {
+                found.push((*name, values[k], defaults[k]));
+            }
+        }
+        // the given parameters were valid: they are again
+        let _ = self.set_params(given);
+        let all_default = values
+            .iter()
+            .zip(&defaults)
+            .all(|(v, d)| v.to_bits() == d.to_bits());
+        (found, all_default)
     }
 }

@@ -452,10 +452,14 @@ pub enum Failure {
         /// `Options::singularity_tol`
         tolerance: f64,
     },
-    #[error("{quantity} of coordinate {coordinate} is not finite")]
+    #[error("{quantity} of coordinate {coordinate} is not finite{cause}")]
     NonFinite {
         quantity: &'static str,
         coordinate: String,
+        /// at the start, the parameters that make it finite when set back to their defaults
+        /// alone ("; with `g` at its default 9.81 rather than 1e300 the start is finite"),
+        /// or that they are all at their defaults; empty otherwise
+        cause: String,
     },
     #[error(
         "{}: take h < {h_stable:.4e} s or an implicit scheme",
@@ -582,6 +586,7 @@ impl Failure {
             Some(i) => Err(Failure::NonFinite {
                 quantity,
                 coordinate: name(i),
+                cause: String::new(),
             }),
         }
     }

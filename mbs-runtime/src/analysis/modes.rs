@@ -113,6 +113,7 @@ pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, A
         return Err(Failure::NonFinite {
             quantity: "A",
             coordinate: String::new(),
+            cause: String::new(),
         }
         .into());
     }

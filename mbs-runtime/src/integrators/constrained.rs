@@ -771,6 +771,7 @@ fn rank_failure(
         return Failure::NonFinite {
             quantity: "B = ∂Φ/∂q",
             coordinate: format!("{} in constraint `{}`", label(i / nc), names[i % nc]),
+            cause: String::new(),
         };
     }
     let (rank, sigma_min, involved) = rank_of(b, nc, n);

@@ -12,8 +12,8 @@ use super::step_control::{Largest, StepBounds, Tolerances, component_name, initi
 use super::stepper::{Attempt, Control, Step, Stepper};
 use super::{Integrator, State};
 use crate::charts::{self, Recentring};
-use crate::erased::OwnedModel;
-use crate::error::{Failure, HeldMost, OutOfSteps};
+use crate::erased::{ErasedModel, OwnedModel};
+use crate::error::{Failure, HeldMost, OutOfSteps, short};
 use crate::model::{Model, Pose};
 use crate::options::{Options, Output, Scheme, StepControl};
 use crate::stats::Stats;
@@ -261,10 +261,14 @@ impl Run {
                 )?;
                 Ok(assembly)
             });
-        let assembly = start.map_err(|e| early(e, problem.stats.clone()))?;
+        let assembly = start.map_err(|e| {
+            let e = with_parameters_blamed(e, &mut problem, &options, 0.0);
+            early(e, problem.stats.clone())
+        })?;
         let ctl = control(&options, groups);
         let mut stepper = stepper_for(&scheme, n);
         if let Err(e) = stepper.start(&mut problem, &cur, &ctl) {
+            let e = with_parameters_blamed(e, &mut problem, &options, 0.0);
             return Err(early(e, problem.stats.clone()));
         }
         if let Some(tol) = ctl.adaptive {
@@ -446,6 +450,12 @@ impl Run {
     }
 
     fn fail(&mut self, kind: Failure, h: f64) -> SimError {
+        // a first step that is not finite: what the parameters have to do with it
+        let kind = if self.problem.stats.steps == 0 && h > 0.0 {
+            with_parameters_blamed(kind, &mut self.problem, &self.options, h)
+        } else {
+            kind
+        };
         // `Output::Last` records at the end: a run that fails keeps its last accepted state
         if self.options.output == Output::Last && self.traj.is_empty() {
             self.record_cur();
@@ -1021,6 +1031,102 @@ fn initial_state(problem: &mut Problem, options: &Options, cur: &mut State) -> R
         problem.stats.chart_switches += moved.len();
     }
     Ok(())
+}
+
+/// A start, or a first step of size `h` (0 for the start), that is not finite, with what the
+/// parameters have to do with it: those that, set back to their default alone, make it finite
+/// (the initial state, or the one the options give, M and h there, and for a step the state a
+/// Taylor step of that size reaches, q + h qd + h²/2 qdd, and M and h there), or that they
+/// are all at their defaults, so that it is an expression of the model (or the state given)
+/// that is not defined there. Other failures unchanged.
+fn with_parameters_blamed(
+    e: Failure,
+    problem: &mut Problem,
+    options: &Options,
+    step: f64,
+) -> Failure {
+    let Failure::NonFinite {
+        quantity,
+        coordinate,
+        cause,
+    } = e
+    else {
+        return e;
+    };
+    if !cause.is_empty() || quantity == "input" {
+        return Failure::NonFinite {
+            quantity,
+            coordinate,
+            cause,
+        };
+    }
+    let n = problem.model.nq();
+    let u = problem.held.clone();
+    let t0 = options.t0;
+    let mut finite_start = |m: &dyn ErasedModel| {
+        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+        let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
+        m.initial_state(&mut q, &mut qd);
+        if let Some(q0) = &options.q0 {
+            q.copy_from_slice(q0);
+        }
+        if let Some(qd0) = &options.qd0 {
+            qd.copy_from_slice(qd0);
+        }
+        let (mut mass, mut h) = (vec![0.0; n * n], vec![0.0; n]);
+        m.dynamics(t0, &q, &qd, &u, &mut mass, &mut h);
+        let mut ok = finite(&q) && finite(&qd) && finite(&mass) && finite(&h);
+        if ok && step > 0.0 {
+            let (mut qdd, mut pivots) = (vec![0.0; n], vec![0.0; n]);
+            m.forward_dynamics(t0, &q, &qd, &u, &mut qdd, &mut pivots);
+            for i in 0..n {
+                q[i] += step * qd[i] + 0.5 * step * step * qdd[i];
+                qd[i] += step * qdd[i];
+            }
+            m.dynamics(t0 + step, &q, &qd, &u, &mut mass, &mut h);
+            ok = finite(&qdd) && finite(&q) && finite(&qd) && finite(&mass) && finite(&h);
+        }
+        // an evaluation that failed in a model's Rust efforts left its failure to be taken
+        ok && m.take_failure().is_none()
+    };
+    let (found, all_default) = problem.model.defaults_for_which(&mut finite_start);
+    let what = if step > 0.0 {
+        "a first step of that size"
+    } else {
+        "the start"
+    };
+    let cause = if !found.is_empty() {
+        let named: Vec<String> = found
+            .iter()
+            .map(|(name, value, default)| {
+                format!(
+                    "`{name}` at its default {} rather than {}",
+                    short(*default),
+                    short(*value)
+                )
+            })
+            .collect();
+        format!(
+            "; with {} {what} is finite: check {}",
+            named.join(", or with "),
+            if found.len() == 1 {
+                "that parameter"
+            } else {
+                "those parameters"
+            }
+        )
+    } else if all_default {
+        format!(
+            "; every parameter is at its default: an expression of the model is not defined at {what} (a square root of a negative, a division by zero), or the state given is not"
+        )
+    } else {
+        String::new()
+    };
+    Failure::NonFinite {
+        quantity,
+        coordinate,
+        cause,
+    }
 }
 
 /// A chart (rows of a rotation matrix) as a quaternion `[x, y, z, w]`, w ≥ 0.

@@ -195,6 +195,7 @@ impl Problem {
                 Err(Failure::NonFinite {
                     quantity: "input",
                     coordinate: format!("u[{i}] at t = {t}"),
+                    cause: String::new(),
                 })
             }
         }

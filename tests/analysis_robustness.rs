@@ -4,7 +4,8 @@
 //! sensitivities of the equilibria found, and inverse dynamics along a run (of every
 //! coordinate, and of actuated sets valid or not) and along a path that turns non-finite.
 //! Each returns finite results, or a typed error with a message; never a panic, never a NaN
-//! in a result it returns.
+//! in a result it returns. Also linearisation, modes and statics with each parameter at the
+//! edges of its range.
 
 #[path = "common/lcg.rs"]
 mod lcg;
@@ -403,4 +404,78 @@ fn statics_of_a_loop_start_where_the_reduced_stiffness_is_singular() {
     );
     assert_eq!(eq.stability, Stability::Stable);
     assert!(eq.residual <= 1e-9 && eq.constraint_residual <= 1e-11);
+}
+
+/// Each parameter of the models at the edges of its range, one at a time (zero, its opposite,
+/// 10⁻⁶ and 10⁶ times its default, ±1e300, 1e-300), where `set_params` accepts it: the
+/// linearisation at the declared start, its modes, and the statics from there return finite
+/// results or a typed error, never a panic.
+fn at_parameter_edges<M: Model + Clone + 'static>(name: &str, model: M, tally: &mut Tally) {
+    use mbs::Parameters;
+    let defaults = model.params().values();
+    let n = M::NQ;
+    let u = vec![0.0; M::NU];
+    for (k, &param) in M::Params::NAMES.iter().enumerate() {
+        let v = defaults[k];
+        for value in [0.0, -v, 1e-6 * v, 1e6 * v, 1e300, -1e300, 1e-300] {
+            let mut p = model.params().clone();
+            p.set(param, value).expect("a known name");
+            let mut m = model.clone();
+            if m.set_params(p).is_err() {
+                continue;
+            }
+            let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
+            m.initial_state(&mut q, &mut qd);
+            let tag = format!("{name} linearize {param} = {value:e}");
+            let lin = tally.record(
+                &tag,
+                call(|| linearize(&m, 0.0, &q, &qd, &u, IterationMatrix::Auto)),
+                |l| {
+                    [&l.m, &l.c, &l.k, &l.a]
+                        .iter()
+                        .all(|x| all_finite(x.iter()))
+                },
+            );
+            if let Some(lin) = lin {
+                let tag = format!("{name} modes {param} = {value:e}");
+                tally.record(&tag, call(|| modes(&lin, None)), |m| {
+                    m.modes.iter().all(|m| m.re.is_finite() && m.im.is_finite())
+                });
+            }
+            let tag = format!("{name} statics {param} = {value:e}");
+            tally.record(
+                &tag,
+                call(|| static_equilibrium(&m, &StaticsOptions::default())),
+                |e| all_finite(&e.q) && e.residual.is_finite() && all_finite(&e.lambda),
+            );
+        }
+    }
+}
+
+#[test]
+fn every_analysis_at_the_edges_of_the_parameters_returns_finite_results_or_a_typed_error() {
+    let mut tally = Tally::default();
+    sweeps::silenced(|| {
+        let t = &mut tally;
+        at_parameter_edges("dpend", dpend::DoublePendulum::default(), t);
+        at_parameter_edges("seed2dof", seed2dof::Seed2dof::default(), t);
+        at_parameter_edges("chain8", chain8::Chain8::default(), t);
+        at_parameter_edges("arm3d_6", arm3d_6::Arm3d6::default(), t);
+        at_parameter_edges("tumble", tumble::TumbleBall::default(), t);
+        at_parameter_edges("top", top::Top::default(), t);
+        at_parameter_edges("springpend", springpend::SpringPend::default(), t);
+        at_parameter_edges("sprung_arm", sprung_arm::SprungArm::default(), t);
+        at_parameter_edges("fourbar", fourbar::FourBar::default(), t);
+        at_parameter_edges("slidercrank", slidercrank::SliderCrankClosed::default(), t);
+        at_parameter_edges("pendulum3", pendulum3::Pendulum3::default(), t);
+        at_parameter_edges("fastlink", fastlink::FastLink::default(), t);
+        at_parameter_edges(
+            "dpend_cartesian",
+            dpend_cartesian::DoublePendulumCartesian::default(),
+            t,
+        );
+        at_parameter_edges("hexapod_standing", hexapod::HexapodStanding::default(), t);
+    });
+    println!("{} calls: {:#?}", tally.calls, tally.kinds);
+    assert!(tally.problems.is_empty(), "{}", tally.problems.join("\n"));
 }

@@ -7,13 +7,16 @@
 //! of two models' motion to their parameters, and 224 under global error control; and every
 //! parameter of 14 models at the edges of its range (291 values refused by `set_params`, 786
 //! runs of the others, where a start or first step that is not finite names the parameter
-//! that makes it so). The sweep that first ran this found a
+//! that makes it so); and every numeric option at the edges of its range on two models under
+//! three schemes (1,008 runs, 733 refused up front). The sweep that first ran this found a
 //! message blaming an error test that had passed (Radau's predictive step correction after
 //! failed Newton iterations, `tests/step_messages.rs`), a loop closure with no advice
 //! (`tests/failures.rs`) and RKC's fixed steps going non-finite on fastlink's saddle
 //! (`tests/scheme_rkc.rs`).
 
-use mbs::{ConstraintMethod, Failure, Model, Options, Output, Scheme, SimError, simulate};
+use mbs::{
+    ConstraintMethod, Failure, Model, Options, Output, Scheme, SimError, StepControl, simulate,
+};
 use mbs_models::*;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
@@ -413,5 +416,163 @@ fn every_parameter_at_its_edges_is_refused_or_runs_typed() {
     });
     println!("{runs} runs after the parameters were accepted");
     assert!(kinds.contains_key("ParamError"), "{kinds:?}");
+    assert!(kinds.contains_key("finished"), "{kinds:?}");
+}
+
+/// Every numeric option at the edges of its range, one at a time (0, −1, 1e-300, 1e300, NaN,
+/// ±∞; counts 0, 1 and the largest; output times unsorted, repeated, before the start, NaN;
+/// a start of the wrong length or not finite), on an open chain and a closed loop under an
+/// explicit, an implicit and a fixed-step scheme: refused up front with a typed
+/// `InvalidOption` that names the option, or run to an end or a typed stop with what it
+/// computed; never a panic.
+#[test]
+fn every_option_at_its_edges_is_refused_or_runs_typed() {
+    type Edit = Box<dyn Fn(&mut Options, f64)>;
+    let float = |set: fn(&mut Options, f64)| -> Edit { Box::new(set) };
+    let fields: Vec<(&str, Edit)> = vec![
+        ("t0", float(|o, x| o.t0 = x)),
+        ("t_end", float(|o, x| o.t_end = x)),
+        ("h_max", float(|o, x| o.h_max = x)),
+        ("h_min", float(|o, x| o.h_min = Some(x))),
+        (
+            "newton.tolerance_factor",
+            float(|o, x| o.newton.tolerance_factor = x),
+        ),
+        ("newton.atol", float(|o, x| o.newton.atol = x)),
+        ("newton.rtol", float(|o, x| o.newton.rtol = x)),
+        ("singularity_tol", float(|o, x| o.singularity_tol = x)),
+        ("chart_switch", float(|o, x| o.chart_switch = x)),
+        (
+            "constraints.tolerance",
+            float(|o, x| o.constraints.tolerance = x),
+        ),
+        (
+            "constraints.drift_tol",
+            float(|o, x| o.constraints.drift_tol = x),
+        ),
+        (
+            "step (rtol)",
+            float(|o, x| {
+                if let StepControl::Adaptive { rtol, .. } = &mut o.step {
+                    *rtol = x;
+                }
+            }),
+        ),
+        (
+            "step (atol)",
+            float(|o, x| {
+                if let StepControl::Adaptive { atol, .. } = &mut o.step {
+                    *atol = x;
+                }
+            }),
+        ),
+        (
+            "step (h0 or h)",
+            float(|o, x| match &mut o.step {
+                StepControl::Adaptive { h0, .. } => *h0 = Some(x),
+                StepControl::Fixed { h } => *h = x,
+            }),
+        ),
+        (
+            "output (dt)",
+            float(|o, x| o.output = Output::Every { dt: x }),
+        ),
+        (
+            "output (times)",
+            float(|o, x| o.output = Output::Times(vec![0.5, x, 0.2])),
+        ),
+        ("q0", float(|o, x| o.q0 = Some(vec![x; 4]))),
+        ("qd0", float(|o, x| o.qd0 = Some(vec![x; 2]))),
+        (
+            "max_steps",
+            float(|o, x| o.max_steps = x.clamp(0.0, 1e9) as usize),
+        ),
+        (
+            "newton.max_iterations",
+            float(|o, x| o.newton.max_iterations = x.clamp(0.0, 1e9) as usize),
+        ),
+        (
+            "constraints.max_iterations",
+            float(|o, x| o.constraints.max_iterations = x.clamp(0.0, 1e9) as usize),
+        ),
+    ];
+    let values = [
+        0.0,
+        -1.0,
+        1e-300,
+        1e300,
+        f64::NAN,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        1.0,
+    ];
+    fn each<M: Model + Clone + 'static>(
+        name: &str,
+        model: M,
+        fields: &[(&str, Edit)],
+        values: &[f64],
+        kinds: &mut Kinds,
+        problems: &mut Vec<String>,
+    ) -> usize {
+        let mut runs = 0;
+        for (field, edit) in fields {
+            for &x in values {
+                for (scheme, base) in [
+                    (Scheme::Dopri5, Options::adaptive(0.3, 1e-6)),
+                    (Scheme::Radau5, Options::adaptive(0.3, 1e-6)),
+                    (Scheme::Rk4, Options::fixed(0.3, 1e-3)),
+                ] {
+                    let mut o = Options {
+                        max_steps: 20_000,
+                        energy: false,
+                        ..base
+                    };
+                    edit(&mut o, x);
+                    if o.max_steps > 20_000 {
+                        // the largest count is a run bounded by t_end alone
+                        o.max_steps = usize::MAX;
+                    }
+                    let tag = format!("{name} {} {field} = {x:e}", scheme.name());
+                    runs += 1;
+                    let m = model.clone();
+                    let r = catch_unwind(AssertUnwindSafe(|| simulate(m, scheme, o)));
+                    if let Ok(Err(e)) = &r
+                        && let Failure::InvalidOption { name, .. } = &e.kind
+                        && name.is_empty()
+                    {
+                        problems.push(format!("{tag}: an invalid option without a name: {e}"));
+                    }
+                    record(
+                        &tag,
+                        r.map(|r| r.map(|(tr, _)| tr)),
+                        "finished",
+                        kinds,
+                        problems,
+                    );
+                }
+            }
+        }
+        runs
+    }
+    // a start of 1e300 rad/s overflows the forces: `NonFinite` at the start is its answer
+    let (runs, kinds) = quietly_finite_or_not(|k, p| {
+        each(
+            "dpend",
+            dpend::DoublePendulum::default(),
+            &fields,
+            &values,
+            k,
+            p,
+        ) + each(
+            "fourbar",
+            fourbar::FourBar::default(),
+            &fields,
+            &values,
+            k,
+            p,
+        )
+    });
+    println!("{runs} runs");
+    assert!(kinds.contains_key("InvalidOption"), "{kinds:?}");
     assert!(kinds.contains_key("finished"), "{kinds:?}");
 }

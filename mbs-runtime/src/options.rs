@@ -448,6 +448,23 @@ impl ConstraintOptions {
                 return Err(invalid(name, v, "must be > 0 and finite"));
             }
         }
+        if self.tolerance < 1e-15 {
+            // Φ of lengths of order one is computed to a few ε ≈ 2.2e-16: Newton cannot
+            // reach less, and stopped after its iterations saying the step left the
+            // constraints too far
+            return Err(invalid(
+                "constraints.tolerance",
+                self.tolerance,
+                "is below what double precision resolves (|Φ| is computed to a few 1e-16 times the model's lengths): take 1e-15 or more",
+            ));
+        }
+        if self.tolerance > self.drift_tol {
+            return Err(invalid(
+                "constraints.tolerance",
+                self.tolerance,
+                "exceeds constraints.drift_tol, at which a run stops: a closure left within the tolerance would stop it; take a tolerance below drift_tol",
+            ));
+        }
         if self.max_iterations == 0 {
             return Err(invalid("constraints.max_iterations", 0, "must be > 0"));
         }
@@ -647,7 +664,11 @@ impl Options {
         for (name, v) in [("q0", &self.q0), ("qd0", &self.qd0)] {
             if let Some(v) = v {
                 if v.len() != nq {
-                    return Err(invalid(name, v.len(), "must have one value per coordinate"));
+                    return Err(invalid(
+                        name,
+                        format!("{} values (the model has {nq} coordinates)", v.len()),
+                        "must have one value per coordinate",
+                    ));
                 }
                 if let Some(i) = v.iter().position(|x| !x.is_finite()) {
                     return Err(invalid(
@@ -773,6 +794,14 @@ impl Options {
                     "h_min",
                     format!("{} (with h_max = {})", short(h), short(self.h_max)),
                     "h_min is above h_max, so no step is allowed: take h_min ≤ h_max",
+                ));
+            }
+            let span = (self.t_end - self.t0).abs();
+            if h > span && span > 0.0 && matches!(self.step, StepControl::Adaptive { .. }) {
+                return Err(invalid(
+                    "h_min",
+                    format!("{} (with a run of {} s)", short(h), short(span)),
+                    "h_min is above the length of the run, so the first step that is rejected stops it: take h_min well below t_end − t0",
                 ));
             }
         }

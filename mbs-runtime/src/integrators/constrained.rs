@@ -901,7 +901,7 @@ pub fn assemble<M: crate::model::Model + 'static>(
         if v.len() != M::NQ {
             return Err(Failure::InvalidOption {
                 name,
-                value: v.len().to_string(),
+                value: format!("{} values (the model has {} coordinates)", v.len(), M::NQ),
                 reason: "must have one value per coordinate",
             });
         }

@@ -1115,9 +1115,13 @@ fn with_parameters_blamed(
                 "those parameters"
             }
         )
+    } else if all_default && (options.q0.is_some() || options.qd0.is_some()) {
+        format!(
+            "; every parameter is at its default: the start given in Options::q0 or qd0 makes {what} not finite, or an expression of the model is not defined there (a square root of a negative, a division by zero)"
+        )
     } else if all_default {
         format!(
-            "; every parameter is at its default: an expression of the model is not defined at {what} (a square root of a negative, a division by zero), or the state given is not"
+            "; every parameter is at its default: an expression of the model is not defined at {what} (a square root of a negative, a division by zero)"
         )
     } else {
         String::new()

@@ -579,3 +579,146 @@ fn command_line_prints_the_block() {
         );
     }
 }
+
+/// The test robots' descriptions changed as a user's slips or a bad export would (an
+/// attribute's value replaced by an empty, non-numeric, non-finite, negative, huge or
+/// mismatched one, or by another of the file's values; a line deleted or repeated; one to
+/// three changes): the importer never panics and returns a model or a typed error with a
+/// message, and a model it returns expands as `multibody!` expands it, to code or to errors
+/// that name their construct, never a panic.
+#[test]
+fn changed_descriptions_import_or_fail_typed_and_what_imports_expands() {
+    use mbs_symbolic::expand::{Expansion, expand_models, multibody_blocks};
+    use std::collections::BTreeMap;
+    /// A linear congruential generator: the same mutants on every run.
+    struct Lcg(u64);
+    impl Lcg {
+        fn below(&mut self, n: usize) -> usize {
+            self.0 = self
+                .0
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((self.0 >> 33) % n as u64) as usize
+        }
+    }
+    const VALUES: [&str; 16] = [
+        "",
+        "nan",
+        "inf",
+        "-inf",
+        "-1",
+        "0",
+        "1e308",
+        "0 0",
+        "1 2 3 4",
+        "x",
+        "revolute",
+        "prismatic",
+        "continuous",
+        "fixed",
+        "floating",
+        "planar",
+    ];
+    std::panic::set_hook(Box::new(|_| {}));
+    let mut tally = BTreeMap::<String, usize>::new();
+    let mut broken = Vec::new();
+    let mut rng = Lcg(7);
+    for (name, floating_base) in ROBOTS {
+        let text = std::fs::read_to_string(urdf_path(name)).unwrap();
+        // the spans of attribute values, inside their quotes
+        let values: Vec<(usize, usize)> = text
+            .match_indices("=\"")
+            .filter_map(|(i, _)| {
+                let start = i + 2;
+                text[start..].find('"').map(|len| (start, start + len))
+            })
+            .collect();
+        for _ in 0..300 {
+            let mut mutant = text.clone();
+            let mut what = String::new();
+            for _ in 0..1 + rng.below(3) {
+                let lines: Vec<&str> = mutant.lines().collect();
+                match rng.below(4) {
+                    0 => {
+                        let l = rng.below(lines.len());
+                        what += &format!(" line {l} deleted;");
+                        let mut v = lines.clone();
+                        v.remove(l);
+                        mutant = v.join("\n");
+                    }
+                    1 => {
+                        let l = rng.below(lines.len());
+                        what += &format!(" line {l} repeated;");
+                        let mut v = lines.clone();
+                        v.insert(l, lines[l]);
+                        mutant = v.join("\n");
+                    }
+                    _ => {
+                        // values of the unchanged text, found again in the mutant by content
+                        let (a, b) = values[rng.below(values.len())];
+                        let old = &text[a..b];
+                        let new = if rng.below(3) == 0 {
+                            let (c, d) = values[rng.below(values.len())];
+                            text[c..d].to_string()
+                        } else {
+                            VALUES[rng.below(VALUES.len())].to_string()
+                        };
+                        let from = format!("=\"{old}\"");
+                        if let Some(i) = mutant.find(&from) {
+                            what += &format!(" \"{old}\" → \"{new}\";");
+                            mutant.replace_range(i..i + from.len(), &format!("=\"{new}\""));
+                        }
+                    }
+                }
+            }
+            let tag = format!("{name}:{what}");
+            let options = ImportOptions { floating_base };
+            let imported =
+                match std::panic::catch_unwind(|| mbs::urdf::import_with(&mutant, options)) {
+                    Err(_) => {
+                        broken.push(format!("{tag} the importer panicked"));
+                        continue;
+                    }
+                    Ok(Err(e)) => {
+                        if e.to_string().trim().is_empty() {
+                            broken.push(format!("{tag} an error without a message"));
+                        }
+                        let kind = format!("{e:?}");
+                        let kind = kind.split([' ', '{', '(']).next().unwrap_or("").to_string();
+                        *tally.entry(format!("refused {kind}")).or_default() += 1;
+                        continue;
+                    }
+                    Ok(Ok(i)) => i,
+                };
+            let block = imported.block("a changed description");
+            let file = match syn::parse_file(&block) {
+                Ok(f) => f,
+                Err(e) => {
+                    broken.push(format!("{tag} the imported block does not parse: {e}"));
+                    continue;
+                }
+            };
+            let tokens = multibody_blocks(&file).remove(0);
+            match std::panic::catch_unwind(|| expand_models(tokens)) {
+                Err(_) => broken.push(format!("{tag} the generator panicked")),
+                Ok(Err(e)) => broken.push(format!("{tag} the block is not a block of models: {e}")),
+                Ok(Ok(expansions)) => {
+                    for e in expansions {
+                        match e {
+                            Expansion::Ok { .. } => {
+                                *tally.entry("imported and generated".into()).or_default() += 1
+                            }
+                            Expansion::Err { error, .. } => {
+                                println!("{tag} imported, then refused: {error}");
+                                *tally.entry("imported, then refused".into()).or_default() += 1
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let _ = std::panic::take_hook();
+    println!("{tally:#?}");
+    assert!(broken.is_empty(), "{}", broken.join("\n"));
+}

@@ -6,6 +6,9 @@ use mbs_models::{dpend::DoublePendulum, seed2dof::Seed2dof};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
+#[path = "common/sweeps.rs"]
+mod sweeps;
+
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("mbs-sweep-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
@@ -921,4 +924,126 @@ fn the_folder_s_plan_records_the_start() {
     assert_eq!(first, second);
     let _ = std::fs::remove_dir_all(&dir);
     let _ = std::fs::remove_dir_all(&again);
+}
+
+/// Plans changed as a user's slips would (a value replaced by an empty, negative, huge,
+/// non-finite, fractional or mistyped one, or by another of the plan's values; a line deleted
+/// or repeated; one to three changes): parsed, expanded into runs, checked against the model
+/// and, when there are at most four runs, run — a typed `SweepError` with a message at the
+/// first step that refuses, never a panic.
+#[test]
+fn changed_plans_are_refused_typed_or_run() {
+    struct Lcg(u64);
+    impl Lcg {
+        fn below(&mut self, n: usize) -> usize {
+            self.0 = self
+                .0
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((self.0 >> 33) % n as u64) as usize
+        }
+    }
+    const VALUES: [&str; 14] = [
+        "0",
+        "-1",
+        "1e308",
+        "-1e308",
+        "nan",
+        "inf",
+        "0.5",
+        "1e12",
+        "\"\"",
+        "\"x\"",
+        "[]",
+        "[1, \"a\"]",
+        "[2, 1]",
+        "18446744073709551615",
+    ];
+    let plans = [
+        "[sweep]\ndesign = \"grid\"\n[[vary]]\nname = \"l\"\nvalues = [0.8, 1.0]\n[[vary]]\nname = \"scheme\"\nvalues = [\"dopri5\", \"radau5\"]\n[[vary]]\nname = \"qd0[1]\"\nrange = [0.0, 1.0]\ncount = 1\n",
+        "[sweep]\ndesign = \"lhs\"\nruns = 3\nseed = 5\n[[vary]]\nname = \"l\"\nuniform = [0.5, 2]\n[[vary]]\nname = \"q0.q[0]\"\nuniform = [0.1, 3]\n[[vary]]\nname = \"rtol\"\nlog_uniform = [1e-9, 1e-5]\n",
+        "[sweep]\ndesign = \"monte-carlo\"\nruns = 3\nseed = 11\n[[vary]]\nname = \"m\"\nnormal = [1, 0.1]\n[simulation]\nt_end = 0.05\n[slurm]\ntasks = 2\n",
+        "[sweep]\ndesign = \"grid\"\n[[vary]]\nname = \"scheme\"\nvalues = [\"dopri5\", \"rk4\"]\n[[vary]]\nname = \"h\"\nvalues = [0.001, 0.5]\n",
+    ];
+    let mut rng = Lcg(3);
+    let mut tally = std::collections::BTreeMap::<&str, usize>::new();
+    let mut broken = Vec::new();
+    let dir = scratch("changed");
+    let short = Options {
+        t_end: 0.05,
+        ..base()
+    };
+    for (p, plan) in plans.iter().enumerate() {
+        for _ in 0..150 {
+            let mut lines: Vec<String> = plan.lines().map(str::to_string).collect();
+            let mut what = String::new();
+            for _ in 0..1 + rng.below(3) {
+                let l = rng.below(lines.len());
+                match rng.below(4) {
+                    0 => {
+                        what += &format!(" line {l} deleted;");
+                        lines.remove(l);
+                    }
+                    1 => {
+                        what += &format!(" line {l} repeated;");
+                        lines.insert(l, lines[l].clone());
+                    }
+                    _ => {
+                        if let Some(i) = lines[l].find(" = ") {
+                            let new = if rng.below(3) == 0 {
+                                let other = plan.lines().nth(rng.below(plan.lines().count()));
+                                other
+                                    .and_then(|o| o.split_once(" = ").map(|x| x.1.to_string()))
+                                    .unwrap_or_default()
+                            } else {
+                                VALUES[rng.below(VALUES.len())].to_string()
+                            };
+                            what += &format!(" `{}` → `{new}`;", lines[l]);
+                            lines[l] = format!("{} = {new}", &lines[l][..i]);
+                        }
+                    }
+                }
+            }
+            let text = lines.join("\n");
+            let tag = format!("plan {p}:{what}");
+            let outcome = sweeps::quiet_catch(|| -> Result<&'static str, SweepError> {
+                let plan = Plan::from_toml(&text)?;
+                let runs = plan.runs(Path::new("."))?;
+                let sweep = Sweep::new(
+                    DoublePendulum::default,
+                    &plan,
+                    Scheme::Dopri5,
+                    short.clone(),
+                )?;
+                if runs.len() > 4 {
+                    return Ok("checked, not run");
+                }
+                let _ = std::fs::remove_dir_all(&dir);
+                sweep.threads(1).run(&dir, &runs)?;
+                Ok("ran")
+            });
+            match outcome {
+                Err(_) => broken.push(format!("{tag} panicked")),
+                Ok(Ok(kind)) => *tally.entry(kind).or_default() += 1,
+                Ok(Err(e)) => {
+                    let text = e.to_string();
+                    if text.trim().is_empty() {
+                        broken.push(format!("{tag} an error without a message"));
+                    }
+                    // the reader quoted 1e308 where a list was expected as its 309 digits
+                    if sweeps::longest_number(&text) > 20 {
+                        broken.push(format!("{tag} a number written out in full: {text}"));
+                    }
+                    *tally.entry("refused").or_default() += 1;
+                }
+            }
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    println!("{tally:?}");
+    assert!(broken.is_empty(), "{}", broken.join("\n"));
+    assert!(
+        tally.contains_key("ran") && tally.contains_key("refused"),
+        "{tally:?}"
+    );
 }

@@ -11,6 +11,8 @@
 
 #[path = "common/blessed.rs"]
 mod blessed;
+#[path = "common/sweeps.rs"]
+mod sweeps;
 
 mod imported {
     include!("urdf/models.rs");
@@ -619,7 +621,6 @@ fn changed_descriptions_import_or_fail_typed_and_what_imports_expands() {
         "floating",
         "planar",
     ];
-    std::panic::set_hook(Box::new(|_| {}));
     let mut tally = BTreeMap::<String, usize>::new();
     let mut broken = Vec::new();
     let mut rng = Lcg(7);
@@ -673,23 +674,22 @@ fn changed_descriptions_import_or_fail_typed_and_what_imports_expands() {
             }
             let tag = format!("{name}:{what}");
             let options = ImportOptions { floating_base };
-            let imported =
-                match std::panic::catch_unwind(|| mbs::urdf::import_with(&mutant, options)) {
-                    Err(_) => {
-                        broken.push(format!("{tag} the importer panicked"));
-                        continue;
+            let imported = match sweeps::quiet_catch(|| mbs::urdf::import_with(&mutant, options)) {
+                Err(_) => {
+                    broken.push(format!("{tag} the importer panicked"));
+                    continue;
+                }
+                Ok(Err(e)) => {
+                    if e.to_string().trim().is_empty() {
+                        broken.push(format!("{tag} an error without a message"));
                     }
-                    Ok(Err(e)) => {
-                        if e.to_string().trim().is_empty() {
-                            broken.push(format!("{tag} an error without a message"));
-                        }
-                        let kind = format!("{e:?}");
-                        let kind = kind.split([' ', '{', '(']).next().unwrap_or("").to_string();
-                        *tally.entry(format!("refused {kind}")).or_default() += 1;
-                        continue;
-                    }
-                    Ok(Ok(i)) => i,
-                };
+                    let kind = format!("{e:?}");
+                    let kind = kind.split([' ', '{', '(']).next().unwrap_or("").to_string();
+                    *tally.entry(format!("refused {kind}")).or_default() += 1;
+                    continue;
+                }
+                Ok(Ok(i)) => i,
+            };
             let block = imported.block("a changed description");
             let file = match syn::parse_file(&block) {
                 Ok(f) => f,
@@ -699,7 +699,7 @@ fn changed_descriptions_import_or_fail_typed_and_what_imports_expands() {
                 }
             };
             let tokens = multibody_blocks(&file).remove(0);
-            match std::panic::catch_unwind(|| expand_models(tokens)) {
+            match sweeps::quiet_catch(|| expand_models(tokens)) {
                 Err(_) => broken.push(format!("{tag} the generator panicked")),
                 Ok(Err(e)) => broken.push(format!("{tag} the block is not a block of models: {e}")),
                 Ok(Ok(expansions)) => {
@@ -718,7 +718,6 @@ fn changed_descriptions_import_or_fail_typed_and_what_imports_expands() {
             }
         }
     }
-    let _ = std::panic::take_hook();
     println!("{tally:#?}");
     assert!(broken.is_empty(), "{}", broken.join("\n"));
 }

@@ -281,10 +281,25 @@ impl RunList {
     }
 }
 
+/// `message` with each number quoted in backticks that is written out longer than a user
+/// would type it written as [`short`] writes it: the TOML reader quotes a value of the wrong
+/// type as `f64`'s Display writes it, 1e308 as 309 digits.
+fn numbers_shortened(message: &str) -> String {
+    let mut parts: Vec<String> = message.split('`').map(str::to_string).collect();
+    for part in parts.iter_mut().skip(1).step_by(2) {
+        if part.len() > 15
+            && let Ok(x) = part.parse::<f64>()
+        {
+            *part = crate::error::short(x);
+        }
+    }
+    parts.join("`")
+}
+
 impl Plan {
     /// Reads a plan from TOML text; unknown keys are errors.
     pub fn from_toml(text: &str) -> Result<Plan, SweepError> {
-        toml::from_str(text).map_err(|e| SweepError::Plan(e.to_string()))
+        toml::from_str(text).map_err(|e| SweepError::Plan(numbers_shortened(&e.to_string())))
     }
 
     /// Reads a plan file.

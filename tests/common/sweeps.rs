@@ -1,5 +1,6 @@
 //! What the sweeps of every scheme and every analysis share: a silent panic report, and the
 //! check of every failure's message.
+#![allow(dead_code)] // each test binary uses a part
 
 /// The most significant digits of any number in `text` (leading zeros not counted): a
 /// message's numbers should read like the ones a user types (`short`, ten digits at most),
@@ -31,4 +32,9 @@ pub fn silenced<T>(f: impl FnOnce() -> T) -> T {
     let out = f();
     QUIET.with(|q| q.set(false));
     out
+}
+
+/// `catch_unwind` of `f` with the panic report [`silenced`].
+pub fn quiet_catch<T>(f: impl FnOnce() -> T) -> std::thread::Result<T> {
+    silenced(|| std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)))
 }

@@ -2,7 +2,9 @@
 //! with its neighbour, a number, a name or an operator replaced), as a user's typing slips
 //! would: every mutant that lexes goes through the generator as `multibody!` gives it.
 //! Asserted: the generator never panics and always returns; an expansion that succeeds emits
-//! code that parses; one that fails carries messages that name the construct, not only the
+//! code that parses and names no `inf` or `NaN` (Display's text of a number that is not
+//! finite, which parses as a name: a mass of 1e308 gave a default shape of radius `inf`); one
+//! that fails carries messages that name the construct, not only the
 //! token the parser expected (syn's bare "expected an expression" is completed by how its
 //! statement is written), and a stub that parses (so that the user's code does not cascade
 //! into more errors). The tokens of `///` comments are left alone: no slip reaches them.
@@ -225,6 +227,14 @@ fn judge(tokens: TokenStream) -> Result<Vec<Outcome>, Broken> {
                     return Err(format!(
                         "model `{name}`: generated code does not parse: {err}"
                     ));
+                }
+                // a number Display wrote (`inf`, `NaN`) parses as a name and does not compile
+                if let Some(word) = generated
+                    .code
+                    .split(|c: char| !c.is_alphanumeric() && c != '_')
+                    .find(|w| matches!(*w, "inf" | "NaN"))
+                {
+                    return Err(format!("model `{name}`: generated code names `{word}`"));
                 }
                 outcomes.push(Outcome::Generated);
             }

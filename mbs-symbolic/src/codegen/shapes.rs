@@ -3,6 +3,7 @@
 //! the default parameters.
 
 use crate::expr::SliceEnv;
+use crate::expr::emit::literal as number;
 use crate::mech::system::{Geometry, IDENTITY, ShapeDef, System};
 
 /// Thinnest side of a default box, relative to its longest: a slender body is drawn as a bar
@@ -60,29 +61,39 @@ pub fn default_shape(frame: usize, m: f64, tensor: [f64; 6]) -> Option<ShapeDef>
         color: None,
         declared: false,
     };
-    // a point mass (or nearly): a sphere of water's density
-    let radius = (3.0 * m / (4.0 * std::f64::consts::PI * POINT_MASS_DENSITY)).cbrt();
+    // a point mass (or nearly): a sphere of water's density (the cube roots apart, so that a
+    // mass near f64::MAX gives a radius rather than overflow to ∞)
+    let radius = m.cbrt() * (3.0 / (4.0 * std::f64::consts::PI * POINT_MASS_DENSITY)).cbrt();
     if longest < 1e-3 * radius {
-        return Some(shape(Geometry::Sphere(radius), IDENTITY));
+        return radius
+            .is_finite()
+            .then(|| shape(Geometry::Sphere(radius), IDENTITY));
     }
     for s in &mut size {
         *s = s.max(MIN_ASPECT * longest);
     }
-    Some(shape(Geometry::Box(size), axes))
+    // a size that overflowed (moments near f64::MAX over a small mass): no shape to draw
+    size.iter()
+        .all(|x| x.is_finite())
+        .then(|| shape(Geometry::Box(size), axes))
 }
 
 /// `&[::mbs::ShapeInfo { … }, …]`, the Rust text of the list.
 pub fn literal(shapes: &[ShapeDef]) -> String {
-    let v3 = |v: [f64; 3]| format!("[{:?}, {:?}, {:?}]", v[0], v[1], v[2]);
+    let v3 = |v: [f64; 3]| format!("[{}, {}, {}]", number(v[0]), number(v[1]), number(v[2]));
     let items: Vec<String> = shapes
         .iter()
         .map(|s| {
             let kind = match s.geometry {
                 Geometry::Box(size) => format!("Box {{ size: {} }}", v3(size)),
                 Geometry::Cylinder(r, l, axis) => {
-                    format!("Cylinder {{ radius: {r:?}, length: {l:?}, axis: {axis} }}")
+                    format!(
+                        "Cylinder {{ radius: {}, length: {}, axis: {axis} }}",
+                        number(r),
+                        number(l)
+                    )
                 }
-                Geometry::Sphere(r) => format!("Sphere {{ radius: {r:?} }}"),
+                Geometry::Sphere(r) => format!("Sphere {{ radius: {} }}", number(r)),
                 Geometry::Line(a, b) => format!("Line {{ from: {}, to: {} }}", v3(a), v3(b)),
             };
             format!(
@@ -113,6 +124,18 @@ mod tests {
     fn geometry(m: f64, t: [f64; 6]) -> (Geometry, [[f64; 3]; 3]) {
         let s = default_shape(0, m, t).unwrap();
         (s.geometry, s.rotation)
+    }
+
+    #[test]
+    fn a_mass_near_the_largest_number_is_drawn_finite_or_not_at_all() {
+        let (Geometry::Sphere(r), _) = geometry(1e308, [0.0; 6]) else {
+            panic!()
+        };
+        assert!(r.is_finite() && r > 0.0, "{r}");
+        // moments near f64::MAX over a small mass: sides that overflow, no shape
+        assert!(default_shape(0, 1e-300, [1e308, 1e308, 1e308, 0.0, 0.0, 0.0]).is_none());
+        let text = literal(&[default_shape(0, 1e308, [0.0; 6]).unwrap()]);
+        assert!(!text.contains("inf") && !text.contains("NaN"), "{text}");
     }
 
     #[test]

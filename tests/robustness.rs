@@ -67,6 +67,9 @@ fn check_failure(tag: &str, e: &SimError) -> Result<(), String> {
     if text.trim().is_empty() {
         return Err(format!("{tag}: an empty message"));
     }
+    if let Failure::InvalidOption { name: "", .. } = &e.kind {
+        return Err(format!("{tag}: an invalid option without a name: {text}"));
+    }
     let longest = sweeps::longest_number(&text);
     if longest > 12 {
         return Err(format!("{tag}: a number of {longest} digits: {text}"));
@@ -117,6 +120,25 @@ fn record(
     }
 }
 
+/// Runs `model` under `scheme` and `o`, its panic caught, and records how it ended.
+fn run_and_record<M: Model + 'static>(
+    tag: &str,
+    model: M,
+    scheme: Scheme,
+    o: Options,
+    kinds: &mut Kinds,
+    problems: &mut Vec<String>,
+) {
+    let r = catch_unwind(AssertUnwindSafe(|| simulate(model, scheme, o)));
+    record(
+        tag,
+        r.map(|r| r.map(|(tr, _)| tr)),
+        "finished",
+        kinds,
+        problems,
+    );
+}
+
 /// Runs the sweep on one model (`make` makes a copy for each run); returns the runs, the
 /// failures by kind and the problems.
 fn sweep<M: Model + 'static>(
@@ -138,16 +160,8 @@ fn sweep<M: Model + 'static>(
                 };
                 o.constraints.method = method;
                 let tag = format!("{name} {} {method:?} {:?}", scheme.name(), o.step);
-                let model = make();
                 runs += 1;
-                let r = catch_unwind(AssertUnwindSafe(|| simulate(model, scheme, o)));
-                record(
-                    &tag,
-                    r.map(|r| r.map(|(tr, _)| tr)),
-                    "finished",
-                    kinds,
-                    problems,
-                );
+                run_and_record(&tag, make(), scheme, o, kinds, problems);
             }
         }
     }
@@ -368,16 +382,8 @@ fn every_parameter_at_its_edges_is_refused_or_runs_typed() {
                         ..Options::adaptive(0.5, 1e-6)
                     };
                     let tag = format!("{tag} {}", scheme.name());
-                    let m = m.clone();
                     runs += 1;
-                    let r = catch_unwind(AssertUnwindSafe(|| simulate(m, scheme, o)));
-                    record(
-                        &tag,
-                        r.map(|r| r.map(|(tr, _)| tr)),
-                        "finished",
-                        kinds,
-                        problems,
-                    );
+                    run_and_record(&tag, m.clone(), scheme, o, kinds, problems);
                 }
             }
         }
@@ -534,21 +540,7 @@ fn every_option_at_its_edges_is_refused_or_runs_typed() {
                     }
                     let tag = format!("{name} {} {field} = {x:e}", scheme.name());
                     runs += 1;
-                    let m = model.clone();
-                    let r = catch_unwind(AssertUnwindSafe(|| simulate(m, scheme, o)));
-                    if let Ok(Err(e)) = &r
-                        && let Failure::InvalidOption { name, .. } = &e.kind
-                        && name.is_empty()
-                    {
-                        problems.push(format!("{tag}: an invalid option without a name: {e}"));
-                    }
-                    record(
-                        &tag,
-                        r.map(|r| r.map(|(tr, _)| tr)),
-                        "finished",
-                        kinds,
-                        problems,
-                    );
+                    run_and_record(&tag, model.clone(), scheme, o, kinds, problems);
                 }
             }
         }

@@ -6,8 +6,11 @@ use mbs_models::{dpend::DoublePendulum, seed2dof::Seed2dof};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
+#[path = "common/lcg.rs"]
+mod lcg;
 #[path = "common/sweeps.rs"]
 mod sweeps;
+use lcg::Lcg;
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("mbs-sweep-{name}-{}", std::process::id()));
@@ -933,16 +936,6 @@ fn the_folder_s_plan_records_the_start() {
 /// first step that refuses, never a panic.
 #[test]
 fn changed_plans_are_refused_typed_or_run() {
-    struct Lcg(u64);
-    impl Lcg {
-        fn below(&mut self, n: usize) -> usize {
-            self.0 = self
-                .0
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((self.0 >> 33) % n as u64) as usize
-        }
-    }
     const VALUES: [&str; 14] = [
         "0",
         "-1",

@@ -11,8 +11,11 @@
 
 #[path = "common/blessed.rs"]
 mod blessed;
+#[path = "common/lcg.rs"]
+mod lcg;
 #[path = "common/sweeps.rs"]
 mod sweeps;
+use lcg::Lcg;
 
 mod imported {
     include!("urdf/models.rs");
@@ -592,17 +595,6 @@ fn command_line_prints_the_block() {
 fn changed_descriptions_import_or_fail_typed_and_what_imports_expands() {
     use mbs_symbolic::expand::{Expansion, expand_models, multibody_blocks};
     use std::collections::BTreeMap;
-    /// A linear congruential generator: the same mutants on every run.
-    struct Lcg(u64);
-    impl Lcg {
-        fn below(&mut self, n: usize) -> usize {
-            self.0 = self
-                .0
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((self.0 >> 33) % n as u64) as usize
-        }
-    }
     const VALUES: [&str; 16] = [
         "",
         "nan",

@@ -10,8 +10,9 @@
 //! into more errors). The tokens of `///` comments are left alone: no slip reaches them.
 //!
 //! `cargo test --release -p mbs-symbolic --test mutations -- --nocapture` prints the count of
-//! each outcome per model; `MUTATION_SECONDS=60` (seconds of expansion per block, 6 by
-//! default) sweeps deeper.
+//! each outcome per model; `MUTATION_SCALE=10` sweeps ten times as many mutants of each
+//! model (at most 250 a block at the default scale), `MUTANTS_CRATE=dir` writes those that generate into a crate
+//! to compile.
 
 use mbs_symbolic::expand::{Expansion, expand_models, multibody_blocks};
 use proc_macro2::{Delimiter, Group, Ident, Punct, Spacing, Span, TokenStream, TokenTree};
@@ -277,6 +278,29 @@ fn model_files() -> Vec<PathBuf> {
     files
 }
 
+/// A crate of the mutants that generate, each block in a module of its own, to compile them
+/// (`MUTANTS_CRATE=dir cargo test --release -p mbs-symbolic --test mutations`, then `cargo
+/// build --release --manifest-path dir/Cargo.toml`): what parses may still not compile.
+fn write_crate(dir: &Path, generated: &[(String, String)]) {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let root = root.canonicalize().expect("the repository");
+    std::fs::create_dir_all(dir.join("src")).expect("the crate's folder");
+    let manifest = format!(
+        "[package]\nname = \"mbs-mutants\"\nversion = \"0.0.0\"\nedition = \"2024\"\npublish = false\n\n\
+         [dependencies]\nmbs = {{ path = {:?} }}\n\n[workspace]\n",
+        root.display().to_string()
+    );
+    std::fs::write(dir.join("Cargo.toml"), manifest).expect("Cargo.toml");
+    let mut lib = String::from("#![allow(dead_code, unused)]\n");
+    for (i, (what, tokens)) in generated.iter().enumerate() {
+        lib += &format!(
+            "// {}\npub mod m{i} {{ mbs::multibody! {{ {tokens} }} }}\n",
+            what.replace('\n', " ")
+        );
+    }
+    std::fs::write(dir.join("src/lib.rs"), lib).expect("lib.rs");
+}
+
 /// Longest a mutant may take before the sweep calls it a hang.
 const HANG: Duration = Duration::from_secs(120);
 
@@ -284,14 +308,16 @@ const HANG: Duration = Duration::from_secs(120);
 fn typing_slips_never_panic_or_hang_the_generator_and_are_named() {
     // the generator's panics are what this test looks for: silence the default hook's text
     std::panic::set_hook(Box::new(|_| {}));
-    // about this many seconds of expansion per block: `MUTATION_SECONDS=60` sweeps deeper
-    let seconds: f64 = std::env::var("MUTATION_SECONDS")
+    // `MUTATION_SCALE=10` sweeps ten times as many mutants of each model
+    let scale: f64 = std::env::var("MUTATION_SCALE")
         .ok()
         .and_then(|s| s.parse().ok())
-        .unwrap_or(6.0);
+        .unwrap_or(1.0);
     let mut broken: Vec<String> = Vec::new();
     let mut total = 0usize;
     let mut outcomes = Vec::new();
+    // the mutants that generate, (what changed, tokens), for `MUTANTS_CRATE`
+    let mut generated: Vec<(String, String)> = Vec::new();
     for file in model_files() {
         let text = std::fs::read_to_string(&file).expect("a model file");
         let Ok(parsed) = syn::parse_file(&text) else {
@@ -311,9 +337,12 @@ fn typing_slips_never_panic_or_hang_the_generator_and_are_named() {
                 matches!(&base, Ok(o) if o.iter().all(|&x| x == Outcome::Generated)),
                 "{name} block {b} does not expand: {base:?}"
             );
-            let count = (seconds / took.as_secs_f64().max(0.01)).clamp(4.0, 400.0) as usize;
             let mut all = Vec::new();
             leaves(&block, &mut all);
+            // fewer mutants of a larger model, whose expansion takes longer: the same mutants
+            // on every machine (a count from the time measured would not be)
+            let count = (scale * 4e7 / (all.len() as f64).powi(2))
+                .clamp(4.0, 250.0 * scale.max(1.0)) as usize;
             let names: Vec<String> = all
                 .iter()
                 .filter_map(|t| match t {
@@ -359,6 +388,9 @@ fn typing_slips_never_panic_or_hang_the_generator_and_are_named() {
                 });
                 match rx.recv_timeout(HANG) {
                     Ok(Ok(Ok(outcomes))) => {
+                        if outcomes.iter().all(|&o| o == Outcome::Generated) {
+                            generated.push((what.clone(), tokens.to_string()));
+                        }
                         for o in outcomes {
                             *tally.entry(o).or_default() += 1;
                         }
@@ -382,12 +414,17 @@ fn typing_slips_never_panic_or_hang_the_generator_and_are_named() {
             total += lexed;
             outcomes.extend(tally.clone());
             println!(
-                "{name:<18} block {b}: {lexed:>3} mutants ({:.2} s unchanged): {tally:?}",
+                "{name:<18} block {b}: {lexed:>3} mutants of {} leaves ({:.2} s unchanged): {tally:?}",
+                all.len(),
                 took.as_secs_f64()
             );
         }
     }
     let _ = std::panic::take_hook();
+    if let Ok(dir) = std::env::var("MUTANTS_CRATE") {
+        write_crate(Path::new(&dir), &generated);
+        println!("{} mutants that generate written to {dir}", generated.len());
+    }
     let mut sum = std::collections::BTreeMap::<Outcome, usize>::new();
     for (o, n) in &outcomes {
         *sum.entry(*o).or_default() += n;

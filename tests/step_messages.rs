@@ -704,3 +704,35 @@ fn a_step_collapsing_at_a_jump_in_the_forces_says_so() {
         assert!(e.to_string().contains("jump"), "{e}");
     }
 }
+
+/// A mass matrix singular at the start because of a parameter names it: a bar of no length
+/// stacks the Cartesian pendulum's hinges on its centre, where its angle moves no mass.
+#[test]
+fn a_mass_matrix_made_singular_by_a_parameter_names_it() {
+    use mbs::{Model, Parameters};
+    use mbs_models::dpend_cartesian::DoublePendulumCartesian;
+    let mut model = DoublePendulumCartesian::default();
+    let mut p = model.params().clone();
+    p.set("l", 0.0).unwrap();
+    model.set_params(p).unwrap();
+    let e = simulate(model, Scheme::Dopri5, Options::adaptive(0.2, 1e-6)).unwrap_err();
+    let msg = e.kind.to_string();
+    println!("{msg}");
+    assert!(matches!(e.kind, Failure::SingularMatrix { .. }), "{msg}");
+    assert!(
+        msg.contains("with `l` at its default 1 rather than 0 M is regular at the start: check that parameter"),
+        "{msg}"
+    );
+    // at the defaults, a singular M is the coordinates' doing: nothing is added
+    let e = simulate(
+        DoublePendulumCartesian::default(),
+        Scheme::Dopri5,
+        Options {
+            q0: Some(vec![0.0; 6]),
+            ..Options::adaptive(0.2, 1e-6)
+        },
+    );
+    if let Err(e) = e {
+        assert!(!e.kind.to_string().contains("default"), "{e}");
+    }
+}

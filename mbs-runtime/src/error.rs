@@ -408,13 +408,16 @@ pub enum Failure {
         fixed: bool,
     },
     #[error(
-        "{matrix} is singular (rcond ≈ {rcond:.1e}){}",
+        "{matrix} is singular (rcond ≈ {rcond:.1e}){}{cause}",
         if coordinates.is_empty() { String::new() } else { format!(" near coordinates {}", coordinates.join(", ")) }
     )]
     SingularMatrix {
         matrix: &'static str,
         rcond: f64,
         coordinates: Vec<String>,
+        /// at the start of a run, the parameters that make M regular when set back to their
+        /// defaults alone ("; with `l` at its default 1 rather than 0 …"); empty otherwise
+        cause: String,
     },
     #[error(
         "the coordinates reach a singular configuration at {coordinate} = {value:.6} (Euler angles at gimbal lock, joint axes lining up, a coordinate that stops moving mass): the mass matrix is nearly singular along {} (a pivot of its factorisation fell to {ratio:.1e} of its start value, below singularity_tol = {tolerance:.0e}); describe this motion with other coordinates",

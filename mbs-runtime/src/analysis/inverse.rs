@@ -427,6 +427,7 @@ impl<'a> Actuation<'a> {
                 matrix: "[S Bᵀ]: B over the unactuated coordinates (the actuated coordinates cannot drive the mechanism here)",
                 rcond: s.rcond,
                 coordinates: self.unactuated.iter().map(|&i| info.dof_label(i)).collect(),
+                cause: String::new(),
             }
             .into());
         }

@@ -163,6 +163,7 @@ fn state_space(
         matrix,
         rcond: s.rcond,
         coordinates: vec![label(s.column)],
+        cause: String::new(),
     })?;
     let mut a = DMatrix::zeros(2 * n, 2 * n);
     let mut b = DMatrix::zeros(2 * n, nu);
@@ -264,6 +265,7 @@ fn linearize_in_chart<M: Model>(
         matrix: "the mass matrix M",
         rcond: s.rcond,
         coordinates: vec![info.dof_label(s.column)],
+        cause: String::new(),
     })?;
     let exact = match how {
         IterationMatrix::Exact => true,
@@ -369,6 +371,7 @@ fn linearize_in_chart<M: Model>(
             matrix: "B over the dependent coordinates",
             rcond: 0.0,
             coordinates: part.dep.iter().map(|&i| info.dof_label(i)).collect(),
+            cause: String::new(),
         })
     })?;
 

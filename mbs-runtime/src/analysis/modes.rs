@@ -190,6 +190,7 @@ pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, A
                 matrix,
                 rcond: 0.0,
                 coordinates: Vec::new(),
+                cause: String::new(),
             }
             .into()
         };

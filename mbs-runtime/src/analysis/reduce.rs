@@ -116,6 +116,7 @@ pub(super) fn nearly_dependent(b: &DMatrix<f64>, names: &[&str]) -> Failure {
                     .iter()
                     .map(|&i| format!("constraint `{}`", names.get(i).copied().unwrap_or("?")))
                     .collect(),
+                cause: String::new(),
             }
         }
     }
@@ -291,6 +292,7 @@ pub(super) fn index1(
                 matrix: "B M⁻¹ Bᵀ",
                 rcond: 0.0,
                 coordinates: Vec::new(),
+                cause: String::new(),
             })
     })?;
     let mut lambda: Vec<f64> = (0..nc)

@@ -405,6 +405,7 @@ pub fn pole_sensitivity<M: Model + Clone>(
                 matrix: "λ²M + λC + K (the pole's eigenvectors)",
                 rcond: 0.0,
                 coordinates: Vec::new(),
+                cause: String::new(),
             }
             .into()
         };

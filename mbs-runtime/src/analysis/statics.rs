@@ -474,6 +474,7 @@ fn unconstrained<M: Model>(
                 matrix: "the stiffness K on the free coordinates (no restoring force along some direction, and a damped step along the forces lowers them no further: no equilibrium near this start, or one that needs a coordinate locked)",
                 rcond: s.rcond,
                 coordinates: vec![info.dof_label(free[s.column])],
+                cause: String::new(),
             };
             if !regular {
                 return Err(error.into());
@@ -925,6 +926,7 @@ fn onto_manifold<M: Model>(
                 matrix: "B Bᵀ over the free coordinates",
                 rcond: 0.0,
                 coordinates: Vec::new(),
+                cause: String::new(),
             })?;
         let dq = bf.transpose() * y;
         for (c, &i) in free.iter().enumerate() {
@@ -1038,6 +1040,7 @@ fn singular_reduced<M: Model>(
         matrix: "the reduced stiffness Nᵀ(K − ∂(Bᵀλ)/∂q)N on the constraint manifold",
         rcond,
         coordinates,
+        cause: String::new(),
     }
     .into())
 }

@@ -598,6 +598,7 @@ impl Constrained {
             matrix: PARTITION_MATRIX,
             rcond: e.rcond,
             coordinates: vec![self.dof_labels[self.dep[e.column.min(self.dep.len() - 1)]].clone()],
+            cause: String::new(),
         }
     }
 

@@ -1033,37 +1033,34 @@ fn initial_state(problem: &mut Problem, options: &Options, cur: &mut State) -> R
     Ok(())
 }
 
-/// A start, or a first step of size `h` (0 for the start), that is not finite, with what the
-/// parameters have to do with it: those that, set back to their default alone, make it finite
-/// (the initial state, or the one the options give, M and h there, and for a step the state a
-/// Taylor step of that size reaches, q + h qd + h²/2 qdd, and M and h there), or that they
-/// are all at their defaults, so that it is an expression of the model (or the state given)
-/// that is not defined there. Other failures unchanged.
+/// A start, or a first step of size `step` (0 for the start), that is not finite, or a mass
+/// matrix singular at the start, with what the parameters have to do with it: those that,
+/// set back to their default alone, make it finite (the initial state, or the one the options
+/// give, M and h there, and for a step the state a Taylor step of that size reaches,
+/// q + h qd + h²/2 qdd, and M and h there) or M regular (its Cholesky factorisation), or that
+/// they are all at their defaults, so that it is an expression of the model (or the state
+/// given) that is not defined there. Other failures unchanged.
 fn with_parameters_blamed(
     e: Failure,
     problem: &mut Problem,
     options: &Options,
     step: f64,
 ) -> Failure {
-    let Failure::NonFinite {
-        quantity,
-        coordinate,
-        cause,
-    } = e
-    else {
+    let singular_mass = matches!(
+        &e,
+        Failure::SingularMatrix { matrix: "the mass matrix M", cause, .. } if cause.is_empty() && step == 0.0
+    );
+    let non_finite = matches!(
+        &e,
+        Failure::NonFinite { quantity, cause, .. } if cause.is_empty() && *quantity != "input"
+    );
+    if !singular_mass && !non_finite {
         return e;
-    };
-    if !cause.is_empty() || quantity == "input" {
-        return Failure::NonFinite {
-            quantity,
-            coordinate,
-            cause,
-        };
     }
     let n = problem.model.nq();
     let u = problem.held.clone();
     let t0 = options.t0;
-    let mut finite_start = |m: &dyn ErasedModel| {
+    let mut holds = |m: &dyn ErasedModel| {
         let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
         let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
         m.initial_state(&mut q, &mut qd);
@@ -1076,6 +1073,9 @@ fn with_parameters_blamed(
         let (mut mass, mut h) = (vec![0.0; n * n], vec![0.0; n]);
         m.dynamics(t0, &q, &qd, &u, &mut mass, &mut h);
         let mut ok = finite(&q) && finite(&qd) && finite(&mass) && finite(&h);
+        if ok && singular_mass {
+            ok = crate::linalg::cholesky(&mut mass, n).is_ok();
+        }
         if ok && step > 0.0 {
             let (mut qdd, mut pivots) = (vec![0.0; n], vec![0.0; n]);
             m.forward_dynamics(t0, &q, &qd, &u, &mut qdd, &mut pivots);
@@ -1089,13 +1089,18 @@ fn with_parameters_blamed(
         // an evaluation that failed in a model's Rust efforts left its failure to be taken
         ok && m.take_failure().is_none()
     };
-    let (found, all_default) = problem.model.defaults_for_which(&mut finite_start);
-    let what = if step > 0.0 {
+    let (found, all_default) = problem.model.defaults_for_which(&mut holds);
+    let what = match (singular_mass, step > 0.0) {
+        (true, _) => "M is regular at the start",
+        (false, true) => "a first step of that size is finite",
+        (false, false) => "the start is finite",
+    };
+    let at = if step > 0.0 {
         "a first step of that size"
     } else {
         "the start"
     };
-    let cause = if !found.is_empty() {
+    let text = if !found.is_empty() {
         let named: Vec<String> = found
             .iter()
             .map(|(name, value, default)| {
@@ -1107,7 +1112,7 @@ fn with_parameters_blamed(
             })
             .collect();
         format!(
-            "; with {} {what} is finite: check {}",
+            "; with {} {what}: check {}",
             named.join(", or with "),
             if found.len() == 1 {
                 "that parameter"
@@ -1115,21 +1120,43 @@ fn with_parameters_blamed(
                 "those parameters"
             }
         )
+    } else if singular_mass {
+        // a singular M with the parameters at their defaults is the coordinates' doing:
+        // the failure's own text says so
+        String::new()
     } else if all_default && (options.q0.is_some() || options.qd0.is_some()) {
         format!(
-            "; every parameter is at its default: the start given in Options::q0 or qd0 makes {what} not finite, or an expression of the model is not defined there (a square root of a negative, a division by zero)"
+            "; every parameter is at its default: the start given in Options::q0 or qd0 makes {at} not finite, or an expression of the model is not defined there (a square root of a negative, a division by zero)"
         )
     } else if all_default {
         format!(
-            "; every parameter is at its default: an expression of the model is not defined at {what} (a square root of a negative, a division by zero)"
+            "; every parameter is at its default: an expression of the model is not defined at {at} (a square root of a negative, a division by zero)"
         )
     } else {
         String::new()
     };
-    Failure::NonFinite {
-        quantity,
-        coordinate,
-        cause,
+    match e {
+        Failure::NonFinite {
+            quantity,
+            coordinate,
+            ..
+        } => Failure::NonFinite {
+            quantity,
+            coordinate,
+            cause: text,
+        },
+        Failure::SingularMatrix {
+            matrix,
+            rcond,
+            coordinates,
+            ..
+        } => Failure::SingularMatrix {
+            matrix,
+            rcond,
+            coordinates,
+            cause: text,
+        },
+        e => e,
     }
 }
 

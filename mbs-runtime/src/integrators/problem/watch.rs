@@ -26,6 +26,7 @@ impl Problem {
             matrix,
             rcond: s.rcond,
             coordinates: vec![coordinate],
+            cause: String::new(),
         }
     }
 
@@ -68,6 +69,7 @@ impl Problem {
             matrix: "the mass matrix M",
             rcond: s.rcond,
             coordinates,
+            cause: String::new(),
         }
     }
 

@@ -479,3 +479,25 @@ fn every_analysis_at_the_edges_of_the_parameters_returns_finite_results_or_a_typ
     println!("{} calls: {:#?}", tally.calls, tally.kinds);
     assert!(tally.problems.is_empty(), "{}", tally.problems.join("\n"));
 }
+
+/// A linearisation whose mass matrix a parameter made singular names the parameter, as a
+/// run's start does (`tests/step_messages.rs`): bars of no length move no inertia.
+#[test]
+fn a_mass_matrix_made_singular_by_a_parameter_is_named_by_linearize() {
+    use mbs::Parameters;
+    let mut model = dpend::DoublePendulum::default();
+    let mut p = model.params().clone();
+    p.set("l", 0.0).unwrap();
+    model.set_params(p).unwrap();
+    let (mut q, mut qd) = ([0.0; 2], [0.0; 2]);
+    model.initial_state(&mut q, &mut qd);
+    let e = linearize(&model, 0.0, &q, &qd, &[], IterationMatrix::Auto).unwrap_err();
+    let msg = e.to_string();
+    println!("{msg}");
+    assert!(
+        msg.contains(
+            "with `l` at its default 1 rather than 0 M is regular there: check that parameter"
+        ),
+        "{msg}"
+    );
+}

@@ -11,7 +11,7 @@ use std::any::Any;
 
 use crate::charts::Recentring;
 use crate::error::{Failure, ModelError};
-use crate::model::{DifferenceBuffers, Energy, Model, ModelInfo, Parameters, Pose};
+use crate::model::{DifferenceBuffers, Energy, Model, ModelInfo, Pose};
 
 /// [`Model`]'s run-time methods, callable on a trait object, with its constants as methods.
 #[allow(clippy::too_many_arguments)]
@@ -243,28 +243,6 @@ impl<M: Model + 'static> OwnedModel for M {
         &mut self,
         holds: &mut dyn FnMut(&dyn ErasedModel) -> bool,
     ) -> (Vec<(&'static str, f64, f64)>, bool) {
-        let given = self.params().clone();
-        let values = given.values();
-        let defaults = M::Params::default().values();
-        let mut found = Vec::new();
-        for (k, name) in M::Params::NAMES.iter().enumerate() {
-            if values[k].to_bits() == defaults[k].to_bits() {
-                continue;
-            }
-            let mut p = given.clone();
-            if p.set(name, defaults[k]).is_err() || self.set_params(p).is_err() {
-                continue;
-            }
-            if holds(&*self) {
-                found.push((*name, values[k], defaults[k]));
-            }
-        }
-        // the given parameters were valid: they are again
-        let _ = self.set_params(given);
-        let all_default = values
-            .iter()
-            .zip(&defaults)
-            .all(|(v, d)| v.to_bits() == d.to_bits());
-        (found, all_default)
+        crate::model::defaults_for_which(self, &mut |m: &M| holds(m))
     }
 }

@@ -1096,3 +1096,64 @@ pub trait Model {
         let _ = (joint, r);
     }
 }
+
+/// Each parameter of `model` whose value is not its default, set back to its default alone
+/// (where the parameters stay valid), `holds` asked of the model so changed; the parameters
+/// restored. The `(name, value, default)` of those for which it held, and whether every
+/// parameter was at its default. What a failure at the start of a run, or of an analysis,
+/// names as its cause ([`blamed_parameters`]).
+pub(crate) fn defaults_for_which<M: Model>(
+    model: &mut M,
+    holds: &mut dyn FnMut(&M) -> bool,
+) -> (Vec<(&'static str, f64, f64)>, bool) {
+    let given = model.params().clone();
+    let values = given.values();
+    let defaults = M::Params::default().values();
+    let mut found = Vec::new();
+    for (k, name) in M::Params::NAMES.iter().enumerate() {
+        if values[k].to_bits() == defaults[k].to_bits() {
+            continue;
+        }
+        let mut p = given.clone();
+        if p.set(name, defaults[k]).is_err() || model.set_params(p).is_err() {
+            continue;
+        }
+        if holds(model) {
+            found.push((*name, values[k], defaults[k]));
+        }
+    }
+    // the given parameters were valid: they are again
+    let _ = model.set_params(given);
+    let all_default = values
+        .iter()
+        .zip(&defaults)
+        .all(|(v, d)| v.to_bits() == d.to_bits());
+    (found, all_default)
+}
+
+/// "; with `l` at its default 1 rather than 0 {what}: check that parameter", for the
+/// parameters [`defaults_for_which`] found; empty when it found none.
+pub(crate) fn blamed_parameters(found: &[(&'static str, f64, f64)], what: &str) -> String {
+    if found.is_empty() {
+        return String::new();
+    }
+    let named: Vec<String> = found
+        .iter()
+        .map(|(name, value, default)| {
+            format!(
+                "`{name}` at its default {} rather than {}",
+                crate::error::short(*default),
+                crate::error::short(*value)
+            )
+        })
+        .collect();
+    format!(
+        "; with {} {what}: check {}",
+        named.join(", or with "),
+        if found.len() == 1 {
+            "that parameter"
+        } else {
+            "those parameters"
+        }
+    )
+}

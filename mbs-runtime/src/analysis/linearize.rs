@@ -234,14 +234,44 @@ pub fn linearize<M: Model + Clone>(
         }
     }
     if model.info().rotation_joints.is_empty() {
-        return linearize_in_chart(model, t, q, qd, u, how);
+        return linearize_in_chart(model, t, q, qd, u, how)
+            .map_err(|e| mass_blamed(e, model, t, q));
     }
     let mut centred = model.clone();
     let (mut q, mut qd) = (q.to_vec(), qd.to_vec());
     crate::charts::recentre(&mut centred, &mut q, &mut qd, &[]);
-    let mut lin = linearize_in_chart(&centred, t, &q, &qd, u, how)?;
+    let mut lin = linearize_in_chart(&centred, t, &q, &qd, u, how)
+        .map_err(|e| mass_blamed(e, &centred, t, &q))?;
     lin.charts = crate::charts::charts_of(&centred);
     Ok(lin)
+}
+
+/// A mass matrix singular at (t, q), with the parameters that, set back to their default
+/// alone, make it regular there (as a run's start names them); other errors unchanged.
+fn mass_blamed<M: Model + Clone>(e: AnalysisError, model: &M, t: f64, q: &[f64]) -> AnalysisError {
+    let AnalysisError::Failure(Failure::SingularMatrix {
+        matrix: matrix @ "the mass matrix M",
+        rcond,
+        coordinates,
+        cause,
+    }) = e
+    else {
+        return e;
+    };
+    let n = M::NQ;
+    let mut copy = model.clone();
+    let (found, _) = crate::model::defaults_for_which(&mut copy, &mut |m: &M| {
+        let mut mass = vec![0.0; n * n];
+        m.mass_matrix(t, q, &mut mass);
+        mass.iter().all(|x| x.is_finite()) && cholesky(&mut mass, n).is_ok()
+    });
+    let blamed = crate::model::blamed_parameters(&found, "M is regular there");
+    AnalysisError::Failure(Failure::SingularMatrix {
+        matrix,
+        rcond,
+        coordinates,
+        cause: cause + &blamed,
+    })
 }
 
 /// [`linearize`] in the model's charts, the inputs checked.

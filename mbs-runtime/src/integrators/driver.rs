@@ -13,7 +13,7 @@ use super::stepper::{Attempt, Control, Step, Stepper};
 use super::{Integrator, State};
 use crate::charts::{self, Recentring};
 use crate::erased::{ErasedModel, OwnedModel};
-use crate::error::{Failure, HeldMost, OutOfSteps, short};
+use crate::error::{Failure, HeldMost, OutOfSteps};
 use crate::model::{Model, Pose};
 use crate::options::{Options, Output, Scheme, StepControl};
 use crate::stats::Stats;
@@ -1101,25 +1101,7 @@ fn with_parameters_blamed(
         "the start"
     };
     let text = if !found.is_empty() {
-        let named: Vec<String> = found
-            .iter()
-            .map(|(name, value, default)| {
-                format!(
-                    "`{name}` at its default {} rather than {}",
-                    short(*default),
-                    short(*value)
-                )
-            })
-            .collect();
-        format!(
-            "; with {} {what}: check {}",
-            named.join(", or with "),
-            if found.len() == 1 {
-                "that parameter"
-            } else {
-                "those parameters"
-            }
-        )
+        crate::model::blamed_parameters(&found, what)
     } else if singular_mass {
         // a singular M with the parameters at their defaults is the coordinates' doing:
         // the failure's own text says so

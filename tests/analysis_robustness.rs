@@ -417,7 +417,7 @@ fn at_parameter_edges<M: Model + Clone + 'static>(name: &str, model: M, tally: &
     let u = vec![0.0; M::NU];
     for (k, &param) in M::Params::NAMES.iter().enumerate() {
         let v = defaults[k];
-        for value in [0.0, -v, 1e-6 * v, 1e6 * v, 1e300, -1e300, 1e-300] {
+        for &value in &sweeps::parameter_edges(v)[..sweeps::PARAMETER_EDGES_FINITE] {
             let mut p = model.params().clone();
             p.set(param, value).expect("a known name");
             let mut m = model.clone();

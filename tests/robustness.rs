@@ -335,18 +335,7 @@ fn every_parameter_at_its_edges_is_refused_or_runs_typed() {
         let defaults = model.params().values();
         for (k, &param) in M::Params::NAMES.iter().enumerate() {
             let v = defaults[k];
-            let edges = [
-                0.0,
-                -v,
-                1e-6 * v,
-                1e6 * v,
-                1e300,
-                -1e300,
-                1e-300,
-                f64::NAN,
-                f64::INFINITY,
-            ];
-            for value in edges {
+            for value in sweeps::parameter_edges(v) {
                 let tag = format!("{name} {param} = {value:e}");
                 let mut p = model.params().clone();
                 if let Err(e) = p.set(param, value) {

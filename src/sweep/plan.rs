@@ -282,7 +282,7 @@ impl RunList {
 }
 
 /// `message` with each number quoted in backticks that is written out longer than a user
-/// would type it written as [`short`] writes it: the TOML reader quotes a value of the wrong
+/// would type it written as `error::short` writes it: the TOML reader quotes a value of the wrong
 /// type as `f64`'s Display writes it, 1e308 as 309 digits.
 fn numbers_shortened(message: &str) -> String {
     let mut parts: Vec<String> = message.split('`').map(str::to_string).collect();

@@ -38,3 +38,23 @@ pub fn silenced<T>(f: impl FnOnce() -> T) -> T {
 pub fn quiet_catch<T>(f: impl FnOnce() -> T) -> std::thread::Result<T> {
     silenced(|| std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)))
 }
+
+/// The values a parameter of default `v` is swept over: zero, its opposite, a millionth and a
+/// million times it, ±1e300, 1e-300, then NaN and infinity (the last two, which `set_params`
+/// refuses, last: the first `PARAMETER_EDGES_FINITE` are finite).
+pub fn parameter_edges(v: f64) -> [f64; 9] {
+    [
+        0.0,
+        -v,
+        1e-6 * v,
+        1e6 * v,
+        1e300,
+        -1e300,
+        1e-300,
+        f64::NAN,
+        f64::INFINITY,
+    ]
+}
+
+/// How many of [`parameter_edges`] are finite (they come first).
+pub const PARAMETER_EDGES_FINITE: usize = 7;

@@ -1009,13 +1009,7 @@ fn validate<M: Model>(
 /// t₀ and the given or declared q₀, qd₀ into `cur`, checked finite.
 fn initial_state(problem: &mut Problem, options: &Options, cur: &mut State) -> Result<(), Failure> {
     cur.t = options.t0;
-    problem.model.initial_state(&mut cur.q, &mut cur.qd);
-    if let Some(q0) = &options.q0 {
-        cur.q.copy_from_slice(q0);
-    }
-    if let Some(qd0) = &options.qd0 {
-        cur.qd.copy_from_slice(qd0);
-    }
+    given_or_declared(problem.model.erased(), options, &mut cur.q, &mut cur.qd);
     problem.check("q0", &cur.q)?;
     problem.check("qd0", &cur.qd)?;
     // a rotation joint that starts near gimbal lock starts in a chart centred on it
@@ -1063,13 +1057,7 @@ fn with_parameters_blamed(
     let mut holds = |m: &dyn ErasedModel| {
         let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
         let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
-        m.initial_state(&mut q, &mut qd);
-        if let Some(q0) = &options.q0 {
-            q.copy_from_slice(q0);
-        }
-        if let Some(qd0) = &options.qd0 {
-            qd.copy_from_slice(qd0);
-        }
+        given_or_declared(m, options, &mut q, &mut qd);
         let (mut mass, mut h) = (vec![0.0; n * n], vec![0.0; n]);
         m.dynamics(t0, &q, &qd, &u, &mut mass, &mut h);
         let mut ok = finite(&q) && finite(&qd) && finite(&mass) && finite(&h);
@@ -1117,28 +1105,21 @@ fn with_parameters_blamed(
     } else {
         String::new()
     };
-    match e {
-        Failure::NonFinite {
-            quantity,
-            coordinate,
-            ..
-        } => Failure::NonFinite {
-            quantity,
-            coordinate,
-            cause: text,
-        },
-        Failure::SingularMatrix {
-            matrix,
-            rcond,
-            coordinates,
-            ..
-        } => Failure::SingularMatrix {
-            matrix,
-            rcond,
-            coordinates,
-            cause: text,
-        },
-        e => e,
+    let mut e = e;
+    if let Failure::NonFinite { cause, .. } | Failure::SingularMatrix { cause, .. } = &mut e {
+        *cause = text;
+    }
+    e
+}
+
+/// The start's q₀ and qd₀: those `options` give, else those `m` declares.
+fn given_or_declared(m: &dyn ErasedModel, options: &Options, q: &mut [f64], qd: &mut [f64]) {
+    m.initial_state(q, qd);
+    if let Some(q0) = &options.q0 {
+        q.copy_from_slice(q0);
+    }
+    if let Some(qd0) = &options.qd0 {
+        qd.copy_from_slice(qd0);
     }
 }
 

@@ -203,9 +203,7 @@ fn statement_form(word: &str) -> String {
 /// "expected an expression") completed by how its statement is written; a number that does
 /// not parse said so, where Rust's parser of integers said "invalid digit found in string".
 fn explained(e: syn::Error, word: &Option<String>) -> syn::Error {
-    let mut out: Option<syn::Error> = None;
-    for one in e {
-        let m = one.to_string();
+    each_message(e, |m| {
         let m = match m.as_str() {
             "invalid digit found in string"
             | "cannot parse integer from empty string"
@@ -219,19 +217,21 @@ fn explained(e: syn::Error, word: &Option<String>) -> syn::Error {
             && !m.contains("write")
             && !m.contains('…')
             && !m.contains("found `");
-        let new = match word {
-            Some(w) if bare => syn::Error::new(
-                one.span(),
-                format!("{m}: this statement is written {}", statement_form(w)),
+        match word {
+            Some(w) if bare => format!("{m}: this statement is written {}", statement_form(w)),
+            None if bare => format!(
+                "{m}: a statement starts with its keyword (param, let, dof, body, TOG, …) or with an effect's name, such as `gravity(…)`"
             ),
-            None if bare => syn::Error::new(
-                one.span(),
-                format!(
-                    "{m}: a statement starts with its keyword (param, let, dof, body, TOG, …) or with an effect's name, such as `gravity(…)`"
-                ),
-            ),
-            _ => syn::Error::new(one.span(), m),
-        };
+            _ => m,
+        }
+    })
+}
+
+/// `e` with each of its messages rewritten by `f`, at its own span.
+fn each_message(e: syn::Error, f: impl Fn(String) -> String) -> syn::Error {
+    let mut out: Option<syn::Error> = None;
+    for one in e {
+        let new = syn::Error::new(one.span(), f(one.to_string()));
         match &mut out {
             None => out = Some(new),
             Some(o) => o.combine(new),
@@ -245,15 +245,7 @@ fn relabel(e: syn::Error, origin: &repeat::Origin) -> syn::Error {
     if origin.is_none() && !e.to_string().contains(repeat::SEP) {
         return e;
     }
-    let mut out: Option<syn::Error> = None;
-    for one in e {
-        let new = syn::Error::new(one.span(), repeat::with_origin(&one.to_string(), origin));
-        match &mut out {
-            None => out = Some(new),
-            Some(o) => o.combine(new),
-        }
-    }
-    out.expect("an error has at least one message")
+    each_message(e, |m| repeat::with_origin(&m, origin))
 }
 
 fn body_ref(input: ParseStream) -> syn::Result<BodyRef> {

@@ -14,27 +14,13 @@
 //! model (at most 250 a block at the default scale), `MUTANTS_CRATE=dir` writes those that generate into a crate
 //! to compile.
 
+mod common;
+use common::Rng;
 use mbs_symbolic::expand::{Expansion, expand_models, multibody_blocks};
 use proc_macro2::{Delimiter, Group, Ident, Punct, Spacing, Span, TokenStream, TokenTree};
 use std::path::{Path, PathBuf};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
-
-/// A linear congruential generator (Knuth's MMIX constants): the same mutants on every run.
-struct Lcg(u64);
-
-impl Lcg {
-    fn next(&mut self) -> u64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        self.0 >> 33
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n as u64) as usize
-    }
-}
 
 /// Numbers a slip or a bad value puts in place of a literal.
 const NUMBERS: [&str; 10] = [
@@ -150,7 +136,7 @@ fn mutate(ts: TokenStream, counter: &mut usize, target: usize, change: &Change) 
 
 /// A replacement for `leaf`: a number for a number, else a name of the model or of the
 /// language for a name, an operator for an operator.
-fn replacement(leaf: &TokenTree, names: &[String], rng: &mut Lcg) -> String {
+fn replacement(leaf: &TokenTree, names: &[String], rng: &mut Rng) -> String {
     match leaf {
         TokenTree::Literal(_) => NUMBERS[rng.below(NUMBERS.len())].to_string(),
         // an operator mostly for an operator, so that more mutants reach the generator
@@ -350,7 +336,8 @@ fn typing_slips_never_panic_or_hang_the_generator_and_are_named() {
                     _ => None,
                 })
                 .collect();
-            let mut rng = Lcg(0x5eed ^ (total as u64 + 1).wrapping_mul(0x9e37_79b9));
+            // seeded by the mutants before: the same mutants on every run
+            let mut rng = Rng::new(0x5eed ^ total as u64);
             let mut tally = std::collections::BTreeMap::<Outcome, usize>::new();
             let mut lexed = 0usize;
             for _ in 0..count {

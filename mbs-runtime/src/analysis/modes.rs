@@ -4,7 +4,8 @@
 //! that its largest component is 1) named by coordinate, and the modal mass φᴴMφ of that shape.
 //! A real eigenvalue is no oscillation: [`Mode::time_constant`] gives 1/|λ|, and the table
 //! ([`Modes`]' Display) shows it as a real pole, unstable or decaying, with that time constant.
-//! Eigenvalues come from nalgebra's Schur decomposition, eigenvectors from inverse iteration.
+//! Eigenvalues come from nalgebra's Schur decomposition of A scaled and balanced, eigenvectors from
+//! inverse iteration on the balanced A.
 //! First-order states ([`crate::Model::first_order_states`], the extra states of
 //! [`crate::WithEfforts`]) ride as the velocities of coordinates whose positions, their
 //! integrals, nothing reads: each adds an eigenvalue 0 to A that is no mode, left out here,
@@ -77,15 +78,20 @@ const DEFLATIONS: [f64; 6] = [f64::EPSILON, 1e-14, 1e-13, 1e-12, 1e-11, 1e-10];
 /// set to zero, and the eigenvalues are those of a matrix within about that much of A's
 /// largest entry; the threshold used is returned ([`Modes::deflation`]). Past the last, an
 /// error rather than a hang.
-fn eigenvalues(a: &DMatrix<f64>) -> Result<(Vec<nalgebra::Complex<f64>>, f64), AnalysisError> {
+fn eigenvalues(
+    balanced: &DMatrix<f64>,
+    a: &DMatrix<f64>,
+) -> Result<(Vec<nalgebra::Complex<f64>>, f64), AnalysisError> {
     let n = a.nrows();
     let schur = |m: &DMatrix<f64>, eps| nalgebra::linalg::Schur::try_new(m.clone(), eps, 200 * n);
     let v = nalgebra::DVector::from_fn(n, |i, _| 1.0 + (i as f64 * 0.618_034).fract());
     let h = DMatrix::identity(n, n) - (&v * v.transpose()) * (2.0 / v.norm_squared());
-    let reflected = &h * a * &h;
+    // the balanced matrix first, then A itself: balancing can give the iteration a structure
+    // it cycles on (the top on a 40 km rod)
+    let tried = [balanced.clone(), &h * balanced * &h, a.clone(), &h * a * &h];
     for eps in DEFLATIONS {
-        if let Some(s) = schur(a, eps).or_else(|| schur(&reflected, eps)) {
-            return Ok((s.complex_eigenvalues().iter().copied().collect(), eps));
+        if let Some(s) = tried.iter().find_map(|m| schur(m, eps)) {
+            return Ok((block_eigenvalues(&s.unpack().1), eps));
         }
     }
     Err(AnalysisError::EigenvaluesNotFound {
@@ -93,6 +99,48 @@ fn eigenvalues(a: &DMatrix<f64>) -> Result<(Vec<nalgebra::Complex<f64>>, f64), A
         size: n,
         deflation: DEFLATIONS[DEFLATIONS.len() - 1],
     })
+}
+
+/// The eigenvalues of a real Schur form T: its 1 × 1 blocks, and each 2 × 2 block's pair.
+/// nalgebra's `complex_eigenvalues` takes every 2 × 2 block for a complex pair and gave NaN
+/// for a block whose pair is real, which its QR iteration leaves where it deflates such a
+/// block undivided (the top on a 40 km rod: A's entries of 1e-4 and 1e-11, a real pair near
+/// zero); here the discriminant decides.
+fn block_eigenvalues(t: &DMatrix<f64>) -> Vec<nalgebra::Complex<f64>> {
+    let n = t.nrows();
+    let mut out = Vec::with_capacity(n);
+    let mut m = 0;
+    while m < n {
+        if m + 1 == n || t[(m + 1, m)] == 0.0 {
+            out.push(nalgebra::Complex::new(t[(m, m)], 0.0));
+            m += 1;
+            continue;
+        }
+        let (a, b, c, d) = (t[(m, m)], t[(m, m + 1)], t[(m + 1, m)], t[(m + 1, m + 1)]);
+        let half_trace = 0.5 * (a + d);
+        let half_diff = 0.5 * (a - d);
+        let discriminant = half_diff * half_diff + b * c;
+        if discriminant >= 0.0 {
+            // real: the larger root from the sum without cancellation, the other from the
+            // determinant's product (a d − b c = λ₁ λ₂)
+            let root = discriminant.sqrt();
+            let big = half_trace + root.copysign(half_trace);
+            let det = a * d - b * c;
+            let small = if big != 0.0 {
+                det / big
+            } else {
+                half_trace - root
+            };
+            out.push(nalgebra::Complex::new(big, 0.0));
+            out.push(nalgebra::Complex::new(small, 0.0));
+        } else {
+            let im = (-discriminant).sqrt();
+            out.push(nalgebra::Complex::new(half_trace, im));
+            out.push(nalgebra::Complex::new(half_trace, -im));
+        }
+        m += 2;
+    }
+    out
 }
 
 /// Computes the modes of `lin` whose frequency is within `window` (Hz, inclusive), or all.
@@ -131,8 +179,30 @@ pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, A
     let kept: Vec<usize> = (0..n2).filter(|i| !lin.first_order.contains(i)).collect();
     let a = lin.a.select_rows(&kept).select_columns(&kept);
     let m2 = kept.len();
-    let (mut eig, deflation) = eigenvalues(&a)?;
     let scale = a.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+    // the eigenvalues and shapes are found on A scaled by a power of two to a largest entry
+    // in [1, 2) (exactly: the same digits), λ scaled back: entries near 1e300 overflowed in
+    // the factorisation and the discriminants, and the Schur form's absolute deflation test
+    // (ε² of the scaled entries) is then relative to A's largest entry
+    let largest = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let unit = if largest > 0.0 {
+        largest.log2().floor().exp2()
+    } else {
+        1.0
+    };
+    let a = a / unit;
+    let mut balanced = a.clone();
+    // balanced (Parlett–Reinsch, by powers of two: D⁻¹ A D, the same eigenvalues, the
+    // eigenvectors D w), as LAPACK's dgeev does: a first-order A whose entries span many
+    // decades is far from normal, and its eigenvectors by inverse iteration far less
+    // accurate than the matrix (the top spun at 2e6 rad/s: K/M of 2e10 beside the identity's
+    // 1, a slow pole's shape 9 % off, its components of 3e-5 of the wrong sign)
+    let balance = nalgebra::linalg::balancing::balance_parlett_reinsch(&mut balanced);
+    let (mut eig, deflation) = eigenvalues(&balanced, &a)?;
+    let balanced_scale = unit * balanced.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    for l in eig.iter_mut() {
+        *l *= unit;
+    }
     // A repeated zero eigenvalue (a free body's rigid motions: Jordan blocks, no stiffness and
     // no damping) comes out split by the rounding into a cluster of radius up to about
     // √(deflation·max|A|), as real pairs ±x that the table would call unstable and decaying
@@ -178,58 +248,39 @@ pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, A
         // rounding of λ may be (1000 ε of A's largest entry), not by a part in 10⁹ of that
         // entry: beside a stiff mode (a gear of 1e10/s²) that shift was 10/s, and a mode at
         // 1/s converged to its neighbour at 1.2/s, or to neither
-        let first = (1e-9 * mag).max(1e3 * f64::EPSILON * scale);
-        let mut shift = first;
-        let mut mu = C64::new(re + shift, im + shift);
-        // the factorisation refuses pivots below nε‖A − μI‖, which a fast mode's pivot near its
-        // eigenvalue can be (1e5 rad/s beside 1 rad/s: about 1e-5 of ‖A‖ at a shift of 2e-3):
-        // μ moves off by ten times more each time, and the iterations are counted at the μ
-        // factorised
-        let singular = |matrix| -> AnalysisError {
-            Failure::SingularMatrix {
-                matrix,
-                rcond: 0.0,
-                coordinates: Vec::new(),
-                cause: String::new(),
+        let shift = (1e-9 * mag).max(1e3 * f64::EPSILON * balanced_scale);
+        let mu = C64::new(re + shift, im + shift);
+        let mu_unit = C64::new(mu.re / unit, mu.im / unit);
+        // A − μI nearly singular is what inverse iteration wants: its pivots below ε‖A‖ are
+        // raised to that (as EISPACK's INVIT does) rather than refused. A slow mode beside a
+        // fast one (the top spun at 2e6 rad/s: its poles of 4.4/s and nutation at
+        // 4.7e5/s) leaves a pivot near |λ − μ|, far below nε‖A‖; refused, the shift was moved
+        // off until another eigenvalue was as near, and the mode had no shape
+        let f = lu.matrix_mut();
+        for j in 0..m2 {
+            for i in 0..m2 {
+                let d = if i == j { mu_unit } else { C64::default() };
+                f[i + m2 * j] = C64::new(balanced[(i, j)], 0.0) - d;
             }
-            .into()
-        };
-        let mut factored = false;
-        for _ in 0..10 {
-            let f = lu.matrix_mut();
-            for j in 0..m2 {
-                for i in 0..m2 {
-                    let d = if i == j { mu } else { C64::default() };
-                    f[i + m2 * j] = C64::new(a[(i, j)], 0.0) - d;
+        }
+        lu.factor_for_inverse_iteration()
+            .map_err(|_| -> AnalysisError {
+                Failure::SingularMatrix {
+                    matrix: "A − μI (a mode's shape by inverse iteration)",
+                    rcond: 0.0,
+                    coordinates: Vec::new(),
+                    cause: String::new(),
                 }
-            }
-            if lu.factor().is_ok() {
-                factored = true;
-                break;
-            }
-            shift *= 10.0;
-            mu = C64::new(re + shift, im + shift);
-        }
-        if !factored {
-            return Err(singular("A − μI (a mode's shape by inverse iteration)"));
-        }
-        // each iteration leaves r = |λ − μ| / |λ' − μ| of the nearest other eigenvalue λ' (at
-        // the μ factorised): iterated until r^k is below rounding (at least three, at most
-        // 100: a repeated eigenvalue, r ≈ 1, keeps the start's mix of its eigenvectors, a
-        // valid one)
+                .into()
+            })?;
+        // each iteration leaves r = |λ − μ| / |λ' − μ| of the nearest other eigenvalue λ':
+        // iterated until r^k is below rounding (at least three, at most 100: a repeated
+        // eigenvalue, r ≈ 1, keeps the start's mix of its eigenvectors, a valid one)
         let nearest = (eig.iter().enumerate())
             .filter(|&(j, o)| j != k && (o - lambda).norm() > real_within)
             .map(|(_, o)| (C64::new(o.re, o.im) - mu).abs())
             .fold(f64::INFINITY, f64::min);
         let r = (C64::new(re, im) - mu).abs() / nearest;
-        if shift > first && r >= 0.5 {
-            // moved so far off that another eigenvalue is about as near: its shape would be
-            // this mode's (at the first shift, r ≈ 1 is a repeated eigenvalue's, whose
-            // vectors are all its own)
-            return Err(singular(
-                "A − μI (a mode's shape by inverse iteration: no shift both factorisable and nearer this eigenvalue than the others)",
-            ));
-        }
         let iterations = super::inverse_iterations(r, 100);
         // the start differs from mode to mode, so that two modes of one repeated eigenvalue
         // get two of its eigenvectors, not one twice
@@ -239,18 +290,35 @@ pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, A
                 C64::new(1.0 + 0.1 * i as f64 + 0.3 * turn.sin(), 0.05 * i as f64)
             })
             .collect();
-        for _ in 0..iterations {
+        // then on until the vector, scaled by its largest component, stops changing: r
+        // leaves out eigenvalues within `real_within`, which it takes for one repeated
+        // eigenvalue, and where they are split (the hexapod's legs: −1037.9261/s twice beside
+        // −1037.9278/s) three iterations left a mix of their vectors (a residual of 2e-10)
+        let mut previous = w.clone();
+        for done in 1..=100 {
             lu.solve(&mut w);
-            let nv = w.iter().map(|z| z.abs()).fold(0.0, f64::max);
-            for z in w.iter_mut() {
-                *z = *z / C64::new(nv, 0.0);
+            let big = (0..m2)
+                .max_by(|&i, &j| w[i].abs().total_cmp(&w[j].abs()))
+                .unwrap_or(0);
+            let pivot = w[big];
+            if !(pivot.abs() > 0.0) || !pivot.abs().is_finite() {
+                break;
+            }
+            let mut change = 0.0f64;
+            for (z, p) in w.iter_mut().zip(previous.iter_mut()) {
+                *z = *z / pivot;
+                change = change.max((*z - *p).abs());
+                *p = *z;
+            }
+            if done >= iterations && change <= 1e-14 {
+                break;
             }
         }
         // the whole state, a first-order state's position entry its own amplitude δx (the
         // velocity entry n + i) rather than its integral's
         let mut v = vec![C64::default(); n2];
         for (r, &i) in kept.iter().enumerate() {
-            v[i] = w[r];
+            v[i] = w[r] * C64::new(balance[r], 0.0);
         }
         for &i in &lin.first_order {
             v[i] = v[n + i];
@@ -483,5 +551,47 @@ mod tests {
         assert_eq!(modes.modes[1].time_constant(), Some(1.0 / 5.62));
         assert_eq!(modes.modes[0].time_constant(), None);
         assert_eq!(modes.modes[3].time_constant(), None);
+    }
+
+    /// A 2 × 2 block of a Schur form whose pair is real (left undivided by the iteration) gives
+    /// its two real eigenvalues, a complex block its conjugate pair, 1 × 1 blocks themselves.
+    #[test]
+    fn a_schur_block_with_a_real_pair_gives_real_eigenvalues() {
+        let t = DMatrix::from_row_slice(
+            5,
+            5,
+            &[
+                2.0, 1.0, 0.3, 0.0, 0.1, //
+                4.0, 2.0, 0.2, 0.5, 0.0, //
+                0.0, 0.0, -1.0, 3.0, 0.0, //
+                0.0, 0.0, -3.0, -1.0, 0.0, //
+                0.0, 0.0, 0.0, 0.0, 7.0,
+            ],
+        );
+        let got = block_eigenvalues(&t);
+        let want = [
+            (4.0, 0.0),
+            (0.0, 0.0),
+            (-1.0, 3.0),
+            (-1.0, -3.0),
+            (7.0, 0.0),
+        ];
+        assert_eq!(got.len(), want.len());
+        for (g, (re, im)) in got.iter().zip(want) {
+            assert!(
+                (g.re - re).abs() < 1e-15 && (g.im - im).abs() < 1e-15,
+                "{g} against {re} {im}"
+            );
+        }
+        // a tiny real pair beside rounding: the smaller root from the determinant, not lost
+        // to cancellation
+        let t = DMatrix::from_row_slice(2, 2, &[1.0, 1e-10, 1e-10, 0.0]);
+        let got = block_eigenvalues(&t);
+        assert!((got[0].re - 1.0).abs() < 1e-15 && got[0].im == 0.0);
+        assert!(
+            (got[1].re + 1e-20).abs() < 1e-30 && got[1].im == 0.0,
+            "{}",
+            got[1]
+        );
     }
 }

@@ -556,3 +556,51 @@ fn a_mass_matrix_made_singular_by_a_parameter_is_named_by_linearize() {
         "{msg}"
     );
 }
+
+/// Statics beside a stiff spring: the sprung arm with its first spring 10⁶ to 10¹⁰ times
+/// stiffer, whose forces' rounding (k q ε ≈ 1e-9 to 1e-5 N) is above the absolute tolerance of
+/// 1e-9 N. Newton stalls there with its correction at q's own rounding, or with forces
+/// backtracking cannot lower; statics said "no static equilibrium found". It now returns
+/// the equilibrium, which is the spring's deflection under its load: (q₀ − 0.6)·k₁, the
+/// load, is the same for every stiffness. And the poles' sensitivities beside it, whose
+/// inverse iteration refused the small pivot of the slow pole (`λ²M + λC + K is singular`).
+#[test]
+fn statics_beside_a_stiff_spring_converge_at_the_rounding_of_the_forces() {
+    use mbs::Parameters;
+    use mbs_models::sprung_arm::SprungArm;
+    let options = StaticsOptions::default();
+    let mut loads = Vec::new();
+    for k1 in [4e7, 4e9, 4e11] {
+        let mut model = SprungArm::default();
+        let mut p = model.params().clone();
+        p.set("k1", k1).unwrap();
+        model.set_params(p).unwrap();
+        let eq =
+            static_equilibrium(&model, &options).unwrap_or_else(|e| panic!("k1 = {k1:e}: {e}"));
+        let load = (eq.q[0] - 0.6) * k1;
+        println!(
+            "k1 = {k1:e}: q = {:?}, forces left {:.1e}, load (q0 − 0.6) k1 = {load:.6}",
+            eq.q, eq.residual
+        );
+        loads.push((load, eq.q[1]));
+        if k1 <= 4e9 {
+            let s = pole_sensitivity(&model, &eq, &options)
+                .unwrap_or_else(|e| panic!("k1 = {k1:e}: {e}"));
+            assert!(s.repeated.is_empty());
+            assert!(
+                s.dpole_dp
+                    .iter()
+                    .all(|(a, b)| a.is_finite() && b.is_finite())
+            );
+        }
+    }
+    for (load, _) in &loads[1..] {
+        assert!((load / loads[0].0 - 1.0).abs() < 1e-5, "{loads:?}");
+    }
+    // the second joint moves with 1/k₁ too: its steps from 4e7 to 4e9 and from 4e9 to 4e11
+    // in the ratio (1/4e7 − 1/4e9) / (1/4e9 − 1/4e11) = 100 (within the 1.7e-11 rad the
+    // stiffest one's rounding leaves)
+    let ratio = (loads[0].1 - loads[1].1) / (loads[1].1 - loads[2].1);
+    println!("second joint's steps in the ratio {ratio:.2} (100 for 1/k1)");
+    assert!((ratio / 100.0 - 1.0).abs() < 0.1, "{ratio}");
+}

@@ -46,7 +46,9 @@ pub struct StaticsOptions {
     /// indices of coordinates held at their starting value (default none)
     pub locked: Vec<usize>,
     /// converged when every free generalised force (with the constraint forces Bᵀλ) is
-    /// below this (N or N·m), default 1e-9
+    /// below this (N or N·m), default 1e-9; or, where the forces' rounding is above it (stiff
+    /// springs), when Newton's correction moves no free coordinate by more than 100 ε of its
+    /// value (`Equilibrium::residual` then says what was left)
     pub tolerance: f64,
     /// constrained models: and every |Φ_i| below this (m or rad), default 1e-11
     pub constraint_tolerance: f64,
@@ -489,6 +491,7 @@ fn unconstrained<M: Model>(
         lu.solve(&mut delta);
         let size = reduce::worst(&delta).0;
         if small && (within_step(&delta, &q, free, options) || iterations == options.max_iterations)
+            || singular.is_none() && at_rounding(&delta, &q, free)
         {
             break Some(size);
         }
@@ -505,7 +508,7 @@ fn unconstrained<M: Model>(
         if !accepted {
             // the forces cannot fall further: at their rounding when they are within the
             // tolerance, the correction then saying how far q may be
-            if small {
+            if small || singular.is_none() && forces_at_rounding(residual, &k, &q, free) {
                 break Some(size);
             }
             if let Some(error) = singular {
@@ -590,6 +593,36 @@ fn backtrack(mut accept: impl FnMut(f64) -> bool) -> bool {
         alpha *= 0.5;
     }
     false
+}
+
+/// Whether Newton's correction δ (over the free coordinates) moves each of them by no more
+/// than 100 ε of its value, its rounding: the equilibrium is then q to the digits q has,
+/// whatever forces are left. Beside a stiff spring the forces' own rounding is above an
+/// absolute tolerance (the sprung arm with a 4e7 N/m spring stalled at 1.1e-9 N, its
+/// correction 1e-17 of q, and statics said that no equilibrium was found).
+fn at_rounding(delta: &[f64], q: &[f64], free: &[usize]) -> bool {
+    delta
+        .iter()
+        .zip(free)
+        .all(|(d, &i)| d.abs() <= 100.0 * f64::EPSILON * q[i].abs())
+}
+
+/// Whether the free forces left, which backtracking could not lower, are within their
+/// rounding: 100 ε of the largest Σ_j |K_ij| |q_j| over the free coordinates, the size of the
+/// terms a stiff spring's force is the difference of. Its rounding reaches the soft
+/// coordinates too (the sprung arm with a 4e11 N/m spring: 5.3e-6 N·m left on its second
+/// joint, whose correction of 1.7e-11 rad no step could take).
+fn forces_at_rounding(residual: f64, k: &[f64], q: &[f64], free: &[usize]) -> bool {
+    let n = q.len();
+    let size = free
+        .iter()
+        .map(|&i| {
+            free.iter()
+                .map(|&j| (k[i + n * j] * q[j]).abs())
+                .sum::<f64>()
+        })
+        .fold(0.0, f64::max);
+    residual <= 100.0 * f64::EPSILON * size
 }
 
 /// Whether Newton's correction δ (over the free coordinates) moves none of them by more than
@@ -807,6 +840,7 @@ fn constrained<M: Model>(
         if small
             && (within_step(&delta[..nf], &q, free, options)
                 || iterations == options.max_iterations)
+            || singular.is_none() && at_rounding(&delta[..nf], &q, free)
         {
             break Some(size);
         }
@@ -848,7 +882,11 @@ fn constrained<M: Model>(
         });
         if !accepted {
             // the residuals cannot fall further: at their rounding when within the tolerances
-            if small {
+            if small
+                || singular.is_none()
+                    && st.constraint_residual() <= options.constraint_tolerance
+                    && forces_at_rounding(st.force_residual(), &k, &q, free)
+            {
                 break Some(size);
             }
             if let Some(error) = singular {

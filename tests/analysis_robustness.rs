@@ -604,3 +604,25 @@ fn statics_beside_a_stiff_spring_converge_at_the_rounding_of_the_forces() {
     println!("second joint's steps in the ratio {ratio:.2} (100 for 1/k1)");
     assert!((ratio / 100.0 - 1.0).abs() < 0.1, "{ratio}");
 }
+
+/// Statics whose stiffness a parameter made singular names the parameter: without gravity
+/// the four-bar has no restoring force, and from its start (not on its loop) no equilibrium
+/// is found; with gravity one is.
+#[test]
+fn a_stiffness_made_singular_by_a_parameter_is_named_by_statics() {
+    use mbs::Parameters;
+    let mut model = fourbar::FourBar::default();
+    let mut p = model.params().clone();
+    p.set("g", 0.0).unwrap();
+    model.set_params(p).unwrap();
+    let e = static_equilibrium(&model, &StaticsOptions::default()).unwrap_err();
+    let msg = e.to_string();
+    println!("{msg}");
+    assert!(
+        msg.contains("is singular")
+            && msg.contains(
+                "with `g` at its default 9.81 rather than 0 an equilibrium is found from this start: check that parameter"
+            ),
+        "{msg}"
+    );
+}

@@ -376,18 +376,32 @@ pub fn static_equilibrium<M: Model + Clone>(
             constrained(model, options, q, &u, &free)
         }
     };
+    // a singular stiffness names the parameters that, set back to their default alone, let
+    // statics find an equilibrium from the same start (as a run's start names them)
+    let blamed = |mut e: AnalysisError, model: &M, q: &[f64]| {
+        if let AnalysisError::Failure(Failure::SingularMatrix { cause, .. }) = &mut e {
+            let (found, _) = crate::model::defaults_for_which(&mut model.clone(), &mut |m: &M| {
+                solve(m, q.to_vec()).is_ok()
+            });
+            cause.push_str(&crate::model::blamed_parameters(
+                &found,
+                "an equilibrium is found from this start",
+            ));
+        }
+        e
+    };
     if model.info().rotation_joints.is_empty() {
-        return solve(model, q);
+        return solve(model, q.clone()).map_err(|e| blamed(e, model, &q));
     }
     let mut centred = model.clone();
     let (mut q, mut zero) = (q, vec![0.0; n]);
     crate::charts::recentre(&mut centred, &mut q, &mut zero, &options.locked);
     // a failure's q is read in the model's charts, where a retry from it starts
-    let mut eq = solve(&centred, q).map_err(|mut e| {
+    let mut eq = solve(&centred, q.clone()).map_err(|mut e| {
         if let AnalysisError::NotConverged { q, .. } = &mut e {
             crate::charts::reread_angles(&centred, model, q);
         }
-        e
+        blamed(e, &centred, &q)
     })?;
     // a restart or two, each from a chart centred on where Newton went; a restart that fails
     // leaves the equilibrium found (converged, in a chart far from its centre)

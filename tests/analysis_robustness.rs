@@ -626,3 +626,33 @@ fn a_stiffness_made_singular_by_a_parameter_is_named_by_statics() {
         "{msg}"
     );
 }
+
+/// Statics of a heavy machine: the 6-joint arm, its first axis along gravity (neutral about
+/// it), with a million times its mass or its gravity. Its forces' rounding, 2e-15 of its
+/// weight's moments, is then above the absolute tolerance of 1e-9 N·m, and where its
+/// stiffness is singular statics said that no equilibrium was found; the equilibrium is the
+/// light arm's, as a pure scaling of the forces leaves it.
+#[test]
+fn statics_of_a_heavy_machine_converge_at_the_rounding_of_its_forces() {
+    use mbs::Parameters;
+    let equilibrium = |param: &str, value: f64| {
+        let mut model = arm3d_6::Arm3d6::default();
+        let mut p = model.params().clone();
+        p.set(param, value).unwrap();
+        model.set_params(p).unwrap();
+        let eq = static_equilibrium(&model, &StaticsOptions::default())
+            .unwrap_or_else(|e| panic!("{param} = {value:e}: {e}"));
+        println!(
+            "{param} = {value:e}: forces left {:.1e}, {:?}",
+            eq.residual, eq.stability
+        );
+        eq.q
+    };
+    let light = equilibrium("m", 1.0);
+    for (param, value) in [("m", 1e6), ("g", 9.81e6)] {
+        let heavy = equilibrium(param, value);
+        for (a, b) in light.iter().zip(&heavy) {
+            assert!((a - b).abs() < 1e-9, "{param}: {light:?} against {heavy:?}");
+        }
+    }
+}

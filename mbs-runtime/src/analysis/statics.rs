@@ -472,8 +472,10 @@ fn unconstrained<M: Model>(
             lu.factor()
         };
         if let Err(s) = fill(&mut lu, &[]) {
-            // a neutral direction at a point whose forces are within the tolerance
-            if small {
+            // a neutral direction at a point whose forces are within the tolerance, or within
+            // their rounding (the 6-joint arm, its first axis along gravity, 1000 t at its
+            // tip: 2e-9 N·m left, its forces' rounding, where the tolerance is 1e-9)
+            if small || forces_at_rounding(residual, &k, &q, free) {
                 break None;
             }
             // a neutral direction at a point that is not yet an equilibrium (the double
@@ -636,7 +638,7 @@ fn forces_at_rounding(residual: f64, k: &[f64], q: &[f64], free: &[usize]) -> bo
                 .sum::<f64>()
         })
         .fold(0.0, f64::max);
-    residual <= 100.0 * f64::EPSILON * size
+    size.is_finite() && residual <= 100.0 * f64::EPSILON * size
 }
 
 /// Whether Newton's correction δ (over the free coordinates) moves none of them by more than
@@ -826,7 +828,10 @@ fn constrained<M: Model>(
             lu.factor()
         };
         if let Err(s) = fill(&mut lu, &[]) {
-            if small {
+            if small
+                || st.constraint_residual() <= options.constraint_tolerance
+                    && forces_at_rounding(st.force_residual(), &k, &q, free)
+            {
                 break None;
             }
             // a neutral direction on the manifold at a point that is not yet an equilibrium

@@ -463,8 +463,9 @@ fn statics_of_a_loop_start_where_the_reduced_stiffness_is_singular() {
 
 /// Each parameter of the models at the edges of its range, one at a time (zero, its opposite,
 /// 10⁻⁶ and 10⁶ times its default, ±1e300, 1e-300), where `set_params` accepts it: the
-/// linearisation at the declared start, its modes, and the statics from there return finite
-/// results or a typed error, never a panic.
+/// linearisation at the declared start, its modes, the statics from there and, for models
+/// with parameters marked `sensitive`, the sensitivities at the equilibrium found return
+/// finite results or a typed error, never a panic.
 fn at_parameter_edges<M: Model + Clone + 'static>(name: &str, model: M, tally: &mut Tally) {
     use mbs::Parameters;
     let defaults = model.params().values();
@@ -498,11 +499,29 @@ fn at_parameter_edges<M: Model + Clone + 'static>(name: &str, model: M, tally: &
                 });
             }
             let tag = format!("{name} statics {param} = {value:e}");
-            tally.record(
-                &tag,
-                call(|| static_equilibrium(&m, &StaticsOptions::default())),
-                |e| all_finite(&e.q) && e.residual.is_finite() && all_finite(&e.lambda),
-            );
+            let options = StaticsOptions::default();
+            let eq = tally.record(&tag, call(|| static_equilibrium(&m, &options)), |e| {
+                all_finite(&e.q) && e.residual.is_finite() && all_finite(&e.lambda)
+            });
+            // the sensitivities at that equilibrium, for the models with parameters marked
+            // `sensitive`
+            let Some(eq) = eq.filter(|_| !M::SENSITIVE.is_empty()) else {
+                continue;
+            };
+            let tag = format!("{name} static_sensitivity {param} = {value:e}");
+            tally.record(&tag, call(|| static_sensitivity(&m, &eq, &options)), |s| {
+                all_finite(&s.dq_dp) && all_finite(&s.dlambda_dp)
+            });
+            let tag = format!("{name} pole_sensitivity {param} = {value:e}");
+            tally.record(&tag, call(|| pole_sensitivity(&m, &eq, &options)), |s| {
+                let repeated = |i: usize| s.repeated.contains(&(i / s.params.len()));
+                s.modes
+                    .modes
+                    .iter()
+                    .all(|p| p.re.is_finite() && p.im.is_finite())
+                    && (s.dpole_dp.iter().enumerate())
+                        .all(|(i, d)| repeated(i) || d.0.is_finite() && d.1.is_finite())
+            });
         }
     }
 }
@@ -521,6 +540,7 @@ fn every_analysis_at_the_edges_of_the_parameters_returns_finite_results_or_a_typ
         at_parameter_edges("springpend", springpend::SpringPend::default(), t);
         at_parameter_edges("sprung_arm", sprung_arm::SprungArm::default(), t);
         at_parameter_edges("fourbar", fourbar::FourBar::default(), t);
+        at_parameter_edges("sensitive_fourbar", fourbar::SensitiveFourBar::default(), t);
         at_parameter_edges("slidercrank", slidercrank::SliderCrankClosed::default(), t);
         at_parameter_edges("pendulum3", pendulum3::Pendulum3::default(), t);
         at_parameter_edges("fastlink", fastlink::FastLink::default(), t);

@@ -455,7 +455,7 @@ pub enum Failure {
         /// `Options::singularity_tol`
         tolerance: f64,
     },
-    #[error("{quantity} of coordinate {coordinate} is not finite{cause}")]
+    #[error("{}", non_finite_text(quantity, coordinate, cause))]
     NonFinite {
         quantity: &'static str,
         coordinate: String,
@@ -592,6 +592,16 @@ impl Failure {
                 cause: String::new(),
             }),
         }
+    }
+}
+
+/// [`Failure::NonFinite`]'s message: "of coordinate …" only where one is named (a whole
+/// matrix has none).
+fn non_finite_text(quantity: &str, coordinate: &str, cause: &str) -> String {
+    if coordinate.is_empty() {
+        format!("{quantity} is not finite{cause}")
+    } else {
+        format!("{quantity} of coordinate {coordinate} is not finite{cause}")
     }
 }
 

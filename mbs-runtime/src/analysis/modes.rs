@@ -265,10 +265,9 @@ pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, A
         }
         lu.factor_for_inverse_iteration()
             .map_err(|_| -> AnalysisError {
-                Failure::SingularMatrix {
-                    matrix: "A − μI (a mode's shape by inverse iteration)",
-                    rcond: 0.0,
-                    coordinates: Vec::new(),
+                Failure::NonFinite {
+                    quantity: "A − μI (a mode's shape by inverse iteration; its entries overflow)",
+                    coordinate: String::new(),
                     cause: String::new(),
                 }
                 .into()

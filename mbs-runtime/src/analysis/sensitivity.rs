@@ -400,24 +400,23 @@ pub fn pole_sensitivity<M: Model + Clone>(
                 }
             }
         }
-        let singular = || -> AnalysisError {
-            Failure::SingularMatrix {
-                matrix: "λ²M + λC + K (the pole's eigenvectors)",
-                rcond: 0.0,
-                coordinates: Vec::new(),
+        // nearly singular is what inverse iteration wants: small pivots raised to ε‖A‖
+        // rather than refused (a slow pole beside a stiff spring's, the sprung arm with a
+        // 4e9 N/m spring, was refused)
+        let overflow = || -> AnalysisError {
+            Failure::NonFinite {
+                quantity: "λ²M + λC + K at the pole (the pole's eigenvectors; its entries overflow)",
+                coordinate: String::new(),
                 cause: String::new(),
             }
             .into()
         };
-        // nearly singular is what inverse iteration wants: small pivots raised to ε‖A‖
-        // rather than refused (a slow pole beside a stiff spring's, the sprung arm with a
-        // 4e9 N/m spring, was refused)
         a_right
             .factor_for_inverse_iteration()
-            .map_err(|_| singular())?;
+            .map_err(|_| overflow())?;
         a_left
             .factor_for_inverse_iteration()
-            .map_err(|_| singular())?;
+            .map_err(|_| overflow())?;
         let start = |i: usize| C64::new(1.0 + 0.1 * i as f64, 0.05 * i as f64);
         let (mut x, mut y): (Vec<C64>, Vec<C64>) =
             ((0..na).map(start).collect(), (0..na).map(start).collect());

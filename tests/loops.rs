@@ -1093,3 +1093,60 @@ fn a_change_point_of_a_loop_stops_the_run_rather_than_switching_branch() {
         assert!(stopped.contains(&name), "{stopped:?}");
     }
 }
+
+/// A loop a million and a hundred million times larger (the four-bar's links of 100 to
+/// 400 km, or of a 0.4 m one written in micrometres) closes to the rounding of its constraints
+/// where the tolerance of 1e-11 is below it (|Φ| ≈ 1e-10): before, every run stopped at its
+/// first projection, "Newton could not close constraint `close.y`". Its motion is the small
+/// four-bar's by dynamic similarity: lengths × s, time × √s, the crank's start speed / √s give
+/// the same angles at the end, which projection under DOPRI5, Radau5 and BDF and partitioning
+/// under DOPRI5 reproduce to 7e-7 at rtol 1e-9 (asserted 5e-6).
+#[test]
+fn a_loop_in_large_units_closes_at_the_rounding_of_its_constraints() {
+    use mbs::Parameters;
+    let run = |scale: f64, scheme: Scheme, method: ConstraintMethod| {
+        let mut model = fourbar::FourBar::default();
+        let mut p = model.params().clone();
+        for (name, length) in [("l0", 0.4), ("l1", 0.1), ("l2", 0.35), ("l3", 0.3)] {
+            p.set(name, length * scale).unwrap();
+        }
+        model.set_params(p).unwrap();
+        let (mut q0, mut qd0) = ([0.0; 3], [0.0; 3]);
+        model.initial_state(&mut q0, &mut qd0);
+        let mut o = Options {
+            t_end: scale.sqrt(),
+            step: StepControl::from_settings(None, 1e-9, None),
+            q0: Some(q0.to_vec()),
+            qd0: Some(qd0.iter().map(|v| v / scale.sqrt()).collect()),
+            ..Options::default()
+        };
+        o.constraints.method = method;
+        let (tr, stats) = simulate(model, scheme, o)
+            .unwrap_or_else(|e| panic!("× {scale:e}, {} {method:?}: {e}", scheme.name()));
+        (tr.q(tr.len() - 1).to_vec(), stats.steps)
+    };
+    let (small, _) = run(1.0, Scheme::Dopri5, ConstraintMethod::Projection);
+    for scale in [1e6, 1e8] {
+        for (scheme, method) in [
+            (Scheme::Dopri5, ConstraintMethod::Projection),
+            (Scheme::Dopri5, ConstraintMethod::Partitioning),
+            (Scheme::Radau5, ConstraintMethod::Projection),
+            (
+                Scheme::Bdf(Default::default()),
+                ConstraintMethod::Projection,
+            ),
+        ] {
+            let (q, steps) = run(scale, scheme, method);
+            let off = (q.iter().zip(&small)).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            println!(
+                "× {scale:e}, {} {method:?}: {steps} steps, angles off the small four-bar's by {off:.1e}",
+                scheme.name()
+            );
+            assert!(
+                off < 5e-6,
+                "× {scale:e}, {} {method:?}: {off:e}",
+                scheme.name()
+            );
+        }
+    }
+}

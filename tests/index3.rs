@@ -258,5 +258,5 @@ fn work_counters_of_an_index3_run() {
         s.factorizations,
         s.newton_iterations,
     ];
-    assert_eq!(counts, [500, 0, 1, 500, 2238, 502, 738], "{s}");
+    assert_eq!(counts, [500, 0, 1, 500, 2235, 502, 735], "{s}");
 }

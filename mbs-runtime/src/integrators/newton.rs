@@ -51,6 +51,8 @@ use crate::linalg::Lu;
 use crate::options::IterationMatrix;
 
 const INDEX3_MATRIX: &str = "the index-3 iteration matrix [M + γ'C + β'K, −Bᵀ; B, 0]";
+/// What a singular stabilized index-2 iteration matrix is named.
+const INDEX2_MATRIX: &str = "the stabilized index-2 iteration matrix [M + γ'C + β'K, −Bᵀ, 0; B, 0, B B₀ᵀ; B + (β'/γ')Z, 0, (β'/γ')Z B₀ᵀ]";
 
 /// Weights of the convergence test: a correction δq_i counts as δq_i / (atol + rtol·|q_i|),
 /// likewise for velocities; converged when the predicted remaining correction is ≤ κ.
@@ -90,6 +92,10 @@ pub(crate) struct AccelNewton {
     /// index 3: constraints, scaling and tolerance on Φ, and buffers
     nc: usize,
     scaled: bool,
+    /// σ = (largest entry of the iteration matrix' dynamics block) / (largest |B_ij|), at
+    /// the matrix last made: about what a multiplier moves per unit of Φ's residual, which
+    /// sets the rounding floor of λ's corrections
+    sigma: f64,
     tol_phi: f64,
     l0: Vec<f64>,
     phi_max: f64,
@@ -125,6 +131,7 @@ impl AccelNewton {
             n,
             nc: 0,
             scaled: true,
+            sigma: 1.0,
             tol_phi: f64::INFINITY,
             l0: Vec::new(),
             phi_max: 0.0,
@@ -251,7 +258,12 @@ impl AccelNewton {
                 } else {
                     self.index3_matrix(p, t, a, lambda, w).and_then(|_| {
                         p.stats.factorizations += 1;
-                        self.lu.factor().map_err(|s| p.singular(INDEX3_MATRIX, s))
+                        let name = if self.index2 {
+                            INDEX2_MATRIX
+                        } else {
+                            INDEX3_MATRIX
+                        };
+                        self.lu.factor().map_err(|s| p.singular(name, s))
                     })
                 };
                 if let Err(e) = made {
@@ -295,11 +307,19 @@ impl AccelNewton {
                     let qmax = self.q.iter().fold(1.0f64, |m, x| m.max(x.abs()));
                     let vmax = self.v.iter().fold(1.0f64, |m, x| m.max(x.abs()));
                     let fv = 10.0 * f64::EPSILON * vmax;
-                    (10.0 * f64::EPSILON * qmax, fv, fv / gamma)
+                    (
+                        10.0 * f64::EPSILON * qmax,
+                        fv,
+                        fv * self.sigma.max(1.0) / gamma,
+                    )
                 } else if nc > 0 {
                     let qmax = self.q.iter().fold(1.0f64, |m, x| m.max(x.abs()));
                     let fq = 10.0 * f64::EPSILON * qmax;
-                    (fq, fq * gamma / beta, fq / beta)
+                    // λ moves by about σ per unit of Φ/β' (a four-bar in millimetres: σ
+                    // 10⁵–10⁶ times its size in metres, where the floor without σ asked λ for
+                    // digits below rounding and Newton failed at every step size); never
+                    // below the floor without it, which held every model in SI units
+                    (fq, fq * gamma / beta, fq * self.sigma.max(1.0) / beta)
                 } else {
                     (0.0, 0.0, 0.0)
                 };
@@ -453,6 +473,14 @@ impl AccelNewton {
             (false, Some(c)) => &c.b,
             (false, None) => &[],
         };
+        // σ: the dynamics block over the constraints' (a four-bar written in millimetres:
+        // M's entries 10⁹ times, B's 10³ times those in metres)
+        self.sigma = 1.0;
+        let block = (0..n * n).fold(0.0f64, |m, x| m.max((self.mm[x] - beta * self.kc[x]).abs()));
+        let bmax = b.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        if block / bmax > 0.0 && (block / bmax).is_finite() {
+            self.sigma = block / bmax;
+        }
         let s = if self.scaled { 1.0 } else { beta };
         let m = self.lu.matrix_mut();
         m.fill(0.0);

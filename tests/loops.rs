@@ -1101,7 +1101,7 @@ fn a_change_point_of_a_loop_stops_the_run_rather_than_switching_branch() {
 /// four-bar's by dynamic similarity: lengths × s, time × √s, the crank's start speed / √s give
 /// the same angles at the end, which projection under DOPRI5, Radau5 and BDF and partitioning
 /// under DOPRI5 reproduce to 7e-7 at rtol 1e-9 (asserted 5e-6); and in millimetres (× 10³)
-/// gen-α and HHT at index 3.
+/// gen-α, HHT, Radau5 and Radau3 at index 3.
 #[test]
 fn a_loop_in_large_units_closes_at_the_rounding_of_its_constraints() {
     use mbs::Parameters;
@@ -1127,12 +1127,15 @@ fn a_loop_in_large_units_closes_at_the_rounding_of_its_constraints() {
         (tr.q(tr.len() - 1).to_vec(), stats.steps)
     };
     let (small, _) = run(1.0, Scheme::Dopri5, ConstraintMethod::Projection);
-    // in millimetres, the Newmark family at index 3 (its default with numerical damping):
+    // in millimetres, at index 3 (the Newmark family's default with numerical damping):
     // Newton's floor for λ's corrections now follows what λ moves per unit of Φ (σ, the
-    // dynamics block over B's entries); without it Newton failed at h_min at t = 0.035 s
+    // dynamics block, or M, over B's entries); without it Newton failed at h_min, under
+    // gen-α at t = 0.035 s
     for scheme in [
         Scheme::GenAlpha(Default::default()),
         Scheme::Hht(Default::default()),
+        Scheme::Radau5,
+        Scheme::Radau3,
     ] {
         let (q, steps) = run(1e3, scheme, ConstraintMethod::Index3);
         let off = (q.iter().zip(&small)).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));

@@ -671,6 +671,17 @@ impl Stepper for Radau {
             self.scq[r] = (tol.weights.atol + tol.weights.rtol * cur.q[r].abs()).max(floor_q);
             self.scv[r] = (tol.weights.atol + tol.weights.rtol * cur.qd[r].abs()).max(floor_v);
         }
+        // (BM⁻¹Bᵀ)⁻¹ B below, taken as σ = max|M| / max|B| (at the last Jacobian; at least 1,
+        // as it was taken): a four-bar in millimetres has σ 10⁶ times its size in metres, and
+        // without it Newton asked λ for digits below rounding and failed at h_min
+        let sigma = {
+            let ratio = largest(&self.m) / largest(&self.bm);
+            if ratio.is_finite() && ratio > 1.0 {
+                ratio
+            } else {
+                1.0
+            }
+        };
         if self.index2 {
             // λ, an index-2 component, weighted by h as RADAU5 weights them (in Newton and
             // in the error test); neither λ nor the velocities below their rounding noise
@@ -686,7 +697,7 @@ impl Stepper for Radau {
             }
             for r in 0..self.nc {
                 self.scl[r] =
-                    (tol.weights.atol + tol.weights.rtol * cur.lambda[r].abs() + noise) / h;
+                    (tol.weights.atol + tol.weights.rtol * cur.lambda[r].abs() + noise * sigma) / h;
             }
         } else if self.nc > 0 {
             // λ and the velocities to the Newton tolerance, but not below their rounding
@@ -702,7 +713,7 @@ impl Stepper for Radau {
             for r in 0..self.nc {
                 self.scl[r] = tol.weights.atol
                     + tol.weights.rtol * cur.lambda[r].abs()
-                    + noise * self.a2inv / h;
+                    + noise * self.a2inv * sigma / h;
             }
         }
         self.h_try = h;

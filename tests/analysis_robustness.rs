@@ -28,15 +28,6 @@ fn all_finite<'a>(xs: impl IntoIterator<Item = &'a f64>) -> bool {
     xs.into_iter().all(|x| x.is_finite())
 }
 
-/// `model` with one parameter set (a valid value of a known name).
-fn with_param<M: Model>(mut model: M, name: &str, value: f64) -> M {
-    use mbs::Parameters;
-    let mut p = model.params().clone();
-    p.set(name, value).expect("a known parameter");
-    model.set_params(p).expect("a valid value");
-    model
-}
-
 /// What one sweep found: results by kind, and the problems.
 #[derive(Default)]
 struct Tally {
@@ -375,7 +366,7 @@ fn largest_modal_residual(lin: &Linearization, found: &Modes) -> f64 {
 #[test]
 fn a_slow_mode_beside_a_fast_one_gets_its_shape() {
     let found = |param: &str, value: f64| {
-        let model = with_param(top::Top::default(), param, value);
+        let model = sweeps::with_params(top::Top::default(), &[(param, value)]);
         let (mut q, mut qd) = ([0.0; 3], [0.0; 3]);
         model.initial_state(&mut q, &mut qd);
         let lin = linearize(&model, 0.0, &q, &qd, &[], IterationMatrix::Auto).unwrap();
@@ -564,7 +555,7 @@ fn every_analysis_at_the_edges_of_the_parameters_returns_finite_results_or_a_typ
 /// run's start does (`tests/step_messages.rs`): bars of no length move no inertia.
 #[test]
 fn a_mass_matrix_made_singular_by_a_parameter_is_named_by_linearize() {
-    let model = with_param(dpend::DoublePendulum::default(), "l", 0.0);
+    let model = sweeps::with_params(dpend::DoublePendulum::default(), &[("l", 0.0)]);
     let (mut q, mut qd) = ([0.0; 2], [0.0; 2]);
     model.initial_state(&mut q, &mut qd);
     let e = linearize(&model, 0.0, &q, &qd, &[], IterationMatrix::Auto).unwrap_err();
@@ -591,7 +582,7 @@ fn statics_beside_a_stiff_spring_converge_at_the_rounding_of_the_forces() {
     let options = StaticsOptions::default();
     let mut loads = Vec::new();
     for k1 in [4e7, 4e9, 4e11] {
-        let model = with_param(SprungArm::default(), "k1", k1);
+        let model = sweeps::with_params(SprungArm::default(), &[("k1", k1)]);
         let eq =
             static_equilibrium(&model, &options).unwrap_or_else(|e| panic!("k1 = {k1:e}: {e}"));
         let load = (eq.q[0] - 0.6) * k1;
@@ -627,7 +618,7 @@ fn statics_beside_a_stiff_spring_converge_at_the_rounding_of_the_forces() {
 /// is found; with gravity one is.
 #[test]
 fn a_stiffness_made_singular_by_a_parameter_is_named_by_statics() {
-    let model = with_param(fourbar::FourBar::default(), "g", 0.0);
+    let model = sweeps::with_params(fourbar::FourBar::default(), &[("g", 0.0)]);
     let e = static_equilibrium(&model, &StaticsOptions::default()).unwrap_err();
     let msg = e.to_string();
     println!("{msg}");
@@ -648,7 +639,7 @@ fn a_stiffness_made_singular_by_a_parameter_is_named_by_statics() {
 #[test]
 fn statics_of_a_heavy_machine_converge_at_the_rounding_of_its_forces() {
     let equilibrium = |param: &str, value: f64| {
-        let model = with_param(arm3d_6::Arm3d6::default(), param, value);
+        let model = sweeps::with_params(arm3d_6::Arm3d6::default(), &[(param, value)]);
         let eq = static_equilibrium(&model, &StaticsOptions::default())
             .unwrap_or_else(|e| panic!("{param} = {value:e}: {e}"));
         println!(

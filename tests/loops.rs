@@ -8,6 +8,8 @@
 //! Every test prints its measured table: `cargo test --release --test loops -- --nocapture`.
 #![allow(clippy::needless_range_loop)]
 
+#[path = "common/sweeps.rs"]
+mod sweeps;
 use mbs_models::dpend;
 use mbs_models::dpend_cartesian;
 use mbs_models::fourbar;
@@ -1104,14 +1106,10 @@ fn a_change_point_of_a_loop_stops_the_run_rather_than_switching_branch() {
 /// gen-α, HHT, Radau5 and Radau3 at index 3.
 #[test]
 fn a_loop_in_large_units_closes_at_the_rounding_of_its_constraints() {
-    use mbs::Parameters;
     let run = |scale: f64, scheme: Scheme, method: ConstraintMethod| {
-        let mut model = fourbar::FourBar::default();
-        let mut p = model.params().clone();
-        for (name, length) in [("l0", 0.4), ("l1", 0.1), ("l2", 0.35), ("l3", 0.3)] {
-            p.set(name, length * scale).unwrap();
-        }
-        model.set_params(p).unwrap();
+        let lengths =
+            [("l0", 0.4), ("l1", 0.1), ("l2", 0.35), ("l3", 0.3)].map(|(n, l)| (n, l * scale));
+        let model = sweeps::with_params(fourbar::FourBar::default(), &lengths);
         let (mut q0, mut qd0) = ([0.0; 3], [0.0; 3]);
         model.initial_state(&mut q0, &mut qd0);
         let mut o = Options {

@@ -5,6 +5,8 @@
 
 use mbs_models::seed2dof;
 
+#[path = "common/sweeps.rs"]
+mod sweeps;
 use mbs::{BdfParams, Failure, GenAlphaParams, Options, Output, Scheme, StepControl, simulate};
 use mbs_models::fastlink::FastLink;
 use mbs_models::undefined_force::{EarlyForce, LateForce};
@@ -270,11 +272,7 @@ fn a_start_made_non_finite_by_a_parameter_names_it() {
     use mbs_models::{dpend::DoublePendulum, top::Top};
     let run = |model: Top| simulate(model, Scheme::Radau5, Options::adaptive(0.1, 1e-6));
     // the top's spin about its axis divides by sin²(theta0): its initial velocities
-    let mut top = Top::default();
-    let mut p = top.params().clone();
-    p.set("theta0", 0.0).unwrap();
-    p.set("m", 2.0).unwrap();
-    top.set_params(p).unwrap();
+    let top = sweeps::with_params(Top::default(), &[("theta0", 0.0), ("m", 2.0)]);
     let e = run(top).unwrap_err();
     let msg = e.kind.to_string();
     println!("{msg}");
@@ -709,12 +707,8 @@ fn a_step_collapsing_at_a_jump_in_the_forces_says_so() {
 /// stacks the Cartesian pendulum's hinges on its centre, where its angle moves no mass.
 #[test]
 fn a_mass_matrix_made_singular_by_a_parameter_names_it() {
-    use mbs::{Model, Parameters};
     use mbs_models::dpend_cartesian::DoublePendulumCartesian;
-    let mut model = DoublePendulumCartesian::default();
-    let mut p = model.params().clone();
-    p.set("l", 0.0).unwrap();
-    model.set_params(p).unwrap();
+    let model = sweeps::with_params(DoublePendulumCartesian::default(), &[("l", 0.0)]);
     let e = simulate(model, Scheme::Dopri5, Options::adaptive(0.2, 1e-6)).unwrap_err();
     let msg = e.kind.to_string();
     println!("{msg}");

@@ -277,10 +277,7 @@ impl<T: Field> Lu<T> {
             }
             self.piv[k] = p;
             let best = a[p + n * k].abs();
-            let refused = match floor {
-                None => !(best > f64::EPSILON * anorm * n as f64),
-                Some(_) => false,
-            };
+            let refused = floor.is_none() && !(best > f64::EPSILON * anorm * n as f64);
             if refused || !best.is_finite() || !anorm.is_finite() {
                 let rcond = if anorm > 0.0 { best / anorm } else { 0.0 };
                 return Err(Singular { column: k, rcond });

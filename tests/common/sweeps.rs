@@ -58,3 +58,14 @@ pub fn parameter_edges(v: f64) -> [f64; 9] {
 
 /// How many of [`parameter_edges`] are finite (they come first).
 pub const PARAMETER_EDGES_FINITE: usize = 7;
+
+/// `model` with some parameters set (valid values of known names).
+pub fn with_params<M: mbs::Model>(mut model: M, values: &[(&str, f64)]) -> M {
+    use mbs::Parameters;
+    let mut p = model.params().clone();
+    for &(name, value) in values {
+        p.set(name, value).expect("a known parameter");
+    }
+    model.set_params(p).expect("valid values");
+    model
+}

@@ -247,31 +247,21 @@ pub fn linearize<M: Model + Clone>(
 }
 
 /// A mass matrix singular at (t, q), with the parameters that, set back to their default
-/// alone, make it regular there (as a run's start names them); other errors unchanged.
-fn mass_blamed<M: Model + Clone>(
-    mut e: AnalysisError,
-    model: &M,
-    t: f64,
-    q: &[f64],
-) -> AnalysisError {
-    if let AnalysisError::Failure(Failure::SingularMatrix {
-        matrix: "the mass matrix M",
-        cause,
-        ..
-    }) = &mut e
-    {
-        let n = M::NQ;
-        let (found, _) = crate::model::defaults_for_which(&mut model.clone(), &mut |m: &M| {
-            let mut mass = vec![0.0; n * n];
-            m.mass_matrix(t, q, &mut mass);
-            mass.iter().all(|x| x.is_finite()) && cholesky(&mut mass, n).is_ok()
-        });
-        cause.push_str(&crate::model::blamed_parameters(
-            &found,
-            "M is regular there",
-        ));
-    }
-    e
+/// alone, make it regular there; other errors unchanged.
+fn mass_blamed<M: Model + Clone>(e: AnalysisError, model: &M, t: f64, q: &[f64]) -> AnalysisError {
+    let n = M::NQ;
+    let regular = |m: &M| {
+        let mut mass = vec![0.0; n * n];
+        m.mass_matrix(t, q, &mut mass);
+        mass.iter().all(|x| x.is_finite()) && cholesky(&mut mass, n).is_ok()
+    };
+    super::singular_blamed(
+        e,
+        Some("the mass matrix M"),
+        model,
+        regular,
+        "M is regular there",
+    )
 }
 
 /// [`linearize`] in the model's charts, the inputs checked.

@@ -113,6 +113,30 @@ fn constraint_scale(block: f64, constraints: f64) -> f64 {
     if s.is_finite() && s > 0.0 { s } else { 1.0 }
 }
 
+/// `e` with, where it is a singular matrix (named `matrix`, or any when None), the
+/// parameters that, set back to their default alone, make `holds` true of the model: "; with
+/// `l` at its default 1 rather than 0 {what}: check that parameter", as a run's start names
+/// them. Other errors unchanged.
+fn singular_blamed<M: Model + Clone>(
+    mut e: AnalysisError,
+    matrix: Option<&str>,
+    model: &M,
+    mut holds: impl FnMut(&M) -> bool,
+    what: &str,
+) -> AnalysisError {
+    if let AnalysisError::Failure(Failure::SingularMatrix {
+        matrix: singular,
+        cause,
+        ..
+    }) = &mut e
+        && matrix.is_none_or(|m| m == *singular)
+    {
+        let (found, _) = crate::model::defaults_for_which(&mut model.clone(), &mut holds);
+        cause.push_str(&crate::model::blamed_parameters(&found, what));
+    }
+    e
+}
+
 /// Steps of inverse iteration at a shift μ that leaves r = |λ − μ| / |λ' − μ| of the nearest
 /// other eigenvalue λ' in the vector at each step: until r^k is below rounding, at least
 /// three and at most 100; `otherwise` where r is not in (0, 1).

@@ -179,12 +179,12 @@ pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, A
     let kept: Vec<usize> = (0..n2).filter(|i| !lin.first_order.contains(i)).collect();
     let a = lin.a.select_rows(&kept).select_columns(&kept);
     let m2 = kept.len();
-    let scale = a.iter().fold(1.0f64, |m, x| m.max(x.abs()));
     // the eigenvalues and shapes are found on A scaled by a power of two to a largest entry
     // in [1, 2) (exactly: the same digits), λ scaled back: entries near 1e300 overflowed in
     // the factorisation and the discriminants, and the Schur form's absolute deflation test
     // (ε² of the scaled entries) is then relative to A's largest entry
     let largest = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let scale = largest.max(1.0);
     let unit = if largest > 0.0 {
         largest.log2().floor().exp2()
     } else {
@@ -245,7 +245,7 @@ pub fn modes(lin: &Linearization, window: Option<(f64, f64)>) -> Result<Modes, A
             }
         }
         // inverse iteration on A − μI, μ a hair off λ: by a part in 10⁹ of λ, or by what the
-        // rounding of λ may be (1000 ε of A's largest entry), not by a part in 10⁹ of that
+        // rounding of λ may be (1000 ε of the balanced A's largest entry), not by a part in 10⁹ of that
         // entry: beside a stiff mode (a gear of 1e10/s²) that shift was 10/s, and a mode at
         // 1/s converged to its neighbour at 1.2/s, or to neither
         let shift = (1e-9 * mag).max(1e3 * f64::EPSILON * balanced_scale);

@@ -378,17 +378,10 @@ pub fn static_equilibrium<M: Model + Clone>(
     };
     // a singular stiffness names the parameters that, set back to their default alone, let
     // statics find an equilibrium from the same start (as a run's start names them)
-    let blamed = |mut e: AnalysisError, model: &M, q: &[f64]| {
-        if let AnalysisError::Failure(Failure::SingularMatrix { cause, .. }) = &mut e {
-            let (found, _) = crate::model::defaults_for_which(&mut model.clone(), &mut |m: &M| {
-                solve(m, q.to_vec()).is_ok()
-            });
-            cause.push_str(&crate::model::blamed_parameters(
-                &found,
-                "an equilibrium is found from this start",
-            ));
-        }
-        e
+    let blamed = |e: AnalysisError, model: &M, q: &[f64]| {
+        let found = |m: &M| solve(m, q.to_vec()).is_ok();
+        let what = "an equilibrium is found from this start";
+        super::singular_blamed(e, None, model, found, what)
     };
     if model.info().rotation_joints.is_empty() {
         return solve(model, q.clone()).map_err(|e| blamed(e, model, &q));

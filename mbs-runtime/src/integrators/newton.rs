@@ -92,9 +92,8 @@ pub(crate) struct AccelNewton {
     /// index 3: constraints, scaling and tolerance on Φ, and buffers
     nc: usize,
     scaled: bool,
-    /// σ = (largest entry of the iteration matrix' dynamics block) / (largest |B_ij|), at
-    /// the matrix last made: about what a multiplier moves per unit of Φ's residual, which
-    /// sets the rounding floor of λ's corrections
+    /// [`super::constrained::multiplier_scale`] at the matrix last made: the rounding floor
+    /// of λ's corrections scales with it
     sigma: f64,
     tol_phi: f64,
     l0: Vec<f64>,
@@ -307,19 +306,12 @@ impl AccelNewton {
                     let qmax = self.q.iter().fold(1.0f64, |m, x| m.max(x.abs()));
                     let vmax = self.v.iter().fold(1.0f64, |m, x| m.max(x.abs()));
                     let fv = 10.0 * f64::EPSILON * vmax;
-                    (
-                        10.0 * f64::EPSILON * qmax,
-                        fv,
-                        fv * self.sigma.max(1.0) / gamma,
-                    )
+                    (10.0 * f64::EPSILON * qmax, fv, fv * self.sigma / gamma)
                 } else if nc > 0 {
                     let qmax = self.q.iter().fold(1.0f64, |m, x| m.max(x.abs()));
                     let fq = 10.0 * f64::EPSILON * qmax;
-                    // λ moves by about σ per unit of Φ/β' (a four-bar in millimetres: σ
-                    // 10⁵–10⁶ times its size in metres, where the floor without σ asked λ for
-                    // digits below rounding and Newton failed at every step size); never
-                    // below the floor without it, which held every model in SI units
-                    (fq, fq * gamma / beta, fq * self.sigma.max(1.0) / beta)
+                    // λ moves by about σ per unit of Φ/β'
+                    (fq, fq * gamma / beta, fq * self.sigma / beta)
                 } else {
                     (0.0, 0.0, 0.0)
                 };
@@ -473,14 +465,8 @@ impl AccelNewton {
             (false, Some(c)) => &c.b,
             (false, None) => &[],
         };
-        // σ: the dynamics block over the constraints' (a four-bar written in millimetres:
-        // M's entries 10⁹ times, B's 10³ times those in metres)
-        self.sigma = 1.0;
         let block = (0..n * n).fold(0.0f64, |m, x| m.max((self.mm[x] - beta * self.kc[x]).abs()));
-        let bmax = b.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        if block / bmax > 0.0 && (block / bmax).is_finite() {
-            self.sigma = block / bmax;
-        }
+        self.sigma = super::constrained::multiplier_scale(block, b);
         let s = if self.scaled { 1.0 } else { beta };
         let m = self.lu.matrix_mut();
         m.fill(0.0);

@@ -671,17 +671,8 @@ impl Stepper for Radau {
             self.scq[r] = (tol.weights.atol + tol.weights.rtol * cur.q[r].abs()).max(floor_q);
             self.scv[r] = (tol.weights.atol + tol.weights.rtol * cur.qd[r].abs()).max(floor_v);
         }
-        // (BM⁻¹Bᵀ)⁻¹ B below, taken as σ = max|M| / max|B| (at the last Jacobian; at least 1,
-        // as it was taken): a four-bar in millimetres has σ 10⁶ times its size in metres, and
-        // without it Newton asked λ for digits below rounding and failed at h_min
-        let sigma = {
-            let ratio = largest(&self.m) / largest(&self.bm);
-            if ratio.is_finite() && ratio > 1.0 {
-                ratio
-            } else {
-                1.0
-            }
-        };
+        // (BM⁻¹Bᵀ)⁻¹ B below, taken as σ from M and B at the last Jacobian
+        let sigma = || super::constrained::multiplier_scale(largest(&self.m), &self.bm);
         if self.index2 {
             // λ, an index-2 component, weighted by h as RADAU5 weights them (in Newton and
             // in the error test); neither λ nor the velocities below their rounding noise
@@ -692,6 +683,7 @@ impl Stepper for Radau {
             // stage λ by that over h (times (BM⁻¹Bᵀ)⁻¹, taken as 1)
             let vmax = cur.qd.iter().fold(1.0f64, |m, x| m.max(x.abs()));
             let noise = 4.0 * f64::EPSILON * vmax / tol.kappa;
+            let sigma = sigma();
             for r in 0..n {
                 self.scv[r] += noise;
             }
@@ -707,6 +699,7 @@ impl Stepper for Radau {
             // δA = M⁻¹Bᵀ δΛ, the stage velocities by up to ‖A⁻¹‖∞ ε max|q|/h
             let qmax = cur.q.iter().fold(1.0f64, |m, x| m.max(x.abs()));
             let noise = f64::EPSILON * qmax / (tol.kappa * h);
+            let sigma = sigma();
             for r in 0..n {
                 self.scv[r] += noise * self.ainv;
             }

@@ -75,6 +75,11 @@ impl Tally {
                 };
                 let kind = kind.split([' ', '(', '{']).next().unwrap_or("").to_string();
                 *self.kinds.entry(format!("{analysis} {kind}")).or_default() += 1;
+                // those that name a parameter to check, counted apart too
+                if text.contains("rather than") && text.contains(": check th") {
+                    let named = format!("{analysis} {kind} naming a parameter");
+                    *self.kinds.entry(named).or_default() += 1;
+                }
                 None
             }
         }

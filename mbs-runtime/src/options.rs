@@ -314,7 +314,11 @@ pub struct NewtonOptions {
     /// convergence when the predicted remaining correction of positions and velocities is
     /// below `tolerance_factor` times the step's error tolerance (adaptive) ...
     pub tolerance_factor: f64,
-    /// ... or, for fixed steps, below ATOL + RTOL·‖…‖ with these (defaults 1e-10, 1e-10)
+    /// ... or, for fixed steps, below ATOL' + RTOL·|…| with these (defaults 1e-10, 1e-10),
+    /// where ATOL' of positions, velocities and multipliers is the smaller of ATOL and RTOL
+    /// times the largest value of that kind in the step: the iteration converges as far in
+    /// any units (an ATOL in SI units alone is loose for a motion whose values are small in
+    /// them)
     pub atol: f64,
     pub rtol: f64,
     /// reuse the factorised iteration matrix across iterations and steps while convergence

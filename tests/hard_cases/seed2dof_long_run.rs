@@ -202,7 +202,7 @@ fn seed2dof_five_steps_per_period_gen_alpha_decays_as_theory_and_rk4_is_refused(
         "seed2dof",
         &snapshots,
         &[
-            [5020, 0, 0, 0, 1, 5021, 10040, 0, 1, 10037, 10037, 5021], // gen-alpha ρ∞ 0.8, h 0.2
+            [5020, 0, 0, 0, 1, 5021, 10044, 0, 1, 10041, 10041, 5021], // gen-alpha ρ∞ 0.8, h 0.2
             [0, 0, 0, 0, 7, 0, 0, 0, 0, 0, 0, 0],                      // rk4 h 0.2 (UnstableStep)
             [22692, 0, 0, 0, 102461, 0, 0, 0, 0, 0, 0, 0],             // rk4 at the advised step
             [22819, 0, 0, 0, 102745, 0, 0, 0, 0, 0, 0, 0],             // rk4 h 0.044

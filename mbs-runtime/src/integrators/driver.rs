@@ -1201,6 +1201,7 @@ fn control(options: &Options, groups: usize) -> Control {
         kappa: 1.0,
         max_iterations: options.newton.max_iterations,
         reuse: options.newton.reuse,
+        follows_motion: true,
     };
     let (adaptive, newton) = match options.step {
         StepControl::Fixed { .. } => (None, newton),
@@ -1210,6 +1211,7 @@ fn control(options: &Options, groups: usize) -> Control {
                 atol,
                 rtol,
                 kappa: options.newton.tolerance_factor,
+                follows_motion: false,
                 ..newton
             },
         ),

@@ -1103,10 +1103,11 @@ fn a_change_point_of_a_loop_stops_the_run_rather_than_switching_branch() {
 /// four-bar's by dynamic similarity: lengths × s, time × √s, the crank's start speed / √s give
 /// the same angles at the end, which projection under DOPRI5, Radau5 and BDF and partitioning
 /// under DOPRI5 reproduce to 7e-7 at rtol 1e-9 (asserted 5e-6); and in millimetres (× 10³)
-/// gen-α, HHT, Radau5 and Radau3 at index 3.
+/// gen-α, HHT, Radau5 and Radau3 at index 3; and × 10⁶ at index 3 and 2 under gen-α and HHT,
+/// at index 2 under Radau5, whose iteration matrices are factorised equilibrated.
 #[test]
 fn a_loop_in_large_units_closes_at_the_rounding_of_its_constraints() {
-    let run = |scale: f64, scheme: Scheme, method: ConstraintMethod| {
+    let run_at = |scale: f64, scheme: Scheme, method: ConstraintMethod, rtol: f64| {
         let lengths =
             [("l0", 0.4), ("l1", 0.1), ("l2", 0.35), ("l3", 0.3)].map(|(n, l)| (n, l * scale));
         let model = sweeps::with_params(fourbar::FourBar::default(), &lengths);
@@ -1114,7 +1115,7 @@ fn a_loop_in_large_units_closes_at_the_rounding_of_its_constraints() {
         model.initial_state(&mut q0, &mut qd0);
         let mut o = Options {
             t_end: scale.sqrt(),
-            step: StepControl::from_settings(None, 1e-9, None),
+            step: StepControl::from_settings(None, rtol, None),
             q0: Some(q0.to_vec()),
             qd0: Some(qd0.iter().map(|v| v / scale.sqrt()).collect()),
             ..Options::default()
@@ -1124,6 +1125,8 @@ fn a_loop_in_large_units_closes_at_the_rounding_of_its_constraints() {
             .unwrap_or_else(|e| panic!("× {scale:e}, {} {method:?}: {e}", scheme.name()));
         (tr.q(tr.len() - 1).to_vec(), stats.steps)
     };
+    let run =
+        |scale: f64, scheme: Scheme, method: ConstraintMethod| run_at(scale, scheme, method, 1e-9);
     let (small, _) = run(1.0, Scheme::Dopri5, ConstraintMethod::Projection);
     // in millimetres, at index 3 (the Newmark family's default with numerical damping):
     // Newton's floor for λ's corrections now follows what λ moves per unit of Φ (σ, the
@@ -1142,6 +1145,24 @@ fn a_loop_in_large_units_closes_at_the_rounding_of_its_constraints() {
             scheme.name()
         );
         assert!(off < 5e-6, "× 1e3, {}: {off:e}", scheme.name());
+    }
+    // × 10⁶ at index 3 and 2, rtol 1e-7: the iteration matrix, its M block ~4·10¹⁶ beside
+    // B's 4·10⁵, is factorised equilibrated (`Lu::factor_equilibrating`); before, it was
+    // refused as singular at t = 0 (rcond ≈ 6e-22)
+    for (scheme, method) in [
+        (gen_alpha(), ConstraintMethod::Index3),
+        (Scheme::Hht(Default::default()), ConstraintMethod::Index3),
+        (gen_alpha(), ConstraintMethod::Index2),
+        (Scheme::Hht(Default::default()), ConstraintMethod::Index2),
+        (Scheme::Radau5, ConstraintMethod::Index2),
+    ] {
+        let (q, steps) = run_at(1e6, scheme, method, 1e-7);
+        let off = (q.iter().zip(&small)).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        println!(
+            "× 1e6, {} {method:?} at rtol 1e-7: {steps} steps, angles off the small four-bar's by {off:.1e}",
+            scheme.name()
+        );
+        assert!(off < 1e-5, "× 1e6, {} {method:?}: {off:e}", scheme.name());
     }
     for scale in [1e6, 1e8] {
         for (scheme, method) in [

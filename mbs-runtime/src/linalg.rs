@@ -214,7 +214,8 @@ impl Field for C64 {
     }
 }
 
-/// An LU factorisation with partial pivoting, P A = L U, kept in its own buffers.
+/// An LU factorisation with partial pivoting, P A = L U, kept in its own buffers; after
+/// [`Lu::factor_equilibrating`] possibly of R A C, R and C diagonal.
 #[derive(Clone, Debug)]
 pub struct Lu<T: Field> {
     n: usize,
@@ -223,6 +224,11 @@ pub struct Lu<T: Field> {
     /// scratch for the condition estimate
     work: Vec<T>,
     work2: Vec<T>,
+    /// [`Lu::factor_equilibrating`]: the matrix as given, and the row and column scales (powers
+    /// of two) of the factorisation when it is of R A C (empty when of A)
+    given: Vec<T>,
+    rows: Vec<f64>,
+    cols: Vec<f64>,
 }
 
 impl<T: Field> Lu<T> {
@@ -234,6 +240,9 @@ impl<T: Field> Lu<T> {
             piv: vec![0; n],
             work: vec![T::default(); n],
             work2: vec![T::default(); n],
+            given: Vec::new(),
+            rows: Vec::new(),
+            cols: Vec::new(),
         }
     }
 
@@ -245,7 +254,69 @@ impl<T: Field> Lu<T> {
     /// Factorises the matrix in [`Lu::matrix_mut`]. On failure, the column whose pivot
     /// vanished and a condition estimate.
     pub fn factor(&mut self) -> Result<(), Singular> {
+        self.rows.clear();
+        self.cols.clear();
         self.factor_with(None).map(|_| ())
+    }
+
+    /// [`Lu::factor`], and where a pivot falls below nε‖A‖₁ the factorisation of R A C
+    /// instead, R scaling each row's largest entry and then C each column's to [½, 1] by powers
+    /// of two (exact, as LAPACK's xGEEQUB chooses them), refused only if a pivot of R A C falls
+    /// below nε‖R A C‖₁. The pivot test against the whole matrix's norm reads a matrix whose
+    /// blocks come in different units as singular: a loop's iteration matrix
+    /// [M + γ'C + β'K, −Bᵀ; B, 0] 10⁶ times larger, its M block ~4·10¹⁶ beside B's 4·10⁵, has a
+    /// pivot BM⁻¹Bᵀ ~ 2·10⁻⁶ in the constraints' rows, 6·10⁻²³ of ‖A‖₁. Where A's own pivots
+    /// pass, the result is [`Lu::factor`]'s, bit for bit (A is kept to try again: one copy of
+    /// it per factorisation, and the memory for it).
+    pub fn factor_equilibrating(&mut self) -> Result<(), Singular> {
+        // the first call reserves what a retry needs: no allocation in later ones
+        self.given.clear();
+        self.given.extend_from_slice(&self.lu);
+        self.rows.reserve(self.n);
+        self.cols.reserve(self.n);
+        match self.factor() {
+            Err(_) => {
+                let n = self.n;
+                self.lu.copy_from_slice(&self.given);
+                let pow2 = |largest: f64| match largest > 0.0 && largest.is_finite() {
+                    // 2^-e with 2^(e-1) ≤ largest < 2^e
+                    true => 2f64.powi(-(largest.log2().floor() as i32 + 1)),
+                    false => 1.0,
+                };
+                let a = &mut self.lu;
+                self.rows.clear();
+                self.rows.extend(
+                    (0..n).map(|i| pow2((0..n).map(|j| a[i + n * j].abs()).fold(0.0, f64::max))),
+                );
+                for j in 0..n {
+                    for i in 0..n {
+                        a[i + n * j] = a[i + n * j] * T::from_f64(self.rows[i]);
+                    }
+                }
+                self.cols.clear();
+                self.cols.extend((0..n).map(|j| {
+                    pow2(
+                        a[j * n..(j + 1) * n]
+                            .iter()
+                            .map(|x| x.abs())
+                            .fold(0.0, f64::max),
+                    )
+                }));
+                for j in 0..n {
+                    let c = T::from_f64(self.cols[j]);
+                    for x in &mut a[j * n..(j + 1) * n] {
+                        *x = *x * c;
+                    }
+                }
+                let scaled = self.factor_with(None).map(|_| ());
+                if scaled.is_err() {
+                    self.rows.clear();
+                    self.cols.clear();
+                }
+                scaled
+            }
+            ok => ok,
+        }
     }
 
     /// Factorises the matrix in [`Lu::matrix_mut`] for inverse iteration, where a matrix
@@ -254,6 +325,8 @@ impl<T: Field> Lu<T> {
     /// grows the component of the eigenvector by about 1/ε rather than failing. Returns the
     /// number of pivots replaced. Fails only where the matrix is not finite.
     pub fn factor_for_inverse_iteration(&mut self) -> Result<usize, Singular> {
+        self.rows.clear();
+        self.cols.clear();
         self.factor_with(Some(f64::EPSILON))
     }
 
@@ -320,6 +393,10 @@ impl<T: Field> Lu<T> {
     pub fn solve(&self, b: &mut [T]) {
         let n = self.n;
         let a = &self.lu;
+        // (R A C)⁻¹ = C⁻¹ A⁻¹ R⁻¹: A⁻¹ b = C (R A C)⁻¹ R b
+        for (x, r) in b.iter_mut().zip(&self.rows) {
+            *x = *x * T::from_f64(*r);
+        }
         for k in 0..n {
             b.swap(k, self.piv[k]);
         }
@@ -337,12 +414,19 @@ impl<T: Field> Lu<T> {
             }
             b[i] = s / a[i + n * i];
         }
+        for (x, c) in b.iter_mut().zip(&self.cols) {
+            *x = *x * T::from_f64(*c);
+        }
     }
 
     /// Solves Aᵀ x = b in place (for the condition estimate).
     fn solve_transpose(&self, b: &mut [T]) {
         let n = self.n;
         let a = &self.lu;
+        // A⁻ᵀ b = R (R A C)⁻ᵀ C b
+        for (x, c) in b.iter_mut().zip(&self.cols) {
+            *x = *x * T::from_f64(*c);
+        }
         for i in 0..n {
             let mut s = b[i];
             for k in 0..i {
@@ -359,6 +443,9 @@ impl<T: Field> Lu<T> {
         }
         for k in (0..n).rev() {
             b.swap(k, self.piv[k]);
+        }
+        for (x, r) in b.iter_mut().zip(&self.rows) {
+            *x = *x * T::from_f64(*r);
         }
     }
 
@@ -476,6 +563,74 @@ mod tests {
                 "{est} vs {exact}"
             );
         }
+    }
+
+    /// A loop's index-3 matrix in large units: [M, −Bᵀ; B, 0] with M ~ 4·10¹⁶ beside B ~ 4·10⁵
+    /// (the four-bar 10⁶ times larger) has a pivot BM⁻¹Bᵀ ~ 10⁻²² of ‖A‖₁, which the plain
+    /// factorisation refuses; equilibrated it solves as nalgebra does, its condition estimate
+    /// (through the transposed solve) bounds the inverse's norm, a singular matrix is still
+    /// refused and a well-scaled one is factorised bit for bit as by `factor`.
+    #[test]
+    fn equilibration_factorises_blocks_in_different_units() {
+        let (n, nc) = (3, 2);
+        let big = n + nc;
+        let r = matrix(n, 5);
+        let mut a = vec![0.0; big * big];
+        for i in 0..n {
+            for j in 0..n {
+                // M = 4·10¹⁶ (RᵀR + I)
+                let m: f64 = (0..n).map(|k| r[k + n * i] * r[k + n * j]).sum();
+                a[i + big * j] = 4e16 * (m + if i == j { 1.0 } else { 0.0 });
+            }
+        }
+        let b = matrix(nc.max(n), 6);
+        for k in 0..nc {
+            for j in 0..n {
+                let bkj = 4e5 * b[k + nc * j];
+                a[n + k + big * j] = bkj;
+                a[j + big * (n + k)] = -bkj;
+            }
+        }
+        let mut lu = Lu::<f64>::new(big);
+        lu.matrix_mut().copy_from_slice(&a);
+        let plain = lu.factor().unwrap_err();
+        assert!(plain.rcond < 1e-20, "{}", plain.rcond);
+        lu.matrix_mut().copy_from_slice(&a);
+        lu.factor_equilibrating().unwrap();
+        let rhs: Vec<f64> = (0..big).map(|i| 1e10 * (i as f64 - 1.5)).collect();
+        let mut x = rhs.clone();
+        lu.solve(&mut x);
+        let na = nalgebra::DMatrix::from_column_slice(big, big, &a);
+        let xr = na
+            .clone()
+            .lu()
+            .solve(&nalgebra::DVector::from_column_slice(&rhs))
+            .unwrap();
+        for i in 0..big {
+            assert!((x[i] - xr[i]).abs() < 1e-9 * xr[i].abs(), "{x:?} vs {xr}");
+        }
+        let (est, _) = lu.inverse_norm_estimate();
+        let exact = norm1(na.try_inverse().unwrap().as_slice(), big);
+        assert!(
+            est <= exact * (1.0 + 1e-9) && est >= exact / 10.0,
+            "{est} vs {exact}"
+        );
+        // still singular: column 2 twice column 0
+        let s = [1.0, 2.0, 3.0, 0.0, 1.0, 4.0, 2.0, 4.0, 6.0];
+        let mut lu3 = Lu::<f64>::new(3);
+        lu3.matrix_mut().copy_from_slice(&s);
+        assert_eq!(lu3.factor_equilibrating().unwrap_err().column, 2);
+        // well scaled: factor's result, bit for bit
+        let w = matrix(7, 3);
+        let (mut p, mut q) = (Lu::<f64>::new(7), Lu::<f64>::new(7));
+        p.matrix_mut().copy_from_slice(&w);
+        q.matrix_mut().copy_from_slice(&w);
+        p.factor().unwrap();
+        q.factor_equilibrating().unwrap();
+        let (mut xp, mut xq) = (vec![1.0; 7], vec![1.0; 7]);
+        p.solve(&mut xp);
+        q.solve(&mut xq);
+        assert_eq!(xp, xq);
     }
 
     #[test]

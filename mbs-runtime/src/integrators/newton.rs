@@ -282,7 +282,9 @@ impl AccelNewton {
                         } else {
                             INDEX3_MATRIX
                         };
-                        self.lu.factor().map_err(|s| p.singular(name, s))
+                        self.lu
+                            .factor_equilibrating()
+                            .map_err(|s| p.singular(name, s))
                     })
                 };
                 if let Err(e) = made {

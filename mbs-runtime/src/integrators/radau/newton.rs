@@ -41,7 +41,11 @@ impl Radau {
                 border(a, &self.bm, n, nc);
             }
             p.stats.factorizations += 1;
-            if let Err(e) = self.lu_c.factor() {
+            let made = match nc {
+                0 => self.lu_c.factor(),
+                _ => self.lu_c.factor_equilibrating(),
+            };
+            if let Err(e) = made {
                 return Err(self.singular(p, e, [MATRIX_C, MATRIX_C3, MATRIX_C2]));
             }
             self.h_c = h;
@@ -62,7 +66,11 @@ impl Radau {
                 border(a, &self.bm, n, nc);
             }
             p.stats.factorizations += 1;
-            if let Err(e) = self.lu_r.factor() {
+            let made = match nc {
+                0 => self.lu_r.factor(),
+                _ => self.lu_r.factor_equilibrating(),
+            };
+            if let Err(e) = made {
                 return Err(self.singular(p, e, [MATRIX_R, MATRIX_R3, MATRIX_R2]));
             }
             self.h_r = h;

@@ -1104,10 +1104,11 @@ fn a_change_point_of_a_loop_stops_the_run_rather_than_switching_branch() {
 /// the same angles at the end, which projection under DOPRI5, Radau5 and BDF and partitioning
 /// under DOPRI5 reproduce to 7e-7 at rtol 1e-9 (asserted 5e-6); and in millimetres (× 10³)
 /// gen-α, HHT, Radau5 and Radau3 at index 3; and × 10⁶ at index 3 and 2 under gen-α and HHT,
-/// at index 2 under Radau5, whose iteration matrices are factorised equilibrated.
+/// at index 2 under Radau5 (also × 10⁻⁶), whose iteration matrices are factorised
+/// equilibrated.
 #[test]
 fn a_loop_in_large_units_closes_at_the_rounding_of_its_constraints() {
-    let run_at = |scale: f64, scheme: Scheme, method: ConstraintMethod, rtol: f64| {
+    let run_with = |scale: f64, scheme: Scheme, method: ConstraintMethod, rtol: f64, tol: f64| {
         let lengths =
             [("l0", 0.4), ("l1", 0.1), ("l2", 0.35), ("l3", 0.3)].map(|(n, l)| (n, l * scale));
         let model = sweeps::with_params(fourbar::FourBar::default(), &lengths);
@@ -1121,9 +1122,13 @@ fn a_loop_in_large_units_closes_at_the_rounding_of_its_constraints() {
             ..Options::default()
         };
         o.constraints.method = method;
+        o.constraints.tolerance = tol;
         let (tr, stats) = simulate(model, scheme, o)
             .unwrap_or_else(|e| panic!("× {scale:e}, {} {method:?}: {e}", scheme.name()));
         (tr.q(tr.len() - 1).to_vec(), stats.steps)
+    };
+    let run_at = |scale: f64, scheme: Scheme, method: ConstraintMethod, rtol: f64| {
+        run_with(scale, scheme, method, rtol, 1e-11)
     };
     let run =
         |scale: f64, scheme: Scheme, method: ConstraintMethod| run_at(scale, scheme, method, 1e-9);
@@ -1148,22 +1153,45 @@ fn a_loop_in_large_units_closes_at_the_rounding_of_its_constraints() {
     }
     // × 10⁶ at index 3 and 2, rtol 1e-7: the iteration matrix, its M block ~4·10¹⁶ beside
     // B's 4·10⁵, is factorised equilibrated (`Lu::factor_equilibrating`); before, it was
-    // refused as singular at t = 0 (rcond ≈ 6e-22)
-    for (scheme, method) in [
-        (gen_alpha(), ConstraintMethod::Index3),
-        (Scheme::Hht(Default::default()), ConstraintMethod::Index3),
-        (gen_alpha(), ConstraintMethod::Index2),
-        (Scheme::Hht(Default::default()), ConstraintMethod::Index2),
-        (Scheme::Radau5, ConstraintMethod::Index2),
+    // refused as singular at t = 0 (rcond ≈ 6e-22); and × 10⁻⁶ under Radau5 at index 2, which
+    // ran out of its 10⁶ steps before
+    for (scale, scheme, method) in [
+        (1e6, gen_alpha(), ConstraintMethod::Index3),
+        (
+            1e6,
+            Scheme::Hht(Default::default()),
+            ConstraintMethod::Index3,
+        ),
+        (1e6, gen_alpha(), ConstraintMethod::Index2),
+        (
+            1e6,
+            Scheme::Hht(Default::default()),
+            ConstraintMethod::Index2,
+        ),
+        (1e6, Scheme::Radau5, ConstraintMethod::Index2),
+        (1e-6, Scheme::Radau5, ConstraintMethod::Index2),
     ] {
-        let (q, steps) = run_at(1e6, scheme, method, 1e-7);
+        let (q, steps) = run_at(scale, scheme, method, 1e-7);
         let off = (q.iter().zip(&small)).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
         println!(
-            "× 1e6, {} {method:?} at rtol 1e-7: {steps} steps, angles off the small four-bar's by {off:.1e}",
+            "× {scale:e}, {} {method:?} at rtol 1e-7: {steps} steps, angles off the small four-bar's by {off:.1e}",
             scheme.name()
         );
-        assert!(off < 1e-5, "× 1e6, {} {method:?}: {off:e}", scheme.name());
+        assert!(
+            off < 1e-5,
+            "× {scale:e}, {} {method:?}: {off:e}",
+            scheme.name()
+        );
     }
+    // × 10⁻⁶ under Radau3 at index 2, which stops in Newton at t = 0 under the default
+    // constraint tolerance (1e-11 m, 1e-4 of the 0.1 µm crank), runs with one in the mechanism's
+    // scale
+    let (q, steps) = run_with(1e-6, Scheme::Radau3, ConstraintMethod::Index2, 1e-7, 1e-14);
+    let off = (q.iter().zip(&small)).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    println!(
+        "× 1e-6, radau3 Index2 at rtol 1e-7, constraints to 1e-14 m: {steps} steps, angles off the small four-bar's by {off:.1e}"
+    );
+    assert!(off < 1e-5, "× 1e-6, radau3 Index2: {off:e}");
     for scale in [1e6, 1e8] {
         for (scheme, method) in [
             (Scheme::Dopri5, ConstraintMethod::Projection),

@@ -315,10 +315,12 @@ pub struct NewtonOptions {
     /// below `tolerance_factor` times the step's error tolerance (adaptive) ...
     pub tolerance_factor: f64,
     /// ... or, for fixed steps, below ATOL' + RTOL·|…| with these (defaults 1e-10, 1e-10),
-    /// where ATOL' of positions, velocities and multipliers is the smaller of ATOL and RTOL
-    /// times the largest value of that kind in the step: the iteration converges as far in
-    /// any units (an ATOL in SI units alone is loose for a motion whose values are small in
-    /// them)
+    /// where, for the Newmark family and the midpoint rule, ATOL' of positions, velocities and
+    /// multipliers is the smaller of ATOL and RTOL times the largest value of that kind in the
+    /// step: the iteration converges as far in any units (an ATOL in SI units alone is loose
+    /// for a motion whose values are small in them); a correction that stalls within ATOL
+    /// itself (values that are rounding errors, as at rest in an equilibrium) converges.
+    /// Radau's weights use ATOL
     pub atol: f64,
     pub rtol: f64,
     /// reuse the factorised iteration matrix across iterations and steps while convergence

@@ -666,18 +666,10 @@ impl Stepper for Radau {
         let largest = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         let (qmax, vmax, amax) = (largest(&cur.q), largest(&cur.qd), largest(&cur.qdd));
         let f = Tolerances::transformed_floor(tol.weights.rtol);
-        let (sq, sv) = (qmax + h * (vmax + h * amax), vmax + h * amax);
-        let (floor_q, floor_v) = (f * sq, f * sv);
-        // at a fixed step the absolute weights follow the motion's magnitude, as the other
-        // implicit schemes' (`NewtonTol::absolute`)
-        let absolute = |s: f64| match tol.adaptive {
-            true => tol.weights.atol,
-            false => ctl.newton.absolute(s),
-        };
-        let (atol_q, atol_v, atol_l) = (absolute(sq), absolute(sv), absolute(largest(&cur.lambda)));
+        let (floor_q, floor_v) = (f * (qmax + h * (vmax + h * amax)), f * (vmax + h * amax));
         for r in 0..n {
-            self.scq[r] = (atol_q + tol.weights.rtol * cur.q[r].abs()).max(floor_q);
-            self.scv[r] = (atol_v + tol.weights.rtol * cur.qd[r].abs()).max(floor_v);
+            self.scq[r] = (tol.weights.atol + tol.weights.rtol * cur.q[r].abs()).max(floor_q);
+            self.scv[r] = (tol.weights.atol + tol.weights.rtol * cur.qd[r].abs()).max(floor_v);
         }
         // (BM⁻¹Bᵀ)⁻¹ B below, taken as σ from M and B at the last Jacobian
         let sigma = || super::constrained::multiplier_scale(largest(&self.m), &self.bm);
@@ -696,7 +688,8 @@ impl Stepper for Radau {
                 self.scv[r] += noise;
             }
             for r in 0..self.nc {
-                self.scl[r] = (atol_l + tol.weights.rtol * cur.lambda[r].abs() + noise * sigma) / h;
+                self.scl[r] =
+                    (tol.weights.atol + tol.weights.rtol * cur.lambda[r].abs() + noise * sigma) / h;
             }
         } else if self.nc > 0 {
             // λ and the velocities to the Newton tolerance, but not below their rounding
@@ -711,7 +704,7 @@ impl Stepper for Radau {
                 self.scv[r] += noise * self.ainv;
             }
             for r in 0..self.nc {
-                self.scl[r] = atol_l
+                self.scl[r] = tol.weights.atol
                     + tol.weights.rtol * cur.lambda[r].abs()
                     + noise * self.a2inv * sigma / h;
             }

@@ -1133,6 +1133,12 @@ fn a_loop_in_large_units_closes_at_the_rounding_of_its_constraints() {
     let run =
         |scale: f64, scheme: Scheme, method: ConstraintMethod| run_at(scale, scheme, method, 1e-9);
     let (small, _) = run(1.0, Scheme::Dopri5, ConstraintMethod::Projection);
+    // the angles at the end against the small four-bar's, printed and bounded
+    let judge = |what: String, (q, steps): (Vec<f64>, usize), bound: f64| {
+        let off = (q.iter().zip(&small)).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        println!("{what}: {steps} steps, angles off the small four-bar's by {off:.1e}");
+        assert!(off < bound, "{what}: {off:e}");
+    };
     // in millimetres, at index 3 (the Newmark family's default with numerical damping):
     // Newton's floor for λ's corrections now follows what λ moves per unit of Φ (σ, the
     // dynamics block, or M, over B's entries); without it Newton failed at h_min, under
@@ -1143,55 +1149,33 @@ fn a_loop_in_large_units_closes_at_the_rounding_of_its_constraints() {
         Scheme::Radau5,
         Scheme::Radau3,
     ] {
-        let (q, steps) = run(1e3, scheme, ConstraintMethod::Index3);
-        let off = (q.iter().zip(&small)).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
-        println!(
-            "× 1e3, {} Index3: {steps} steps, angles off the small four-bar's by {off:.1e}",
-            scheme.name()
-        );
-        assert!(off < 5e-6, "× 1e3, {}: {off:e}", scheme.name());
+        let what = format!("× 1e3, {} Index3", scheme.name());
+        judge(what, run(1e3, scheme, ConstraintMethod::Index3), 5e-6);
     }
     // × 10⁶ at index 3 and 2, rtol 1e-7: the iteration matrix, its M block ~4·10¹⁶ beside
     // B's 4·10⁵, is factorised equilibrated (`Lu::factor_equilibrating`); before, it was
     // refused as singular at t = 0 (rcond ≈ 6e-22); and × 10⁻⁶ under Radau5 at index 2, which
     // ran out of its 10⁶ steps before
+    let hht = Scheme::Hht(Default::default());
     for (scale, scheme, method) in [
         (1e6, gen_alpha(), ConstraintMethod::Index3),
-        (
-            1e6,
-            Scheme::Hht(Default::default()),
-            ConstraintMethod::Index3,
-        ),
+        (1e6, hht, ConstraintMethod::Index3),
         (1e6, gen_alpha(), ConstraintMethod::Index2),
-        (
-            1e6,
-            Scheme::Hht(Default::default()),
-            ConstraintMethod::Index2,
-        ),
+        (1e6, hht, ConstraintMethod::Index2),
         (1e6, Scheme::Radau5, ConstraintMethod::Index2),
         (1e-6, Scheme::Radau5, ConstraintMethod::Index2),
     ] {
-        let (q, steps) = run_at(scale, scheme, method, 1e-7);
-        let off = (q.iter().zip(&small)).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
-        println!(
-            "× {scale:e}, {} {method:?} at rtol 1e-7: {steps} steps, angles off the small four-bar's by {off:.1e}",
-            scheme.name()
-        );
-        assert!(
-            off < 1e-5,
-            "× {scale:e}, {} {method:?}: {off:e}",
-            scheme.name()
-        );
+        let what = format!("× {scale:e}, {} {method:?} at rtol 1e-7", scheme.name());
+        judge(what, run_at(scale, scheme, method, 1e-7), 1e-5);
     }
     // × 10⁻⁶ under Radau3 at index 2, which stops in Newton at t = 0 under the default
-    // constraint tolerance (1e-11 m, 1e-4 of the 0.1 µm crank), runs with one in the mechanism's
-    // scale
-    let (q, steps) = run_with(1e-6, Scheme::Radau3, ConstraintMethod::Index2, 1e-7, 1e-14);
-    let off = (q.iter().zip(&small)).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
-    println!(
-        "× 1e-6, radau3 Index2 at rtol 1e-7, constraints to 1e-14 m: {steps} steps, angles off the small four-bar's by {off:.1e}"
+    // constraint tolerance (1e-11 m, 1e-4 of the 0.1 µm crank), runs with one in the
+    // mechanism's scale
+    judge(
+        "× 1e-6, radau3 Index2 at rtol 1e-7, constraints to 1e-14 m".into(),
+        run_with(1e-6, Scheme::Radau3, ConstraintMethod::Index2, 1e-7, 1e-14),
+        1e-5,
     );
-    assert!(off < 1e-5, "× 1e-6, radau3 Index2: {off:e}");
     for scale in [1e6, 1e8] {
         for (scheme, method) in [
             (Scheme::Dopri5, ConstraintMethod::Projection),
@@ -1202,17 +1186,8 @@ fn a_loop_in_large_units_closes_at_the_rounding_of_its_constraints() {
                 ConstraintMethod::Projection,
             ),
         ] {
-            let (q, steps) = run(scale, scheme, method);
-            let off = (q.iter().zip(&small)).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
-            println!(
-                "× {scale:e}, {} {method:?}: {steps} steps, angles off the small four-bar's by {off:.1e}",
-                scheme.name()
-            );
-            assert!(
-                off < 5e-6,
-                "× {scale:e}, {} {method:?}: {off:e}",
-                scheme.name()
-            );
+            let what = format!("× {scale:e}, {} {method:?}", scheme.name());
+            judge(what, run(scale, scheme, method), 5e-6);
         }
     }
 }

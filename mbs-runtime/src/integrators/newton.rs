@@ -368,9 +368,11 @@ impl AccelNewton {
                     let eq = beta * dq / (atol_q + tol.rtol * self.q[i].abs() + fq);
                     let ev = gamma * d / (atol_v + tol.rtol * self.v[i].abs() + fv);
                     s += eq * eq + ev * ev;
-                    let pq = beta * dq / (tol.atol + tol.rtol * self.q[i].abs() + fq);
-                    let pv = gamma * d / (tol.atol + tol.rtol * self.v[i].abs() + fv);
-                    plain += pq * pq + pv * pv;
+                    if tol.follows_motion {
+                        let pq = beta * dq / (tol.atol + tol.rtol * self.q[i].abs() + fq);
+                        let pv = gamma * d / (tol.atol + tol.rtol * self.v[i].abs() + fv);
+                        plain += pq * pq + pv * pv;
+                    }
                     largest.see(eq * eq, 0, i);
                     largest.see(ev * ev, 1, i);
                 }
@@ -379,8 +381,10 @@ impl AccelNewton {
                     lambda[k] += d;
                     let el = d / (atol_l + tol.rtol * lambda[k].abs() + fl);
                     s += el * el;
-                    let pl = d / (tol.atol + tol.rtol * lambda[k].abs() + fl);
-                    plain += pl * pl;
+                    if tol.follows_motion {
+                        let pl = d / (tol.atol + tol.rtol * lambda[k].abs() + fl);
+                        plain += pl * pl;
+                    }
                     largest.see(el * el, 2, k);
                 }
                 self.largest = largest.at;

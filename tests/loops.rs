@@ -1108,7 +1108,8 @@ fn a_change_point_of_a_loop_stops_the_run_rather_than_switching_branch() {
 /// equilibrated.
 #[test]
 fn a_loop_in_large_units_closes_at_the_rounding_of_its_constraints() {
-    let run_with = |scale: f64, scheme: Scheme, method: ConstraintMethod, rtol: f64, tol: f64| {
+    // the four-bar × scale (lengths × s, time × √s, the crank's start speed / √s)
+    let similar = |scale: f64, scheme: Scheme, method: ConstraintMethod, rtol: f64, tol: f64| {
         let lengths =
             [("l0", 0.4), ("l1", 0.1), ("l2", 0.35), ("l3", 0.3)].map(|(n, l)| (n, l * scale));
         let model = sweeps::with_params(fourbar::FourBar::default(), &lengths);
@@ -1123,7 +1124,10 @@ fn a_loop_in_large_units_closes_at_the_rounding_of_its_constraints() {
         };
         o.constraints.method = method;
         o.constraints.tolerance = tol;
-        let (tr, stats) = simulate(model, scheme, o)
+        simulate(model, scheme, o)
+    };
+    let run_with = |scale: f64, scheme: Scheme, method: ConstraintMethod, rtol: f64, tol: f64| {
+        let (tr, stats) = similar(scale, scheme, method, rtol, tol)
             .unwrap_or_else(|e| panic!("× {scale:e}, {} {method:?}: {e}", scheme.name()));
         (tr.q(tr.len() - 1).to_vec(), stats.steps)
     };
@@ -1176,6 +1180,17 @@ fn a_loop_in_large_units_closes_at_the_rounding_of_its_constraints() {
         run_with(1e-6, Scheme::Radau3, ConstraintMethod::Index2, 1e-7, 1e-14),
         1e-5,
     );
+    // not fixed: Radau at index 3 weighs λ's error by h², as RADAU5 weighs an index-3
+    // component, which is not dimensionless: at × 10⁶ λ holds most of its steps, and it stops
+    // in Newton at h_min at t ≈ 404 s where λ of `close.y` passes through zero
+    let radau = |scale: f64| similar(scale, Scheme::Radau5, ConstraintMethod::Index3, 1e-7, 1e-11);
+    let (_, unit) = radau(1.0).expect("the four-bar in metres");
+    let e = radau(1e6).expect_err("× 1e6 under Radau5 at index 3");
+    println!(
+        "Radau5 Index3, error test held most by: × 1 {:?}; × 1e6 {:?}, which stopped at t = {:.0} s: {e}",
+        unit.held_most, e.stats.held_most, e.t
+    );
+    assert!(matches!(e.kind, Failure::NewtonDiverged { .. }), "{e}");
     for scale in [1e6, 1e8] {
         for (scheme, method) in [
             (Scheme::Dopri5, ConstraintMethod::Projection),

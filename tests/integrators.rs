@@ -232,8 +232,8 @@ fn outputs_at_chosen_times_observers_and_frames() {
 /// kind the step handles: the 8-bar chain 10⁶ times longer (its velocities 10³ times slower)
 /// at the same dimensionless step ends within 2.1e-7 rad of a unit chain whose Newton
 /// converges to 1e-15 (asserted 1e-6), where with atol = 1e-10 alone it ended 1.0–1.1e-4 rad
-/// off. Radau, whose Newton weighs its stages by atol (Radau3 2.4e-7 off, Radau5 8e-7), is not
-/// changed. And a step from a static equilibrium at rest, whose velocities and accelerations
+/// off. Radau, whose Newton weighs its stages by atol (Radau3 2.4e-7 off, Radau5 8e-7,
+/// asserted 2e-6), is not changed. And a step from a static equilibrium at rest, whose velocities and accelerations
 /// are rounding errors, converges at what it resolves when that is within atol itself: the
 /// sprung arm so started stays at rest for 1 s, where it stopped in Newton at t = 0.
 #[test]
@@ -251,7 +251,14 @@ fn a_fixed_step_s_newton_converges_as_far_in_any_units() {
         let (tr, _) = simulate(model, scheme, o).unwrap();
         tr.q(tr.len() - 1).to_vec()
     };
-    for name in ["newmark", "hht", "gen-alpha", "midpoint"] {
+    for name in [
+        "newmark",
+        "hht",
+        "gen-alpha",
+        "midpoint",
+        "radau3",
+        "radau5",
+    ] {
         let scheme = Scheme::from_name(name).unwrap();
         // from the sprung arm's static equilibrium, at rest
         let arm = SprungArm::default();
@@ -273,7 +280,13 @@ fn a_fixed_step_s_newton_converges_as_far_in_any_units() {
             let q = run(s, scheme, false);
             let off = (q.iter().zip(&unit)).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
             println!("{name:<10} × {s:e}: {off:.1e} rad from the converged unit chain");
-            assert!(off < 1e-6, "{name} × {s:e}: {off:e}");
+            // Radau's weights keep atol
+            let bound = if name.starts_with("radau") {
+                2e-6
+            } else {
+                1e-6
+            };
+            assert!(off < bound, "{name} × {s:e}: {off:e}");
         }
     }
 }

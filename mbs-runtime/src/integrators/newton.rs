@@ -304,12 +304,19 @@ impl AccelNewton {
             let mut prev = f64::NAN;
             let mut eta = self.eta.max(f64::EPSILON).powf(0.8);
             let mut settled = false;
-            // the absolute weights of q, v and λ, from the values the step handles
-            let largest = |x: &[f64]| x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            let amax = largest(a);
-            let atol_q = tol.absolute(largest(step.qhat) + beta * amax);
-            let atol_v = tol.absolute(largest(step.vhat) + gamma * amax);
-            let atol_l = tol.absolute(largest(lambda));
+            // the absolute weights of q, v and λ, at fixed steps from the values the step
+            // handles
+            let (atol_q, atol_v, atol_l) = if tol.follows_motion {
+                let peak = |x: &[f64]| x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                let amax = peak(a);
+                (
+                    tol.absolute(peak(step.qhat) + beta * amax),
+                    tol.absolute(peak(step.vhat) + gamma * amax),
+                    tol.absolute(peak(lambda)),
+                )
+            } else {
+                (tol.atol, tol.atol, tol.atol)
+            };
             for it in 0..tol.max_iterations {
                 self.affine(step, a);
                 let n = self.n;

@@ -38,7 +38,11 @@
 //! order-2 scheme whose local error is held at tol per step has a global error ∝ tol^⅔; this
 //! makes it follow rtol. f ≥ 10⁴ε/rtol: no local tolerance below 10⁴ε (at index 2 the rounding
 //! of the accelerations would reject the step; with the positions alone 100ε would do, but the
-//! tumbling body at rtol 1e-10 then took more than 10⁶ steps). Newton's tolerance follows
+//! tumbling body at rtol 1e-10 then took more than 10⁶ steps). No weight f·(atol + rtol·|y_i|)
+//! counts below 100ε times the largest entry of its kind, as in every scheme's test (taken
+//! before the factor f, that floor sat f times lower, below rounding: the four-bar in
+//! micrometres, its velocities of 10⁴ rad/s weighed at atol·f ≈ 1e-13 rad/s under rtol 1e-7,
+//! stopped at h_min at index 2). Newton's tolerance follows
 //! (rtol·f, atol·f, floored at 4ε). 0.3 is measured. At index 3, whose test sees the
 //! positions alone while the velocities, of order 2 too, go untested, f = 0.07·√rtol and the
 //! floor is 10³ε: with 0.3 its runs fell 0.9–3.1 digits short of rtol, up to 1.42 digits below
@@ -57,8 +61,7 @@
 //! better than rtol to 2.2 short at index 2, 0.2–2.8 short with projection or partitioning and
 //! 0.5–2.4 short at index 3, the amplifying loops (four-bar, slider-crank, fastlink) the
 //! furthest. Below rtol 1e-7 (2e-8 at index 3) the local tolerance reaches its floor and the
-//! digits stall (6.3–7.5 on pendulum3, 4.6–6.5 on the loops); gen-α at index 2 stops with
-//! `StepTooSmall` on fastlink at rtol 1e-8. Before the transformation (the test per step at
+//! digits stall (6.3–7.5 on pendulum3, 4.6–6.5 on the loops). Before the transformation (the test per step at
 //! rtol itself, as at index 3 and with projection until then) the runs fell 2.9–5.5 digits
 //! short of rtol on average, gaining ⅔ of a digit per decade. The transformation costs what order 2 costs: dpend to 2 s at rtol
 //! 1e-6 takes 14,957 steps where the per-step test took 1,001 (`tests/work_counters.rs`),
@@ -119,7 +122,9 @@ use super::at::{Affine, At, Weights};
 use super::constrained::{Constrained, Mode};
 use super::newton::{AccelNewton, NewtonTol};
 use super::problem::{Loops, Problem};
-use super::step_control::{ErrorNorm, Largest, next_step, order_two_factor, order_two_floored};
+use super::step_control::{
+    ErrorNorm, Largest, Tolerances, next_step, order_two_factor, order_two_floored,
+};
 use super::{Attempt, Control, State, Step, Stepper};
 use crate::charts::Recentring;
 use crate::error::Failure;
@@ -404,6 +409,13 @@ impl Stepper for AlphaFamily {
             // them, where Φ(q₁) = 0 holds anyway
             p.tangent_part(cur.t + h, &next.q, &mut self.err)?;
         }
+        // the local tolerances rtol·f and atol·f, the rounding floor under them as under
+        // every scheme's (100ε times the largest entry of a kind)
+        let tol = Tolerances {
+            rtol: tol.rtol * f,
+            atol: tol.atol * f,
+            ..tol
+        };
         let eq = tol.norm(&self.err, &cur.q, &next.q, cur.q.len());
         self.test = eq;
         // index 2: positions and velocities, otherwise positions (local error ∝ h³)
@@ -413,9 +425,9 @@ impl Stepper for AlphaFamily {
             if ev.value > eq.value {
                 self.test.held_by = ev.held_by.map(Largest::as_velocity);
             }
-            (0.5 * (eq.value * eq.value + ev.value * ev.value)).sqrt() / f
+            (0.5 * (eq.value * eq.value + ev.value * ev.value)).sqrt()
         } else {
-            eq.value / f
+            eq.value
         };
         let order = 2;
         if err <= 1.0 {

@@ -44,6 +44,7 @@
 //! |Φ̇_i|/max(1, |v|) below the constraint tolerance.
 
 use super::at::{Affine, At, Weights};
+use super::constrained::closure_floor;
 use super::problem::Problem;
 use super::step_control::Argmax;
 use crate::error::Failure;
@@ -120,6 +121,8 @@ pub(crate) struct AccelNewton {
     tol_phi: f64,
     l0: Vec<f64>,
     phi_max: f64,
+    /// what rounding leaves of Φ at the last residual ([`closure_floor`])
+    phi_floor: f64,
     /// stabilized index 2: the second multiplier ν (scaled: q = q̂ + β'(a + B₀ᵀν)), its
     /// guess, B₀ = B(q₀) of the step's start, and Φ_t
     index2: bool,
@@ -156,6 +159,7 @@ impl AccelNewton {
             tol_phi: f64::INFINITY,
             l0: Vec::new(),
             phi_max: 0.0,
+            phi_floor: 0.0,
             index2: false,
             nu: Vec::new(),
             b0: Vec::new(),
@@ -398,7 +402,9 @@ impl AccelNewton {
                 let norm = (s / (2 * n + nc).max(1) as f64).sqrt();
                 let plain = (plain / (2 * n + nc).max(1) as f64).sqrt();
                 // index 3: Φ after this update, predicted from its value before
-                let phi_ok = |eta: f64| nc == 0 || self.phi_max * eta.min(1.0) <= self.tol_phi;
+                let phi_ok = |eta: f64| {
+                    nc == 0 || self.phi_max * eta.min(1.0) <= self.tol_phi.max(self.phi_floor)
+                };
                 settled = tol.follows_motion && plain <= 1e-3 * tol.kappa && phi_ok(1.0);
                 last = norm;
                 if !norm.is_finite() {
@@ -469,6 +475,9 @@ impl AccelNewton {
                 self.r[n + k] = s * c.phi[k];
             }
             self.phi_max = c.worst().0;
+            // Φ (and Φ̇ per unit of velocity scale, whose rounding is within it) closes to
+            // the tolerance or to what rounding leaves of it
+            self.phi_floor = closure_floor(&c.b, nc, &self.q);
             if self.index2 {
                 p.model.constraint_rate(t, &self.q, &mut self.phi_t);
                 p.stats.constraints += 1;

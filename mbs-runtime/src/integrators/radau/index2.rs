@@ -3,6 +3,7 @@
 //! bordered by both constraint rows, and the error estimate for an index-2 DAE.
 
 use super::super::State;
+use super::super::constrained::rate_floor;
 use super::super::problem::Problem;
 use super::estimate::floored;
 use super::{Radau, Tol};
@@ -94,20 +95,22 @@ impl Radau {
         Ok(())
     }
 
-    /// Index 2: the largest |Φ̇| = |B(Q_s)V_s + Φ_t| of the last stage (the new state), at t.
-    pub(super) fn final_rate(&mut self, p: &mut Problem, t: f64) -> f64 {
+    /// Index 2: whether |Φ̇| = |B(Q_s)V_s + Φ_t| of the last stage (the new state), at t, is
+    /// within the constraint tolerance, or within what rounding leaves of it (`rate_floor`).
+    pub(super) fn final_rate_closed(&mut self, p: &mut Problem, t: f64) -> bool {
         let (s, n, nc) = (self.k.s, self.n, self.nc);
         let (lo, hi) = ((s - 1) * n, s * n);
         let Some(c) = p.loops.closed_mut() else {
-            return 0.0;
+            return true;
         };
         c.eval_b(p.model.erased(), &mut p.stats, t, &self.qs[lo..hi]);
         p.model.constraint_rate(t, &self.qs[lo..hi], &mut self.phit);
         p.stats.constraints += 1;
         let v = &self.vs[lo..hi];
-        (0..nc)
+        let rate = (0..nc)
             .map(|k| (self.phit[k] + (0..n).map(|j| c.b[k + nc * j] * v[j]).sum::<f64>()).abs())
-            .fold(0.0, f64::max)
+            .fold(0.0, f64::max);
+        rate <= self.tol_phi.max(rate_floor(&c.b, nc, v, &self.phit))
     }
 
     /// Index 2: the weighted RMS of the stage position corrections h Σ_j a_ij B₀ᵀδM_j

@@ -3,6 +3,7 @@
 //! bordered blocks.
 
 use super::super::State;
+use super::super::constrained::{closure_floor, rate_floor};
 use super::super::problem::Problem;
 use super::Radau;
 use crate::error::Failure;
@@ -119,6 +120,8 @@ impl Radau {
             }
             self.phis[i * nc..(i + 1) * nc].copy_from_slice(&c.phi);
             self.phi_max = self.phi_max.max(c.worst().0);
+            let floor = closure_floor(&c.b, nc, &self.qs[lo..hi]);
+            self.phi_floor = self.phi_floor.max(floor);
             if self.index2 {
                 p.model.constraint_rate(t, &self.qs[lo..hi], &mut self.phit);
                 p.stats.constraints += 1;
@@ -128,6 +131,8 @@ impl Radau {
                     self.psis[i * nc + k] = x;
                     self.psi_max = self.psi_max.max(x.abs());
                 }
+                let floor = rate_floor(&c.b, nc, v, &self.phit);
+                self.psi_floor = self.psi_floor.max(floor);
             }
         }
         p.check("τ − Bᵀλ", &self.res[lo..hi])

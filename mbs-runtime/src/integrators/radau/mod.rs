@@ -482,6 +482,10 @@ pub(crate) struct Radau {
     dlam: Vec<f64>,
     scl: Vec<f64>,
     phi_max: f64,
+    /// what rounding leaves of the stages' Φ and (index 2) Φ̇, the largest over the stages
+    /// (`closure_floor`, `rate_floor`): each closes to the tolerance or to this
+    phi_floor: f64,
+    psi_floor: f64,
     /// error estimate: the velocity row's bracket, Φ in the constraint row, λ₀ + e_λ
     bv: Vec<f64>,
     phix: Vec<f64>,
@@ -568,6 +572,8 @@ impl Radau {
             dlam: Vec::new(),
             scl: Vec::new(),
             phi_max: 0.0,
+            phi_floor: 0.0,
+            psi_floor: 0.0,
             bv: Vec::new(),
             phix: Vec::new(),
             lx: Vec::new(),

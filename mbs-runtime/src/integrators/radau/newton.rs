@@ -307,6 +307,8 @@ impl Radau {
             self.stages(cur, h);
             self.phi_max = 0.0;
             self.psi_max = 0.0;
+            self.phi_floor = 0.0;
+            self.psi_floor = 0.0;
             for i in 0..s {
                 let (lo, hi) = (i * n, (i + 1) * n);
                 let ti = cur.t + self.k.c[i] * h;
@@ -379,14 +381,14 @@ impl Radau {
             // before; at index 2 |Φ̇_i| before it (the prediction falls short there: 4e-11
             // after an update predicted below 1e-11 on the pendulum at rtol 1e-4)
             let phi_ok = self.nc == 0
-                || (self.phi_max * self.faccon.min(1.0) <= self.tol_phi
-                    && self.psi_max <= self.tol_phi);
+                || (self.phi_max * self.faccon.min(1.0) <= self.tol_phi.max(self.phi_floor)
+                    && self.psi_max <= self.tol_phi.max(self.psi_floor));
             residual_only = self.faccon * dyno <= tol.kappa;
             if residual_only && phi_ok {
                 self.stages(cur, h);
                 // index 2: the new state's |Φ̇| too (the simplified Newton's Z is frozen at
                 // the start of the step, so an update may leave Φ̇ above what it was before)
-                if !self.index2 || self.final_rate(p, cur.t + h) <= self.tol_phi {
+                if !self.index2 || self.final_rate_closed(p, cur.t + h) {
                     return Ok(newt);
                 }
             }

@@ -56,7 +56,7 @@
 //! largest mixed error over (q, qd) (Test Set for IVP Solvers, floor 0.01) as digits on
 //! pendulum3, the Cartesian double pendulum, the four-bar, slider-crank (a) and fastlink. From
 //! rtol 1e-4 to 1e-7 the digits gain 1.0–1.1 per decade at index 2 (gen-α at ρ∞ 0.8: pendulum3
-//! 4.07 5.07 6.07 7.07, four-bar 2.47 3.63 4.69 5.71, fastlink 1.86 3.08 4.17 5.21), 1.0–1.4
+//! 4.07 5.07 6.07 7.07, four-bar 2.47 3.63 4.69 5.71, fastlink 1.86 3.08 4.18 5.22), 1.0–1.4
 //! with projection or partitioning, 0.8–1.1 on average at index 3; they land from 0.1 digits
 //! better than rtol to 2.2 short at index 2, 0.2–2.8 short with projection or partitioning and
 //! 0.5–2.4 short at index 3, the amplifying loops (four-bar, slider-crank, fastlink) the

@@ -762,6 +762,12 @@ pub(crate) fn closure_floor(b: &[f64], nc: usize, q: &[f64]) -> f64 {
             column * q[j].abs().max(1.0)
         })
         .fold(0.0f64, f64::max);
+    rounding_of(size)
+}
+
+/// What rounding leaves of a sum whose largest term is `size`: 100 ε of it, 0 when it is not
+/// finite (a state that is not finite is refused elsewhere, and must not raise a tolerance).
+fn rounding_of(size: f64) -> f64 {
     if size.is_finite() {
         100.0 * f64::EPSILON * size
     } else {
@@ -780,14 +786,11 @@ pub(crate) fn rate_floor(b: &[f64], nc: usize, v: &[f64], phi_t: &[f64]) -> f64 
             .fold(0.0f64, |m, x| m.max(x.abs()));
         column * v[j].abs()
     });
-    let size = terms
-        .chain(phi_t.iter().map(|x| x.abs()))
-        .fold(0.0f64, f64::max);
-    if size.is_finite() {
-        100.0 * f64::EPSILON * size
-    } else {
-        0.0
-    }
+    rounding_of(
+        terms
+            .chain(phi_t.iter().map(|x| x.abs()))
+            .fold(0.0f64, f64::max),
+    )
 }
 
 /// σ = `block` / max|B_ij|, at least 1: about what a multiplier λ moves per unit of Φ's
@@ -1111,6 +1114,21 @@ pub(crate) fn assemble_erased(
     };
     let sign0 = det_sign(&b);
     let q_start = q.to_vec();
+    // Newton's direction at q: B, what rounding leaves of Φ there, and the least correction
+    // (None: B over the free coordinates is rank-deficient)
+    let direction = |q: &[f64], phi: &[f64], b: &mut [f64], mm: &mut [f64]| {
+        model.constraint_jacobian(t, q, b);
+        model.mass_matrix(t, q, mm);
+        (closure_floor(b, nc, q), least_correction(b, mm, &free, phi))
+    };
+    // q less `step` times the correction, and its Φ and largest |Φ|
+    let (mut trial, mut phi_trial) = (q.to_vec(), vec![0.0; nc]);
+    let try_step = |q: &[f64], dx: &[f64], step: f64, trial: &mut [f64], phi: &mut [f64]| {
+        for (k, &j) in free.iter().enumerate() {
+            trial[j] = q[j] - step * dx[k];
+        }
+        eval(trial, phi).0
+    };
     let mut it = 0;
     let mut res = before;
     // what rounding leaves of Φ, from B at the iterate before (none at the first)
@@ -1123,23 +1141,17 @@ pub(crate) fn assemble_erased(
                 it,
             ));
         }
-        model.constraint_jacobian(t, q, &mut b);
-        floor = closure_floor(&b, nc, q);
-        model.mass_matrix(t, q, &mut mm);
-        let Some(dx) = least_correction(&b, &mm, &free, &phi) else {
+        let (f, dx) = direction(q, &phi, &mut b, &mut mm);
+        floor = f;
+        let Some(dx) = dx else {
             return Err(deficient(&b, &phi, it));
         };
         // at most MAX_MOVE per coordinate and step, so that a far start does not wander off
         // by whole turns
         let biggest = dx.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         let mut step = (MAX_MOVE / biggest).min(1.0);
-        let mut trial = q.to_vec();
-        let mut phi_trial = vec![0.0; nc];
         loop {
-            for (k, &j) in free.iter().enumerate() {
-                trial[j] = q[j] - step * dx[k];
-            }
-            let (r, _) = eval(&trial, &mut phi_trial);
+            let r = try_step(q, dx.as_slice(), step, &mut trial, &mut phi_trial);
             if r < res || step < 1e-4 {
                 res = r;
                 break;
@@ -1165,18 +1177,12 @@ pub(crate) fn assemble_erased(
         if res <= floor {
             break;
         }
-        model.constraint_jacobian(t, q, &mut b);
-        floor = closure_floor(&b, nc, q);
-        model.mass_matrix(t, q, &mut mm);
-        let Some(dx) = least_correction(&b, &mm, &free, &phi) else {
+        let (f, dx) = direction(q, &phi, &mut b, &mut mm);
+        floor = f;
+        let Some(dx) = dx else {
             break;
         };
-        let mut trial = q.to_vec();
-        let mut phi_trial = vec![0.0; nc];
-        for (k, &j) in free.iter().enumerate() {
-            trial[j] = q[j] - dx[k];
-        }
-        let (r, _) = eval(&trial, &mut phi_trial);
+        let r = try_step(q, dx.as_slice(), 1.0, &mut trial, &mut phi_trial);
         if !(r < 0.5 * res) {
             break;
         }

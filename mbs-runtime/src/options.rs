@@ -371,7 +371,8 @@ pub enum ConstraintMethod {
     /// exact solution; q₁ += Bᵀν in the Newmark family, the stabilized index-2
     /// generalized-α of Arnold, Brüls & Cardona); velocities satisfy their constraints at
     /// every step, and the error test covers positions and velocities (radau3, radau5:
-    /// q and qd of order 2s − 1, λ of order s)
+    /// q and qd of order 2s − 1, λ of order s, its error counted by the velocities
+    /// h M_ii⁻¹(Bᵀe_λ)_i it moves in a step)
     Index2,
     /// the index-1 form (B qdd = γ, λ eliminated) with Baumgarte's stabilisation
     /// Φ̈ + 2αΦ̇ + β²Φ = 0 (α, β in 1/s; α = β = 0 is the plain index-1 form, which drifts);

@@ -142,6 +142,27 @@ impl Radau {
         self.weighted_norm(tol)
     }
 
+    /// The weighted norm of `err`'s positions and velocities alone, the weights taken from
+    /// the states before and after the step (index 2, where λ's error is in the velocities').
+    pub(super) fn error_over_motion(&mut self, cur: &State, next: &State, tol: &Tol) -> f64 {
+        let n = self.n;
+        self.y0[..n].copy_from_slice(&cur.q);
+        self.y0[n..2 * n].copy_from_slice(&cur.qd);
+        self.y1[..n].copy_from_slice(&next.q);
+        self.y1[n..2 * n].copy_from_slice(&next.qd);
+        self.motion_norm(tol)
+    }
+
+    /// [`Self::weighted_norm`] over the positions and velocities alone.
+    pub(super) fn motion_norm(&mut self, tol: &Tol) -> f64 {
+        let n = self.n;
+        let norm = tol
+            .weights
+            .norm(&self.err[..2 * n], &self.y0[..2 * n], &self.y1[..2 * n], n);
+        self.test = norm;
+        norm.value
+    }
+
     /// Index 3: RADAU5's estimate for the DAE E y' = f(y), y = (q, v, λ), f = (v, h + Bᵀλ,
     /// Φ), with the velocity errors weighted by h and the multipliers' by h² (RADAU5's
     /// scaling of index-2 and index-3 components).

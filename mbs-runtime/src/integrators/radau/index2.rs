@@ -140,8 +140,10 @@ impl Radau {
     /// [M + gC + g²K̃, −Bᵀ, g²K̃Bᵀ; B, 0, BBᵀ; B, 0, 0] (e_v, g e_λ, e_μ)
     ///   = (b_v − gK̃ r_q, −(Φ + B r_q)/g, −Φ̇/g),   e_q = r_q + g (e_v + Bᵀe_μ);
     ///
-    /// into `err` as (e_q, e_v, h e_λ); `phix` and `psix` hold Φ and Φ̇ (zero for the first
-    /// estimate).
+    /// into `err` as (e_q, e_v + h M_d⁻¹Bᵀe_λ): λ's error by the velocities it moves in one
+    /// step, each coordinate by its own inertia M_ii (M_d, the diagonal of M; module notes,
+    /// "λ in the error test"); `phix` and `psix` hold Φ and Φ̇ (zero for the first estimate).
+    /// `tmp` keeps (e_v, g e_λ, e_μ) for the estimate's second evaluation.
     fn filter2(&mut self, p: &mut Problem, g: f64, h: f64) {
         let (n, nc) = (self.n, self.nc);
         self.filter_rhs(g);
@@ -150,21 +152,23 @@ impl Radau {
         }
         self.lu_r.solve(&mut self.tmp);
         p.stats.solves += 1;
+        let diag_max = (0..n).fold(0.0f64, |m, i| m.max(self.m[i + n * i]));
         for i in 0..n {
             let btm: f64 = (0..nc)
                 .map(|k| self.bm[k + nc * i] * self.tmp[n + nc + k])
                 .sum();
             self.err[i] = self.rq[i] + g * (self.tmp[i] + btm);
-            self.err[n + i] = self.tmp[i];
-        }
-        for k in 0..nc {
-            self.err[2 * n + k] = h * self.tmp[n + k] / g;
+            // Bᵀe_λ, a generalised force of coordinate i, over M_ii (not below 1e-12 of the
+            // largest, which a positive definite M never is below in practice) and times h
+            let btl: f64 = (0..nc).map(|k| self.bm[k + nc * i] * self.tmp[n + k]).sum();
+            let inertia = self.m[i + n * i].max(1e-12 * diag_max);
+            self.err[n + i] = self.tmp[i] + h * btl / (g * inertia);
         }
     }
 
     /// Index 2: RADAU5's estimate for the index-2 DAE E y' = f(y); q and qd are differential
-    /// components (unscaled), λ an index-2 one (weighted by h, RADAU5's scaling), μ (zero on
-    /// the exact solution) left out.
+    /// components (unscaled), λ an index-2 one, measured by the velocities h M_d⁻¹Bᵀe_λ it
+    /// moves (`filter2`), μ (zero on the exact solution) left out.
     pub(super) fn estimate2(
         &mut self,
         p: &mut Problem,
@@ -188,7 +192,7 @@ impl Radau {
         self.phix.fill(0.0);
         self.psix.fill(0.0);
         self.filter2(p, g, h);
-        let mut err = self.error_with_multipliers(cur, next, tol);
+        let mut err = self.error_over_motion(cur, next, tol);
         if err >= 1.0 && (self.first || self.reject) {
             // RADAU5: f(y₀ + err) in place of f(y₀); its position row less f_q(y₀) is
             // e_v + B₀ᵀe_μ (e_μ still in `tmp`)
@@ -196,12 +200,12 @@ impl Radau {
                 let btm: f64 = (0..nc)
                     .map(|k| self.bm[k + nc * r] * self.tmp[n + nc + k])
                     .sum();
-                self.rq[r] += g * (self.err[n + r] + btm);
+                self.rq[r] += g * (self.tmp[r] + btm);
             }
-            let hr = 1.0 / h;
+            // e_v and e_λ as the filter solved them (`tmp`), not as the norm weighs them
             for r in 0..n {
                 self.qx[r] = cur.q[r] + self.err[r];
-                self.vx[r] = cur.qd[r] + self.err[n + r];
+                self.vx[r] = cur.qd[r] + self.tmp[r];
             }
             for k in 0..nc {
                 let lambda0 = if self.own_end_valid() {
@@ -209,7 +213,7 @@ impl Radau {
                 } else {
                     cur.lambda[k]
                 };
-                self.lx[k] = lambda0 + self.err[2 * n + k] * hr;
+                self.lx[k] = lambda0 + self.tmp[n + k] / g;
             }
             if self.residual_at(p, cur) {
                 if let Some(c) = p.loops.closed_mut() {
@@ -225,7 +229,7 @@ impl Radau {
                 }
                 if self.psix.iter().all(|x| x.is_finite()) {
                     self.filter2(p, g, h);
-                    err = self.weighted_norm(tol);
+                    err = self.motion_norm(tol);
                 }
             }
         }

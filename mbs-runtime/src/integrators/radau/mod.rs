@@ -227,9 +227,27 @@
 //! Error estimate: RADAU5's for the index-2 DAE, E = diag(I, M, 0, 0) on (q, v, λ, μ): the
 //! real block above solves (e_v, g e_λ, e_μ) from (M r_v − gK̃ r_q, −B r_q/g, 0), e_q = r_q +
 //! g(e_v + B₀ᵀe_μ), where r_q has the embedded formula's μ part h Σ (b̂ − b)_j B₀ᵀM_j. q and qd
-//! are both differential components, so the norm runs over (e_q, e_v) unscaled; λ, index 2, is
-//! in it weighted by h (RADAU5's scaling); μ (zero on the exact solution) is left out. The
-//! error test is `ErrorTest::PositionsVelocities`. The estimate's f(y₀) takes the scheme's own
+//! are both differential components, so the norm runs over (e_q, e_v) unscaled; μ (zero on the
+//! exact solution) is left out. The error test is `ErrorTest::PositionsVelocities`.
+//!
+//! λ in the error test. RADAU5 weighs an index-2 component's error by h, so that its order
+//! matches the others'; for λ that is h e_λ against atol + rtol|λ|, a ratio in seconds: the
+//! same mechanism written in other units, or larger, is judged differently (the four-bar by
+//! dynamic similarity, rtol 1e-7: Radau5 took 198 steps at × 1, 383 at × 10³ and 1,506 at
+//! × 10⁸, λ holding three quarters of them, and Radau3 fell below h_min from × 10⁷,
+//! `tests/loops.rs`, `the_four_bar_at_every_scale_runs_or_stops_typed`). Here e_λ counts by
+//! what it does to the motion in one step: the velocities h M_ii⁻¹(Bᵀe_λ)_i, each coordinate
+//! by its own inertia (the diagonal of M: cheap, and in the units of qd whatever the units of
+//! the model), added to e_v. Radau5 now takes 196–331 steps over that sweep and Radau3 runs at
+//! every scale. At × 1 its runs take more steps for each rtol and give more digits
+//! (`tests/tolerance_proportionality.rs`, Radau5: 0.3 to 1.9 digits above projection, where
+//! from 0.4 below to 1.9 above; fastlink at rtol 1e-6 5.05 digits in 986 steps, where 3.40 in
+//! 485, steps from `examples/work_precision.rs`); for the steps they take, about as many
+//! digits on fastlink and slider-crank (a), and fewer on the four-bar with Radau5: about 0.8
+//! at 400 steps, 2.4 at 1,150, where the h-weighted runs gained 1.6 digits from rtol 1e-9 to
+//! 1e-10 (9.61 digits in 1,150 steps; now 8.33 in 1,924). Also measured: the
+//! full M⁻¹ in place of its diagonal (the same within 0.2 digits), and λ left out of the test
+//! (nearly scale-free too, but the four-bar at rtol 1e-10 gave 7.10 digits). The estimate's f(y₀) takes the scheme's own
 //! end values (the last stage's A_s and Λ_s); the state an accepted step hands on has qdd and λ
 //! from the index-1 equations at its (q, qd) instead (`consistent_end`: one evaluation of M and
 //! h and one bordered solve per step). The stage Λ_s is of order s only, and the interpolant
@@ -680,9 +698,10 @@ impl Stepper for Radau {
         // (BM⁻¹Bᵀ)⁻¹ B below, taken as σ from M and B at the last Jacobian
         let sigma = || super::constrained::multiplier_scale(largest(&self.m), &self.bm);
         if self.index2 {
-            // λ, an index-2 component, weighted by h as RADAU5 weights them (in Newton and
-            // in the error test); neither λ nor the velocities below their rounding noise
-            // (Newton stops when its predicted error is below κ times the weights): rounding
+            // λ, an index-2 component, weighted by h in Newton as RADAU5 weights them (the
+            // error test counts it by the velocities it moves, module notes); neither λ nor
+            // the velocities below their rounding noise (Newton stops when its predicted
+            // error is below κ times the weights): rounding
             // errors in the stage values of Φ̇ move the stage velocities by a few ε max|qd|
             // (4 ε max|qd| here: measured about 3 on the four-bar, where the floor matters
             // when the rocker's velocity passes through zero with rtol' near 1e-11) and the

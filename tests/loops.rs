@@ -1099,14 +1099,17 @@ fn a_change_point_of_a_loop_stops_the_run_rather_than_switching_branch() {
 /// The four-bar from a 0.4 µm mechanism to one of 40,000 km (× 10⁻⁶ … 10⁸, dynamically
 /// similar), under every scheme and constraint method that solves it (DOPRI5, Radau5,
 /// Radau3, BDF, gen-α, HHT; index 3, index 2, projection, partitioning), at rtol 1e-7 and the
-/// default constraint tolerance (1e-11 m): every run but two ends at t = √s with the
-/// small four-bar's angles to 1e-4 (3e-4 at index 3, whose test sees the positions alone);
-/// Radau3 at index 3 from × 10⁷ stops typed, its trajectory kept (its test weighs the
-/// velocities' errors by h and λ's by h², in seconds: the larger the mechanism, the larger
-/// its steps and the tighter these weights). At index 2 Radau weighed λ's error by h too,
-/// and Radau3 stopped there also from × 10⁷ (and Radau5 took 1,506 steps at × 10⁸ against
-/// 198 at × 1); λ now counts by the velocities it moves in a step, h M_ii⁻¹(Bᵀe_λ)_i,
-/// which is the same at every scale (Radau5 196–331 steps over the sweep). Before, at × 10⁻⁶
+/// default constraint tolerance (1e-11 m): every run ends at t = √s with the small
+/// four-bar's angles to 1e-4 (3e-4 at index 3, whose test sees the positions alone), or
+/// would stop typed, its trajectory kept. Radau weighed the velocities' errors by h and λ's
+/// by h² at index 3 and λ's by h at index 2, as RADAU5 does, ratios in seconds: Radau5 at
+/// index 3 took 146 steps at × 1 and 180,363 at × 10⁸, and Radau3 stopped from × 10⁷ at
+/// index 3 (out of steps) and 2 (below h_min). These errors now count by what they move in
+/// one step, the velocities at index 2 (h M_ii⁻¹(Bᵀe_λ)_i) and the positions at index 3
+/// (h e_v + h² M_ii⁻¹(Bᵀe_λ)_i), the same at every scale: Radau5 at index 3 takes 216–265
+/// steps over the sweep, at index 2 196–331. And the drift check after a step allows ten
+/// times what rounding leaves of Φ (at × 10⁷ Radau5's index-3 steps of 6 s ended at
+/// |Φ| = 1.46e-6 m, beyond the absolute drift_tol of 1e-6 m). Before, at × 10⁻⁶
 /// Radau3 at index 2 stopped in Newton at t = 0 (its start closed only to the absolute
 /// tolerance, 1e-4 of the crank) and gen-α and HHT at index 2 at h_min (their velocities'
 /// weights atol·f below rounding); from × 10⁶ Radau at index 3 and 2 stopped in Newton at h_min
@@ -1179,10 +1182,7 @@ fn the_four_bar_at_every_scale_runs_or_stops_typed() {
         "{ran} runs ended at t = √s, {} stopped: {stopped:?}",
         stopped.len()
     );
-    let expected: Vec<_> = [1e7, 1e8]
-        .map(|scale| (scale, "radau3", ConstraintMethod::Index3))
-        .to_vec();
-    assert_eq!(stopped, expected);
+    assert!(stopped.is_empty(), "{stopped:?}");
 }
 
 /// The four-bar × `scale` by dynamic similarity (lengths × s, time × √s, the crank's start

@@ -361,9 +361,9 @@ pub enum ConstraintMethod {
     /// (generalized-α, HHT, Newmark with the scaled iteration matrix of Bottasso, Dopico &
     /// Trainelli 2008; refused for the undamped members with adaptive steps), or at every
     /// stage with (A_i, Λ_i) as unknowns (radau3, radau5, as Hairer's RADAU5 solves index-3
-    /// DAEs: positions of order 2s − 1, velocities s, λ s − 1; the error test weights velocity
-    /// errors by h and λ errors by h², `ErrorTest::PositionsScaledVelocities`, so rtol bounds
-    /// the positions only)
+    /// DAEs: positions of order 2s − 1, velocities s, λ s − 1; the error test counts velocity
+    /// and λ errors by the positions they move in a step, h e_v + h² M_ii⁻¹(Bᵀe_λ)_i,
+    /// `ErrorTest::PositionsScaledVelocities`, so rtol bounds the positions only)
     Index3,
     /// the stabilized index-2 form of Gear, Gupta & Leimkuhler (1985): Φ(q) = 0 and
     /// Φ̇ = B qd + Φ_t = 0 both enforced, the second by a multiplier μ that corrects the

@@ -105,8 +105,9 @@ pub enum ErrorTest {
     /// multipliers' does not)
     Positions,
 
-    /// positions, with velocities weighted by h and multipliers by h² (Radau IIA at index 3,
-    /// as Hairer's RADAU5): velocities and multipliers follow the step size, not rtol
+    /// positions, and the positions that the velocities' and multipliers' errors move in one
+    /// step, h e_v + h² M_ii⁻¹(Bᵀe_λ)_i (Radau IIA at index 3; Hairer's RADAU5 weighs them by
+    /// h and h² in their own units): velocities and multipliers follow the step size, not rtol
     PositionsScaledVelocities,
 }
 
@@ -118,7 +119,7 @@ impl fmt::Display for ErrorTest {
             ErrorTest::Positions => "positions only",
 
             ErrorTest::PositionsScaledVelocities => {
-                "positions; velocities weighted by h and multipliers by h²"
+                "positions, and what the velocities' and multipliers' errors move them in a step"
             }
         })
     }

@@ -98,19 +98,35 @@ impl Radau {
 
     /// Index 3: the filter (E − gJ)⁻¹ on y = (q, v, λ), E = diag(I, M, 0), in second-order
     /// form with the real block: [M + gC + g²K̃, −Bᵀ; B, 0] (e_v, g e_λ) =
-    /// (b_v − gK̃ r_q, −(Φ + B r_q)/g), e_q = r_q + g e_v; into `err` as (e_q, h e_v, h² e_λ).
+    /// (b_v − gK̃ r_q, −(Φ + B r_q)/g), e_q = r_q + g e_v; into `err` as
+    /// (e_q, h e_v + h² M_d⁻¹Bᵀe_λ), both in positions (M_d the diagonal of M; the module
+    /// notes on the error estimate). `tmp` keeps (e_v, g e_λ) for the second evaluation.
     pub(super) fn filter3(&mut self, p: &mut Problem, g: f64, h: f64) {
         let (n, nc) = (self.n, self.nc);
         self.filter_rhs(g);
         self.lu_r.solve(&mut self.tmp);
         p.stats.solves += 1;
+        let diag_max = (0..n).fold(0.0f64, |m, i| m.max(self.m[i + n * i]));
         for i in 0..n {
             self.err[i] = self.rq[i] + g * self.tmp[i];
-            self.err[n + i] = h * self.tmp[i];
+            // the positions that e_v and e_λ move in one step: h e_v, and h² times the
+            // acceleration Bᵀe_λ gives coordinate i over its own inertia M_ii (not below
+            // 1e-12 of the largest)
+            let btl: f64 = (0..nc).map(|k| self.bm[k + nc * i] * self.tmp[n + k]).sum();
+            let inertia = self.m[i + n * i].max(1e-12 * diag_max);
+            self.err[n + i] = h * (self.tmp[i] + h * btl / (g * inertia));
         }
-        for k in 0..nc {
-            self.err[2 * n + k] = h * h * self.tmp[n + k] / g;
-        }
+    }
+
+    /// The weighted norm of `err`'s two position-valued blocks (index 3: e_q, and what e_v
+    /// and e_λ move the positions in a step), both against the positions' weights.
+    fn error_in_positions(&mut self, cur: &State, next: &State, tol: &Tol) -> f64 {
+        let n = self.n;
+        self.y0[..n].copy_from_slice(&cur.q);
+        self.y0[n..2 * n].copy_from_slice(&cur.q);
+        self.y1[..n].copy_from_slice(&next.q);
+        self.y1[n..2 * n].copy_from_slice(&next.q);
+        self.motion_norm(tol)
     }
 
     /// bv = M r_v: the velocity row's bracket of the constrained estimates (index 3 and 2).
@@ -127,19 +143,6 @@ impl Radau {
         let norm = tol.weights.norm(&self.err, &self.y0, &self.y1, self.n);
         self.test = norm;
         norm.value
-    }
-
-    /// The weighted norm of `err` over (q, qd, λ), the weights taken from the states before
-    /// and after the step (stacked into `y0`, `y1`).
-    pub(super) fn error_with_multipliers(&mut self, cur: &State, next: &State, tol: &Tol) -> f64 {
-        let (n, nc) = (self.n, self.nc);
-        self.y0[..n].copy_from_slice(&cur.q);
-        self.y0[n..2 * n].copy_from_slice(&cur.qd);
-        self.y0[2 * n..].copy_from_slice(&cur.lambda[..nc]);
-        self.y1[..n].copy_from_slice(&next.q);
-        self.y1[n..2 * n].copy_from_slice(&next.qd);
-        self.y1[2 * n..].copy_from_slice(&next.lambda[..nc]);
-        self.weighted_norm(tol)
     }
 
     /// The weighted norm of `err`'s positions and velocities alone, the weights taken from
@@ -164,8 +167,8 @@ impl Radau {
     }
 
     /// Index 3: RADAU5's estimate for the DAE E y' = f(y), y = (q, v, λ), f = (v, h + Bᵀλ,
-    /// Φ), with the velocity errors weighted by h and the multipliers' by h² (RADAU5's
-    /// scaling of index-2 and index-3 components).
+    /// Φ), the velocities' and multipliers' errors counted by the positions they move in a
+    /// step (h e_v + h² M_d⁻¹Bᵀe_λ), where RADAU5 weighs them by h and h² in their own units.
     pub(super) fn estimate3(
         &mut self,
         p: &mut Problem,
@@ -182,25 +185,24 @@ impl Radau {
         self.mass_times_rv();
         self.phix.fill(0.0);
         self.filter3(p, g, h);
-        let mut err = self.error_with_multipliers(cur, next, tol);
+        let mut err = self.error_in_positions(cur, next, tol);
         if err >= 1.0 && (self.first || self.reject) {
             // RADAU5: f(y₀ + err) in place of f(y₀); its velocity row, less M qdd₀, is
             // −(τ(q₀ + e_q, v₀ + e_v, qdd₀) − Bᵀ(λ₀ + e_λ)) up to O(e_q) terms
-            let hr = 1.0 / h;
             for r in 0..n {
                 self.qx[r] = cur.q[r] + self.err[r];
-                self.vx[r] = cur.qd[r] + self.err[n + r] * hr;
+                self.vx[r] = cur.qd[r] + self.tmp[r];
             }
             for k in 0..nc {
-                self.lx[k] = cur.lambda[k] + self.err[2 * n + k] * hr * hr;
+                self.lx[k] = cur.lambda[k] + self.tmp[n + k] / g;
             }
             if self.residual_at(p, cur) {
                 for r in 0..n {
-                    self.rq[r] += g * self.err[n + r] * hr;
+                    self.rq[r] += g * self.tmp[r];
                     self.bv[r] -= g * self.ax[r];
                 }
                 self.filter3(p, g, h);
-                err = self.weighted_norm(tol);
+                err = self.motion_norm(tol);
             }
         }
         floored(err)

@@ -158,19 +158,29 @@
 //! ```
 //!
 //! Newton's real block for s = 3 (an extra factorisation for s = 2, as before), Φ(q₀) taken as 0
-//! (it is below the constraint tolerance). As RADAU5 does for index-2 and index-3 components
-//! (its NIND2, NIND3), the norm weights the velocity errors by h and the λ errors by h²: it is
-//! taken on (e_q, h e_v, h² e_λ) against atol + rtol·max(|y₀|, |y₁|) of q, qd and λ, so that each
-//! part is O(h^(s+1)) like the position part. The second estimate after a rejection uses f(y₀ +
-//! err): velocity row −(τ(q₀ + e_q, v₀ + e_v, qdd₀) − B(q₀ + e_q)ᵀ(λ₀ + e_λ)) in place of 0,
-//! constraint row Φ(q₀ + e_q).
+//! (it is below the constraint tolerance). RADAU5 weighs the errors of index-2 and index-3
+//! components (its NIND2, NIND3) by h and h², so that each part is O(h^(s+1)) like the
+//! position part: (e_q, h e_v, h² e_λ) against atol + rtol·max(|y₀|, |y₁|) of q, qd and λ.
+//! Those ratios are in seconds and seconds squared, and a mechanism in other units, or
+//! larger, was judged otherwise (the four-bar by dynamic similarity at rtol 1e-7: Radau5 took
+//! 146 steps at × 1, 3,064 at × 10⁶ and 180,363 at × 10⁸, λ holding most of them from × 10³;
+//! Radau3 ran out of steps from × 10⁷). Here the same orders of h count what these errors move
+//! the positions by in one step: the norm is taken on (e_q, h e_v + h² M_d⁻¹Bᵀe_λ), both
+//! against the positions' weights atol + rtol·max(|q₀|, |q₁|) (M_d, the diagonal of M: each
+//! coordinate's acceleration from Bᵀe_λ over its own inertia). Radau5 now takes 216–265 steps
+//! from × 10⁻⁶ to × 10⁸, Radau3 about 4,000 (`tests/loops.rs`,
+//! `the_four_bar_at_every_scale_runs_or_stops_typed`); at × 1 more steps for each rtol (146 →
+//! 232 there) and, in the proportionality sweep, from 0.9 fewer digits to 2.0 more at each
+//! rtol, still short of rtol and not asserted (`tests/tolerance_proportionality.rs`). The
+//! second estimate after a rejection uses f(y₀ + err): velocity row −(τ(q₀ + e_q, v₀ + e_v,
+//! qdd₀) − B(q₀ + e_q)ᵀ(λ₀ + e_λ)) in place of 0, constraint row Φ(q₀ + e_q).
 //!
 //! Orders (Hairer, Lubich & Roche 1989; Jay 1993; Hairer & Wanner §VII.4): for index-3 systems
 //! Radau IIA with s stages gives positions of order 2s − 1, velocities of order s, λ of order
 //! s − 1 (Radau5: 5, 3, 2; Radau3: 3, 2, 1), as measured on the pendulum with fixed steps
 //! (`tests/radau_index3.rs`; Radau3's positions 2.8–2.9 at h = 1/80..1/640). The velocity and λ
-//! errors are local (those of the last step) and, since the step control weights them by h
-//! and h², follow the step size rather than rtol: λ within 1e-6 takes h ≲ 2e-3 with Radau5;
+//! errors are local (those of the last step) and, since the step control weighs them by the
+//! positions they move in a step (h and h²), follow the step size rather than rtol: λ within 1e-6 takes h ≲ 2e-3 with Radau5;
 //! with Radau3 (first order in λ, about 0.12h on the pendulum) only near h = 1e-5, where the
 //! rounding noise of λ (∝ ε/h²) is already as large (fixed steps of 1/80 000: 8.9e-7; of
 //! 1/160 000: 3.6e-5).
@@ -292,7 +302,7 @@
 //! 1e-6: −0.54 → 0.94, 0.5 digits lost): the estimate is O(h^(s+1)) and the global error O(h^(2s−1)), so an
 //! estimate held at rtol' gives a global error ∝ rtol'^((2s−1)/(s+1)), and RADAU5's rtol' ∝
 //! rtol^((s+1)/(2s)) (made for the local error O(h^(2s))) leaves it ∝ rtol^((2s−1)/(2s)). At
-//! index 3 the errors do not follow rtol at all (velocities weighted by h): on the slider-crank
+//! index 3 the errors do not follow rtol at all (velocities counted by h e_v): on the slider-crank
 //! 2.2 → 5.2 (radau3) and 2.3 → 4.3 (radau5). The mapping that makes the global error follow
 //! rtol is rtol' = c·rtol^((s+1)/(2s−1)), linear for s = 2 and rtol^0.8 for s = 3. Measured
 //! with c = 0.02 (s = 2) and 0.05 (s = 3) in place of the transformation (the same runs):

@@ -339,8 +339,14 @@ pub fn failure_text(e: &SimError) -> String {
             constraint,
             value,
             tolerance,
+            closed_by_scheme,
         } => format!(
-            "constraint `{constraint}` drifted to |Φ| = {value:.2e}, beyond {tolerance:.1e} {at}: use --constraints projection, index3 or partitioning, or larger baumgarte:ALPHA,BETA"
+            "constraint `{constraint}` drifted to |Φ| = {value:.2e}, beyond {tolerance:.1e} {at}: {}",
+            if *closed_by_scheme {
+                "the scheme closes it at index 3 or 2 by Newton, to the constraint tolerance on its predicted Φ, and the new state landed beyond the drift tolerance: keep that well above the constraint tolerance, or use --constraints projection"
+            } else {
+                "use --constraints projection, index3 or partitioning, or larger baumgarte:ALPHA,BETA"
+            }
         ),
         // an undamped member of the Newmark family asked to control its step at index 3
         // or 2: a fixed step, or a member with damping (it is among the schemes that can)

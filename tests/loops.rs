@@ -723,7 +723,8 @@ fn cartesian_dpend_multipliers_are_the_hinge_forces() {
 /// constraint, with or without a coordinate marked independent; too many independent
 /// coordinates cannot close the loop; DOPRI5 does not
 /// solve index 3; the plain index-1 form (Baumgarte α = β = 0) drifts out of drift_tol on a
-/// long four-bar run, keeping the trajectory computed before.
+/// long four-bar run, keeping the trajectory computed before; at index 3 a drift_tol as tight
+/// as the constraint tolerance stops the run with advice of its own.
 #[test]
 fn typed_errors_of_constrained_runs() {
     let o = || Options::adaptive(1.0, 1e-8);
@@ -809,10 +810,11 @@ fn typed_errors_of_constrained_runs() {
     );
     let drift_tol = ConstraintOptions::default().drift_tol;
     assert!(
-        matches!(&e.kind, Failure::ConstraintDrift { tolerance, .. } if *tolerance == drift_tol),
+        matches!(&e.kind, Failure::ConstraintDrift { tolerance, closed_by_scheme: false, .. } if *tolerance == drift_tol),
         "{:?}",
         e.kind
     );
+    assert!(e.to_string().contains("Baumgarte"), "{e}");
     let tr = &e.trajectory;
     assert!(!tr.is_empty());
     assert!(e.t > 1.0 && e.t < 100.0);
@@ -823,6 +825,34 @@ fn typed_errors_of_constrained_runs() {
     );
     assert!(tr.constraint_residual(&FourBar::default()) <= drift_tol);
     assert_eq!(tr.lambda_data.len(), tr.len() * 2);
+
+    // at index 3 the scheme closes the loop itself, by Newton to constraints.tolerance on its
+    // predicted Φ; a drift_tol no larger than that tolerance is met only by chance (Radau5 at
+    // rtol 1e-4 ends a step at 1.6e-11 where 1e-11 is asked), and the message says so, not
+    // to use index 3, which the run already does
+    let tight = Options {
+        constraints: ConstraintOptions {
+            method: ConstraintMethod::Index3,
+            drift_tol: 1e-11,
+            ..ConstraintOptions::default()
+        },
+        ..Options::adaptive(2.0, 1e-4)
+    };
+    let e = simulate(FourBar::default(), Scheme::Radau5, tight).expect_err("drift_tol = tolerance");
+    println!("Radau5 at index 3, drift_tol 1e-11: {e}");
+    assert!(
+        matches!(
+            &e.kind,
+            Failure::ConstraintDrift {
+                closed_by_scheme: true,
+                ..
+            }
+        ),
+        "{:?}",
+        e.kind
+    );
+    assert!(e.to_string().contains("keep drift_tol well above"), "{e}");
+    assert!(!e.trajectory.is_empty() && *e.trajectory.t.last().unwrap() == e.t);
 }
 
 mbs::multibody! {

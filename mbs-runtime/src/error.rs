@@ -499,12 +499,16 @@ pub enum Failure {
         iterations: usize,
     },
     #[error(
-        "constraint `{constraint}` drifted to |Φ| = {value:.2e}, beyond drift_tol = {tolerance:.1e}: use Projection, Index3 or Partitioning, or stronger Baumgarte terms"
+        "constraint `{constraint}` drifted to |Φ| = {value:.2e}, beyond drift_tol = {tolerance:.1e}: {}",
+        if *.closed_by_scheme { "the scheme closes it at index 3 or 2 by Newton, to constraints.tolerance on its predicted Φ, and the new state landed beyond drift_tol: keep drift_tol well above constraints.tolerance, or use Projection" } else { "use Projection, Index3 or Partitioning, or stronger Baumgarte terms" }
     )]
     ConstraintDrift {
         constraint: String,
         value: f64,
         tolerance: f64,
+        /// whether the scheme closes the constraints itself (index 3 or 2), rather than
+        /// Baumgarte's terms holding them
+        closed_by_scheme: bool,
     },
     #[error(
         "Newton could not close constraint `{constraint}` by moving {what} (|Φ| = {residual:.2e} after {iterations} iterations): the step left the constraints farther than Newton reaches from there; at a fixed step take a smaller one, or adaptive steps, which retry it smaller (with adaptive steps it failed at h_min: near a singular configuration of the loop)"

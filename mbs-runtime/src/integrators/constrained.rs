@@ -745,6 +745,7 @@ impl Constrained {
                 constraint: self.name(at),
                 value: worst,
                 tolerance,
+                closed_by_scheme: matches!(self.mode, Mode::Index3 | Mode::Index2),
             });
         }
         if self.watch_tol > 0.0 && !self.mode.is_ode() {

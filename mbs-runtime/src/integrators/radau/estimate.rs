@@ -121,11 +121,17 @@ impl Radau {
     /// The weighted norm of `err`'s two position-valued blocks (index 3: e_q, and what e_v
     /// and e_λ move the positions in a step), both against the positions' weights.
     fn error_in_positions(&mut self, cur: &State, next: &State, tol: &Tol) -> f64 {
+        self.norm_against([&cur.q, &cur.q], [&next.q, &next.q], tol)
+    }
+
+    /// [`Self::motion_norm`] with the weights of its two blocks taken from `before` and
+    /// `after` (stacked into `y0`, `y1`).
+    fn norm_against(&mut self, before: [&[f64]; 2], after: [&[f64]; 2], tol: &Tol) -> f64 {
         let n = self.n;
-        self.y0[..n].copy_from_slice(&cur.q);
-        self.y0[n..2 * n].copy_from_slice(&cur.q);
-        self.y1[..n].copy_from_slice(&next.q);
-        self.y1[n..2 * n].copy_from_slice(&next.q);
+        for (b, (y0, y1)) in before.iter().zip(&after).enumerate() {
+            self.y0[b * n..(b + 1) * n].copy_from_slice(y0);
+            self.y1[b * n..(b + 1) * n].copy_from_slice(y1);
+        }
         self.motion_norm(tol)
     }
 
@@ -148,12 +154,7 @@ impl Radau {
     /// The weighted norm of `err`'s positions and velocities alone, the weights taken from
     /// the states before and after the step (index 2, where λ's error is in the velocities').
     pub(super) fn error_over_motion(&mut self, cur: &State, next: &State, tol: &Tol) -> f64 {
-        let n = self.n;
-        self.y0[..n].copy_from_slice(&cur.q);
-        self.y0[n..2 * n].copy_from_slice(&cur.qd);
-        self.y1[..n].copy_from_slice(&next.q);
-        self.y1[n..2 * n].copy_from_slice(&next.qd);
-        self.motion_norm(tol)
+        self.norm_against([&cur.q, &cur.qd], [&next.q, &next.qd], tol)
     }
 
     /// [`Self::weighted_norm`] over the positions and velocities alone.

@@ -1133,7 +1133,7 @@ fn a_change_point_of_a_loop_stops_the_run_rather_than_switching_branch() {
 /// four-bar's angles to 1e-4 (3e-4 at index 3, whose test sees the positions alone), or
 /// would stop typed, its trajectory kept. Radau weighed the velocities' errors by h and λ's
 /// by h² at index 3 and λ's by h at index 2, as RADAU5 does, ratios in seconds: Radau5 at
-/// index 3 took 146 steps at × 1 and 180,363 at × 10⁸, and Radau3 stopped from × 10⁷ at
+/// index 3 took 146 steps at × 1 and 188,704 at × 10⁸, and Radau3 stopped from × 10⁷ at
 /// index 3 (out of steps) and 2 (below h_min). These errors now count by what they move in
 /// one step, the velocities at index 2 (h M_ii⁻¹(Bᵀe_λ)_i) and the positions at index 3
 /// (h e_v + h² M_ii⁻¹(Bᵀe_λ)_i), the same at every scale: Radau5 at index 3 takes 216–265

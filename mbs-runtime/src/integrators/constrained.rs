@@ -735,8 +735,8 @@ impl Constrained {
         let (worst, at) = self.worst();
         // not below ten times what rounding leaves of Φ (from the last B evaluated, none
         // before the first): the four-bar 10⁷ times larger, its Φ sums of 10⁶ m and that
-        // floor 4.4e-7 m, ended Radau's index-3 steps of 6 s at |Φ| = 1.46e-6 m, which the
-        // absolute drift_tol of 1e-6 called a drift
+        // floor just under 1e-6 m, ended Radau's index-3 steps of 6 s at |Φ| = 1.46e-6 m,
+        // which the absolute drift_tol of 1e-6 called a drift
         let tolerance = self
             .drift_tol
             .max(10.0 * closure_floor(&self.b, self.nc, q));

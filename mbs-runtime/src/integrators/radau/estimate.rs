@@ -102,20 +102,33 @@ impl Radau {
     /// (e_q, h e_v + h² M_d⁻¹Bᵀe_λ), both in positions (M_d the diagonal of M; the module
     /// notes on the error estimate). `tmp` keeps (e_v, g e_λ) for the second evaluation.
     pub(super) fn filter3(&mut self, p: &mut Problem, g: f64, h: f64) {
-        let (n, nc) = (self.n, self.nc);
+        let n = self.n;
         self.filter_rhs(g);
         self.lu_r.solve(&mut self.tmp);
         p.stats.solves += 1;
-        let diag_max = (0..n).fold(0.0f64, |m, i| m.max(self.m[i + n * i]));
+        let least = self.least_inertia();
         for i in 0..n {
             self.err[i] = self.rq[i] + g * self.tmp[i];
-            // the positions that e_v and e_λ move in one step: h e_v, and h² times the
-            // acceleration Bᵀe_λ gives coordinate i over its own inertia M_ii (not below
-            // 1e-12 of the largest)
-            let btl: f64 = (0..nc).map(|k| self.bm[k + nc * i] * self.tmp[n + k]).sum();
-            let inertia = self.m[i + n * i].max(1e-12 * diag_max);
-            self.err[n + i] = h * (self.tmp[i] + h * btl / (g * inertia));
+            // the positions that e_v and e_λ move in one step
+            self.err[n + i] = h * (self.tmp[i] + self.lambda_velocity(i, h, g, least));
         }
+    }
+
+    /// The velocity of coordinate i that λ's error moves in a step h: h (Bᵀe_λ)_i over its own
+    /// inertia M_ii, not below `least` ([`Self::least_inertia`]); e_λ is `tmp[n..n + nc]`
+    /// over g, as the filters solve it. A generalised force over an inertia, times a time: in
+    /// the units of qd whatever the model's.
+    pub(super) fn lambda_velocity(&self, i: usize, h: f64, g: f64, least: f64) -> f64 {
+        let (n, nc) = (self.n, self.nc);
+        let btl: f64 = (0..nc).map(|k| self.bm[k + nc * i] * self.tmp[n + k]).sum();
+        h * btl / (g * self.m[i + n * i].max(least))
+    }
+
+    /// 1e-12 of M's largest diagonal entry, the least inertia [`Self::lambda_velocity`]
+    /// divides by (which a positive definite M never falls below in practice).
+    pub(super) fn least_inertia(&self) -> f64 {
+        let n = self.n;
+        1e-12 * (0..n).fold(0.0f64, |m, i| m.max(self.m[i + n * i]))
     }
 
     /// The weighted norm of `err`'s two position-valued blocks (index 3: e_q, and what e_v

@@ -152,17 +152,14 @@ impl Radau {
         }
         self.lu_r.solve(&mut self.tmp);
         p.stats.solves += 1;
-        let diag_max = (0..n).fold(0.0f64, |m, i| m.max(self.m[i + n * i]));
+        let least = self.least_inertia();
         for i in 0..n {
             let btm: f64 = (0..nc)
                 .map(|k| self.bm[k + nc * i] * self.tmp[n + nc + k])
                 .sum();
             self.err[i] = self.rq[i] + g * (self.tmp[i] + btm);
-            // Bᵀe_λ, a generalised force of coordinate i, over M_ii (not below 1e-12 of the
-            // largest, which a positive definite M never is below in practice) and times h
-            let btl: f64 = (0..nc).map(|k| self.bm[k + nc * i] * self.tmp[n + k]).sum();
-            let inertia = self.m[i + n * i].max(1e-12 * diag_max);
-            self.err[n + i] = self.tmp[i] + h * btl / (g * inertia);
+            // the velocities that e_v and e_λ move in one step
+            self.err[n + i] = self.tmp[i] + self.lambda_velocity(i, h, g, least);
         }
     }
 

@@ -163,7 +163,7 @@
 //! position part: (e_q, h e_v, h² e_λ) against atol + rtol·max(|y₀|, |y₁|) of q, qd and λ.
 //! Those ratios are in seconds and seconds squared, and a mechanism in other units, or
 //! larger, was judged otherwise (the four-bar by dynamic similarity at rtol 1e-7: Radau5 took
-//! 146 steps at × 1, 3,064 at × 10⁶ and 180,363 at × 10⁸, λ holding most of them from × 10³;
+//! 146 steps at × 1, 3,074 at × 10⁶ and 188,704 at × 10⁸, λ holding most of them from × 10³;
 //! Radau3 ran out of steps from × 10⁷). Here the same orders of h count what these errors move
 //! the positions by in one step: the norm is taken on (e_q, h e_v + h² M_d⁻¹Bᵀe_λ), both
 //! against the positions' weights atol + rtol·max(|q₀|, |q₁|) (M_d, the diagonal of M: each
@@ -180,7 +180,8 @@
 //! s − 1 (Radau5: 5, 3, 2; Radau3: 3, 2, 1), as measured on the pendulum with fixed steps
 //! (`tests/radau_index3.rs`; Radau3's positions 2.8–2.9 at h = 1/80..1/640). The velocity and λ
 //! errors are local (those of the last step) and, since the step control weighs them by the
-//! positions they move in a step (h and h²), follow the step size rather than rtol: λ within 1e-6 takes h ≲ 2e-3 with Radau5;
+//! positions they move in a step (h and h²), follow the step size rather than rtol: λ within
+//! 1e-6 takes h ≲ 2e-3 with Radau5;
 //! with Radau3 (first order in λ, about 0.12h on the pendulum) only near h = 1e-5, where the
 //! rounding noise of λ (∝ ε/h²) is already as large (fixed steps of 1/80 000: 8.9e-7; of
 //! 1/160 000: 3.6e-5).
@@ -256,8 +257,10 @@
 //! digits on fastlink and slider-crank (a), and fewer on the four-bar with Radau5: about 0.8
 //! at 400 steps, 2.4 at 1,150, where the h-weighted runs gained 1.6 digits from rtol 1e-9 to
 //! 1e-10 (9.61 digits in 1,150 steps; now 8.33 in 1,924). Also measured: the
-//! full M⁻¹ in place of its diagonal (the same within 0.2 digits), and λ left out of the test
-//! (nearly scale-free too, but the four-bar at rtol 1e-10 gave 7.10 digits). The estimate's f(y₀) takes the scheme's own
+//! full M⁻¹ in place of its diagonal (within 0.3 digits of it at each rtol), and λ left out of the test
+//! (nearly scale-free too, but the four-bar at rtol 1e-10 gave 7.10 digits).
+//!
+//! The estimate's f(y₀) takes the scheme's own
 //! end values (the last stage's A_s and Λ_s); the state an accepted step hands on has qdd and λ
 //! from the index-1 equations at its (q, qd) instead (`consistent_end`: one evaluation of M and
 //! h and one bordered solve per step). The stage Λ_s is of order s only, and the interpolant

@@ -48,7 +48,12 @@ impl Inputs {
         Inputs::default()
     }
 
-    /// u(t) (it adds to the controllers' outputs).
+    /// u(t) (it adds to the controllers' outputs). It is called wherever the run needs u: at
+    /// the schemes' stage times, at the times of rejected steps and again at interpolated
+    /// output times, so not in the order of time and more than once at some times. It must
+    /// be a function of t alone (`FnMut` lets it keep caches); what depends on the run's
+    /// past, as a controller's state, belongs in a [`Controller`], which is called once per
+    /// sample instant, in order.
     pub fn function(mut self, f: impl FnMut(f64, &mut [f64]) + 'static) -> Inputs {
         self.function = Some(Box::new(f));
         self

@@ -102,12 +102,12 @@ const LOSS: f64 = 0.2;
 /// error test's norm, as a fraction of the tolerance. DOPRI5's median is 0.091, 0.028 and
 /// 0.011 at rtol 1e-4, 1e-6 and 1e-8 (largest 2.14, 0.38, 0.063: at 1e-4 it makes the errors
 /// its rtol allows, its estimate, the 4th-order companion's error, realistic at large
-/// steps), where Radau5's stays at 0.001–0.003, BDF's at 0.001–0.002 and Radau3's below 0.001
-/// at every rtol: at 1e-4 DOPRI5's local errors are 50–100 times theirs, and the median it is
+/// steps), where Radau5's stays at 0.001–0.003, BDF's at 0.001–0.002 and Radau3's at 0.001 or
+/// less at every rtol: at 1e-4 DOPRI5's median is 45–90 times theirs, and the median it is
 /// compared with is the caution of the implicit schemes' estimates. Maps that tighten
 /// DOPRI5's loose end smoothly, rtol' = min(rtol, c·rtol^e) (builds not kept): from 1e-8 on
 /// with e = 0.75 (a decade tighter at 1e-4, half a decade at the default 1e-6) slider-crank
-/// (b) at 1e-4 gives 2.86 digits against the median's 3.96, and ten other tests' figures
+/// (b) at 1e-4 gives 2.86 digits against the median's 3.96, and nine other tests' figures
 /// moved (a run at rtol 0.2 no longer runs away, since rtol' stays below 0.01 for every
 /// rtol < 1); with e = 0.7 slider-crank (b) gives 3.22, but fastlink loses 0.43 digits from
 /// 1e-4 to 1e-5 (3.88, then 3.45); from 1e-10 on with e = ⅚ DOPRI5 lifts the median at tight

@@ -22,7 +22,10 @@
 //! placement of gains `--place` and `--place-time`, default 1 and 0.5 s, filtered over
 //! `--filter`, default 0.1 s) where the residual torques' shares leave it free, and the
 //! program reports that run alone (`--pressure 30 --free 10 --pelvis-axes 0,1,0 --balance`:
-//! free to pitch and roll).
+//! free to pitch and roll). With `--ff H` the tracking adds a feedforward: the joint torques
+//! of a first run, tracked at 3·10⁴ N·m/rad with the pelvis held, over its second cycle,
+//! fitted with H harmonics (`Tracking::feedforward_of`), so that a softer `--kp` follows the
+//! cycle (`--kp 1000 --ff 20`: the stiff run's forces within 0.05 body weights).
 //! The run lasts `--cycles` cycles (default 2) and the last one is reported: each foot's
 //! vertical and fore–aft ground reaction forces in body weights (first peak, trough, second
 //! peak, braking, propulsion, the fore–aft means over the stance's halves), the vertical
@@ -85,11 +88,12 @@ usage: human_gait [options]
   --place-time T     its foot placement's gain on velocity (0.5 s)
   --filter T         the placement's filter time (0.1 s)
   --muscle-rtol R    Radau5's rtol on the muscles (1e-4)
+  --ff H             feedforward torques: the held cycle's joint torques, H harmonics (0: none)
   --out DIR          where the plots, animation and CSV go (target/human_gait)
   --help             this text";
 
 /// The options that take a value; `--balance` and `--help` take none.
-const VALUED: [&str; 18] = [
+const VALUED: [&str; 19] = [
     "--period",
     "--kp",
     "--pelvis",
@@ -107,6 +111,7 @@ const VALUED: [&str; 18] = [
     "--place-time",
     "--filter",
     "--muscle-rtol",
+    "--ff",
     "--out",
 ];
 
@@ -187,6 +192,7 @@ fn gait() -> Result<(), Box<dyn std::error::Error>> {
     let filter = number("--filter", 0.1, 1e-3, 10.0)?;
     let eps = number("--eps", Human::default().params().eps_foot, 1e-6, 1.0)?;
     let muscle_rtol = number("--muscle-rtol", 1e-4, 1e-12, 0.1)?;
+    let ff = number("--ff", 0.0, 0.0, 100.0)?.round() as usize;
     let out = PathBuf::from(value("--out").map_or("target/human_gait", |s| s.as_str()));
     std::fs::create_dir_all(&out)?;
 
@@ -265,8 +271,29 @@ fn gait() -> Result<(), Box<dyn std::error::Error>> {
         );
     }
     let reference = grounded.reference;
+    let mut feedforward = Vec::new();
     let (q0, qd0) = cycle_start(&model, &reference);
+    if ff > 0 {
+        // the held cycle's joint torques, as the feedforward of a softer tracking
+        let mut held = Tracking::new(reference.clone(), info, GAIT_KP, GAIT_KP / 100.0)?;
+        held.pelvis_kp = GAIT_PELVIS_KP;
+        held.pelvis_kd = GAIT_PELVIS_KP / 10.0;
+        let options = Options {
+            q0: Some(q0.clone()),
+            qd0: Some(qd0.clone()),
+            output: Output::Every { dt: 0.005 },
+            ..Options::adaptive(2.0 * period, 1e-5)
+        };
+        let tr = run(
+            WithEfforts::new(model.clone(), held.clone()),
+            options,
+            "held for the feedforward",
+            2.0,
+        );
+        feedforward = held.feedforward_of(&tr, ff)?;
+    }
     let mut tracking = Tracking::new(reference.clone(), info, kp, kp / 100.0)?;
+    tracking.feedforward = feedforward;
     tracking.pelvis_kp = pelvis_kp;
     tracking.pelvis_kd = pelvis_kp / 10.0;
     tracking.pelvis_axes = axes;
@@ -343,11 +370,13 @@ fn gait() -> Result<(), Box<dyn std::error::Error>> {
                 cycle.moments.iter().map(|m| m[1]).fold(0.0, f64::max)
             );
             let tr_m = run(on_muscles, options, &format!("{cycles} cycles"), cycles);
-            let reserve = |tr: &Trajectory| tracking.rms_over_last_cycle(info, tr, &MUSCLE_JOINTS);
+            // the reserves are the tracking without its feedforward (`muscle_cycle`)
+            let mut reserves = tracking.clone();
+            reserves.feedforward.clear();
             println!(
                 "  reserve torques at hip flexion, knee and ankle: rms {:.1} N·m, against {:.1} N·m with no muscles",
-                reserve(&tr_m)?,
-                reserve(&tr)?
+                reserves.rms_over_last_cycle(info, &tr_m, &MUSCLE_JOINTS)?,
+                tracking.rms_over_last_cycle(info, &tr, &MUSCLE_JOINTS)?
             );
             let forces_m = CycleForces::of(&model, &tracking, &tr_m, weight);
             print(&forces_m, mass);

@@ -740,6 +740,60 @@ fn the_prescribed_cycle_gives_a_normal_double_hump_braking_then_propulsion_also_
     assert!((c.impulse_ratio - 1.0).abs() < 0.05, "{}", c.impulse_ratio);
     assert!(c.airborne < 0.01, "{}", c.airborne);
 
+    // a tracking thirty times softer (10³ N·m/rad) walks the same cycle with the same forces
+    // when this run's joint torques are its feedforward; without them the legs lag the
+    // reference and the forces leave the normal ranges
+    let stiff = [right, left];
+    let soft = |feedforward: Vec<Fourier>| {
+        let mut t = tracking.clone();
+        (t.kp, t.kd, t.toes_kp, t.toes_kd) = (
+            GAIT_KP / 30.0,
+            GAIT_KP / 3000.0,
+            GAIT_KP / 30.0,
+            GAIT_KP / 3000.0,
+        );
+        t.feedforward = feedforward;
+        let options = Options {
+            q0: Some(tr.q(0).to_vec()),
+            qd0: Some(tr.qd(0).to_vec()),
+            output: Output::Every { dt: 0.005 },
+            ..Options::adaptive(2.0 * period, 1e-5)
+        };
+        let (run, _) = mbs::simulate(
+            mbs::WithEfforts::new(model.clone(), t.clone()),
+            Scheme::Radau5,
+            options,
+        )
+        .unwrap();
+        let c = CycleForces::of(&model, &t, &run, weight);
+        [c.figures(0), c.figures(1)]
+    };
+    let fed = soft(tracking.feedforward_of(&tr, 20).unwrap());
+    let unfed = soft(Vec::new());
+    println!("softer tracking with feedforward: {fed:.2?}\n without: {unfed:.2?}");
+    for (g, s) in fed.iter().zip(stiff) {
+        let close =
+            |a: Option<f64>, b: Option<f64>| a.zip(b).is_some_and(|(a, b)| (a - b).abs() < 0.1);
+        assert!(
+            close(g.first_peak, s.first_peak)
+                && close(g.trough, s.trough)
+                && close(g.second_peak, s.second_peak),
+            "{g:?} {s:?}"
+        );
+        assert!(
+            close(g.braking, s.braking) && close(g.propulsion, s.propulsion),
+            "{g:?} {s:?}"
+        );
+    }
+    assert!(
+        unfed
+            .iter()
+            .any(|g| !within(g.first_peak, 1.0, 1.3) || !within(g.trough, 0.6, 0.9)),
+        "{unfed:?}"
+    );
+    // fewer harmonics than samples are asked of a whole cycle
+    assert!(tracking.feedforward_of(&tr, 120).is_err());
+
     // on muscles: excitations from this cycle's moments, the tracking as reserves; the
     // muscles' 36 states and the passive moments' 17 integrated with the body for two
     // cycles, which must end without a muscle leaving its fibre's range

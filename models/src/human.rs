@@ -679,7 +679,9 @@ impl GaitReference {
 ///   figures were worked out with 5);
 pub const FIT_HARMONICS: usize = 5;
 /// - the joints tracked with 3·10⁴ N·m/rad (and a hundredth of it in N·m·s/rad): at
-///   3·10³ the legs lag the reference and the fore–aft force propels first, then brakes;
+///   3·10³ the legs lag the reference and the fore–aft force propels first, then brakes
+///   (with that run's joint torques as feedforward, [`Tracking::feedforward_of`], 10³ gives
+///   its forces within 0.05 body weights);
 pub const GAIT_KP: f64 = 3e4;
 /// - the feet's Hunt–Crossley dissipation 10 s/m (the model's 1 s/m, a hard sole, lets the
 ///   heel strike peak at 1.8 body weights: the tracked legs have no muscles' give);
@@ -1376,6 +1378,10 @@ pub struct Tracking {
     /// a balance controller ([`Balance`]): its ankle strategy turns the standing feet's
     /// references here, its foot placement needs [`Balanced`]; none by default
     pub balance: Option<Balance>,
+    /// feedforward torques over the cycle, per tracked joint (in the order of the
+    /// reference's joints), added to the stiffness' and damping's: none (empty) by default;
+    /// [`Tracking::feedforward_of`] takes them from a run
+    pub feedforward: Vec<Fourier>,
     pub guard: Guard,
 }
 
@@ -1402,6 +1408,7 @@ impl Tracking {
                 .frame_index("pelvis_o")
                 .ok_or("the model has no frame `pelvis_o`")?,
             balance: None,
+            feedforward: Vec::new(),
             guard: Guard::new(info)?,
         })
     }
@@ -1424,8 +1431,54 @@ impl Tracking {
                 } else {
                     (self.kp, self.kd)
                 };
-                (*i, kp * (r - q[*i]) + kd * (rd - qd[*i]))
+                let ff = self.feedforward.get(k).map_or(0.0, |f| f.eval(t)[0]);
+                (*i, ff + kp * (r - q[*i]) + kd * (rd - qd[*i]))
             })
+    }
+
+    /// The joints' torques of this tracking over the last whole cycle of `tr` (a run with
+    /// it, sampled uniformly at a step that divides the period, as `Output::Every`),
+    /// fitted with `harmonics` harmonics: the feedforward ([`Tracking::feedforward`]) of a
+    /// tracking that follows that run with less stiffness. An error where `tr` does not
+    /// cover a whole cycle so sampled, with more than 2 `harmonics` samples.
+    pub fn feedforward_of(
+        &self,
+        tr: &mbs::Trajectory,
+        harmonics: usize,
+    ) -> Result<Vec<Fourier>, String> {
+        let n = Human::NQ;
+        let period = self.reference.period;
+        let start = last_cycle_start(tr, period);
+        let rows: Vec<usize> = (0..tr.len())
+            .filter(|s| tr.t[*s] >= start - 1e-9 && tr.t[*s] < start + period - 1e-9)
+            .collect();
+        let end = tr.t.last().copied().unwrap_or(0.0);
+        let uniform = rows.len() > 2 * harmonics
+            && end >= start + period - 1e-9
+            && rows.iter().enumerate().all(|(k, &s)| {
+                (tr.t[s] - start - k as f64 * period / rows.len() as f64).abs() < 1e-9 * period
+            });
+        if !uniform {
+            return Err(format!(
+                "the run does not cover a whole cycle ({period} s from t = {start}) sampled \
+                 uniformly at a step dividing it, with more than {} samples: run it longer, \
+                 with Output::Every at such a step",
+                2 * harmonics
+            ));
+        }
+        let mut samples = vec![Vec::with_capacity(rows.len()); self.reference.joints.len()];
+        for s in rows {
+            for (k, (_, tau)) in self
+                .torques(tr.t[s], &tr.q(s)[..n], &tr.qd(s)[..n])
+                .enumerate()
+            {
+                samples[k].push(tau);
+            }
+        }
+        Ok(samples
+            .iter()
+            .map(|y| Fourier::fit(y, harmonics, period))
+            .collect())
     }
 
     /// The rms over the last whole cycle of `tr` (a run with this tracking, sampled

@@ -696,7 +696,7 @@ impl MuscleCycle {
 /// fitted with `harmonics` harmonics, and its excitation the one under which its activation
 /// follows that series (the activation dynamics inverted at each instant,
 /// [`mbs::muscle::excitation_for_rate`], fitted alike; the activations start on the series).
-/// The tracking stays on every joint.
+/// The tracking stays on every joint, as reserves (its feedforward, if any, left out).
 pub fn muscle_cycle(
     model: &Human,
     tracking: &Tracking,
@@ -773,7 +773,11 @@ pub fn muscle_cycle(
         })
         .collect();
     driven.muscles.activation_pattern = fitted;
-    driven.passive.tracking = Some(tracking.clone());
+    // the reserves: the tracking's stiffness and damping, not its feedforward, whose moments
+    // the muscles now give
+    let mut reserves = tracking.clone();
+    reserves.feedforward.clear();
+    driven.passive.tracking = Some(reserves);
     Ok(MuscleCycle {
         driven,
         activations,

@@ -1447,25 +1447,7 @@ impl Tracking {
         harmonics: usize,
     ) -> Result<Vec<Fourier>, String> {
         let n = Human::NQ;
-        let period = self.reference.period;
-        let start = last_cycle_start(tr, period);
-        let rows: Vec<usize> = (0..tr.len())
-            .filter(|s| tr.t[*s] >= start - 1e-9 && tr.t[*s] < start + period - 1e-9)
-            .collect();
-        let end = tr.t.last().copied().unwrap_or(0.0);
-        let uniform = rows.len() > 2 * harmonics
-            && end >= start + period - 1e-9
-            && rows.iter().enumerate().all(|(k, &s)| {
-                (tr.t[s] - start - k as f64 * period / rows.len() as f64).abs() < 1e-9 * period
-            });
-        if !uniform {
-            return Err(format!(
-                "the run does not cover a whole cycle ({period} s from t = {start}) sampled \
-                 uniformly at a step dividing it, with more than {} samples: run it longer, \
-                 with Output::Every at such a step",
-                2 * harmonics
-            ));
-        }
+        let rows = last_cycle_rows(tr, self.reference.period, harmonics)?;
         let mut samples = vec![Vec::with_capacity(rows.len()); self.reference.joints.len()];
         for s in rows {
             for (k, (_, tau)) in self
@@ -1477,7 +1459,7 @@ impl Tracking {
         }
         Ok(samples
             .iter()
-            .map(|y| Fourier::fit(y, harmonics, period))
+            .map(|y| Fourier::fit(y, harmonics, self.reference.period))
             .collect())
     }
 
@@ -2162,6 +2144,38 @@ pub fn ground_forces(
 pub fn last_cycle_start(tr: &mbs::Trajectory, period: f64) -> f64 {
     let end = tr.t.last().copied().unwrap_or(0.0);
     ((end / period).round() - 1.0).max(0.0) * period
+}
+
+/// The output instants of the last whole cycle of `tr` (see [`last_cycle_start`]), which
+/// must be uniform over it (`Output::Every` at a step dividing `period`) and more than
+/// 2 `harmonics`: the samples a Fourier fit of that many harmonics takes.
+pub(crate) fn last_cycle_rows(
+    tr: &mbs::Trajectory,
+    period: f64,
+    harmonics: usize,
+) -> Result<Vec<usize>, String> {
+    let start = last_cycle_start(tr, period);
+    let rows: Vec<usize> = (0..tr.len())
+        .filter(|i| tr.t[*i] >= start - 1e-9 && tr.t[*i] < start + period - 1e-9)
+        .collect();
+    let dt = period / rows.len().max(1) as f64;
+    let end = tr.t.last().copied().unwrap_or(0.0);
+    let uniform = rows.len() > 2 * harmonics
+        && end >= start + period - 1e-9
+        && rows
+            .iter()
+            .enumerate()
+            .all(|(k, i)| (tr.t[*i] - start - k as f64 * dt).abs() < 1e-6);
+    if !uniform {
+        return Err(format!(
+            "the run must cover a whole cycle of {period} s sampled uniformly (Output::Every at \
+             a step dividing it), more than {} outputs over it; it ends at t = {end} s, {} \
+             outputs in its last cycle",
+            2 * harmonics,
+            rows.len()
+        ));
+    }
+    Ok(rows)
 }
 
 /// What a gait laboratory reads from the last cycle of a mode-1 run: the ground reaction

@@ -19,7 +19,7 @@
 
 use super::{
     Fourier, GaitReference, Guard, Human, PassiveJoints, TRACKED, Tracking, cycle_start, dof_index,
-    last_cycle_start,
+    last_cycle_rows,
 };
 use mbs::Model;
 use mbs::elements::Path;
@@ -707,25 +707,7 @@ pub fn muscle_cycle(
     let info = model.info();
     let n = Human::NQ;
     let period = tracking.reference.period;
-    let start = last_cycle_start(tr, period);
-    let instants: Vec<usize> = (0..tr.len())
-        .filter(|i| tr.t[*i] >= start - 1e-9 && tr.t[*i] < start + period - 1e-9)
-        .collect();
-    let dt = period / instants.len().max(1) as f64;
-    let uniform = instants.len() > 2 * harmonics
-        && instants
-            .iter()
-            .enumerate()
-            .all(|(k, i)| (tr.t[*i] - start - k as f64 * dt).abs() < 1e-6);
-    if !uniform {
-        let end = tr.t.last().copied().unwrap_or(0.0);
-        return Err(format!(
-            "the run must cover a whole cycle of {period} s sampled uniformly (Output::Every), \
-             more than {} outputs over it; it ends at t = {end} s, {} outputs in its last cycle",
-            2 * harmonics,
-            instants.len()
-        ));
-    }
+    let instants = last_cycle_rows(tr, period, harmonics)?;
     let mut driven = MuscleDriven {
         passive: PassiveJoints::new(info, 0.1, 0.01)?,
         muscles: Muscles::new(info)?,

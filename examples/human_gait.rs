@@ -370,9 +370,12 @@ fn gait() -> Result<(), Box<dyn std::error::Error>> {
                 cycle.moments.iter().map(|m| m[1]).fold(0.0, f64::max)
             );
             let tr_m = run(on_muscles, options, &format!("{cycles} cycles"), cycles);
-            // the reserves are the tracking without its feedforward (`muscle_cycle`)
-            let mut reserves = tracking.clone();
-            reserves.feedforward.clear();
+            let reserves = cycle
+                .driven
+                .passive
+                .tracking
+                .as_ref()
+                .ok_or("the cycle has no reserves")?;
             println!(
                 "  reserve torques at hip flexion, knee and ankle: rms {:.1} N·m, against {:.1} N·m with no muscles",
                 reserves.rms_over_last_cycle(info, &tr_m, &MUSCLE_JOINTS)?,

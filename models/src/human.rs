@@ -274,20 +274,37 @@ impl Fourier {
         }
     }
 
-    /// The value and its first and second time derivatives at `t`.
-    /// (One sine and cosine per call: the harmonics' by the angle-addition recurrence.)
-    pub fn eval(&self, t: f64) -> [f64; 3] {
-        let mut out = [self.a0, 0.0, 0.0];
+    /// Each harmonic at `t`: its frequency kω, its coefficients aₖ, bₖ and cos kωt, sin kωt
+    /// (one sine and cosine per call: the harmonics' by the angle-addition recurrence).
+    fn harmonics(&self, t: f64) -> impl Iterator<Item = (f64, f64, f64, f64, f64)> + '_ {
         let (s1, c1) = (self.omega * t).sin_cos();
         let (mut s, mut c) = (s1, c1);
-        for (k, (a, b)) in self.a.iter().zip(&self.b).enumerate() {
-            let w = (k + 1) as f64 * self.omega;
+        self.a
+            .iter()
+            .zip(&self.b)
+            .enumerate()
+            .map(move |(k, (a, b))| {
+                let h = ((k + 1) as f64 * self.omega, *a, *b, c, s);
+                (s, c) = (s * c1 + c * s1, c * c1 - s * s1);
+                h
+            })
+    }
+
+    /// The value and its first and second time derivatives at `t`.
+    pub fn eval(&self, t: f64) -> [f64; 3] {
+        let mut out = [self.a0, 0.0, 0.0];
+        for (w, a, b, c, s) in self.harmonics(t) {
             out[0] += a * c + b * s;
             out[1] += w * (b * c - a * s);
             out[2] -= w * w * (a * c + b * s);
-            (s, c) = (s * c1 + c * s1, c * c1 - s * s1);
         }
         out
+    }
+
+    /// The value alone at `t` (what [`Fourier::eval`] gives first).
+    pub fn value(&self, t: f64) -> f64 {
+        self.harmonics(t)
+            .fold(self.a0, |v, (_, a, b, c, s)| v + (a * c + b * s))
     }
 }
 
@@ -665,7 +682,7 @@ impl GaitReference {
 
     /// The pelvis' rotation matrix at `t`: Rz(tilt) Rx(list) Ry(rotation).
     pub fn pelvis_rotation(&self, t: f64) -> [[f64; 3]; 3] {
-        let [a, b, c] = [0, 1, 2].map(|k| self.pelvis[k].eval(t + self.offset)[0]);
+        let [a, b, c] = [0, 1, 2].map(|k| self.pelvis[k].value(t + self.offset));
         mul(&mul(&rot(2, a), &rot(0, b)), &rot(1, c))
     }
 }
@@ -1431,7 +1448,7 @@ impl Tracking {
                 } else {
                     (self.kp, self.kd)
                 };
-                let ff = self.feedforward.get(k).map_or(0.0, |f| f.eval(t)[0]);
+                let ff = self.feedforward.get(k).map_or(0.0, |f| f.value(t));
                 (*i, ff + kp * (r - q[*i]) + kd * (rd - qd[*i]))
             })
     }

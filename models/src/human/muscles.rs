@@ -358,7 +358,7 @@ impl Muscles {
 
 /// A series of excitations or activations at `t`, clamped to [`MIN_ACTIVATION`, 1].
 fn on_series(f: &Fourier, t: f64) -> f64 {
-    f.eval(t)[0].clamp(MIN_ACTIVATION, 1.0)
+    f.value(t).clamp(MIN_ACTIVATION, 1.0)
 }
 
 /// Names of the extra states of [`MuscleDriven`] after the passive joints' 17: the 18

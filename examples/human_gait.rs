@@ -25,7 +25,13 @@
 //! free to pitch and roll). With `--ff H` the tracking adds a feedforward: the joint torques
 //! of a first run, tracked at 3·10⁴ N·m/rad with the pelvis held, over its second cycle,
 //! fitted with H harmonics (`Tracking::feedforward_of`), so that a softer `--kp` follows the
-//! cycle (`--kp 1000 --ff 20`: the stiff run's forces within 0.05 body weights).
+//! cycle (`--kp 1000 --ff 20`: the stiff run's forces within 0.05 body weights). With
+//! `--reduce N` the residual torques are reduced with the feet's own contacts first
+//! (`Tracking::reduced`: N Levenberg–Marquardt iterations over corrections of the leg
+//! joints, each running the held cycle once per unknown), and the program reports the run
+//! that follows alone: from the held run's state at its second cycle, nothing holding the
+//! pelvis, each of `--cycles` cycles (`--pressure 30 --free 10 --reduce 8`: a normal first
+//! cycle with the pelvis wholly free, about 3 minutes on two cores).
 //! The run lasts `--cycles` cycles (default 2) and the last one is reported: each foot's
 //! vertical and fore–aft ground reaction forces in body weights (first peak, trough, second
 //! peak, braking, propulsion, the fore–aft means over the stance's halves), the vertical
@@ -89,11 +95,13 @@ usage: human_gait [options]
   --filter T         the placement's filter time (0.1 s)
   --muscle-rtol R    Radau5's rtol on the muscles (1e-4)
   --ff H             feedforward torques: the held cycle's joint torques, H harmonics (0: none)
+  --reduce N         residual reduction with the feet's contacts, N iterations, then the
+                     pelvis wholly free (0: none)
   --out DIR          where the plots, animation and CSV go (target/human_gait)
   --help             this text";
 
 /// The options that take a value; `--balance` and `--help` take none.
-const VALUED: [&str; 19] = [
+const VALUED: [&str; 20] = [
     "--period",
     "--kp",
     "--pelvis",
@@ -112,6 +120,7 @@ const VALUED: [&str; 19] = [
     "--filter",
     "--muscle-rtol",
     "--ff",
+    "--reduce",
     "--out",
 ];
 
@@ -193,6 +202,7 @@ fn gait() -> Result<(), Box<dyn std::error::Error>> {
     let eps = number("--eps", Human::default().params().eps_foot, 1e-6, 1.0)?;
     let muscle_rtol = number("--muscle-rtol", 1e-4, 1e-12, 0.1)?;
     let ff = number("--ff", 0.0, 0.0, 100.0)?.round() as usize;
+    let reduce = number("--reduce", 0.0, 0.0, 1000.0)?.round() as usize;
     let out = PathBuf::from(value("--out").map_or("target/human_gait", |s| s.as_str()));
     std::fs::create_dir_all(&out)?;
 
@@ -291,6 +301,82 @@ fn gait() -> Result<(), Box<dyn std::error::Error>> {
             2.0,
         );
         feedforward = held.feedforward_of(&tr, ff)?;
+    }
+    if reduce > 0 {
+        // residual reduction with the feet's own contacts, then the pelvis wholly free:
+        // report that run alone
+        let mut held = Tracking::new(reference.clone(), info, kp, kp / 100.0)?;
+        held.pelvis_kp = GAIT_PELVIS_KP;
+        held.pelvis_kd = GAIT_PELVIS_KP / 10.0;
+        let clock = std::time::Instant::now();
+        let how = Reduction {
+            iterations: reduce,
+            ..Reduction::default()
+        };
+        let reduced = held.reduced(&model, &how)?;
+        println!(
+            "residual reduction with the feet's contacts ({} iterations, {:.0} s on {} threads): the residual torques \
+             holding the pelvis {:.1} → {:.1} N·m rms over the held second cycle, angles corrected by up to {:.1}° more",
+            reduced.iterations,
+            clock.elapsed().as_secs_f64(),
+            std::thread::available_parallelism().map_or(1, |n| n.get()),
+            reduced.residual_rms[0],
+            reduced.residual_rms[1],
+            reduced.largest_change.to_degrees()
+        );
+        let changes: Vec<String> = reduced
+            .changes
+            .iter()
+            .map(|(joint, c)| format!("{joint} {:.1}°", c.to_degrees()))
+            .collect();
+        println!(
+            "  the largest correction of each leg joint: {}",
+            changes.join(", ")
+        );
+        let mut free = held.clone();
+        free.reference = reduced.reference.clone();
+        free.pelvis_kp = 0.0;
+        free.pelvis_kd = 0.0;
+        let (t0, q0, qd0) = reduced.start.clone();
+        let options = Options {
+            t0,
+            q0: Some(q0),
+            qd0: Some(qd0),
+            output: Output::Every { dt: 0.005 },
+            frames: true,
+            ..Options::adaptive(t0 + cycles * period, 1e-5)
+        };
+        let wrapped = WithEfforts::new(model.clone(), free.clone());
+        let what = format!(
+            "{cycles} cycles with the pelvis wholly free, from the held run's second cycle"
+        );
+        let tr = run(wrapped.clone(), options, &what, cycles);
+        let mut first = None;
+        for k in 1..=cycles as usize {
+            let end = t0 + k as f64 * period;
+            let mut part = tr.clone();
+            part.clear_outputs();
+            for i in (0..tr.len()).filter(|i| tr.t[*i] <= end + 1e-9) {
+                part.push_output(&tr, i);
+            }
+            println!("  cycle {k} with the pelvis free:");
+            let forces = CycleForces::of(&model, &free, &part, weight);
+            print(&forces, mass);
+            first.get_or_insert(forces);
+            if tr.t.last().is_none_or(|t| *t < end - 1e-9) {
+                break;
+            }
+        }
+        if let Some(forces) = first {
+            plots(&forces, mass, &out, &tr, &free, info)?;
+        }
+        mbs::anim::write_html(&out.join("walk.html"), wrapped.info(), &tr)?;
+        tr.write_csv(std::fs::File::create(out.join("gait.csv"))?)?;
+        println!(
+            "plots of the first free cycle, animation and CSV in {}",
+            out.display()
+        );
+        return Ok(());
     }
     let mut tracking = Tracking::new(reference.clone(), info, kp, kp / 100.0)?;
     tracking.feedforward = feedforward;

@@ -20,6 +20,8 @@
 //!   double hump, braking then propulsion, and the weight's vertical impulse; on muscles
 //!   (the tracking as reserves, the excitations made to lead the activations by their
 //!   dynamics) the reserves carry less than 40 % of the moments (rms), the walk unchanged;
+//! - with its residual torques reduced by corrections of the leg joints, the pressed cycle
+//!   walks a normal cycle with the pelvis wholly free, where the cycle as it was does not;
 //! - residual torques hold the pelvis on its reference orientation;
 //! - in flight, the angular momentum about the centre of mass (`Centroid`) is conserved.
 
@@ -651,6 +653,155 @@ fn the_grounded_cycle_levels_the_feet_keeps_them_together_and_bounds_the_centre_
         axes[0] == 0.0 && axes[2] == 0.0 && axes[1] > 0.0,
         "{axes:?}"
     );
+}
+
+/// Mode 1 with the pelvis wholly free: the pressed cycle's residual torques reduced with the
+/// feet's own contacts (`Tracking::reduced`), then one cycle run from the held run's state at
+/// its second cycle with nothing holding the pelvis (`human_gait -- --pressure 30 --free 10
+/// --reduce 6 --cycles 1`).
+#[test]
+fn with_its_residuals_reduced_the_cycle_walks_with_the_pelvis_free() {
+    let mut model = Human::default();
+    let mut params = model.params().clone();
+    params.d_foot = GAIT_DISSIPATION;
+    model.set_params(params).unwrap();
+    let info = model.info();
+    let grounded = normal_cycle(&model, 1.1)
+        .grounded(&model, &Grounding::default())
+        .unwrap();
+    let pressed = grounded
+        .reference
+        .grounded(
+            &model,
+            &Grounding {
+                pressure: [30.0, 10.0],
+                ..Default::default()
+            },
+        )
+        .unwrap()
+        .reference;
+    let mut held = Tracking::new(pressed, info, GAIT_KP, GAIT_KP / 100.0).unwrap();
+    held.pelvis_kp = GAIT_PELVIS_KP;
+    held.pelvis_kd = GAIT_PELVIS_KP / 10.0;
+    // what it lowers are the torques holding the pelvis about every axis
+    let mut turn_only = held.clone();
+    turn_only.pelvis_axes = [0.0, 1.0, 0.0];
+    let e = turn_only
+        .reduced(&model, &Reduction::default())
+        .unwrap_err();
+    assert!(e.contains("pelvis_axes"), "{e}");
+    // no iteration: the held run on the cycle as given, and where it starts its second cycle
+    let given = held
+        .reduced(
+            &model,
+            &Reduction {
+                iterations: 0,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+    let clock = std::time::Instant::now();
+    let reduced = held
+        .reduced(
+            &model,
+            &Reduction {
+                iterations: 6,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+    println!(
+        "reduced in {} iterations, {:.0} s: residual torques {:.1} → {:.1} N·m rms, angles corrected by up to {:.1}° \
+         (per joint, rad: {:.3?})",
+        reduced.iterations,
+        clock.elapsed().as_secs_f64(),
+        reduced.residual_rms[0],
+        reduced.residual_rms[1],
+        reduced.largest_change.to_degrees(),
+        reduced.changes
+    );
+    assert_eq!(given.residual_rms[0], given.residual_rms[1]);
+    assert_eq!(given.residual_rms[0], reduced.residual_rms[0]);
+    assert!(
+        reduced.residual_rms[1] < 0.1 * reduced.residual_rms[0],
+        "{:?}",
+        reduced.residual_rms
+    );
+    assert!(reduced.largest_change < 0.35, "{}", reduced.largest_change);
+    let weight = total_mass(&model) * G;
+    // one cycle with the pelvis free; the largest angle between the pelvis' orientation and
+    // its reference's over it
+    let free = |cycle: &Reduced| {
+        let mut free = held.clone();
+        free.reference = cycle.reference.clone();
+        free.pelvis_kp = 0.0;
+        free.pelvis_kd = 0.0;
+        let (t0, q0, qd0) = cycle.start.clone();
+        let options = Options {
+            t0,
+            q0: Some(q0),
+            qd0: Some(qd0),
+            output: Output::Every { dt: 0.005 },
+            ..Options::adaptive(t0 + 1.1, 1e-5)
+        };
+        let tr = match mbs::simulate(
+            mbs::WithEfforts::new(model.clone(), free.clone()),
+            Scheme::Radau5,
+            options,
+        ) {
+            Ok((tr, _)) => tr,
+            Err(e) => *e.trajectory,
+        };
+        let mut kin = Kinematics::new::<Human>();
+        let tilt = (0..tr.len())
+            .map(|i| {
+                model.kinematics(
+                    tr.t[i],
+                    &tr.q(i)[..Human::NQ],
+                    &tr.qd(i)[..Human::NQ],
+                    &mut kin,
+                );
+                let r = frame(&model, &kin, "pelvis_o").rotation;
+                let rr = cycle.reference.pelvis_rotation(tr.t[i]);
+                let trace: f64 = (0..3)
+                    .map(|a| (0..3).map(|m| rr[a][m] * r[a][m]).sum::<f64>())
+                    .sum();
+                (0.5 * (trace - 1.0)).clamp(-1.0, 1.0).acos()
+            })
+            .fold(0.0, f64::max);
+        (CycleForces::of(&model, &free, &tr, weight), tilt)
+    };
+    let (c, tilt) = free(&reduced);
+    let (right, left) = (c.figures(0), c.figures(1));
+    println!(
+        "pelvis free, reduced: right {right:.2?}; left {left:.2?}; impulse ratio {:.4}, covered {:.2}, the pelvis \
+         within {tilt:.3} rad of its reference",
+        c.impulse_ratio, c.covered
+    );
+    assert!(c.covered > 0.999, "{}", c.covered);
+    for g in [right, left] {
+        assert!(within(g.first_peak, 1.0, 1.3), "{g:?}");
+        assert!(within(g.trough, 0.6, 0.9), "{g:?}");
+        assert!(within(g.second_peak, 1.0, 1.3), "{g:?}");
+        assert!(within(g.braking, -0.3, -0.05), "{g:?}");
+        assert!(within(g.propulsion, 0.05, 0.4), "{g:?}");
+    }
+    assert!((c.impulse_ratio - 1.0).abs() < 0.05, "{}", c.impulse_ratio);
+    assert!(c.airborne < 0.01, "{}", c.airborne);
+    assert!(tilt < 0.1, "{tilt}");
+    // the cycle as given, free from the same instant of its own held run: out of the normal
+    // ranges, the pelvis turned away from its reference
+    let (c, tilt) = free(&given);
+    let (right, left) = (c.figures(0), c.figures(1));
+    println!(
+        "pelvis free, as given: right {right:.2?}; left {left:.2?}; the pelvis within {tilt:.3} rad"
+    );
+    let normal = [right, left].iter().all(|g| {
+        within(g.first_peak, 1.0, 1.3)
+            && within(g.trough, 0.6, 0.9)
+            && within(g.second_peak, 1.0, 1.3)
+    });
+    assert!(!normal && tilt > 0.2, "{right:?} {left:?} {tilt}");
 }
 
 /// Mode 1 as the gait program runs it: the grounded normal cycle tracked, the pelvis held by

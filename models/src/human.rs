@@ -559,96 +559,12 @@ impl GaitReference {
         };
         let nx = 5 * (2 * how.harmonics + 1);
         let mut kin = Kinematics::new::<Human>();
-        let mut x = vec![0.0; nx];
-        pass.speed = pass.speed(&pass.samples(&x, &mut kin, false));
-        let cost = |r: &[f64]| r.iter().map(|v| v * v).sum::<f64>();
-        let mut r = pass.residuals(&x, &mut kin);
-        let mut mu = 1e-3;
-        let mut iterations = 0;
-        // the cost after each iteration: the pass stops when ten iterations together
-        // lower it by less than 1e-4 of itself (the cost falls slowly along a valley for
-        // a hundred iterations or more, and an earlier stop depends on rounding)
-        let mut costs = vec![cost(&r)];
-        let (window, tol) = (10, 1e-4);
-        while iterations < how.iterations {
-            iterations += 1;
-            let m = r.len();
-            // the columns by forward differences, shared among the cores
-            let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
-            let columns: Vec<Vec<Vec<f64>>> = std::thread::scope(|scope| {
-                let chunks: Vec<_> = (0..threads)
-                    .map(|t| {
-                        let (pass, x, r) = (&pass, &x, &r);
-                        scope.spawn(move || {
-                            let mut kin = Kinematics::new::<Human>();
-                            (t..nx)
-                                .step_by(threads)
-                                .map(|c| {
-                                    let mut xp = x.clone();
-                                    xp[c] += 1e-6;
-                                    let rp = pass.residuals(&xp, &mut kin);
-                                    (0..m).map(|i| (rp[i] - r[i]) / 1e-6).collect::<Vec<f64>>()
-                                })
-                                .collect::<Vec<_>>()
-                        })
-                    })
-                    .collect();
-                chunks
-                    .into_iter()
-                    .map(|h| h.join().expect("a column's thread"))
-                    .collect()
-            });
-            // column c is the (c / threads)-th of thread c % threads
-            let jac = mbs::DMatrix::from_fn(m, nx, |i, c| columns[c % threads][c / threads][i]);
-            let jtj = jac.transpose() * &jac;
-            let jtr = jac.transpose() * mbs::DMatrix::from_column_slice(m, 1, &r);
-            let mut improved = false;
-            for _ in 0..10 {
-                let mut a = jtj.clone();
-                for d in 0..nx {
-                    a[(d, d)] += mu * (1.0 + jtj[(d, d)]);
-                }
-                let Some(step) = a.lu().solve(&(-&jtr)) else {
-                    mu *= 10.0;
-                    continue;
-                };
-                let xn: Vec<f64> = (0..nx).map(|d| x[d] + step[d]).collect();
-                let rn = pass.residuals(&xn, &mut kin);
-                if cost(&rn) < cost(&r) {
-                    x = xn;
-                    r = rn;
-                    mu = (mu * 0.3).max(1e-9);
-                    improved = true;
-                    break;
-                }
-                mu *= 10.0;
-            }
-            costs.push(cost(&r));
-            let k = costs.len() - 1;
-            if !improved || (k >= window && costs[k] > (1.0 - tol) * costs[k - window]) {
-                break;
-            }
-        }
+        pass.speed = pass.speed(&pass.samples(&vec![0.0; nx], &mut kin, false));
+        let residuals = |x: &[f64]| pass.residuals(x, &mut Kinematics::new::<Human>());
+        let (x, iterations) = levenberg_marquardt(nx, &residuals, how.iterations, 1e-6, 1e-3);
         // the corrected reference: each joint's series plus its correction
-        let mut reference = self.clone();
-        let h = how.harmonics;
-        for (leg, row) in joints.iter().enumerate() {
-            for (j, (k, _)) in row.iter().enumerate() {
-                let c = &x[j * (2 * h + 1)..(j + 1) * (2 * h + 1)];
-                let f = &mut reference.joints[*k].1;
-                f.a0 += c[0];
-                if f.a.len() < h {
-                    f.a.resize(h, 0.0);
-                    f.b.resize(h, 0.0);
-                }
-                for m in 1..=h {
-                    // the left leg half a cycle later: odd harmonics change sign
-                    let sign = if leg == 1 && m % 2 == 1 { -1.0 } else { 1.0 };
-                    f.a[m - 1] += sign * c[m];
-                    f.b[m - 1] += sign * c[h + m];
-                }
-            }
-        }
+        let slots: Vec<[usize; 2]> = (0..5).map(|j| [joints[0][j].0, joints[1][j].0]).collect();
+        let reference = self.corrected(&slots, &x, how.harmonics);
         let samples = pass.samples(&x, &mut kin, true);
         let (level, clearance, acceleration, slip) = pass.measure(&samples);
         let (pressure_beyond, free_moment) = pass.pressure(&samples);
@@ -675,6 +591,34 @@ impl GaitReference {
         })
     }
 
+    /// This cycle with periodic corrections of some leg joints: for each entry of `slots`,
+    /// the indices in [`GaitReference::joints`] of one joint of the right and the left leg,
+    /// and 2 `harmonics` + 1 coefficients of `x` (constant, cosines, sines) added to the
+    /// right leg's series and to the left leg's half a cycle later (odd harmonics of
+    /// opposite sign), so that the cycle stays symmetric.
+    fn corrected(&self, slots: &[[usize; 2]], x: &[f64], harmonics: usize) -> GaitReference {
+        let mut reference = self.clone();
+        let h = harmonics;
+        for (j, legs) in slots.iter().enumerate() {
+            let c = &x[j * (2 * h + 1)..(j + 1) * (2 * h + 1)];
+            for (leg, k) in legs.iter().enumerate() {
+                let f = &mut reference.joints[*k].1;
+                f.a0 += c[0];
+                if f.a.len() < h {
+                    f.a.resize(h, 0.0);
+                    f.b.resize(h, 0.0);
+                }
+                for m in 1..=h {
+                    // the left leg half a cycle later: odd harmonics change sign
+                    let sign = if leg == 1 && m % 2 == 1 { -1.0 } else { 1.0 };
+                    f.a[m - 1] += sign * c[m];
+                    f.b[m - 1] += sign * c[h + m];
+                }
+            }
+        }
+        reference
+    }
+
     /// Joint `k` of `joints` at `t`: angle, rate, acceleration.
     pub fn joint(&self, k: usize, t: f64) -> [f64; 3] {
         self.joints[k].1.eval(t + self.offset)
@@ -685,6 +629,87 @@ impl GaitReference {
         let [a, b, c] = [0, 1, 2].map(|k| self.pelvis[k].value(t + self.offset));
         mul(&mul(&rot(2, a), &rot(0, b)), &rot(1, c))
     }
+}
+
+/// Levenberg–Marquardt from x = 0 (`nx` unknowns) on `residuals`, their Jacobian by
+/// forward differences of `step` shared among the cores, the damping starting at `mu`: at
+/// most `iterations`, fewer when no step lowers the cost or when ten iterations together
+/// lower it by less than 1e-4 of itself (the cost can fall slowly along a valley for a
+/// hundred iterations or more, and an earlier stop depends on rounding). The unknowns and
+/// the iterations taken.
+fn levenberg_marquardt(
+    nx: usize,
+    residuals: &(dyn Fn(&[f64]) -> Vec<f64> + Sync),
+    iterations: usize,
+    step: f64,
+    mu: f64,
+) -> (Vec<f64>, usize) {
+    let cost = |r: &[f64]| r.iter().map(|v| v * v).sum::<f64>();
+    let mut x = vec![0.0; nx];
+    let mut r = residuals(&x);
+    let mut mu = mu;
+    let mut taken = 0;
+    let mut costs = vec![cost(&r)];
+    let (window, tol) = (10, 1e-4);
+    while taken < iterations {
+        taken += 1;
+        let m = r.len();
+        // the columns by forward differences, shared among the cores
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+        let columns: Vec<Vec<Vec<f64>>> = std::thread::scope(|scope| {
+            let chunks: Vec<_> = (0..threads)
+                .map(|t| {
+                    let (x, r) = (&x, &r);
+                    scope.spawn(move || {
+                        (t..nx)
+                            .step_by(threads)
+                            .map(|c| {
+                                let mut xp = x.clone();
+                                xp[c] += step;
+                                let rp = residuals(&xp);
+                                (0..m).map(|i| (rp[i] - r[i]) / step).collect::<Vec<f64>>()
+                            })
+                            .collect::<Vec<_>>()
+                    })
+                })
+                .collect();
+            chunks
+                .into_iter()
+                .map(|h| h.join().expect("a column's thread"))
+                .collect()
+        });
+        // column c is the (c / threads)-th of thread c % threads
+        let jac = mbs::DMatrix::from_fn(m, nx, |i, c| columns[c % threads][c / threads][i]);
+        let jtj = jac.transpose() * &jac;
+        let jtr = jac.transpose() * mbs::DMatrix::from_column_slice(m, 1, &r);
+        let mut improved = false;
+        for _ in 0..10 {
+            let mut a = jtj.clone();
+            for d in 0..nx {
+                a[(d, d)] += mu * (1.0 + jtj[(d, d)]);
+            }
+            let Some(step) = a.lu().solve(&(-&jtr)) else {
+                mu *= 10.0;
+                continue;
+            };
+            let xn: Vec<f64> = (0..nx).map(|d| x[d] + step[d]).collect();
+            let rn = residuals(&xn);
+            if cost(&rn) < cost(&r) {
+                x = xn;
+                r = rn;
+                mu = (mu * 0.3).max(1e-9);
+                improved = true;
+                break;
+            }
+            mu *= 10.0;
+        }
+        costs.push(cost(&r));
+        let k = costs.len() - 1;
+        if !improved || (k >= window && costs[k] > (1.0 - tol) * costs[k - window]) {
+            break;
+        }
+    }
+    (x, taken)
 }
 
 /// Mode 1's settings, shared by the gait program and its test, chosen on the normal cycle
@@ -1562,6 +1587,234 @@ impl Tracking {
         ];
         let w = k.angular_velocity;
         (theta, std::array::from_fn(|i| w_ref[i] - w[i]))
+    }
+}
+
+/// The leg joints [`Tracking::reduced`] corrects: each leg's seven.
+const REDUCED_JOINTS: [&str; 7] = [
+    "hip_flexion",
+    "hip_adduction",
+    "hip_rotation",
+    "knee",
+    "ankle",
+    "subtalar",
+    "mtp",
+];
+
+/// What [`Tracking::reduced`] asks: a residual reduction with the model's own contacts.
+#[derive(Clone, Debug)]
+pub struct Reduction {
+    /// harmonics of the corrections of each leg joint
+    pub harmonics: usize,
+    /// Levenberg–Marquardt iterations at most; each runs the held cycle once per unknown
+    /// (7 joints × (2 `harmonics` + 1)) for its Jacobian, then once or a few times more
+    pub iterations: usize,
+    /// the weight of the corrections' coefficients (per radian) against the residual
+    /// torques (per 10 N·m)
+    pub penalty: f64,
+    /// the weight of the change of each foot's vertical and fore–aft force from the
+    /// uncorrected held cycle's (per body weight): the corrections keep its forces
+    pub forces: f64,
+    /// Radau5's rtol on the held runs
+    pub rtol: f64,
+    /// the held runs' output step, at which the residuals are read (s)
+    pub sample: f64,
+}
+
+impl Default for Reduction {
+    /// 5 harmonics, 8 iterations, penalty 10, forces 5, rtol 1e-6, samples every 10 ms:
+    /// on the pressed cycle (`human_gait -- --pressure 30 --free 10`) the residual torques
+    /// fall from 112 to 7 N·m rms in 6 iterations and the pelvis walks a normal cycle
+    /// wholly free.
+    fn default() -> Self {
+        Reduction {
+            harmonics: 5,
+            iterations: 8,
+            penalty: 10.0,
+            forces: 5.0,
+            rtol: 1e-6,
+            sample: 0.01,
+        }
+    }
+}
+
+/// A cycle whose residual torques [`Tracking::reduced`] has lowered.
+#[derive(Clone, Debug)]
+pub struct Reduced {
+    /// the corrected cycle
+    pub reference: GaitReference,
+    /// the residual torques' rms over the held run's second cycle, on the cycle given and
+    /// on the corrected one (N·m)
+    pub residual_rms: [f64; 2],
+    /// the largest correction of an angle (rad)
+    pub largest_change: f64,
+    /// the largest correction of each leg joint (the right leg's name, rad)
+    pub changes: Vec<(String, f64)>,
+    pub iterations: usize,
+    /// the held run on the corrected cycle (two cycles from [`cycle_start`])
+    pub held: mbs::Trajectory,
+    /// its time and state (q, q̇) at the start of its second cycle: where a run with the
+    /// pelvis free starts on its own motion
+    pub start: (f64, Vec<f64>, Vec<f64>),
+}
+
+/// The held run's second cycle, as [`Tracking::reduced`] reads it.
+struct HeldCycle {
+    tr: mbs::Trajectory,
+    /// the residual torque at each output (world axes, N·m)
+    torques: Vec<f64>,
+    /// the feet's vertical and fore–aft forces at each output (body weights)
+    forces: Vec<f64>,
+}
+
+impl Tracking {
+    /// Residual reduction with the model's contacts: this tracking's cycle with its leg
+    /// joints corrected (each leg's seven, periodic series of `how.harmonics`, the legs
+    /// half a cycle apart) until the residual torques that hold the pelvis on its
+    /// reference orientation nearly vanish, so that the feet's contacts carry the motion
+    /// and the pelvis can be let free. OpenSim's residual reduction adjusts the kinematics
+    /// against measured ground forces; here the forces are the ellipsoids' own, read from a
+    /// run: Levenberg–Marquardt over the corrections, whose residuals are the residual
+    /// torques over the second cycle of a run held by this tracking from [`cycle_start`]
+    /// (its pelvis' orientation held, its translation free), the change of each foot's
+    /// vertical and fore–aft force from that of the uncorrected cycle (weighted by
+    /// `how.forces`) and the corrections' coefficients (weighted by `how.penalty`); the
+    /// Jacobian by forward differences of those runs, shared among the cores. An error
+    /// where this tracking does not hold the pelvis about every axis, where a joint it
+    /// corrects is not tracked, or where the held run on the uncorrected cycle stops.
+    pub fn reduced(&self, model: &Human, how: &Reduction) -> Result<Reduced, String> {
+        if self.pelvis_kp <= 0.0 || self.pelvis_axes.iter().any(|a| *a <= 0.0) {
+            return Err(format!(
+                "the residual reduction lowers the torques that hold the pelvis: the tracking \
+                 must hold it about every axis (pelvis_kp > 0, pelvis_axes all > 0; it has \
+                 pelvis_kp = {}, pelvis_axes = {:?})",
+                self.pelvis_kp, self.pelvis_axes
+            ));
+        }
+        let info = model.info();
+        let reference = &self.reference;
+        let slots = REDUCED_JOINTS
+            .iter()
+            .map(|name| {
+                let mut legs = [0; 2];
+                for (leg, k) in legs.iter_mut().enumerate() {
+                    let i = dof_index(info, &format!("{name}[{leg}]"))?;
+                    *k = reference
+                        .joints
+                        .iter()
+                        .position(|(c, _)| *c == i)
+                        .ok_or_else(|| format!("`{name}[{leg}]` is not tracked"))?;
+                }
+                Ok(legs)
+            })
+            .collect::<Result<Vec<[usize; 2]>, String>>()?;
+        let h = how.harmonics;
+        let nx = slots.len() * (2 * h + 1);
+        let before = self
+            .held_cycle(model, reference, how)
+            .map_err(|e| format!("the held cycle before the reduction stopped: {e}"))?;
+        let (nt, nf) = (before.torques.len(), before.forces.len());
+        let residuals = |x: &[f64]| -> Vec<f64> {
+            let mut r = match self.held_cycle(model, &reference.corrected(&slots, x, h), how) {
+                // the torques per 10 N·m
+                Ok(c) => c
+                    .torques
+                    .iter()
+                    .map(|t| 0.1 * t)
+                    .chain(
+                        c.forces
+                            .iter()
+                            .zip(&before.forces)
+                            .map(|(f, f0)| how.forces * (f - f0)),
+                    )
+                    .collect(),
+                // a run that stops: a step the search rejects
+                Err(_) => vec![1e3; nt + nf],
+            };
+            r.resize(nt + nf, 1e3);
+            r.extend(x.iter().map(|c| how.penalty * c));
+            r
+        };
+        let (x, iterations) = levenberg_marquardt(nx, &residuals, how.iterations, 1e-4, 1e-2);
+        let corrected = reference.corrected(&slots, &x, h);
+        let after = self
+            .held_cycle(model, &corrected, how)
+            .map_err(|e| format!("the held cycle after the reduction stopped: {e}"))?;
+        let rms = |t: &[f64]| (t.iter().map(|v| v * v).sum::<f64>() / (t.len() / 3) as f64).sqrt();
+        let changes: Vec<(String, f64)> = REDUCED_JOINTS
+            .iter()
+            .zip(&slots)
+            .map(|(name, [k, _])| {
+                let change = (0..200)
+                    .map(|s| s as f64 / 200.0 * reference.period)
+                    .map(|t| (corrected.joint(*k, t)[0] - reference.joint(*k, t)[0]).abs())
+                    .fold(0.0, f64::max);
+                (format!("{name}[0]"), change)
+            })
+            .collect();
+        let largest_change = changes.iter().map(|(_, c)| *c).fold(0.0, f64::max);
+        let period = reference.period;
+        let i = (0..after.tr.len())
+            .find(|i| after.tr.t[*i] >= period - 1e-9)
+            .ok_or("the held cycle has no output at its second cycle's start")?;
+        let n = Human::NQ;
+        let start = (
+            after.tr.t[i],
+            after.tr.q(i)[..n].to_vec(),
+            after.tr.qd(i)[..n].to_vec(),
+        );
+        Ok(Reduced {
+            reference: corrected,
+            residual_rms: [rms(&before.torques), rms(&after.torques)],
+            largest_change,
+            changes,
+            iterations,
+            held: after.tr,
+            start,
+        })
+    }
+
+    /// Two cycles of `reference` held by this tracking from [`cycle_start`], Radau5 at
+    /// `how.rtol`, and the residual torques and the feet's forces at the outputs of the
+    /// second.
+    fn held_cycle(
+        &self,
+        model: &Human,
+        reference: &GaitReference,
+        how: &Reduction,
+    ) -> Result<HeldCycle, String> {
+        let period = reference.period;
+        let (q0, qd0) = cycle_start(model, reference);
+        let tracking = Tracking {
+            reference: reference.clone(),
+            ..self.clone()
+        };
+        let options = mbs::Options {
+            q0: Some(q0),
+            qd0: Some(qd0),
+            output: mbs::Output::Every { dt: how.sample },
+            ..mbs::Options::adaptive(2.0 * period, how.rtol)
+        };
+        let (tr, _) = mbs::simulate(
+            mbs::WithEfforts::new(model.clone(), tracking.clone()),
+            mbs::Scheme::Radau5,
+            options,
+        )
+        .map_err(|e| e.to_string())?;
+        let n = Human::NQ;
+        let weight = total_mass(model) * G;
+        let mut kin = Kinematics::new::<Human>();
+        let (mut torques, mut forces) = (Vec::new(), Vec::new());
+        for i in (0..tr.len()).filter(|i| tr.t[*i] >= period - 1e-9) {
+            let f = ground_forces(model, tr.t[i], &tr.q(i)[..n], &tr.qd(i)[..n], &mut kin);
+            torques.extend(tracking.pelvis_torque(tr.t[i], &kin));
+            forces.extend([f[0][1], f[1][1], f[0][0], f[1][0]].map(|v| v / weight));
+        }
+        Ok(HeldCycle {
+            tr,
+            torques,
+            forces,
+        })
     }
 }
 

@@ -31,7 +31,10 @@
 //! joints, each running the held cycle once per unknown), and the program reports the run
 //! that follows alone: from the held run's state at its second cycle, nothing holding the
 //! pelvis, each of `--cycles` cycles (`--pressure 30 --free 10 --reduce 8`: a normal first
-//! cycle with the pelvis wholly free, about 3 minutes on two cores).
+//! cycle with the pelvis wholly free, about 3 minutes on two cores; `--refresh K` takes the
+//! Jacobian by differences every K iterations only, Broyden's updates between: cheaper, but
+//! the free pelvis then departs further from its reference), printing how far the pelvis
+//! departs from its reference orientation.
 //! The run lasts `--cycles` cycles (default 2) and the last one is reported: each foot's
 //! vertical and fore–aft ground reaction forces in body weights (first peak, trough, second
 //! peak, braking, propulsion, the fore–aft means over the stance's halves), the vertical
@@ -97,11 +100,13 @@ usage: human_gait [options]
   --ff H             feedforward torques: the held cycle's joint torques, H harmonics (0: none)
   --reduce N         residual reduction with the feet's contacts, N iterations, then the
                      pelvis wholly free (0: none)
+  --refresh K        its Jacobian by differences every K iterations, Broyden's updates
+                     between (1)
   --out DIR          where the plots, animation and CSV go (target/human_gait)
   --help             this text";
 
 /// The options that take a value; `--balance` and `--help` take none.
-const VALUED: [&str; 20] = [
+const VALUED: [&str; 21] = [
     "--period",
     "--kp",
     "--pelvis",
@@ -121,6 +126,7 @@ const VALUED: [&str; 20] = [
     "--muscle-rtol",
     "--ff",
     "--reduce",
+    "--refresh",
     "--out",
 ];
 
@@ -203,6 +209,7 @@ fn gait() -> Result<(), Box<dyn std::error::Error>> {
     let muscle_rtol = number("--muscle-rtol", 1e-4, 1e-12, 0.1)?;
     let ff = number("--ff", 0.0, 0.0, 100.0)?.round() as usize;
     let reduce = number("--reduce", 0.0, 0.0, 1000.0)?.round() as usize;
+    let refresh = number("--refresh", 1.0, 1.0, 1000.0)?.round() as usize;
     let out = PathBuf::from(value("--out").map_or("target/human_gait", |s| s.as_str()));
     std::fs::create_dir_all(&out)?;
 
@@ -311,6 +318,7 @@ fn gait() -> Result<(), Box<dyn std::error::Error>> {
         let clock = std::time::Instant::now();
         let how = Reduction {
             iterations: reduce,
+            refresh,
             ..Reduction::default()
         };
         let reduced = held.reduced(&model, &how)?;
@@ -359,7 +367,10 @@ fn gait() -> Result<(), Box<dyn std::error::Error>> {
             for i in (0..tr.len()).filter(|i| tr.t[*i] <= end + 1e-9) {
                 part.push_output(&tr, i);
             }
-            println!("  cycle {k} with the pelvis free:");
+            println!(
+                "  cycle {k} with the pelvis free: the pelvis up to {:.3} rad from its reference orientation so far",
+                free.reference.pelvis_departure(&model, &part)
+            );
             let forces = CycleForces::of(&model, &free, &part, weight);
             print(&forces, mass);
             first.get_or_insert(forces);

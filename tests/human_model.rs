@@ -759,23 +759,7 @@ fn with_its_residuals_reduced_the_cycle_walks_with_the_pelvis_free() {
             Ok((tr, _)) => tr,
             Err(e) => *e.trajectory,
         };
-        let mut kin = Kinematics::new::<Human>();
-        let tilt = (0..tr.len())
-            .map(|i| {
-                model.kinematics(
-                    tr.t[i],
-                    &tr.q(i)[..Human::NQ],
-                    &tr.qd(i)[..Human::NQ],
-                    &mut kin,
-                );
-                let r = frame(&model, &kin, "pelvis_o").rotation;
-                let rr = cycle.reference.pelvis_rotation(tr.t[i]);
-                let trace: f64 = (0..3)
-                    .map(|a| (0..3).map(|m| rr[a][m] * r[a][m]).sum::<f64>())
-                    .sum();
-                (0.5 * (trace - 1.0)).clamp(-1.0, 1.0).acos()
-            })
-            .fold(0.0, f64::max);
+        let tilt = cycle.reference.pelvis_departure(&model, &tr);
         (CycleForces::of(&model, &free, &tr, weight), tilt)
     };
     let (c, tilt) = free(&reduced);

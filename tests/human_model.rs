@@ -50,6 +50,15 @@ fn within(x: Option<f64>, lo: f64, hi: f64) -> bool {
     x.is_some_and(|v| v >= lo && v <= hi)
 }
 
+/// The model as mode 1 runs it: its feet dissipating [`GAIT_DISSIPATION`].
+fn gait_model() -> Human {
+    let mut model = Human::default();
+    let mut params = model.params().clone();
+    params.d_foot = GAIT_DISSIPATION;
+    model.set_params(params).unwrap();
+    model
+}
+
 /// A foot's double hump in the normal ranges, its first peak within `first` (1.0–1.3 is
 /// normal): a trough of 0.6–0.9 and a second peak of 1.0–1.3 body weights, braking then
 /// propulsion.
@@ -590,10 +599,7 @@ fn the_grounded_cycle_levels_the_feet_keeps_them_together_and_bounds_the_centre_
     // controller, the residual torque about the vertical alone holding its turn, into a
     // steady walk (`human_gait -- --pressure 30 --free 10 --pelvis-axes 0,1,0 --balance
     // --cycles 4`)
-    let mut walker = model.clone();
-    let mut params = walker.params().clone();
-    params.d_foot = GAIT_DISSIPATION;
-    walker.set_params(params).unwrap();
+    let walker = gait_model();
     let info = walker.info();
     let reference = pressed.reference;
     let mut tracking = Tracking::new(reference.clone(), info, GAIT_KP, GAIT_KP / 100.0).unwrap();
@@ -668,10 +674,7 @@ fn the_grounded_cycle_levels_the_feet_keeps_them_together_and_bounds_the_centre_
 /// --reduce 6 --cycles 1`).
 #[test]
 fn with_its_residuals_reduced_the_cycle_walks_with_the_pelvis_free() {
-    let mut model = Human::default();
-    let mut params = model.params().clone();
-    params.d_foot = GAIT_DISSIPATION;
-    model.set_params(params).unwrap();
+    let model = gait_model();
     let info = model.info();
     let grounded = normal_cycle(&model, 1.1)
         .grounded(&model, &Grounding::default())
@@ -792,10 +795,7 @@ fn with_its_residuals_reduced_the_cycle_walks_with_the_pelvis_free() {
 /// tracking as reserves.
 #[test]
 fn the_prescribed_cycle_gives_a_normal_double_hump_braking_then_propulsion_also_on_muscles() {
-    let mut model = Human::default();
-    let mut params = model.params().clone();
-    params.d_foot = GAIT_DISSIPATION;
-    model.set_params(params).unwrap();
+    let model = gait_model();
     let info = model.info();
     let period = 1.1;
     let fitted = normal_cycle(&model, period);

@@ -5,8 +5,8 @@
 //! cargo run --release --example work_precision -- --model dpend --out docs/figures
 //! ```
 //!
-//! `--model` is seed2dof, dpend, chain8, dampedchain, slidercrank, hexapod, fourbar, pendulum3, fastlink,
-//! tumble, top or all; `--out DIR` writes
+//! `--model` is seed2dof, dpend, chain8, dampedchain, slidercrank, hexapod, fourbar, pendulum3,
+//! dpendcart, fastlink, tumble, top or all; `--out DIR` writes
 //! `DIR/wp_MODEL.csv` and `DIR/wp_MODEL.svg`; `--repeats N` times each run N times and keeps
 //! the best (default 5; fewer for a run past 1 s). Each model in its natural setting:
 //!
@@ -29,7 +29,10 @@
 //!   reference (DOPRI5 at rtol 1e-13, checked by RK4 at h = 5e-5), every 0.05 s;
 //! - the loops fourbar (to 2 s, self-computed: DOPRI5 with projection at rtol 1e-13, checked by
 //!   Radau5 with projection, every 0.05 s), pendulum3 (to t = 1 against
-//!   `tests/reference/pendulum3.json`) and fastlink (to 30 ms against
+//!   `tests/reference/pendulum3.json`), dpendcart (dpend in Cartesian coordinates, each bar
+//!   free in the plane and the hinges as four constraints, to 2 s against
+//!   `tests/reference/dpend.json` mapped to the bars' centres and absolute angles, at t =
+//!   0.5, 1, 2 s) and fastlink (to 30 ms against
 //!   `tests/reference/fastlink.json`, SymPy and SciPy DOP853 at 1e-13, every 1 ms), each over
 //!   rtol 1e-4 … 1e-10 with every constraint method a scheme offers: DOPRI5 and BDF with
 //!   projection, Radau5 and generalized-α at index 3 and with projection, HHT at index 3, and
@@ -51,6 +54,7 @@
 use mbs_models::chain8;
 use mbs_models::damped_chain;
 use mbs_models::dpend;
+use mbs_models::dpend_cartesian;
 use mbs_models::fastlink;
 use mbs_models::fourbar;
 use mbs_models::hexapod;
@@ -71,8 +75,8 @@ use std::time::Instant;
 
 #[derive(Parser, Debug)]
 struct Args {
-    /// seed2dof, dpend, chain8, slidercrank, hexapod, fourbar, pendulum3, fastlink, tumble,
-    /// top or all
+    /// seed2dof, dpend, chain8, dampedchain, slidercrank, hexapod, fourbar, pendulum3,
+    /// dpendcart, fastlink, tumble, top or all
     #[arg(long, default_value = "all")]
     model: String,
     /// write DIR/wp_MODEL.csv and DIR/wp_MODEL.svg
@@ -83,7 +87,7 @@ struct Args {
     repeats: u16,
 }
 
-const MODELS: [&str; 11] = [
+const MODELS: [&str; 12] = [
     "seed2dof",
     "dpend",
     "chain8",
@@ -92,6 +96,7 @@ const MODELS: [&str; 11] = [
     "hexapod",
     "fourbar",
     "pendulum3",
+    "dpendcart",
     "fastlink",
     "tumble",
     "top",
@@ -431,6 +436,26 @@ fn study(name: &str, repeats: usize) -> WorkPrecision {
                 ..Study::new("pendulum3", r)
             });
             s.run(&pendulum3::Pendulum3::default()).expect("study")
+        }
+        "dpendcart" => {
+            // dpend's external reference (relative angles) mapped to the bars' centres and
+            // absolute angles, and their rates
+            let times = vec![0.5, 1.0, 2.0];
+            let states = json_reference("dpend", &times)
+                .into_iter()
+                .map(|y| dpend_cartesian::from_relative(&y))
+                .collect();
+            let r = Reference::data(
+                "tests/reference/dpend.json (SymPy equations in relative angles, SciPy DOP853 at rtol = atol = 1e-13) mapped to the bars' centres and absolute angles",
+                times,
+                states,
+            );
+            let s = finish(Study {
+                sweeps: loop_sweeps::<dpend_cartesian::DoublePendulumCartesian>(&decades(4, 10)),
+                ..Study::new("dpendcart", r)
+            });
+            s.run(&dpend_cartesian::DoublePendulumCartesian::default())
+                .expect("study")
         }
         "fastlink" => {
             let times = samples(0.03, 30);

@@ -132,6 +132,7 @@ fn labels(name: &str) -> &'static [&'static str] {
         "HHT" => &["hht"],
         "gen-α" => &["gen-alpha"],
         "DOPRI5 + projection" => &["dopri5 (projection)"],
+        "BDF + projection" => &["bdf (projection)"],
         "Radau5 index 3" => &["radau5 (index3)"],
         "Radau5 + projection" => &["radau5 (projection)"],
         "gen-α index 3" => &["gen-alpha (index3)"],
@@ -292,6 +293,7 @@ fn the_work_precision_table_quotes_the_committed_csv_files() {
             "hexapod",
             "fourbar",
             "pendulum3",
+            "dpendcart",
             "fastlink",
             "tumble",
             "top"
@@ -342,6 +344,38 @@ fn the_text_after_the_table_quotes_the_committed_csv_files() {
     assert_eq!(failed.len(), 3, "{failed:?}");
     for r in failed {
         assert!(r.label == "newmark (index3)" && r.setting == "h" && r.value >= 1e-3);
+    }
+
+    // dpendcart: "Radau5 at stabilized index 2 gives 5.22 digits at rtol 1e-4 and 9.94 at
+    // 1e-10, with projection 4.10 and 9.40; DOPRI5 with projection 2.39 digits at rtol 1e-4, …
+    // and 9.04 at 1e-10"
+    let runs = read_runs("dpendcart");
+    let quoted = [
+        (
+            "index 2 gives 5.22 digits at rtol 1e-4",
+            "radau5 (index2)",
+            1e-4,
+            "5.22",
+        ),
+        ("and 9.94 at 1e-10", "radau5 (index2)", 1e-10, "9.94"),
+        ("with projection 4.10", "radau5 (projection)", 1e-4, "4.10"),
+        ("and 9.40;", "radau5 (projection)", 1e-10, "9.40"),
+        (
+            "DOPRI5 with projection 2.39 digits at rtol 1e-4",
+            "dopri5 (projection)",
+            1e-4,
+            "2.39",
+        ),
+        ("and 9.04 at 1e-10", "dopri5 (projection)", 1e-10, "9.04"),
+    ];
+    for (phrase, label, rtol, printed) in quoted {
+        assert!(text.contains(phrase), "the dpendcart paragraph: `{phrase}`");
+        let d = runs
+            .iter()
+            .find(|r| r.label == label && r.setting == "rtol" && r.value == rtol && r.ok)
+            .unwrap_or_else(|| panic!("dpendcart's {label} run at rtol {rtol:e}"))
+            .mescd;
+        assert!(rounds_to(d, printed), "{label} at rtol {rtol:e}: {d:.4}");
     }
 
     // fastlink: "DOPRI5 gains about a digit per decade of rtol (1.43 digits at rtol 1e-4, 8.00

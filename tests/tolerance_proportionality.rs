@@ -456,17 +456,7 @@ fn cartesian_double_pendulum() {
     let times = samples(1.0, 10);
     let r = computed(&dpend::DoublePendulum::default(), times).map(
         "dpend (relative angles) mapped to Cartesian coordinates",
-        |_, y| {
-            let (a, b, ad, bd) = (y[0], y[0] + y[1], y[2], y[2] + y[3]);
-            let (x1, y1) = (0.5 * a.sin(), -0.5 * a.cos());
-            let (x2, y2) = (a.sin() + 0.5 * b.sin(), -a.cos() - 0.5 * b.cos());
-            let (x1d, y1d) = (0.5 * a.cos() * ad, 0.5 * a.sin() * ad);
-            let (x2d, y2d) = (
-                a.cos() * ad + 0.5 * b.cos() * bd,
-                a.sin() * ad + 0.5 * b.sin() * bd,
-            );
-            vec![x1, y1, a, x2, y2, b, x1d, y1d, ad, x2d, y2d, bd]
-        },
+        |_, y| dpend_cartesian::from_relative(y),
     );
     let model = dpend_cartesian::DoublePendulumCartesian::default();
     assert_proportional(measure(study("dpend (Cartesian)", r, true), &model));

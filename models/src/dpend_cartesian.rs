@@ -35,3 +35,18 @@ mbs::multibody! {
 pub fn tip(q: &[f64]) -> (f64, f64) {
     (q[3] + 0.5 * q[5].sin(), q[4] - 0.5 * q[5].cos())
 }
+
+/// The state (q, qd) of [`DoublePendulumCartesian`] from a state of
+/// [`dpend`](crate::dpend) (relative angles q0, q1 and their rates), l = 1 m: the bars'
+/// centres and absolute angles θ1 = q0, θ2 = q0 + q1, then their rates.
+pub fn from_relative(y: &[f64]) -> Vec<f64> {
+    let (a, b, ad, bd) = (y[0], y[0] + y[1], y[2], y[2] + y[3]);
+    let (x1, y1) = (0.5 * a.sin(), -0.5 * a.cos());
+    let (x2, y2) = (a.sin() + 0.5 * b.sin(), -a.cos() - 0.5 * b.cos());
+    let (x1d, y1d) = (0.5 * a.cos() * ad, 0.5 * a.sin() * ad);
+    let (x2d, y2d) = (
+        a.cos() * ad + 0.5 * b.cos() * bd,
+        a.sin() * ad + 0.5 * b.sin() * bd,
+    );
+    vec![x1, y1, a, x2, y2, b, x1d, y1d, ad, x2d, y2d, bd]
+}

@@ -5,8 +5,8 @@
 //! cargo run --release --example work_precision -- --model dpend --out docs/figures
 //! ```
 //!
-//! `--model` is seed2dof, dpend, chain8, dampedchain, slidercrank, hexapod, fourbar, pendulum3,
-//! dpendcart, fastlink, tumble, top or all; `--out DIR` writes
+//! `--model` is seed2dof, dpend, chain8, dampedchain, slidercrank, slidercrankb, hexapod,
+//! fourbar, pendulum3, dpendcart, fastlink, tumble, top or all; `--out DIR` writes
 //! `DIR/wp_MODEL.csv` and `DIR/wp_MODEL.svg`; `--repeats N` times each run N times and keeps
 //! the best (default 5; fewer for a run past 1 s). Each model in its natural setting:
 //!
@@ -23,6 +23,8 @@
 //!   the explicit schemes, BDF and Radau5, index 3 for the Newmark family and Radau5; against
 //!   form (b) (θ alone, the loop in closed form) computed by DOPRI5 at rtol 1e-13 (checked by
 //!   RK4 at h = 5e-5) and mapped to (θ, ψ, s) and their rates, every 0.05 s;
+//! - slidercrankb, form (b) itself (θ alone, no constraint: what the closed form saves) to
+//!   2 s against the same reference, every 0.05 s, with the schemes of an unconstrained model;
 //! - hexapod, free-floating, no contact, to 1 s, tumbling: the declared pose with the
 //!   MODELS.md test-state velocities qd_i = 0.7 cos(0.9 i + 0.2) (from rest it would fall
 //!   with its legs still, exactly for every scheme of order ≥ 2); against a self-computed
@@ -75,8 +77,8 @@ use std::time::Instant;
 
 #[derive(Parser, Debug)]
 struct Args {
-    /// seed2dof, dpend, chain8, dampedchain, slidercrank, hexapod, fourbar, pendulum3,
-    /// dpendcart, fastlink, tumble, top or all
+    /// seed2dof, dpend, chain8, dampedchain, slidercrank, slidercrankb, hexapod, fourbar,
+    /// pendulum3, dpendcart, fastlink, tumble, top or all
     #[arg(long, default_value = "all")]
     model: String,
     /// write DIR/wp_MODEL.csv and DIR/wp_MODEL.svg
@@ -87,12 +89,13 @@ struct Args {
     repeats: u16,
 }
 
-const MODELS: [&str; 12] = [
+const MODELS: [&str; 13] = [
     "seed2dof",
     "dpend",
     "chain8",
     "dampedchain",
     "slidercrank",
+    "slidercrankb",
     "hexapod",
     "fourbar",
     "pendulum3",
@@ -367,6 +370,30 @@ fn study(name: &str, repeats: usize) -> WorkPrecision {
                 ..Study::new("slidercrank (a)", r)
             });
             s.run(&slidercrank::SliderCrank::default()).expect("study")
+        }
+        "slidercrankb" => {
+            let closed = slidercrank::SliderCrankClosed::default();
+            let r = computed(
+                &closed,
+                samples(2.0, 40),
+                (Scheme::Rk4, Setting::Step(5e-5)),
+                &mbs::Options::default(),
+            );
+            let plan = Plan {
+                dopri5: (3, 11),
+                bdf: (3, 10),
+                radau3: (3, 10),
+                radau5: (3, 11),
+                order2: (3, 8),
+                rk4: (0.01, 7),
+                midpoint: (0.005, 6),
+                euler: None,
+            };
+            let s = finish(Study {
+                sweeps: sweeps(&plan),
+                ..Study::new("slidercrank (b)", r)
+            });
+            s.run(&closed).expect("study")
         }
         "hexapod" => {
             let model = hexapod::Hexapod::default();

@@ -290,6 +290,7 @@ fn the_work_precision_table_quotes_the_committed_csv_files() {
             "chain8",
             "dampedchain",
             "slidercrank",
+            "slidercrankb",
             "hexapod",
             "fourbar",
             "pendulum3",

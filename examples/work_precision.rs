@@ -216,7 +216,7 @@ struct Plan {
     euler: Option<(f64, usize)>,
 }
 
-/// The plan of the chains (2 s).
+/// The plan of the chains and of the slider-crank's closed form (2 s).
 fn chain_plan() -> Plan {
     Plan {
         dopri5: (3, 11),
@@ -249,6 +249,23 @@ fn sweeps(p: &Plan) -> Vec<Sweep> {
         v.push(Sweep::fixed(Scheme::ExplicitEuler, &halvings(h, n)));
     }
     v
+}
+
+/// A study of an unconstrained model over 2 s with the chains' plan, against DOPRI5 at rtol
+/// 1e-13 checked by RK4 at h = 5e-5, every 0.05 s (chain8, the slider-crank's form (b)).
+fn chain_study<M: Model + Clone + 'static>(model: &M, name: &str, repeats: usize) -> WorkPrecision {
+    let r = computed(
+        model,
+        samples(2.0, 40),
+        (Scheme::Rk4, Setting::Step(5e-5)),
+        &mbs::Options::default(),
+    );
+    let s = Study {
+        sweeps: sweeps(&chain_plan()),
+        repeats,
+        ..Study::new(name, r)
+    };
+    s.run(model).expect("study")
 }
 
 fn study(name: &str, repeats: usize) -> WorkPrecision {
@@ -300,20 +317,7 @@ fn study(name: &str, repeats: usize) -> WorkPrecision {
             });
             s.run(&dpend::DoublePendulum::default()).expect("study")
         }
-        "chain8" => {
-            let model = chain8::Chain8::default();
-            let r = computed(
-                &model,
-                samples(2.0, 40),
-                (Scheme::Rk4, Setting::Step(5e-5)),
-                &mbs::Options::default(),
-            );
-            let s = finish(Study {
-                sweeps: sweeps(&chain_plan()),
-                ..Study::new("chain8", r)
-            });
-            s.run(&model).expect("study")
-        }
+        "chain8" => chain_study(&chain8::Chain8::default(), "chain8", repeats),
         "dampedchain" => {
             let model = damped_chain::DampedChain::default();
             let r = computed(
@@ -371,30 +375,11 @@ fn study(name: &str, repeats: usize) -> WorkPrecision {
             });
             s.run(&slidercrank::SliderCrank::default()).expect("study")
         }
-        "slidercrankb" => {
-            let closed = slidercrank::SliderCrankClosed::default();
-            let r = computed(
-                &closed,
-                samples(2.0, 40),
-                (Scheme::Rk4, Setting::Step(5e-5)),
-                &mbs::Options::default(),
-            );
-            let plan = Plan {
-                dopri5: (3, 11),
-                bdf: (3, 10),
-                radau3: (3, 10),
-                radau5: (3, 11),
-                order2: (3, 8),
-                rk4: (0.01, 7),
-                midpoint: (0.005, 6),
-                euler: None,
-            };
-            let s = finish(Study {
-                sweeps: sweeps(&plan),
-                ..Study::new("slidercrank (b)", r)
-            });
-            s.run(&closed).expect("study")
-        }
+        "slidercrankb" => chain_study(
+            &slidercrank::SliderCrankClosed::default(),
+            "slidercrank (b)",
+            repeats,
+        ),
         "hexapod" => {
             let model = hexapod::Hexapod::default();
             // tumbling: the declared pose with the MODELS.md test-state velocities (from rest

@@ -227,6 +227,28 @@ fn check_item(model: &str, runs: &[Run], digits: f64, item: &str) -> Option<f64>
     }
 }
 
+/// The digits at t_end of `model`'s run `label` at `rtol` (its CSV row).
+fn digits_at(runs: &[Run], model: &str, label: &str, rtol: f64) -> f64 {
+    runs.iter()
+        .find(|r| r.label == label && r.setting == "rtol" && r.value == rtol && r.ok)
+        .unwrap_or_else(|| panic!("{model}'s {label} run at rtol {rtol:e}"))
+        .mescd
+}
+
+/// Each (phrase, label, rtol, digits as printed) of `quoted`: the phrase is in the text and
+/// the digits are those of `model`'s CSV row.
+fn check_quoted(text: &str, model: &str, quoted: &[(&str, &str, f64, &str)]) {
+    let runs = read_runs(model);
+    for &(phrase, label, rtol, printed) in quoted {
+        assert!(text.contains(phrase), "the {model} paragraph: `{phrase}`");
+        let d = digits_at(&runs, model, label, rtol);
+        assert!(
+            rounds_to(d, printed),
+            "{model}: {label} at rtol {rtol:e}: {d:.4}"
+        );
+    }
+}
+
 /// The README's section `title`, from its heading to the next.
 fn section(readme: &str, title: &str) -> String {
     let start = readme
@@ -350,7 +372,6 @@ fn the_text_after_the_table_quotes_the_committed_csv_files() {
     // dpendcart: "Radau5 at stabilized index 2 gives 5.22 digits at rtol 1e-4 and 9.94 at
     // 1e-10, with projection 4.10 and 9.40; DOPRI5 with projection 2.39 digits at rtol 1e-4, …
     // and 9.04 at 1e-10"
-    let runs = read_runs("dpendcart");
     let quoted = [
         (
             "index 2 gives 5.22 digits at rtol 1e-4",
@@ -369,26 +390,13 @@ fn the_text_after_the_table_quotes_the_committed_csv_files() {
         ),
         ("and 9.04 at 1e-10", "dopri5 (projection)", 1e-10, "9.04"),
     ];
-    for (phrase, label, rtol, printed) in quoted {
-        assert!(text.contains(phrase), "the dpendcart paragraph: `{phrase}`");
-        let d = runs
-            .iter()
-            .find(|r| r.label == label && r.setting == "rtol" && r.value == rtol && r.ok)
-            .unwrap_or_else(|| panic!("dpendcart's {label} run at rtol {rtol:e}"))
-            .mescd;
-        assert!(rounds_to(d, printed), "{label} at rtol {rtol:e}: {d:.4}");
-    }
+    check_quoted(&text, "dpendcart", &quoted);
 
     // fastlink: "DOPRI5 gains about a digit per decade of rtol (1.43 digits at rtol 1e-4, 8.00
     // at 1e-10); Radau5 at index 3 gives 3.30, 3.79 and 4.28 digits at rtol 1e-5, 1e-6 and
     // 1e-7, … no order-2 run reaches 6.3 digits"
     let runs = read_runs("fastlink");
-    let digits_at = |label: &str, rtol: f64| {
-        runs.iter()
-            .find(|r| r.label == label && r.setting == "rtol" && r.value == rtol && r.ok)
-            .unwrap_or_else(|| panic!("fastlink's {label} run at rtol {rtol:e}"))
-            .mescd
-    };
+    let digits_at = |label: &str, rtol: f64| digits_at(&runs, "fastlink", label, rtol);
     let quoted = [
         (
             "(1.43 digits at rtol 1e-4",
@@ -398,11 +406,7 @@ fn the_text_after_the_table_quotes_the_committed_csv_files() {
         ),
         (" 8.00 at 1e-10)", "dopri5 (projection)", 1e-10, "8.00"),
     ];
-    for (phrase, label, rtol, printed) in quoted {
-        assert!(text.contains(phrase), "the fastlink paragraph: `{phrase}`");
-        let d = digits_at(label, rtol);
-        assert!(rounds_to(d, printed), "{label} at rtol {rtol:e}: {d:.4}");
-    }
+    check_quoted(&text, "fastlink", &quoted);
     assert!(text.contains(
         "Radau5 at index 3 gives 3.30, 3.79 and 4.28 digits at rtol 1e-5, 1e-6 and 1e-7"
     ));

@@ -58,8 +58,8 @@
 //! rtol 1e-4 to 1e-7 the digits gain 1.0–1.1 per decade at index 2 (gen-α at ρ∞ 0.8: pendulum3
 //! 4.07 5.07 6.07 7.07, four-bar 2.47 3.63 4.69 5.71, fastlink 1.86 3.08 4.18 5.22), 1.0–1.4
 //! with projection or partitioning, 0.8–1.1 on average at index 3; they land from 0.1 digits
-//! better than rtol to 2.2 short at index 2, 0.2–2.8 short with projection or partitioning and
-//! 0.5–2.4 short at index 3, the amplifying loops (four-bar, slider-crank, fastlink) the
+//! better than rtol to 2.2 short at index 2, 0.2–2.8 short with projection, from 0.1 better to
+//! 2.8 short with partitioning and 0.5–2.4 short at index 3, the amplifying loops (four-bar, slider-crank, fastlink) the
 //! furthest. Below rtol 1e-7 (2e-8 at index 3) the local tolerance reaches its floor and the
 //! digits stall (6.3–7.5 on pendulum3, 4.6–6.5 on the loops). Before the transformation (the test per step at
 //! rtol itself, as at index 3 and with projection until then) the runs fell 2.9–5.5 digits

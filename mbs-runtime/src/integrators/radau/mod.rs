@@ -333,7 +333,7 @@
 //! **Chosen:** Radau3 takes the mapping with c = 0.1, RADAU5's factor (5× looser than the
 //! table above: by its order, about ⅔ of a digit less accurate for 40 % fewer steps). In the
 //! tolerance-proportionality sweeps (`tests/tolerance_proportionality.rs`, rtol 1e-4…1e-10 on
-//! six loops) its digits now gain 0.93–1.02 per decade with projection, partitioning or at
+//! six loops) its digits now gain 0.89–1.02 per decade with projection, partitioning or at
 //! index 2 (0.58–0.76 before), and its mean offset from rtol with projection is −2.2 to +1.3
 //! digits (−3.9 to −0.5 before), in the band of DOPRI5, BDF and Radau5; those sweeps are
 //! asserted there with theirs. It costs Radau3 the steps its order asks for: dpend to 2 s at

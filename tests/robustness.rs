@@ -8,7 +8,7 @@
 //! parameter of 14 models at the edges of its range (291 values refused by `set_params`, 786
 //! runs of the others, where a start or first step that is not finite names the parameter
 //! that makes it so); and every numeric option at the edges of its range on two models under
-//! three schemes (1,008 runs, 733 refused up front). The sweep that first ran this found a
+//! three schemes (1,008 runs, 727 refused up front). The sweep that first ran this found a
 //! message blaming an error test that had passed (Radau's predictive step correction after
 //! failed Newton iterations, `tests/step_messages.rs`), a loop closure with no advice
 //! (`tests/failures.rs`) and RKC's fixed steps going non-finite on fastlink's saddle

@@ -82,8 +82,10 @@ const LOSS: f64 = 0.2;
 /// phase of the fast crank turns; the Cartesian double pendulum at 1e-4 and 1e-5, 1.04–1.44
 /// below; slider-crank (b) at 1e-5, 3.20 against 5.20). Measured, not kept: a
 /// map of DOPRI5's loose tolerances alone, rtol' = 1e-6·(rtol/1e-6)^e above 1e-6. At e = 0.5
-/// it brings rtol 1e-4 within a digit of the median on every loop, but slider-crank (b) by
-/// 0.05 digits only, and global control, which estimates the error by a run at rtol/10, then
+/// it brought rtol 1e-4 within a digit of the median on every loop, slider-crank (b) by 0.05
+/// digits only (measured again on a later build, whose other schemes' median had moved, it
+/// failed there: 2.86 digits against the median's 3.96 at rtol 1e-4, 3.75 against 4.95 at
+/// 1e-5), and global control, which estimates the error by a run at rtol/10, then
 /// compares runs only 10^0.5 apart at the loose end: its runs at 1e-4 fell to 0.47 digits
 /// short of rtol (fastlink, partitioning; 0.30 above before) and −0.06 on the Cartesian
 /// double pendulum (+0.87 before). At e = 0.4 the four-bar and fastlink lose 0.43–0.85

@@ -236,12 +236,11 @@ fn digits_at(runs: &[Run], model: &str, label: &str, rtol: f64) -> f64 {
 }
 
 /// Each (phrase, label, rtol, digits as printed) of `quoted`: the phrase is in the text and
-/// the digits are those of `model`'s CSV row.
-fn check_quoted(text: &str, model: &str, quoted: &[(&str, &str, f64, &str)]) {
-    let runs = read_runs(model);
+/// the digits are those of the row in `model`'s `runs`.
+fn check_quoted(text: &str, model: &str, runs: &[Run], quoted: &[(&str, &str, f64, &str)]) {
     for &(phrase, label, rtol, printed) in quoted {
         assert!(text.contains(phrase), "the {model} paragraph: `{phrase}`");
-        let d = digits_at(&runs, model, label, rtol);
+        let d = digits_at(runs, model, label, rtol);
         assert!(
             rounds_to(d, printed),
             "{model}: {label} at rtol {rtol:e}: {d:.4}"
@@ -390,7 +389,7 @@ fn the_text_after_the_table_quotes_the_committed_csv_files() {
         ),
         ("and 9.04 at 1e-10", "dopri5 (projection)", 1e-10, "9.04"),
     ];
-    check_quoted(&text, "dpendcart", &quoted);
+    check_quoted(&text, "dpendcart", &read_runs("dpendcart"), &quoted);
 
     // fastlink: "DOPRI5 gains about a digit per decade of rtol (1.43 digits at rtol 1e-4, 8.00
     // at 1e-10); Radau5 at index 3 gives 3.30, 3.79 and 4.28 digits at rtol 1e-5, 1e-6 and
@@ -406,7 +405,7 @@ fn the_text_after_the_table_quotes_the_committed_csv_files() {
         ),
         (" 8.00 at 1e-10)", "dopri5 (projection)", 1e-10, "8.00"),
     ];
-    check_quoted(&text, "fastlink", &quoted);
+    check_quoted(&text, "fastlink", &runs, &quoted);
     assert!(text.contains(
         "Radau5 at index 3 gives 3.30, 3.79 and 4.28 digits at rtol 1e-5, 1e-6 and 1e-7"
     ));

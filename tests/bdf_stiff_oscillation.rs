@@ -21,6 +21,9 @@
 use mbs::{BdfParams, Model, Options, Output, Scheme, Stats, simulate};
 use mbs_models::chain30_stiff::Chain30Stiff;
 
+#[path = "common/quoted.rs"]
+mod quoted;
+
 const T_END: f64 = 2.0;
 
 fn bdf(max_order: usize) -> Scheme {
@@ -114,6 +117,19 @@ fn bdf_keeps_to_order_2_on_an_undamped_stiff_chain() {
         s8.steps <= 10_000 && e8 <= e8_2,
         "{} steps, {e8:e}",
         s8.steps
+    );
+    let bdf: Vec<&(Stats, f64)> = table.iter().map(|row| &row[0]).collect();
+    quoted::says(
+        "README.md",
+        &[format!(
+            "{} / {} / {} steps (errors {:.1e} / {:.1e} / {:.1e}), no step above order 2",
+            quoted::thousands(bdf[0].0.steps),
+            quoted::thousands(bdf[1].0.steps),
+            quoted::thousands(bdf[2].0.steps),
+            bdf[0].1,
+            bdf[1].1,
+            bdf[2].1
+        )],
     );
     // the error falls with the tolerance (order 2 at rtol' = 0.1·rtol^1.25: ×1/27 per 100 in rtol)
     assert!(table[0][0].1 > 10.0 * e6 && *e6 > 10.0 * e8);

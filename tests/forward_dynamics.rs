@@ -11,6 +11,9 @@ use mbs::Model;
 use mbs::linalg::{cholesky, cholesky_solve};
 use mbs_models::*;
 
+#[path = "common/quoted.rs"]
+mod quoted;
+
 /// A small deterministic generator (xorshift), uniform in [-1, 1).
 struct Draw(u64);
 
@@ -33,9 +36,18 @@ fn flops<M: Model>(model: &M, prefix: &str) -> (String, usize) {
         .unwrap_or_else(|| panic!("no `{prefix}` row"))
 }
 
+/// What [`check`] measured of one model.
+struct Checked {
+    /// the worst relative differences of qdd and of log Π pivots, in their bounds
+    worst: (f64, f64),
+    name: String,
+    /// flops of M + h and of forward dynamics
+    flops: (usize, usize),
+}
+
 /// The worst relative difference of qdd and of log Π pivots against log det M over `STATES`
 /// states; prints the op counts.
-fn check<M: Model>(name: &str, model: &M) -> (f64, f64) {
+fn check<M: Model>(name: &str, model: &M) -> Checked {
     const STATES: usize = 20;
     let n = M::NQ;
     let (mut q0, mut qd0) = (vec![0.0; n], vec![0.0; n]);
@@ -133,13 +145,21 @@ fn check<M: Model>(name: &str, model: &M) -> (f64, f64) {
         "{name}: backward error {:.1e}",
         worst_eta.0
     );
-    (worst_qdd, worst_det)
+    Checked {
+        name: name.to_string(),
+        worst: (worst_qdd, worst_det),
+        flops: (dynamics, fwd),
+    }
 }
 
 #[test]
 fn forward_dynamics_equal_the_dense_solve_on_every_model() {
     let mut worst = (0.0f64, 0.0f64);
-    let mut see = |r: (f64, f64)| worst = (worst.0.max(r.0), worst.1.max(r.1));
+    let mut flops = std::collections::HashMap::new();
+    let mut see = |c: Checked| {
+        worst = (worst.0.max(c.worst.0), worst.1.max(c.worst.1));
+        flops.insert(c.name, c.flops);
+    };
     see(check("seed2dof", &seed2dof::Seed2dof::default()));
     see(check("dpend", &dpend::DoublePendulum::default()));
     see(check(
@@ -200,6 +220,37 @@ fn forward_dynamics_equal_the_dense_solve_on_every_model() {
     println!(
         "worst: qdd {:.2}, log det {:.2} of max(1e-12, 4 ε κ₁(M))",
         worst.0, worst.1
+    );
+    // the README's op counts (`mbs expand --counts-only` prints the same rows)
+    let t = |name: &str, which: usize| {
+        let f = flops[name];
+        quoted::thousands(if which == 0 { f.0 } else { f.1 })
+    };
+    quoted::says(
+        "README.md",
+        &[
+            format!(
+                "arm3d_6 {}, chain8 {}, chain16_stiff {}, chain24 {}, chain30_stiff {} flops; dpend {}, fourbar {}, fastlink {}, slidercrank {} (closed: {}), tumble {}",
+                t("arm3d_6", 0),
+                t("chain8", 0),
+                t("chain16_stiff", 0),
+                t("chain24", 0),
+                t("chain30_stiff", 0),
+                t("dpend", 0),
+                t("fourbar", 0),
+                t("fastlink", 0),
+                t("slidercrank", 0),
+                t("slidercrank closed", 0),
+                t("tumble", 0)
+            ),
+            format!("chain8 by sparse LᵀDL {}", t("chain8", 1)),
+            format!(
+                "(chain16_stiff {}, chain24 {}, chain30_stiff {}: O(n), below M+h alone)",
+                t("chain16_stiff", 1),
+                t("chain24", 1),
+                t("chain30_stiff", 1)
+            ),
+        ],
     );
     assert!(worst.0 <= 1.0, "qdd differs by {:.2} of its bound", worst.0);
     assert!(

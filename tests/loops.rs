@@ -8,6 +8,8 @@
 //! Every test prints its measured table: `cargo test --release --test loops -- --nocapture`.
 #![allow(clippy::needless_range_loop)]
 
+#[path = "common/quoted.rs"]
+mod quoted;
 #[path = "common/sweeps.rs"]
 mod sweeps;
 use mbs_models::dpend;
@@ -417,24 +419,28 @@ fn partitioning_switches_from_the_slider_at_dead_centre() {
 #[test]
 fn fourbar_constraints_hold_over_100_s() {
     let t_end = 100.0;
-    for (method, scheme, step, label) in [
+    let mut quotes = Vec::new();
+    for (method, scheme, step, label, quote) in [
         (
             ConstraintMethod::Projection,
             Scheme::Dopri5,
             adaptive(1e-8),
             "dopri5 rtol 1e-8",
+            "projection (DOPRI5, rtol 1e-8)",
         ),
         (
             ConstraintMethod::Index3,
             gen_alpha(),
             StepControl::Fixed { h: 1e-3 },
             "gen-alpha h 1e-3",
+            "index 3 (gen-α, h = 1 ms)",
         ),
         (
             ConstraintMethod::Partitioning,
             Scheme::Dopri5,
             adaptive(1e-8),
             "dopri5 rtol 1e-8",
+            "partitioning (DOPRI5, rtol 1e-8)",
         ),
     ] {
         let start = Instant::now();
@@ -456,7 +462,15 @@ fn fourbar_constraints_hold_over_100_s() {
         assert_eq!(tr.t[tr.len() - 1], t_end);
         assert!(turns > 50.0, "the crank turns");
         assert!(phi <= 1e-10, "{} {label}: {phi:e}", method.name());
+        if quotes.is_empty() {
+            // a cell of the README's table, its bars escaped
+            quotes.push(format!(
+                r"four-bar over 100 s ({turns:.0} crank turns), max \|Φ\|"
+            ));
+        }
+        quotes.push(format!("{quote} {phi:.1e} in"));
     }
+    quoted::says("README.md", &quotes);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1165,6 +1179,8 @@ fn the_four_bar_at_every_scale_runs_or_stops_typed() {
         ConstraintMethod::Partitioning,
     ];
     let (mut ran, mut stopped) = (0, Vec::new());
+    // Radau5's steps at index 3 and 2 over the scales, as the README quotes them
+    let (mut radau5_index3, mut radau5_index2) = (Vec::new(), Vec::new());
     for scale in [1e-6, 1e-3, 1.0, 1e3, 1e6, 1e7, 1e8] {
         for scheme in schemes {
             for method in methods {
@@ -1183,6 +1199,13 @@ fn the_four_bar_at_every_scale_runs_or_stops_typed() {
                         };
                         assert!(off < bound, "{what}: {off:e}");
                         ran += 1;
+                        if scheme == Scheme::Radau5 {
+                            match method {
+                                ConstraintMethod::Index3 => radau5_index3.push(stats.steps),
+                                ConstraintMethod::Index2 => radau5_index2.push(stats.steps),
+                                _ => {}
+                            }
+                        }
                     }
                     Err(e) if matches!(e.kind, Failure::ConstraintsUnsupported { .. }) => {}
                     Err(e) => {
@@ -1213,6 +1236,22 @@ fn the_four_bar_at_every_scale_runs_or_stops_typed() {
         stopped.len()
     );
     assert!(stopped.is_empty(), "{stopped:?}");
+    let range = |v: &[usize]| {
+        let (lo, hi) = (v.iter().min(), v.iter().max());
+        format!("{}–{}", lo.unwrap_or(&0), hi.unwrap_or(&0))
+    };
+    quoted::says(
+        "README.md",
+        &[format!(
+            "Radau5 takes {} steps from × 10⁻⁶ to × 10⁸",
+            range(&radau5_index2)
+        )],
+    );
+    println!(
+        "Radau5 over the scales: index 3 {} steps, index 2 {}",
+        range(&radau5_index3),
+        range(&radau5_index2)
+    );
 }
 
 /// The four-bar × `scale` by dynamic similarity (lengths × s, time × √s, the crank's start

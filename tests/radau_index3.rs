@@ -22,6 +22,8 @@ use pendulum3::Pendulum3;
 #[path = "common/alloc.rs"]
 mod alloc;
 mod common;
+#[path = "common/quoted.rs"]
+mod quoted;
 use common::{fixed, with_method};
 
 /// (x, y, ẋ, ẏ, λ) at t = 1 from `tests/reference/pendulum3.json`.
@@ -122,6 +124,13 @@ fn adaptive_radau5_reaches_the_reference() {
     let (s, st) = index3(Scheme::Radau5, Options::adaptive(1.0, rtol));
     let (e, inv) = print_row("radau5 rtol 1e-10", &s, &st);
     assert!(e[0] < 1e-9 && e[1] < 1e-6, "{e:?}");
+    let mut quotes = vec![format!(
+        "index 3: {} steps, {} evaluations, q within {:.1e}, λ within {:.1e}",
+        st.steps,
+        quoted::thousands(st.evaluations()),
+        e[0],
+        e[2]
+    )];
     assert!(inv[0] <= 10.0 * rtol && inv[1] <= 10.0 * rtol, "{inv:?}");
     // λ: second order, about 0.2 h² at the last steps
     assert!(e[2] < 2e-4 && inv[2] < 2e-4, "{e:?} {inv:?}");
@@ -145,6 +154,12 @@ fn adaptive_radau5_reaches_the_reference() {
     let (e, _) = print_row("radau5 rtol 1e-10 (Auto)", &auto, &st);
     assert!(st.projections > 0);
     assert!(e.iter().all(|&x| x < 1e-8), "{e:?}");
+    quotes.push(format!(
+        "projection: {} steps, {} evaluations",
+        st.steps,
+        quoted::thousands(st.evaluations())
+    ));
+    quoted::says("README.md", &quotes);
 }
 
 /// Adaptive Radau3 at index 3: q and qd within 1e-6; λ is first order, within 1e-3.

@@ -20,8 +20,17 @@ use mbs::{
 use mbs_models::*;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
+#[path = "common/quoted.rs"]
+mod quoted;
 #[path = "common/sweeps.rs"]
 mod sweeps;
+
+use quoted::thousands;
+
+/// The runs that ended as `kind` (0 where none did).
+fn count(kinds: &Kinds, kind: &str) -> usize {
+    kinds.get(kind).copied().unwrap_or(0)
+}
 
 fn methods(closed: bool) -> Vec<ConstraintMethod> {
     if !closed {
@@ -190,6 +199,16 @@ fn quietly_finite_or_not(
     (runs, kinds)
 }
 
+/// A count under ten as the documentation writes it, in words.
+fn number_word(n: usize) -> String {
+    const WORDS: [&str; 10] = [
+        "zero", "one", "two", "three", "four", "five", "six", "seven", "eight", "nine",
+    ];
+    WORDS
+        .get(n)
+        .map_or_else(|| n.to_string(), |w| w.to_string())
+}
+
 /// Endings by kind.
 type Kinds = std::collections::BTreeMap<String, usize>;
 
@@ -218,6 +237,15 @@ fn every_run_ends_or_stops_typed_with_what_it_computed() {
         runs
     });
     assert_eq!(runs, 2145);
+    quoted::says(
+        "README.md",
+        &[format!(
+            "{} runs: {} finish, the others stop with one of {} typed failures",
+            thousands(runs),
+            thousands(count(&kinds, "finished")),
+            number_word(kinds.len() - 1)
+        )],
+    );
     // the sweep reaches every kind of ending it is meant to test
     for kind in [
         "finished",
@@ -242,13 +270,20 @@ fn every_run_ends_or_stops_typed_with_what_it_computed() {
 #[test]
 fn every_run_with_sensitivities_ends_or_stops_typed() {
     use mbs::Sensitivities;
-    let (_, kinds) = quietly(|k, p| {
+    let (runs, kinds) = quietly(|k, p| {
         let arm = || Sensitivities::new(sprung_arm::SprungArm::default()).unwrap();
         let fourbar = || Sensitivities::new(fourbar::SensitiveFourBar::default()).unwrap();
         sweep("sprung_arm sensitivities", arm, false, k, p)
             + sweep("fourbar sensitivities", fourbar, true, k, p)
     });
     assert!(kinds.contains_key("finished"), "{kinds:?}");
+    quoted::says(
+        "README.md",
+        &[format!(
+            "the same holds for {runs} runs with the sensitivities of two models' motion, {} finished",
+            count(&kinds, "finished")
+        )],
+    );
 }
 
 /// Global error control (`simulate_global`) over every adaptive scheme and constraint method
@@ -302,7 +337,7 @@ fn every_globally_controlled_run_ends_or_stops_typed() {
         }
         runs
     }
-    let (_, kinds) = quietly(|k, p| {
+    let (runs, kinds) = quietly(|k, p| {
         each("dpend", dpend::DoublePendulum::default(), false, k, p)
             + each("tumble", tumble::TumbleBall::default(), false, k, p)
             + each("fourbar", fourbar::FourBar::default(), true, k, p)
@@ -314,6 +349,14 @@ fn every_globally_controlled_run_ends_or_stops_typed() {
             "no run ended in {kind}: {kinds:?}"
         );
     }
+    quoted::says(
+        "README.md",
+        &[format!(
+            "for {runs} runs under global error control, {} met, {} `GlobalToleranceNotMet`",
+            count(&kinds, "met"),
+            count(&kinds, "GlobalToleranceNotMet")
+        )],
+    );
 }
 
 /// Every parameter of every model set to the edges of its range, one at a time: zero, its
@@ -412,6 +455,15 @@ fn every_parameter_at_its_edges_is_refused_or_runs_typed() {
     println!("{runs} runs after the parameters were accepted");
     assert!(kinds.contains_key("ParamError"), "{kinds:?}");
     assert!(kinds.contains_key("finished"), "{kinds:?}");
+    quoted::says(
+        "README.md",
+        &[format!(
+            "`set_params` refuses {} with a typed `ParamError` and of the {} runs of the others {} finish",
+            thousands(count(&kinds, "ParamError")),
+            thousands(runs),
+            thousands(count(&kinds, "finished"))
+        )],
+    );
 }
 
 /// Every numeric option at the edges of its range, one at a time (0, −1, 1e-300, 1e300, NaN,
@@ -556,4 +608,12 @@ fn every_option_at_its_edges_is_refused_or_runs_typed() {
     println!("{runs} runs");
     assert!(kinds.contains_key("InvalidOption"), "{kinds:?}");
     assert!(kinds.contains_key("finished"), "{kinds:?}");
+    quoted::says(
+        "README.md",
+        &[format!(
+            "{} of {} runs refused up front with an `InvalidOption`",
+            thousands(count(&kinds, "InvalidOption")),
+            thousands(runs)
+        )],
+    );
 }

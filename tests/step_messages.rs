@@ -5,6 +5,8 @@
 
 use mbs_models::seed2dof;
 
+#[path = "common/quoted.rs"]
+mod quoted;
 #[path = "common/sweeps.rs"]
 mod sweeps;
 use mbs::{BdfParams, Failure, GenAlphaParams, Options, Output, Scheme, StepControl, simulate};
@@ -362,6 +364,7 @@ fn an_rtol_beyond_the_index3_floor_is_said() {
 #[test]
 fn a_weight_held_at_its_rounding_is_said() {
     let bdf = Scheme::Bdf(BdfParams::default());
+    let mut counts = Vec::new();
     for (scheme, rtol) in [(Scheme::Dopri5, 1e-10), (Scheme::Radau3, 1e-8), (bdf, 1e-8)] {
         let run = |atol: f64| {
             let o = Options {
@@ -390,7 +393,20 @@ fn a_weight_held_at_its_rounding_is_said() {
                 .to_string()
                 .contains("held a component at its rounding")
         );
+        counts.push((
+            quoted::thousands(low.floored_steps),
+            quoted::thousands(low.steps),
+        ));
     }
+    let [(d, dn), (r, rn), (b, bn)] = &counts[..] else {
+        unreachable!("three schemes")
+    };
+    quoted::says(
+        "README.md",
+        &[format!(
+            "on fastlink under atol = 1e-12 DOPRI5 at rtol 1e-10 {d} of its {dn} steps, Radau3 at 1e-8 {r} of {rn}, BDF at 1e-8 {b} of {bn}, none under atol = 1e-9"
+        )],
+    );
 }
 
 fn adaptive(t_end: f64, rtol: f64, atol: f64) -> Options {

@@ -1,0 +1,51 @@
+//! The documentation's figures against what a test computes: a test that computes a figure the
+//! README (or a page of `docs/`) quotes checks that the text still quotes it, so that a change
+//! of the code that moves the figure fails until the text says what the code does now. The
+//! text's line breaks do not matter: runs of white space compare as one space.
+#![allow(dead_code)]
+
+/// The file `path` (relative to the repository's root), its white space collapsed.
+fn text(path: &str) -> String {
+    let full = format!("{}/{path}", env!("CARGO_MANIFEST_DIR"));
+    let raw = std::fs::read_to_string(&full).unwrap_or_else(|e| panic!("reading {path}: {e}"));
+    collapse(&raw)
+}
+
+/// `s` with each run of white space replaced by one space.
+fn collapse(s: &str) -> String {
+    s.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+/// Fails unless `path` contains every phrase of `phrases` (white space collapsed), naming the
+/// ones it lacks: each is a figure this test computed, written as the text writes it.
+#[track_caller]
+pub fn says(path: &str, phrases: &[String]) {
+    let doc = text(path);
+    let missing: Vec<&String> = phrases
+        .iter()
+        .filter(|p| !doc.contains(&collapse(p)))
+        .collect();
+    assert!(
+        missing.is_empty(),
+        "{path} no longer quotes what this test computed; write these figures into it \
+         (or correct the test's phrase):\n{}",
+        missing
+            .iter()
+            .map(|p| format!("  `{p}`"))
+            .collect::<Vec<_>>()
+            .join("\n")
+    );
+}
+
+/// `n` with commas between thousands, as the documentation writes counts: 12,524.
+pub fn thousands(n: usize) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (k, c) in digits.chars().enumerate() {
+        if k > 0 && (digits.len() - k) % 3 == 0 {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
+}

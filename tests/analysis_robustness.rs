@@ -24,6 +24,10 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 #[path = "common/sweeps.rs"]
 mod sweeps;
 
+#[path = "common/quoted.rs"]
+mod quoted;
+use quoted::thousands;
+
 fn all_finite<'a>(xs: impl IntoIterator<Item = &'a f64>) -> bool {
     xs.into_iter().all(|x| x.is_finite())
 }
@@ -34,6 +38,10 @@ struct Tally {
     kinds: BTreeMap<String, usize>,
     problems: Vec<String>,
     calls: usize,
+    /// (calls, ok results) by model and analysis
+    by_model: BTreeMap<(String, String), (usize, usize)>,
+    /// the models swept
+    models: std::collections::BTreeSet<String>,
 }
 
 impl Tally {
@@ -46,6 +54,12 @@ impl Tally {
     ) -> Option<T> {
         self.calls += 1;
         let analysis = tag.split(' ').nth(1).unwrap_or("");
+        let model = tag.split(' ').next().unwrap_or("");
+        let here = (self.by_model)
+            .entry((model.to_string(), analysis.to_string()))
+            .or_default();
+        here.0 += 1;
+        here.1 += usize::from(matches!(r, Ok(Ok(_))));
         match r {
             Err(_) => {
                 self.problems.push(format!("{tag}: panicked"));
@@ -83,6 +97,23 @@ impl Tally {
                 None
             }
         }
+    }
+
+    /// How many results of this kind (`"statics ok"`, `"modes SingularMatrix"`).
+    fn count(&self, kind: &str) -> usize {
+        self.kinds.get(kind).copied().unwrap_or(0)
+    }
+
+    /// The models swept.
+    fn models(&self) -> usize {
+        self.models.len()
+    }
+
+    /// (calls, ok results) of `analysis` over the models `which` accepts.
+    fn of(&self, analysis: &str, which: impl Fn(&str) -> bool) -> (usize, usize) {
+        (self.by_model.iter())
+            .filter(|((m, a), _)| a == analysis && which(m))
+            .fold((0, 0), |(c, k), (_, &(n, ok))| (c + n, k + ok))
     }
 }
 
@@ -129,6 +160,7 @@ fn states<M: Model + Clone + 'static>(model: &M) -> (mbs::Trajectory, Vec<NamedS
 }
 
 fn sweep<M: Model + Clone + 'static>(name: &str, model: M, tally: &mut Tally) {
+    tally.models.insert(name.to_string());
     let (tr, list) = states(&model);
     let u = vec![0.0; M::NU];
     let ways = [
@@ -300,6 +332,19 @@ fn every_analysis_returns_finite_results_or_a_typed_error() {
     });
     println!("{} calls: {:#?}", tally.calls, tally.kinds);
     assert!(tally.problems.is_empty(), "{}", tally.problems.join("\n"));
+    quoted::says(
+        "README.md",
+        &[
+            format!(
+                "A sweep of every analysis over {} models from seven states each",
+                tally.models()
+            ),
+            format!(
+                "with inverse dynamics of valid and invalid actuated sets, {} calls, asserts",
+                thousands(tally.calls)
+            ),
+        ],
+    );
 }
 
 /// The hexapod released above the ground: six rigid motions with neither stiffness nor
@@ -335,6 +380,13 @@ fn the_modes_of_a_free_body_beside_stiff_joints_are_found() {
     let worst = largest_modal_residual(&lin, &found);
     println!("largest residual of (λ²M + λC + K)φ: {worst:.1e} of |K| + |λ||C| + |λ|²|M|");
     assert!(worst < 1e-11, "{worst:e}");
+    quoted::says(
+        "README.md",
+        &[format!(
+            "every mode of the hexapod in the air satisfies (λ²M + λC + K)φ = 0 to {worst:.1e} \
+             of |K| + |λ||C| + |λ|²|M| (asserted 1e-11)"
+        )],
+    );
 }
 
 /// The largest residual of (λ²M + λC + K)φ = 0 over the modes, relative to
@@ -387,16 +439,23 @@ fn a_slow_mode_beside_a_fast_one_gets_its_shape() {
             .map(|m| if m.im != 0.0 { 2 } else { 1 })
             .sum();
         assert_eq!(poles, 6, "{param} = {value:e}: every eigenvalue of A");
-        modes
+        (modes, worst)
     };
-    // the nutation, the fastest pole, over the spin
+    // the nutation, the fastest pole, over the spin, and the largest residual
     let nutation = |w3: f64| {
-        let modes = found("w3", w3);
+        let (modes, worst) = found("w3", w3);
         let fast = modes.modes.last().unwrap();
         assert!(fast.re.abs() < 1e-9 * fast.im, "{fast:?}");
-        fast.im / w3
+        (fast.im / w3, worst)
     };
-    let (n6, n8) = (nutation(2e6), nutation(2e8));
+    let ((n6, worst6), (n8, worst8)) = (nutation(2e6), nutation(2e8));
+    quoted::says(
+        "README.md",
+        &[format!(
+            "its nutation five and seven decades above its slowest poles, to {:.1e} (asserted 1e-12",
+            worst6.max(worst8)
+        )],
+    );
     // I3 / I1' with I1' = I1 + m l² (the default top: 4e-5 / 1.8e-4), as a fast top's
     // nutation is about I3 ω3 / I1' (the precession's share moves it by a few per cent)
     let ratio = 4e-5 / (2e-5 + 0.1 * 0.04 * 0.04);
@@ -427,6 +486,7 @@ fn statics_start_where_the_stiffness_is_singular() {
     assert!(eq.q.iter().all(|q| q.abs() < 1e-9), "{:?}", eq.q);
     assert_eq!(eq.stability, Stability::Stable);
     assert!(eq.residual <= 1e-9);
+    let dpend_iterations = eq.iterations;
     let arm = arm3d_6::Arm3d6::default();
     let eq = static_equilibrium(&arm, &StaticsOptions::default()).unwrap();
     println!(
@@ -438,6 +498,14 @@ fn statics_start_where_the_stiffness_is_singular() {
     assert!((eq.q[0] - 0.2).abs() < 1e-9 && (eq.q[1] - std::f64::consts::FRAC_PI_2).abs() < 1e-9);
     assert!(eq.q[2..].iter().all(|q| q.abs() < 1e-9));
     assert_eq!(eq.stability, Stability::Neutral);
+    quoted::says(
+        "README.md",
+        &[format!(
+            "reaches the hanging equilibrium in {dpend_iterations} iterations, the 6-joint arm's \
+             (its first axis along gravity, neutral) in {},",
+            eq.iterations
+        )],
+    );
 }
 
 /// The same on a closed loop: pendulum3 (a mass on a rod, Cartesian x, y and the rod's
@@ -460,6 +528,14 @@ fn statics_of_a_loop_start_where_the_reduced_stiffness_is_singular() {
     );
     assert_eq!(eq.stability, Stability::Stable);
     assert!(eq.residual <= 1e-9 && eq.constraint_residual <= 1e-11);
+    quoted::says(
+        "README.md",
+        &[format!(
+            "pendulum3's default start (the rod horizontal) the mass hanging below the pivot in {} \
+             iterations;",
+            eq.iterations
+        )],
+    );
 }
 
 /// Each parameter of the models at the edges of its range, one at a time (zero, its opposite,
@@ -469,6 +545,7 @@ fn statics_of_a_loop_start_where_the_reduced_stiffness_is_singular() {
 /// finite results or a typed error, never a panic.
 fn at_parameter_edges<M: Model + Clone + 'static>(name: &str, model: M, tally: &mut Tally) {
     use mbs::Parameters;
+    tally.models.insert(name.to_string());
     let defaults = model.params().values();
     let n = M::NQ;
     let u = vec![0.0; M::NU];
@@ -554,6 +631,42 @@ fn every_analysis_at_the_edges_of_the_parameters_returns_finite_results_or_a_typ
     });
     println!("{} calls: {:#?}", tally.calls, tally.kinds);
     assert!(tally.problems.is_empty(), "{}", tally.problems.join("\n"));
+    let ok: usize = (tally.kinds.iter())
+        .filter(|(k, _)| k.ends_with(" ok"))
+        .map(|(_, n)| n)
+        .sum();
+    let (modes_calls, modes_ok) = tally.of("modes", |_| true);
+    assert_eq!(modes_ok, modes_calls, "every modes call returns its modes");
+    let (statics, statics_ok) = tally.of("statics", |_| true);
+    let others = |m: &str| m != "sensitive_fourbar";
+    let (statics_others, statics_others_ok) = tally.of("statics", others);
+    let (poles, poles_ok) = tally.of("pole_sensitivity", |_| true);
+    quoted::says(
+        "README.md",
+        &[
+            format!(
+                "{} of the {} singular stiffnesses left in the sweep below name one",
+                tally.count("statics SingularMatrix naming a parameter"),
+                tally.count("statics SingularMatrix")
+            ),
+            format!(
+                "so does a second over each parameter of {} models at the edges of its range",
+                tally.models()
+            ),
+            format!(
+                "{} calls, {} of them ok (every one of the {} modes calls:",
+                thousands(tally.calls),
+                thousands(ok),
+                thousands(modes_calls)
+            ),
+            format!(
+                "statics {statics_ok} of {statics}, and on the {} models other than the sensitive \
+                 four-bar {statics_others_ok} of {statics_others}, where 165 did before",
+                tally.models() - 1
+            ),
+            format!("the pole sensitivities {poles_ok} of {poles}, the others typed"),
+        ],
+    );
 }
 
 /// A linearisation whose mass matrix a parameter made singular names the parameter, as a
@@ -607,9 +720,18 @@ fn statics_beside_a_stiff_spring_converge_at_the_rounding_of_the_forces() {
             );
         }
     }
+    let mut spread = 0.0f64;
     for (load, _) in &loads[1..] {
         assert!((load / loads[0].0 - 1.0).abs() < 1e-5, "{loads:?}");
+        spread = spread.max((load / loads[0].0 - 1.0).abs());
     }
+    quoted::says(
+        "README.md",
+        &[format!(
+            "(q₀ − 0.6)·k₁ = {} N at every stiffness to {spread:.0e} of it (asserted 1e-5;",
+            format!("{:.4}", loads[0].0).replace('-', "−")
+        )],
+    );
     // the second joint moves with 1/k₁ too: its steps from 4e7 to 4e9 and from 4e9 to 4e11
     // in the ratio (1/4e7 − 1/4e9) / (1/4e9 − 1/4e11) = 100 (within the 1.7e-11 rad the
     // stiffest one's rounding leaves)

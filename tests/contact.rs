@@ -10,6 +10,9 @@
 
 mod common;
 
+#[path = "common/quoted.rs"]
+mod quoted;
+
 use common::{accelerations, energy_rate, fd_tangents};
 use mbs::{Kinematics, Model, Options, Output, Scheme, simulate};
 
@@ -436,6 +439,16 @@ fn a_dropped_box_comes_to_rest_on_its_weight_and_never_gains_energy() {
     assert!(max_abs(qd) < 1e-6, "still moving: {qd:?}");
     assert_eq!(touching, 4, "resting on a face: {f:?}");
     assert!((total - G).abs() < 1e-6 * G, "Σ F_n = {total}");
+    // as the README says it: the weight to 1e-9 relative
+    println!("Σ F_n against m g: {:.1e} relative", (total - G).abs() / G);
+    assert!((total - G).abs() <= 1e-9 * G, "Σ F_n = {total}");
+    quoted::says(
+        "README.md",
+        &[format!(
+            "a dropped box rests with its normal forces summing to its weight to 1e-9 relative, \
+             its energy never rising by more than {rise:.0e} J"
+        )],
+    );
 }
 
 /// Times of the upward zero crossings of a sampled signal (linear interpolation).

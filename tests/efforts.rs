@@ -7,6 +7,9 @@
 
 use mbs::{Effort, Efforts, Failure, Model, Options, Output, Scheme, Stats, WithEfforts, simulate};
 
+#[path = "common/quoted.rs"]
+mod quoted;
+
 mbs::multibody! {
     /// A double pendulum with a damper between the bars and a horizontal push at the tip,
     /// both in the DSL (scene `Full`) or left out (scene `Bare`) for the hook to add.
@@ -407,6 +410,8 @@ fn rejected_trial_states_are_retried_smaller() {
     // a guard 1e-6 above it: large steps' trial states overshoot it; a plain Err stops the
     // run there, a rejection retries the step smaller and the run goes on
     let limit = reach + 1e-6;
+    // the earliest and latest stops of the plain Err, the fewest and most steps retried
+    let (mut stops, mut retried) = ((f64::INFINITY, 0.0f64), (usize::MAX, 0));
     for (scheme, rtol) in [
         (Scheme::Dopri5, 1e-2),
         (Scheme::Dopri5, 1e-3),
@@ -432,7 +437,20 @@ fn rejected_trial_states_are_retried_smaller() {
         assert!(stats.rejected_effort >= 1, "{name}");
         assert_eq!(tr.t.last(), Some(&t_end), "{name}");
         assert!((0..tr.len()).all(|i| tr.q(i)[0].abs() <= limit), "{name}");
+        stops = (stops.0.min(hard.t), stops.1.max(hard.t));
+        retried = (
+            retried.0.min(stats.rejected_effort),
+            retried.1.max(stats.rejected_effort),
+        );
     }
+    quoted::says(
+        "README.md",
+        &[format!(
+            "stops DOPRI5 (rtol 1e-2, 1e-3) and Radau5 (rtol 1e-3) at t ≈ {:.1}–{:.1} s as a plain \
+             `Err`; as a rejection they run to the end, retrying {}–{} steps",
+            stops.0, stops.1, retried.0, retried.1
+        )],
+    );
     // a guard the motion itself crosses: the run stops with the typed failure where smaller
     // steps cannot avoid it, the trajectory until then kept
     let e = simulate(

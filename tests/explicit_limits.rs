@@ -1,6 +1,9 @@
 //! Explicit schemes know their limits: past them they stop with a typed error that says what
 //! to do, before any non-finite value, rather than return a wrong trajectory.
 
+#[path = "common/quoted.rs"]
+mod quoted;
+
 use mbs_models::{dpend, seed2dof};
 
 use mbs::{Failure, Options, Output, Scheme, simulate};
@@ -52,6 +55,13 @@ fn euler_refuses_a_step_that_pumps_energy_into_an_oscillation() {
     assert!(
         text.contains("explicit Euler") && text.contains("take h <"),
         "{text}"
+    );
+    quoted::says(
+        "README.md",
+        &[format!(
+            "explicit Euler | `euler` | 1 | unstable on undamped oscillations: refused past ωh = \
+             {limit:.3} (amplitude ×2 a period)"
+        )],
     );
 
     // the advised step runs, and the energy stays within a factor 2 of its start over a period
@@ -109,6 +119,12 @@ fn euler_on_a_decaying_mode_keeps_its_real_interval() {
         } => {
             assert_eq!(limit, 2.0);
             assert!((h_stable - 0.02).abs() < 1e-4, "{h_stable}");
+            quoted::says(
+                "README.md",
+                &[format!(
+                    "(amplitude ×2 a period), \\|hλ\\| < {limit} on decay (a typed error)"
+                )],
+            );
         }
         other => panic!("{other}"),
     }

@@ -1,6 +1,9 @@
 //! Failures are values: typed errors with the trajectory computed so far, never a panic, never
 //! a non-finite value in a trajectory.
 
+#[path = "common/quoted.rs"]
+mod quoted;
+
 use mbs_models::seed2dof;
 
 use mbs::{
@@ -372,6 +375,22 @@ fn requests_beyond_memory_or_size_are_refused() {
         Failure::InvalidOption { name, value, .. } => {
             assert_eq!(*name, "output", "{e}");
             assert!(value.starts_with("90000001 outputs of"), "{e}");
+            // the size and the limit, as the README quotes them
+            let size = value.trim_start_matches("90000001 outputs of ");
+            let limit = e.to_string();
+            let limit = limit
+                .split("than a trajectory may (")
+                .nth(1)
+                .and_then(|t| t.split(')').next())
+                .unwrap_or_else(|| panic!("{e}"))
+                .to_string();
+            quoted::says(
+                "README.md",
+                &[format!(
+                    "outputs that would take more than {limit} of memory, with their size: 9·10⁷ \
+                     outputs of seed2dof with its frames' poses, {size}, filled the memory"
+                )],
+            );
         }
         other => panic!("{other}"),
     }

@@ -10,6 +10,10 @@ use mbs_models::hexapod;
 
 use hexapod::Hexapod;
 
+#[path = "common/quoted.rs"]
+mod quoted;
+use quoted::thousands;
+
 /// The MODELS.md test state: q_i = 0.5 sin(1.3 i + 0.4), qd_i = 0.7 cos(0.9 i + 0.2).
 fn test_state(n: usize) -> (Vec<f64>, Vec<f64>) {
     let q = (0..n).map(|i| 0.5 * (1.3 * i as f64 + 0.4).sin()).collect();
@@ -141,4 +145,22 @@ fn hexapod_free_scene_keeps_the_contact_free_op_counts() {
     assert_eq!((dynamics.flops(), dynamics.funcs), (5887, 42));
     assert_eq!(count("static_forces").flops(), 1020);
     assert_eq!(count("power").flops(), 0);
+    let flops = thousands(dynamics.flops());
+    quoted::says(
+        "README.md",
+        &[
+            format!(
+                "| M+h operations, hexapod (24 dof, 49 bodies) | {flops} flops, {} sin/cos, its base on `Tfree`",
+                dynamics.funcs
+            ),
+            format!("hexapod {flops} on `Tfree` against"),
+        ],
+    );
+    quoted::says(
+        "docs/rotations.md",
+        &[
+            format!("M + h {flops} flops on `Tfree` against"),
+            format!("the model the README calls the hexapod (scene `Free`, {flops})"),
+        ],
+    );
 }

@@ -25,7 +25,7 @@ use mbs_models::hexapod;
 
 use hexapod::{Hexapod, HexapodStanding};
 
-/// Simulated time (s): the issue asks for rest within 5 s.
+/// Simulated time (s): the hexapod must come to rest within 5 s.
 const T_END: f64 = 5.0;
 /// "At rest": every |qd_i| below this (m/s, rad/s). A thousandth of a millimetre per second:
 /// 1e-4 of the friction's regularisation velocity eps = 1e-2 m/s, where the friction left is

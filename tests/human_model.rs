@@ -31,6 +31,35 @@
 use mbs::{Efforts, Kinematics, Model, Options, Output, Scheme};
 use mbs_models::human::*;
 
+#[path = "common/quoted.rs"]
+mod quoted;
+use quoted::thousands;
+
+/// `x` to `digits` decimals with its sign, a minus as the documents write it: −0.15, +0.28.
+fn signed(x: f64, digits: usize) -> String {
+    format!("{x:+.digits$}").replace('-', "−")
+}
+
+/// A foot's figure to two decimals, as the documents write it.
+fn two(x: Option<f64>) -> String {
+    format!("{:.2}", x.expect("the figure was reached"))
+}
+
+/// A foot's force figure to two decimals with its sign: −0.15, +0.28.
+fn two_signed(x: Option<f64>) -> String {
+    signed(x.expect("the figure was reached"), 2)
+}
+
+/// `[lo, hi]` as the documents write it: −0.15…+0.18, or ±0.10 when symmetric.
+fn span([lo, hi]: [f64; 2], digits: usize) -> String {
+    let (l, h) = (signed(lo, digits), signed(hi, digits));
+    if l.strip_prefix('−') == h.strip_prefix('+') {
+        format!("±{}", &h[1..])
+    } else {
+        format!("{l}…{h}")
+    }
+}
+
 const G: f64 = 9.80665;
 /// gait2392's 75.1646 kg and two patellas of 0.0862 kg (Rajagopal 2015)
 const MASS: f64 = 75.1646 + 2.0 * 0.0862;
@@ -212,6 +241,12 @@ fn the_fourier_fit_reproduces_the_gait_table() {
     }
     println!("8 harmonics: largest deviation from the table {worst:.3}°");
     assert!(worst < 1.0, "{worst}°");
+    quoted::says(
+        "docs/human_gait.md",
+        &[format!(
+            "deviation from the table ({worst:.2}° with 8 harmonics, asserted < 1°)"
+        )],
+    );
 }
 
 #[test]
@@ -261,6 +296,28 @@ fn the_model_stands_on_its_feet() {
     assert!(((f[0][1] + f[1][1]) / weight - 1.0).abs() < 0.01);
     // symmetric stance: each foot about half
     assert!((f[0][1] / weight - 0.5).abs() < 0.05 && (f[1][1] / weight - 0.5).abs() < 0.05);
+    let shares = [f[0][1] / weight, f[1][1] / weight].map(|s| format!("{s:.4}"));
+    assert_eq!(
+        shares[0], shares[1],
+        "the documents say each foot carries as much"
+    );
+    let moved = (0..3).map(|j| (ql[j] - q0[j]).abs()).fold(0.0, f64::max);
+    quoted::says(
+        "docs/human_gait.md",
+        &[format!(
+            "({} Radau5 steps; the ground carries {} of the weight on each foot, asserted within 1 % in total and 5 % per foot; the pelvis moves {:.1} mm, asserted < 1 cm)",
+            stats.steps,
+            shares[0],
+            1e3 * moved
+        )],
+    );
+    quoted::says(
+        "README.md",
+        &[format!(
+            "the model stands 3 s on its twelve ellipsoids with its joints held, the ground carrying {} of the weight on each foot",
+            shares[0]
+        )],
+    );
     for j in 0..3 {
         assert!((ql[j] - q0[j]).abs() < 0.01, "pelvis drifted along {j}");
         assert!(
@@ -396,6 +453,16 @@ fn passive_moments_catch_a_collapsing_body_near_its_joints_ranges() {
     assert!(a > 3.0, "{a}");
     assert_eq!(*held.t.last().unwrap(), t_end);
     assert!(b < 0.5, "{b} rad beyond ({wb})");
+    assert!(
+        wa.starts_with("mtp"),
+        "the documents say the toes spin: {wa}"
+    );
+    quoted::says(
+        "docs/human_gait.md",
+        &[format!(
+            "in 0.4 s of a collapse they keep every joint within {b:.2} rad of its range (asserted < 0.5) where without them the toes spin {a:.1} rad beyond theirs"
+        )],
+    );
 }
 
 #[test]
@@ -531,6 +598,51 @@ fn the_grounded_cycle_levels_the_feet_keeps_them_together_and_bounds_the_centre_
         raw.speed
     );
     assert!(g.largest_change < 20f64.to_radians());
+    let [ra, rv, _] = raw.acceleration;
+    let [ga, gv, gl] = g.acceleration;
+    let widest = g
+        .acceleration
+        .iter()
+        .flatten()
+        .fold(0.0f64, |m, a| m.max(a.abs()));
+    quoted::says(
+        "docs/human_gait.md",
+        &[
+            format!(
+                "in double support one foot is up to {:.1} cm above the other and the two slide apart at up to {:.2} m/s, the swinging foot falls up to {:.1} cm short of the clearance asked (2 cm at mid-swing), and the centre of mass, carried by the standing foot, accelerates by {} g fore–aft and {} g vertically",
+                1e2 * raw.level,
+                raw.slip,
+                -1e2 * raw.clearance,
+                span(ra, 1),
+                span(rv, 1)
+            ),
+            format!(
+                "(Levenberg–Marquardt over the cycle, up to {:.1}°, {} iterations,",
+                g.largest_change.to_degrees(),
+                g.iterations
+            ),
+            format!(
+                "in double support the feet are level within {:.1} mm and slide apart at {:.2} m/s at most, the swinging foot clears within {:.1} mm of the height asked, the centre of mass accelerates within {} g fore–aft, {} g vertically and {} g laterally",
+                1e3 * g.level,
+                g.slip,
+                -1e3 * g.clearance,
+                span(ga, 2),
+                span(gv, 2),
+                span(gl, 2)
+            ),
+            format!(
+                "the walking speed stays near the published one ({:.2} against {:.2} m/s)",
+                g.speed, raw.speed
+            ),
+        ],
+    );
+    quoted::says(
+        "README.md",
+        &[format!(
+            "(Levenberg–Marquardt over the cycle, up to {:.1}°) until the feet are level and together in double support and the centre of mass accelerates within ±{widest:.2} g",
+            g.largest_change.to_degrees()
+        )],
+    );
     // what the cycle still asks of the ground: the centre of pressure its motion needs lies
     // beyond the standing feet (the residual torques supply that moment), less so than the
     // fitted cycle's, whose vertical force nearly vanishes at instants
@@ -547,6 +659,24 @@ fn the_grounded_cycle_levels_the_feet_keeps_them_together_and_bounds_the_centre_
         "{:?} {:?}",
         g.pressure_beyond,
         raw.pressure_beyond
+    );
+    quoted::says(
+        "docs/human_gait.md",
+        &[format!(
+            "It lies up to {:.2} m beside the standing foot's support (the soft maximum of its ellipsoids' support points within about 1 mm of its lowest) and {:.2} m beyond it fore–aft, and the motion needs a free moment about the vertical of up to {:.0} N·m (the published cycle before the corrections: {:.1} and {:.1} m,",
+            g.pressure_beyond[1],
+            g.pressure_beyond[0],
+            g.free_moment,
+            raw.pressure_beyond[0],
+            raw.pressure_beyond[1]
+        )],
+    );
+    quoted::says(
+        "README.md",
+        &[format!(
+            "because the cycle needs its centre of pressure up to {:.2} m beside the standing foot",
+            g.pressure_beyond[1]
+        )],
     );
     // asked of the grounded cycle, the pass puts that centre of pressure within the feet
     // and lowers the free moment, keeping the feet level and together and the speed
@@ -589,6 +719,21 @@ fn the_grounded_cycle_levels_the_feet_keeps_them_together_and_bounds_the_centre_
         (pressed.speed / raw.speed - 1.0).abs() < 0.15,
         "{}",
         pressed.speed
+    );
+    quoted::says(
+        "docs/human_gait.md",
+        &[
+            format!("in {} more iterations (", pressed.iterations),
+            format!(
+                "up to {:.1}° more of angle) the centre of pressure lies within {:.1} mm of the feet's support and the free moment needed falls to {:.0} N·m, the feet stay level within {:.1} mm and together within {:.2} m/s, the speed {:.2} m/s",
+                pressed.largest_change.to_degrees(),
+                1e3 * pressed.pressure_beyond[0].max(pressed.pressure_beyond[1]),
+                pressed.free_moment,
+                1e3 * pressed.level,
+                pressed.slip,
+                pressed.speed
+            ),
+        ],
     );
     // the corrected series are what the pass measured: the reference at an instant of
     // double support has its feet level
@@ -665,6 +810,27 @@ fn the_grounded_cycle_levels_the_feet_keeps_them_together_and_bounds_the_centre_
     assert!(
         axes[0] == 0.0 && axes[2] == 0.0 && axes[1] > 0.0,
         "{axes:?}"
+    );
+    let peaks = format!("{} and {}", two(right.first_peak), two(left.first_peak));
+    let sideways = c.landing.map(|v| format!("{:.2}", v.unwrap()[2].abs()));
+    // a bound: the largest |angle| rounded up to hundredths
+    let largest = |[lo, hi]: [f64; 2]| (100.0 * lo.abs().max(hi.abs())).ceil() / 100.0;
+    quoted::says(
+        "docs/human_gait.md",
+        &[
+            format!(
+                "asserts the last of four cycles: first peaks {peaks}, troughs {} and {}, pitch and roll within {:.2} and {:.2} rad)",
+                two(right.trough),
+                two(left.trough),
+                largest(pitch),
+                largest(roll)
+            ),
+            format!(
+                "against that walk's first peaks of {peaks} and heels landing at {} and {} m/s sideways",
+                sideways[0], sideways[1]
+            ),
+            format!("({peaks} without the feedforward at 3·10⁴"),
+        ],
     );
 }
 
@@ -779,6 +945,63 @@ fn with_its_residuals_reduced_the_cycle_walks_with_the_pelvis_free() {
     assert!((c.impulse_ratio - 1.0).abs() < 0.05, "{}", c.impulse_ratio);
     assert!(c.airborne < 0.01, "{}", c.airborne);
     assert!(tilt < 0.1, "{tilt}");
+    // the corrections per joint (degrees) and the free cycle's figures, as the documents
+    // write them
+    let degrees = |joint: &str| {
+        reduced
+            .changes
+            .iter()
+            .find(|(name, _)| name.starts_with(joint))
+            .unwrap_or_else(|| panic!("no {joint} in {:?}", reduced.changes))
+            .1
+            .to_degrees()
+    };
+    let others = ["knee", "ankle", "mtp"].map(degrees);
+    let (least, most) = (
+        others.iter().copied().fold(f64::INFINITY, f64::min),
+        others.iter().copied().fold(0.0, f64::max),
+    );
+    // every joint but the hip's rotation and adduction
+    let rest = reduced
+        .changes
+        .iter()
+        .filter(|(name, _)| !name.starts_with("hip_rotation") && !name.starts_with("hip_adduction"))
+        .map(|(_, c)| c.to_degrees())
+        .fold(0.0, f64::max);
+    let alike = |a: String, b: String| if a == b { a } else { format!("{a} and {b}") };
+    let [from, to] = reduced.residual_rms;
+    let free_cycle = (
+        format!(
+            "first peaks {} and {} body weights, troughs {}, second peaks {}, braking {} and {} then propulsion {}, a vertical impulse of {:.3} × weight × time, the pelvis within {tilt:.3} rad of its reference orientation over the cycle",
+            two(right.first_peak),
+            two(left.first_peak),
+            alike(two(right.trough), two(left.trough)),
+            alike(two(right.second_peak), two(left.second_peak)),
+            two_signed(right.braking),
+            two_signed(left.braking),
+            alike(two_signed(right.propulsion), two_signed(left.propulsion)),
+            c.impulse_ratio
+        ),
+        format!(
+            "double humps of {}, {}, {} and {}, {}, {} body weights, braking then propulsion ({} and {}, {}), a vertical impulse of {:.3} × weight × time, the pelvis within {tilt:.3} rad of its reference orientation",
+            two(right.first_peak),
+            two(right.trough),
+            two(right.second_peak),
+            two(left.first_peak),
+            two(left.trough),
+            two(left.second_peak),
+            two_signed(right.braking),
+            two_signed(left.braking),
+            alike(two_signed(right.propulsion), two_signed(left.propulsion)),
+            c.impulse_ratio
+        ),
+        format!(
+            "walks a normal cycle (humps {}, {}, {} body weights",
+            two(right.first_peak),
+            two(right.trough),
+            two(right.second_peak)
+        ),
+    );
     // the cycle as given, free from the same instant of its own held run: out of the normal
     // ranges, the pelvis turned away from its reference
     let (c, tilt) = free(&given);
@@ -788,6 +1011,52 @@ fn with_its_residuals_reduced_the_cycle_walks_with_the_pelvis_free() {
     );
     let normal = [right, left].iter().all(|g| double_hump(g, [1.0, 1.3]));
     assert!(!normal && tilt > 0.2, "{right:?} {left:?} {tilt}");
+    // the right foot's trough falls to 0, as the documents say
+    assert!(right.trough.unwrap() < 0.005, "{right:?}");
+    quoted::says(
+        "docs/human_gait.md",
+        &[
+            format!("six iterations take the residual torques from {from:.1} to {to:.1} N·m rms ("),
+            format!(
+                "mostly by turning the hips (rotation by up to {:.1}°, adduction {:.1}°; knee, ankle and toes {least:.1}–{most:.1}°, hip flexion {:.1}°, subtalar {:.1}°)",
+                degrees("hip_rotation"),
+                degrees("hip_adduction"),
+                degrees("hip_flexion"),
+                degrees("subtalar")
+            ),
+            free_cycle.0,
+            format!(
+                "from the same instant of the pressed cycle as it was, the left heel strikes at {} body weights, the right foot's trough falls to 0 and the pelvis turns {tilt:.2} rad away",
+                two(left.first_peak)
+            ),
+            format!(
+                "(up to 18.7°, and {:.1}° more to reduce its residuals)",
+                reduced.largest_change.to_degrees()
+            ),
+        ],
+    );
+    quoted::says(
+        "README.md",
+        &[
+            format!(
+                "iterations lower the residual torques from {from:.1} to {to:.1} N·m rms (114–126 s on two cores; the hips' rotation corrected by up to {:.1}°, their adduction {:.1}°, the other joints {rest:.1}° at most)",
+                degrees("hip_rotation"),
+                degrees("hip_adduction")
+            ),
+            free_cycle.1,
+            format!(
+                "from the same instant of the cycle as given, first peaks of {} and {}, a trough of 0, the pelvis {tilt:.2} rad off",
+                two(right.first_peak),
+                two(left.first_peak)
+            ),
+            format!("residual torques {from:.1} → {to:.1} N·m rms) the pelvis wholly free"),
+            free_cycle.2,
+            format!(
+                "(up to 18.7° grounding it, {:.1}° more reducing its residuals)",
+                reduced.largest_change.to_degrees()
+            ),
+        ],
+    );
 }
 
 /// Mode 1 as the gait program runs it: the grounded normal cycle tracked, the pelvis held by
@@ -836,6 +1105,60 @@ fn the_prescribed_cycle_gives_a_normal_double_hump_braking_then_propulsion_also_
          (about the fore–aft, vertical and lateral axes {:.0?})",
         stats.steps, c.impulse_ratio, c.airborne, c.residual_rms, c.residual_axes
     );
+    let mass = total_mass(&model);
+    let hump = |g: &FootFigures| {
+        format!(
+            "{} and {} body weights over a trough of {}",
+            two(g.first_peak),
+            two(g.second_peak),
+            two(g.trough)
+        )
+    };
+    assert_eq!(hump(&right), hump(&left), "the documents say each foot");
+    assert_eq!(format!("{right:.2?}"), format!("{left:.2?}"));
+    let [fore_aft, vertical, lateral] = h;
+    quoted::says(
+        "docs/human_gait.md",
+        &[
+            format!(
+                "the second cycle gives each foot a double hump of {}, braking then propulsion (peaks {} and {}, means {} and {} body weights over the stance's halves), a vertical impulse of {:.3} × weight × time, always a foot on the ground, and residual torques of {:.2} N·m/kg rms ({:.2} peak): {:.0} N·m rms about the fore–aft axis, {:.0} about the vertical and {:.0} about the lateral.",
+                hump(&right),
+                two_signed(right.braking),
+                two_signed(right.propulsion),
+                two_signed(right.first_half),
+                two_signed(right.second_half),
+                c.impulse_ratio,
+                c.residual_rms / mass,
+                c.residual_peak / mass,
+                c.residual_axes[0],
+                c.residual_axes[1],
+                c.residual_axes[2]
+            ),
+            format!(
+                "walking speed and the centre of mass' height as Herr & Popovic (2008) do: {} about the lateral axis, {} fore–aft, {} vertical",
+                span(lateral, 3),
+                span(fore_aft, 3),
+                span(vertical, 3)
+            ),
+        ],
+    );
+    quoted::says(
+        "README.md",
+        &[
+            format!(
+                "each foot shows the double hump, {}, braking then propulsion ({}, {}), a vertical impulse of {:.3} × weight × time, residual torques {:.2} N·m/kg rms",
+                hump(&right),
+                two_signed(right.braking),
+                two_signed(right.propulsion),
+                c.impulse_ratio,
+                c.residual_rms / mass
+            ),
+            format!(
+                "residual torques {:.2} N·m/kg rms, because",
+                c.residual_rms / mass
+            ),
+        ],
+    );
     // the axes' parts make up the whole
     let parts = c.residual_axes.iter().map(|a| a * a).sum::<f64>().sqrt();
     assert!(
@@ -854,6 +1177,20 @@ fn the_prescribed_cycle_gives_a_normal_double_hump_braking_then_propulsion_also_
     println!(
         "landing velocities (fore–aft, vertical, lateral; m/s): {:.3?}",
         c.landing
+    );
+    let landing = c
+        .landing
+        .map(|v| v.unwrap().map(|x| format!("{:.2}", x.abs())));
+    assert_eq!(
+        landing[0], landing[1],
+        "the documents say the heels land alike"
+    );
+    quoted::says(
+        "docs/human_gait.md",
+        &[format!(
+            "asserts its landing: {} m/s down, {} fore–aft, {} sideways",
+            landing[0][1], landing[0][0], landing[0][2]
+        )],
     );
     for v in c.landing {
         let [x, y, z] = v.expect("each foot lands in the cycle");
@@ -886,18 +1223,76 @@ fn the_prescribed_cycle_gives_a_normal_double_hump_braking_then_propulsion_also_
         );
         t.feedforward = feedforward;
         // the stiff run's start, outputs and tolerance
-        let (run, _) = mbs::simulate(
+        let (run, st) = mbs::simulate(
             mbs::WithEfforts::new(model.clone(), t.clone()),
             Scheme::Radau5,
             options.clone(),
         )
         .unwrap();
         let c = CycleForces::of(&model, &t, &run, weight);
-        [c.figures(0), c.figures(1)]
+        ([c.figures(0), c.figures(1)], c.landing, st.steps)
     };
-    let fed = soft(tracking.feedforward_of(&tr, 20).unwrap());
-    let unfed = soft(Vec::new());
+    let (fed, fed_landing, fed_steps) = soft(tracking.feedforward_of(&tr, 20).unwrap());
+    let (unfed, unfed_landing, _) = soft(Vec::new());
     println!("softer tracking with feedforward: {fed:.2?}\n without: {unfed:.2?}");
+    println!(
+        "landing velocities with feedforward: {fed_landing:.3?}; without: {unfed_landing:.3?}; {fed_steps} steps with feedforward"
+    );
+    let pair = |f: fn(&FootFigures) -> Option<f64>, sign: bool| {
+        let v = fed.map(|g| if sign { two_signed(f(&g)) } else { two(f(&g)) });
+        format!("{} and {}", v[0], v[1])
+    };
+    let down = fed_landing.map(|v| format!("{:.2}", -v.unwrap()[1]));
+    let lag = unfed_landing
+        .iter()
+        .map(|v| -v.unwrap()[1])
+        .fold(0.0f64, f64::max);
+    quoted::says(
+        "docs/human_gait.md",
+        &[
+            format!(
+                "thirty times softer, the tracking gives first peaks of {} body weights, troughs of {}, second peaks of {}, braking {}, propulsion {}, the heels landing at {} and {} m/s downward",
+                pair(|g| g.first_peak, false),
+                pair(|g| g.trough, false),
+                pair(|g| g.second_peak, false),
+                pair(|g| g.braking, true),
+                pair(|g| g.propulsion, true),
+                down[0],
+                down[1]
+            ),
+            format!(
+                "a heel lands at {lag:.2} m/s, and the forces leave the normal ranges (first peaks {} and {}, troughs {} and {}, propulsion {} under the right foot;",
+                two(unfed[0].first_peak),
+                two(unfed[1].first_peak),
+                two(unfed[0].trough),
+                two(unfed[1].trough),
+                two_signed(unfed[0].propulsion)
+            ),
+            format!(
+                "The two cycles take {} Radau5 steps where the stiff tracking takes {}.",
+                thousands(fed_steps),
+                thousands(stats.steps)
+            ),
+        ],
+    );
+    quoted::says(
+        "README.md",
+        &[
+            format!(
+                "gives the same double hump within 0.05 body weights ({}, troughs {}, braking {})",
+                pair(|g| g.first_peak, false),
+                pair(|g| g.trough, false),
+                pair(|g| g.braking, true)
+            ),
+            format!(
+                "a heel lands at {lag:.2} m/s (first peaks {} and {}, troughs {} and {};",
+                two(unfed[0].first_peak),
+                two(unfed[1].first_peak),
+                two(unfed[0].trough),
+                two(unfed[1].trough)
+            ),
+        ],
+    );
     for (g, s) in fed.iter().zip(stiff) {
         let close =
             |a: Option<f64>, b: Option<f64>| a.zip(b).is_some_and(|(a, b)| (a - b).abs() < 0.1);
@@ -957,6 +1352,27 @@ fn the_prescribed_cycle_gives_a_normal_double_hump_braking_then_propulsion_also_
     // the reserves; 22.0 when the excitations were the activations, their lag ignored), and
     // the walk stays normal
     assert!(reserves < 0.4 * alone, "{reserves} {alone}");
+    let forces = format!(
+        "({}, {}, {})",
+        two(g.first_peak),
+        two(g.trough),
+        two(g.second_peak)
+    );
+    quoted::says(
+        "docs/human_gait.md",
+        &[
+            format!(
+                "the reserves' torques at hip, knee and ankle fall from {alone:.1} to {reserves:.1} N·m rms with the forces unchanged {forces}"
+            ),
+            format!("walk alone (the reserves carry {reserves:.1} N·m rms"),
+        ],
+    );
+    quoted::says(
+        "README.md",
+        &[format!(
+            "nearly the same forces {forces}, the reserves falling from {alone:.1} to {reserves:.1} N·m rms"
+        )],
+    );
     assert!(
         within(g.first_peak, 1.0, 1.3) && within(g.second_peak, 1.0, 1.3),
         "{g:?}"
@@ -1075,6 +1491,12 @@ fn in_flight_the_angular_momentum_about_the_centre_of_mass_is_conserved() {
         first.angular_momentum
     );
     assert!(swing > 0.3, "the legs hardly moved: {swing}");
+    quoted::says(
+        "docs/human_gait.md",
+        &[format!(
+            "conserved in flight to {worst:.1e} of itself while the legs swing"
+        )],
+    );
     assert!(
         worst < 1e-6,
         "angular momentum changed by {worst:.2e} of it"
@@ -1262,4 +1684,10 @@ fn the_ground_wrench_a_cycle_needs_is_its_inverse_dynamics() {
         "{worst_force} {worst_moment}"
     );
     assert!(worst_point < 1e-12, "{worst_point}");
+    quoted::says(
+        "docs/human_gait.md",
+        &[format!(
+            "checks that force and moment against the model's inverse dynamics along the cycle, to {worst_force:.1e} of the body's weight, asserted 1e-5"
+        )],
+    );
 }

@@ -27,6 +27,9 @@ use mbs::muscle::{self, MuscleError, Musculotendon};
 use mbs::{Effort, Efforts, Failure, Kinematics, Model, Options, Output, Scheme, WithEfforts};
 use mbs_models::human::*;
 
+#[path = "common/quoted.rs"]
+mod quoted;
+
 #[test]
 fn curves_meet_their_anchor_points_and_sympy() {
     assert!((muscle::active_force(1.0) - 1.0).abs() < 1e-2);
@@ -417,6 +420,22 @@ fn the_model_stands_on_its_muscles_with_constant_excitations() {
     );
     assert_eq!(growing.len(), 1, "{growing:?}");
     assert!((ratio / (0.5 * lambda).exp() - 1.0).abs() < 0.2, "{ratio}");
+    let says = (0.5 * lambda).exp();
+    quoted::says(
+        "docs/human_gait.md",
+        &[
+            format!("(asserted < 1e-6) in {} Radau5 steps", stats.steps),
+            format!(
+                "the linearisation one growing pole ({lambda:.2}/s), and a body pushed at 1e-4 rad/s departs × {ratio:.2} between 0.5 s and 1 s where the pole says × {says:.2} (asserted within 20 %)"
+            ),
+        ],
+    );
+    quoted::says(
+        "README.md",
+        &[format!(
+            "one growing pole of {lambda:.2}/s, and a pushed body departs × {ratio:.2} between 0.5 s and 1 s where the pole says × {says:.2}"
+        )],
+    );
 }
 
 /// OpenSim's moving insertion points of the quadriceps in the tibia's axes (gait10dof18musc,
@@ -497,6 +516,20 @@ fn the_quadriceps_insert_where_opensims_moving_points_are() {
         1e3 * worst
     );
     assert!(worst < 1.5e-3, "{worst}");
+    let mm = 1e3 * worst;
+    quoted::says(
+        "docs/human_gait.md",
+        &[
+            format!("which follows OpenSim's moving insertion points within {mm:.1} mm"),
+            format!("insertions against OpenSim's moving points ({mm:.2} mm, asserted < 1.5 mm)"),
+        ],
+    );
+    quoted::says(
+        "README.md",
+        &[format!(
+            "the quadriceps' moving insertions against OpenSim's ({mm:.2} mm)"
+        )],
+    );
 }
 
 /// A unit's invalid parameters, a non-finite input, and a tendon pulling more than any fibre

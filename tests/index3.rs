@@ -5,6 +5,8 @@
 //! Trainelli (2008), work counters. (No allocation per step: `tests/no_alloc.rs`.)
 
 mod common;
+#[path = "common/quoted.rs"]
+mod quoted;
 
 use mbs::integrators::index3_iteration_matrix;
 use mbs::{
@@ -88,6 +90,23 @@ fn pendulum3_at_t1_with_generalized_alpha() {
         .map(|i| invariants(traj.q(i), traj.qd(i), traj.lambda(i)[0])[0].abs())
         .fold(0.0, f64::max);
     assert!(worst < 1e-10, "max |Φ| along the run {worst:e}");
+    quoted::says(
+        "README.md",
+        &[format!(
+            "pendulum3 at t = 1 within {} (gen-α, h = 1 ms)",
+            bound(e.iter().copied().fold(0.0, f64::max))
+        )],
+    );
+}
+
+/// `x` rounded up to one significant digit, as a bound: 5.34e-7 → "6e-7".
+fn bound(x: f64) -> String {
+    let mut exponent = x.log10().floor() as i32;
+    let mut digit = (x / 10f64.powi(exponent)).ceil();
+    if digit >= 10.0 {
+        (digit, exponent) = (1.0, exponent + 1);
+    }
+    format!("{digit}e{exponent}")
 }
 
 /// log2 of successive error ratios over step halvings.
@@ -98,6 +117,7 @@ fn orders(errs: &[f64]) -> Vec<f64> {
 #[test]
 fn generalized_alpha_index3_is_second_order_in_q_and_lambda() {
     let hs = [8e-3, 4e-3, 2e-3, 1e-3];
+    let mut lowest = f64::INFINITY;
     for rho in [0.5, 0.8] {
         let mut eq = Vec::new();
         let mut el = Vec::new();
@@ -129,7 +149,12 @@ fn generalized_alpha_index3_is_second_order_in_q_and_lambda() {
         );
         assert!(oq.iter().all(|&o| o >= 1.9), "q orders {oq:?}");
         assert!(ol.iter().all(|&o| o >= 1.9), "λ orders {ol:?}");
+        lowest = oq.iter().chain(&ol).copied().fold(lowest, f64::min);
     }
+    quoted::says(
+        "README.md",
+        &[format!("q and λ of order {lowest:.0} at index 3")],
+    );
 }
 
 /// At ρ∞ = 1 (no numerical damping) q still converges with order 2, but λ does not: the
@@ -217,6 +242,24 @@ fn scaling_keeps_the_iteration_matrix_conditioned_as_h_shrinks() {
     assert!(
         su < -1.8,
         "unscaled slope {su}: the condition should grow as h⁻²"
+    );
+    // the scaled condition as the README writes it: one figure when every h gives it
+    let figures: Vec<String> = scaled.iter().map(|c| format!("{c:.2}")).collect();
+    let scaled_text = if figures.iter().all(|f| *f == figures[0]) {
+        format!("{} throughout", figures[0])
+    } else {
+        figures.join(", ")
+    };
+    let minus = |s: String| s.replace('-', "−");
+    quoted::says(
+        "README.md",
+        &[format!(
+            "scaled: {scaled_text} (log–log slope {}); unscaled: {:.1e} → {:.1e} (slope {})",
+            minus(format!("{ss:.3}")),
+            unscaled[0],
+            unscaled[hs.len() - 1],
+            minus(format!("{su:.3}"))
+        )],
     );
 }
 

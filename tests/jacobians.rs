@@ -7,6 +7,13 @@
 
 use mbs::Model;
 
+#[path = "common/quoted.rs"]
+mod quoted;
+
+/// How far the two forms' Jacobians may differ, and their M relative to its largest entry.
+const JACOBIANS_WITHIN: f64 = 1e-13;
+const M_WITHIN: f64 = 1e-14;
+
 macro_rules! mechanism {
     ($name:ident, $form:ident) => {
         mbs::multibody! {
@@ -89,7 +96,7 @@ fn both_forms_agree() {
             for (f, (x, y)) in kg.frames.iter().zip(&ka.frames).enumerate() {
                 let d = max_diff(&x.jv, &y.jv).max(max_diff(&x.jw, &y.jw));
                 assert!(
-                    d < 1e-13,
+                    d < JACOBIANS_WITHIN,
                     "state {k}, {label}: frame {f}'s Jacobians differ by {d:e}"
                 );
                 assert_eq!(x.pose, y.pose, "state {k}, {label}: frame {f}'s pose");
@@ -99,7 +106,7 @@ fn both_forms_agree() {
             for (i, (x, y)) in kg.points.iter().zip(&ka.points).enumerate() {
                 let d = max_diff(&x.jv, &y.jv);
                 assert!(
-                    d < 1e-13,
+                    d < JACOBIANS_WITHIN,
                     "state {k}, {label}: point {i}'s Jacobian differs by {d:e}"
                 );
                 worst = worst.max(d);
@@ -113,7 +120,7 @@ fn both_forms_agree() {
             for (i, (x, y)) in kg.points.iter().zip(&kp.points).enumerate() {
                 let d = max_diff(&x.jv, &y.jv);
                 assert!(
-                    d < 1e-13,
+                    d < JACOBIANS_WITHIN,
                     "state {k}, {label}: point_kinematics' point {i} differs by {d:e}"
                 );
                 assert_eq!(x.position, y.position);
@@ -121,6 +128,13 @@ fn both_forms_agree() {
         }
     }
     println!("largest difference between the two forms: {worst:e}");
+    quoted::says(
+        "README.md",
+        &[format!(
+            "`tests/jacobians.rs` checks both forms against each other (Jacobians to \
+             {JACOBIANS_WITHIN:.0e}, M to {M_WITHIN:.0e} of its largest entry)"
+        )],
+    );
 }
 
 /// M assembled from the twists and composite inertias equals the generated M, and
@@ -139,7 +153,7 @@ fn assembled_mass_matrix_equals_generated() {
             let scale = mg.iter().fold(0.0f64, |m, x| m.max(x.abs()));
             let d = max_diff(&mg, &ma) / scale;
             assert!(
-                d < 1e-14,
+                d < M_WITHIN,
                 "state {k}: M differs by {d:e} of its largest entry"
             );
             assert!(max_diff(&hg, &ha) < 1e-12, "state {k}: h");

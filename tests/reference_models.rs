@@ -8,6 +8,9 @@
 use mbs::Model;
 use serde_json::Value;
 
+#[path = "common/quoted.rs"]
+mod quoted;
+
 use mbs_models::arm3d_6;
 use mbs_models::dpend;
 use mbs_models::seed2dof;
@@ -103,8 +106,8 @@ fn mat_vec(m: &[f64], x: &[f64]) -> Vec<f64> {
 /// Relative tolerance of every comparison (worst measured: 1.4e-15, M of dpend).
 const TOL: f64 = 1e-14;
 
-/// Checks `model` against `tests/reference/{name}.json`.
-fn check<Mo: Model>(model: &Mo, name: &str) {
+/// Checks `model` against `tests/reference/{name}.json`; returns the relative errors of M and h.
+fn check<Mo: Model>(model: &Mo, name: &str) -> (f64, f64) {
     let r = reference(name);
     let n = Mo::NQ;
     assert_eq!(r.q.len(), n, "{name}: number of coordinates");
@@ -200,6 +203,7 @@ fn check<Mo: Model>(model: &Mo, name: &str) {
         rel_err(&q0, &r.q0),
         rel_err(&m_only, &m)
     );
+    (err_m, err_h)
 }
 
 #[test]
@@ -220,4 +224,25 @@ fn chain4_matches_reference() {
 #[test]
 fn arm3d_6_matches_reference() {
     check(&arm3d_6::Arm3d6::default(), "arm3d_6");
+}
+
+/// The worst of the four models' M and h, as the README quotes it (the checks again: a few
+/// microseconds).
+#[test]
+fn the_worst_error_is_the_one_quoted() {
+    let worst = [
+        check(&seed2dof::Seed2dof::default(), "seed2dof"),
+        check(&dpend::DoublePendulum::default(), "dpend"),
+        check(&Chain4::default(), "chain4"),
+        check(&arm3d_6::Arm3d6::default(), "arm3d_6"),
+    ]
+    .into_iter()
+    .fold(0.0f64, |w, (m, h)| w.max(m).max(h));
+    quoted::says(
+        "README.md",
+        &[format!(
+            "M and h match SymPy/Pinocchio/MuJoCo reference data to {TOL:.0e} relative to their \
+             largest entry (asserted in `tests/reference_models.rs`; worst measured {worst:.1e})"
+        )],
+    );
 }

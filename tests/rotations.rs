@@ -15,6 +15,16 @@ use mbs_models::spherical_pendulum::{SphericalPendulum, SphericalPendulumZyx};
 use mbs_models::top::{Top, TopZyx};
 use mbs_models::tumble::{INERTIA, PHI0, TumbleBall, turned_start};
 
+#[path = "common/quoted.rs"]
+mod quoted;
+use quoted::thousands;
+
+/// A small count as the documents write it in words.
+fn word(n: usize) -> String {
+    let words = ["no", "one", "two", "three", "four", "five"];
+    words.get(n).map_or(n.to_string(), |w| w.to_string())
+}
+
 /// Adaptive steps at `rtol` (atol = rtol/100), an output at every step.
 fn adaptive(t_end: f64, rtol: f64) -> Options {
     Options {
@@ -25,6 +35,9 @@ fn adaptive(t_end: f64, rtol: f64) -> Options {
 
 #[test]
 fn tumble_on_a_ball_joint_keeps_energy_and_momentum_through_its_flips() {
+    // (re-centrings, energy drift, momentum drift, steps) per scheme, as docs/rotations.md
+    // quotes them
+    let mut rows = Vec::new();
     for (scheme, bound) in [
         (Scheme::Dopri5, 1e-8),
         (Scheme::Radau5, 1e-8),
@@ -45,13 +58,34 @@ fn tumble_on_a_ball_joint_keeps_energy_and_momentum_through_its_flips() {
             "{}: {de:e} {dl:e}",
             scheme.name()
         );
+        rows.push((st.chart_switches, de, dl, thousands(st.steps)));
     }
+    let [(s0, e0, l0, n0), (s1, e1, l1, n1), (s2, e2, l2, n2)] = &rows[..] else {
+        unreachable!()
+    };
+    quoted::says(
+        "docs/rotations.md",
+        &[
+            format!(
+                "| tumble, MODELS.md's start, DOPRI5 | {s0} re-centrings, E {e0:.1e}, L {l0:.1e}, {n0} steps |"
+            ),
+            format!("| same, Radau5 | {s1}, {e1:.1e}, {l1:.1e}, {n1} steps |"),
+            format!(
+                "| same, generalized-α adaptive (ρ∞ 0.8) | {s2}, {e2:.1e}, {l2:.1e}, {n2} steps |"
+            ),
+            format!(
+                "adaptive steps at rtol 1e-10: {e2:.1e} (energy) and {l2:.1e} (momentum), {n2} steps"
+            ),
+        ],
+    );
 }
 
 #[test]
 fn top_runs_through_the_vertical_where_its_euler_angles_stop() {
     let (m, l, i1, i3) = (0.1, 0.04, 2e-5, 4e-5);
     let inertia = [i3, i1 + m * l * l, i1 + m * l * l];
+    // (passages, closest, re-centrings, energy drift, L_z drift) with DOPRI5 and Radau5
+    let mut rows = Vec::new();
     for scheme in [Scheme::Dopri5, Scheme::Radau5] {
         let (tr, st) = simulate(Top::default(), scheme, adaptive(2.0, 1e-10))
             .unwrap_or_else(|e| panic!("{}: {e}", scheme.name()));
@@ -73,6 +107,7 @@ fn top_runs_through_the_vertical_where_its_euler_angles_stop() {
         // a chart re-centred near the vertical has it at its centre
         assert!(st.chart_switches >= 1);
         assert!(de <= 1e-8 && dlz <= 1e-8, "{de:e} {dlz:e}");
+        rows.push((passages, closest, st.chart_switches, de, dlz));
     }
     let Err(e) = simulate(TopZyx::default(), Scheme::Dopri5, adaptive(2.0, 1e-10)) else {
         panic!("the Euler angles stop at the vertical")
@@ -82,6 +117,27 @@ fn top_runs_through_the_vertical_where_its_euler_angles_stop() {
         matches!(e.kind, Failure::SingularConfiguration { .. }),
         "{e}"
     );
+    let [(p0, c0, s0, e0, l0), (p1, c1, s1, e1, l1)] = rows[..] else {
+        unreachable!()
+    };
+    let passages = if p0 == p1 {
+        p0.to_string()
+    } else {
+        format!("{p0} / {p1}")
+    };
+    let stop = e.t;
+    quoted::says(
+        "docs/rotations.md",
+        &[format!(
+            "| fast top through the vertical, 2 s, DOPRI5 / Radau5 | {passages} passages within {c0:.1e} / {c1:.1e} rad of the vertical, {s0} / {s1} re-centrings, E {e0:.1e} / {e1:.1e}, L_z {l0:.1e} / {l1:.1e} | — | stops at t = {stop:.3} s |"
+        )],
+    );
+    quoted::says(
+        "README.md",
+        &[format!(
+            "| {passages} passages; DOPRI5 {s0} re-centrings, energy {e0:.1e}, vertical momentum {l0:.1e}; Radau5 {s1} re-centrings, {e1:.1e}, {l1:.1e}; on ZYX angles it stops at t = {stop:.3} s |"
+        )],
+    );
 }
 
 #[test]
@@ -89,6 +145,8 @@ fn spherical_pendulum_swings_through_the_bottom() {
     let (m, l, r) = (1.0, 1.0, 0.05);
     let ig = 0.4 * m * r * r;
     let inertia = [ig, ig + m * l * l, ig + m * l * l];
+    // (energy drift, L_z drift) with DOPRI5 and Radau5
+    let mut rows = Vec::new();
     for scheme in [Scheme::Dopri5, Scheme::Radau5] {
         let (tr, st) = simulate(SphericalPendulum::default(), scheme, adaptive(3.0, 1e-10))
             .unwrap_or_else(|e| panic!("{}: {e}", scheme.name()));
@@ -105,6 +163,7 @@ fn spherical_pendulum_swings_through_the_bottom() {
         assert!(closest < 2e-2, "{closest}");
         assert!(st.chart_switches >= 2);
         assert!(de <= 1e-8 && dlz <= 1e-8, "{de:e} {dlz:e}");
+        rows.push((de, dlz));
     }
     let model = SphericalPendulumZyx::default();
     let Err(e) = simulate(model, Scheme::Dopri5, adaptive(3.0, 1e-10)) else {
@@ -116,6 +175,22 @@ fn spherical_pendulum_swings_through_the_bottom() {
         "{e}"
     );
     let _ = SphericalPendulum::default().info();
+    let [(e0, l0), (e1, l1)] = rows[..] else {
+        unreachable!()
+    };
+    let stop = e.t;
+    quoted::says(
+        "docs/rotations.md",
+        &[format!(
+            "| spherical pendulum through the bottom, 3 s | E {e0:.1e} / {e1:.1e}, L_z {l0:.1e} / {l1:.1e} | — | stops at t = {stop:.3} s (DOPRI5)"
+        )],
+    );
+    quoted::says(
+        "README.md",
+        &[format!(
+            "| spherical pendulum through the bottom, 3 s | DOPRI5 {e0:.1e}, {l0:.1e}; Radau5 {e1:.1e}, {l1:.1e}; on ZYX angles it stops at t = {stop:.3} s (DOPRI5)"
+        )],
+    );
 }
 
 /// The tumble's start turned by φ0 about world x, whose accurate flip meets the singularity
@@ -151,6 +226,8 @@ fn every_scheme_runs_the_tumble_through_its_flips() {
         (Scheme::Radau5, 5e-9, Some((1e-6, 1e-6))),
         (Scheme::ImplicitMidpoint, 5e-4, None),
     ];
+    // (re-centrings, the larger drift, scheme, how) of every run
+    let mut runs_made = Vec::new();
     for (scheme, bound_fixed, adaptive_run) in schemes {
         let fixed = Options {
             t_end: 20.0,
@@ -180,8 +257,22 @@ fn every_scheme_runs_the_tumble_through_its_flips() {
                 "{} {how}: {de:e} {dl:e}",
                 scheme.name()
             );
+            runs_made.push((st.chart_switches, de.max(dl), scheme, how));
         }
     }
+    let fewest = runs_made.iter().map(|r| r.0).min().unwrap();
+    let most = runs_made.iter().map(|r| r.0).max().unwrap();
+    let least = runs_made.iter().min_by(|a, b| a.1.total_cmp(&b.1)).unwrap();
+    let worst = runs_made.iter().max_by(|a, b| a.1.total_cmp(&b.1)).unwrap();
+    assert_eq!((least.2, least.3), (Scheme::Dopri5, "h 1e-3"));
+    assert_eq!(worst.2, Scheme::ExplicitEuler);
+    quoted::says(
+        "docs/rotations.md",
+        &[format!(
+            "completes with {fewest}–{most} re-centrings; drifts from {:.0e} (DOPRI5 at h 1e-3) to {:.0e} (explicit Euler)",
+            least.1, worst.1
+        )],
+    );
 }
 
 /// The sleeping top — spinning upright, exactly where its ZYX angles lock — linearised in the
@@ -214,6 +305,12 @@ fn the_sleeping_top_linearised_through_gimbal_lock_has_the_closed_form_poles() {
     let found: Vec<f64> = im.iter().copied().filter(|&w| w > 1e-6).collect();
     assert_eq!(found.len(), 2, "{im:?}");
     assert!((found[0] - slow).abs() < 1e-9 * slow && (found[1] - fast).abs() < 1e-9 * fast);
+    quoted::says(
+        "docs/rotations.md",
+        &[format!(
+            "in a chart centred on it, has the closed-form poles ±{slow:.6}i, ±{fast:.6}i to 1e-9"
+        )],
+    );
     // slower, below L3² = 4 I1' m g l, the upright top is unstable: a real pole pair
     let slow_top = mbs_models::top::TopParams {
         w3: 50.0,
@@ -579,4 +676,11 @@ fn inverse_dynamics_along_a_recentred_run_is_zero() {
     assert!(worst < 1e-6 * scale, "{worst:e}");
     assert_eq!(efforts.t.len(), tr.len());
     assert!(along < 1e-6 * scale, "{along:e}");
+    quoted::says(
+        "README.md",
+        &[format!(
+            "τ along the top's free run, through {} re-centrings, is at most {along:.1e} N·m",
+            word(st.chart_switches)
+        )],
+    );
 }

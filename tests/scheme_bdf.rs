@@ -4,6 +4,8 @@
 //! steps, failures.
 
 mod common;
+#[path = "common/quoted.rs"]
+mod quoted;
 use mbs_models::dpend;
 use mbs_models::seed2dof;
 
@@ -126,7 +128,7 @@ fn dpend_errors(states: &[(f64, Vec<f64>, Vec<f64>)]) -> Vec<f64> {
 /// - a shift of 1e-10 of q0 alone moves the state at 10 s by ~2e-5 (amplification ~2e5):
 ///   every one of the local errors of ~1e-10 (rtol·|y|, |y| up to 14) is amplified
 ///   likewise, so rtol 1e-10 cannot be relied on for 1e-6;
-/// - tightening rtol reaches it: 5.6e-7 at rtol 1e-14 (29,777 steps).
+/// - tightening rtol reaches it: 4.7e-7 at rtol 1e-14 (30,196 steps).
 #[test]
 fn dpend_error_is_amplified_by_the_chaos() {
     let (states, st) = dpend_run(1e-10, 1e-12, 0.0);
@@ -212,6 +214,14 @@ fn work_counters_snapshot() {
         got,
         (631, 62, 0, 746, 103, 1689, vec![2, 19, 4, 45, 561]),
         "{st}"
+    );
+    quoted::says(
+        "README.md",
+        &[format!(
+            "{} beside {} τ for BDF",
+            quoted::thousands(st.mass_matrix),
+            quoted::thousands(st.inverse_dynamics)
+        )],
     );
 }
 

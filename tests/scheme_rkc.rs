@@ -5,6 +5,9 @@
 //!
 //! `cargo test --release --test scheme_rkc -- --nocapture` prints the figures.
 
+#[path = "common/quoted.rs"]
+mod quoted;
+
 use mbs::{Failure, Model, Options, Output, Scheme, simulate};
 use mbs_models::damped_chain::DampedChain;
 use mbs_models::{chain16_stiff, dpend};
@@ -135,6 +138,12 @@ fn fast_decay_costs_the_square_root_of_its_stiffness() {
     assert!(per_step <= stages + 1.5, "{per_step} against {stages}");
     assert!(stats.evaluations() * 3 < stats4.evaluations());
     assert!(err < 1e-3, "{err}");
+    quoted::says(
+        "README.md",
+        &[format!(
+            "dampedchain (2 s, self-computed; a damper in every joint, decaying modes to {rho:.1e} 1/s)"
+        )],
+    );
 }
 
 #[test]
@@ -255,15 +264,21 @@ fn adaptive_steps_follow_rtol() {
 fn a_step_that_outgrows_a_growing_mode_is_refused() {
     use mbs::ConstraintMethod;
     use mbs_models::fastlink::FastLink;
+    // ρ and the limit of the first refusal, as the README quotes them
+    let mut first = None;
     for method in [ConstraintMethod::Auto, ConstraintMethod::Projection] {
         for h in [0.03, 0.1] {
             let mut o = Options::fixed(0.1, h);
             o.constraints.method = method;
             let e = simulate(FastLink::default(), Scheme::Rkc, o).unwrap_err();
             println!("{method:?}, h = {h}: {e}");
-            let Failure::UnstableStep { rho, h_rho, .. } = e.kind else {
+            let Failure::UnstableStep {
+                rho, h_rho, limit, ..
+            } = e.kind
+            else {
                 panic!("{e}")
             };
+            first.get_or_insert((rho, limit));
             assert!((700.0..900.0).contains(&rho), "{rho}");
             assert!((h_rho - h * rho).abs() < 1e-9 * h_rho);
             assert_eq!(e.trajectory.len(), 1, "the start kept");
@@ -283,4 +298,13 @@ fn a_step_that_outgrows_a_growing_mode_is_refused() {
             }
         }
     }
+    let (rho, limit) = first.expect("refused");
+    quoted::says(
+        "README.md",
+        &[format!(
+            "a fixed step whose stages go non-finite past h·ρ = {limit:.2} is refused as outgrowing \
+             a growing mode (fastlink released into its spring, a saddle whose sign the estimate \
+             misreads, ρ ≈ {rho:.0} 1/s: at 30 ms and 0.1 s it ended with"
+        )],
+    );
 }

@@ -11,6 +11,8 @@ mod lcg;
 #[path = "common/sweeps.rs"]
 mod sweeps;
 use lcg::Lcg;
+#[path = "common/quoted.rs"]
+mod quoted;
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("mbs-sweep-{name}-{}", std::process::id()));
@@ -1038,5 +1040,13 @@ fn changed_plans_are_refused_typed_or_run() {
     assert!(
         tally.contains_key("ran") && tally.contains_key("refused"),
         "{tally:?}"
+    );
+    quoted::says(
+        "README.md",
+        &[format!(
+            "a line deleted or repeated; {} plans) are refused with a typed `SweepError` or run, \
+             never a panic",
+            quoted::thousands(tally.values().sum())
+        )],
     );
 }

@@ -23,6 +23,9 @@ use mbs::terrain::{Block, ContactLaw, Ellipsoid, Terrain};
 use mbs::{Efforts, Kinematics, Model, Options, Output, Scheme, WithEfforts};
 use mbs_models::human::*;
 
+#[path = "common/quoted.rs"]
+mod quoted;
+
 const G: f64 = 9.80665;
 /// gait2392's 75.1646 kg and two patellas of 0.0862 kg (Rajagopal 2015)
 const MASS: f64 = 75.1646 + 2.0 * 0.0862;
@@ -321,9 +324,20 @@ fn an_ellipsoid_pressed_deep_on_an_edge_leaves_by_its_shortest_way() {
         let got = touches[0];
         assert!((got.depth + s).abs() < 1e-9, "{} against {}", got.depth, -s);
         assert!(close(got.normal, n, 1e-6), "{:?} against {n:?}", got.normal);
-        depths.push(got.depth);
+        depths.push((got.depth, got.normal));
     }
-    assert!((depths[0] - depths[1]).abs() < 1e-6, "{depths:?}");
+    assert!((depths[0].0 - depths[1].0).abs() < 1e-6, "{depths:?}");
+    // the way out's angle above the side's normal (y), in the plane across the edge
+    let above = depths[0].1[2].atan2(depths[0].1[1]).to_degrees();
+    quoted::says(
+        "README.md",
+        &[format!(
+            "leaves by its shortest way, {:.1} mm at {above:.0}° above the side's normal ({:.0}° from the top's), where the edge was skipped for the top's 20 mm, and 0.1 µm further out the edge's {:.1} mm",
+            1e3 * depths[0].0,
+            90.0 - above,
+            1e3 * depths[1].0
+        )],
+    );
 }
 
 /// A box entered with its corners swapped, or of no height, is not silently left out: the
@@ -677,6 +691,18 @@ fn the_model_stands_on_a_platform() {
     model.kinematics(tr.t[last], ql, qdl, &mut kin);
     let f = on.forces(&kin);
     let weight = MASS * G;
+    let shares = [f[0][1] / weight, f[1][1] / weight].map(|s| format!("{s:.4}"));
+    assert_eq!(
+        shares[0], shares[1],
+        "the documents say each foot carries as much"
+    );
+    quoted::says(
+        "docs/human_gait.md",
+        &[format!(
+            "it stands the same way on a 10 cm platform: the platform carries {} of the weight on each foot",
+            shares[0]
+        )],
+    );
     println!(
         "standing 3 s on a {height} m platform, radau5 rtol 1e-5: {} steps; pelvis moved \
          ({:+.2e}, {:+.2e}, {:+.2e}) m; the platform carries {:.4} and {:.4} of the weight",
@@ -800,6 +826,12 @@ fn ellipsoids_pressed_into_a_corner_leave_by_the_shortest_way() {
         }
     }
     println!("{touching} of 600 touching; depths within {worst:.1e} m of the sampled search's");
+    quoted::says(
+        "README.md",
+        &[format!(
+            "leave by the shortest way to within {worst:.1e} m of the sampled search"
+        )],
+    );
     assert!(touching > 300);
 }
 

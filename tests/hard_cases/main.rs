@@ -1,4 +1,4 @@
-//! Hard cases (issue "prove that hard cases stay numerically stable", item 3): each case
+//! Hard cases that must stay numerically stable: each case
 //! asserts stability or the typed error, prints its figures and snapshots its work counters
 //! as `tests/work_counters.rs` does. `cargo test --release --test hard_cases -- --nocapture`
 //! prints the tables.
@@ -6,6 +6,8 @@
 
 #[path = "../common/mod.rs"]
 mod common;
+#[path = "../common/quoted.rs"]
+mod quoted;
 mod support;
 
 mod chain16;

@@ -729,7 +729,7 @@ fn statics_beside_a_stiff_spring_converge_at_the_rounding_of_the_forces() {
         "README.md",
         &[format!(
             "(q₀ − 0.6)·k₁ = {} N at every stiffness to {spread:.0e} of it (asserted 1e-5;",
-            format!("{:.4}", loads[0].0).replace('-', "−")
+            quoted::minus(format!("{:.4}", loads[0].0))
         )],
     );
     // the second joint moves with 1/k₁ too: its steps from 4e7 to 4e9 and from 4e9 to 4e11

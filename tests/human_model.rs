@@ -37,7 +37,7 @@ use quoted::thousands;
 
 /// `x` to `digits` decimals with its sign, a minus as the documents write it: −0.15, +0.28.
 fn signed(x: f64, digits: usize) -> String {
-    format!("{x:+.digits$}").replace('-', "−")
+    quoted::minus(format!("{x:+.digits$}"))
 }
 
 /// A foot's figure to two decimals, as the documents write it.

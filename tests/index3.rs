@@ -250,15 +250,14 @@ fn scaling_keeps_the_iteration_matrix_conditioned_as_h_shrinks() {
     } else {
         figures.join(", ")
     };
-    let minus = |s: String| s.replace('-', "−");
     quoted::says(
         "README.md",
         &[format!(
             "scaled: {scaled_text} (log–log slope {}); unscaled: {:.1e} → {:.1e} (slope {})",
-            minus(format!("{ss:.3}")),
+            quoted::minus(format!("{ss:.3}")),
             unscaled[0],
             unscaled[hs.len() - 1],
-            minus(format!("{su:.3}"))
+            quoted::minus(format!("{su:.3}"))
         )],
     );
 }

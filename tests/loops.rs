@@ -1164,10 +1164,6 @@ fn a_change_point_of_a_loop_stops_the_run_rather_than_switching_branch() {
     let change_points = (1..10)
         .filter(|&k| (a0..=a1).contains(&(k as f64 * PI)))
         .count();
-    let words = [
-        "no", "one", "two", "three", "four", "five", "six", "seven", "eight",
-    ];
-    let word = |n: usize| words.get(n).map_or(n.to_string(), |w| w.to_string());
     let radau3_fine = [
         format!("radau3 Index3 {:?}", adaptive(1e-8)),
         format!("radau3 Index2 {:?}", adaptive(1e-8)),
@@ -1185,13 +1181,13 @@ fn a_change_point_of_a_loop_stops_the_run_rather_than_switching_branch() {
                  fixed steps of 1–10 ms, {t_end} s through {} change points) {passed} stay on it \
                  throughout, {} stop with `SingularLoop` within a step of a change point and {} \
                  ({which}) with Newton failing at h_min beside it",
-                word(change_points),
+                quoted::word(change_points),
                 stopped.len() - at_h_min.len(),
-                word(at_h_min.len()),
+                quoted::word(at_h_min.len()),
             ),
             format!(
                 "Radau5 with projection at rtol 1e-8 ran on backwards at {} rad/s",
-                format!("{crank:.0}").replace('-', "−")
+                quoted::minus(format!("{crank:.0}"))
             ),
         ],
     );

@@ -199,16 +199,6 @@ fn quietly_finite_or_not(
     (runs, kinds)
 }
 
-/// A count under ten as the documentation writes it, in words.
-fn number_word(n: usize) -> String {
-    const WORDS: [&str; 10] = [
-        "zero", "one", "two", "three", "four", "five", "six", "seven", "eight", "nine",
-    ];
-    WORDS
-        .get(n)
-        .map_or_else(|| n.to_string(), |w| w.to_string())
-}
-
 /// Endings by kind.
 type Kinds = std::collections::BTreeMap<String, usize>;
 
@@ -243,7 +233,7 @@ fn every_run_ends_or_stops_typed_with_what_it_computed() {
             "{} runs: {} finish, the others stop with one of {} typed failures",
             thousands(runs),
             thousands(count(&kinds, "finished")),
-            number_word(kinds.len() - 1)
+            quoted::word(kinds.len() - 1)
         )],
     );
     // the sweep reaches every kind of ending it is meant to test

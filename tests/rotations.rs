@@ -19,12 +19,6 @@ use mbs_models::tumble::{INERTIA, PHI0, TumbleBall, turned_start};
 mod quoted;
 use quoted::thousands;
 
-/// A small count as the documents write it in words.
-fn word(n: usize) -> String {
-    let words = ["no", "one", "two", "three", "four", "five"];
-    words.get(n).map_or(n.to_string(), |w| w.to_string())
-}
-
 /// Adaptive steps at `rtol` (atol = rtol/100), an output at every step.
 fn adaptive(t_end: f64, rtol: f64) -> Options {
     Options {
@@ -680,7 +674,7 @@ fn inverse_dynamics_along_a_recentred_run_is_zero() {
         "README.md",
         &[format!(
             "τ along the top's free run, through {} re-centrings, is at most {along:.1e} N·m",
-            word(st.chart_switches)
+            quoted::word(st.chart_switches)
         )],
     );
 }

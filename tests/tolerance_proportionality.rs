@@ -217,10 +217,7 @@ fn median(props: &[Proportionality], r: f64) -> Option<f64> {
     let mut d: Vec<f64> = props
         .iter()
         .filter(|p| asserted(&p.label, r))
-        .filter_map(|p| {
-            let k = p.rtols.iter().position(|&x| (x / r - 1.0).abs() < 1e-9)?;
-            p.digits[k]
-        })
+        .filter_map(|p| digits_at(p, r))
         .collect();
     d.sort_by(f64::total_cmp);
     d.get(d.len() / 2).copied()
@@ -498,21 +495,14 @@ fn bracket(lo: f64, hi: f64) -> String {
 
 /// The least-squares slope of digits against −log10 rtol over the rtols `keep` accepts.
 fn slope_where(p: &Proportionality, keep: impl Fn(f64) -> bool) -> f64 {
-    let kept = Proportionality {
-        rtols: Vec::new(),
-        digits: Vec::new(),
-        ..p.clone()
-    };
-    let kept = p
-        .rtols
-        .iter()
-        .zip(&p.digits)
+    let (rtols, digits) = (p.rtols.iter().zip(&p.digits))
         .filter(|(r, _)| keep(**r))
-        .fold(kept, |mut k, (r, d)| {
-            k.rtols.push(*r);
-            k.digits.push(*d);
-            k
-        });
+        .unzip();
+    let kept = Proportionality {
+        label: p.label.clone(),
+        rtols,
+        digits,
+    };
     kept.slope().expect("a slope over two rtols or more")
 }
 

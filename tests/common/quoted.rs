@@ -37,6 +37,22 @@ pub fn says(path: &str, phrases: &[String]) {
     );
 }
 
+/// A count under ten in words, as the documents write it ("no" for zero); larger ones in
+/// digits.
+pub fn word(n: usize) -> String {
+    const WORDS: [&str; 10] = [
+        "no", "one", "two", "three", "four", "five", "six", "seven", "eight", "nine",
+    ];
+    WORDS
+        .get(n)
+        .map_or_else(|| n.to_string(), |w| w.to_string())
+}
+
+/// `s` with its hyphen-minus signs written as the documents write them: −5.
+pub fn minus(s: String) -> String {
+    s.replace('-', "−")
+}
+
 /// `n` with commas between thousands, as the documentation writes counts: 12,524.
 pub fn thousands(n: usize) -> String {
     let digits = n.to_string();

@@ -137,6 +137,36 @@ fn claimed(label: &str) -> Option<(f64, f64)> {
     }
 }
 
+/// The README's table "What rtol means, at a glance" gives each scheme's asserted range as
+/// `claimed` holds it, and says where index 3 is left out.
+#[test]
+fn the_readme_table_gives_the_asserted_ranges() {
+    let rows = [
+        ("DOPRI5", "dopri5"),
+        ("BDF", "bdf"),
+        ("Radau5", "radau5"),
+        ("Radau3", "radau3"),
+        ("RKC", "rkc"),
+        ("gen-α, HHT", "gen-alpha"),
+        ("gen-α, HHT", "hht"),
+    ];
+    for (first, scheme) in rows {
+        let (loose, tight) = claimed(&format!("{scheme} projection")).expect("asserted");
+        let offered = !matches!(scheme, "dopri5" | "bdf" | "rkc");
+        let but = if offered && claimed(&format!("{scheme} index3")).is_none() {
+            ", but at index 3"
+        } else {
+            ""
+        };
+        let range = format!("| {loose:e} … {tight:e}{but} |");
+        let row = quoted::row("README.md", first);
+        assert!(
+            row.ends_with(&range),
+            "README's row `{row}` should end `{range}`"
+        );
+    }
+}
+
 /// Whether `rtol` lies in the asserted range of the sweep `label`.
 fn asserted(label: &str, rtol: f64) -> bool {
     claimed(label).is_some_and(|(loose, tight)| rtol <= loose * 1.001 && rtol >= tight * 0.999)

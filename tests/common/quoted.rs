@@ -37,6 +37,19 @@ pub fn says(path: &str, phrases: &[String]) {
     );
 }
 
+/// The row of a table in `path` whose first cell is `first` (white space collapsed), or a
+/// failure naming the row it lacks.
+#[track_caller]
+pub fn row(path: &str, first: &str) -> String {
+    let full = format!("{}/{path}", env!("CARGO_MANIFEST_DIR"));
+    let raw = std::fs::read_to_string(&full).unwrap_or_else(|e| panic!("reading {path}: {e}"));
+    let start = format!("| {first} |");
+    raw.lines()
+        .map(collapse)
+        .find(|l| l.starts_with(&start))
+        .unwrap_or_else(|| panic!("{path} has no table row `{start} …`"))
+}
+
 /// A count under ten in words, as the documents write it ("no" for zero); larger ones in
 /// digits.
 pub fn word(n: usize) -> String {

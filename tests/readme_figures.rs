@@ -265,7 +265,11 @@ fn readme() -> String {
 #[test]
 fn the_work_precision_table_quotes_the_committed_csv_files() {
     let text = section(&readme(), "What accuracy costs");
-    let mut rows = text.lines().filter(|l| l.starts_with('|'));
+    // the section's first table (the tables after it say what rtol means)
+    let mut rows = text
+        .lines()
+        .skip_while(|l| !l.starts_with('|'))
+        .take_while(|l| l.starts_with('|'));
     let header: Vec<&str> = rows.next().expect("the table").split('|').collect();
     let digits: Vec<f64> = header[2..header.len() - 1]
         .iter()

@@ -4,11 +4,15 @@
 //! text's line breaks do not matter: runs of white space compare as one space.
 #![allow(dead_code)]
 
-/// The file `path` (relative to the repository's root), its white space collapsed.
-fn text(path: &str) -> String {
+/// The file `path` (relative to the repository's root).
+fn read(path: &str) -> String {
     let full = format!("{}/{path}", env!("CARGO_MANIFEST_DIR"));
-    let raw = std::fs::read_to_string(&full).unwrap_or_else(|e| panic!("reading {path}: {e}"));
-    collapse(&raw)
+    std::fs::read_to_string(&full).unwrap_or_else(|e| panic!("reading {path}: {e}"))
+}
+
+/// The file `path`, its white space collapsed.
+fn text(path: &str) -> String {
+    collapse(&read(path))
 }
 
 /// `s` with each run of white space replaced by one space.
@@ -41,10 +45,9 @@ pub fn says(path: &str, phrases: &[String]) {
 /// failure naming the row it lacks.
 #[track_caller]
 pub fn row(path: &str, first: &str) -> String {
-    let full = format!("{}/{path}", env!("CARGO_MANIFEST_DIR"));
-    let raw = std::fs::read_to_string(&full).unwrap_or_else(|e| panic!("reading {path}: {e}"));
     let start = format!("| {first} |");
-    raw.lines()
+    read(path)
+        .lines()
         .map(collapse)
         .find(|l| l.starts_with(&start))
         .unwrap_or_else(|| panic!("{path} has no table row `{start} …`"))

@@ -375,7 +375,7 @@ fn requests_beyond_memory_or_size_are_refused() {
         Failure::InvalidOption { name, value, .. } => {
             assert_eq!(*name, "output", "{e}");
             assert!(value.starts_with("90000001 outputs of"), "{e}");
-            // the size and the limit, as the README quotes them
+            // the size and the limit, as docs/accuracy.md quotes them
             let size = value.trim_start_matches("90000001 outputs of ");
             let limit = e.to_string();
             let limit = limit
@@ -385,7 +385,7 @@ fn requests_beyond_memory_or_size_are_refused() {
                 .unwrap_or_else(|| panic!("{e}"))
                 .to_string();
             quoted::says(
-                "README.md",
+                "docs/accuracy.md",
                 &[format!(
                     "outputs that would take more than {limit} of memory, with their size: 9·10⁷ \
                      outputs of seed2dof with its frames' poses, {size}, filled the memory"

@@ -402,7 +402,7 @@ fn a_weight_held_at_its_rounding_is_said() {
         unreachable!("three schemes")
     };
     quoted::says(
-        "README.md",
+        "docs/accuracy.md",
         &[format!(
             "on fastlink under atol = 1e-12 DOPRI5 at rtol 1e-10 {d} of its {dn} steps, Radau3 at 1e-8 {r} of {rn}, BDF at 1e-8 {b} of {bn}, none under atol = 1e-9"
         )],

@@ -491,12 +491,18 @@ fn record(m: Measured) {
     let mut all = MEASURED.lock().unwrap_or_else(|e| e.into_inner());
     all.push(m);
     if all.len() == STUDIES {
-        let phrases = readme_phrases(&all);
-        println!("\nthe README's figures, as measured here:");
-        for p in &phrases {
-            println!("  {p}");
+        let phrases = quoted_phrases(&all);
+        for file in [README, ACCURACY] {
+            println!("\nthe figures of {file}, as measured here:");
+            let of_file: Vec<String> = (phrases.iter())
+                .filter(|(f, _)| *f == file)
+                .map(|(_, p)| p.clone())
+                .collect();
+            for p in &of_file {
+                println!("  {p}");
+            }
+            quoted::says(file, &of_file);
         }
-        quoted::says("README.md", &phrases);
     }
 }
 
@@ -558,9 +564,15 @@ fn mean(v: impl IntoIterator<Item = f64>) -> f64 {
     s / n as f64
 }
 
-/// The README's figures of "What rtol means" and "Global error control", computed from the six
-/// studies and written as the README writes them.
-fn readme_phrases(all: &[Measured]) -> Vec<String> {
+/// The README, whose section "What accuracy costs" sums up what rtol means and says what global
+/// control did.
+const README: &str = "README.md";
+/// The page that gives the figures of what rtol means scheme by scheme.
+const ACCURACY: &str = "docs/accuracy.md";
+
+/// The figures of "What rtol means" and "Global error control", computed from the six studies
+/// and written as the file that quotes each of them writes it: (file, phrase).
+fn quoted_phrases(all: &[Measured]) -> Vec<(&'static str, String)> {
     let study = |title: &str| {
         all.iter()
             .find(|m| m.title == title)
@@ -590,9 +602,12 @@ fn readme_phrases(all: &[Measured]) -> Vec<String> {
             .into_iter()
             .map(|(_, p)| slope_where(p, |r| asserted(&p.label, r))),
     );
-    out.push(format!(
-        "gain {} digits per decade of rtol (least squares over their range)",
-        bracket(lo, hi)
+    out.push((
+        README,
+        format!(
+            "gain {} digits per decade of rtol (least squares over their range)",
+            bracket(lo, hi)
+        ),
     ));
 
     // the three exceptions
@@ -600,19 +615,20 @@ fn readme_phrases(all: &[Measured]) -> Vec<String> {
     let fast_median = |r: f64| median(&study("fastlink").props, r).expect("median");
     let (lo, hi) =
         min_max([1e-6, 1e-7, 1e-8].map(|r| fast_median(r) - digits_at(fast, r).expect("a run")));
-    out.push(format!(
+    out.push((ACCURACY, format!(
         "DOPRI5 with partitioning on fastlink, {lo:.2}–{hi:.2} digits below from rtol 1e-6 to 1e-8"
-    ));
+    )));
     let d = digits_at(sweep("slider-crank (b)", "radau5 auto"), 1e-7).expect("a run");
     let m = median(&study("slider-crank (b)").props, 1e-7).expect("median");
-    out.push(format!(
-        "Radau5 on slider-crank (b) at rtol 1e-7, {d:.2} digits against {m:.2}"
+    out.push((
+        ACCURACY,
+        format!("Radau5 on slider-crank (b) at rtol 1e-7, {d:.2} digits against {m:.2}"),
     ));
     let d = digits_at(sweep("pendulum3", "bdf projection"), 1e-10).expect("a run");
-    out.push(format!(
+    out.push((ACCURACY, format!(
         "BDF with projection on Cash's pendulum at rtol 1e-10, {d:.2} digits, {:.2} short of rtol's 10",
         10.0 - d
-    ));
+    )));
 
     // DOPRI5's loose end: where it falls more than its allowance below the median
     let mut loose = Vec::new();
@@ -645,8 +661,11 @@ fn readme_phrases(all: &[Measured]) -> Vec<String> {
         Some((last, rest)) => format!("{} and {last}", rest.join(", ")),
         None => "no loop".into(),
     };
-    out.push(format!(
-        "at 1e-4 and 1e-5 it falls {lo:.1}–{hi:.1} digits below the others' median on {listed}"
+    out.push((
+        ACCURACY,
+        format!(
+            "at 1e-4 and 1e-5 it falls {lo:.1}–{hi:.1} digits below the others' median on {listed}"
+        ),
     ));
 
     // BDF's and DOPRI5's mean offsets over every run on the loops
@@ -657,10 +676,13 @@ fn readme_phrases(all: &[Measured]) -> Vec<String> {
                 .flat_map(|(_, p)| p.offsets().map(|(_, o)| o).collect::<Vec<_>>()),
         )
     };
-    out.push(format!(
-        "now {:.1} short, DOPRI5's {:.1}",
-        -offset(&["bdf"]),
-        -offset(&["dopri5"])
+    out.push((
+        ACCURACY,
+        format!(
+            "now {:.1} short, DOPRI5's {:.1}",
+            -offset(&["bdf"]),
+            -offset(&["dopri5"])
+        ),
     ));
 
     // Radau3 with projection, partitioning or at index 2
@@ -675,10 +697,10 @@ fn readme_phrases(all: &[Measured]) -> Vec<String> {
             .into_iter()
             .map(|(_, p)| slope_where(p, |_| true)),
     );
-    out.push(format!(
+    out.push((ACCURACY, format!(
         "now from {:.1} short to {hi:.1} better on average at {slo:.2}–{shi:.2} digits per decade",
         -lo
-    ));
+    )));
 
     // the Newmark family at index 3, its default, over its asserted range; and where it stalls
     let newmark3 = ["gen-alpha index3", "hht index3"];
@@ -693,10 +715,10 @@ fn readme_phrases(all: &[Measured]) -> Vec<String> {
             }),
     );
     let hht = digits_at(sweep("pendulum3", "hht index3"), 1e-4).expect("a run");
-    out.push(format!(
+    out.push((ACCURACY, format!(
         "HHT on Cash's pendulum at rtol 1e-4 2.58 digits against 4.07, now {hht:.2}, and 0.9–3.1 digits short of rtol, now {:.1}–{:.1}",
         -hi, -lo
-    ));
+    )));
     let (lo, hi) = min_max(sweeps(&starts(&["gen-alpha", "hht"])).into_iter().flat_map(
         |(_, p)| {
             p.rtols
@@ -707,8 +729,9 @@ fn readme_phrases(all: &[Measured]) -> Vec<String> {
                 .collect::<Vec<_>>()
         },
     ));
-    out.push(format!(
-        "below rtol 1e-7, the digits stall at {lo:.1}–{hi:.1}"
+    out.push((
+        ACCURACY,
+        format!("below rtol 1e-7, the digits stall at {lo:.1}–{hi:.1}"),
     ));
 
     // local control: how far from rtol, on the motions that do and do not amplify errors
@@ -726,10 +749,10 @@ fn readme_phrases(all: &[Measured]) -> Vec<String> {
         )
     };
     let ((slo, shi), (alo, ahi)) = (spread(&SMOOTH), spread(&AMPLIFYING));
-    out.push(format!(
+    out.push((README, format!(
         "from {shi:.1} digits better to {:.1} short on Cash's pendulum, the Cartesian double pendulum and slider-crank (b), from {ahi:.1} better to {:.1} short on the four-bar, slider-crank (a) and fastlink",
         -slo, -alo
-    ));
+    )));
 
     // Radau5 at index 2 against projection; Radau at index 3
     let (slo, shi) = min_max(
@@ -752,15 +775,18 @@ fn readme_phrases(all: &[Measured]) -> Vec<String> {
                     .collect::<Vec<_>>()
             }),
     );
-    out.push(format!(
+    out.push((ACCURACY, format!(
         "Radau5 at index 2 is asserted too ({slo:.2}–{shi:.2} digits per decade, {alo:.1} to {ahi:.1} digits above projection"
-    ));
+    )));
     let (lo, hi) = min_max(
         sweeps(&starts(&["radau3 index3", "radau5 index3"]))
             .into_iter()
             .map(|(_, p)| mean(p.offsets().map(|(_, o)| o))),
     );
-    out.push(format!("{:.1}–{:.1} digits short on average", -hi, -lo));
+    out.push((
+        ACCURACY,
+        format!("{:.1}–{:.1} digits short on average", -hi, -lo),
+    ));
 
     // global control over every study
     let returned: Vec<f64> = all
@@ -777,13 +803,17 @@ fn readme_phrases(all: &[Measured]) -> Vec<String> {
         .filter(|g| matches!(g, GlobalOutcome::NotMet))
         .count();
     let (lo, hi) = min_max(returned.iter().copied());
-    out.push(format!(
-        "the {} runs it returned were from {:.2} digits short of rtol to {hi:.1} better",
-        returned.len(),
-        -lo
+    out.push((
+        README,
+        format!(
+            "the {} runs it returned were from {:.2} digits short of rtol to {hi:.1} better",
+            returned.len(),
+            -lo
+        ),
     ));
-    out.push(format!(
-        "and the {not_met} others ended in `GlobalToleranceNotMet`"
+    out.push((
+        README,
+        format!("and the {not_met} others ended in `GlobalToleranceNotMet`"),
     ));
     out
 }

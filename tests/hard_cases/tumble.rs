@@ -163,7 +163,7 @@ fn tumble_keeps_its_energy_until_the_euler_singularity_which_is_a_typed_error() 
     assert!(r.end == End::Singular && (7.9..8.1).contains(&r.t));
     // the error test's floor by kind (positions, velocities) against one over the whole state
     crate::quoted::says(
-        "README.md",
+        "docs/accuracy.md",
         &[format!(
             "the tumbling body's DOPRI5 run at rtol 1e-10 takes {} steps with the floor by kind, \
              1,214 with the floor over the whole state",

@@ -1294,7 +1294,7 @@ fn the_four_bar_at_every_scale_runs_or_stops_typed() {
         format!("{}–{}", lo.unwrap_or(&0), hi.unwrap_or(&0))
     };
     quoted::says(
-        "README.md",
+        "docs/closed_loops.md",
         &[format!(
             "Radau5 takes {} steps from × 10⁻⁶ to × 10⁸",
             range(&radau5_index2)

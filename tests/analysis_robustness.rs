@@ -642,13 +642,16 @@ fn every_analysis_at_the_edges_of_the_parameters_returns_finite_results_or_a_typ
     let (statics_others, statics_others_ok) = tally.of("statics", others);
     let (poles, poles_ok) = tally.of("pole_sensitivity", |_| true);
     quoted::says(
+        "docs/robustness.md",
+        &[format!(
+            "{} of the {} singular stiffnesses left in the statics sweep (the README's \"Analyses\") name one",
+            tally.count("statics SingularMatrix naming a parameter"),
+            tally.count("statics SingularMatrix")
+        )],
+    );
+    quoted::says(
         "README.md",
         &[
-            format!(
-                "{} of the {} singular stiffnesses left in the sweep below name one",
-                tally.count("statics SingularMatrix naming a parameter"),
-                tally.count("statics SingularMatrix")
-            ),
             format!(
                 "so does a second over each parameter of {} models at the edges of its range",
                 tally.models()

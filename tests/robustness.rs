@@ -228,7 +228,7 @@ fn every_run_ends_or_stops_typed_with_what_it_computed() {
     });
     assert_eq!(runs, 2145);
     quoted::says(
-        "README.md",
+        "docs/robustness.md",
         &[format!(
             "{} runs: {} finish, the others stop with one of {} typed failures",
             thousands(runs),
@@ -268,7 +268,7 @@ fn every_run_with_sensitivities_ends_or_stops_typed() {
     });
     assert!(kinds.contains_key("finished"), "{kinds:?}");
     quoted::says(
-        "README.md",
+        "docs/robustness.md",
         &[format!(
             "the same holds for {runs} runs with the sensitivities of two models' motion, {} finished",
             count(&kinds, "finished")
@@ -340,7 +340,7 @@ fn every_globally_controlled_run_ends_or_stops_typed() {
         );
     }
     quoted::says(
-        "README.md",
+        "docs/robustness.md",
         &[format!(
             "for {runs} runs under global error control, {} met, {} `GlobalToleranceNotMet`",
             count(&kinds, "met"),
@@ -446,7 +446,7 @@ fn every_parameter_at_its_edges_is_refused_or_runs_typed() {
     assert!(kinds.contains_key("ParamError"), "{kinds:?}");
     assert!(kinds.contains_key("finished"), "{kinds:?}");
     quoted::says(
-        "README.md",
+        "docs/robustness.md",
         &[format!(
             "`set_params` refuses {} with a typed `ParamError` and of the {} runs of the others {} finish",
             thousands(count(&kinds, "ParamError")),
@@ -599,7 +599,7 @@ fn every_option_at_its_edges_is_refused_or_runs_typed() {
     assert!(kinds.contains_key("InvalidOption"), "{kinds:?}");
     assert!(kinds.contains_key("finished"), "{kinds:?}");
     quoted::says(
-        "README.md",
+        "docs/robustness.md",
         &[format!(
             "{} of {} runs refused up front with an `InvalidOption`",
             thousands(count(&kinds, "InvalidOption")),

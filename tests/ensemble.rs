@@ -290,7 +290,7 @@ fn a_free_body_re_centres_each_member_s_chart_on_its_own() {
     );
     // the runs alone's counts (those on lanes depend on the processor's vector units)
     quoted::says(
-        "README.md",
+        "docs/ensembles.md",
         &[format!(
             "six members of the free body tumbling at pitch rates up to 6 rad/s re-centred \
              {fewest}–{most} times each, exactly as often as alone"
@@ -504,7 +504,7 @@ fn a_free_body_runs_on_lanes_with_its_charts_held() {
     );
     // the runs alone's error (that on lanes depends on the processor's vector units)
     quoted::says(
-        "README.md",
+        "docs/ensembles.md",
         &[format!(
             "on lanes and {by_itself:.1e} alone. A member that fails"
         )],

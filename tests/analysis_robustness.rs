@@ -333,7 +333,7 @@ fn every_analysis_returns_finite_results_or_a_typed_error() {
     println!("{} calls: {:#?}", tally.calls, tally.kinds);
     assert!(tally.problems.is_empty(), "{}", tally.problems.join("\n"));
     quoted::says(
-        "README.md",
+        "docs/analyses.md",
         &[
             format!(
                 "A sweep of every analysis over {} models from seven states each",
@@ -381,7 +381,7 @@ fn the_modes_of_a_free_body_beside_stiff_joints_are_found() {
     println!("largest residual of (λ²M + λC + K)φ: {worst:.1e} of |K| + |λ||C| + |λ|²|M|");
     assert!(worst < 1e-11, "{worst:e}");
     quoted::says(
-        "README.md",
+        "docs/analyses.md",
         &[format!(
             "every mode of the hexapod in the air satisfies (λ²M + λC + K)φ = 0 to {worst:.1e} \
              of |K| + |λ||C| + |λ|²|M| (asserted 1e-11)"
@@ -450,7 +450,7 @@ fn a_slow_mode_beside_a_fast_one_gets_its_shape() {
     };
     let ((n6, worst6), (n8, worst8)) = (nutation(2e6), nutation(2e8));
     quoted::says(
-        "README.md",
+        "docs/analyses.md",
         &[format!(
             "its nutation five and seven decades above its slowest poles, to {:.1e} (asserted 1e-12",
             worst6.max(worst8)
@@ -644,13 +644,13 @@ fn every_analysis_at_the_edges_of_the_parameters_returns_finite_results_or_a_typ
     quoted::says(
         "docs/robustness.md",
         &[format!(
-            "{} of the {} singular stiffnesses left in the statics sweep (the README's \"Analyses\") name one",
+            "{} of the {} singular stiffnesses left in the statics sweep (analyses.md) name one",
             tally.count("statics SingularMatrix naming a parameter"),
             tally.count("statics SingularMatrix")
         )],
     );
     quoted::says(
-        "README.md",
+        "docs/analyses.md",
         &[
             format!(
                 "so does a second over each parameter of {} models at the edges of its range",
@@ -729,7 +729,7 @@ fn statics_beside_a_stiff_spring_converge_at_the_rounding_of_the_forces() {
         spread = spread.max((load / loads[0].0 - 1.0).abs());
     }
     quoted::says(
-        "README.md",
+        "docs/analyses.md",
         &[format!(
             "(q₀ − 0.6)·k₁ = {} N at every stiffness to {spread:.0e} of it (asserted 1e-5;",
             quoted::minus(format!("{:.4}", loads[0].0))

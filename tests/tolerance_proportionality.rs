@@ -471,7 +471,7 @@ enum GlobalOutcome {
     NotMet,
 }
 
-/// What one study measured that the README quotes across the studies.
+/// What one study measured that the README and `docs/accuracy.md` quote across the studies.
 struct Measured {
     title: String,
     props: Vec<Proportionality>,
@@ -485,7 +485,7 @@ const STUDIES: usize = 6;
 /// The studies measured so far, in the order they ended (the tests run in parallel).
 static MEASURED: std::sync::Mutex<Vec<Measured>> = std::sync::Mutex::new(Vec::new());
 
-/// Keeps what a study measured; the study that completes the set checks the README's figures
+/// Keeps what a study measured; the study that completes the set checks the figures of the README and `docs/accuracy.md`
 /// against all of them (a run of some of the tests checks nothing).
 fn record(m: Measured) {
     let mut all = MEASURED.lock().unwrap_or_else(|e| e.into_inner());
@@ -494,7 +494,8 @@ fn record(m: Measured) {
         let phrases = quoted_phrases(&all);
         for file in [README, ACCURACY] {
             println!("\nthe figures of {file}, as measured here:");
-            let of_file: Vec<String> = (phrases.iter())
+            let of_file: Vec<String> = phrases
+                .iter()
                 .filter(|(f, _)| *f == file)
                 .map(|(_, p)| p.clone())
                 .collect();

@@ -1,11 +1,13 @@
 //! Radau IIA 3 and 5 (`mbs-runtime/src/integrators/radau/`) on the canonical models:
 //! observed orders on seed2dof (fixed step and adaptive), accuracy against the reference runs
 //! of dpend and arm3d_6, work counters of one reference run per scheme, and the iteration
-//! matrices (failures and allocations are checked with every scheme in `failures.rs` and
+//! matrices and how long they are kept (failures and allocations are checked with every scheme in `failures.rs` and
 //! `no_alloc.rs`).
 
 use mbs_models::arm3d_6;
 mod common;
+#[path = "common/quoted.rs"]
+mod quoted;
 use mbs_models::dpend;
 use mbs_models::seed2dof;
 
@@ -281,5 +283,107 @@ fn newton_limited_steps_are_remembered() {
             st.steps, st.rejected_newton, st.rejected_error
         );
         assert_eq!((st.steps, st.rejected_newton), (steps, rejected));
+    }
+}
+
+/// Radau keeps its iteration matrices for the next step while Newton contracts below
+/// `NewtonOptions::keep_below` (RADAU5's THET): raised from its 0.001 to 0.1, as RADAU5's
+/// documentation advises where the matrices are costly, the free hexapod tumbling (24
+/// coordinates, no generated tangents: each matrix 1 M and 2n + 1 = 49 τ) takes fewer
+/// evaluations for an error as small (the work–precision study's run, 1 s at rtol 1e-6: the
+/// README's figures). A value out of (0, 1) is refused, naming the option.
+#[test]
+fn costly_iteration_matrices_are_kept_longer_when_asked() {
+    use mbs_models::hexapod::Hexapod;
+    let t_end = 1.0;
+    let start = Options {
+        qd0: Some(
+            (0..24)
+                .map(|i| 0.7 * (0.9 * i as f64 + 0.2).cos())
+                .collect(),
+        ),
+        output: Output::Last,
+        energy: false,
+        ..Options::adaptive(t_end, 1e-6)
+    };
+    let reference = {
+        let opts = Options {
+            step: Options::adaptive(t_end, 1e-12).step,
+            ..start.clone()
+        };
+        simulate(Hexapod::default(), Scheme::Dopri5, opts).unwrap()
+    };
+    let (q, qd) = (reference.0.q(0).to_vec(), reference.0.qd(0).to_vec());
+    let run = |keep_below: f64| {
+        let opts = Options {
+            newton: mbs::NewtonOptions {
+                keep_below,
+                ..Default::default()
+            },
+            ..start.clone()
+        };
+        let (tr, st) = simulate(Hexapod::default(), Scheme::Radau5, opts).unwrap();
+        let e = final_error(&tr, &q, &qd);
+        println!(
+            "hexapod, Radau5 at rtol 1e-6, keep_below {keep_below}: error {e:.2e}, {} steps, \
+             {} matrices, {} evaluations, {} factorisations, {} Newton iterations, {} chart switches",
+            st.steps,
+            st.mass_matrix,
+            st.evaluations(),
+            st.factorizations,
+            st.newton_iterations,
+            st.chart_switches
+        );
+        (e, st)
+    };
+    println!("reference: {} chart switches", reference.1.chart_switches);
+    let (e0, s0) = run(mbs::options::DEFAULT_KEEP_BELOW);
+    let (e1, s1) = run(0.1);
+    assert!(s1.mass_matrix * 2 < s0.mass_matrix, "{s0}\n{s1}");
+    assert!(2 * s1.evaluations() < s0.evaluations(), "{s0}\n{s1}");
+    assert!(e0 < 1e-5 && e1 < 1e-5, "{e0:e} {e1:e}");
+    quoted::says(
+        "README.md",
+        &[format!(
+            "1 s at rtol 1e-6, {} → {} evaluations, its error {e0:.1e} → {e1:.1e};",
+            s0.evaluations(),
+            s1.evaluations()
+        )],
+    );
+    // chain24 (24 coordinates, differences too), whose Newton contracts by more than 0.1 at
+    // most steps: nearly as many matrices either way
+    for keep_below in [mbs::options::DEFAULT_KEEP_BELOW, 0.1] {
+        let opts = Options {
+            output: Output::Last,
+            energy: false,
+            newton: mbs::NewtonOptions {
+                keep_below,
+                ..Default::default()
+            },
+            ..Options::adaptive(2.0, 1e-6)
+        };
+        let (_, st) = simulate(
+            mbs_models::chain24::Chain24::default(),
+            Scheme::Radau5,
+            opts,
+        )
+        .unwrap();
+        println!(
+            "chain24 over 2 s, Radau5 at rtol 1e-6, keep_below {keep_below}: {} steps, {} matrices, {} evaluations",
+            st.steps,
+            st.mass_matrix,
+            st.evaluations()
+        );
+    }
+    for bad in [0.0, 1.0, -0.1, f64::NAN] {
+        let opts = Options {
+            newton: mbs::NewtonOptions {
+                keep_below: bad,
+                ..Default::default()
+            },
+            ..start.clone()
+        };
+        let e = simulate(Hexapod::default(), Scheme::Radau5, opts).unwrap_err();
+        assert!(e.to_string().contains("newton.keep_below"), "{e}");
     }
 }

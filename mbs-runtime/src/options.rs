@@ -326,6 +326,22 @@ pub struct NewtonOptions {
     /// reuse the factorised iteration matrix across iterations and steps while convergence
     /// is fast (modified Newton; default true)
     pub reuse: bool,
+    /// Radau IIA: the contraction θ of Newton's iteration below which the iteration matrices
+    /// are kept for the next step (RADAU5's THET; default 0.001, which re-evaluates them
+    /// after nearly every step that needed more than one iteration). Raise it, to 0.1 say,
+    /// where they are costly: finite differences of a model with many coordinates and no
+    /// generated tangents (2n evaluations each), as with efforts written in Rust. On the
+    /// free hexapod (24 coordinates) at rtol 1e-6, 581 → 261 evaluations for the same
+    /// digits; on small models a stale matrix costs more than it saves (README, "Schemes")
+    #[serde(default = "default_keep_below")]
+    pub keep_below: f64,
+}
+
+/// RADAU5's THET: [`NewtonOptions::keep_below`]'s default.
+pub const DEFAULT_KEEP_BELOW: f64 = 0.001;
+
+fn default_keep_below() -> f64 {
+    DEFAULT_KEEP_BELOW
 }
 
 impl Default for NewtonOptions {
@@ -336,6 +352,7 @@ impl Default for NewtonOptions {
             atol: 1e-10,
             rtol: 1e-10,
             reuse: true,
+            keep_below: DEFAULT_KEEP_BELOW,
         }
     }
 }
@@ -895,6 +912,13 @@ impl Options {
             if !(v > 0.0) || !v.is_finite() {
                 return Err(invalid(name, v, "must be > 0 and finite"));
             }
+        }
+        if !(n.keep_below > 0.0 && n.keep_below < 1.0) {
+            return Err(invalid(
+                "newton.keep_below",
+                n.keep_below,
+                "must be in (0, 1): a contraction θ below it keeps Radau's iteration matrices (0.001 by default, 0.1 where they are costly); set newton.reuse = false to re-evaluate them at every step",
+            ));
         }
         let c = &self.constraints;
         c.validate()?;

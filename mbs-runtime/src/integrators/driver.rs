@@ -1201,6 +1201,7 @@ fn control(options: &Options, groups: usize) -> Control {
         kappa: 1.0,
         max_iterations: options.newton.max_iterations,
         reuse: options.newton.reuse,
+        keep_below: options.newton.keep_below,
         follows_motion: true,
     };
     let (adaptive, newton) = match options.step {

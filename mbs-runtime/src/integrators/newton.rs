@@ -64,6 +64,8 @@ pub(crate) struct NewtonTol {
     pub kappa: f64,
     pub max_iterations: usize,
     pub reuse: bool,
+    /// Radau: the contraction below which its matrices are kept for the next step
+    pub keep_below: f64,
     /// fixed steps: the absolute part of each kind's weight (positions, velocities,
     /// multipliers) is atol or rtol times the largest value of that kind the step handles,
     /// whichever is smaller ([`NewtonTol::absolute`])

@@ -44,9 +44,10 @@
 //! adaptive, as soon as the predicted η‖δ‖θ^(k_max − 1 − k) exceeds κ (h·0.8·q^(−1/(4 +
 //! k_max − 1 − k))). The first iteration starts from the previous step's collocation
 //! polynomial (the Lagrange polynomial through its stage accelerations, extrapolated), or
-//! from qdd₀ at the first step. M, C_t, K_t are kept across steps while θ ≤ 0.001 and the
-//! factorisations too when moreover h stays (h is kept when the controller proposes a factor
-//! in [1, 1.2]); after a rejection they are re-evaluated unless they are already fresh.
+//! from qdd₀ at the first step. M, C_t, K_t are kept across steps while θ ≤
+//! `NewtonOptions::keep_below` (RADAU5's THET, 0.001 by default) and the factorisations too
+//! when moreover h stays (h is kept when the controller proposes a factor in [1, 1.2]); after
+//! a rejection they are re-evaluated unless they are already fresh.
 //! With `NewtonOptions::reuse = false` they are re-evaluated at every attempt.
 //!
 //! ## Error estimate
@@ -367,8 +368,6 @@ use crate::linalg::{C64, Lu};
 use crate::stats::ErrorTest;
 use tableau::Coefficients;
 
-/// θ below which M, C_t, K_t are kept for the next step (RADAU5's THET)
-const THET: f64 = 0.001;
 /// h is kept (and the factorisations with it) when the proposed h_new/h is in [QUOT1, QUOT2]
 const QUOT1: f64 = 1.0;
 const QUOT2: f64 = 1.2;
@@ -392,6 +391,9 @@ struct Tol {
     kappa: f64,
     max_iterations: usize,
     adaptive: bool,
+    /// θ below which M, C_t, K_t are kept for the next step (RADAU5's THET,
+    /// `NewtonOptions::keep_below`)
+    keep_below: f64,
 }
 
 impl Tol {
@@ -417,6 +419,7 @@ impl Tol {
                     kappa: (10.0 * f64::EPSILON / r).max(ctl.newton.kappa.min(r.sqrt())),
                     max_iterations: ctl.newton.max_iterations,
                     adaptive: true,
+                    keep_below: ctl.newton.keep_below,
                 }
             }
             None => Tol {
@@ -429,6 +432,7 @@ impl Tol {
                 // a failure is final at a fixed step: twice the iterations before giving up
                 max_iterations: 2 * ctl.newton.max_iterations,
                 adaptive: false,
+                keep_below: ctl.newton.keep_below,
             },
         }
     }
@@ -586,7 +590,7 @@ impl Radau {
             y0: vec![0.0; 2 * n],
             y1: vec![0.0; 2 * n],
             faccon: 1.0,
-            theta: THET,
+            theta: crate::options::DEFAULT_KEEP_BELOW,
             first: true,
             h_newton: f64::INFINITY,
             reject: false,
@@ -818,7 +822,7 @@ impl Stepper for Radau {
         next.qdd.copy_from_slice(&self.acc[last..]);
         let nc = self.nc;
         next.lambda[..nc].copy_from_slice(&self.lam[(s - 1) * nc..]);
-        let keep_matrices = ctl.newton.reuse && self.theta <= THET;
+        let keep_matrices = ctl.newton.reuse && self.theta <= tol.keep_below;
         if !tol.adaptive {
             self.consistent_end(p, cur.t + h, next)?;
             self.first = false;

@@ -8,7 +8,7 @@ use super::index2::border2;
 use super::index3::border;
 use super::tableau::re;
 use super::{
-    MATRIX_C, MATRIX_C2, MATRIX_C3, MATRIX_R, MATRIX_R2, MATRIX_R3, NewtonFail, Radau, THET, Tol,
+    MATRIX_C, MATRIX_C2, MATRIX_C3, MATRIX_R, MATRIX_R2, MATRIX_R3, NewtonFail, Radau, Tol,
 };
 use crate::error::Failure;
 use crate::linalg::{C64, Singular};
@@ -287,7 +287,7 @@ impl Radau {
         let (s, n) = (self.k.s, self.n);
         let nit = tol.max_iterations;
         self.faccon = self.faccon.max(f64::EPSILON).powf(0.8);
-        self.theta = THET;
+        self.theta = tol.keep_below;
         let (mut newt, mut dynold, mut thqold) = (0usize, 1.0, 1.0);
         let mut last = f64::INFINITY;
         let mut dyn1 = f64::INFINITY;

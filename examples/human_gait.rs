@@ -31,7 +31,7 @@
 //! joints, each running the held cycle once per unknown), and the program reports the run
 //! that follows alone: from the held run's state at its second cycle, nothing holding the
 //! pelvis, each of `--cycles` cycles (`--pressure 30 --free 10 --reduce 8`: a normal first
-//! cycle with the pelvis wholly free, about 3 minutes on two cores; `--refresh K` takes the
+//! cycle with the pelvis wholly free, about 2.5 minutes on two cores; `--refresh K` takes the
 //! Jacobian by differences every K iterations only, Broyden's updates between: cheaper, but
 //! the free pelvis then departs further from its reference), printing how far the pelvis
 //! departs from its reference orientation.

@@ -13,8 +13,9 @@
 //!   and a size of a few centimetres, on both legs alike;
 //! - a fibre at rest from `equilibrium` has zero length rate; the tension applied along a
 //!   path is the generalised force −T ∂l/∂q;
-//! - a muscle stretched beyond its fibre's range stops a run with a typed failure, the
-//!   trajectory kept; a unit's invalid parameters, non-finite inputs and a tendon no fibre
+//! - a muscle stretched beyond its fibre's range stops a run with a typed failure
+//!   (`EffortRejected`: the state is rejected, smaller steps tried, since a Newton iteration's
+//!   trial state can overshoot where the motion never goes), the trajectory kept; a unit's invalid parameters, non-finite inputs and a tendon no fibre
 //!   speed balances are typed errors;
 //! - standing on the muscles (mode 2): excitations from the statics of the held body and a
 //!   static optimisation (co-contraction about 0.5), the equilibrium under them by statics
@@ -298,7 +299,7 @@ fn a_fibre_beyond_its_range_is_a_typed_failure() {
     .expect_err("the vasti leave their range");
     println!("{err}");
     match &err.kind {
-        Failure::UserEffort { .. } => {}
+        Failure::EffortRejected { .. } => {}
         other => panic!("{other:?}"),
     }
     let message = err.to_string();

@@ -477,7 +477,10 @@ fn every_option_at_its_edges_is_refused_or_runs_typed() {
         ),
         ("newton.atol", float(|o, x| o.newton.atol = x)),
         ("newton.rtol", float(|o, x| o.newton.rtol = x)),
-        ("newton.keep_below", float(|o, x| o.newton.keep_below = x)),
+        (
+            "newton.keep_below",
+            float(|o, x| o.newton.keep_below = Some(x)),
+        ),
         ("singularity_tol", float(|o, x| o.singularity_tol = x)),
         ("chart_switch", float(|o, x| o.chart_switch = x)),
         (

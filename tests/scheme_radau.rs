@@ -287,34 +287,24 @@ fn newton_limited_steps_are_remembered() {
 }
 
 /// Radau keeps its iteration matrices for the next step while Newton contracts below
-/// `NewtonOptions::keep_below` (RADAU5's THET): raised from its 0.001 to 0.1, as RADAU5's
-/// documentation advises where the matrices are costly, the free hexapod tumbling (24
-/// coordinates, no generated tangents: each matrix 1 M and 2n + 1 = 49 τ) takes fewer
-/// evaluations for an error as small (the work–precision study's run, 1 s at rtol 1e-6: the
-/// README's figures). A value out of (0, 1) is refused, naming the option.
+/// `NewtonOptions::keep_below` (RADAU5's THET): by default 0.1 where they are differences on
+/// 16 coordinates or more, as RADAU5's documentation advises where they are costly, and
+/// RADAU5's 0.001 otherwise. The free hexapod tumbling (24 coordinates, no generated
+/// tangents: each matrix 1 M and 2n + 1 = 49 τ; the work–precision study's run, 1 s at rtol
+/// 1e-6) and the standing one (2 s at rtol 1e-6, its contacts and PD torques written in the
+/// language) take fewer evaluations for an error as small: the README's figures. A value out
+/// of (0, 1) is refused, naming the option.
 #[test]
-fn costly_iteration_matrices_are_kept_longer_when_asked() {
-    use mbs_models::hexapod::Hexapod;
-    let t_end = 1.0;
-    let start = Options {
-        qd0: Some(
-            (0..24)
-                .map(|i| 0.7 * (0.9 * i as f64 + 0.2).cos())
-                .collect(),
-        ),
-        output: Output::Last,
-        energy: false,
-        ..Options::adaptive(t_end, 1e-6)
-    };
-    let reference = {
-        let opts = Options {
-            step: Options::adaptive(t_end, 1e-12).step,
-            ..start.clone()
-        };
-        simulate(Hexapod::default(), Scheme::Dopri5, opts).unwrap()
-    };
-    let (q, qd) = (reference.0.q(0).to_vec(), reference.0.qd(0).to_vec());
-    let run = |keep_below: f64| {
+fn costly_iteration_matrices_are_kept_longer() {
+    use mbs::options::{COSTLY_KEEP_BELOW, RADAU5_KEEP_BELOW};
+    use mbs_models::hexapod::{Hexapod, HexapodStanding};
+    fn run<M: mbs::Model + Clone + 'static>(
+        name: &str,
+        model: &M,
+        start: &Options,
+        keep_below: Option<f64>,
+        reference: &mbs::Trajectory,
+    ) -> (f64, Stats) {
         let opts = Options {
             newton: mbs::NewtonOptions {
                 keep_below,
@@ -322,37 +312,104 @@ fn costly_iteration_matrices_are_kept_longer_when_asked() {
             },
             ..start.clone()
         };
-        let (tr, st) = simulate(Hexapod::default(), Scheme::Radau5, opts).unwrap();
-        let e = final_error(&tr, &q, &qd);
+        let (tr, st) = simulate(model.clone(), Scheme::Radau5, opts).unwrap();
+        let e = final_error(&tr, reference.q(0), reference.qd(0));
         println!(
-            "hexapod, Radau5 at rtol 1e-6, keep_below {keep_below}: error {e:.2e}, {} steps, \
-             {} matrices, {} evaluations, {} factorisations, {} Newton iterations, {} chart switches",
+            "{name}, Radau5 at rtol 1e-6, keep_below {keep_below:?}: error {e:.2e}, {} steps, \
+             {} matrices, {} evaluations, {} factorisations, {} Newton iterations",
             st.steps,
             st.mass_matrix,
             st.evaluations(),
             st.factorizations,
-            st.newton_iterations,
-            st.chart_switches
+            st.newton_iterations
         );
         (e, st)
+    }
+    // DOPRI5 at rtol 1e-12 where the motion is smooth, Radau5 at 1e-10 (its matrices as
+    // RADAU5 keeps them) on the stiff contacts
+    fn reference<M: mbs::Model + Clone + 'static>(
+        model: &M,
+        start: &Options,
+        scheme: Scheme,
+        rtol: f64,
+    ) -> mbs::Trajectory {
+        let opts = Options {
+            step: Options::adaptive(start.t_end, rtol).step,
+            newton: mbs::NewtonOptions {
+                keep_below: Some(RADAU5_KEEP_BELOW),
+                ..Default::default()
+            },
+            ..start.clone()
+        };
+        let (tr, st) = simulate(model.clone(), scheme, opts).unwrap();
+        assert_eq!(st.chart_switches, 0, "the runs compare q in one chart");
+        tr
+    }
+    let free = Options {
+        qd0: Some(
+            (0..24)
+                .map(|i| 0.7 * (0.9 * i as f64 + 0.2).cos())
+                .collect(),
+        ),
+        output: Output::Last,
+        energy: false,
+        ..Options::adaptive(1.0, 1e-6)
     };
-    println!("reference: {} chart switches", reference.1.chart_switches);
-    let (e0, s0) = run(mbs::options::DEFAULT_KEEP_BELOW);
-    let (e1, s1) = run(0.1);
+    let standing = Options {
+        output: Output::Last,
+        energy: false,
+        ..Options::adaptive(2.0, 1e-6)
+    };
+    let mut phrases = Vec::new();
+    let r = reference(&Hexapod::default(), &free, Scheme::Dopri5, 1e-12);
+    let free_run = |keep_below| run("free hexapod", &Hexapod::default(), &free, keep_below, &r);
+    let (e0, s0) = free_run(Some(RADAU5_KEEP_BELOW));
+    let (e1, s1) = free_run(None);
+    let (_, s2) = free_run(Some(COSTLY_KEEP_BELOW));
+    assert_eq!(
+        s1.evaluations(),
+        s2.evaluations(),
+        "the default is 0.1 here"
+    );
     assert!(s1.mass_matrix * 2 < s0.mass_matrix, "{s0}\n{s1}");
     assert!(2 * s1.evaluations() < s0.evaluations(), "{s0}\n{s1}");
     assert!(e0 < 1e-5 && e1 < 1e-5, "{e0:e} {e1:e}");
-    quoted::says(
-        "README.md",
-        &[format!(
-            "1 s at rtol 1e-6, {} → {} evaluations, its error {e0:.1e} → {e1:.1e};",
-            s0.evaluations(),
-            s1.evaluations()
-        )],
+    phrases.push(format!(
+        "1 s at rtol 1e-6, {} → {} evaluations, its error {e0:.1e} → {e1:.1e};",
+        quoted::thousands(s0.evaluations()),
+        quoted::thousands(s1.evaluations())
+    ));
+    let r = reference(
+        &HexapodStanding::default(),
+        &standing,
+        Scheme::Radau5,
+        1e-10,
     );
+    let (e0, s0) = run(
+        "standing hexapod",
+        &HexapodStanding::default(),
+        &standing,
+        Some(RADAU5_KEEP_BELOW),
+        &r,
+    );
+    let (e1, s1) = run(
+        "standing hexapod",
+        &HexapodStanding::default(),
+        &standing,
+        None,
+        &r,
+    );
+    assert!(s1.evaluations() < s0.evaluations(), "{s0}\n{s1}");
+    assert!(e0 < 1e-4 && e1 < 1e-4, "{e0:e} {e1:e}");
+    phrases.push(format!(
+        "standing on its feet, 2 s, {} → {} evaluations, its error {e0:.1e} → {e1:.1e}",
+        quoted::thousands(s0.evaluations()),
+        quoted::thousands(s1.evaluations())
+    ));
+    quoted::says("README.md", &phrases);
     // chain24 (24 coordinates, differences too), whose Newton contracts by more than 0.1 at
     // most steps: nearly as many matrices either way
-    for keep_below in [mbs::options::DEFAULT_KEEP_BELOW, 0.1] {
+    for keep_below in [Some(RADAU5_KEEP_BELOW), None] {
         let opts = Options {
             output: Output::Last,
             energy: false,
@@ -369,7 +426,7 @@ fn costly_iteration_matrices_are_kept_longer_when_asked() {
         )
         .unwrap();
         println!(
-            "chain24 over 2 s, Radau5 at rtol 1e-6, keep_below {keep_below}: {} steps, {} matrices, {} evaluations",
+            "chain24 over 2 s, Radau5 at rtol 1e-6, keep_below {keep_below:?}: {} steps, {} matrices, {} evaluations",
             st.steps,
             st.mass_matrix,
             st.evaluations()
@@ -378,10 +435,10 @@ fn costly_iteration_matrices_are_kept_longer_when_asked() {
     for bad in [0.0, 1.0, -0.1, f64::NAN] {
         let opts = Options {
             newton: mbs::NewtonOptions {
-                keep_below: bad,
+                keep_below: Some(bad),
                 ..Default::default()
             },
-            ..start.clone()
+            ..free.clone()
         };
         let e = simulate(Hexapod::default(), Scheme::Radau5, opts).unwrap_err();
         assert!(e.to_string().contains("newton.keep_below"), "{e}");

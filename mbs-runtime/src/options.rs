@@ -327,22 +327,22 @@ pub struct NewtonOptions {
     /// is fast (modified Newton; default true)
     pub reuse: bool,
     /// Radau IIA: the contraction θ of Newton's iteration below which the iteration matrices
-    /// are kept for the next step (RADAU5's THET; default 0.001, which re-evaluates them
-    /// after nearly every step that needed more than one iteration). Raise it, to 0.1 say,
-    /// where they are costly: finite differences of a model with many coordinates and no
-    /// generated tangents (2n evaluations each), as with efforts written in Rust. On the
-    /// free hexapod (24 coordinates) at rtol 1e-6, 581 → 261 evaluations for the same
-    /// digits; on small models a stale matrix costs more than it saves (README, "Schemes")
-    #[serde(default = "default_keep_below")]
-    pub keep_below: f64,
+    /// are kept for the next step (RADAU5's THET). `None` (the default): [`COSTLY_KEEP_BELOW`]
+    /// where they are costly, differences (of τ, or of the index-1 form of a closed loop) on
+    /// a model of [`COSTLY_COORDINATES`] coordinates or more, 2n + 1 evaluations each, as
+    /// RADAU5's documentation advises; RADAU5's [`RADAU5_KEEP_BELOW`] otherwise, which
+    /// re-evaluates them after nearly every step that needed more than one iteration (on
+    /// small models a stale matrix costs more than it saves). The figures: README, "Schemes"
+    #[serde(default)]
+    pub keep_below: Option<f64>,
 }
 
-/// RADAU5's THET: [`NewtonOptions::keep_below`]'s default.
-pub const DEFAULT_KEEP_BELOW: f64 = 0.001;
-
-fn default_keep_below() -> f64 {
-    DEFAULT_KEEP_BELOW
-}
+/// RADAU5's THET, [`NewtonOptions::keep_below`] where the iteration matrices are cheap.
+pub const RADAU5_KEEP_BELOW: f64 = 0.001;
+/// [`NewtonOptions::keep_below`] where the iteration matrices are costly.
+pub const COSTLY_KEEP_BELOW: f64 = 0.1;
+/// The size from which iteration matrices by differences count as costly.
+pub const COSTLY_COORDINATES: usize = 16;
 
 impl Default for NewtonOptions {
     fn default() -> Self {
@@ -352,7 +352,7 @@ impl Default for NewtonOptions {
             atol: 1e-10,
             rtol: 1e-10,
             reuse: true,
-            keep_below: DEFAULT_KEEP_BELOW,
+            keep_below: None,
         }
     }
 }
@@ -913,10 +913,10 @@ impl Options {
                 return Err(invalid(name, v, "must be > 0 and finite"));
             }
         }
-        if !(n.keep_below > 0.0 && n.keep_below < 1.0) {
+        if let Some(keep) = n.keep_below.filter(|k| !(*k > 0.0 && *k < 1.0)) {
             return Err(invalid(
                 "newton.keep_below",
-                n.keep_below,
+                keep,
                 "must be in (0, 1): a contraction θ below it keeps Radau's iteration matrices (0.001 by default, 0.1 where they are costly); set newton.reuse = false to re-evaluate them at every step",
             ));
         }

@@ -1689,9 +1689,9 @@ impl Default for Reduction {
     /// --free 10`) the residual torques fall from 112 to 7 N·m rms in 6 iterations and the
     /// pelvis walks a normal cycle wholly free, within 0.08 rad of its reference
     /// orientation. Broyden's updates between differences every 6 iterations (`refresh`)
-    /// take half the time to 11 N·m in 12 iterations, with corrections a third as large,
-    /// and the forces of the free cycle as normal, but the pelvis turns up to 0.22 rad away
-    /// from its reference.
+    /// take a third of the time to 10 N·m in 12 iterations, with corrections a third as
+    /// large, and the forces of the free cycle as normal, but the pelvis turns up to 0.21
+    /// rad away from its reference.
     fn default() -> Self {
         Reduction {
             harmonics: 5,

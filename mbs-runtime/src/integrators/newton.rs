@@ -64,8 +64,9 @@ pub(crate) struct NewtonTol {
     pub kappa: f64,
     pub max_iterations: usize,
     pub reuse: bool,
-    /// Radau: the contraction below which its matrices are kept for the next step
-    pub keep_below: f64,
+    /// Radau: the contraction below which its matrices are kept for the next step (`None`:
+    /// by their cost)
+    pub keep_below: Option<f64>,
     /// fixed steps: the absolute part of each kind's weight (positions, velocities,
     /// multipliers) is atol or rtol times the largest value of that kind the step handles,
     /// whichever is smaller ([`NewtonTol::absolute`])

@@ -112,6 +112,12 @@ impl Problem {
     /// (t, q, qd, qdd), n × n column-major each, as `self.iteration` says: exact (M and the
     /// generated tangents: one evaluation of each), finite differences (M exact, C_t and K_t
     /// by forward differences of τ: 2n + 1 evaluations of τ), or mass only (C_t = K_t = 0).
+    /// Whether the iteration matrices are built by differences (of τ, or of the ODE of a
+    /// closed loop's index-1 form): 2n + 1 evaluations each.
+    pub fn matrices_by_differences(&self) -> bool {
+        self.ode() || self.iteration == IterationMatrix::FiniteDifferences
+    }
+
     pub fn tangent_matrices(
         &mut self,
         at: At,

@@ -45,7 +45,8 @@
 //! k_max − 1 − k))). The first iteration starts from the previous step's collocation
 //! polynomial (the Lagrange polynomial through its stage accelerations, extrapolated), or
 //! from qdd₀ at the first step. M, C_t, K_t are kept across steps while θ ≤
-//! `NewtonOptions::keep_below` (RADAU5's THET, 0.001 by default) and the factorisations too
+//! `NewtonOptions::keep_below` (RADAU5's THET: 0.001, or 0.1 where the matrices are
+//! differences on 16 coordinates or more) and the factorisations too
 //! when moreover h stays (h is kept when the controller proposes a factor in [1, 1.2]); after
 //! a rejection they are re-evaluated unless they are already fresh.
 //! With `NewtonOptions::reuse = false` they are re-evaluated at every attempt.
@@ -397,7 +398,15 @@ struct Tol {
 }
 
 impl Tol {
-    fn new(ctl: &Control, s: usize) -> Tol {
+    fn new(ctl: &Control, s: usize, p: &Problem) -> Tol {
+        use crate::options::{COSTLY_COORDINATES, COSTLY_KEEP_BELOW, RADAU5_KEEP_BELOW};
+        let keep_below = ctl.newton.keep_below.unwrap_or(
+            if p.n >= COSTLY_COORDINATES && p.matrices_by_differences() {
+                COSTLY_KEEP_BELOW
+            } else {
+                RADAU5_KEEP_BELOW
+            },
+        );
         match ctl.adaptive {
             Some(Tolerances { rtol, atol, groups }) => {
                 // Radau5: RADAU5's transformation 0.1·rtol^((s+1)/(2s)); Radau3: the global
@@ -419,7 +428,7 @@ impl Tol {
                     kappa: (10.0 * f64::EPSILON / r).max(ctl.newton.kappa.min(r.sqrt())),
                     max_iterations: ctl.newton.max_iterations,
                     adaptive: true,
-                    keep_below: ctl.newton.keep_below,
+                    keep_below,
                 }
             }
             None => Tol {
@@ -432,7 +441,7 @@ impl Tol {
                 // a failure is final at a fixed step: twice the iterations before giving up
                 max_iterations: 2 * ctl.newton.max_iterations,
                 adaptive: false,
-                keep_below: ctl.newton.keep_below,
+                keep_below,
             },
         }
     }
@@ -590,7 +599,7 @@ impl Radau {
             y0: vec![0.0; 2 * n],
             y1: vec![0.0; 2 * n],
             faccon: 1.0,
-            theta: crate::options::DEFAULT_KEEP_BELOW,
+            theta: crate::options::RADAU5_KEEP_BELOW,
             first: true,
             h_newton: f64::INFINITY,
             reject: false,
@@ -698,7 +707,7 @@ impl Stepper for Radau {
     fn attempt(&mut self, step: Step<'_>) -> Result<Attempt, Failure> {
         let Step(p, cur, h, ctl, next) = step;
         let (s, n) = (self.k.s, self.n);
-        let tol = Tol::new(ctl, s);
+        let tol = Tol::new(ctl, s, p);
         // Newton's weights, like the error test's, not below the rounding of the values the
         // stages handle: 100ε (or rtol', if tighter) times the largest position
         // |q| + h|qd| + h²|qdd| and the largest velocity |qd| + h|qdd|. Without it a start at

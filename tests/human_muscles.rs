@@ -14,9 +14,10 @@
 //! - a fibre at rest from `equilibrium` has zero length rate; the tension applied along a
 //!   path is the generalised force −T ∂l/∂q;
 //! - a muscle stretched beyond its fibre's range stops a run with a typed failure
-//!   (`EffortRejected`: the state is rejected, smaller steps tried, since a Newton iteration's
-//!   trial state can overshoot where the motion never goes), the trajectory kept; a unit's invalid parameters, non-finite inputs and a tendon no fibre
-//!   speed balances are typed errors;
+//!   (`EffortRejected`: the state is rejected, smaller steps tried, since a Newton
+//!   iteration's trial state can overshoot where the motion never goes), the trajectory
+//!   kept; a unit's invalid parameters, non-finite inputs and a tendon no fibre speed
+//!   balances are typed errors;
 //! - standing on the muscles (mode 2): excitations from the statics of the held body and a
 //!   static optimisation (co-contraction about 0.5), the equilibrium under them by statics
 //!   with the fibres at rest; the body stands 2 s on constant excitations within 1e-6 of it.

@@ -107,17 +107,17 @@ impl Problem {
         (exact && !self.ode()).then_some((&self.m[..], &self.c[..], &self.k[..]))
     }
 
-    /// The pieces of the iteration matrix, unfactorised, for schemes that combine them with
-    /// several (or complex) coefficients: M, C_t = ∂τ/∂qd and K_t = ∂τ/∂q at
-    /// (t, q, qd, qdd), n × n column-major each, as `self.iteration` says: exact (M and the
-    /// generated tangents: one evaluation of each), finite differences (M exact, C_t and K_t
-    /// by forward differences of τ: 2n + 1 evaluations of τ), or mass only (C_t = K_t = 0).
     /// Whether the iteration matrices are built by differences (of τ, or of the ODE of a
     /// closed loop's index-1 form): 2n + 1 evaluations each.
     pub fn matrices_by_differences(&self) -> bool {
         self.ode() || self.iteration == IterationMatrix::FiniteDifferences
     }
 
+    /// The pieces of the iteration matrix, unfactorised, for schemes that combine them with
+    /// several (or complex) coefficients: M, C_t = ∂τ/∂qd and K_t = ∂τ/∂q at
+    /// (t, q, qd, qdd), n × n column-major each, as `self.iteration` says: exact (M and the
+    /// generated tangents: one evaluation of each), finite differences (M exact, C_t and K_t
+    /// by forward differences of τ: 2n + 1 evaluations of τ), or mass only (C_t = K_t = 0).
     pub fn tangent_matrices(
         &mut self,
         at: At,

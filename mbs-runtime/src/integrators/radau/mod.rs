@@ -46,9 +46,9 @@
 //! polynomial (the Lagrange polynomial through its stage accelerations, extrapolated), or
 //! from qdd₀ at the first step. M, C_t, K_t are kept across steps while θ ≤
 //! `NewtonOptions::keep_below` (RADAU5's THET: 0.001, or 0.1 where the matrices are
-//! differences on 16 coordinates or more) and the factorisations too
-//! when moreover h stays (h is kept when the controller proposes a factor in [1, 1.2]); after
-//! a rejection they are re-evaluated unless they are already fresh.
+//! differences on 16 coordinates or more) and the factorisations too when moreover h stays
+//! (h is kept when the controller proposes a factor in [1, 1.2]); after a rejection they are
+//! re-evaluated unless they are already fresh.
 //! With `NewtonOptions::reuse = false` they are re-evaluated at every attempt.
 //!
 //! ## Error estimate

@@ -803,7 +803,7 @@ fn differences_see_forces_on_a_micrometre_scale() {
     println!("state matrix by differences, relative error {err:.1e}");
     assert!(err < 1e-6, "{err:e}");
     quoted::says(
-        "README.md",
+        "docs/status.md",
         &[format!(
             "from a step of 6 µm where they are 200 and 2, now within {err:.1e};"
         )],
@@ -1117,7 +1117,7 @@ fn mode_shapes_beside_a_stiff_mode_are_their_own() {
     }
     assert!(worst_mass < 1e-12, "{worst_mass:e}");
     quoted::says(
-        "README.md",
+        "docs/status.md",
         &[format!(
             "three oscillators of 1, 1.2 and 1e5 rad/s each give a shape on their own coordinate \
              alone (off-axis {worst_off:.1e} at most, modal masses 1 to 1e-12)"
@@ -1176,7 +1176,7 @@ fn an_unstable_direction_beside_a_stiff_spring_is_unstable() {
     );
     assert_eq!(eq.stability, Stability::Unstable);
     quoted::says(
-        "README.md",
+        "docs/status.md",
         &[format!(
             "and −0.49 N·m/rad beside 1e10 N/m is `{:?}`, where a threshold",
             eq.stability

@@ -443,7 +443,7 @@ fn a_dropped_box_comes_to_rest_on_its_weight_and_never_gains_energy() {
     println!("Σ F_n against m g: {:.1e} relative", (total - G).abs() / G);
     assert!((total - G).abs() <= 1e-9 * G, "Σ F_n = {total}");
     quoted::says(
-        "README.md",
+        "docs/status.md",
         &[format!(
             "a dropped box rests with its normal forces summing to its weight to 1e-9 relative, \
              its energy never rising by more than {rise:.0e} J"

@@ -672,7 +672,7 @@ fn the_grounded_cycle_levels_the_feet_keeps_them_together_and_bounds_the_centre_
         )],
     );
     quoted::says(
-        "README.md",
+        "docs/status.md",
         &[format!(
             "because the cycle needs its centre of pressure up to {:.2} m beside the standing foot",
             g.pressure_beyond[1]
@@ -1050,13 +1050,13 @@ fn with_its_residuals_reduced_the_cycle_walks_with_the_pelvis_free() {
                 two(left.first_peak)
             ),
             format!("residual torques {from:.1} → {to:.1} N·m rms) the pelvis wholly free"),
-            free_cycle.2,
             format!(
                 "(up to 18.7° grounding it, {:.1}° more reducing its residuals)",
                 reduced.largest_change.to_degrees()
             ),
         ],
     );
+    quoted::says("docs/status.md", &[free_cycle.2]);
 }
 
 /// Mode 1 as the gait program runs it: the grounded normal cycle tracked, the pelvis held by
@@ -1153,11 +1153,14 @@ fn the_prescribed_cycle_gives_a_normal_double_hump_braking_then_propulsion_also_
                 c.impulse_ratio,
                 c.residual_rms / mass
             ),
-            format!(
-                "residual torques {:.2} N·m/kg rms, because",
-                c.residual_rms / mass
-            ),
         ],
+    );
+    quoted::says(
+        "docs/status.md",
+        &[format!(
+            "residual torques {:.2} N·m/kg rms, because",
+            c.residual_rms / mass
+        )],
     );
     // the axes' parts make up the whole
     let parts = c.residual_axes.iter().map(|a| a * a).sum::<f64>().sqrt();

@@ -330,7 +330,7 @@ fn an_ellipsoid_pressed_deep_on_an_edge_leaves_by_its_shortest_way() {
     // the way out's angle above the side's normal (y), in the plane across the edge
     let above = depths[0].1[2].atan2(depths[0].1[1]).to_degrees();
     quoted::says(
-        "README.md",
+        "docs/status.md",
         &[format!(
             "leaves by its shortest way, {:.1} mm at {above:.0}° above the side's normal ({:.0}° from the top's), where the edge was skipped for the top's 20 mm, and 0.1 µm further out the edge's {:.1} mm",
             1e3 * depths[0].0,
@@ -827,7 +827,7 @@ fn ellipsoids_pressed_into_a_corner_leave_by_the_shortest_way() {
     }
     println!("{touching} of 600 touching; depths within {worst:.1e} m of the sampled search's");
     quoted::says(
-        "README.md",
+        "docs/status.md",
         &[format!(
             "leave by the shortest way to within {worst:.1e} m of the sampled search"
         )],

@@ -1144,16 +1144,14 @@ fn the_prescribed_cycle_gives_a_normal_double_hump_braking_then_propulsion_also_
     );
     quoted::says(
         "README.md",
-        &[
-            format!(
-                "each foot shows the double hump, {}, braking then propulsion ({}, {}), a vertical impulse of {:.3} × weight × time, residual torques {:.2} N·m/kg rms",
-                hump(&right),
-                two_signed(right.braking),
-                two_signed(right.propulsion),
-                c.impulse_ratio,
-                c.residual_rms / mass
-            ),
-        ],
+        &[format!(
+            "each foot shows the double hump, {}, braking then propulsion ({}, {}), a vertical impulse of {:.3} × weight × time, residual torques {:.2} N·m/kg rms",
+            hump(&right),
+            two_signed(right.braking),
+            two_signed(right.propulsion),
+            c.impulse_ratio,
+            c.residual_rms / mass
+        )],
     );
     quoted::says(
         "docs/status.md",

@@ -5,8 +5,10 @@
 
 use mbs_models::dpend;
 
+mod common;
 #[path = "common/quoted.rs"]
 mod quoted;
+use common::work_counts;
 use quoted::thousands;
 
 use mbs::{GenAlphaParams, HhtParams, NewmarkParams, Options, Output, Scheme, Stats, simulate};
@@ -25,23 +27,6 @@ fn run(scheme: Scheme) -> Stats {
     simulate(dpend::DoublePendulum::default(), scheme, opts)
         .unwrap()
         .1
-}
-
-/// steps, rejected by the error test, by Newton, M+h, forward dynamics, M, τ, factorisations,
-/// solves, Newton iterations
-fn counts(s: &Stats) -> [usize; 10] {
-    [
-        s.steps,
-        s.rejected_error,
-        s.rejected_newton,
-        s.dynamics,
-        s.forward_dynamics,
-        s.mass_matrix,
-        s.inverse_dynamics,
-        s.factorizations,
-        s.solves,
-        s.newton_iterations,
-    ]
 }
 
 #[test]
@@ -78,7 +63,7 @@ fn work_counters_of_reference_runs() {
             [1000, 0, 0, 0, 1001, 1, 5123, 34, 5021, 5021],
         ),
     ];
-    let got: Vec<[usize; 10]> = cases.iter().map(|(s, _)| counts(&run(*s))).collect();
+    let got: Vec<[usize; 10]> = cases.iter().map(|(s, _)| work_counts(&run(*s))).collect();
     for ((scheme, _), got) in cases.iter().zip(&got) {
         println!("{:<10} {got:?}", scheme.name());
     }

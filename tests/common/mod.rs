@@ -1,7 +1,7 @@
 //! Helpers shared by the integration tests: exact solutions and reference data.
 #![allow(dead_code)]
 
-use mbs::{ConstraintMethod, ConstraintOptions, Model, Options, Output, Trajectory};
+use mbs::{ConstraintMethod, ConstraintOptions, Model, Options, Output, Stats, Trajectory};
 
 /// The seed2dof system: M = I, K = [[k1 + k2, −k2], [−k2, k2]], q0 = (0, 1), qd0 = 0.
 pub const K1: f64 = 79.15;
@@ -208,4 +208,21 @@ pub fn accelerations<M: Model>(m: &M, t: f64, q: &[f64], qd: &[f64]) -> Vec<f64>
         .solve(&nalgebra::DVector::from_column_slice(&h))
         .as_slice()
         .to_vec()
+}
+
+/// steps, rejected by the error test, by Newton, M+h, forward dynamics, M, τ, factorisations,
+/// solves, Newton iterations
+pub fn work_counts(s: &Stats) -> [usize; 10] {
+    [
+        s.steps,
+        s.rejected_error,
+        s.rejected_newton,
+        s.dynamics,
+        s.forward_dynamics,
+        s.mass_matrix,
+        s.inverse_dynamics,
+        s.factorizations,
+        s.solves,
+        s.newton_iterations,
+    ]
 }

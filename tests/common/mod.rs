@@ -226,3 +226,35 @@ pub fn work_counts(s: &Stats) -> [usize; 10] {
         s.newton_iterations,
     ]
 }
+
+/// The characteristic polynomial x³ + c₀x² + c₁x + c₂ of generalized-α's amplification matrix
+/// (Chung & Hulbert 1993) on ẍ = −ω²x, state (d, v, a), with h = 1 and ω = `wh`:
+/// (1 − α_m) a₁ + α_m a₀ = −ω²((1 − α_f) d₁ + α_f d₀) with Newmark's
+/// d₁ = d₀ + h v₀ + h²((½ − β) a₀ + β a₁), v₁ = v₀ + h((1 − γ) a₀ + γ a₁); returns
+/// [c₀, c₁, c₂] = [−trace, sum of the principal 2×2 minors, −determinant].
+pub fn gen_alpha_characteristic(am: f64, af: f64, beta: f64, gamma: f64, wh: f64) -> [f64; 3] {
+    // with h = 1 and ω = wh: eliminate a₁ from the equilibrium
+    let w2 = wh * wh;
+    let den = (1.0 - am) + (1.0 - af) * w2 * beta;
+    // a₁ = (−α_m a₀ − ω²((1 − α_f)(d₀ + v₀ + (½ − β) a₀) + α_f d₀)) / den
+    let a1 = [
+        -w2 / den,
+        -(1.0 - af) * w2 / den,
+        (-am - (1.0 - af) * w2 * (0.5 - beta)) / den,
+    ];
+    let mut m = [[0.0; 3]; 3];
+    for j in 0..3 {
+        let unit = |k: usize| if j == k { 1.0 } else { 0.0 };
+        m[0][j] = unit(0) + unit(1) + (0.5 - beta) * unit(2) + beta * a1[j];
+        m[1][j] = unit(1) + (1.0 - gamma) * unit(2) + gamma * a1[j];
+        m[2][j] = a1[j];
+    }
+    let tr = m[0][0] + m[1][1] + m[2][2];
+    let minors = m[0][0] * m[1][1] - m[0][1] * m[1][0] + m[0][0] * m[2][2] - m[0][2] * m[2][0]
+        + m[1][1] * m[2][2]
+        - m[1][2] * m[2][1];
+    let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+    [-tr, minors, -det]
+}

@@ -5,7 +5,7 @@
 //! before any non-finite value, and its stability edge for the 10 Hz mode lies between
 //! h = 0.044 s (1000 periods, bounded) and 0.046 s (refused).
 
-use crate::common::seed2dof_modes;
+use crate::common::{gen_alpha_characteristic, seed2dof_modes};
 use crate::support::{Work, all_finite, check_work, fit_line, work};
 use mbs::{Failure, GenAlphaParams, Options, Output, Scheme, Trajectory, simulate};
 use mbs_models::seed2dof::Seed2dof;
@@ -14,30 +14,8 @@ use mbs_models::seed2dof::Seed2dof;
 /// h = 1 and ω = wh): its spectral radius, from the characteristic polynomial (the largest
 /// root in modulus, by Durand–Kerner), as in `tests/spectral.rs`.
 fn spectral_radius(p: &GenAlphaParams, wh: f64) -> f64 {
-    let (am, af, beta, gamma) = (p.alpha_m, p.alpha_f, p.beta, p.gamma);
-    let w2 = wh * wh;
-    let den = (1.0 - am) + (1.0 - af) * w2 * beta;
-    let a1 = [
-        -w2 / den,
-        -(1.0 - af) * w2 / den,
-        (-am - (1.0 - af) * w2 * (0.5 - beta)) / den,
-    ];
-    let mut m = [[0.0; 3]; 3];
-    for j in 0..3 {
-        let unit = |k: usize| if j == k { 1.0 } else { 0.0 };
-        m[0][j] = unit(0) + unit(1) + (0.5 - beta) * unit(2) + beta * a1[j];
-        m[1][j] = unit(1) + (1.0 - gamma) * unit(2) + gamma * a1[j];
-        m[2][j] = a1[j];
-    }
-    let tr = m[0][0] + m[1][1] + m[2][2];
-    let minors = m[0][0] * m[1][1] - m[0][1] * m[1][0] + m[0][0] * m[2][2] - m[0][2] * m[2][0]
-        + m[1][1] * m[2][2]
-        - m[1][2] * m[2][1];
-    let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
-    // roots of x³ − tr x² + minors x − det (Durand–Kerner on complex pairs (re, im))
-    let c = [-tr, minors, -det];
+    let c = gen_alpha_characteristic(p.alpha_m, p.alpha_f, p.beta, p.gamma, wh);
+    // its roots (Durand–Kerner on complex pairs (re, im)); the largest in modulus
     let mul = |a: (f64, f64), b: (f64, f64)| (a.0 * b.0 - a.1 * b.1, a.0 * b.1 + a.1 * b.0);
     let div = |a: (f64, f64), b: (f64, f64)| {
         let d = b.0 * b.0 + b.1 * b.1;

@@ -368,20 +368,12 @@ fn costly_iteration_matrices_are_kept_longer() {
         Scheme::Radau5,
         1e-10,
     );
-    let (e0, s0) = run(
-        "standing hexapod",
-        &HexapodStanding::default(),
-        &standing,
-        Some(RADAU5_KEEP_BELOW),
-        &r,
-    );
-    let (e1, s1) = run(
-        "standing hexapod",
-        &HexapodStanding::default(),
-        &standing,
-        None,
-        &r,
-    );
+    let standing_run = |keep_below| {
+        let model = HexapodStanding::default();
+        run("standing hexapod", &model, &standing, keep_below, &r)
+    };
+    let (e0, s0) = standing_run(Some(RADAU5_KEEP_BELOW));
+    let (e1, s1) = standing_run(None);
     assert!(s1.evaluations() < s0.evaluations(), "{s0}\n{s1}");
     assert!(e0 < 1e-4 && e1 < 1e-4, "{e0:e} {e1:e}");
     phrases.push(format!(

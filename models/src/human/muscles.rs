@@ -518,10 +518,7 @@ impl Efforts for MuscleDriven {
             // a fibre beyond its range rejects the state: a Newton iteration's trial state
             // can overshoot where the motion never goes (a smaller step is tried; the run
             // stops typed, `EffortRejected`, where the motion itself goes there)
-            let f = match self.fibre(e, i) {
-                Ok(f) => f,
-                Err(m) => return Err(e.reject(m)),
-            };
+            let f = self.fibre(e, i).map_err(|m| e.reject(m))?;
             self.muscles.units[i].1.apply(e, f.tendon_force);
         }
         Ok(())

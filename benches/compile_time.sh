@@ -8,7 +8,10 @@
 #
 #   benches/compile_time.sh            # all cases
 #   benches/compile_time.sh chain32    # one case (arm24, chain32, hexapod, hexapod-radau,
-#                                      # chain200, arm24-dev, arm24-batch: the arm with
+#                                      # hexapod-code, hexapod-table, hexapod-table-radau:
+#                                      # the hexapod with `option tangents = code;` or
+#                                      # `= table;`, tangent-forms: Radau5 runs of both
+#                                      # alternated, chain200, arm24-dev, arm24-batch: the arm with
 #                                      # `option batch;`, arm24-ensemble: the same, its
 #                                      # program running an ensemble and nothing else, which
 #                                      # compiles the batch code's two instances)
@@ -63,8 +66,10 @@ arm() { # n joints, n even; then options of the language
     echo "arm!(Model, $n, $((n / 2 - 1)), $((n - 1)), $((n - 2))${*:+, $*});"
 }
 
-hexapod() { # the hexapod of models/src with `option tangents;` before its closing braces
-    sed 's/^    }$/        option tangents;\n    }/' "$root/models/src/hexapod.rs"
+hexapod() { # the hexapod of models/src with `option tangents;` (or `option tangents = $1;`)
+    # before its closing braces
+    local option="tangents${1:+ = $1}"
+    sed "s/^    }\$/        option $option;\n    }/" "$root/models/src/hexapod.rs"
     echo 'pub type Model = Hexapod;'
 }
 
@@ -85,8 +90,9 @@ RS
 }
 
 # what `main` does besides forward dynamics: the batch call and nothing else, or
-# (hexapod-radau) also a Radau5 run of the standing hexapod with its tangents, so that every
-# function a run calls is compiled
+# (hexapod-radau, hexapod-table-radau) also Radau5 runs of the standing hexapod with its
+# tangents, so that every function a run calls is compiled, timed: what the tangents' form
+# costs at run time
 no_run() {
     x4_call
     echo 'pub fn run() {}'
@@ -96,10 +102,58 @@ radau_run() {
     cat <<'RS'
 pub fn run() {
     let mut options = mbs::Options::default();
-    options.t_end = 0.2;
-    let (_, stats) = mbs::simulate(HexapodStanding::default(), mbs::Scheme::Radau5, options)
-        .expect("the standing hexapod's run");
-    println!("Radau5, standing hexapod: {} steps", stats.steps);
+    options.t_end = 1.0;
+    // the fastest of three runs: what the form of the tangents costs at run time
+    let mut fastest = f64::INFINITY;
+    let mut steps = 0;
+    for _ in 0..3 {
+        let start = std::time::Instant::now();
+        let (_, stats) = mbs::simulate(HexapodStanding::default(), mbs::Scheme::Radau5, options.clone())
+            .expect("the standing hexapod's run");
+        fastest = fastest.min(start.elapsed().as_secs_f64());
+        steps = stats.steps;
+    }
+    println!("Radau5, standing hexapod, 1 s: {steps} steps in {:.1} ms (fastest of 3)", fastest * 1e3);
+}
+RS
+}
+
+# (tangent-forms) the standing hexapod twice, its tangents as code and as a table, each form's
+# Radau5 run of 1 s alternated with the other's: what the table costs at run time, measured in
+# one program (its build time is that of both models)
+tangent_forms() {
+    echo 'pub mod code {'
+    hexapod code
+    echo '}'
+    echo 'pub mod table {'
+    hexapod table
+    echo '}'
+    echo 'pub type Model = code::Hexapod;'
+    echo 'pub fn batch(_: &Model) -> Option<f64> { None }'
+    cat <<'RS'
+fn radau<M: mbs::Model + 'static>(m: M) -> f64 {
+    let mut options = mbs::Options::default();
+    options.t_end = 1.0;
+    let start = std::time::Instant::now();
+    mbs::simulate(m, mbs::Scheme::Radau5, options).expect("the standing hexapod's run");
+    start.elapsed().as_secs_f64() * 1e3
+}
+pub fn run() {
+    let mut ratios = Vec::new();
+    for pair in 0..15 {
+        let code = radau(code::HexapodStanding::default());
+        let table = radau(table::HexapodStanding::default());
+        println!("pair {pair}: Radau5, standing hexapod, 1 s: tangents as code {code:.1} ms, as a table {table:.1} ms");
+        ratios.push(table / code);
+    }
+    ratios.sort_by(f64::total_cmp);
+    println!(
+        "table / code over {} pairs: {:.3} to {:.3}, median {:.3}",
+        ratios.len(),
+        ratios[0],
+        ratios[ratios.len() - 1],
+        ratios[ratios.len() / 2]
+    );
 }
 RS
 }
@@ -157,6 +211,10 @@ for case in ${cases[@]}; do
         chain200) { chain 200; no_run; } > src/model.rs ;;
         hexapod) { hexapod; no_run; } > src/model.rs ;;
         hexapod-radau) { hexapod; radau_run; } > src/model.rs ;;
+        hexapod-code) { hexapod code; no_run; } > src/model.rs ;;
+        hexapod-table) { hexapod table; no_run; } > src/model.rs ;;
+        hexapod-table-radau) { hexapod table; radau_run; } > src/model.rs ;;
+        tangent-forms) tangent_forms > src/model.rs ;;
         arm24-dev) { arm 24; no_run; } > src/model.rs; profile=dev ;;
         arm24-batch) { arm 24 batch; no_run; } > src/model.rs ;;
         arm24-ensemble) { arm 24 batch; ensemble_run; } > src/model.rs ;;

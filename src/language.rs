@@ -55,6 +55,7 @@
 //! | `constraint hinge: align(A, B, about = [x, y]);` | frame B keeps its orientation relative to A about A's axes: `hinge.rx`, `hinge.ry` |
 //! | `dof crank = PI/3, independent;` | kept at its value when a closed loop is assembled |
 //! | `option tangents;` | also generate exact K_t = ∂τ/∂q and C_t = ∂τ/∂qd |
+//! | `option tangents = table;` | the same tangents, the same bits, written as a table of operations that one loop of the runtime reads: far less for rustc to check and no code to generate (the hexapod with tangents built in 3.1–3.8 s against 4.1–5.5 s, a program running it with Radau5 in 3.9–4.7 s against 10.7–16.2 s), each evaluation about 2.3× the time of the straight-line code (`option tangents = code;`, the default; a Radau5 run of the hexapod about a sixth longer); the measurements: `docs/compile_time.md` |
 //! | `option batch;` | also generate `dynamics_x4` and `forward_dynamics_x4`: four states at once on SIMD lanes ([`crate::lanes`]; without the option they call the one-state functions lane by lane), and `dynamics_lanes` and `forward_dynamics_lanes`, the same with four models, each lane its model's parameters and charts, which ensembles of runs ([`crate::simulate_ensemble`], [`crate::simulate_ensemble_each`]) and sweeps over starts and parameters evaluate their stages on |
 //! | `option formulation = recursive;` | force `recursive` or `virtual_power` (default: the cheaper by op count) |
 //! | `shape arm: box(0.3, 0.05, 0.05);` | what to draw with a body, a frame or the `ground` (below); no effect on the dynamics |

@@ -82,6 +82,7 @@ pub use mbs_runtime::*;
 #[doc(hidden)]
 pub mod __private {
     pub use mbs_runtime::model::TwistTree;
+    pub use mbs_runtime::tape;
     pub use serde;
 
     /// The `N` elements of `s` as an array, for the generated code's stores of runs of

@@ -3,8 +3,8 @@
 //! `tests/compiled_trees/models.rs`, against the same independent numeric oracle (RNEA, CRBA,
 //! energies). `random_trees.rs` evaluates the generator's expression graph; this test runs
 //! what `multibody!` emits: M and h, `mass_matrix`, τ, static forces, energies and (for the
-//! models with `option tangents;`) K_t and C_t against central differences of the oracle's τ,
-//! and the Jacobians of `kinematics` (every column generated, or summed from the twists on the
+//! models with `option tangents;`, one with `option tangents = table;`) K_t and C_t against
+//! central differences of the oracle's τ, and the Jacobians of `kinematics` (every column generated, or summed from the twists on the
 //! trees of [`ASSEMBLED`]) against central differences of the frames' poses.
 //! The largest tree has 24 coordinates, so its functions are split into chunks.
 //!
@@ -44,6 +44,10 @@ const STATES: usize = 3;
 /// (`option jacobians = assembled;`); the others generate every column.
 const ASSEMBLED: [u64; 2] = [3, 9];
 
+/// The trees with tangents whose tangents are a table of operations (`option tangents =
+/// table;`); the others' are straight-line code.
+const TABLE: [u64; 1] = [6];
+
 fn desc(seed: u64, min_dof: usize, max_dof: usize) -> Desc {
     random_desc(
         &mut Rng::new(seed),
@@ -77,7 +81,9 @@ fn model(name: &str, seed: u64, d: &Desc, tangents: bool) -> String {
     let mut rng = Rng::new(seed ^ 0x5eed);
     let mut s = String::new();
     let _ = writeln!(s, "    pub model {name} {{");
-    if tangents {
+    if tangents && TABLE.contains(&seed) {
+        s.push_str("        option tangents = table;\n");
+    } else if tangents {
         s.push_str("        option tangents;\n");
     }
     if ASSEMBLED.contains(&seed) {

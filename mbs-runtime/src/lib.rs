@@ -28,6 +28,7 @@ pub mod options;
 pub mod sensitivity;
 pub mod spline;
 pub mod stats;
+pub mod tape;
 pub mod terrain;
 pub mod trajectory;
 

@@ -78,7 +78,7 @@ mbs::multibody! {
         gravity((-1.0810745809727287), (-5.937068193796591), 2.106151136210664);
     }
     pub model Tree6 {
-        option tangents;
+        option tangents = table;
         dof q[0] = 0.0;
         dof q[1] = 0.0;
         dof q[2] = 0.0;

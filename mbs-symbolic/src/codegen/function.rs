@@ -109,6 +109,9 @@ pub struct FnSpec {
     pub numbers: Numbers,
     /// a second method made of this one's first chunks, when it has several
     pub prefix: Option<Prefix>,
+    /// written as a table of operations that the runtime reads in a loop (`codegen::tape`),
+    /// where it can be one
+    pub table: bool,
 }
 
 /// A method computing the outputs before `outputs[split]` of a chunked [`FnSpec`] by calling
@@ -138,6 +141,7 @@ impl FnSpec {
             outputs: Vec::new(),
             numbers: Numbers::Scalar,
             prefix: None,
+            table: false,
         }
     }
 
@@ -305,6 +309,11 @@ pub fn emit_fn(
     spec: &FnSpec,
     names: &dyn Naming,
 ) -> Result<EmittedFn, Vec<MissingDerivative>> {
+    if spec.table
+        && let Some(e) = super::tape::emit(arena, spec, names)
+    {
+        return Ok(e);
+    }
     let roots: Vec<ExprId> = spec.outputs.iter().map(|o| o.1).collect();
     let targets: Vec<String> = spec.outputs.iter().map(|o| o.0.clone()).collect();
     let prefix = spec.prefix.as_ref();

@@ -7,12 +7,13 @@ pub mod formulas;
 pub mod function;
 mod ltdl;
 pub mod shapes;
+mod tape;
 
 use crate::expr::emit::MissingDerivative;
 use crate::expr::{ExprId, OpCount};
 use crate::mech::SymbolicModel;
 use crate::mech::dynamics::SceneEquations;
-use crate::mech::system::{Formulation, Load, System};
+use crate::mech::system::{Formulation, Load, System, TangentForm};
 use crate::mech::world::{self, Twist};
 use api::{Sizes, args};
 use formulas::Formulas;
@@ -486,6 +487,7 @@ fn emit_params(
         }
         if sys.options.tangents {
             let mut f = FnSpec::new(&shared_part_fn("tangents", i), &with_charts("tangents"));
+            f.table = tangents_as_table(sys);
             if i == 0 {
                 f.matrix(a, "k", &part.k);
                 f.matrix(a, "c", &part.c);
@@ -868,6 +870,7 @@ fn emit_scene(
     }
     if let Some((kt, ct)) = &eq.tangents {
         let mut f = FnSpec::new("__tangents", args("tangents"));
+        f.table = tangents_as_table(sys);
         f.matrix(a, "k", kt);
         f.matrix(a, "c", ct);
         specs.push((f, Some("tangents (K, C)")));
@@ -1381,4 +1384,9 @@ fn emit_chunks(
         code.push_str("}\n");
     }
     code.push_str(&items);
+}
+
+/// Whether the tangents K and C are written as tables of operations (`codegen::tape`).
+fn tangents_as_table(sys: &System) -> bool {
+    sys.options.tangent_form == Some(TangentForm::Table)
 }

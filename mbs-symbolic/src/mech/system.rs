@@ -304,6 +304,8 @@ pub enum Formulation {
 pub struct Options {
     /// emit exact tangents K_t = ∂τ/∂q and C_t = ∂τ/∂qd
     pub tangents: bool,
+    /// force the form of the tangents' code; `None` picks by their size
+    pub tangent_form: Option<TangentForm>,
     /// emit `dynamics_x4` and `forward_dynamics_x4`: four states at once on SIMD lanes
     pub batch: bool,
     /// force a formulation; `None` picks the cheaper by op count
@@ -311,6 +313,16 @@ pub struct Options {
     /// force the form of the Jacobians of `kinematics` and `point_kinematics` and of M;
     /// `None` picks by the size of the model (`SymbolicModel::assembled`)
     pub jacobians: Option<Jacobians>,
+}
+
+/// How the tangents are written.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TangentForm {
+    /// straight-line code, as every other function
+    Code,
+    /// a table of operations the runtime reads in a loop (`mbs::__private::tape`): far less
+    /// for rustc to check, a dispatch per operation at run time
+    Table,
 }
 
 /// How `kinematics` and `point_kinematics` give the Jacobians of frames and points, and

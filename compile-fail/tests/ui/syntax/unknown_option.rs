@@ -8,6 +8,8 @@ mbs::multibody! {
         option batch = 4;
         option jacobians = sparse;
         option jacobians;
+        option tangents = sparse;
+        option tangents = 2;
     }
 }
 

@@ -7,6 +7,18 @@ impl Checker {
     pub(super) fn lower_option(&mut self, key: &Ident, value: Option<&Expr>) {
         match (key.to_string().as_str(), value) {
             ("tangents", None) => self.sys.options.tangents = true,
+            ("tangents", Some(Expr::Path(p))) if p.path.get_ident().is_some() => {
+                let v = p.path.get_ident().unwrap();
+                self.sys.options.tangents = true;
+                self.sys.options.tangent_form = match v.to_string().as_str() {
+                    "code" => Some(TangentForm::Code),
+                    "table" => Some(TangentForm::Table),
+                    other => {
+                        self.error(v.span(), format!("unknown form of tangents `{other}`: write `option tangents;`, `option tangents = code;` or `option tangents = table;`"));
+                        None
+                    }
+                }
+            }
             ("batch", None) => self.sys.options.batch = true,
             ("formulation", Some(Expr::Path(p))) if p.path.get_ident().is_some() => {
                 let v = p.path.get_ident().unwrap();
@@ -32,8 +44,9 @@ impl Checker {
                 }
             }
             ("jacobians", _) => self.error(key.span(), "write `option jacobians = generated;` or `option jacobians = assembled;`"),
-            (name @ ("tangents" | "batch"), Some(v)) => self.error(v.span(), format!("write `option {name};` (it takes no value)")),
-            (other, _) => self.error(key.span(), format!("unknown option `{other}`: the options are `tangents`, `batch`, `formulation = recursive | virtual_power` and `jacobians = generated | assembled`")),
+            ("tangents", Some(v)) => self.error(v.span(), "write `option tangents;`, `option tangents = code;` or `option tangents = table;`"),
+            ("batch", Some(v)) => self.error(v.span(), "write `option batch;` (it takes no value)"),
+            (other, _) => self.error(key.span(), format!("unknown option `{other}`: the options are `tangents [= code | table]`, `batch`, `formulation = recursive | virtual_power` and `jacobians = generated | assembled`")),
         }
     }
 

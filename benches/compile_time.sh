@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Compile time and peak memory of one model in a crate of its own, dependencies built first
 # and not timed: release builds of a 24-joint spatial arm, a 32-bar planar chain, the
-# hexapod with exact tangents (its forward dynamics called, then a program that runs it with
-# Radau5) and a 200-bar chain, then a debug build of the arm, and the arm with the batch
+# hexapod with exact tangents, as code and as a table (its forward dynamics called, then a
+# program that runs it with Radau5) and a 200-bar chain, then a debug build of the arm, and the arm with the batch
 # functions of `option batch;` (its program calling them, and a program running an ensemble
 # of it and nothing else).
 #
@@ -202,7 +202,7 @@ if [ -r /proc/cpuinfo ]; then
     field() { grep -m1 "^$1[[:space:]]*:" /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//'; }
     echo "processor: $(field 'model name') (family $(field 'cpu family'), model $(field model))"
 fi
-cases=("${@:-arm24 chain32 hexapod hexapod-radau chain200 arm24-dev arm24-batch arm24-ensemble}")
+cases=("${@:-arm24 chain32 hexapod hexapod-table hexapod-radau hexapod-table-radau chain200 arm24-dev arm24-batch arm24-ensemble}")
 for case in ${cases[@]}; do
     profile=release
     case "$case" in

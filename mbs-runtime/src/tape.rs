@@ -1,7 +1,7 @@
 //! Tables of operations: a generated function written as data that one loop reads, instead of
 //! straight-line code the compiler checks statement by statement. The generator writes a model's
-//! tangents so when they are large (`option tangents = table;`): the hexapod's are about 54,000
-//! operations, which cost rustc more than the rest of the model together.
+//! tangents so when the model asks for it (`option tangents = table;`): the hexapod's are about
+//! 54,000 flops, whose straight-line code costs rustc more than the rest of the model.
 //!
 //! This file has no dependencies: the runtime declares it as a module and the generator
 //! includes the same file, so the operations the generator writes and the loop that reads them
@@ -42,6 +42,10 @@ pub const FUNCTIONS: [&str; 16] = [
     "sin", "cos", "tan", "asin", "acos", "atan", "sinh", "cosh", "tanh", "exp", "ln", "sqrt",
     "abs", "sign", "pos", "step",
 ];
+/// output `a`, element `c` = slot `b`
+pub const STORE: u16 = 24;
+/// output `a`, element `c` += slot `b`
+pub const STORE_ADD: u16 = 25;
 /// `a = b · c + d`
 pub const MULADD: u16 = 26;
 /// `a = b · c − d`
@@ -52,10 +56,6 @@ pub const SUBMUL: u16 = 28;
 pub const DOT2: u16 = 29;
 /// `a = b · c − d · e`
 pub const DIFF2: u16 = 30;
-/// output `a`, element `c` = slot `b`
-pub const STORE: u16 = 24;
-/// output `a`, element `c` += slot `b`
-pub const STORE_ADD: u16 = 25;
 
 /// The words of one instruction of `op`.
 pub const fn words(op: u16) -> usize {

@@ -1388,5 +1388,5 @@ fn emit_chunks(
 
 /// Whether the tangents K and C are written as tables of operations (`codegen::tape`).
 fn tangents_as_table(sys: &System) -> bool {
-    sys.options.tangent_form == Some(TangentForm::Table)
+    sys.options.tangent_form == TangentForm::Table
 }

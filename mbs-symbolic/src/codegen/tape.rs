@@ -166,13 +166,8 @@ fn table(arena: &Arena, spec: &FnSpec) -> Option<Table> {
         _ => None,
     };
     let mut absorbed: FxHashSet<ExprId> = FxHashSet::default();
-    // every operation as an instruction (operation, node, operands, immediate), grouped by
-    // depth, then by operation; the stores of a depth's outputs after it
-    let mut depth: FxHashMap<ExprId, u32> = FxHashMap::default();
-    let mut by_depth: Vec<Vec<Instruction>> = Vec::new();
-    for &n in order.iter().rev() {
+    for &n in &order {
         if let Node::Add(x, y) | Node::Sub(x, y) = arena.node(n)
-            && !absorbed.contains(&n)
             && x != y
         {
             for z in [x, y] {
@@ -182,6 +177,10 @@ fn table(arena: &Arena, spec: &FnSpec) -> Option<Table> {
             }
         }
     }
+    // every operation as an instruction (operation, node, operands, immediate), grouped by
+    // depth, then by operation; the stores of a depth's outputs after it
+    let mut depth: FxHashMap<ExprId, u32> = FxHashMap::default();
+    let mut by_depth: Vec<Vec<Instruction>> = Vec::new();
     for &n in &order {
         if absorbed.contains(&n) {
             continue;
@@ -280,7 +279,7 @@ fn table(arena: &Arena, spec: &FnSpec) -> Option<Table> {
     let mut batch_at = usize::MAX;
     let mut batch_op = u16::MAX;
     let release = |free: &mut Vec<u16>, slot: &FxHashMap<ExprId, u16>, x: ExprId, k| {
-        if last.get(&x) == Some(&k) && slot[&x] as usize >= fixed && !free.contains(&slot[&x]) {
+        if last.get(&x) == Some(&k) && slot[&x] as usize >= fixed {
             free.push(slot[&x]);
         }
     };
@@ -288,8 +287,11 @@ fn table(arena: &Arena, spec: &FnSpec) -> Option<Table> {
         let (op, instruction) = match item {
             Item::Op(i) => {
                 let read: Vec<u16> = i.operands.iter().map(|x| slot[x]).collect();
-                for &x in &i.operands {
-                    release(&mut free, &slot, x, k);
+                // an operand read twice by the instruction gives its slot back once
+                for (j, &x) in i.operands.iter().enumerate() {
+                    if !i.operands[..j].contains(&x) {
+                        release(&mut free, &slot, x, k);
+                    }
                 }
                 let a = free.pop().unwrap_or_else(|| {
                     slots += 1;

@@ -304,8 +304,8 @@ pub enum Formulation {
 pub struct Options {
     /// emit exact tangents K_t = ∂τ/∂q and C_t = ∂τ/∂qd
     pub tangents: bool,
-    /// force the form of the tangents' code; `None` picks by their size
-    pub tangent_form: Option<TangentForm>,
+    /// the form of the tangents' code (`option tangents = table;`)
+    pub tangent_form: TangentForm,
     /// emit `dynamics_x4` and `forward_dynamics_x4`: four states at once on SIMD lanes
     pub batch: bool,
     /// force a formulation; `None` picks the cheaper by op count
@@ -316,12 +316,13 @@ pub struct Options {
 }
 
 /// How the tangents are written.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum TangentForm {
     /// straight-line code, as every other function
+    #[default]
     Code,
     /// a table of operations the runtime reads in a loop (`mbs::__private::tape`): far less
-    /// for rustc to check, a dispatch per operation at run time
+    /// for rustc to check, each operation read from the table at run time
     Table,
 }
 

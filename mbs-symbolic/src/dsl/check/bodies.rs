@@ -10,13 +10,10 @@ impl Checker {
             ("tangents", Some(Expr::Path(p))) if p.path.get_ident().is_some() => {
                 let v = p.path.get_ident().unwrap();
                 self.sys.options.tangents = true;
-                self.sys.options.tangent_form = match v.to_string().as_str() {
-                    "code" => Some(TangentForm::Code),
-                    "table" => Some(TangentForm::Table),
-                    other => {
-                        self.error(v.span(), format!("unknown form of tangents `{other}`: write `option tangents;`, `option tangents = code;` or `option tangents = table;`"));
-                        None
-                    }
+                match v.to_string().as_str() {
+                    "code" => self.sys.options.tangent_form = TangentForm::Code,
+                    "table" => self.sys.options.tangent_form = TangentForm::Table,
+                    other => self.error(v.span(), format!("unknown form of tangents `{other}`: write `option tangents;`, `option tangents = code;` or `option tangents = table;`")),
                 }
             }
             ("batch", None) => self.sys.options.batch = true,

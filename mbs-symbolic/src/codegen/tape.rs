@@ -1,9 +1,9 @@
 //! A method written as a table of operations (`mbs::__private::tape`) that one loop of the
 //! runtime reads: `option tangents = table;`. rustc then checks a byte string instead of one
-//! statement per operation; the run costs the loop's dispatch on every operation.
+//! statement per operation; the run reads every operation's slots from the table.
 
 use super::function::{EmittedFn, FnSpec};
-use crate::expr::emit::{Naming, Numbers};
+use crate::expr::emit::{Naming, Numbers, split_index};
 use crate::expr::{Arena, ExprId, Func, Node, Var, ops_of_nodes};
 use rustc_hash::{FxHashMap, FxHashSet};
 use std::fmt::Write;
@@ -16,7 +16,6 @@ mod ops;
 const MAX_SLOTS: usize = 8192;
 
 /// One operation of a table before its slots are chosen.
-#[derive(Clone)]
 struct Instruction {
     op: u16,
     node: ExprId,
@@ -54,14 +53,7 @@ pub fn emit(arena: &Arena, spec: &FnSpec, names: &dyn Naming) -> Option<EmittedF
     if spec.numbers != Numbers::Scalar || spec.prefix.is_some() {
         return None;
     }
-    let Table {
-        words,
-        constants,
-        leaves,
-        buffers,
-        slots,
-        count,
-    } = table(arena, spec)?;
+    let t = table(arena, spec)?;
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -71,18 +63,18 @@ pub fn emit(arena: &Arena, spec: &FnSpec, names: &dyn Naming) -> Option<EmittedF
     for p in &spec.prelude {
         let _ = writeln!(s, "{p}");
     }
-    for &v in &leaves {
+    for &v in &t.leaves {
         let b = names.bind(v);
         if !b.is_empty() {
             let _ = writeln!(s, "{b}");
         }
     }
-    let _ = write!(s, "const CONSTANTS: [f64; {}] = [", constants.len());
-    for c in &constants {
+    let _ = write!(s, "const CONSTANTS: [f64; {}] = [", t.constants.len());
+    for c in &t.constants {
         let _ = write!(s, "{}, ", crate::expr::emit::literal(*c));
     }
     s.push_str("];\n// the operations: see `mbs::__private::tape`\nconst CODE: &[u8] = b\"");
-    for byte in words.iter().flat_map(|w| w.to_le_bytes()) {
+    for byte in t.words.iter().flat_map(|w| w.to_le_bytes()) {
         match byte {
             0 => s.push_str("\\0"),
             b'0'..=b'9' | b'a'..=b'z' | b'A'..=b'Z' => s.push(byte as char),
@@ -93,10 +85,11 @@ pub fn emit(arena: &Arena, spec: &FnSpec, names: &dyn Naming) -> Option<EmittedF
     }
     let _ = writeln!(
         s,
-        "\";\nstatic WORDS: ::mbs::__private::tape::Words = ::mbs::__private::tape::Words::new();\nlet mut slots = [0.0f64; {slots}];"
+        "\";\nstatic WORDS: ::mbs::__private::tape::Words = ::mbs::__private::tape::Words::new();\nlet mut slots = [0.0f64; {}];",
+        t.slots
     );
-    let leaves: Vec<String> = leaves.iter().map(|&v| names.var(v)).collect();
-    let outputs: Vec<String> = buffers.iter().map(|b| format!("&mut *{b}")).collect();
+    let leaves: Vec<String> = t.leaves.iter().map(|&v| names.var(v)).collect();
+    let outputs: Vec<String> = t.buffers.iter().map(|b| format!("&mut *{b}")).collect();
     let _ = writeln!(
         s,
         "::mbs::__private::tape::run(&WORDS, CODE, &CONSTANTS, &[{}], &mut slots, &mut [{}]);\n}}",
@@ -106,7 +99,7 @@ pub fn emit(arena: &Arena, spec: &FnSpec, names: &dyn Naming) -> Option<EmittedF
     Some(EmittedFn {
         text: s,
         chunks: Vec::new(),
-        count,
+        count: t.count,
         prefix: None,
     })
 }
@@ -119,8 +112,8 @@ fn table(arena: &Arena, spec: &FnSpec) -> Option<Table> {
     let mut buffers: Vec<String> = Vec::new();
     let mut stores: FxHashMap<ExprId, Vec<(u16, u16)>> = FxHashMap::default();
     for (target, root) in &spec.outputs {
-        let (base, index) = target.strip_suffix(']')?.split_once('[')?;
-        let index: u16 = index.parse().ok()?;
+        let (base, index) = split_index(target)?;
+        let index = u16::try_from(index).ok()?;
         let b = match buffers.iter().position(|x| x == base) {
             Some(b) => b,
             None => {
@@ -223,7 +216,7 @@ fn table(arena: &Arena, spec: &FnSpec) -> Option<Table> {
             .unwrap_or(0);
         depth.insert(n, d);
         if by_depth.len() < d as usize {
-            by_depth.resize(d as usize, Vec::new());
+            by_depth.resize_with(d as usize, Vec::new);
         }
         by_depth[d as usize - 1].push(Instruction {
             op,
@@ -298,9 +291,6 @@ fn table(arena: &Arena, spec: &FnSpec) -> Option<Table> {
                     (slots - 1) as u16
                 });
                 slot.insert(i.node, a);
-                if !last.contains_key(&i.node) {
-                    free.push(a);
-                }
                 let mut w = vec![a];
                 w.extend(read);
                 w.extend(i.immediate);

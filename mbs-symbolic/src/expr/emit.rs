@@ -540,7 +540,7 @@ fn bounded<'a>(elements: impl Iterator<Item = (&'a str, usize)>) -> String {
 }
 
 /// `"a.b[3]"` → `("a.b", 3)`.
-fn split_index(t: &str) -> Option<(&str, usize)> {
+pub(crate) fn split_index(t: &str) -> Option<(&str, usize)> {
     let inner = t.strip_suffix(']')?;
     let open = inner.rfind('[')?;
     let k = inner[open + 1..].parse().ok()?;

@@ -605,7 +605,9 @@
 //! ## Reading the generated code
 //!
 //! `mbs expand FILE.rs [--model NAME] [--scene S]` prints exactly what the macro emits,
-//! pretty-printed, with a table of operations per generated function. It reads the blocks of
+//! pretty-printed, with a table of operations per generated function; below a method written
+//! as a table of operations (`option tangents = table;`) it lists the operations one a line
+//! as comments (`// s14 = p_k * s12 + s9`, `// k[3] = s14`). It reads the blocks of
 //! `FILE.rs` and of the files it includes, found as rustc finds them (`mod name;`: `name.rs`
 //! or `name/mod.rs`, in a folder named after a file that is not a crate root or `mod.rs`;
 //! `#[path = "…"] mod name;` relative to the file's folder), and of the modules of workspace

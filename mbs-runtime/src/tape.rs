@@ -197,6 +197,61 @@ pub fn run(
     }
 }
 
+/// The operations of the table `code`, one line each, in the order `run` does them, for a
+/// reader (`mbs expand` prints them below the table): `s14 = p_k * s12 + s9`, `k[3] += s14`.
+/// `slot` names a slot (a constant by its value, a leaf by its argument, a computed value
+/// `s` and its slot, as the caller chooses) and `output` an output by its number; a table cut
+/// short ends the listing with a line that says so.
+pub fn listing(
+    code: &[u8],
+    slot: &dyn Fn(u16) -> String,
+    output: &dyn Fn(u16) -> String,
+) -> Vec<String> {
+    let w: Vec<u16> = code
+        .chunks_exact(2)
+        .map(|w| u16::from_le_bytes([w[0], w[1]]))
+        .collect();
+    let mut lines = Vec::new();
+    let mut at = 0;
+    while at + 2 <= w.len() {
+        let (op, n) = (w[at], w[at + 1] as usize);
+        if op > DIFF2 {
+            lines.push(format!("(operation {op} unknown: the listing stops)"));
+            break;
+        }
+        let Some(batch) = w.get(at + 2..at + 2 + words(op) * n) else {
+            lines.push(format!(
+                "(the table ends within a batch of {n} operations {op})"
+            ));
+            break;
+        };
+        at += 2 + batch.len();
+        for i in batch.chunks_exact(words(op)) {
+            let s = |k: usize| slot(i[k]);
+            let line = match op {
+                ADD => format!("{} = {} + {}", s(0), s(1), s(2)),
+                SUB => format!("{} = {} - {}", s(0), s(1), s(2)),
+                MUL => format!("{} = {} * {}", s(0), s(1), s(2)),
+                DIV => format!("{} = {} / {}", s(0), s(1), s(2)),
+                NEG => format!("{} = -{}", s(0), s(1)),
+                POWI => format!("{} = powi({}, {})", s(0), s(1), i[2] as i16),
+                POW => format!("{} = pow({}, {})", s(0), s(1), s(2)),
+                ATAN2 => format!("{} = atan2({}, {})", s(0), s(1), s(2)),
+                MULADD => format!("{} = {} * {} + {}", s(0), s(1), s(2), s(3)),
+                MULSUB => format!("{} = {} * {} - {}", s(0), s(1), s(2), s(3)),
+                SUBMUL => format!("{} = {} - {} * {}", s(0), s(3), s(1), s(2)),
+                DOT2 => format!("{} = {} * {} + {} * {}", s(0), s(1), s(2), s(3), s(4)),
+                DIFF2 => format!("{} = {} * {} - {} * {}", s(0), s(1), s(2), s(3), s(4)),
+                STORE => format!("{}[{}] = {}", output(i[0]), i[2], s(1)),
+                STORE_ADD => format!("{}[{}] += {}", output(i[0]), i[2], s(1)),
+                f => format!("{} = {}({})", s(0), FUNCTIONS[(f - SIN) as usize], s(1)),
+            };
+            lines.push(line);
+        }
+    }
+    lines
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -238,6 +293,71 @@ mod tests {
         let angle = 3.0f64.atan2(0.5);
         assert_eq!(o0, [angle, 1.5 + 4.0]);
         assert_eq!(o1, [1.0 + 2.0f64.sqrt(), -angle]);
+    }
+
+    #[test]
+    fn a_listing_reads_as_the_run_computes() {
+        let mut code = Vec::new();
+        batch(&mut code, MULADD, &[&[3, 1, 2, 0], &[4, 1, 1, 3]]);
+        batch(&mut code, SUBMUL, &[&[3, 4, 0, 1]]);
+        batch(&mut code, DIFF2, &[&[4, 3, 1, 2, 0]]);
+        batch(&mut code, POWI, &[&[3, 4, (-2i16) as u16]]);
+        batch(&mut code, SIN + 11, &[&[4, 3]]);
+        batch(&mut code, STORE, &[&[0, 4, 7]]);
+        batch(&mut code, STORE_ADD, &[&[1, 3, 0]]);
+        let names = ["2.0", "x", "y"];
+        let slot = |s: u16| {
+            names
+                .get(s as usize)
+                .map_or(format!("s{s}"), |n| n.to_string())
+        };
+        let output = |o: u16| ["k", "c"][o as usize].to_string();
+        let lines = listing(&code, &slot, &output);
+        assert_eq!(
+            lines,
+            [
+                "s3 = x * y + 2.0",
+                "s4 = x * x + s3",
+                "s3 = x - s4 * 2.0",
+                "s4 = s3 * x - y * 2.0",
+                "s3 = powi(s4, -2)",
+                "s4 = sqrt(s3)",
+                "k[7] = s4",
+                "c[0] += s3",
+            ]
+        );
+        // the same table run: each line's value as the listing says
+        let (x, y): (f64, f64) = (0.5, 3.0);
+        let s3 = x * y + 2.0;
+        let s4 = x * x + s3;
+        let s3 = x - s4 * 2.0;
+        let s4 = s3 * x - y * 2.0;
+        let s3 = s4.powi(-2);
+        let (mut k, mut c) = ([0.0; 8], [1.0]);
+        let mut slots = [0.0; 5];
+        run(
+            &Words::new(),
+            &code,
+            &[2.0],
+            &[x, y],
+            &mut slots,
+            &mut [&mut k[..], &mut c[..]],
+        );
+        assert_eq!((k[7], c[0]), (s3.sqrt(), 1.0 + s3));
+        // a table cut short or with an unknown operation says so
+        let cut = listing(&code[..code.len() - 2], &slot, &output);
+        assert!(
+            cut.last().unwrap().contains("ends within a batch"),
+            "{cut:?}"
+        );
+        let mut unknown = code.clone();
+        batch(&mut unknown, 99, &[]);
+        assert!(
+            listing(&unknown, &slot, &output)
+                .last()
+                .unwrap()
+                .contains("unknown")
+        );
     }
 
     #[test]

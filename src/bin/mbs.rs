@@ -3,8 +3,9 @@
 //! `mbs expand FILE.rs [--model NAME] [--scene S]` prints the code that `multibody!` generates
 //! for the blocks of a file and of the files it includes (`mod name;`, `#[path = "…"] mod
 //! name;`, and the modules of workspace crates it names in `use`), exactly as the macro emits
-//! it, pretty-printed, then a table of operation counts per generated function and the
-//! generation time. Errors are reported with file:line:col, after every model is tried.
+//! it, pretty-printed (below each table of operations, `option tangents = table;`, its
+//! operations one a line as comments), then a table of operation counts per generated function
+//! and the generation time. Errors are reported with file:line:col, after every model is tried.
 //!
 //! `mbs import urdf FILE.urdf [--floating-base] > model.rs` writes a robot's URDF description
 //! as a `multibody!` block to edit (feature `urdf`; see `mbs::urdf`).
@@ -273,12 +274,17 @@ fn print_model(
         .collect();
     let mut out = String::new();
     if !counts_only {
+        let listings = table_listings(&items);
         let shown = syn::File {
             shebang: None,
             attrs: Vec::new(),
             items,
         };
-        let _ = writeln!(out, "{}", prettyplease::unparse(&shown));
+        let _ = writeln!(
+            out,
+            "{}",
+            with_listings(&prettyplease::unparse(&shown), &listings)
+        );
     }
     let _ = writeln!(
         out,
@@ -310,6 +316,145 @@ fn print_model(
         }
         _ => Ok(()),
     }
+}
+
+/// The operations of every table (`option tangents = table;`) in `items`, in the order they are
+/// printed, one line each (`mbs_runtime::tape::listing`): constants by their value, leaves by
+/// their names, the values computed as `s` and their slot.
+fn table_listings(items: &[syn::Item]) -> Vec<Vec<String>> {
+    struct Tables(Vec<Vec<String>>);
+    impl<'a> syn::visit::Visit<'a> for Tables {
+        fn visit_block(&mut self, block: &'a syn::Block) {
+            if let Some(l) = block_listing(block) {
+                self.0.push(l);
+            }
+            syn::visit::visit_block(self, block);
+        }
+    }
+    let mut tables = Tables(Vec::new());
+    for item in items {
+        syn::visit::Visit::visit_item(&mut tables, item);
+    }
+    tables.0
+}
+
+/// The listing of the table a method's body holds: its `const CONSTANTS`, `const CODE` and the
+/// leaves and outputs of its call of `tape::run`.
+fn block_listing(block: &syn::Block) -> Option<Vec<String>> {
+    let (mut code, mut constants, mut call) = (None, None, None);
+    for stmt in &block.stmts {
+        match stmt {
+            syn::Stmt::Item(syn::Item::Const(c)) if c.ident == "CODE" => {
+                if let syn::Expr::Lit(syn::ExprLit {
+                    lit: syn::Lit::ByteStr(b),
+                    ..
+                }) = &*c.expr
+                {
+                    code = Some(b.value());
+                }
+            }
+            syn::Stmt::Item(syn::Item::Const(c)) if c.ident == "CONSTANTS" => {
+                if let syn::Expr::Array(a) = &*c.expr {
+                    constants = Some(a.elems.iter().map(expr_text).collect::<Vec<_>>());
+                }
+            }
+            syn::Stmt::Expr(syn::Expr::Call(c), _) => {
+                let is_run = matches!(&*c.func, syn::Expr::Path(p)
+                    if p.path.segments.iter().rev().take(2).map(|s| s.ident.to_string()).eq(["run", "tape"]));
+                if is_run && c.args.len() == 6 {
+                    call = Some(c);
+                }
+            }
+            _ => {}
+        }
+    }
+    let (code, constants, call) = (code?, constants?, call?);
+    let elements = |e: &syn::Expr| -> Vec<String> {
+        match e {
+            syn::Expr::Reference(r) => match &*r.expr {
+                syn::Expr::Array(a) => a.elems.iter().map(expr_text).collect(),
+                _ => Vec::new(),
+            },
+            _ => Vec::new(),
+        }
+    };
+    let leaves = elements(&call.args[3]);
+    let outputs = elements(&call.args[5]);
+    let slot = |i: u16| {
+        let i = i as usize;
+        match constants.get(i) {
+            Some(c) => c.clone(),
+            None => leaves
+                .get(i - constants.len())
+                .cloned()
+                .unwrap_or_else(|| format!("s{i}")),
+        }
+    };
+    let output = |o: u16| {
+        outputs
+            .get(o as usize)
+            .cloned()
+            .unwrap_or_else(|| format!("output{o}"))
+    };
+    Some(mbs_runtime::tape::listing(&code, &slot, &output))
+}
+
+/// A constant, leaf or output of a table's call as the listing names it: `-2.0`, `q_1`, `k`.
+fn expr_text(e: &syn::Expr) -> String {
+    match e {
+        syn::Expr::Lit(syn::ExprLit {
+            lit: syn::Lit::Float(f),
+            ..
+        }) => f.to_string(),
+        syn::Expr::Lit(syn::ExprLit {
+            lit: syn::Lit::Int(i),
+            ..
+        }) => i.to_string(),
+        syn::Expr::Unary(u) => {
+            let inner = expr_text(&u.expr);
+            match u.op {
+                syn::UnOp::Neg(_) => format!("-{inner}"),
+                _ => inner,
+            }
+        }
+        syn::Expr::Reference(r) => expr_text(&r.expr),
+        syn::Expr::Path(p) => p
+            .path
+            .segments
+            .iter()
+            .map(|s| s.ident.to_string())
+            .collect::<Vec<_>>()
+            .join("::"),
+        _ => "?".into(),
+    }
+}
+
+/// `code` with each table's listing written below its `const CODE` line, as comments at its
+/// indentation, in the order of `listings`.
+fn with_listings(code: &str, listings: &[Vec<String>]) -> String {
+    if listings.is_empty() {
+        return code.to_string();
+    }
+    let mut out = String::with_capacity(code.len());
+    let mut next = listings.iter();
+    for line in code.lines() {
+        out.push_str(line);
+        out.push('\n');
+        let trimmed = line.trim_start();
+        if trimmed.starts_with("const CODE: &[u8] = b\"") {
+            if let Some(listing) = next.next() {
+                let indent = &line[..line.len() - trimmed.len()];
+                let _ = writeln!(
+                    out,
+                    "{indent}// CODE, one operation a line: constants by their value, leaves by name, s<n> the value in slot n"
+                );
+                for l in listing {
+                    let _ = writeln!(out, "{indent}// {l}");
+                }
+            }
+        }
+    }
+    out
 }
 
 /// Whether a generated item is part of scene `scene` of model `name` (the parameter struct is

@@ -54,3 +54,71 @@ pub fn processor() -> String {
         _ => "unknown".into(),
     }
 }
+
+/// Rounds of [`paired`].
+#[allow(dead_code)] // the benchmarks that measure in pairs print it
+pub const ROUNDS: usize = 401;
+
+/// The ratio of the times of `second` and `first`, measured in pairs ([`paired`]).
+#[allow(dead_code)] // not every benchmark measures in pairs
+#[derive(Clone, Copy, Debug)]
+pub struct Paired {
+    /// quartiles of the rounds' ratios
+    pub quartiles: [f64; 3],
+    /// the ratio of the two functions' fastest blocks: the moments the machine ran each
+    /// fastest, where the delays of other work, which only add time, were least
+    pub fastest: f64,
+}
+
+#[allow(dead_code)] // not every benchmark measures in pairs
+impl Paired {
+    /// Not measured (criterion's test mode, or a filter left the function out).
+    pub const NONE: Paired = Paired {
+        quartiles: [f64::NAN; 3],
+        fastest: f64::NAN,
+    };
+}
+
+/// The ratio of the times of `second` and `first`, measured in pairs: in each of [`ROUNDS`]
+/// rounds a block of calls of each, back to back (which goes first alternates), each block
+/// about 50 µs. A slower moment of the machine slows both blocks of a round, where criterion
+/// measures one function for seconds, then the other; but on a shared machine a busy moment
+/// can slow one kind of code more than another (the forward dynamics' chain of dependent
+/// operations and the dense path's independent ones), so the ratio of the fastest blocks is
+/// given too.
+#[allow(dead_code)] // not every benchmark measures in pairs
+pub fn paired(first: &mut dyn FnMut(), second: &mut dyn FnMut()) -> Paired {
+    let time = |f: &mut dyn FnMut(), calls: usize| {
+        let t = std::time::Instant::now();
+        for _ in 0..calls {
+            f();
+        }
+        t.elapsed().as_secs_f64()
+    };
+    let once = time(first, 100) / 100.0;
+    let calls = ((50e-6 / once) as usize).max(1);
+    let (mut fastest_a, mut fastest_b) = (f64::INFINITY, f64::INFINITY);
+    let mut ratios: Vec<f64> = (0..ROUNDS)
+        .map(|r| {
+            let (a, b) = if r % 2 == 0 {
+                let a = time(first, calls);
+                (a, time(second, calls))
+            } else {
+                let b = time(second, calls);
+                (time(first, calls), b)
+            };
+            fastest_a = fastest_a.min(a);
+            fastest_b = fastest_b.min(b);
+            b / a
+        })
+        .collect();
+    ratios.sort_by(f64::total_cmp);
+    Paired {
+        quartiles: [
+            ratios[ROUNDS / 4],
+            ratios[ROUNDS / 2],
+            ratios[3 * ROUNDS / 4],
+        ],
+        fastest: fastest_b / fastest_a,
+    }
+}

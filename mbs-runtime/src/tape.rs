@@ -105,6 +105,13 @@ fn function(f: u16, x: f64) -> f64 {
 /// A table's words, decoded from its bytes once (the first call of the function).
 pub type Words = std::sync::OnceLock<Vec<u16>>;
 
+/// The words of a table's bytes (little-endian `u16`).
+fn decode(code: &[u8]) -> Vec<u16> {
+    code.chunks_exact(2)
+        .map(|w| u16::from_le_bytes([w[0], w[1]]))
+        .collect()
+}
+
 /// Runs the table `code` over `slots`: its head is set to `constants`, then `leaves`, and the
 /// stores write or add to `outputs`. `decoded` keeps the words of `code` from the first call
 /// on. The generator sizes `slots` for its table.
@@ -116,11 +123,7 @@ pub fn run(
     slots: &mut [f64],
     outputs: &mut [&mut [f64]],
 ) {
-    let code = decoded.get_or_init(|| {
-        code.chunks_exact(2)
-            .map(|w| u16::from_le_bytes([w[0], w[1]]))
-            .collect()
-    });
+    let code = decoded.get_or_init(|| decode(code));
     let (head, _) = slots.split_at_mut(constants.len() + leaves.len());
     let (c, l) = head.split_at_mut(constants.len());
     c.copy_from_slice(constants);
@@ -207,10 +210,7 @@ pub fn listing(
     slot: &dyn Fn(u16) -> String,
     output: &dyn Fn(u16) -> String,
 ) -> Vec<String> {
-    let w: Vec<u16> = code
-        .chunks_exact(2)
-        .map(|w| u16::from_le_bytes([w[0], w[1]]))
-        .collect();
+    let w = decode(code);
     let mut lines = Vec::new();
     let mut at = 0;
     while at + 2 <= w.len() {

@@ -321,11 +321,15 @@ fn short(x: f64) -> String {
     format!("{x:.1e}").replace(".0e", "e")
 }
 
-/// The range of `v` as the README writes it: "1.4–2.1e-7" (one exponent when both share it).
+/// The range of `v` as the README writes it: "1.4–2.1e-7" (one exponent when both share it,
+/// one figure when both ends print alike).
 fn range(v: &[f64]) -> String {
     let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
     let hi = v.iter().copied().fold(0.0, f64::max);
     let (lo, hi) = (format!("{lo:.1e}"), format!("{hi:.1e}"));
+    if lo == hi {
+        return lo;
+    }
     match (lo.split_once('e'), hi.split_once('e')) {
         (Some((m, e)), Some((_, f))) if e == f => format!("{m}–{hi}"),
         _ => format!("{lo}–{hi}"),

@@ -331,7 +331,7 @@ fn the_work_precision_table_quotes_the_committed_csv_files() {
 #[test]
 fn the_text_after_the_table_quotes_the_committed_csv_files() {
     let text = section(&readme(), "What accuracy costs").replace('\n', " ");
-    // "(173 LU for 2,225 steps at rtol 1e-7)": BDF on chain8
+    // "(162 LU for 2,229 steps at rtol 1e-7)": BDF on chain8
     let (_, rest) = text
         .split_once("BDF's modified Newton reuses one LU over many steps (")
         .expect("the sentence on BDF's factorisations");

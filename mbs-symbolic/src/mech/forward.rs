@@ -108,10 +108,12 @@ pub fn ltdl(a: &mut Arena, m: &[Vec<ExprId>], h: &[ExprId]) -> Forward {
     let zero = a.zero();
     let nonzero = |a: &Arena, e: ExprId| !a.is_num(e, 0.0);
     let mut d = vec![zero; n];
+    let mut inv_d = vec![zero; n];
     for k in (0..n).rev() {
         d[k] = l[k][k];
         let one = a.one();
         let inv = a.div(one, d[k]);
+        inv_d[k] = inv;
         for i in (0..k).rev() {
             if !nonzero(a, l[k][i]) {
                 continue;
@@ -136,8 +138,10 @@ pub fn ltdl(a: &mut Arena, m: &[Vec<ExprId>], h: &[ExprId]) -> Forward {
             }
         }
     }
+    // by the pivots' reciprocals, which the factorisation has computed: a product where a
+    // division would wait on its numerator again
     for i in 0..n {
-        x[i] = a.div(x[i], d[i]);
+        x[i] = a.mul(x[i], inv_d[i]);
     }
     // L x = w, from the first
     for i in 0..n {

@@ -18,7 +18,7 @@ mod common;
 #[path = "scaling/models.rs"]
 mod models;
 
-use common::{Paired, ROUNDS, median_ns, paired, test_state};
+use common::{Paired, ROUNDS, median_ns, paired_if_measured, test_state};
 use criterion::Criterion;
 use mbs::{F64x4, LANES, Model};
 use std::hint::black_box;
@@ -93,7 +93,8 @@ fn bench_model<M: Model + Clone>(
         model.forward_dynamics_x4(t4, black_box(&q4), black_box(&qd4), &u4, &mut a4, &mut p4);
         black_box(&a4);
     };
-    let mut g = c.benchmark_group(format!("batch_{name}"));
+    let group = format!("batch_{name}");
+    let mut g = c.benchmark_group(&group);
     g.bench_function("dynamics_one_state_x4", |b| b.iter(&mut dynamics_one));
     g.bench_function("dynamics_lanes", |b| b.iter(&mut dynamics_lanes));
     g.bench_function("forward_one_state_x4", |b| b.iter(&mut forward_one));
@@ -116,16 +117,18 @@ fn bench_model<M: Model + Clone>(
         })
     });
     g.finish();
-    // in pairs only in a measuring run, which criterion's medians mark
-    let group = format!("batch_{name}");
-    let pairs = |one: &mut dyn FnMut(), lanes: &mut dyn FnMut(), id: &str| match median_ns(
-        &group, id, since,
-    ) {
-        Some(_) => paired(lanes, one),
-        None => Paired::NONE,
-    };
-    let d = pairs(&mut dynamics_one, &mut dynamics_lanes, "dynamics_lanes");
-    let f = pairs(&mut forward_one, &mut forward_lanes, "forward_lanes");
+    let d = paired_if_measured(
+        (&group, "dynamics_lanes"),
+        since,
+        &mut dynamics_lanes,
+        &mut dynamics_one,
+    );
+    let f = paired_if_measured(
+        (&group, "forward_lanes"),
+        since,
+        &mut forward_lanes,
+        &mut forward_one,
+    );
     (name, d, f)
 }
 

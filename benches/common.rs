@@ -79,6 +79,21 @@ impl Paired {
     };
 }
 
+/// [`paired`] in a measuring run, which criterion's median of `group/id` marks ([`median_ns`]);
+/// [`Paired::NONE`] in test mode or where a filter left that function out.
+#[allow(dead_code)] // not every benchmark measures in pairs
+pub fn paired_if_measured(
+    (group, id): (&str, &str),
+    since: SystemTime,
+    first: &mut dyn FnMut(),
+    second: &mut dyn FnMut(),
+) -> Paired {
+    match median_ns(group, id, since) {
+        Some(_) => paired(first, second),
+        None => Paired::NONE,
+    }
+}
+
 /// The ratio of the times of `second` and `first`, measured in pairs: in each of [`ROUNDS`]
 /// rounds a block of calls of each, back to back (which goes first alternates), each block
 /// about 50 µs. A slower moment of the machine slows both blocks of a round, where criterion

@@ -19,7 +19,7 @@ mod common;
 #[path = "scaling/models.rs"]
 mod models;
 
-use common::{Paired, ROUNDS, median_ns, paired, test_state};
+use common::{Paired, ROUNDS, median_ns, paired_if_measured, test_state};
 use criterion::Criterion;
 use mbs::Model;
 use std::hint::black_box;
@@ -89,15 +89,12 @@ fn bench_model<M: Model>(
         model.forward_dynamics(0.0, q, qd, &u, &mut qdd, &mut pivots);
         black_box(&qdd);
     };
-    let mut g = c.benchmark_group(format!("scaling_{name}"));
+    let group = format!("scaling_{name}");
+    let mut g = c.benchmark_group(&group);
     g.bench_function("dense", |b| b.iter(&mut dense));
     g.bench_function("forward", |b| b.iter(&mut forward));
     g.finish();
-    // in pairs only in a measuring run, which criterion's medians mark
-    let pairs = match median_ns(&format!("scaling_{name}"), "forward", since) {
-        Some(_) => paired(&mut dense, &mut forward),
-        None => Paired::NONE,
-    };
+    let pairs = paired_if_measured((&group, "forward"), since, &mut dense, &mut forward);
     (name, n, goal, pairs)
 }
 

@@ -52,7 +52,7 @@
 //! the digits of q and qd apart at rtol 1e-8, and the global-control runs.
 
 use mbs::work_precision::{
-    Proportionality, Reference, Setting, Study, Sweep, WorkPrecision, decades, mixed_error,
+    Proportionality, Reference, Row, Setting, Study, Sweep, WorkPrecision, decades, mixed_error,
 };
 use mbs::{ConstraintMethod, GenAlphaParams, HhtParams, Model, Options, Scheme};
 use mbs_models::{dpend, dpend_cartesian, fastlink, fourbar, pendulum3, slidercrank};
@@ -334,21 +334,121 @@ fn study(title: &str, reference: Reference, constrained: bool) -> Study {
 
 /// Runs the study, prints its proportionality table and, at rtol 1e-8, the digits over q
 /// alone and qd alone of every offered sweep (where the error sits); returns what breaks
-/// proportionality.
-fn measure<M: Model + Clone + 'static>(s: Study, model: &M) -> Vec<String> {
-    let wp = s.run(model).expect("study");
+/// proportionality. The sweeps under local control and those under global control run on two
+/// threads; an `auto` sweep whose run at the loosest rtol equals, to the bit in its work
+/// counters and errors, that of the method it resolves to is that method's sweep again (the
+/// choice is made once per run from the scheme, not from the motion) and takes its rows.
+fn measure<M: Model + Clone + Sync + 'static>(s: Study, model: &M) -> Vec<String> {
+    let twins = auto_twins(&s, model);
+    let run = Study {
+        sweeps: s
+            .sweeps
+            .iter()
+            .filter(|w| !twins.iter().any(|(auto, _)| *auto == w.label))
+            .cloned()
+            .collect(),
+        ..s.clone()
+    };
+    let global = global_study(&run);
+    let ((wp, split), global) = std::thread::scope(|scope| {
+        let global = scope.spawn(|| global.run(model).expect("study"));
+        let local = run.run(model).expect("study");
+        let split = digits_apart(&run, model);
+        (
+            (local, split),
+            global.join().expect("the global-control sweeps"),
+        )
+    });
+    let wp = with_twins(wp, &s.sweeps, &twins, |w| w.clone());
+    let global = with_twins(global, &s.sweeps, &twins, |w| w.clone().global());
+    for (auto, of) in &twins {
+        println!("{auto}: the runs of {of}, equal to the bit at the loosest rtol");
+    }
     let (mut bad, props) = judge(&wp, M::NC > 0);
-    let (global_bad, global) = measure_global(&s, model);
+    let (global_bad, global) = judge_global(&global);
     bad.extend(global_bad);
     record(Measured {
         title: wp.title.clone(),
         props,
         global,
     });
-    let n = M::NQ;
     println!(
         "digits over q alone and qd alone at rtol 1e-8 (largest mixed error over the samples):"
     );
+    for sweep in &s.sweeps {
+        let label = twins
+            .iter()
+            .find(|(auto, _)| *auto == sweep.label)
+            .map_or(&sweep.label, |(_, of)| of);
+        if let Some((_, q, qd)) = split.iter().find(|(l, _, _)| l == label) {
+            println!("  {:<28} q {q:5.2}  qd {qd:5.2}", sweep.label);
+        }
+    }
+    bad
+}
+
+/// The `auto` sweeps of `s` that are another sweep of the same scheme again, (auto's label,
+/// the other's): their runs at the loosest rtol have equal work counters and outcomes.
+fn auto_twins<M: Model + Clone + 'static>(s: &Study, model: &M) -> Vec<(String, String)> {
+    let first = |w: &Sweep| Sweep {
+        settings: w.settings[..1].to_vec(),
+        ..w.clone()
+    };
+    let loosest = Study {
+        sweeps: s.sweeps.iter().map(first).collect(),
+        ..s.clone()
+    }
+    .run(model)
+    .expect("study");
+    let same = |a: &Row, b: &Row| a.stats == b.stats && a.outcome == b.outcome;
+    let mut twins = Vec::new();
+    for (w, row) in s.sweeps.iter().zip(&loosest.rows) {
+        if w.constraints != Some(ConstraintMethod::Auto) {
+            continue;
+        }
+        let of = s.sweeps.iter().zip(&loosest.rows).find(|(o, r)| {
+            o.scheme == w.scheme && o.constraints != Some(ConstraintMethod::Auto) && same(row, r)
+        });
+        if let Some((o, _)) = of {
+            twins.push((w.label.clone(), o.label.clone()));
+        }
+    }
+    twins
+}
+
+/// `wp`'s rows in the order of `sweeps`, each twin taking its sweep's rows under its own
+/// label; `as_run` gives the label a sweep's rows carry in `wp`.
+fn with_twins(
+    wp: WorkPrecision,
+    sweeps: &[Sweep],
+    twins: &[(String, String)],
+    as_run: impl Fn(&Sweep) -> Sweep,
+) -> WorkPrecision {
+    let mut rows = Vec::new();
+    for w in sweeps {
+        let label = as_run(w).label;
+        let twin = twins.iter().find(|(auto, _)| *auto == w.label);
+        let source = match twin {
+            Some((_, of)) => {
+                let of = sweeps.iter().find(|o| o.label == *of).expect("a sweep");
+                as_run(of).label
+            }
+            None => label.clone(),
+        };
+        rows.extend(wp.rows.iter().filter(|r| r.label == source).map(|r| Row {
+            label: label.clone(),
+            constraints: w.constraints.or(r.constraints),
+            ..r.clone()
+        }));
+    }
+    WorkPrecision { rows, ..wp }
+}
+
+/// The digits over q alone and over qd alone (largest mixed error over the samples) of every
+/// sweep of `s` at rtol 1e-8, (label, q, qd); a run that fails is left out.
+fn digits_apart<M: Model + Clone + 'static>(s: &Study, model: &M) -> Vec<(String, f64, f64)> {
+    let n = M::NQ;
+    let mut out = Vec::new();
     for sweep in &s.sweeps {
         let o = s.options_for(sweep, Setting::Rtol(1e-8));
         let Ok((tr, _)) = mbs::simulate(model.clone(), sweep.scheme, o) else {
@@ -359,14 +459,9 @@ fn measure<M: Model + Clone + 'static>(s: Study, model: &M) -> Vec<String> {
             eq = eq.max(mixed_error(tr.q(i), &r[..n], s.floor));
             ev = ev.max(mixed_error(tr.qd(i), &r[n..], s.floor));
         }
-        println!(
-            "  {:<28} q {:5.2}  qd {:5.2}",
-            sweep.label,
-            -eq.log10(),
-            -ev.log10()
-        );
+        out.push((sweep.label.clone(), -eq.log10(), -ev.log10()));
     }
-    bad
+    out
 }
 
 /// The tolerances of the global-control sweeps; the schemes of order 2 and 3 stop at 1e-6
@@ -388,16 +483,9 @@ fn global_rtols(label: &str) -> &'static [f64] {
 const GLOBAL_SLACK: f64 = 0.5;
 
 /// The study's sweeps again under global error control (`mbs::simulate_global`) at
-/// [`GLOBAL_RTOLS`]: prints, per run, the digits beyond −log10 rtol (or the failure) and the
-/// steps of all its runs; returns the runs that mislead: a result more than
-/// [`GLOBAL_SLACK`] digits short of rtol, or a failure other than the typed
-/// `GlobalToleranceNotMet` (and `ConstraintsUnsupported`, a method not offered), or a
-/// failure of DOPRI5 or Radau5 with the default constraint method.
-fn measure_global<M: Model + Clone + 'static>(
-    s: &Study,
-    model: &M,
-) -> (Vec<String>, Vec<GlobalOutcome>) {
-    let g = Study {
+/// [`GLOBAL_RTOLS`].
+fn global_study(s: &Study) -> Study {
+    Study {
         sweeps: s
             .sweeps
             .iter()
@@ -413,8 +501,15 @@ fn measure_global<M: Model + Clone + 'static>(
             })
             .collect(),
         ..s.clone()
-    };
-    let wp = g.run(model).expect("study");
+    }
+}
+
+/// The global-control sweeps' results: prints, per run, the digits beyond −log10 rtol (or
+/// the failure) and the steps of all its runs; returns the runs that mislead: a result more
+/// than [`GLOBAL_SLACK`] digits short of rtol, or a failure other than the typed
+/// `GlobalToleranceNotMet` (and `ConstraintsUnsupported`, a method not offered), or a
+/// failure of DOPRI5 or Radau5 with the default constraint method.
+fn judge_global(wp: &WorkPrecision) -> (Vec<String>, Vec<GlobalOutcome>) {
     println!(
         "\nglobal error control: {} (digits − (−log10 rtol), steps of all runs)",
         wp.title

@@ -19,6 +19,7 @@ macro_rules! mechanism {
         mbs::multibody! {
             pub model $name {
                 option jacobians = $form;
+                option motion;
                 param l = 0.4;
                 dof x = 0.1; dof y = -0.2; dof z = 0.3;
                 dof psi = 0.2; dof theta = 0.1; dof phi = -0.3;
@@ -234,4 +235,79 @@ fn assembled_form_generates_fewer_operations() {
     );
     println!("kinematics: {g} flops generated, {a} with the Jacobians assembled");
     assert!(a < g, "{a} vs {g}");
+}
+
+/// `motion` (`option motion;`) is `kinematics` less its Jacobians and bias accelerations: the
+/// poses and velocities of every frame and point the same to the bit, on the mechanism in both
+/// forms and on the human model, and what it does not compute left as it was; without the
+/// option, all of `kinematics`.
+#[test]
+fn motion_is_kinematics_without_its_jacobians() {
+    fn check<M: Model>(model: &M, t: f64, q: &[f64], qd: &[f64], label: &str) {
+        let mut full = mbs::Kinematics::new::<M>();
+        model.kinematics(t, q, qd, &mut full);
+        let mut moved = mbs::Kinematics::new::<M>();
+        for f in &mut moved.frames {
+            f.jv.fill(7.0);
+            f.bias_acceleration = [7.0; 3];
+        }
+        for p in &mut moved.points {
+            p.jv.fill(7.0);
+        }
+        model.motion(t, q, qd, &mut moved);
+        for (i, (a, b)) in full.frames.iter().zip(&moved.frames).enumerate() {
+            assert_eq!(a.pose, b.pose, "{label}: frame {i}'s pose");
+            assert_eq!(a.velocity, b.velocity, "{label}: frame {i}'s velocity");
+            assert_eq!(a.angular_velocity, b.angular_velocity, "{label}: frame {i}");
+            assert!(b.jv.iter().all(|v| *v == 7.0), "{label}: frame {i}'s J_v");
+            assert_eq!(b.bias_acceleration, [7.0; 3], "{label}: frame {i}");
+        }
+        for (i, (a, b)) in full.points.iter().zip(&moved.points).enumerate() {
+            assert_eq!(a.position, b.position, "{label}: point {i}'s position");
+            assert_eq!(a.velocity, b.velocity, "{label}: point {i}'s velocity");
+            assert!(b.jv.iter().all(|v| *v == 7.0), "{label}: point {i}'s J_v");
+        }
+    }
+    for (g, a, label) in both_forms() {
+        for k in 0..4 {
+            let (t, q, qd) = state(k);
+            check(&g, t, &q, &qd, &format!("generated, {label}, state {k}"));
+            check(&a, t, &q, &qd, &format!("assembled, {label}, state {k}"));
+        }
+    }
+    // without `option motion;`, all of `kinematics`
+    let dpend = mbs_models::dpend::DoublePendulum::default();
+    let (mut full, mut moved) = (
+        mbs::Kinematics::new::<mbs_models::dpend::DoublePendulum>(),
+        mbs::Kinematics::new::<mbs_models::dpend::DoublePendulum>(),
+    );
+    dpend.kinematics(0.1, &[0.3, -0.2], &[1.0, 0.5], &mut full);
+    dpend.motion(0.1, &[0.3, -0.2], &[1.0, 0.5], &mut moved);
+    assert_eq!(full, moved);
+    let human = mbs_models::human::Human::default();
+    let n = mbs_models::human::Human::NQ;
+    let q: Vec<f64> = (0..n)
+        .map(|i| 0.1 * ((i * 37 % 11) as f64 - 5.0) / 5.0)
+        .collect();
+    let qd: Vec<f64> = (0..n)
+        .map(|i| 0.5 * ((i * 53 % 13) as f64 - 6.0) / 6.0)
+        .collect();
+    check(&human, 0.0, &q, &qd, "human");
+    let flops = |label: &str| {
+        let ops = &human.info().ops;
+        let row = ops.iter().find(|(l, _)| *l == label);
+        row.unwrap_or_else(|| panic!("no row {label}")).1.flops()
+    };
+    let (motion, kinematics) = (flops("motion"), flops("kinematics"));
+    println!("human model: motion {motion} flops, kinematics {kinematics}");
+    assert!(3 * motion < kinematics, "{motion} against {kinematics}");
+    let thousands = |n: usize| format!("{},{:03}", n / 1000, n % 1000);
+    quoted::says(
+        "README.md",
+        &[format!(
+            "model's {} flops where `kinematics` takes {}, `mbs expand models/src/human.rs",
+            thousands(motion),
+            thousands(kinematics)
+        )],
+    );
 }

@@ -791,6 +791,11 @@ impl<M: Model, E: Efforts> Model for WithEfforts<M, E> {
         self.model.kinematics(t, &q[..n], &qd[..n], out);
     }
 
+    fn motion(&self, t: f64, q: &[f64], qd: &[f64], out: &mut Kinematics) {
+        let n = M::NQ;
+        self.model.motion(t, &q[..n], &qd[..n], out);
+    }
+
     fn take_failure(&self) -> Option<Failure> {
         self.failure.borrow_mut().take()
     }

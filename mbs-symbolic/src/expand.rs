@@ -246,6 +246,7 @@ fn validate(&self) -> ::core::result::Result<(), ::mbs::ParamError> {{ {never} }
         nc: 0,
         charts: 0,
         batch: false,
+        motion: false,
         sensitive: Vec::new(),
         rest_derivatives: false,
         constraint_sensitivity: false,

@@ -43,6 +43,8 @@ mbs::multibody! {
     /// Human lower limbs (gait2392 segments, spline knee, patella), pelvis free, feet on
     /// ellipsoids.
     pub model Human {
+        // the poses and velocities alone, for the ground checks and the passes over the cycle
+        option motion;
         param k_foot = 2e6; param d_foot = 1.0; param mu_foot = 0.8; param eps_foot = 0.01;
         // the tibia's origin in the femur's axes against the knee angle (gait2392)
         fn knee_x(a) = spline(a, [(-2.0944, -0.0032), (-1.74533, 0.00179), (-1.39626, 0.00411),
@@ -632,7 +634,7 @@ impl GaitReference {
         (0..tr.len())
             .map(|i| {
                 mbs::charts::use_charts_of(&mut model, tr, i);
-                model.kinematics(tr.t[i], &tr.q(i)[..n], &tr.qd(i)[..n], &mut kin);
+                model.motion(tr.t[i], &tr.q(i)[..n], &tr.qd(i)[..n], &mut kin);
                 let r = kin.frames[pelvis].pose.rotation;
                 let rr = self.pelvis_rotation(tr.t[i]);
                 // the angle of R_ref^T R from its trace
@@ -1102,7 +1104,7 @@ impl Pass<'_> {
                         qd[*i] += rate;
                     }
                 }
-                self.model.kinematics(0.0, &q, &qd, kin);
+                self.model.motion(0.0, &q, &qd, kin);
                 let sp = self.feet.support_points(kin);
                 // each foot's lowest point and its contact's velocity, smoothed over the
                 // ellipsoids (a soft minimum of their heights and the velocities weighted
@@ -1965,7 +1967,7 @@ impl Balance {
         for i in 0..BALANCE_POINTS {
             let t = reference.period * i as f64 / BALANCE_POINTS as f64;
             let (q, qd) = reference_state(model, reference, t);
-            model.kinematics(t, &q, &qd, &mut kin);
+            model.motion(t, &q, &qd, &mut kin);
             model.mass_matrix(t, &q, &mut m);
             let (g, p) = mass_centre(model, &q, &qd, &m);
             let v = p.map(|p| p / m[0]);
@@ -2446,8 +2448,8 @@ impl Guard {
 }
 
 /// The force of the ground on each foot (world axes) at a state, recomputed from the
-/// kinematics with the model's contact law (for reports: the dynamics use the generated
-/// code).
+/// motion of the feet with the model's contact law (for reports: the dynamics use the
+/// generated code); `kin` holds that motion after ([`Model::motion`]: no Jacobians).
 pub fn ground_forces(
     model: &Human,
     t: f64,
@@ -2455,7 +2457,7 @@ pub fn ground_forces(
     qd: &[f64],
     kin: &mut Kinematics,
 ) -> [[f64; 3]; 2] {
-    model.kinematics(t, q, qd, kin);
+    model.motion(t, q, qd, kin);
     let p = model.params();
     let sp = support_points(model, kin);
     let mut out = [[0.0; 3]; 2];
@@ -2707,7 +2709,7 @@ pub const START_DEPTH: f64 = 2e-3;
 pub fn cycle_start(model: &Human, reference: &GaitReference) -> (Vec<f64>, Vec<f64>) {
     let (mut q, mut qd) = reference_state(model, reference, 0.0);
     let mut kin = Kinematics::new::<Human>();
-    model.kinematics(0.0, &q, &qd, &mut kin);
+    model.motion(0.0, &q, &qd, &mut kin);
     let sp = support_points(model, &kin);
     let lowest = sp
         .iter()
@@ -2734,7 +2736,7 @@ pub fn walking_speed(model: &Human, reference: &GaitReference) -> f64 {
         let phase = reference.period * (0.15 + 0.25 * s as f64 / (samples - 1) as f64);
         let t = phase - reference.offset;
         let (q, qd) = reference_state(model, reference, t);
-        model.kinematics(t, &q, &qd, &mut kin);
+        model.motion(t, &q, &qd, &mut kin);
         sum -= feet.support_points(&kin)[0][1].1[0];
     }
     sum / samples as f64

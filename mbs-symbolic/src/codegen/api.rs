@@ -116,6 +116,14 @@ pub const POINT_KINEMATICS: Method = method(
     "",
 );
 
+/// `motion`, which has a default in the trait (all of `kinematics`) that models with
+/// `option motion;` override with `kinematics` less its Jacobians and bias accelerations.
+pub const MOTION: Method = method(
+    "motion",
+    "t: f64, q: &[f64], qd: &[f64], out: &mut ::mbs::Kinematics",
+    "",
+);
+
 /// `parameter_tangents`, which has a default in the trait (an error) that models with
 /// parameters marked `sensitive` override.
 pub const PARAMETER_TANGENTS: Method = method(
@@ -223,6 +231,8 @@ pub struct Sizes {
     pub charts: usize,
     /// `option batch;`: the model overrides the methods of [`BATCH`]
     pub batch: bool,
+    /// `option motion;`: the model overrides [`MOTION`]
+    pub motion: bool,
     /// the parameters marked `sensitive` (field names): the model overrides
     /// [`PARAMETER_TANGENTS`] and [`START_SENSITIVITIES`] and sets `SENSITIVE`
     pub sensitive: Vec<String>,
@@ -253,6 +263,7 @@ pub fn model_impl(
         nc,
         charts,
         batch,
+        motion,
         sensitive,
         rest_derivatives,
         constraint_sensitivity,
@@ -299,6 +310,7 @@ const BATCH_GENERATED: bool = {batch};
             &FORWARD_DYNAMICS_FORCED,
             &POINT_KINEMATICS,
         ])
+        .chain(motion.then_some(&MOTION))
         .chain(batch_methods)
         .chain(sensitivity_methods)
         .chain(constraint_methods)

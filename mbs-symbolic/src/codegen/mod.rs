@@ -664,6 +664,8 @@ fn kinematics_specs(
     };
     let mut frames = FnSpec::new("__frames", &with_charts("frames"));
     let mut fk = FnSpec::new("__kinematics", &kin_args);
+    // `kinematics` less the Jacobians, for what reads the motion of frames and points alone
+    let mut fm = FnSpec::new("__motion", &with_charts("kinematics"));
     for (i, &node) in model.tree.frame_node.iter().enumerate() {
         let k = &model.world.nodes[node];
         for r in 0..3 {
@@ -671,20 +673,24 @@ fn kinematics_specs(
                 frames
                     .outputs
                     .push((format!("out[{i}].rotation[{r}][{c}]"), k.r[r][c]));
-                fk.outputs.push((
-                    format!("out.frames[{i}].pose.rotation[{r}][{c}]"),
-                    k.r[r][c],
-                ));
+                for g in [&mut fk, &mut fm] {
+                    g.outputs.push((
+                        format!("out.frames[{i}].pose.rotation[{r}][{c}]"),
+                        k.r[r][c],
+                    ));
+                }
             }
             frames
                 .outputs
                 .push((format!("out[{i}].position[{r}]"), k.p[r]));
-            fk.outputs
-                .push((format!("out.frames[{i}].pose.position[{r}]"), k.p[r]));
-            fk.outputs
-                .push((format!("out.frames[{i}].velocity[{r}]"), k.v[r]));
-            fk.outputs
-                .push((format!("out.frames[{i}].angular_velocity[{r}]"), k.w[r]));
+            for g in [&mut fk, &mut fm] {
+                g.outputs
+                    .push((format!("out.frames[{i}].pose.position[{r}]"), k.p[r]));
+                g.outputs
+                    .push((format!("out.frames[{i}].velocity[{r}]"), k.v[r]));
+                g.outputs
+                    .push((format!("out.frames[{i}].angular_velocity[{r}]"), k.w[r]));
+            }
             fk.outputs
                 .push((format!("out.frames[{i}].bias_acceleration[{r}]"), k.ab[r]));
             fk.outputs.push((
@@ -706,6 +712,10 @@ fn kinematics_specs(
                 format!("out.points[{i}].bias_acceleration[{r}]"),
                 pk.bias[r],
             ));
+            fm.outputs
+                .push((format!("out.points[{i}].position[{r}]"), pk.position[r]));
+            fm.outputs
+                .push((format!("out.points[{i}].velocity[{r}]"), pk.velocity[r]));
         }
         for g in [&mut fk, &mut fp] {
             for r in 0..3 {
@@ -742,11 +752,15 @@ fn kinematics_specs(
             }
         }
     }
-    vec![
+    let mut specs = vec![
         (frames, "frames"),
         (fk, "kinematics"),
         (fp, "point_kinematics"),
-    ]
+    ];
+    if model.sys.options.motion {
+        specs.push((fm, "motion"));
+    }
+    specs
 }
 
 fn dense3(a: &crate::expr::Arena, cols: &world::Cols, n: usize) -> Vec<Vec<ExprId>> {
@@ -1167,6 +1181,7 @@ fn emit_scene(
         nc: sys.constraints.len(),
         charts: sys.rotation_joints.len(),
         batch: sys.options.batch,
+        motion: sys.options.motion,
         sensitive: sys
             .params
             .iter()
@@ -1236,7 +1251,7 @@ fn emit_scene(
                 m.call(),
                 name == "kinematics"
             ),
-            name @ ("frames" | "kinematics" | "point_kinematics") => {
+            name @ ("frames" | "kinematics" | "point_kinematics" | "motion") => {
                 format!("self.params.__{name}(&self.charts, {})", m.call())
             }
             // M assembled from the twists and composite inertias the generated code writes

@@ -308,6 +308,8 @@ pub struct Options {
     pub tangent_form: TangentForm,
     /// emit `dynamics_x4` and `forward_dynamics_x4`: four states at once on SIMD lanes
     pub batch: bool,
+    /// emit `motion`: the poses and velocities of `kinematics` without its Jacobians
+    pub motion: bool,
     /// force a formulation; `None` picks the cheaper by op count
     pub formulation: Option<Formulation>,
     /// force the form of the Jacobians of `kinematics` and `point_kinematics` and of M;

@@ -10,6 +10,7 @@ mbs::multibody! {
         option jacobians;
         option tangents = sparse;
         option tangents = 2;
+        option motion = true;
     }
 }
 

@@ -17,6 +17,7 @@ impl Checker {
                 }
             }
             ("batch", None) => self.sys.options.batch = true,
+            ("motion", None) => self.sys.options.motion = true,
             ("formulation", Some(Expr::Path(p))) if p.path.get_ident().is_some() => {
                 let v = p.path.get_ident().unwrap();
                 self.sys.options.formulation = match v.to_string().as_str() {
@@ -43,7 +44,8 @@ impl Checker {
             ("jacobians", _) => self.error(key.span(), "write `option jacobians = generated;` or `option jacobians = assembled;`"),
             ("tangents", Some(v)) => self.error(v.span(), "write `option tangents;`, `option tangents = code;` or `option tangents = table;`"),
             ("batch", Some(v)) => self.error(v.span(), "write `option batch;` (it takes no value)"),
-            (other, _) => self.error(key.span(), format!("unknown option `{other}`: the options are `tangents [= code | table]`, `batch`, `formulation = recursive | virtual_power` and `jacobians = generated | assembled`")),
+            ("motion", Some(v)) => self.error(v.span(), "write `option motion;` (it takes no value)"),
+            (other, _) => self.error(key.span(), format!("unknown option `{other}`: the options are `tangents [= code | table]`, `batch`, `motion`, `formulation = recursive | virtual_power` and `jacobians = generated | assembled`")),
         }
     }
 

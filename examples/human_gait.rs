@@ -694,7 +694,7 @@ fn muscle_plot(
     let mut model = model.clone();
     for s in 0..tr.len() {
         mbs::charts::use_charts_of(&mut model, tr, s);
-        model.kinematics(tr.t[s], &tr.q(s)[..n], &tr.qd(s)[..n], &mut kin);
+        model.motion(tr.t[s], &tr.q(s)[..n], &tr.qd(s)[..n], &mut kin);
         let x = &tr.qd(s)[n..];
         for (i, line) in lines.iter_mut().enumerate() {
             let (unit, path) = &muscles.units[i];

@@ -390,25 +390,41 @@ fn measure<M: Model + Clone + Sync + 'static>(s: Study, model: &M) -> Vec<String
 /// The `auto` sweeps of `s` that are another sweep of the same scheme again, (auto's label,
 /// the other's): their runs at the loosest rtol have equal work counters and outcomes.
 fn auto_twins<M: Model + Clone + 'static>(s: &Study, model: &M) -> Vec<(String, String)> {
-    let first = |w: &Sweep| Sweep {
-        settings: w.settings[..1].to_vec(),
-        ..w.clone()
-    };
+    let auto = |w: &Sweep| w.constraints == Some(ConstraintMethod::Auto);
+    // the sweeps of the schemes that have an `auto` sweep and another (none on a model
+    // without constraints), at their loosest rtol
+    let paired: Vec<Sweep> = s
+        .sweeps
+        .iter()
+        .filter(|w| {
+            s.sweeps
+                .iter()
+                .any(|o| o.scheme == w.scheme && auto(o) != auto(w))
+        })
+        .map(|w| Sweep {
+            settings: w.settings[..1].to_vec(),
+            ..w.clone()
+        })
+        .collect();
+    if paired.is_empty() {
+        return Vec::new();
+    }
     let loosest = Study {
-        sweeps: s.sweeps.iter().map(first).collect(),
+        sweeps: paired.clone(),
         ..s.clone()
     }
     .run(model)
     .expect("study");
     let same = |a: &Row, b: &Row| a.stats == b.stats && a.outcome == b.outcome;
     let mut twins = Vec::new();
-    for (w, row) in s.sweeps.iter().zip(&loosest.rows) {
-        if w.constraints != Some(ConstraintMethod::Auto) {
+    for (w, row) in paired.iter().zip(&loosest.rows) {
+        if !auto(w) {
             continue;
         }
-        let of = s.sweeps.iter().zip(&loosest.rows).find(|(o, r)| {
-            o.scheme == w.scheme && o.constraints != Some(ConstraintMethod::Auto) && same(row, r)
-        });
+        let of = paired
+            .iter()
+            .zip(&loosest.rows)
+            .find(|(o, r)| o.scheme == w.scheme && !auto(o) && same(row, r));
         if let Some((o, _)) = of {
             twins.push((w.label.clone(), o.label.clone()));
         }

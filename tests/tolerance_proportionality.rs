@@ -344,7 +344,7 @@ fn measure<M: Model + Clone + Sync + 'static>(s: Study, model: &M) -> Vec<String
         sweeps: s
             .sweeps
             .iter()
-            .filter(|w| !twins.iter().any(|(auto, _)| *auto == w.label))
+            .filter(|w| twin_of(&twins, &w.label).is_none())
             .cloned()
             .collect(),
         ..s.clone()
@@ -376,10 +376,7 @@ fn measure<M: Model + Clone + Sync + 'static>(s: Study, model: &M) -> Vec<String
         "digits over q alone and qd alone at rtol 1e-8 (largest mixed error over the samples):"
     );
     for sweep in &s.sweeps {
-        let label = twins
-            .iter()
-            .find(|(auto, _)| *auto == sweep.label)
-            .map_or(&sweep.label, |(_, of)| of);
+        let label = twin_of(&twins, &sweep.label).unwrap_or(&sweep.label);
         if let Some((_, q, qd)) = split.iter().find(|(l, _, _)| l == label) {
             println!("  {:<28} q {q:5.2}  qd {qd:5.2}", sweep.label);
         }
@@ -432,6 +429,14 @@ fn auto_twins<M: Model + Clone + 'static>(s: &Study, model: &M) -> Vec<(String, 
     twins
 }
 
+/// The sweep whose rows the `auto` sweep `label` takes, if it is a twin.
+fn twin_of<'a>(twins: &'a [(String, String)], label: &str) -> Option<&'a str> {
+    twins
+        .iter()
+        .find(|(auto, _)| auto == label)
+        .map(|(_, of)| of.as_str())
+}
+
 /// `wp`'s rows in the order of `sweeps`, each twin taking its sweep's rows under its own
 /// label; `as_run` gives the label a sweep's rows carry in `wp`.
 fn with_twins(
@@ -443,12 +448,8 @@ fn with_twins(
     let mut rows = Vec::new();
     for w in sweeps {
         let label = as_run(w).label;
-        let twin = twins.iter().find(|(auto, _)| *auto == w.label);
-        let source = match twin {
-            Some((_, of)) => {
-                let of = sweeps.iter().find(|o| o.label == *of).expect("a sweep");
-                as_run(of).label
-            }
+        let source = match twin_of(twins, &w.label) {
+            Some(of) => as_run(sweeps.iter().find(|o| o.label == of).expect("a sweep")).label,
             None => label.clone(),
         };
         rows.extend(wp.rows.iter().filter(|r| r.label == source).map(|r| Row {

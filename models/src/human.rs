@@ -630,12 +630,12 @@ impl GaitReference {
             return f64::NAN;
         };
         let (n, mut model) = (Human::NQ, model.clone());
-        let mut kin = Kinematics::new::<Human>();
+        let mut poses = vec![mbs::Pose::default(); Human::NFRAMES];
         (0..tr.len())
             .map(|i| {
                 mbs::charts::use_charts_of(&mut model, tr, i);
-                model.motion(tr.t[i], &tr.q(i)[..n], &tr.qd(i)[..n], &mut kin);
-                let r = kin.frames[pelvis].pose.rotation;
+                model.frames(tr.t[i], &tr.q(i)[..n], &mut poses);
+                let r = poses[pelvis].rotation;
                 let rr = self.pelvis_rotation(tr.t[i]);
                 // the angle of R_ref^T R from its trace
                 let trace: f64 = (0..3)

@@ -10,6 +10,11 @@
 //! in ns per call. The assembled form generates O(n) code (the coordinates' twists, the
 //! composite inertias) and sums the O(n²) columns and entries of M at run time in a generic
 //! loop, where the generated form writes each with the model's zeros folded.
+//!
+//! Then the human model (`option motion;`): `kinematics` against `motion` and `transmit`, and
+//! one evaluation of its gait tracking with the pelvis held (`WithEfforts::dynamics`, the
+//! held runs of its residual reduction), the efforts carried through every frame's Jacobians
+//! or transmitted by one inward pass (`Efforts::reads_jacobians`).
 
 mod common;
 
@@ -67,6 +72,61 @@ fn bench<M: Model + Default>(c: &mut Criterion, name: &str, form: &str) {
     g.finish();
 }
 
+/// The human's gait tracking, the pelvis held, its efforts read through the Jacobians or
+/// transmitted.
+#[derive(Clone)]
+struct Held(mbs_models::human::Tracking, bool);
+
+impl mbs::Efforts for Held {
+    fn reads_jacobians(&self) -> bool {
+        self.1
+    }
+    fn efforts(&mut self, e: &mut mbs::Effort) -> Result<(), String> {
+        self.0.efforts(e)
+    }
+}
+
+fn human(c: &mut Criterion) {
+    use mbs_models::human::*;
+    let model = Human::default();
+    let info = model.info();
+    println!(
+        "human     kinematics: {:>6} flops generated, motion: {:>6}, transmit: {:>6}",
+        flops(&model, "kinematics"),
+        flops(&model, "motion"),
+        flops(&model, "transmit")
+    );
+    let reference = GaitReference::fit(&GaitTable::normal(), info, 1.1, FIT_HARMONICS)
+        .and_then(|r| r.symmetric(info))
+        .expect("the normal cycle fits");
+    let (q, qd) = cycle_start(&model, &reference);
+    let mut held = Tracking::new(reference, info, GAIT_KP, GAIT_KP / 100.0).expect("tracking");
+    held.pelvis_kp = GAIT_PELVIS_KP;
+    held.pelvis_kd = GAIT_PELVIS_KP / 10.0;
+    let n = Human::NQ;
+    let mut out = Kinematics::new::<Human>();
+    let wrenches = vec![1.0; 6 * Human::NFRAMES + 3 * Human::NPOINTS];
+    let mut qg = vec![0.0; n];
+    let mut g = c.benchmark_group("kinematics_human");
+    g.bench_function("kinematics", |b| {
+        b.iter(|| model.kinematics(0.0, black_box(&q), black_box(&qd), &mut out))
+    });
+    g.bench_function("motion", |b| {
+        b.iter(|| model.motion(0.0, black_box(&q), black_box(&qd), &mut out))
+    });
+    g.bench_function("transmit", |b| {
+        b.iter(|| model.transmit(0.0, black_box(&q), black_box(&wrenches), &mut qg))
+    });
+    let (mut m, mut h) = (vec![0.0; n * n], vec![0.0; n]);
+    for (id, reads) in [("held_jacobians", true), ("held_transmitted", false)] {
+        let wrapped = mbs::WithEfforts::new(model.clone(), Held(held.clone(), reads));
+        g.bench_function(id, |b| {
+            b.iter(|| wrapped.dynamics(0.0, black_box(&q), black_box(&qd), &[], &mut m, &mut h))
+        });
+    }
+    g.finish();
+}
+
 fn main() {
     let since = std::time::SystemTime::now();
     let mut c = Criterion::default().configure_from_args();
@@ -74,6 +134,7 @@ fn main() {
     bench::<Chain32Assembled>(&mut c, "chain32", "assembled");
     bench::<Arm24Generated>(&mut c, "arm3d_24", "generated");
     bench::<Arm24Assembled>(&mut c, "arm3d_24", "assembled");
+    human(&mut c);
     c.final_summary();
     let rows = [
         ("chain32", "generated"),
@@ -84,6 +145,11 @@ fn main() {
         ("arm3d_24", "assembled"),
         ("arm3d_24", "generated_dynamics"),
         ("arm3d_24", "assembled_dynamics"),
+        ("human", "kinematics"),
+        ("human", "motion"),
+        ("human", "transmit"),
+        ("human", "held_jacobians"),
+        ("human", "held_transmitted"),
     ];
     // criterion's medians exist after a measuring run (`cargo bench`), not in test mode
     let medians: Vec<_> = rows

@@ -1038,8 +1038,9 @@ fn with_its_residuals_reduced_the_cycle_walks_with_the_pelvis_free() {
     quoted::says(
         "README.md",
         &[
+            format!("iterations lower the residual torques from {from:.1} to {to:.1} N·m rms ("),
             format!(
-                "iterations lower the residual torques from {from:.1} to {to:.1} N·m rms (97–106 s on two cores; the hips' rotation corrected by up to {:.1}°, their adduction {:.1}°, the other joints {rest:.1}° at most)",
+                "the hips' rotation corrected by up to {:.1}°, their adduction {:.1}°, the other joints {rest:.1}° at most)",
                 degrees("hip_rotation"),
                 degrees("hip_adduction")
             ),

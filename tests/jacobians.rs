@@ -311,3 +311,115 @@ fn motion_is_kinematics_without_its_jacobians() {
         )],
     );
 }
+
+/// `transmit` (`option motion;`) carries wrenches to the coordinates by one inward pass of the
+/// tree: Q = Σ J_vᵀ F + J_ωᵀ T over the frames and J_vᵀ F over the points, the Jacobians those
+/// of `kinematics`, on the mechanism in both forms and on the human model; a wrapper whose
+/// efforts are transmitted (`Efforts::reads_jacobians` false) forms the h of one that reads the
+/// Jacobians.
+#[test]
+fn transmit_is_the_jacobians_transposed() {
+    fn check<M: Model>(model: &M, t: f64, q: &[f64], label: &str) -> f64 {
+        let (n, nf, np) = (M::NQ, M::NFRAMES, M::NPOINTS);
+        let f: Vec<f64> = (0..6 * nf + 3 * np)
+            .map(|i| ((i * 7919 % 1000) as f64 / 500.0 - 1.0) * 10.0)
+            .collect();
+        let mut kin = mbs::Kinematics::new::<M>();
+        model.kinematics(t, q, &vec![0.0; n], &mut kin);
+        let mut by_jacobians = vec![0.0; n];
+        let dot = |j: &[f64], k: usize, w: &[f64]| (0..3).map(|r| j[3 * k + r] * w[r]).sum::<f64>();
+        for (k, g) in by_jacobians.iter_mut().enumerate() {
+            for (i, fr) in kin.frames.iter().enumerate() {
+                *g += dot(&fr.jv, k, &f[6 * i..]) + dot(&fr.jw, k, &f[6 * i + 3..]);
+            }
+            for (j, p) in kin.points.iter().enumerate() {
+                *g += dot(&p.jv, k, &f[6 * nf + 3 * j..]);
+            }
+        }
+        let mut transmitted = vec![7.0; n];
+        model.transmit(t, q, &f, &mut transmitted);
+        let scale = by_jacobians.iter().fold(1.0, |m: f64, v| m.max(v.abs()));
+        let err = max_diff(&by_jacobians, &transmitted) / scale;
+        assert!(err < 1e-13, "{label}: transmitted Q {err:e} from Σ Jᵀ W");
+        err
+    }
+    let mut worst: f64 = 0.0;
+    for (g, a, label) in both_forms() {
+        const { assert!(Generated::MOTION_GENERATED && Assembled::MOTION_GENERATED) };
+        for k in 0..4 {
+            let (t, q, _) = state(k);
+            worst = worst.max(check(&g, t, &q, &format!("generated, {label}, state {k}")));
+            worst = worst.max(check(&a, t, &q, &format!("assembled, {label}, state {k}")));
+        }
+    }
+    let human = mbs_models::human::Human::default();
+    let q: Vec<f64> = (0..mbs_models::human::Human::NQ)
+        .map(|i| 0.1 * ((i * 37 % 11) as f64 - 5.0) / 5.0)
+        .collect();
+    worst = worst.max(check(&human, 0.0, &q, "human"));
+    // a model without the option: the default, through the Jacobians
+    let dpend = mbs_models::dpend::DoublePendulum::default();
+    const { assert!(!mbs_models::dpend::DoublePendulum::MOTION_GENERATED) };
+    check(&dpend, 0.0, &[0.3, -0.2], "dpend");
+    println!("transmitted Q within {worst:.1e} of Σ Jᵀ W (relative to its largest entry)");
+    let transmit = human
+        .info()
+        .ops
+        .iter()
+        .find(|(l, _)| *l == "transmit")
+        .expect("a row transmit")
+        .1
+        .flops();
+    let kinematics = human
+        .info()
+        .ops
+        .iter()
+        .find(|(l, _)| *l == "kinematics")
+        .unwrap()
+        .1
+        .flops();
+    assert!(transmit < kinematics / 2, "{transmit} against {kinematics}");
+    quoted::says(
+        "README.md",
+        &[format!(
+            "the human model's transmission is {},{:03} flops, within {worst:.1e} of Σ Jᵀ W",
+            transmit / 1000,
+            transmit % 1000
+        )],
+    );
+
+    // the same efforts through the Jacobians and transmitted
+    #[derive(Clone)]
+    struct Pushes<const JACOBIANS: bool>;
+    impl<const JACOBIANS: bool> mbs::Efforts for Pushes<JACOBIANS> {
+        fn reads_jacobians(&self) -> bool {
+            JACOBIANS
+        }
+        fn efforts(&mut self, e: &mut mbs::Effort) -> Result<(), String> {
+            let v = e.frame(3).velocity;
+            let at = e.point(1).position;
+            e.force_on_frame(3, at, [-2.0 * v[0], 1.0 + v[1], 0.5]);
+            e.torque_on_frame(5, [0.3, -0.1 * e.qd[6], 0.2]);
+            e.torque_on_frame(0, [0.1, 0.2, 0.3]);
+            e.force_at_point(2, [1.0, 0.0, -3.0 * e.point(2).velocity[2]]);
+            e.force_at_point(0, [0.0, 4.0, 0.0]);
+            e.generalized_force(9, 0.7);
+            Ok(())
+        }
+    }
+    for (g, _, label) in both_forms() {
+        let read = mbs::WithEfforts::new(g.clone(), Pushes::<true>);
+        let transmitted = mbs::WithEfforts::new(g, Pushes::<false>);
+        let n = Generated::NQ;
+        for k in 0..3 {
+            let (t, q, qd) = state(k);
+            let (mut m1, mut h1) = (vec![0.0; n * n], vec![0.0; n]);
+            let (mut m2, mut h2) = (vec![0.0; n * n], vec![0.0; n]);
+            read.dynamics(t, &q, &qd, &[], &mut m1, &mut h1);
+            transmitted.dynamics(t, &q, &qd, &[], &mut m2, &mut h2);
+            let scale = h1.iter().fold(1.0, |m: f64, v| m.max(v.abs()));
+            let err = max_diff(&h1, &h2) / scale;
+            assert!(err < 1e-13, "{label}, state {k}: h {err:e} apart");
+        }
+    }
+}

@@ -7,7 +7,11 @@
 //! - at every evaluation the generated kinematics of `M` (poses, velocities and Jacobians of
 //!   its frames and points) are handed to [`Efforts::efforts`], which adds forces and torques
 //!   in world axes at points of bodies ([`Effort`]); they are projected to generalised forces
-//!   through the Jacobians, Q = Σ J_vᵀF + J_ωᵀT, and added to h;
+//!   through the Jacobians, Q = Σ J_vᵀF + J_ωᵀT, and added to h. A user part that reads no
+//!   Jacobian ([`Efforts::reads_jacobians`] false) on a model with `option motion;` gets the
+//!   poses and velocities alone ([`Model::motion`]) and its forces and torques are carried
+//!   to Q by one inward pass of the tree ([`Model::transmit`], O(n)): the human model's
+//!   12,227 flops of `kinematics` become 3,264 of `motion` and 3,992 of `transmit`;
 //! - `E::NX` extra states x with ẋ = f(t, q, qd, x, u) ([`Efforts::state_derivatives`]: motor
 //!   currents, PID integrators, activation dynamics) ride along as auxiliary coordinates s
 //!   with ṡ = x and s̈ = f: unit mass, no other coupling. Every scheme integrates them with its
@@ -52,8 +56,21 @@ pub trait Efforts: 'static {
     /// whether [`Efforts::efforts`] reads frames ([`Effort::frame`]); when false only the
     /// points' positions, velocities and Jacobians are computed at each evaluation
     /// ([`Model::point_kinematics`], a fraction of the cost on a model of many bodies), and
-    /// the frames and the points' bias accelerations are left unset
+    /// the frames and the points' bias accelerations are left unset (efforts transmitted,
+    /// [`Efforts::reads_jacobians`], read [`Model::motion`]'s frames and points whatever
+    /// this says)
     const FRAMES: bool = true;
+    /// Whether [`Efforts::efforts`] and [`Efforts::state_derivatives`] read Jacobians or
+    /// bias accelerations (`e.frame(i).jv`, `e.point(i).jv`, …): asked at each evaluation,
+    /// and must not change during a run. When false and the model is generated with
+    /// `option motion;` ([`Model::MOTION_GENERATED`]), each evaluation computes the poses
+    /// and velocities alone ([`Model::motion`]) and carries the forces and torques the user
+    /// part adds to generalised forces by one inward pass of the tree ([`Model::transmit`]):
+    /// no Jacobian is computed, and the Jacobians and bias accelerations are left unset.
+    /// Without the option the Jacobians are computed and read as when it is true.
+    fn reads_jacobians(&self) -> bool {
+        true
+    }
     /// x(0) (NX)
     fn initial_states(&self, _x: &mut [f64]) {}
     /// Adds the efforts at the state in `e` (world axes). An `Err` stops the run;
@@ -85,6 +102,9 @@ pub struct Effort<'a> {
     /// the charts of the rotation joints ([`Effort::chart`])
     charts: &'a [[[f64; 3]; 3]],
     qg: &'a mut [f64],
+    /// where forces and torques are summed when they are transmitted ([`Efforts::reads_jacobians`]
+    /// false): 6 per frame (force at its origin, torque), then 3 per point
+    wrenches: Option<&'a mut [f64]>,
     rejected: bool,
 }
 
@@ -110,7 +130,8 @@ impl Effort<'_> {
     }
 
     /// Kinematics of frame (or body) `i` (`ModelInfo::frame_index`); unset when the user
-    /// part says it reads no frames ([`Efforts::FRAMES`]).
+    /// part says it reads no frames ([`Efforts::FRAMES`]), its Jacobians and bias
+    /// accelerations unset when the efforts are transmitted ([`Efforts::reads_jacobians`]).
     pub fn frame(&self, i: usize) -> &FrameKinematics {
         &self.kin.frames[i]
     }
@@ -123,8 +144,11 @@ impl Effort<'_> {
 
     /// A force (world axes) at declared point `i`.
     pub fn force_at_point(&mut self, i: usize, f: [f64; 3]) {
-        let jv = &self.kin.points[i].jv;
-        add_jt(self.qg, jv, f);
+        let nf = self.kin.frames.len();
+        match &mut self.wrenches {
+            Some(w) => add3(&mut w[6 * nf + 3 * i..], f),
+            None => add_jt(self.qg, &self.kin.points[i].jv, f),
+        }
     }
 
     /// A force (world axes) applied at the world position `at` of a point of frame `i`.
@@ -132,18 +156,36 @@ impl Effort<'_> {
         let k = &self.kin.frames[i];
         let o = k.pose.position;
         let r = [at[0] - o[0], at[1] - o[1], at[2] - o[2]];
-        add_jt(self.qg, &k.jv, f);
-        add_jt(self.qg, &k.jw, cross(r, f));
+        match &mut self.wrenches {
+            Some(w) => {
+                add3(&mut w[6 * i..], f);
+                add3(&mut w[6 * i + 3..], cross(r, f));
+            }
+            None => {
+                add_jt(self.qg, &k.jv, f);
+                add_jt(self.qg, &k.jw, cross(r, f));
+            }
+        }
     }
 
     /// A torque (world axes) on frame `i`.
     pub fn torque_on_frame(&mut self, i: usize, torque: [f64; 3]) {
-        add_jt(self.qg, &self.kin.frames[i].jw, torque);
+        match &mut self.wrenches {
+            Some(w) => add3(&mut w[6 * i + 3..], torque),
+            None => add_jt(self.qg, &self.kin.frames[i].jw, torque),
+        }
     }
 
     /// A generalised force on coordinate `i` of the wrapped model.
     pub fn generalized_force(&mut self, i: usize, value: f64) {
         self.qg[i] += value;
+    }
+}
+
+/// w[..3] += f
+fn add3(w: &mut [f64], f: [f64; 3]) {
+    for (w, f) in w.iter_mut().zip(f) {
+        *w += f;
     }
 }
 
@@ -165,6 +207,9 @@ struct Scratch {
     c: Vec<f64>,
     qg: Vec<f64>,
     xd: Vec<f64>,
+    /// the wrenches summed for [`Model::transmit`] and what it makes of them
+    wrenches: Vec<f64>,
+    transmitted: Vec<f64>,
     qg1: Vec<f64>,
     xd1: Vec<f64>,
     qp: Vec<f64>,
@@ -208,6 +253,8 @@ impl<M: Model + 'static, E: Efforts> WithEfforts<M, E> {
             c: z(n * n),
             qg: z(n),
             xd: z(nx),
+            wrenches: z(6 * M::NFRAMES + 3 * M::NPOINTS),
+            transmitted: z(n),
             qg1: z(n),
             xd1: z(nx),
             qp: z(big),
@@ -268,6 +315,13 @@ fn extended_info<M: Model + 'static, E: Efforts>(inner: &'static ModelInfo) -> &
 }
 
 impl<M: Model, E: Efforts> WithEfforts<M, E> {
+    /// Whether the user part's efforts are summed as wrenches and carried to the
+    /// coordinates by [`Model::transmit`] on the poses and velocities of [`Model::motion`]
+    /// ([`Efforts::reads_jacobians`]).
+    fn transmits(&self) -> bool {
+        M::MOTION_GENERATED && !self.user.borrow().reads_jacobians()
+    }
+
     /// The user part at (t, q, qd, u) (q, qd of length NQ_M + NX) into `qg` (NQ_M) and `xd`
     /// (NX); false (with the failure kept) when it fails or gives a non-finite value.
     fn user(
@@ -280,7 +334,9 @@ impl<M: Model, E: Efforts> WithEfforts<M, E> {
         into_1: bool,
     ) -> bool {
         let n = M::NQ;
-        if E::FRAMES {
+        if self.transmits() {
+            self.model.motion(t, &q[..n], &qd[..n], &mut s.kin);
+        } else if E::FRAMES {
             self.model.kinematics(t, &q[..n], &qd[..n], &mut s.kin);
         } else {
             self.model
@@ -310,7 +366,12 @@ impl<M: Model, E: Efforts> WithEfforts<M, E> {
         qg.fill(0.0);
         xd.fill(0.0);
         crate::charts::read_charts(&self.model, &mut s.charts);
+        let transmits = self.transmits();
         let mut user = self.user.borrow_mut();
+        let wrenches = transmits.then(|| {
+            s.wrenches.fill(0.0);
+            &mut s.wrenches[..]
+        });
         let mut e = Effort {
             t,
             q: &q[..n],
@@ -320,13 +381,22 @@ impl<M: Model, E: Efforts> WithEfforts<M, E> {
             kin: &s.kin,
             charts: &s.charts,
             qg,
+            wrenches,
             rejected: false,
         };
         let r = user
             .efforts(&mut e)
             .and_then(|_| user.state_derivatives(&e, xd));
+        let rejected = e.rejected;
+        if r.is_ok() && transmits {
+            self.model
+                .transmit(t, &q[..n], &s.wrenches, &mut s.transmitted);
+            for (g, w) in qg.iter_mut().zip(&s.transmitted) {
+                *g += w;
+            }
+        }
         if let Err(message) = r {
-            self.fail(if e.rejected {
+            self.fail(if rejected {
                 Failure::EffortRejected { t, message }
             } else {
                 Failure::UserEffort { t, message }

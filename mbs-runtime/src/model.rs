@@ -661,6 +661,10 @@ pub trait Model {
     /// on [`F64x4`] (`option batch;`); otherwise they call the one-state functions lane by
     /// lane
     const BATCH_GENERATED: bool = false;
+    /// whether [`Model::motion`] and [`Model::transmit`] are generated (`option motion;`):
+    /// the poses and velocities without Jacobians, and the generalised forces of wrenches by
+    /// one inward pass of the tree; otherwise both go through [`Model::kinematics`]
+    const MOTION_GENERATED: bool = false;
     /// the parameters marked `sensitive` in the model (`param k = 1e4 sensitive;`), in
     /// declaration order: the columns of [`Model::parameter_tangents`]
     const SENSITIVE: &'static [&'static str] = &[];
@@ -1062,6 +1066,44 @@ pub trait Model {
     /// of `kinematics` are 3,264 here), the default all of [`Model::kinematics`].
     fn motion(&self, t: f64, q: &[f64], qd: &[f64], out: &mut Kinematics) {
         self.kinematics(t, q, qd, out);
+    }
+
+    /// Writes into `qg` (NQ) the generalised forces Q = Σ J_vᵀ F + J_ωᵀ T of wrenches given in `f`,
+    /// world axes: for frame i a force at its origin `f[6i..6i + 3]` and a torque
+    /// `f[6i + 3..6i + 6]`, then for declared point j a force `f[6 NFRAMES + 3j..][..3]`
+    /// (length 6 NFRAMES + 3 NPOINTS). Models generated with `option motion;` carry the
+    /// wrenches to the coordinates by one inward pass of the tree, O(n), without a Jacobian
+    /// ([`Model::MOTION_GENERATED`]); the default reads the Jacobians of
+    /// [`Model::kinematics`] in buffers it allocates at each call.
+    fn transmit(&self, t: f64, q: &[f64], f: &[f64], qg: &mut [f64]) {
+        let n = Self::NQ;
+        let frame = FrameKinematics {
+            jv: vec![0.0; 3 * n],
+            jw: vec![0.0; 3 * n],
+            ..Default::default()
+        };
+        let point = PointKinematics {
+            jv: vec![0.0; 3 * n],
+            ..Default::default()
+        };
+        let mut kin = Kinematics {
+            frames: vec![frame; Self::NFRAMES],
+            points: vec![point; Self::NPOINTS],
+        };
+        self.kinematics(t, q, &vec![0.0; n], &mut kin);
+        let nf = Self::NFRAMES;
+        qg.fill(0.0);
+        let dot = |j: &[f64], k: usize, w: &[f64]| {
+            j[3 * k] * w[0] + j[3 * k + 1] * w[1] + j[3 * k + 2] * w[2]
+        };
+        for (k, g) in qg.iter_mut().enumerate().take(n) {
+            for (i, fr) in kin.frames.iter().enumerate() {
+                *g += dot(&fr.jv, k, &f[6 * i..]) + dot(&fr.jw, k, &f[6 * i + 3..]);
+            }
+            for (j, p) in kin.points.iter().enumerate() {
+                *g += dot(&p.jv, k, &f[6 * nf + 3 * j..]);
+            }
+        }
     }
 
     /// A failure of user code during the evaluations since the last call (efforts written in

@@ -1889,6 +1889,12 @@ impl Tracking {
 }
 
 impl Efforts for Tracking {
+    /// only the ankle strategy of a balance reads Jacobians (the feet's); the pelvis' torque
+    /// and the guard's forces are transmitted without them
+    fn reads_jacobians(&self) -> bool {
+        self.balance.as_ref().is_some_and(|b| b.ankle[0] != 0.0)
+    }
+
     fn efforts(&mut self, e: &mut Effort) -> Result<(), String> {
         self.guard.apply(e)?;
         let (q, qd) = (e.q, e.qd);
@@ -2334,6 +2340,10 @@ impl<E: Efforts> Efforts for OnTerrain<E> {
 
     fn initial_states(&self, x: &mut [f64]) {
         self.inner.initial_states(x)
+    }
+
+    fn reads_jacobians(&self) -> bool {
+        self.inner.reads_jacobians()
     }
 
     fn efforts(&mut self, e: &mut Effort) -> Result<(), String> {
@@ -2921,6 +2931,10 @@ impl PassiveJoints {
 impl Efforts for PassiveJoints {
     const NX: usize = 17;
     const STATE_NAMES: &'static [&'static str] = &PASSIVE_STATES;
+
+    fn reads_jacobians(&self) -> bool {
+        self.tracking.as_ref().is_some_and(|t| t.reads_jacobians())
+    }
 
     fn efforts(&mut self, e: &mut Effort) -> Result<(), String> {
         if self.tracking.is_none() {

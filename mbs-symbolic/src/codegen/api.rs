@@ -124,6 +124,15 @@ pub const MOTION: Method = method(
     "",
 );
 
+/// `transmit`, which has a default in the trait (through the Jacobians of `kinematics`) that
+/// models with `option motion;` override with one inward pass of the tree: the generalised
+/// forces of wrenches on the frames and forces at the points (`f`, world axes) into `qg`.
+pub const TRANSMIT: Method = method(
+    "transmit",
+    "t: f64, q: &[f64], f: &[f64], qg: &mut [f64]",
+    "",
+);
+
 /// `parameter_tangents`, which has a default in the trait (an error) that models with
 /// parameters marked `sensitive` override.
 pub const PARAMETER_TANGENTS: Method = method(
@@ -279,6 +288,7 @@ const NPOINTS: usize = {npoints};
 const NC: usize = {nc};
 const FORWARD_DYNAMICS_GENERATED: bool = true;
 const BATCH_GENERATED: bool = {batch};
+const MOTION_GENERATED: bool = {motion};
 "
     );
     if !sensitive.is_empty() {
@@ -311,6 +321,7 @@ const BATCH_GENERATED: bool = {batch};
             &POINT_KINEMATICS,
         ])
         .chain(motion.then_some(&MOTION))
+        .chain(motion.then_some(&TRANSMIT))
         .chain(batch_methods)
         .chain(sensitivity_methods)
         .chain(constraint_methods)

@@ -757,8 +757,14 @@ fn kinematics_specs(
         (fk, "kinematics"),
         (fp, "point_kinematics"),
     ];
-    if model.sys.options.motion {
+    if let Some(q) = &model.transmission {
         specs.push((fm, "motion"));
+        let mut ft = FnSpec::new(
+            "__transmit",
+            &format!("charts: &[[[f64; 3]; 3]], {}", api::TRANSMIT.args),
+        );
+        ft.vector("qg", q);
+        specs.push((ft, "transmit"));
     }
     specs
 }
@@ -1251,7 +1257,7 @@ fn emit_scene(
                 m.call(),
                 name == "kinematics"
             ),
-            name @ ("frames" | "kinematics" | "point_kinematics" | "motion") => {
+            name @ ("frames" | "kinematics" | "point_kinematics" | "motion" | "transmit") => {
                 format!("self.params.__{name}(&self.charts, {})", m.call())
             }
             // M assembled from the twists and composite inertias the generated code writes

@@ -10,7 +10,7 @@ use super::spatial::{self as s, Matrix};
 use super::system::{Jacobians, System};
 use super::tree::Tree;
 use super::world::{Cols, World, composite_inertias};
-use crate::expr::ExprId;
+use crate::expr::{ExprId, Var};
 
 /// Kinematics of a declared point, world axes.
 #[derive(Clone, Debug)]
@@ -78,6 +78,11 @@ pub struct SymbolicModel {
     /// with `assembled`, per node with twists its origin and composite inertia
     /// (`world::composite_inertias`), from which the runtime assembles M
     pub composites: Vec<[ExprId; 13]>,
+    /// with `option motion;`, the generalised forces of wrenches given at run time
+    /// (`Var::Force`: per frame a force at its origin and a torque, then per point a force,
+    /// world axes), Q = Σ J_vᵀ F + J_ωᵀ T carried by one inward pass of the tree
+    /// ([`transmission`])
+    pub transmission: Option<Vec<ExprId>>,
 }
 
 /// Nonzero columns of the frames' and points' Jacobians above which they, and M, are
@@ -233,6 +238,10 @@ impl SymbolicModel {
             })
             .collect();
         let constraints = ConstraintEquations::build(&mut sys, &tree, &world);
+        let transmission = sys
+            .options
+            .motion
+            .then(|| transmission(&mut sys, &tree, &world));
         let assembled = match sys.options.jacobians {
             Some(j) => j == Jacobians::Assembled,
             None => {
@@ -261,6 +270,55 @@ impl SymbolicModel {
             scenes,
             shared_parts,
             constraints,
+            transmission,
         }
     }
+}
+
+/// The generalised forces Q of wrenches on every frame and forces at every point, given at
+/// run time as `f` (`Var::Force`): `f[6i..6i+3]` a force at frame i's origin and
+/// `f[6i+3..6i+6]` a torque on it, then `f[6 NF + 3j..]` a force at point j, all in world
+/// axes. Newton–Euler's inward pass without the bodies (τ is linear in the loads): the
+/// wrenches are carried from node to parent and projected on each factor's motion, O(n),
+/// where Σ Jᵢᵀ Wᵢ reads every frame's Jacobian.
+pub fn transmission(sys: &mut System, tree: &Tree, world: &World) -> Vec<ExprId> {
+    let nf = tree.frame_node.len();
+    let a = &mut sys.arena;
+    let mut input = |k: usize| a.var(Var::Force(k as u16));
+    let mut forces = Vec::new();
+    let mut torques = Vec::new();
+    for (i, &node) in tree.frame_node.iter().enumerate() {
+        // a frame of the ground moves no coordinate
+        if node == 0 {
+            continue;
+        }
+        let f = [input(6 * i), input(6 * i + 1), input(6 * i + 2)];
+        let t = [input(6 * i + 3), input(6 * i + 4), input(6 * i + 5)];
+        forces.push((node, None, f));
+        torques.push((node, t));
+    }
+    for (j, p) in sys.points.iter().enumerate() {
+        let Some(frame) = p.frame else { continue };
+        let node = tree.frame_node[frame];
+        if node == 0 {
+            continue;
+        }
+        let k = 6 * nf + 3 * j;
+        forces.push((node, Some(p.pos), [input(k), input(k + 1), input(k + 2)]));
+    }
+    let zero3 = s::zero3(a);
+    let loads = Loads {
+        gravity: None,
+        forces: forces
+            .into_iter()
+            .map(|(n, r, f)| (n, r.unwrap_or(zero3), f))
+            .collect(),
+        torques,
+        generalized: Vec::new(),
+        elastic_potential: None,
+        power: None,
+    };
+    // τ = −Q of the loads
+    let tau = load_tau(sys, tree, world, &loads);
+    tau.into_iter().map(|t| sys.arena.neg(t)).collect()
 }

@@ -512,6 +512,11 @@ impl Efforts for MuscleDriven {
     const NX: usize = PASSIVE_N + 2 * NM;
     const STATE_NAMES: &'static [&'static str] = &STATES;
 
+    /// the muscles pull at their paths' points, which needs no Jacobian
+    fn reads_jacobians(&self) -> bool {
+        self.passive.reads_jacobians()
+    }
+
     fn efforts(&mut self, e: &mut Effort) -> Result<(), String> {
         self.passive.efforts(e)?;
         for i in 0..NM {
@@ -546,6 +551,10 @@ impl Efforts for MuscleDriven {
 pub struct MusclesAtRest(pub MuscleDriven);
 
 impl Efforts for MusclesAtRest {
+    fn reads_jacobians(&self) -> bool {
+        self.0.reads_jacobians()
+    }
+
     fn efforts(&mut self, e: &mut Effort) -> Result<(), String> {
         let MuscleDriven { passive, muscles } = &mut self.0;
         passive.guard.apply(e)?;

@@ -423,3 +423,47 @@ fn transmit_is_the_jacobians_transposed() {
         }
     }
 }
+
+/// A user part that says it reads no Jacobian (`Efforts::reads_jacobians` false) and reads
+/// one all the same finds it NaN, and the run stops with a typed error at its first
+/// evaluation, the trajectory before it kept; the same user part saying it reads them runs.
+#[test]
+fn a_jacobian_read_where_the_efforts_are_transmitted_stops_the_run_typed() {
+    #[derive(Clone)]
+    struct Reads<const SAYS: bool>;
+    impl<const SAYS: bool> mbs::Efforts for Reads<SAYS> {
+        fn reads_jacobians(&self) -> bool {
+            SAYS
+        }
+        fn efforts(&mut self, e: &mut mbs::Effort) -> Result<(), String> {
+            let j = e.frame(1).jw[3 * 6 + 2];
+            e.torque_on_frame(1, [0.0, 0.0, -0.1 * j]);
+            Ok(())
+        }
+    }
+    let (g, _, _) = both_forms().remove(0);
+    let options = mbs::Options::adaptive(0.1, 1e-6);
+    let ok = mbs::simulate(
+        mbs::WithEfforts::new(g.clone(), Reads::<true>),
+        mbs::Scheme::Dopri5,
+        options.clone(),
+    );
+    assert!(ok.is_ok(), "{:?}", ok.err().map(|e| e.to_string()));
+    let e = mbs::simulate(
+        mbs::WithEfforts::new(g, Reads::<false>),
+        mbs::Scheme::Dopri5,
+        options,
+    )
+    .expect_err("a NaN Jacobian read");
+    assert!(
+        matches!(&e.kind, mbs::Failure::NonFinite { quantity, .. } if *quantity == "user effort"),
+        "{e}"
+    );
+    assert_eq!(e.t, 0.0, "{e}");
+    assert!(
+        e.to_string()
+            .contains("`Efforts::reads_jacobians` is false"),
+        "{e}"
+    );
+    println!("{e}");
+}

@@ -66,8 +66,13 @@ pub trait Efforts: 'static {
     /// `option motion;` ([`Model::MOTION_GENERATED`]), each evaluation computes the poses
     /// and velocities alone ([`Model::motion`]) and carries the forces and torques the user
     /// part adds to generalised forces by one inward pass of the tree ([`Model::transmit`]):
-    /// no Jacobian is computed, and the Jacobians and bias accelerations are left unset.
+    /// no Jacobian is computed, and the Jacobians and bias accelerations are NaN (a user
+    /// part that reads them all the same stops with [`Failure::NonFinite`]).
     /// Without the option the Jacobians are computed and read as when it is true.
+    /// `transmit` takes a wrench on every frame and a force at every point: where the
+    /// efforts act at a few points of a large model and read nothing else, the points'
+    /// Jacobians ([`Efforts::FRAMES`] false) may cost less (`mbs expand FILE --counts-only`
+    /// gives both counts).
     fn reads_jacobians(&self) -> bool {
         true
     }
@@ -131,7 +136,7 @@ impl Effort<'_> {
 
     /// Kinematics of frame (or body) `i` (`ModelInfo::frame_index`); unset when the user
     /// part says it reads no frames ([`Efforts::FRAMES`]), its Jacobians and bias
-    /// accelerations unset when the efforts are transmitted ([`Efforts::reads_jacobians`]).
+    /// accelerations NaN when the efforts are transmitted ([`Efforts::reads_jacobians`]).
     pub fn frame(&self, i: usize) -> &FrameKinematics {
         &self.kin.frames[i]
     }
@@ -182,6 +187,20 @@ impl Effort<'_> {
     }
 }
 
+/// What `motion` does not compute, set to NaN.
+fn unset(kin: &mut Kinematics) {
+    for f in &mut kin.frames {
+        f.jv.fill(f64::NAN);
+        f.jw.fill(f64::NAN);
+        f.bias_acceleration = [f64::NAN; 3];
+        f.bias_angular_acceleration = [f64::NAN; 3];
+    }
+    for p in &mut kin.points {
+        p.jv.fill(f64::NAN);
+        p.bias_acceleration = [f64::NAN; 3];
+    }
+}
+
 /// w[..3] += f
 fn add3(w: &mut [f64], f: [f64; 3]) {
     for (w, f) in w.iter_mut().zip(f) {
@@ -210,6 +229,10 @@ struct Scratch {
     /// the wrenches summed for [`Model::transmit`] and what it makes of them
     wrenches: Vec<f64>,
     transmitted: Vec<f64>,
+    /// whether the Jacobians and bias accelerations in `kin` are NaN: set before the first
+    /// evaluation whose efforts are transmitted, so that a user part that reads them
+    /// anyway stops with [`Failure::NonFinite`] rather than reading stale values
+    unset_nan: bool,
     qg1: Vec<f64>,
     xd1: Vec<f64>,
     qp: Vec<f64>,
@@ -255,6 +278,7 @@ impl<M: Model + 'static, E: Efforts> WithEfforts<M, E> {
             xd: z(nx),
             wrenches: z(6 * M::NFRAMES + 3 * M::NPOINTS),
             transmitted: z(n),
+            unset_nan: false,
             qg1: z(n),
             xd1: z(nx),
             qp: z(big),
@@ -335,10 +359,16 @@ impl<M: Model, E: Efforts> WithEfforts<M, E> {
     ) -> bool {
         let n = M::NQ;
         if self.transmits() {
+            if !s.unset_nan {
+                unset(&mut s.kin);
+                s.unset_nan = true;
+            }
             self.model.motion(t, &q[..n], &qd[..n], &mut s.kin);
         } else if E::FRAMES {
+            s.unset_nan = false;
             self.model.kinematics(t, &q[..n], &qd[..n], &mut s.kin);
         } else {
+            s.unset_nan = false;
             self.model
                 .point_kinematics(t, &q[..n], &qd[..n], &mut s.kin);
         }
@@ -413,10 +443,19 @@ impl<M: Model, E: Efforts> WithEfforts<M, E> {
                     .map(|k| self.info.dof_label(n + k))
             });
         if let Some(coordinate) = bad {
+            // where the Jacobians are NaN, reading them is the likely cause
+            let cause = if transmits {
+                "; the efforts are transmitted (`Efforts::reads_jacobians` is false), so the \
+                 Jacobians and bias accelerations the user part is handed are NaN: a user part \
+                 that reads them must say so"
+                    .to_string()
+            } else {
+                String::new()
+            };
             self.fail(Failure::NonFinite {
                 quantity: "user effort",
                 coordinate,
-                cause: String::new(),
+                cause,
             });
             return false;
         }

@@ -237,6 +237,25 @@ fn assembled_form_generates_fewer_operations() {
     assert!(a < g, "{a} vs {g}");
 }
 
+/// A state of the human model: (q, qd).
+fn human_state() -> (Vec<f64>, Vec<f64>) {
+    let n = mbs_models::human::Human::NQ;
+    let q = (0..n)
+        .map(|i| 0.1 * ((i * 37 % 11) as f64 - 5.0) / 5.0)
+        .collect();
+    let qd = (0..n)
+        .map(|i| 0.5 * ((i * 53 % 13) as f64 - 6.0) / 6.0)
+        .collect();
+    (q, qd)
+}
+
+/// The flops of the human model's generated function `label` (`mbs expand --counts-only`).
+fn human_flops(human: &mbs_models::human::Human, label: &str) -> usize {
+    let ops = &human.info().ops;
+    let row = ops.iter().find(|(l, _)| *l == label);
+    row.unwrap_or_else(|| panic!("no row {label}")).1.flops()
+}
+
 /// `motion` (`option motion;`) is `kinematics` less its Jacobians and bias accelerations: the
 /// poses and velocities of every frame and point the same to the bit, on the mechanism in both
 /// forms and on the human model, and what it does not compute left as it was; without the
@@ -285,20 +304,12 @@ fn motion_is_kinematics_without_its_jacobians() {
     dpend.motion(0.1, &[0.3, -0.2], &[1.0, 0.5], &mut moved);
     assert_eq!(full, moved);
     let human = mbs_models::human::Human::default();
-    let n = mbs_models::human::Human::NQ;
-    let q: Vec<f64> = (0..n)
-        .map(|i| 0.1 * ((i * 37 % 11) as f64 - 5.0) / 5.0)
-        .collect();
-    let qd: Vec<f64> = (0..n)
-        .map(|i| 0.5 * ((i * 53 % 13) as f64 - 6.0) / 6.0)
-        .collect();
+    let (q, qd) = human_state();
     check(&human, 0.0, &q, &qd, "human");
-    let flops = |label: &str| {
-        let ops = &human.info().ops;
-        let row = ops.iter().find(|(l, _)| *l == label);
-        row.unwrap_or_else(|| panic!("no row {label}")).1.flops()
-    };
-    let (motion, kinematics) = (flops("motion"), flops("kinematics"));
+    let (motion, kinematics) = (
+        human_flops(&human, "motion"),
+        human_flops(&human, "kinematics"),
+    );
     println!("human model: motion {motion} flops, kinematics {kinematics}");
     assert!(3 * motion < kinematics, "{motion} against {kinematics}");
     let thousands = |n: usize| format!("{},{:03}", n / 1000, n % 1000);
@@ -353,31 +364,14 @@ fn transmit_is_the_jacobians_transposed() {
         }
     }
     let human = mbs_models::human::Human::default();
-    let q: Vec<f64> = (0..mbs_models::human::Human::NQ)
-        .map(|i| 0.1 * ((i * 37 % 11) as f64 - 5.0) / 5.0)
-        .collect();
-    worst = worst.max(check(&human, 0.0, &q, "human"));
+    worst = worst.max(check(&human, 0.0, &human_state().0, "human"));
     // a model without the option: the default, through the Jacobians
     let dpend = mbs_models::dpend::DoublePendulum::default();
     const { assert!(!mbs_models::dpend::DoublePendulum::MOTION_GENERATED) };
     check(&dpend, 0.0, &[0.3, -0.2], "dpend");
     println!("transmitted Q within {worst:.1e} of Σ Jᵀ W (relative to its largest entry)");
-    let transmit = human
-        .info()
-        .ops
-        .iter()
-        .find(|(l, _)| *l == "transmit")
-        .expect("a row transmit")
-        .1
-        .flops();
-    let kinematics = human
-        .info()
-        .ops
-        .iter()
-        .find(|(l, _)| *l == "kinematics")
-        .unwrap()
-        .1
-        .flops();
+    let transmit = human_flops(&human, "transmit");
+    let kinematics = human_flops(&human, "kinematics");
     assert!(transmit < kinematics / 2, "{transmit} against {kinematics}");
     quoted::says(
         "README.md",

@@ -209,7 +209,7 @@ fn add3(w: &mut [f64], f: [f64; 3]) {
 }
 
 /// qg += Jᵀ f for a 3 × n Jacobian stored column-major (`j[3k + i]`).
-fn add_jt(qg: &mut [f64], j: &[f64], f: [f64; 3]) {
+pub(crate) fn add_jt(qg: &mut [f64], j: &[f64], f: [f64; 3]) {
     for (k, g) in qg.iter_mut().enumerate() {
         *g += j[3 * k] * f[0] + j[3 * k + 1] * f[1] + j[3 * k + 2] * f[2];
     }

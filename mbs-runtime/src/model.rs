@@ -1075,34 +1075,21 @@ pub trait Model {
     /// wrenches to the coordinates by one inward pass of the tree, O(n), without a Jacobian
     /// ([`Model::MOTION_GENERATED`]); the default reads the Jacobians of
     /// [`Model::kinematics`] in buffers it allocates at each call.
-    fn transmit(&self, t: f64, q: &[f64], f: &[f64], qg: &mut [f64]) {
-        let n = Self::NQ;
-        let frame = FrameKinematics {
-            jv: vec![0.0; 3 * n],
-            jw: vec![0.0; 3 * n],
-            ..Default::default()
-        };
-        let point = PointKinematics {
-            jv: vec![0.0; 3 * n],
-            ..Default::default()
-        };
-        let mut kin = Kinematics {
-            frames: vec![frame; Self::NFRAMES],
-            points: vec![point; Self::NPOINTS],
-        };
-        self.kinematics(t, q, &vec![0.0; n], &mut kin);
-        let nf = Self::NFRAMES;
+    fn transmit(&self, t: f64, q: &[f64], f: &[f64], qg: &mut [f64])
+    where
+        Self: Sized,
+    {
+        let mut kin = Kinematics::new::<Self>();
+        self.kinematics(t, q, &vec![0.0; Self::NQ], &mut kin);
+        let three = |w: &[f64]| [w[0], w[1], w[2]];
         qg.fill(0.0);
-        let dot = |j: &[f64], k: usize, w: &[f64]| {
-            j[3 * k] * w[0] + j[3 * k + 1] * w[1] + j[3 * k + 2] * w[2]
-        };
-        for (k, g) in qg.iter_mut().enumerate().take(n) {
-            for (i, fr) in kin.frames.iter().enumerate() {
-                *g += dot(&fr.jv, k, &f[6 * i..]) + dot(&fr.jw, k, &f[6 * i + 3..]);
-            }
-            for (j, p) in kin.points.iter().enumerate() {
-                *g += dot(&p.jv, k, &f[6 * nf + 3 * j..]);
-            }
+        for (i, fr) in kin.frames.iter().enumerate() {
+            crate::efforts::add_jt(qg, &fr.jv, three(&f[6 * i..]));
+            crate::efforts::add_jt(qg, &fr.jw, three(&f[6 * i + 3..]));
+        }
+        let nf = Self::NFRAMES;
+        for (j, p) in kin.points.iter().enumerate() {
+            crate::efforts::add_jt(qg, &p.jv, three(&f[6 * nf + 3 * j..]));
         }
     }
 

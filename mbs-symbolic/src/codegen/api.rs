@@ -240,7 +240,7 @@ pub struct Sizes {
     pub charts: usize,
     /// `option batch;`: the model overrides the methods of [`BATCH`]
     pub batch: bool,
-    /// `option motion;`: the model overrides [`MOTION`]
+    /// `option motion;`: the model overrides [`MOTION`] and [`TRANSMIT`]
     pub motion: bool,
     /// the parameters marked `sensitive` (field names): the model overrides
     /// [`PARAMETER_TANGENTS`] and [`START_SENSITIVITIES`] and sets `SENSITIVE`
@@ -299,6 +299,11 @@ const MOTION_GENERATED: bool = {motion};
         ));
     }
     let batch_methods = if *batch { &BATCH[..] } else { &[] };
+    let motion_methods = if *motion {
+        &[MOTION, TRANSMIT][..]
+    } else {
+        &[]
+    };
     let sensitivity_methods = match (sensitive.is_empty(), rest_derivatives) {
         (true, _) => &[][..],
         (false, false) => &[PARAMETER_TANGENTS, START_SENSITIVITIES][..],
@@ -320,8 +325,7 @@ const MOTION_GENERATED: bool = {motion};
             &FORWARD_DYNAMICS_FORCED,
             &POINT_KINEMATICS,
         ])
-        .chain(motion.then_some(&MOTION))
-        .chain(motion.then_some(&TRANSMIT))
+        .chain(motion_methods)
         .chain(batch_methods)
         .chain(sensitivity_methods)
         .chain(constraint_methods)

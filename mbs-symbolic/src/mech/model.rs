@@ -284,6 +284,7 @@ impl SymbolicModel {
 pub fn transmission(sys: &mut System, tree: &Tree, world: &World) -> Vec<ExprId> {
     let nf = tree.frame_node.len();
     let a = &mut sys.arena;
+    let zero3 = s::zero3(a);
     let mut input = |k: usize| a.var(Var::Force(k as u16));
     let mut forces = Vec::new();
     let mut torques = Vec::new();
@@ -294,7 +295,7 @@ pub fn transmission(sys: &mut System, tree: &Tree, world: &World) -> Vec<ExprId>
         }
         let f = [input(6 * i), input(6 * i + 1), input(6 * i + 2)];
         let t = [input(6 * i + 3), input(6 * i + 4), input(6 * i + 5)];
-        forces.push((node, None, f));
+        forces.push((node, zero3, f));
         torques.push((node, t));
     }
     for (j, p) in sys.points.iter().enumerate() {
@@ -304,15 +305,11 @@ pub fn transmission(sys: &mut System, tree: &Tree, world: &World) -> Vec<ExprId>
             continue;
         }
         let k = 6 * nf + 3 * j;
-        forces.push((node, Some(p.pos), [input(k), input(k + 1), input(k + 2)]));
+        forces.push((node, p.pos, [input(k), input(k + 1), input(k + 2)]));
     }
-    let zero3 = s::zero3(a);
     let loads = Loads {
         gravity: None,
-        forces: forces
-            .into_iter()
-            .map(|(n, r, f)| (n, r.unwrap_or(zero3), f))
-            .collect(),
+        forces,
         torques,
         generalized: Vec::new(),
         elastic_potential: None,

@@ -308,7 +308,8 @@ pub struct Options {
     pub tangent_form: TangentForm,
     /// emit `dynamics_x4` and `forward_dynamics_x4`: four states at once on SIMD lanes
     pub batch: bool,
-    /// emit `motion`: the poses and velocities of `kinematics` without its Jacobians
+    /// emit `motion`, the poses and velocities of `kinematics` without its Jacobians, and
+    /// `transmit`, the generalised forces of wrenches by one inward pass of the tree
     pub motion: bool,
     /// force a formulation; `None` picks the cheaper by op count
     pub formulation: Option<Formulation>,

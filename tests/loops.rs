@@ -1164,12 +1164,13 @@ fn a_change_point_of_a_loop_stops_the_run_rather_than_switching_branch() {
     let change_points = (1..10)
         .filter(|&k| (a0..=a1).contains(&(k as f64 * PI)))
         .count();
-    let radau3_fine = [
+    let radau_fine = [
+        format!("radau5 Index3 {:?}", adaptive(1e-8)),
         format!("radau3 Index3 {:?}", adaptive(1e-8)),
         format!("radau3 Index2 {:?}", adaptive(1e-8)),
     ];
-    let which = if at_h_min == radau3_fine {
-        "Radau3 at rtol 1e-8, index 3 and 2".to_string()
+    let which = if at_h_min == radau_fine {
+        "at rtol 1e-8 Radau5 at index 3, Radau3 at index 3 and 2".to_string()
     } else {
         at_h_min.join("; ")
     };

@@ -9,7 +9,10 @@ use mbs_models::seed2dof;
 mod quoted;
 #[path = "common/sweeps.rs"]
 mod sweeps;
-use mbs::{BdfParams, Failure, GenAlphaParams, Options, Output, Scheme, StepControl, simulate};
+use mbs::{
+    BdfParams, ConstraintMethod, Failure, GenAlphaParams, Options, Output, Scheme, StepControl,
+    simulate,
+};
 use mbs_models::fastlink::FastLink;
 use mbs_models::undefined_force::{EarlyForce, LateForce};
 use seed2dof::Seed2dof;
@@ -342,15 +345,33 @@ fn an_rtol_beyond_a_schemes_floor_is_said() {
     }
 }
 
-/// At index 3 the Newmark family holds 0.07·rtol^1.5, floored at 10³ε: on a closed loop
-/// (fastlink, gen-α at index 3, its default) rtol 5e-8 is held, 1e-8 is not.
+/// At index 3 the Newmark family holds 0.07·rtol^1.5, floored at 10³ε, and Radau5
+/// 3·rtol^(4/3), floored at 10⁵ε: on a closed loop (fastlink, gen-α at index 3, its default)
+/// rtol 5e-8 is held, 1e-8 is not; Radau5 at index 3 holds 5e-9 and not 4e-9, and with
+/// projection RADAU5's transformation has no floor.
 #[test]
 fn an_rtol_beyond_the_index3_floor_is_said() {
     let gen_alpha = Scheme::GenAlpha(GenAlphaParams::from_rho_inf(0.8));
-    for (rtol, floor) in [(5e-8, None), (1e-8, Some(1e3 * f64::EPSILON))] {
-        let o = quiet(Options::adaptive(2e-4, rtol));
-        let (_, stats) = simulate(FastLink::default(), gen_alpha, o).unwrap();
-        assert_eq!(stats.tolerance_floor, floor, "rtol {rtol:e}");
+    let eps = f64::EPSILON;
+    for (scheme, method, rtol, floor) in [
+        (gen_alpha, ConstraintMethod::Auto, 5e-8, None),
+        (gen_alpha, ConstraintMethod::Auto, 1e-8, Some(1e3 * eps)),
+        (Scheme::Radau5, ConstraintMethod::Index3, 5e-9, None),
+        (
+            Scheme::Radau5,
+            ConstraintMethod::Index3,
+            4e-9,
+            Some(1e5 * eps),
+        ),
+        (Scheme::Radau5, ConstraintMethod::Projection, 4e-9, None),
+    ] {
+        let mut o = quiet(Options::adaptive(2e-4, rtol));
+        o.constraints.method = method;
+        let (_, stats) = simulate(FastLink::default(), scheme, o).unwrap();
+        assert_eq!(
+            stats.tolerance_floor, floor,
+            "{scheme:?} {method:?} at rtol {rtol:e}"
+        );
     }
 }
 

@@ -107,7 +107,9 @@ pub enum ErrorTest {
 
     /// positions, and the positions that the velocities' and multipliers' errors move in one
     /// step, h e_v + h² M_ii⁻¹(Bᵀe_λ)_i (Radau IIA at index 3; Hairer's RADAU5 weighs them by
-    /// h and h² in their own units): velocities and multipliers follow the step size, not rtol
+    /// h and h² in their own units): the velocities' and multipliers' errors follow the step
+    /// size; Radau5 maps rtol' = 3·rtol^(4/3) so that its velocities follow rtol, Radau3's
+    /// 0.1·rtol bounds the positions only, and the multipliers follow rtol under neither
     PositionsScaledVelocities,
 }
 
@@ -264,7 +266,7 @@ impl fmt::Display for Stats {
         if let Some(floor) = self.tolerance_floor {
             write!(
                 f,
-                "\nrtol asks more than this scheme's local error test holds: its tolerance stopped at its floor {floor:.1e}, so expect fewer digits than rtol (radau5 follows rtol further)"
+                "\nrtol asks more than this scheme's local error test holds: its tolerance stopped at its floor {floor:.1e}, so expect fewer digits than rtol (radau5 with projection, its default, follows rtol further)"
             )?;
         }
         if let Some(h) = &self.held_most {

@@ -39,9 +39,9 @@
 //! error test sees.
 //!
 //! Printed, not asserted: Radau3 at index 3 (its velocities of order 2 follow rtol^⅔ under its
-//! error test's h e_v; mapped as Radau5's, rtol' = c·rtol^1.5, it stalls at 4.5–7.5 digits
-//! from rtol 1e-6 or 1e-7 on and stops at h_min on fastlink at 1e-6, where the rounding of its
-//! stage multipliers, ∝ ε/h², holds Newton).
+//! error test's h e_v; mapped as Radau5's, rtol' = 0.1·rtol^1.5, it stalled at 4.5–7.5
+//! digits from rtol 1e-5, 1e-6 or 1e-7 on and stopped at h_min on fastlink at 1e-6, Newton
+//! failing there).
 //!
 //! Global error control (`mbs::simulate_global`) is what makes rtol a bound on these errors:
 //! every sweep runs again under it at rtol 1e-4, 1e-6 and 1e-8 (the schemes of order 2 and 3

@@ -354,15 +354,16 @@
 //! rtol 1e-4, 5.18 at 1e-10). Radau5 at index 3 therefore holds rtol' = 3·rtol^(4/3), the
 //! exponent (s+1)/s that makes the velocities follow rtol, not below 10⁵ε (reached from rtol
 //! ≈ 4.5e-9); its digits follow rtol from 1e-4 to 1e-8 in the proportionality sweeps, where
-//! they are asserted. Also measured: c = 0.3 and 0.1, up to a digit more than c = 3 for 1.7×
-//! and 2.2× the steps (the four-bar at rtol 1e-6), and above the other schemes, whose median
-//! they lifted; floors of 100ε and 10⁴ε, under which fastlink stopped at h_min from rtol
+//! they are asserted. Also measured: c = 0.3 and 0.1, up to 1.3 and 1.6 digits more than
+//! c = 3 (at rtol 1e-4) for 1.7× and 2.2× its steps (the four-bar at rtol 1e-6), and above
+//! the other schemes, whose median they lifted; floors of 100ε and 10⁴ε, under which fastlink stopped at h_min from rtol
 //! 1e-8, its velocity's error 8.3e-14 against a weight of 4.0e-14 set by rounding (the stage
 //! velocities' rounding grows as ε/h). It costs steps: the four-bar to 2 s at rtol 1e-6
 //! takes 1,254 steps where the transformation took 314 (projection: 297). Radau3 at index 3
-//! keeps 0.1·rtol and is not asserted: mapped alike (c·rtol^1.5 or c·rtol^1.25) it stalled
-//! at 4.5–7.5 digits from rtol 1e-6 or 1e-7 on and stopped at h_min on fastlink at 1e-6 or
-//! 1e-7, its multipliers of order 1 and their rounding ∝ ε/h² holding Newton.
+//! keeps 0.1·rtol and is not asserted: mapped alike (0.1·rtol^1.5 or 0.05·rtol^1.25) it
+//! stalled at 4.5–7.5 digits from rtol 1e-5, 1e-6 or 1e-7 on and stopped at h_min on
+//! fastlink at 1e-6 or 1e-7 (Newton failing there: its multipliers are of order 1 at index
+//! 3, and their rounding grows as ε/h²).
 //!
 //! ## Files
 //! Here the step (`attempt`) and its control; `newton.rs`: the simplified Newton iteration and

@@ -690,15 +690,24 @@ fn every_dt_ends_on_t_end_and_a_failed_last_output_run_keeps_its_state() {
     assert!(e.t > 0.0);
 }
 
-/// A step that shrank for Newton's sake is not blamed on the error test: fastlink at index 3
-/// under Radau3 at rtol 1e-9 fails its Newton iterations down to h_min, then accepts a step
-/// there with an error 6e-4 of its tolerance. The predictive correction took the shrinking
-/// for the error's trend and cut the next step by 5, below h_min, and the run stopped with
-/// "the step fell below h_min … raise atol"; it now says that Newton did not converge there.
+/// A step that shrank for Newton's sake is not blamed on the error test: fastlink at index 2
+/// under Radau3 at rtol 1e-9 and atol 1e-14 fails its Newton iterations down to h_min at
+/// t = 6.4e-8 s, no step rejected by its error, and says that Newton did not converge there.
+/// The case that first showed it, fastlink at index 3 at rtol 1e-9, accepted a step at h_min
+/// with an error 6e-4 of its tolerance, and the predictive correction took the shrinking for
+/// the error's trend and cut the next step by 5, below h_min ("the step fell below h_min …
+/// raise atol"): Radau now restarts that correction after a failed Newton iteration. That case
+/// runs to its end since Radau3's tolerance at index 3 has its floor, and this one ends alike
+/// with or without the restart (measured): no case known now reaches the restart.
 #[test]
 fn a_step_shrunk_by_newton_is_not_blamed_on_the_error_test() {
     let mut o = quiet(Options::adaptive(0.03, 1e-9));
-    o.constraints.method = mbs::ConstraintMethod::Index3;
+    o.step = StepControl::Adaptive {
+        rtol: 1e-9,
+        atol: 1e-14,
+        h0: None,
+    };
+    o.constraints.method = mbs::ConstraintMethod::Index2;
     let e = simulate(FastLink::default(), Scheme::Radau3, o).unwrap_err();
     println!("{e}\n{}", e.stats);
     assert!(

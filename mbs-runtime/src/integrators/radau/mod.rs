@@ -85,8 +85,8 @@
 //! ## Step control
 //! RADAU5's, but for the tolerances: Radau5 transforms them as RADAU5 does, rtol' =
 //! 0.1·rtol^((s+1)/(2s)) = 0.1·rtol^(2/3), atol' = rtol'·atol/rtol; Radau3 maps them linearly,
-//! rtol' = 0.1·rtol (not below 100ε), atol' likewise, so that its global error follows rtol
-//! ("What rtol means", below);
+//! rtol' = 0.1·rtol (not below 100ε), atol' likewise, so that its global error follows rtol;
+//! at index 3 both hold 3·rtol^((s+1)/s) ("What rtol means", below);
 //! h_new = h/q with q = err^(1/(s+1))/fac clamped to [1/8, 5], fac = min(0.9, 0.9(1 + 2k_max)/
 //! (k + 2k_max)) for k Newton iterations, and Gustafsson's predictive controller (ACM TOMS 20,
 //! 1994) on accepted steps: q ← max(q, (h_acc/h)(err²/err_acc)^(1/(s+1))/0.9), err_acc and
@@ -359,11 +359,20 @@
 //! the other schemes, whose median they lifted; floors of 100ε and 10⁴ε, under which fastlink stopped at h_min from rtol
 //! 1e-8, its velocity's error 8.3e-14 against a weight of 4.0e-14 set by rounding (the stage
 //! velocities' rounding grows as ε/h). It costs steps: the four-bar to 2 s at rtol 1e-6
-//! takes 1,254 steps where the transformation took 314 (projection: 297). Radau3 at index 3
-//! keeps 0.1·rtol and is not asserted: mapped alike (0.1·rtol^1.5 or 0.05·rtol^1.25) it
-//! stalled at 4.5–7.5 digits from rtol 1e-5, 1e-6 or 1e-7 on and stopped at h_min on
-//! fastlink at 1e-6 or 1e-7 (Newton failing there: its multipliers are of order 1 at index
-//! 3, and their rounding grows as ε/h²).
+//! takes 1,254 steps where the transformation took 314 (projection: 297).
+//!
+//! Radau3 at index 3 holds 3·rtol^1.5 alike, not below 2e-9 (reached from rtol ≈ 7.6e-7),
+//! and its digits follow rtol from 1e-4 to 1e-6, where they are asserted. Unmapped (0.1·rtol)
+//! they fell 1.6–2.6 digits short on average; mapped without a floor they gained half a digit
+//! per decade from rtol 1e-6 to 1e-8 on the four-bar and slider-crank (a), stalled from 1e-8
+//! on on every loop (5.4–7.4 digits), and fastlink stopped at h_min from rtol 1e-7 on, Newton
+//! failing there (its multipliers are of order s − 1 = 1 at index 3, and their rounding grows
+//! as ε/h²); with the floor every run reaches its end, at 4.4–6.2 digits below rtol 1e-6.
+//! Also measured: 0.1·rtol^1.5 and 0.05·rtol^1.25, which stalled at 4.5–7.5 digits from
+//! rtol 1e-5, 1e-6 or 1e-7 on and stopped at h_min on fastlink at 1e-6 or 1e-7.
+//! A floor holds for every rtol below the one that reaches it, though it is looser than
+//! rtol there (before, rtol' fell back to rtol below the floor, so that Radau3 at index 3
+//! took rtol' = 1e-10 at rtol 1e-10 and stopped at h_min on fastlink at t = 4.5e-9).
 //!
 //! ## Files
 //! Here the step (`attempt`) and its control; `newton.rs`: the simplified Newton iteration and
@@ -406,32 +415,47 @@ const MATRIX_R2: &str = "the Radau index-2 iteration matrix [M + hγ₀C + h²γ
 /// RADAU5's factor with the exponent of the global error, (s+1)/(2s−1) = 1.
 const RADAU3_TOL_FACTOR: f64 = 0.1;
 
-/// Radau5's local tolerance per unit of the user's rtol^(4/3) at index 3: rtol' =
-/// 3·rtol^(4/3), the exponent (s+1)/s of velocities of order s ("What rtol means").
-const RADAU5_INDEX3_TOL_FACTOR: f64 = 3.0;
+/// Radau's local tolerance per unit of the user's rtol^((s+1)/s) at index 3: rtol' =
+/// 3·rtol^(4/3) for Radau5, 3·rtol^1.5 for Radau3, the exponent (s+1)/s of velocities of
+/// order s ("What rtol means").
+const INDEX3_TOL_FACTOR: f64 = 3.0;
 
 /// The least local tolerance of Radau5 at index 3, 10⁵ε: below it the rounding of the stage
 /// velocities and multipliers (∝ ε/h and ε/h²) holds the error test, and fastlink's runs
 /// stopped at h_min ("What rtol means").
 const RADAU5_INDEX3_FLOOR: f64 = 1e5 * f64::EPSILON;
 
+/// The least local tolerance of Radau3 at index 3, 2e-9 (reached from rtol ≈ 7.6e-7): its
+/// velocities' digits stall below it (its multipliers are of order 1 at index 3, s − 1), and
+/// fastlink's runs stopped at h_min from rtol 1e-7 on ("What rtol means").
+const RADAU3_INDEX3_FLOOR: f64 = 2e-9;
+
 /// The local tolerance rtol' the error test holds for the user's `rtol`, with the floor when
-/// it set it (`Stats::tolerance_floor`). Radau5: RADAU5's transformation 0.1·rtol^((s+1)/(2s)),
-/// at index 3 3·rtol^(4/3) not below 10⁵ε; Radau3: the global error's mapping
-/// c·rtol^((s+1)/(2s−1)), linear for s = 2, not below 100ε, where rounding would hold the
-/// error test; these two never looser than rtol.
+/// it set it (`Stats::tolerance_floor`). Radau5: RADAU5's transformation 0.1·rtol^((s+1)/(2s));
+/// Radau3: the global error's mapping c·rtol^((s+1)/(2s−1)), linear for s = 2, not below 100ε,
+/// where rounding would hold the error test; at index 3 3·rtol^((s+1)/s), not below 10⁵ε
+/// (Radau5) or 2e-9 (Radau3). All but RADAU5's transformation are never looser than rtol,
+/// but for their floors: the least rtol' the scheme holds, for every rtol below.
 fn local_rtol(rtol: f64, s: usize, index3: bool) -> (f64, Option<f64>) {
     let (mapped, floor) = match (s, index3) {
-        (2, _) => (RADAU3_TOL_FACTOR * rtol, 100.0 * f64::EPSILON),
         (_, true) => (
-            RADAU5_INDEX3_TOL_FACTOR * rtol.powf((s + 1) as f64 / s as f64),
-            RADAU5_INDEX3_FLOOR,
+            INDEX3_TOL_FACTOR * rtol.powf((s + 1) as f64 / s as f64),
+            if s == 2 {
+                RADAU3_INDEX3_FLOOR
+            } else {
+                RADAU5_INDEX3_FLOOR
+            },
         ),
+        (2, _) => (RADAU3_TOL_FACTOR * rtol, 100.0 * f64::EPSILON),
         // looser than rtol below rtol 1e-3, as in RADAU5
         _ => return (0.1 * rtol.powf((s + 1) as f64 / (2 * s) as f64), None),
     };
-    let r = mapped.max(floor).min(rtol);
-    (r, (mapped < floor && floor < rtol).then_some(r))
+    let r = mapped.min(rtol);
+    if r < floor {
+        (floor, Some(floor))
+    } else {
+        (r, None)
+    }
 }
 
 /// The weights of Newton and of the error test, Newton's κ and its iteration limit.
@@ -446,7 +470,7 @@ struct Tol {
 }
 
 impl Tol {
-    fn new(ctl: &Control, s: usize, p: &Problem) -> Tol {
+    fn new(ctl: &Control, s: usize, index3: bool, p: &Problem) -> Tol {
         use crate::options::{COSTLY_COORDINATES, COSTLY_KEEP_BELOW, RADAU5_KEEP_BELOW};
         let keep_below = ctl.newton.keep_below.unwrap_or(
             if p.n >= COSTLY_COORDINATES && p.matrices_by_differences() {
@@ -457,7 +481,7 @@ impl Tol {
         );
         match ctl.adaptive {
             Some(Tolerances { rtol, atol, groups }) => {
-                let r = local_rtol(rtol, s, p.loops.index3().is_some()).0;
+                let r = local_rtol(rtol, s, index3).0;
                 Tol {
                     weights: Tolerances {
                         rtol: r,
@@ -682,6 +706,11 @@ impl Radau {
     pub fn radau5(n: usize) -> Radau {
         Radau::new(n, 3)
     }
+
+    /// Whether the run integrates a closed loop at index 3 (its own tolerance map and floor).
+    fn index3(&self) -> bool {
+        self.nc > 0 && !self.index2
+    }
 }
 
 /// The growth of the Newton-limited step per accepted step, and the fraction of it the error
@@ -699,7 +728,7 @@ impl Stepper for Radau {
     }
 
     fn tolerance_floor(&self, rtol: f64) -> Option<f64> {
-        local_rtol(rtol, self.k.s, self.nc > 0 && !self.index2).1
+        local_rtol(rtol, self.k.s, self.index3()).1
     }
 
     fn error_test(&self, p: &Problem) -> ErrorTest {
@@ -750,7 +779,7 @@ impl Stepper for Radau {
     fn attempt(&mut self, step: Step<'_>) -> Result<Attempt, Failure> {
         let Step(p, cur, h, ctl, next) = step;
         let (s, n) = (self.k.s, self.n);
-        let tol = Tol::new(ctl, s, p);
+        let tol = Tol::new(ctl, s, self.index3(), p);
         // Newton's weights, like the error test's, not below the rounding of the values the
         // stages handle: 100ε (or rtol', if tighter) times the largest position
         // |q| + h|qd| + h²|qdd| and the largest velocity |qd| + h|qdd|. Without it a start at

@@ -41,9 +41,9 @@
 //!
 //! Radau3 at index 3 (rtol' = 3·rtol^1.5, floor 2e-9, reached from rtol ≈ 7.6e-7) is
 //! asserted to rtol 1e-6. Mapped without a floor it gained half a digit per decade from 1e-6
-//! to 1e-8 on the four-bar and slider-crank (a), stalled from 1e-8 on on every loop at 5.4–7.4
-//! digits, and stopped at h_min on fastlink from rtol 1e-7 on, Newton failing there (its
-//! multipliers are of order 1 at index 3); with the floor every run reaches its end, at 4.4–6.2
+//! to 1e-8 on the four-bar and slider-crank (a), stalled from 1e-8 on on the other loops but
+//! fastlink at 5.4–7.4 digits, and failed on fastlink from rtol 1e-7 on (its multipliers are
+//! of order 1 at index 3); with the floor every run reaches its end, at 4.4–6.2
 //! digits below rtol 1e-6. Unmapped (0.1·rtol, the positions alone bounded) it fell 1.6–2.6
 //! digits short of rtol on average, 4.71 digits at rtol 1e-6 on Cash's pendulum against the
 //! median's 6.14.

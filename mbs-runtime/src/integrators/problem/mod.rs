@@ -19,7 +19,7 @@ pub(crate) use matrices::model_error_reason;
 mod projection;
 mod watch;
 
-use super::constrained::{Constrained, Mode};
+use super::constrained::Constrained;
 use crate::erased::OwnedModel;
 use crate::error::Failure;
 use crate::linalg::{PIVOT_FLOOR, cholesky, cholesky_solve};
@@ -108,11 +108,6 @@ impl Loops {
             Loops::Open => None,
             Loops::Closed(c) => Some(c),
         }
-    }
-
-    /// The constraints when closed and solved at index 3 by the scheme itself.
-    pub fn index3(&self) -> Option<&Constrained> {
-        self.closed().filter(|c| c.mode == Mode::Index3)
     }
 }
 

@@ -365,9 +365,9 @@
 //! and its digits follow rtol from 1e-4 to 1e-6, where they are asserted. Unmapped (0.1·rtol)
 //! they fell 1.6–2.6 digits short on average; mapped without a floor they gained half a digit
 //! per decade from rtol 1e-6 to 1e-8 on the four-bar and slider-crank (a), stalled from 1e-8
-//! on on every loop (5.4–7.4 digits), and fastlink stopped at h_min from rtol 1e-7 on, Newton
-//! failing there (its multipliers are of order s − 1 = 1 at index 3, and their rounding grows
-//! as ε/h²); with the floor every run reaches its end, at 4.4–6.2 digits below rtol 1e-6.
+//! on on the other loops but fastlink (5.4–7.4 digits), and failed on fastlink from rtol 1e-7
+//! on (its multipliers are of order s − 1 = 1 at index 3, and their rounding grows as ε/h²);
+//! with the floor every run reaches its end, at 4.4–6.2 digits below rtol 1e-6.
 //! Also measured: 0.1·rtol^1.5 and 0.05·rtol^1.25, which stalled at 4.5–7.5 digits from
 //! rtol 1e-5, 1e-6 or 1e-7 on and stopped at h_min on fastlink at 1e-6 or 1e-7.
 //! A floor holds for every rtol below the one that reaches it, though it is looser than
@@ -427,7 +427,7 @@ const RADAU5_INDEX3_FLOOR: f64 = 1e5 * f64::EPSILON;
 
 /// The least local tolerance of Radau3 at index 3, 2e-9 (reached from rtol ≈ 7.6e-7): its
 /// velocities' digits stall below it (its multipliers are of order 1 at index 3, s − 1), and
-/// fastlink's runs stopped at h_min from rtol 1e-7 on ("What rtol means").
+/// fastlink's runs failed from rtol 1e-7 on ("What rtol means").
 const RADAU3_INDEX3_FLOOR: f64 = 2e-9;
 
 /// The local tolerance rtol' the error test holds for the user's `rtol`, with the floor when
@@ -731,8 +731,8 @@ impl Stepper for Radau {
         local_rtol(rtol, self.k.s, self.index3()).1
     }
 
-    fn error_test(&self, p: &Problem) -> ErrorTest {
-        if p.loops.index3().is_some() {
+    fn error_test(&self, _p: &Problem) -> ErrorTest {
+        if self.index3() {
             ErrorTest::PositionsScaledVelocities
         } else {
             // the ODE, the index-1 forms, and the stabilized index-2 form, where positions

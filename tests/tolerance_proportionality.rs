@@ -22,7 +22,7 @@
 //!   is 4.9.) Five sweeps are held to 1.5 digits, as measured: DOPRI5 with partitioning on
 //!   fastlink (1.22–1.26 digits below the median from rtol 1e-6 to 1e-8; with projection it is
 //!   within 0.3 of it), on the four-bar and on the Cartesian double pendulum (up to 1.27 and
-//!   1.11 below from rtol 1e-6 to 1e-8, where Radau5's runs at index 3, asserted since their
+//!   1.04 below from rtol 1e-6 to 1e-8, where Radau5's runs at index 3, asserted since their
 //!   tolerance was mapped, lift the median; within a digit before); neither its error
 //!   estimate's dependent part mapped through the completion, −B_d⁻¹B_i e_i, nor
 //!   interpolated samples completed brought it closer: the first made it
@@ -43,7 +43,7 @@
 //! asserted to rtol 1e-6. Mapped without a floor it gained half a digit per decade from 1e-6
 //! to 1e-8 on the four-bar and slider-crank (a), stalled from 1e-8 on on the other loops but
 //! fastlink at 5.4–7.4 digits, and failed on fastlink from rtol 1e-7 on (its multipliers are
-//! of order 1 at index 3); with the floor every run reaches its end, at 4.4–6.2
+//! of order 1 at index 3); with the floor every run reaches its end, at 4.3–6.1
 //! digits below rtol 1e-6. Unmapped (0.1·rtol, the positions alone bounded) it fell 1.6–2.6
 //! digits short of rtol on average, 4.71 digits at rtol 1e-6 on Cash's pendulum against the
 //! median's 6.14.

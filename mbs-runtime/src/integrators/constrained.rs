@@ -93,6 +93,10 @@ pub(crate) struct Constrained {
     /// solve's are judged, and those of B Bᵀ (in `bbt`), against which the states after the
     /// steps of index-3 and index-2 forms are judged
     watch_tol: f64,
+    /// the ratio of the watch's last judgement (the pivot that fell most against its start
+    /// value; 1 before any): σ_min(B)² against the start's, by which rounding errors in Φ
+    /// and Φ̇ are amplified squared in the coordinates that solve them
+    pub fallen: f64,
     start_s: Vec<f64>,
     start_bbt: Vec<f64>,
     bbt: Vec<f64>,
@@ -140,6 +144,7 @@ impl Constrained {
             rate0: z(nc),
             phi_tp: z(nc),
             watch_tol: 0.0,
+            fallen: 1.0,
             start_s: z(nc),
             start_bbt: z(nc),
             bbt: z(nc * nc),
@@ -200,6 +205,7 @@ impl Constrained {
             LoopMatrix::Gram => (&self.bbt, &self.start_bbt),
         };
         let ratio = Self::fallen(factor, start, self.nc);
+        self.fallen = ratio;
         if ratio < self.watch_tol {
             return Err(self.singular_loop(m, st, at.0, at.1, matrix, ratio));
         }

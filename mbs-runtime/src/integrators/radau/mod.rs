@@ -146,9 +146,13 @@
 //! `ConstraintOptions::tolerance`. At index 3 rounding errors ε·max|q| in the stage values of Φ
 //! move the stage λ by up to ‖A⁻²‖∞ ε max|q|/h² (22 and 125 ε/h² for s = 2, 3, with (BM⁻¹Bᵀ)⁻¹
 //! taken as 1) and, through δA = M⁻¹Bᵀ δΛ, the stage velocities by ‖A⁻¹‖∞ ε max|q|/h (7 and 18
-//! ε/h); the weights of λ and velocity corrections are floored at these noise levels over κ, so
-//! that Newton stops at the noise instead of stalling on it (without the floors the pendulum's
-//! step collapsed at rtol 1e-13).
+//! ε/h), and the stage positions by ε max|q| itself, at every h; the weights of position,
+//! velocity and λ corrections are floored at these noise levels over κ, so that Newton stops
+//! at the noise instead of stalling on it (without the floors of λ and velocities the
+//! pendulum's step collapsed at rtol 1e-13; without that of the positions the parallelogram's
+//! under Radau5 at rtol 1e-8, 0.12 rad before its change point). Near a change point the
+//! noise grows as B's smallest singular value σ falls: times σ₀/σ, and λ's times (σ₀/σ)², from
+//! the ratio (σ/σ₀)² of the loops' watch at its last judgement (`Options::singularity_tol`).
 //!
 //! Error estimate: RADAU5's for E y' = f(y) with a singular E, on y = (q, v, λ), E = diag(I, M,
 //! 0), f = (v, h + Bᵀλ, Φ): err = (E − gJ)⁻¹[γ₀h f(y₀) + E Σ e_i Z_i], g = hγ₀, whose λ row is
@@ -359,7 +363,7 @@
 //! the other schemes, whose median they lifted; floors of 100ε and 10⁴ε, under which fastlink stopped at h_min from rtol
 //! 1e-8, its velocity's error 8.3e-14 against a weight of 4.0e-14 set by rounding (the stage
 //! velocities' rounding grows as ε/h). It costs steps: the four-bar to 2 s at rtol 1e-6
-//! takes 1,254 steps where the transformation took 314 (projection: 297).
+//! takes 1,243 steps where the transformation took 314 (projection: 297).
 //!
 //! Radau3 at index 3 holds 3·rtol^1.5 alike, not below 2e-9 (reached from rtol ≈ 7.6e-7),
 //! and its digits follow rtol from 1e-4 to 1e-6, where they are asserted. Unmapped (0.1·rtol)
@@ -367,7 +371,7 @@
 //! per decade from rtol 1e-6 to 1e-8 on the four-bar and slider-crank (a), stalled from 1e-8
 //! on on the other loops but fastlink (5.4–7.4 digits), and failed on fastlink from rtol 1e-7
 //! on (its multipliers are of order s − 1 = 1 at index 3, and their rounding grows as ε/h²);
-//! with the floor every run reaches its end, at 4.4–6.2 digits below rtol 1e-6.
+//! with the floor every run reaches its end, at 4.3–6.1 digits below rtol 1e-6.
 //! Also measured: 0.1·rtol^1.5 and 0.05·rtol^1.25, which stalled at 4.5–7.5 digits from
 //! rtol 1e-5, 1e-6 or 1e-7 on and stopped at h_min on fastlink at 1e-6 or 1e-7.
 //! A floor holds for every rtol below the one that reaches it, though it is looser than
@@ -795,6 +799,28 @@ impl Stepper for Radau {
         }
         // (BM⁻¹Bᵀ)⁻¹ B below, taken as σ from M and B at the last Jacobian
         let sigma = || super::constrained::multiplier_scale(largest(&self.m), &self.bm);
+        // Rounding floors of Newton's weights where it iterates on the loops (index 3 and 2;
+        // Newton stops when its predicted error is below κ times the weights, so a weight
+        // below a value's rounding over κ asks for digits no iteration gives). The stage
+        // positions solve Φ = 0, so rounding errors ε·max|q| in the stage values of Φ move
+        // them by as much at every h (the stages' sums alone leave h²‖A²δ‖): without this
+        // floor Newton saw no contraction in that noise at small steps, each failure halving
+        // h (the parallelogram under Radau5 at index 3 at rtol 1e-8, κ = 3.4e-5, went down
+        // to h_min 0.12 rad before its change point, where the loop's watch now stops it).
+        // Near a change point B's smallest singular value σ falls, and the positions,
+        // velocities and multipliers that solve Φ and Φ̇ take their rounding errors times
+        // σ₀/σ (λ times (σ₀/σ)²), the watch's ratio (σ/σ₀)² (Radau3 at index 2, same run:
+        // Newton at h_min 0.045 rad before it, now its error test 0.010 rad before it)
+        let q_scale = cur.q.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+        let amplified = p
+            .loops
+            .closed()
+            .map_or(1.0, |c| 1.0 / c.fallen.clamp(1e-12, 1.0).sqrt());
+        let noise_q = if self.nc > 0 {
+            amplified * f64::EPSILON * q_scale / tol.kappa
+        } else {
+            0.0
+        };
         if self.index2 {
             // λ, an index-2 component, weighted by h in Newton as RADAU5 weights them (the
             // error test counts it by the velocities it moves, module notes); neither λ nor
@@ -805,14 +831,17 @@ impl Stepper for Radau {
             // when the rocker's velocity passes through zero with rtol' near 1e-11) and the
             // stage λ by that over h (times (BM⁻¹Bᵀ)⁻¹, taken as 1)
             let vmax = cur.qd.iter().fold(1.0f64, |m, x| m.max(x.abs()));
-            let noise = 4.0 * f64::EPSILON * vmax / tol.kappa;
+            let noise = amplified * 4.0 * f64::EPSILON * vmax / tol.kappa;
             let sigma = sigma();
             for r in 0..n {
+                self.scq[r] += noise_q;
                 self.scv[r] += noise;
             }
             for r in 0..self.nc {
-                self.scl[r] =
-                    (tol.weights.atol + tol.weights.rtol * cur.lambda[r].abs() + noise * sigma) / h;
+                self.scl[r] = (tol.weights.atol
+                    + tol.weights.rtol * cur.lambda[r].abs()
+                    + noise * sigma * amplified)
+                    / h;
             }
         } else if self.nc > 0 {
             // λ and the velocities to the Newton tolerance, but not below their rounding
@@ -820,16 +849,16 @@ impl Stepper for Radau {
             // rounding errors ε·max|q| in the stage values of Φ move the stage λ by up to
             // ‖A⁻²‖∞ ε max|q|/h² (times (BM⁻¹Bᵀ)⁻¹, taken as 1) and, through
             // δA = M⁻¹Bᵀ δΛ, the stage velocities by up to ‖A⁻¹‖∞ ε max|q|/h
-            let qmax = cur.q.iter().fold(1.0f64, |m, x| m.max(x.abs()));
-            let noise = f64::EPSILON * qmax / (tol.kappa * h);
+            let noise = noise_q / h;
             let sigma = sigma();
             for r in 0..n {
+                self.scq[r] += noise_q;
                 self.scv[r] += noise * self.ainv;
             }
             for r in 0..self.nc {
                 self.scl[r] = tol.weights.atol
                     + tol.weights.rtol * cur.lambda[r].abs()
-                    + noise * self.a2inv * sigma / h;
+                    + noise * self.a2inv * sigma * amplified / h;
             }
         }
         self.h_try = h;

@@ -44,8 +44,8 @@
 use crate::plot::{Chart, Series, line_chart};
 use crate::{
     ConstraintMethod, ConstraintOptions, CsvWriter, Failure, GlobalControl, GlobalReport, HeldBy,
-    HeldMost, Inputs, Model, Options, Output, Scheme, SimError, Simulation, Stats, StepControl,
-    Trajectory, error::short, simulate_global,
+    HeldMost, Inputs, Model, NearChangePoint, Options, Output, Scheme, SimError, Simulation, Stats,
+    StepControl, Trajectory, error::short, simulate_global,
 };
 /// `RunArgs::parse()` needs this trait in scope: programs can name it without depending on
 /// clap themselves (`use mbs::cli::Parser;`).
@@ -280,20 +280,28 @@ pub fn failure_text(e: &SimError) -> String {
             h_min,
             held_by,
             jump: Some(order),
+            near_change_point,
             ..
         } if !held_by.as_ref().is_some_and(|b| b.ran_away()) => format!(
-            "the step fell below {h_min:e} s {at}: {}{}",
+            "the step fell below {h_min:e} s {at}: {}{}{}",
             HeldBy::jump(*order, "--atol"),
             held_by
                 .as_ref()
                 .map(|b| format!("; {}", b.held()))
-                .unwrap_or_default()
+                .unwrap_or_default(),
+            NearChangePoint::clause(near_change_point)
         ),
-        Failure::StepTooSmall { h_min, held_by, .. } => {
+        Failure::StepTooSmall {
+            h_min,
+            held_by,
+            near_change_point,
+            ..
+        } => {
+            let near = NearChangePoint::clause(near_change_point);
             match held_by.as_ref().and_then(|b| b.fix("--atol", "--rtol")) {
-                Some(fix) => format!("the step fell below {h_min:e} s {at}: {fix}"),
+                Some(fix) => format!("the step fell below {h_min:e} s {at}: {fix}{near}"),
                 None => format!(
-                    "the step fell below {h_min:e} s {at}: the solution may be singular or too stiff for the scheme (try --scheme radau5 or bdf){}",
+                    "the step fell below {h_min:e} s {at}: the solution may be singular or too stiff for the scheme (try --scheme radau5 or bdf){}{near}",
                     held_by
                         .as_ref()
                         .map(|b| format!("; {}", b.held()))
@@ -306,6 +314,7 @@ pub fn failure_text(e: &SimError) -> String {
             iterations,
             correction,
             largest,
+            ..
         } => format!(
             "Newton did not converge in {iterations} iterations at the fixed step (last correction {correction:.2e}{}) {at}: take a smaller step, e.g. --h {:.1e}, or an adaptive one (no --h)",
             largest

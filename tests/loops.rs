@@ -1096,11 +1096,21 @@ fn a_change_point_of_a_loop_stops_the_run_rather_than_switching_branch() {
                         let Failure::SingularLoop { constraints, .. } = &e.kind else {
                             // a step that cannot be made near the change point is no switch
                             // (its error test or its Newton iteration failing at h_min)
-                            let what = match e.kind {
-                                Failure::StepTooSmall { .. } => "its error test",
-                                Failure::NewtonDiverged { fixed: false, .. } => "Newton",
+                            let (what, near) = match &e.kind {
+                                Failure::StepTooSmall {
+                                    near_change_point, ..
+                                } => ("its error test", near_change_point),
+                                Failure::NewtonDiverged {
+                                    fixed: false,
+                                    near_change_point,
+                                    ..
+                                } => ("Newton", near_change_point),
                                 _ => panic!("{name}: {e}"),
                             };
+                            // and it says that the loops are near a change point
+                            let near = near.unwrap_or_else(|| panic!("{name}: {e}"));
+                            assert!(near.ratio < 100.0 * near.tolerance, "{name}: {e}");
+                            assert!(e.to_string().contains("near a change point"), "{e}");
                             // the crank's angle before the change point a = kπ
                             let a = PI / 3.0 + 5.0 * e.t;
                             let before = (a / PI).ceil() * PI - a;
@@ -1177,7 +1187,10 @@ fn a_change_point_of_a_loop_stops_the_run_rather_than_switching_branch() {
                 Some((run, rest)) => format!("{run} at rtol {}", rest.split(',').next().unwrap()),
                 None => words,
             };
-            format!("{words}, {what} failing at h_min {before:.3} rad before it")
+            format!(
+                "{words}, {what} failing at h_min {before:.3} rad before it, which its message \
+                 says is near a change point"
+            )
         })
         .collect();
     quoted::says(

@@ -124,6 +124,40 @@ pub struct HeldBy {
     pub start: Option<f64>,
 }
 
+/// Closed loops near a change point or dead centre when a step failed at h_min: the pivot
+/// ratio the loops' watch last judged ([`Options::singularity_tol`](crate::Options)), within a
+/// hundred times the threshold at which it stops the run with [`Failure::SingularLoop`]. Near
+/// there B's rounding errors are amplified (by σ₀/σ in the coordinates that solve Φ and Φ̇,
+/// (σ₀/σ)² in λ) and a step may fail for that before the watch speaks: the parallelogram
+/// four-bar under Radau3 at index 2 at rtol 1e-8 stopped in its error test, held by the
+/// folding angle's velocity, 0.010 rad before its change point, at a ratio of 1.2e-4.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct NearChangePoint {
+    /// the pivot of B Bᵀ or S = B M⁻¹ Bᵀ that fell most, against its start value
+    pub ratio: f64,
+    /// `Options::singularity_tol`
+    pub tolerance: f64,
+}
+
+impl NearChangePoint {
+    /// How far within the threshold a ratio counts as near: a hundred times it.
+    pub const NEAR: f64 = 100.0;
+
+    /// The clause a failure's message ends with, empty when `near` is none.
+    pub fn clause(near: &Option<NearChangePoint>) -> String {
+        near.map(|n| {
+            format!(
+                "; the closed loops are near a change point or dead centre (a pivot of their \
+                 constraints' matrix fell to {:.1e} of its start value; singularity_tol = {:.0e} \
+                 stops the run there with SingularLoop), where rounding errors grow as the \
+                 pivot falls and a step may fail for that: loosen atol or end the run before it",
+                n.ratio, n.tolerance
+            )
+        })
+        .unwrap_or_default()
+    }
+}
+
 /// The coordinate (its position or velocity) or multiplier whose term weighed most in the
 /// error tests of the most accepted steps of a run: what kept the steps small when a run runs
 /// out of steps.
@@ -360,9 +394,10 @@ pub enum Failure {
     #[error("invalid parameters: {0}")]
     InvalidParameters(ParamError),
     #[error(
-        "the step fell below h_min = {h_min:e}{}{}",
+        "the step fell below h_min = {h_min:e}{}{}{}",
         if *given { ", the floor given in Options::h_min" } else { "" },
-        HeldBy::clause(held_by, *given, *jump)
+        HeldBy::clause(held_by, *given, *jump),
+        NearChangePoint::clause(near_change_point)
     )]
     StepTooSmall {
         h_min: f64,
@@ -376,6 +411,8 @@ pub enum Failure {
         /// below 1.5: forces that are not smooth within the step, a jump (about 1) or a law
         /// that switches with the state (about 0) ([`HeldBy::jump`])
         jump: Option<f64>,
+        /// closed loops near a change point when the step failed
+        near_change_point: Option<NearChangePoint>,
     },
     #[error(
         "more than {max_steps} steps: {}{}",
@@ -391,13 +428,14 @@ pub enum Failure {
         cause: OutOfSteps,
     },
     #[error(
-        "Newton did not converge in {iterations} iterations (last correction {correction:.2e}{}) {}",
+        "Newton did not converge in {iterations} iterations (last correction {correction:.2e}{}) {}{}",
         largest.as_ref().map(|c| format!(", largest in {c}")).unwrap_or_default(),
         if *fixed {
             "at the fixed step, which is not reduced: take a smaller step (StepControl::Fixed)"
         } else {
             "at the smallest step allowed (h_min)"
-        }
+        },
+        NearChangePoint::clause(near_change_point)
     )]
     NewtonDiverged {
         iterations: usize,
@@ -406,6 +444,8 @@ pub enum Failure {
         largest: Option<String>,
         /// whether the step was the user's fixed step (else the adaptive step at h_min)
         fixed: bool,
+        /// closed loops near a change point when the step failed
+        near_change_point: Option<NearChangePoint>,
     },
     #[error(
         "{matrix} is singular (rcond ≈ {rcond:.1e}){}{cause}",

@@ -169,6 +169,18 @@ impl Constrained {
         }
     }
 
+    /// The watch's last ratio when within [`NearChangePoint::NEAR`] times its threshold;
+    /// none without the watch.
+    pub fn near_change_point(&self) -> Option<crate::error::NearChangePoint> {
+        use crate::error::NearChangePoint;
+        (self.watch_tol > 0.0 && self.fallen < NearChangePoint::NEAR * self.watch_tol).then_some(
+            NearChangePoint {
+                ratio: self.fallen,
+                tolerance: self.watch_tol,
+            },
+        )
+    }
+
     /// The Cholesky factor of B Bᵀ (of `self.b`) into `bbt`.
     fn gram(&mut self) -> Result<(), Singular> {
         let (n, nc) = (self.n, self.nc);

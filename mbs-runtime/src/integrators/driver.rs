@@ -688,6 +688,7 @@ impl Run {
                 held_by,
                 given: self.options.h_min.is_some(),
                 jump,
+                near_change_point: self.near_change_point(),
             });
             return Err(self.fail(kind, h));
         }
@@ -844,6 +845,7 @@ impl Run {
                         correction,
                         largest,
                         fixed,
+                        near_change_point: self.near_change_point(),
                     });
                     return Err(self.fail(kind, h));
                 }
@@ -853,6 +855,11 @@ impl Run {
             }
         }
         Ok(false)
+    }
+
+    /// The closed loops near a change point, for a step that failed at h_min.
+    fn near_change_point(&self) -> Option<crate::error::NearChangePoint> {
+        self.problem.loops.closed()?.near_change_point()
     }
 
     fn check_next(&self) -> Result<(), Failure> {

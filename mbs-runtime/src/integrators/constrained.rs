@@ -94,8 +94,9 @@ pub(crate) struct Constrained {
     /// steps of index-3 and index-2 forms are judged
     watch_tol: f64,
     /// the ratio of the watch's last judgement (the pivot that fell most against its start
-    /// value; 1 before any): σ_min(B)² against the start's, by which rounding errors in Φ
-    /// and Φ̇ are amplified squared in the coordinates that solve them
+    /// value; 1 before any), about (σ/σ₀)² for B's smallest singular value σ: rounding errors
+    /// in Φ and Φ̇ grow as its inverse square root in the coordinates that solve them, and as
+    /// its inverse in λ
     pub fallen: f64,
     start_s: Vec<f64>,
     start_bbt: Vec<f64>,

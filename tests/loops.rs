@@ -22,7 +22,7 @@ use dpend_cartesian::DoublePendulumCartesian;
 use fourbar::FourBar;
 use mbs::{
     ConstraintMethod, ConstraintOptions, Failure, GenAlphaParams, HhtParams, Integrator, Model,
-    Options, Output, Scheme, Simulation, StepControl, Trajectory, simulate,
+    NearChangePoint, Options, Output, Scheme, Simulation, StepControl, Trajectory, simulate,
 };
 use slidercrank::{SliderCrank, SliderCrankClosed};
 use std::f64::consts::PI;
@@ -1109,7 +1109,10 @@ fn a_change_point_of_a_loop_stops_the_run_rather_than_switching_branch() {
                             };
                             // and it says that the loops are near a change point
                             let near = near.unwrap_or_else(|| panic!("{name}: {e}"));
-                            assert!(near.ratio < 100.0 * near.tolerance, "{name}: {e}");
+                            assert!(
+                                near.ratio < NearChangePoint::NEAR * near.tolerance,
+                                "{name}: {e}"
+                            );
                             assert!(e.to_string().contains("near a change point"), "{e}");
                             // the crank's angle before the change point a = kπ
                             let a = PI / 3.0 + 5.0 * e.t;

@@ -347,9 +347,9 @@ fn an_rtol_beyond_a_schemes_floor_is_said() {
 }
 
 /// At index 3 the Newmark family holds 0.07·rtol^1.5, floored at 10³ε, Radau5
-/// 3·rtol^(4/3), floored at 10⁵ε, and Radau3 3·rtol^1.5, floored at 2e-9: on a closed loop
+/// 3·rtol^(4/3) and Radau3 3·rtol^1.5, both floored at 10⁵ε: on a closed loop
 /// (fastlink, gen-α at index 3, its default) rtol 5e-8 is held, 1e-8 is not; Radau5 at index
-/// 3 holds 5e-9 and not 4e-9, Radau3 1e-6 and not 5e-7; a floor holds for every rtol below
+/// 3 holds 5e-9 and not 4e-9, Radau3 4e-8 and not 3.5e-8; a floor holds for every rtol below
 /// it, though looser than rtol (Radau5 at 1e-12, Radau3 at 1e-10: before, rtol' fell back to
 /// rtol there, and Radau3 at index 3 stopped at h_min on fastlink at rtol 1e-10); with
 /// projection RADAU5's transformation has no floor.
@@ -373,9 +373,19 @@ fn an_rtol_beyond_the_index3_floor_is_said() {
             1e-12,
             Some(1e5 * eps),
         ),
-        (Scheme::Radau3, ConstraintMethod::Index3, 1e-6, None),
-        (Scheme::Radau3, ConstraintMethod::Index3, 5e-7, Some(2e-9)),
-        (Scheme::Radau3, ConstraintMethod::Index3, 1e-10, Some(2e-9)),
+        (Scheme::Radau3, ConstraintMethod::Index3, 4e-8, None),
+        (
+            Scheme::Radau3,
+            ConstraintMethod::Index3,
+            3.5e-8,
+            Some(1e5 * eps),
+        ),
+        (
+            Scheme::Radau3,
+            ConstraintMethod::Index3,
+            1e-10,
+            Some(1e5 * eps),
+        ),
         (Scheme::Radau5, ConstraintMethod::Projection, 4e-9, None),
     ] {
         let mut o = quiet(Options::adaptive(2e-4, rtol));

@@ -381,7 +381,7 @@ pub enum ConstraintMethod {
     /// DAEs: positions of order 2s − 1, velocities s, λ s − 1; the error test counts velocity
     /// and λ errors by the positions they move in a step, h e_v + h² M_ii⁻¹(Bᵀe_λ)_i,
     /// `ErrorTest::PositionsScaledVelocities`; radau5 holds it at 3·rtol^(4/3), so that its
-    /// velocities follow rtol from 1e-4 to 1e-8, radau3 at 3·rtol^1.5, from 1e-4 to 1e-6)
+    /// velocities follow rtol from 1e-4 to 1e-8, radau3 at 3·rtol^1.5, alike)
     Index3,
     /// the stabilized index-2 form of Gear, Gupta & Leimkuhler (1985): Φ(q) = 0 and
     /// Φ̇ = B qd + Φ_t = 0 both enforced, the second by a multiplier μ that corrects the

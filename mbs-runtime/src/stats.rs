@@ -74,8 +74,8 @@ pub struct Stats {
     /// scheme's floor, which it held instead: the run then gives fewer digits than rtol, where
     /// a tighter rtol would otherwise have taken more steps (the Newmark family from rtol ≈
     /// 4e-8 on, its floor 10⁴ε, at index 3 from ≈ 2e-8, its floor 10³ε; RKC from ≈ 2e-9,
-    /// BDF from ≈ 8e-11, their floors 100ε; Radau at index 3, Radau5 from ≈ 4.5e-9, its floor
-    /// 10⁵ε, Radau3 from ≈ 7.6e-7, its floor 2e-9)
+    /// BDF from ≈ 8e-11, their floors 100ε; Radau at index 3, its floor 10⁵ε, Radau5 from
+    /// ≈ 4.5e-9, Radau3 from ≈ 3.8e-8)
     pub tolerance_floor: Option<f64>,
     /// accepted steps whose error test raised some component's weight atol' + rtol'·|y_i| to
     /// its rounding floor, 100ε times the largest entry of its kind (positions, velocities,

@@ -365,13 +365,16 @@
 //! velocities' rounding grows as ε/h). It costs steps: the four-bar to 2 s at rtol 1e-6
 //! takes 1,243 steps where the transformation took 314 (projection: 297).
 //!
-//! Radau3 at index 3 holds 3·rtol^1.5 alike, not below 2e-9 (reached from rtol ≈ 7.6e-7),
-//! and its digits follow rtol from 1e-4 to 1e-6, where they are asserted. Unmapped (0.1·rtol)
-//! they fell 1.6–2.6 digits short on average; mapped without a floor they gained half a digit
-//! per decade from rtol 1e-6 to 1e-8 on the four-bar and slider-crank (a), stalled from 1e-8
-//! on on the other loops but fastlink (5.4–7.4 digits), and failed on fastlink from rtol 1e-7
-//! on (its multipliers are of order s − 1 = 1 at index 3, and their rounding grows as ε/h²);
-//! with the floor every run reaches its end, at 4.3–6.1 digits below rtol 1e-6.
+//! Radau3 at index 3 holds 3·rtol^1.5 alike, not below 10⁵ε either (reached from rtol ≈
+//! 3.8e-8, so that its run at 1e-8 holds the floor), and its digits follow rtol from 1e-4 to
+//! 1e-8, where they are asserted; below, at the floor, they stay at 5.2–7.3. A floor of 10⁴ε
+//! (reached from ≈ 8e-9) lost 0.40–0.63 digits from rtol 1e-7 to 1e-8 on the four-bar and
+//! slider-crank (a) (5.10 → 4.47, 5.47 → 5.07): its multipliers are of order s − 1 = 1 at
+//! index 3, and their rounding grows as ε/h² as the steps shorten. Unmapped (0.1·rtol) its
+//! digits fell 1.6–2.6 short on average. Its floor was 2e-9 (reached from rtol ≈ 7.6e-7) while
+//! Newton weighed the stage positions finer than their rounding: without it, it failed on
+//! fastlink from rtol 1e-7 on. Since, every run reaches its end under Radau5's floor, with
+//! 0.87–1.95 digits more at rtol 1e-8 than under 2e-9.
 //! Also measured: 0.1·rtol^1.5 and 0.05·rtol^1.25, which stalled at 4.5–7.5 digits from
 //! rtol 1e-5, 1e-6 or 1e-7 on and stopped at h_min on fastlink at 1e-6 or 1e-7.
 //! A floor holds for every rtol below the one that reaches it, though it is looser than
@@ -424,31 +427,23 @@ const RADAU3_TOL_FACTOR: f64 = 0.1;
 /// order s ("What rtol means").
 const INDEX3_TOL_FACTOR: f64 = 3.0;
 
-/// The least local tolerance of Radau5 at index 3, 10⁵ε: below it the rounding of the stage
-/// velocities and multipliers (∝ ε/h and ε/h²) holds the error test, and fastlink's runs
-/// stopped at h_min ("What rtol means").
-const RADAU5_INDEX3_FLOOR: f64 = 1e5 * f64::EPSILON;
-
-/// The least local tolerance of Radau3 at index 3, 2e-9 (reached from rtol ≈ 7.6e-7): its
-/// velocities' digits stall below it (its multipliers are of order 1 at index 3, s − 1), and
-/// fastlink's runs failed from rtol 1e-7 on ("What rtol means").
-const RADAU3_INDEX3_FLOOR: f64 = 2e-9;
+/// The least local tolerance of Radau at index 3, 10⁵ε (Radau5 reaches it from rtol ≈ 4.5e-9,
+/// Radau3 from ≈ 3.8e-8): below it the rounding of the stage velocities and multipliers (∝ ε/h
+/// and ε/h²) holds the error test, and fastlink's runs under Radau5 stopped at h_min ("What
+/// rtol means").
+const INDEX3_FLOOR: f64 = 1e5 * f64::EPSILON;
 
 /// The local tolerance rtol' the error test holds for the user's `rtol`, with the floor when
 /// it set it (`Stats::tolerance_floor`). Radau5: RADAU5's transformation 0.1·rtol^((s+1)/(2s));
 /// Radau3: the global error's mapping c·rtol^((s+1)/(2s−1)), linear for s = 2, not below 100ε,
-/// where rounding would hold the error test; at index 3 3·rtol^((s+1)/s), not below 10⁵ε
-/// (Radau5) or 2e-9 (Radau3). All but RADAU5's transformation are never looser than rtol,
+/// where rounding would hold the error test; at index 3 3·rtol^((s+1)/s), not below 10⁵ε.
+/// All but RADAU5's transformation are never looser than rtol,
 /// but for their floors: the least rtol' the scheme holds, for every rtol below.
 fn local_rtol(rtol: f64, s: usize, index3: bool) -> (f64, Option<f64>) {
     let (mapped, floor) = match (s, index3) {
         (_, true) => (
             INDEX3_TOL_FACTOR * rtol.powf((s + 1) as f64 / s as f64),
-            if s == 2 {
-                RADAU3_INDEX3_FLOOR
-            } else {
-                RADAU5_INDEX3_FLOOR
-            },
+            INDEX3_FLOOR,
         ),
         (2, _) => (RADAU3_TOL_FACTOR * rtol, 100.0 * f64::EPSILON),
         // looser than rtol below rtol 1e-3, as in RADAU5

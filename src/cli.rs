@@ -283,12 +283,8 @@ pub fn failure_text(e: &SimError) -> String {
             near_change_point,
             ..
         } if !held_by.as_ref().is_some_and(|b| b.ran_away()) => format!(
-            "the step fell below {h_min:e} s {at}: {}{}{}",
-            HeldBy::jump(*order, "--atol"),
-            held_by
-                .as_ref()
-                .map(|b| format!("; {}", b.held()))
-                .unwrap_or_default(),
+            "the step fell below {h_min:e} s {at}: {}{}",
+            HeldBy::not_smooth(held_by, *order, "--atol"),
             NearChangePoint::clause(near_change_point)
         ),
         Failure::StepTooSmall {

@@ -43,9 +43,9 @@
 
 use crate::plot::{Chart, Series, line_chart};
 use crate::{
-    ConstraintMethod, ConstraintOptions, CsvWriter, Failure, GlobalControl, GlobalReport, HeldBy,
-    HeldMost, Inputs, Model, NearChangePoint, Options, Output, Scheme, SimError, Simulation, Stats,
-    StepControl, Trajectory, error::short, simulate_global,
+    ConstraintMethod, ConstraintOptions, CsvWriter, Failure, FlooredTolerance, GlobalControl,
+    GlobalReport, HeldBy, HeldMost, Inputs, Model, NearChangePoint, Options, Output, Scheme,
+    SimError, Simulation, Stats, StepControl, Trajectory, error::short, simulate_global,
 };
 /// `RunArgs::parse()` needs this trait in scope: programs can name it without depending on
 /// clap themselves (`use mbs::cli::Parser;`).
@@ -271,9 +271,11 @@ pub fn failure_text(e: &SimError) -> String {
             max_steps,
             held_most,
             cause,
+            floored,
         } => format!(
-            "more than {max_steps} steps {at}: {}{}",
+            "more than {max_steps} steps {at}: {}{}{}",
             cause.advice("--max-steps", "--rtol", "a larger --h", "--scheme "),
+            FlooredTolerance::clause(floored, "--rtol"),
             HeldMost::clause(held_most)
         ),
         Failure::StepTooSmall {

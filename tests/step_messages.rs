@@ -398,6 +398,57 @@ fn an_rtol_beyond_the_index3_floor_is_said() {
     }
 }
 
+/// A run that runs out of steps while its local tolerance is at the scheme's floor says so,
+/// and from which rtol on loosening it saves steps: below that rtol every run holds the same
+/// floor (Radau3 at index 3 on fastlink at rtol 1e-10 and 1e-9, its floor 10⁵ε held from rtol
+/// ≈ 3.8e-8 on, take the same steps but for the first); where rtol set the tolerance the message says nothing of
+/// a floor.
+#[test]
+fn a_run_out_of_steps_at_its_tolerance_floor_says_which_rtol_leaves_it() {
+    let run = |rtol: f64| {
+        let mut o = quiet(Options {
+            max_steps: 300,
+            ..Options::adaptive(0.03, rtol)
+        });
+        o.constraints.method = ConstraintMethod::Index3;
+        simulate(FastLink::default(), Scheme::Radau3, o).unwrap_err()
+    };
+    let (tight, tighter) = (run(1e-9), run(1e-10));
+    for e in [&tight, &tighter] {
+        let Failure::TooMuchWork {
+            floored: Some(f), ..
+        } = &e.kind
+        else {
+            panic!("{e}")
+        };
+        assert_eq!(f.floor, 1e5 * f64::EPSILON, "{e}");
+        // 3·rtol^1.5 = 10⁵ε
+        let from = (1e5 * f64::EPSILON / 3.0).powf(1.0 / 1.5);
+        assert!(
+            (f.from / from - 1.0).abs() < 1e-5,
+            "{} against {from:e}",
+            f.from
+        );
+        assert!(
+            e.to_string()
+                .contains("its local error test held its floor of 2.2e-11, as it does at every rtol below 3.80e-8"),
+            "{e}"
+        );
+    }
+    // the same run below that rtol but for its first step: loosening rtol from 1e-10 to 1e-9
+    // took the 300 steps 0.14 % further
+    assert!(
+        (tight.t / tighter.t - 1.0).abs() < 0.01,
+        "{tight}\n{tighter}"
+    );
+    let loose = run(1e-6);
+    assert!(
+        matches!(loose.kind, Failure::TooMuchWork { floored: None, .. }),
+        "{loose}"
+    );
+    assert!(!loose.to_string().contains("floor"), "{loose}");
+}
+
 /// A component near zero beside large ones of its kind, under an atol below their rounding,
 /// is tested at that rounding (100ε times the largest of its kind), not at atol: fastlink's
 /// velocities (a crank at 1,100 rad/s, a coupler turning through zero) under atol = 1e-12.

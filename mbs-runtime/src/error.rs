@@ -124,6 +124,33 @@ pub struct HeldBy {
     pub start: Option<f64>,
 }
 
+/// A run that ran out of steps while its scheme's local error test held its floor rather
+/// than the tolerance its map of rtol asked ([`Stats::tolerance_floor`](crate::Stats)): every
+/// rtol below `from` holds the same floor and takes as many steps, so that loosening rtol
+/// saves steps only above it (the four-bar under Radau3 at index 3 at rtol 1e-10, its floor
+/// 10⁵ε held from rtol ≈ 3.8e-8 on, ran out of 20,000 steps, and was told to loosen rtol).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct FlooredTolerance {
+    /// the local tolerance the error test held
+    pub floor: f64,
+    /// the loosest rtol whose local tolerance is that floor (within a part in 10⁶)
+    pub from: f64,
+}
+
+impl FlooredTolerance {
+    /// "; its local error test held its floor …", with the option named `rtol` (`--rtol` on
+    /// a command line); empty without a floor.
+    pub fn clause(floored: &Option<Box<FlooredTolerance>>, rtol: &str) -> String {
+        match floored.as_deref() {
+            None => String::new(),
+            Some(f) => format!(
+                "; its local error test held its floor of {:.1e}, as it does at every {rtol} below {:.2e}: a looser {rtol} takes fewer steps only above that",
+                f.floor, f.from
+            ),
+        }
+    }
+}
+
 /// Closed loops near a change point or dead centre when a step failed at h_min: the pivot
 /// ratio the loops' watch last judged ([`Options::singularity_tol`](crate::Options)), within a
 /// hundred times the threshold at which it stops the run with [`Failure::SingularLoop`]. Near
@@ -429,8 +456,9 @@ pub enum Failure {
         near_change_point: Option<NearChangePoint>,
     },
     #[error(
-        "more than {max_steps} steps: {}{}",
+        "more than {max_steps} steps: {}{}{}",
         cause.advice("Options::max_steps", "rtol", "a larger fixed step", ""),
+        FlooredTolerance::clause(floored, "rtol"),
         HeldMost::clause(held_most)
     )]
     TooMuchWork {
@@ -440,6 +468,8 @@ pub enum Failure {
         held_most: Option<HeldMost>,
         /// what the kind of step and the scheme say of the cause, and so what to change
         cause: OutOfSteps,
+        /// the local tolerance at the scheme's floor, where rtol asked for less
+        floored: Option<Box<FlooredTolerance>>,
     },
     #[error(
         "Newton did not converge in {iterations} iterations (last correction {correction:.2e}{}) {}{}",

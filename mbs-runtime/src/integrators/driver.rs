@@ -13,7 +13,7 @@ use super::stepper::{Attempt, Control, Step, Stepper};
 use super::{Integrator, State};
 use crate::charts::{self, Recentring};
 use crate::erased::{ErasedModel, OwnedModel};
-use crate::error::{Failure, HeldMost, OutOfSteps};
+use crate::error::{Failure, FlooredTolerance, HeldMost, OutOfSteps};
 use crate::model::{Model, Pose};
 use crate::options::{Options, Output, Scheme, StepControl};
 use crate::stats::Stats;
@@ -618,6 +618,32 @@ impl Run {
         }
     }
 
+    /// The scheme's floor when its local error test held it rather than what rtol asked, with
+    /// the loosest rtol that holds it: the schemes' maps of rtol grow with it, so that it is
+    /// found by doubling rtol, then bisecting (in log rtol) to a part in 10⁶.
+    fn floored(&self) -> Option<Box<FlooredTolerance>> {
+        let floor = self.problem.stats.tolerance_floor?;
+        let rtol = self.ctl.adaptive?.rtol;
+        let held = |r: f64| self.stepper.tolerance_floor(r).is_some();
+        let (mut lo, mut hi) = (rtol, rtol);
+        while held(hi) {
+            lo = hi;
+            hi *= 2.0;
+            if hi >= 1.0 {
+                return None;
+            }
+        }
+        while hi / lo > 1.0 + 1e-6 {
+            let mid = (lo * hi).sqrt();
+            if held(mid) {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        Some(Box::new(FlooredTolerance { floor, from: lo }))
+    }
+
     /// The next attempt towards `t_stop`: its size, landing on t_stop exactly, counted; the
     /// run's failure when it has no steps left or the step fell below h_min.
     pub(super) fn plan(&mut self, t_stop: f64) -> Result<Planned, SimError> {
@@ -648,6 +674,7 @@ impl Run {
                             _ => None,
                         },
                     ),
+                    floored: self.floored(),
                 },
             };
             return Err(self.fail(kind, self.h));

@@ -7,8 +7,8 @@
 //! `cargo test --release --test global_error -- --nocapture` prints the reports.
 
 use mbs::{
-    ConstraintMethod, Failure, GenAlphaParams, GlobalControl, Model, Options, Output, Scheme,
-    Trajectory, simulate, simulate_global,
+    ConstraintMethod, Failure, GenAlphaParams, GlobalControl, GlobalFloor, Model, Options, Output,
+    Scheme, Trajectory, simulate, simulate_global,
 };
 use mbs_models::{fastlink, fourbar, tumble};
 
@@ -96,24 +96,95 @@ fn global_control_brings_the_four_bar_within_rtol_where_local_control_falls_shor
     );
 }
 
-/// A tolerance the scheme cannot reach: generalized-α at index 3 tests positions only and
-/// is 4–5 digits short of rtol on fastlink, so rtol 1e-8 would take a local rtol below 1e-13.
-/// The control stops with the typed failure and keeps its most accurate complete run.
+/// A tolerance the scheme cannot reach: generalized-α at index 3 holds its local error test
+/// at its floor (10³ε) from local rtol ≈ 2.2e-8 on, and is 4–5 digits short of rtol on
+/// fastlink. At rtol 1e-8 its first run is already floored: no tighter run could check it, and
+/// the control stops after it, saying so, with the typed failure and that run's whole
+/// trajectory (before, it ran a second, floored run of as many steps to find that out).
+/// At rtol 1e-6 it tightens until its candidates reach twice that rtol, and stops there.
 #[test]
 fn an_unreachable_tolerance_is_a_typed_failure_that_keeps_the_trajectory() {
     let model = fastlink::FastLink::default();
-    let mut o = options(0.03, 1e-8, 30);
-    o.constraints.method = ConstraintMethod::Index3;
     let scheme = Scheme::GenAlpha(GenAlphaParams::from_rho_inf(0.8));
-    let err = simulate_global(&model, scheme, &o, &GlobalControl::default())
-        .expect_err("1e-8 is out of gen-α index 3's reach on fastlink");
-    println!("{}", err.kind);
-    let Failure::GlobalToleranceNotMet { estimate, runs, .. } = err.kind else {
-        panic!("a typed failure: {}", err.kind);
-    };
-    assert!(estimate > 1.0 && runs >= 2);
-    assert_eq!(err.trajectory.len(), 30, "the whole trajectory is kept");
-    assert!((err.t - 0.03).abs() < 1e-12);
+    for (rtol, expected_runs) in [(1e-8, 1..=1), (1e-6, 2..=6)] {
+        let mut o = options(0.03, rtol, 30);
+        o.constraints.method = ConstraintMethod::Index3;
+        let err = simulate_global(&model, scheme, &o, &GlobalControl::default())
+            .expect_err("out of gen-α index 3's reach on fastlink");
+        println!("rtol {rtol:e}: {}", err.kind);
+        let Failure::GlobalToleranceNotMet {
+            estimate,
+            runs,
+            floor,
+            rtol: kept,
+            ..
+        } = err.kind
+        else {
+            panic!("a typed failure: {}", err.kind);
+        };
+        let Some(GlobalFloor::Held { from }) = floor else {
+            panic!("stopped at the scheme's floor: {floor:?}");
+        };
+        assert_eq!(
+            Some(from),
+            err.stats.floor_from,
+            "the floor the runs report"
+        );
+        assert!((2e-8..2.5e-8).contains(&from), "{from}");
+        assert!(estimate > 1.0, "{estimate}");
+        assert!(expected_runs.contains(&runs), "{runs} runs");
+        // the first run, at the user's rtol, or a run no tighter than the floor's edge
+        assert!(
+            kept == rtol || kept >= from * (1.0 - 1e-9),
+            "kept the run at local rtol {kept:e}"
+        );
+        assert!(
+            err.kind.to_string().contains(&format!(
+                "holds its floor at every local rtol below {from:.1e}"
+            )),
+            "{}",
+            err.kind
+        );
+        assert_eq!(err.trajectory.len(), 30, "the whole trajectory is kept");
+        assert!((err.t - 0.03).abs() < 1e-12);
+    }
+}
+
+/// The default Newmark scheme, generalized-α at index 3, on the four-bar over 2 s at rtol 1e-4:
+/// its local control is 1.5 digits short (2.46 digits), it takes local rtol 2.2e-7 to meet the
+/// tolerance, and its local error test holds its floor from 2.2e-8 on. The control keeps its
+/// candidates at twice that rtol or above, so that a run at it can check them, and meets the
+/// tolerance; before, a candidate chosen at 1.2e-8, floored, could be checked by no tighter
+/// run, and the control stopped `GlobalToleranceNotMet`.
+#[test]
+fn global_control_keeps_its_candidates_where_a_tighter_run_can_check_them() {
+    let model = fourbar::FourBar::default();
+    let rtol = 1e-4;
+    let scheme = Scheme::GenAlpha(GenAlphaParams::from_rho_inf(0.8));
+    let (reference, _) =
+        simulate(model.clone(), Scheme::Dopri5, options(2.0, 1e-13, 20)).expect("reference");
+    let o = options(2.0, rtol, 20);
+    let (local, local_stats) = simulate(model.clone(), scheme, o.clone()).expect("local");
+    let e_local = error_in_tolerance(&model, &local, &reference, rtol, rtol / 100.0);
+    let (tr, stats, report) =
+        simulate_global(&model, scheme, &o, &GlobalControl::default()).expect("met");
+    let e = error_in_tolerance(&model, &tr, &reference, rtol, rtol / 100.0);
+    println!("local: {e_local:.3e} of the tolerance; global: {e:.3e}, {report}");
+    let from = local_stats
+        .floor_from
+        .expect("gen-α at index 3 has a floor");
+    assert!((2e-8..2.5e-8).contains(&from), "{from}");
+    assert!(e_local > 10.0, "local control is more than a digit short");
+    assert!(e <= 1.0 && report.estimate <= 1.0, "met: {e}");
+    let (last, candidates) = report.runs.split_last().expect("runs");
+    for run in candidates {
+        assert!(run.rtol >= 2.0 * from * (1.0 - 1e-9), "{report}");
+    }
+    assert!(
+        last.rtol >= from * (1.0 - 1e-9),
+        "the checking run is not floored"
+    );
+    assert!(report.runs.iter().any(|r| r.steps == stats.steps));
 }
 
 /// Fixed steps have no tolerance to meet: refused before any work, by name.

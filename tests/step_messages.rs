@@ -343,6 +343,15 @@ fn an_rtol_beyond_a_schemes_floor_is_said() {
             .to_string()
             .contains("its tolerance stopped at its floor");
         assert_eq!(said, floor.is_some(), "{stats}");
+        // the rtol from which the floor holds: every rtol below it is floored, and said
+        match stats.floor_from {
+            Some(from) => {
+                assert_eq!(floor.is_some(), rtol < from, "{scheme:?}: from {from:e}");
+                let below = format!("as at every rtol below {from:.1e}");
+                assert_eq!(stats.to_string().contains(&below), floor.is_some());
+            }
+            None => assert!(matches!(scheme, Scheme::Radau5), "{scheme:?} has a floor"),
+        }
     }
 }
 
@@ -395,6 +404,10 @@ fn an_rtol_beyond_the_index3_floor_is_said() {
             stats.tolerance_floor, floor,
             "{scheme:?} {method:?} at rtol {rtol:e}"
         );
+        // with projection Radau5 has no floor; where one is, every rtol below it is floored
+        let from = stats.floor_from;
+        assert_eq!(from.is_none(), method == ConstraintMethod::Projection);
+        assert!(from.is_none_or(|from| floor.is_some() == (rtol < from)));
     }
 }
 

@@ -631,9 +631,10 @@ pub enum Failure {
         held_most: Option<HeldMost>,
     },
     #[error(
-        "global error control: {} after {runs} runs, the most accurate at local rtol {rtol:.1e}{}{}; loosen rtol, or use a scheme of higher order (radau5, dopri5, bdf) or another constraint method",
+        "global error control: {} after {runs} run{}, the most accurate at local rtol {rtol:.1e}{}{}; loosen rtol, or use a scheme of higher order (radau5, dopri5, bdf) or another constraint method",
         estimated(*estimate),
-        if *floor { " (the last run took no more steps at a tenth of the tolerance: rtol does not set this scheme's step here, and the runs' difference says nothing of the error)" } else { "" }, cause.as_ref().map(|c| format!(" (the next run failed: {c})")).unwrap_or_default()
+        if *runs == 1 { "" } else { "s" },
+        floor.map(GlobalFloor::said).unwrap_or_default(), cause.as_ref().map(|c| format!(" (the next run failed: {c})")).unwrap_or_default()
     )]
     GlobalToleranceNotMet {
         /// the last estimate, in the user's tolerance (1 = met): of the run before the one
@@ -643,14 +644,36 @@ pub enum Failure {
         /// the local rtol of the most accurate complete run (the trajectory kept)
         rtol: f64,
         runs: usize,
-        /// the last, tighter run took at most 5 % more steps than the run before: rtol does not
-        /// set the scheme's step (its local tolerance is at a floor), and the error cannot be
-        /// estimated
-        floor: bool,
+        /// the runs reached the scheme's floor: no tighter run could check the last
+        floor: Option<GlobalFloor>,
         /// why the next, tighter run stopped, when it did (`None`: the limits of
         /// [`GlobalControl`](crate::GlobalControl) were reached)
         cause: Option<Box<Failure>>,
     },
+}
+
+/// Why global error control checked no tighter run ([`Failure::GlobalToleranceNotMet`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum GlobalFloor {
+    /// the last, tighter run took at most 5 % more steps than the run before: rtol does not
+    /// set the scheme's step (its local tolerance is at a floor), and the runs' difference
+    /// says nothing of the error
+    NoMoreSteps,
+    /// the scheme's local error test holds its floor at every local rtol below `from`
+    /// ([`Stats::floor_from`](crate::Stats)), where a tighter rtol takes no more steps, and
+    /// the last run was too close to it to be checked by a tighter one (the control keeps
+    /// its candidates at twice `from` or above, checked by runs at `from` or above)
+    Held { from: f64 },
+}
+
+impl GlobalFloor {
+    fn said(self) -> String {
+        match self {
+            GlobalFloor::NoMoreSteps => " (the last run took no more steps at a tenth of the tolerance: rtol does not set this scheme's step here, and the runs' difference says nothing of the error)".to_string(),
+            GlobalFloor::Held { from } => format!(" (this scheme's local error test holds its floor at every local rtol below {from:.1e}, where a tighter rtol takes no more steps: no run tighter than the last could check it)"),
+        }
+    }
 }
 
 /// The estimate of a [`Failure::GlobalToleranceNotMet`], in words.

@@ -38,8 +38,8 @@ pub use analysis::{
 };
 pub use efforts::{Effort, Efforts, WithEfforts};
 pub use error::{
-    Failure, FlooredTolerance, HeldBy, HeldMost, LoopMatrix, ModelError, NearChangePoint,
-    OutOfSteps, ParamError, check_inertia,
+    Failure, FlooredTolerance, GlobalFloor, HeldBy, HeldMost, LoopMatrix, ModelError,
+    NearChangePoint, OutOfSteps, ParamError, check_inertia,
 };
 pub use integrators::{
     Assembly, Controller, EnsembleReport, GlobalControl, GlobalReport, GlobalRun, Inputs,

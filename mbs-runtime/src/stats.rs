@@ -77,6 +77,11 @@ pub struct Stats {
     /// BDF from ≈ 8e-11, their floors 100ε; Radau at index 3, its floor 10⁵ε, Radau5 from
     /// ≈ 4.5e-9, Radau3 from ≈ 3.8e-8)
     pub tolerance_floor: Option<f64>,
+    /// the loosest rtol at which the scheme's local error test holds its floor rather than
+    /// its transformation of rtol (adaptive steps of a scheme with a floor, `None` otherwise):
+    /// a tighter rtol than this takes no more steps, and the error of a run at it cannot be
+    /// measured against a run at a tighter one (global error control keeps its runs above it)
+    pub floor_from: Option<f64>,
     /// accepted steps whose error test raised some component's weight atol' + rtol'·|y_i| to
     /// its rounding floor, 100ε times the largest entry of its kind (positions, velocities,
     /// multipliers): a component near zero beside large ones of its kind was tested at the
@@ -265,9 +270,12 @@ impl fmt::Display for Stats {
             write!(f, "\nerror test on: {}", self.error_test)?;
         }
         if let Some(floor) = self.tolerance_floor {
+            let from = (self.floor_from)
+                .map(|r| format!(", as at every rtol below {r:.1e}"))
+                .unwrap_or_default();
             write!(
                 f,
-                "\nrtol asks more than this scheme's local error test holds: its tolerance stopped at its floor {floor:.1e}, so expect fewer digits than rtol (radau5 with projection, its default, follows rtol further)"
+                "\nrtol asks more than this scheme's local error test holds: its tolerance stopped at its floor {floor:.1e}{from}, so expect fewer digits than rtol (radau5 with projection, its default, follows rtol further)"
             )?;
         }
         if let Some(h) = &self.held_most {

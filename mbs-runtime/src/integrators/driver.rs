@@ -274,6 +274,7 @@ impl Run {
         if let Some(tol) = ctl.adaptive {
             problem.stats.error_test = stepper.error_test(&problem);
             problem.stats.tolerance_floor = stepper.tolerance_floor(tol.rtol);
+            problem.stats.floor_from = floor_from(|r| stepper.tolerance_floor(r).is_some());
         }
         let h = match options.step {
             StepControl::Fixed { h } => h,
@@ -619,29 +620,13 @@ impl Run {
     }
 
     /// The scheme's floor when its local error test held it rather than what rtol asked, with
-    /// the loosest rtol that holds it: the schemes' maps of rtol grow with it, so that it is
-    /// found by doubling rtol, then bisecting (in log rtol) to a part in 10⁶.
+    /// the loosest rtol that holds it.
     fn floored(&self) -> Option<Box<FlooredTolerance>> {
-        let floor = self.problem.stats.tolerance_floor?;
-        let rtol = self.ctl.adaptive?.rtol;
-        let held = |r: f64| self.stepper.tolerance_floor(r).is_some();
-        let (mut lo, mut hi) = (rtol, rtol);
-        while held(hi) {
-            lo = hi;
-            hi *= 2.0;
-            if hi >= 1.0 {
-                return None;
-            }
-        }
-        while hi / lo > 1.0 + 1e-6 {
-            let mid = (lo * hi).sqrt();
-            if held(mid) {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        Some(Box::new(FlooredTolerance { floor, from: lo }))
+        let stats = &self.problem.stats;
+        Some(Box::new(FlooredTolerance {
+            floor: stats.tolerance_floor?,
+            from: stats.floor_from?,
+        }))
     }
 
     /// The next attempt towards `t_stop`: its size, landing on t_stop exactly, counted; the
@@ -1305,4 +1290,28 @@ fn output_times(options: &Options) -> Vec<f64> {
         }
         Output::Steps | Output::Last => Vec::new(),
     }
+}
+
+/// The loosest rtol at which a scheme's local error test holds its floor (`held`), `None`
+/// when it holds none from 0.5 down to 1e-16: halving rtol from 0.5 finds the first held,
+/// then bisecting (in log rtol) to a part in 10⁶ its edge (the schemes' maps of rtol grow
+/// with it; the Newmark family's holds no floor for an rtol below the floor itself).
+fn floor_from(held: impl Fn(f64) -> bool) -> Option<f64> {
+    let mut hi = 0.5;
+    while !held(hi / 2.0) {
+        hi /= 2.0;
+        if hi < 1e-16 {
+            return None;
+        }
+    }
+    let mut lo = hi / 2.0;
+    while hi / lo > 1.0 + 1e-6 {
+        let mid = (lo * hi).sqrt();
+        if held(mid) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Some(lo)
 }

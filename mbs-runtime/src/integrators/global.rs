@@ -31,12 +31,31 @@
 //! an unmeasured amount). Otherwise the next local tolerance is a tenth of the last when the
 //! last run is predicted within half the tolerance (it only needs checking), or whatever the
 //! measured rate s predicts brings it to 0.3 of the tolerance (at most 100× tighter in one
-//! go). The rate is re-measured from each pair of estimates (clamped to [0.3, 2]). The runs
-//! stop with [`Failure::GlobalToleranceNotMet`], keeping the most
+//! go). The rate is re-measured from each pair of estimates (clamped to [0.3, 2]).
+//!
+//! **The scheme's floor.** A scheme whose local error test holds a floor below some local
+//! rtol ([`Stats::floor_from`]: the Newmark family, RKC, BDF, Radau at index 3) takes no more
+//! steps below it: a run there is a run at its edge, and one at the edge checks nothing. The
+//! candidates therefore stay at twice that rtol or above, the runs that check them at it or
+//! above; when the last candidate lies below four times that rtol, the next run, at the edge,
+//! only checks it, and a last run below twice that rtol ends the sequence
+//! ([`GlobalFloor::Held`]). Generalized-α at index 3 on the four-bar at rtol 1e-4, its floor
+//! held from local rtol 2.2e-8, chose a candidate at 1.2e-8 (the 100× step below from an
+//! estimate of 1.8 and a slow rate), which no tighter run could check, and stopped
+//! `GlobalToleranceNotMet` (`tests/global_error.rs`). Before, a checking run below the floor's
+//! edge, which takes the steps of a run at the edge, counted as a run ten times tighter than
+//! its candidate where it was less, and the estimate came out too small: over the tolerance
+//! test's runs (`tests/tolerance_proportionality.rs`) eight returned as met were 0.01–0.26
+//! digits short of rtol, and seven more (BDF at rtol 1e-8 on the Cartesian double pendulum
+//! and the four-bar, Radau at index 3 on Cash's pendulum and the double pendulum) returned
+//! within it, which a run at the floor's edge cannot show; all fifteen now end
+//! `GlobalToleranceNotMet`, and the returned runs are at most 0.05 digits short.
+//!
+//! **When it stops.** The runs stop with [`Failure::GlobalToleranceNotMet`], keeping the most
 //! accurate complete trajectory, after [`GlobalControl::max_runs`] runs, when the local rtol
 //! would fall below [`GlobalControl::min_rtol`], when a run fails (its failure is the
-//! `cause`), or when the tighter run of a pair takes at most 5 % more steps than the looser
-//! one (`floor`): rtol then does not set the step (the Newmark family at index 2 holds its
+//! `cause`), at the scheme's floor as above, or when the tighter run of a pair takes at most 5 %
+//! more steps than the looser one ([`GlobalFloor::NoMoreSteps`]): rtol then does not set the step (the Newmark family at index 2 holds its
 //! local tolerance at 10⁴ε; Radau5 at index 2 takes no more steps either on fastlink and on
 //! the Cartesian double pendulum at rtol 1e-4, `tests/tolerance_proportionality.rs`), the runs differ by the noise of Newton's iterations,
 //! and their difference says nothing of the error: before this check, gen-α at index 2 on
@@ -59,7 +78,7 @@
 
 use super::driver::{refused, simulate};
 use super::sim_error::SimError;
-use crate::error::Failure;
+use crate::error::{Failure, GlobalFloor};
 use crate::model::Model;
 use crate::options::{Options, Output, Scheme, StepControl};
 use crate::stats::Stats;
@@ -211,6 +230,9 @@ pub fn simulate_global<M: Model + Clone + 'static>(
     }
     let times = Output::Times(first.t.clone());
     let mut work = first_stats.clone();
+    // below this local rtol the scheme's error test holds its floor: a run there takes no
+    // more steps than one at it, and checks nothing
+    let floor_from = first_stats.floor_from;
     let mut runs = vec![GlobalRun {
         rtol,
         atol,
@@ -224,7 +246,7 @@ pub fn simulate_global<M: Model + Clone + 'static>(
     let mut prev: Option<(f64, f64)> = None;
     loop {
         let (r_last, a_last) = runs.last().map(|r| (r.rtol, r.atol)).expect("one run");
-        let factor = match prev {
+        let mut factor = match prev {
             None => 0.1,
             Some((r_prev, e_prev)) => {
                 let predicted = e_prev * (r_last / r_prev).powf(rate);
@@ -235,8 +257,24 @@ pub fn simulate_global<M: Model + Clone + 'static>(
                 }
             }
         };
+        let mut held = None;
+        if let Some(from) = floor_from {
+            if r_last < 2.0 * from {
+                // a run at the floor's edge (or below it, which takes the same steps) would be
+                // less than twice as tight as the last: too close to check it
+                held = Some(GlobalFloor::Held { from });
+            } else if r_last * factor < 2.0 * from {
+                factor = if r_last >= 4.0 * from {
+                    // the tightest candidate a run at the floor's edge can still check
+                    2.0 * from / r_last
+                } else {
+                    // the last candidate: the next run, at the floor's edge, checks it
+                    from / r_last
+                };
+            }
+        }
         let r_next = r_last * factor;
-        let not_met = |floor: bool, cause: Option<Failure>, work, traj: Trajectory, runs| {
+        let not_met = |floor, cause: Option<Failure>, work, traj: Trajectory, runs| {
             let t = traj.t.last().copied().unwrap_or(options.t0);
             SimError {
                 kind: Failure::GlobalToleranceNotMet {
@@ -252,15 +290,18 @@ pub fn simulate_global<M: Model + Clone + 'static>(
                 trajectory: Box::new(traj),
             }
         };
+        if held.is_some() {
+            return Err(not_met(held, None, work, last.1, runs.len()));
+        }
         if runs.len() >= control.max_runs || r_next < control.min_rtol {
-            return Err(not_met(false, None, work, last.1, runs.len()));
+            return Err(not_met(None, None, work, last.1, runs.len()));
         }
         let a_next = a_last * factor;
         let (next, next_stats) = match run(times.clone(), r_next, a_next) {
             Ok(run) => run,
             Err(e) => {
                 work.add_work(&e.stats);
-                return Err(not_met(false, Some(e.kind), work, last.1, runs.len() + 1));
+                return Err(not_met(None, Some(e.kind), work, last.1, runs.len() + 1));
             }
         };
         work.add_work(&next_stats);
@@ -269,7 +310,13 @@ pub fn simulate_global<M: Model + Clone + 'static>(
         if next_stats.steps as f64 <= 1.05 * last.2.steps as f64 {
             // a tenth of the tolerance and no more steps: rtol does not set the step (the
             // scheme holds its local tolerance at a floor), and the runs differ by noise
-            return Err(not_met(true, None, work, last.1, runs.len() + 1));
+            return Err(not_met(
+                Some(GlobalFloor::NoMoreSteps),
+                None,
+                work,
+                last.1,
+                runs.len() + 1,
+            ));
         }
         // the tighter run's own error is ρ^s of the looser one's
         let ratio = factor.powf(rate.max(0.5));

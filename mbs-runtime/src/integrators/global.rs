@@ -61,7 +61,7 @@
 //! and their difference says nothing of the error: before this check, gen-α at index 2 on
 //! the four-bar at rtol 1e-8 took the same steps (within a few) at local rtol 1e-8 and 1e-9,
 //! and their difference called a run 1.9 digits short "within rtol" (the
-//! tolerance-proportionality test now asserts that no returned run is more than half a digit
+//! tolerance-proportionality test now asserts that no returned run is more than 0.2 digits
 //! short).
 //!
 //! **Cost.** Two runs at least, the second at a tenth of the tolerance: by the order, about

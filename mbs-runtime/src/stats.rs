@@ -79,8 +79,9 @@ pub struct Stats {
     pub tolerance_floor: Option<f64>,
     /// the loosest rtol at which the scheme's local error test holds its floor rather than
     /// its transformation of rtol (adaptive steps of a scheme with a floor, `None` otherwise):
-    /// a tighter rtol than this takes no more steps, and the error of a run at it cannot be
-    /// measured against a run at a tighter one (global error control keeps its runs above it)
+    /// a tighter rtol than this takes no more steps than it, so that no tighter run can
+    /// measure the error of a run at it (global error control keeps its candidates at twice
+    /// this rtol or above)
     pub floor_from: Option<f64>,
     /// accepted steps whose error test raised some component's weight atol' + rtol'·|y_i| to
     /// its rounding floor, 100ε times the largest entry of its kind (positions, velocities,

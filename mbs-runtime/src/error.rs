@@ -631,10 +631,11 @@ pub enum Failure {
         held_most: Option<HeldMost>,
     },
     #[error(
-        "global error control: {} after {runs} run{}, the most accurate at local rtol {rtol:.1e}{}{}; loosen rtol, or use a scheme of higher order (radau5, dopri5, bdf) or another constraint method",
+        "global error control: {} after {runs} run{}, the most accurate at local rtol {rtol:.1e}{}{}; loosen rtol, or use {}",
         estimated(*estimate),
         if *runs == 1 { "" } else { "s" },
-        floor.map(GlobalFloor::said).unwrap_or_default(), cause.as_ref().map(|c| format!(" (the next run failed: {c})")).unwrap_or_default()
+        floor.map(GlobalFloor::said).unwrap_or_default(), cause.as_ref().map(|c| format!(" (the next run failed: {c})")).unwrap_or_default(),
+        if floor.is_some() { "a scheme whose local error test holds no floor there (dopri5, or radau5 with projection, its default)" } else { "a scheme of higher order (radau5, dopri5, bdf) or another constraint method" }
     )]
     GlobalToleranceNotMet {
         /// the last estimate, in the user's tolerance (1 = met): of the run before the one

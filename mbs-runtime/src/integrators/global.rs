@@ -257,23 +257,6 @@ pub fn simulate_global<M: Model + Clone + 'static>(
                 }
             }
         };
-        let mut held = None;
-        if let Some(from) = floor_from {
-            if r_last < 2.0 * from {
-                // a run at the floor's edge (or below it, which takes the same steps) would be
-                // less than twice as tight as the last: too close to check it
-                held = Some(GlobalFloor::Held { from });
-            } else if r_last * factor < 2.0 * from {
-                factor = if r_last >= 4.0 * from {
-                    // the tightest candidate a run at the floor's edge can still check
-                    2.0 * from / r_last
-                } else {
-                    // the last candidate: the next run, at the floor's edge, checks it
-                    from / r_last
-                };
-            }
-        }
-        let r_next = r_last * factor;
         let not_met = |floor, cause: Option<Failure>, work, traj: Trajectory, runs| {
             let t = traj.t.last().copied().unwrap_or(options.t0);
             SimError {
@@ -290,9 +273,24 @@ pub fn simulate_global<M: Model + Clone + 'static>(
                 trajectory: Box::new(traj),
             }
         };
-        if held.is_some() {
-            return Err(not_met(held, None, work, last.1, runs.len()));
+        if let Some(from) = floor_from {
+            if r_last < 2.0 * from {
+                // a run at the floor's edge (or below it, which takes the same steps) would be
+                // less than twice as tight as the last: too close to check it
+                let held = Some(GlobalFloor::Held { from });
+                return Err(not_met(held, None, work, last.1, runs.len()));
+            }
+            if r_last * factor < 2.0 * from {
+                factor = if r_last >= 4.0 * from {
+                    // the tightest candidate a run at the floor's edge can still check
+                    2.0 * from / r_last
+                } else {
+                    // the last candidate: the next run, at the floor's edge, checks it
+                    from / r_last
+                };
+            }
         }
+        let r_next = r_last * factor;
         if runs.len() >= control.max_runs || r_next < control.min_rtol {
             return Err(not_met(None, None, work, last.1, runs.len()));
         }

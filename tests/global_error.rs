@@ -7,8 +7,8 @@
 //! `cargo test --release --test global_error -- --nocapture` prints the reports.
 
 use mbs::{
-    ConstraintMethod, Failure, GenAlphaParams, GlobalControl, GlobalFloor, Model, Options, Output,
-    Scheme, Trajectory, simulate, simulate_global,
+    ConstraintMethod, Failure, GenAlphaParams, GlobalControl, GlobalFloor, GlobalLimit, Model,
+    Options, Output, Scheme, Trajectory, simulate, simulate_global,
 };
 use mbs_models::{fastlink, fourbar, tumble};
 
@@ -188,6 +188,72 @@ fn global_control_keeps_its_candidates_where_a_tighter_run_can_check_them() {
         "the checking run is not floored"
     );
     assert!(report.runs.iter().any(|r| r.steps == stats.steps));
+}
+
+/// The limits of `GlobalControl` that end the runs are named, and the advice fits the scheme:
+/// DOPRI5 on fastlink at rtol 1e-10 would need its next run at local rtol 1e-14, below
+/// `min_rtol` (the linkage amplifies each step's error by more than three decades), and is
+/// not told to use a scheme of higher order, which it is; on the four-bar at rtol 1e-6 with
+/// two runs allowed, where it takes four, it is told to raise that limit; gen-α, of order 2,
+/// stopped there by the same limit at rtol 1e-4, is told of DOPRI5 and Radau5. Before, each
+/// was advised "a scheme of higher order (radau5, dopri5, bdf)", BDF among them, whose error
+/// test holds a floor of 100ε, and not told which limit had stopped it.
+#[test]
+fn the_limit_that_ended_the_runs_is_named_and_the_advice_fits_the_scheme() {
+    let gen_alpha = Scheme::GenAlpha(GenAlphaParams::from_rho_inf(0.8));
+    let two_runs = GlobalControl {
+        max_runs: 2,
+        ..GlobalControl::default()
+    };
+    let fast = |scheme, rtol, control: &GlobalControl| {
+        let model = fastlink::FastLink::default();
+        simulate_global(&model, scheme, &options(0.03, rtol, 20), control)
+    };
+    let four_bar = |scheme, rtol, control: &GlobalControl| {
+        let model = fourbar::FourBar::default();
+        simulate_global(&model, scheme, &options(2.0, rtol, 20), control)
+    };
+    let cases = [
+        fast(Scheme::Dopri5, 1e-10, &GlobalControl::default()),
+        four_bar(Scheme::Dopri5, 1e-6, &two_runs),
+        four_bar(gen_alpha, 1e-4, &two_runs),
+    ];
+    for (result, scheme) in cases
+        .into_iter()
+        .zip([Scheme::Dopri5, Scheme::Dopri5, gen_alpha])
+    {
+        let err = result.expect_err("not met within the limits");
+        let text = err.kind.to_string();
+        println!("{}: {text}", scheme.name());
+        let Failure::GlobalToleranceNotMet {
+            limit: Some(limit),
+            floor: None,
+            scheme: named,
+            ..
+        } = err.kind
+        else {
+            panic!("stopped by a limit of GlobalControl: {text}");
+        };
+        assert_eq!(named, scheme.name());
+        match limit {
+            GlobalLimit::MinRtol { needed, min_rtol } => {
+                assert!(needed < min_rtol && min_rtol == 1e-13, "{needed:e}");
+                assert!(text.contains("`GlobalControl::min_rtol`"), "{text}");
+            }
+            GlobalLimit::Runs { max_runs } => {
+                assert_eq!(max_runs, 2);
+                assert!(text.contains("raise `GlobalControl::max_runs`"), "{text}");
+            }
+            other => panic!("{other:?}"),
+        }
+        assert_eq!(
+            text.contains("a scheme of higher order"),
+            scheme == gen_alpha,
+            "{text}"
+        );
+        assert!(!text.contains("bdf"), "BDF has a floor: {text}");
+        assert_eq!(err.trajectory.len(), 20, "the whole trajectory is kept");
+    }
 }
 
 /// Fixed steps have no tolerance to meet: refused before any work, by name.

@@ -631,13 +631,17 @@ pub enum Failure {
         held_most: Option<HeldMost>,
     },
     #[error(
-        "global error control: {} after {runs} run{}, the most accurate at local rtol {rtol:.1e}{}{}; loosen rtol, or use {}",
+        "global error control: {} after {runs} run{}, the most accurate at local rtol {rtol:.1e}{}{}{}; {}",
         estimated(*estimate),
         if *runs == 1 { "" } else { "s" },
-        floor.map(GlobalFloor::said).unwrap_or_default(), cause.as_ref().map(|c| format!(" (the next run failed: {c})")).unwrap_or_default(),
-        if floor.is_some() { "a scheme whose local error test holds no floor there (dopri5, or radau5 with projection, its default)" } else { "a scheme of higher order (radau5, dopri5, bdf) or another constraint method" }
+        floor.map(GlobalFloor::said).unwrap_or_default(),
+        limit.map(GlobalLimit::said).unwrap_or_default(),
+        cause.as_ref().map(|c| format!(" (the next run failed: {c})")).unwrap_or_default(),
+        global_advice(scheme, floor, limit)
     )]
     GlobalToleranceNotMet {
+        /// the scheme ([`Scheme::name`](crate::Scheme::name))
+        scheme: &'static str,
         /// the last estimate, in the user's tolerance (1 = met): of the run before the one
         /// kept, whose own error no tighter run checked (it read as the kept run's, which
         /// at a tighter rtol is likely smaller)
@@ -647,6 +651,8 @@ pub enum Failure {
         runs: usize,
         /// the runs reached the scheme's floor: no tighter run could check the last
         floor: Option<GlobalFloor>,
+        /// a limit of [`GlobalControl`](crate::GlobalControl) ended the runs
+        limit: Option<GlobalLimit>,
         /// why the next, tighter run stopped, when it did (`None`: the limits of
         /// [`GlobalControl`](crate::GlobalControl) were reached)
         cause: Option<Box<Failure>>,
@@ -674,6 +680,53 @@ impl GlobalFloor {
             GlobalFloor::NoMoreSteps => " (the last run took no more steps at a tenth of the tolerance: rtol does not set this scheme's step here, and the runs' difference says nothing of the error)".to_string(),
             GlobalFloor::Held { from } => format!(" (this scheme's local error test holds its floor at every local rtol below {from:.1e}, where a tighter rtol takes no more steps: no run tighter than the last could check it)"),
         }
+    }
+}
+
+/// Which limit of [`GlobalControl`](crate::GlobalControl) ended the runs of a
+/// [`Failure::GlobalToleranceNotMet`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum GlobalLimit {
+    /// `max_runs` runs were made
+    Runs { max_runs: usize },
+    /// the next run would have needed the local rtol `needed`, below `min_rtol`
+    MinRtol { needed: f64, min_rtol: f64 },
+}
+
+impl GlobalLimit {
+    fn said(self) -> String {
+        match self {
+            GlobalLimit::Runs { max_runs } => {
+                format!(" (the most runs allowed, {max_runs}: `GlobalControl::max_runs`)")
+            }
+            GlobalLimit::MinRtol { needed, min_rtol } => format!(
+                " (the next would have needed local rtol {needed:.1e}, below the smallest allowed, {min_rtol:.0e}, `GlobalControl::min_rtol`, near rounding: the motion amplifies each step's error more than this tolerance leaves room for)"
+            ),
+        }
+    }
+}
+
+/// The schemes of the highest order, whose local error test holds no floor where global
+/// control takes them.
+const HIGHEST_ORDER: [&str; 2] = ["dopri5", "radau5"];
+
+/// What a [`Failure::GlobalToleranceNotMet`] advises, for `scheme`.
+fn global_advice(scheme: &str, floor: &Option<GlobalFloor>, limit: &Option<GlobalLimit>) -> String {
+    let highest = HIGHEST_ORDER.contains(&scheme);
+    let runs = if matches!(limit, Some(GlobalLimit::Runs { .. })) {
+        "raise `GlobalControl::max_runs`, "
+    } else {
+        ""
+    };
+    if floor.is_some() {
+        "loosen rtol, or use a scheme whose local error test holds no floor there (dopri5, or radau5 with projection, its default)".to_string()
+    } else if highest {
+        format!("{runs}loosen rtol, or try another constraint method")
+    } else {
+        format!(
+            "{runs}loosen rtol, or use a scheme of higher order whose local error test holds no floor (dopri5, or radau5 with projection, its default) or another constraint method"
+        )
     }
 }
 

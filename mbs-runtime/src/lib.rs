@@ -38,7 +38,7 @@ pub use analysis::{
 };
 pub use efforts::{Effort, Efforts, WithEfforts};
 pub use error::{
-    Failure, FlooredTolerance, GlobalFloor, HeldBy, HeldMost, LoopMatrix, ModelError,
+    Failure, FlooredTolerance, GlobalFloor, GlobalLimit, HeldBy, HeldMost, LoopMatrix, ModelError,
     NearChangePoint, OutOfSteps, ParamError, check_inertia,
 };
 pub use integrators::{

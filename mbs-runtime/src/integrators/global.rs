@@ -53,8 +53,8 @@
 //!
 //! **When it stops.** The runs stop with [`Failure::GlobalToleranceNotMet`], keeping the most
 //! accurate complete trajectory, after [`GlobalControl::max_runs`] runs, when the local rtol
-//! would fall below [`GlobalControl::min_rtol`], when a run fails (its failure is the
-//! `cause`), at the scheme's floor as above, or when the tighter run of a pair takes at most 5 %
+//! would fall below [`GlobalControl::min_rtol`] (the two its `limit`, [`GlobalLimit`]), when a
+//! run fails (its failure is the `cause`), at the scheme's floor as above, or when the tighter run of a pair takes at most 5 %
 //! more steps than the looser one ([`GlobalFloor::NoMoreSteps`]): rtol then does not set the step (the Newmark family at index 2 holds its
 //! local tolerance at 10⁴ε; Radau5 at index 2 takes no more steps either on fastlink and on
 //! the Cartesian double pendulum at rtol 1e-4, `tests/tolerance_proportionality.rs`), the runs differ by the noise of Newton's iterations,
@@ -78,7 +78,7 @@
 
 use super::driver::{refused, simulate};
 use super::sim_error::SimError;
-use crate::error::{Failure, GlobalFloor};
+use crate::error::{Failure, GlobalFloor, GlobalLimit};
 use crate::model::Model;
 use crate::options::{Options, Output, Scheme, StepControl};
 use crate::stats::Stats;
@@ -257,14 +257,16 @@ pub fn simulate_global<M: Model + Clone + 'static>(
                 }
             }
         };
-        let not_met = |floor, cause: Option<Failure>, work, traj: Trajectory, runs| {
+        let not_met = |floor, limit, cause: Option<Failure>, work, traj: Trajectory, runs| {
             let t = traj.t.last().copied().unwrap_or(options.t0);
             SimError {
                 kind: Failure::GlobalToleranceNotMet {
+                    scheme: scheme.name(),
                     estimate,
                     rtol: r_last,
                     runs,
                     floor,
+                    limit,
                     cause: cause.map(Box::new),
                 },
                 t,
@@ -278,7 +280,7 @@ pub fn simulate_global<M: Model + Clone + 'static>(
                 // a run at the floor's edge (or below it, which takes the same steps) would be
                 // less than twice as tight as the last: too close to check it
                 let held = Some(GlobalFloor::Held { from });
-                return Err(not_met(held, None, work, last.1, runs.len()));
+                return Err(not_met(held, None, None, work, last.1, runs.len()));
             }
             if r_last * factor < 2.0 * from {
                 factor = if r_last >= 4.0 * from {
@@ -291,15 +293,34 @@ pub fn simulate_global<M: Model + Clone + 'static>(
             }
         }
         let r_next = r_last * factor;
-        if runs.len() >= control.max_runs || r_next < control.min_rtol {
-            return Err(not_met(None, None, work, last.1, runs.len()));
+        let limit = if runs.len() >= control.max_runs {
+            Some(GlobalLimit::Runs {
+                max_runs: control.max_runs,
+            })
+        } else if r_next < control.min_rtol {
+            Some(GlobalLimit::MinRtol {
+                needed: r_next,
+                min_rtol: control.min_rtol,
+            })
+        } else {
+            None
+        };
+        if limit.is_some() {
+            return Err(not_met(None, limit, None, work, last.1, runs.len()));
         }
         let a_next = a_last * factor;
         let (next, next_stats) = match run(times.clone(), r_next, a_next) {
             Ok(run) => run,
             Err(e) => {
                 work.add_work(&e.stats);
-                return Err(not_met(None, Some(e.kind), work, last.1, runs.len() + 1));
+                return Err(not_met(
+                    None,
+                    None,
+                    Some(e.kind),
+                    work,
+                    last.1,
+                    runs.len() + 1,
+                ));
             }
         };
         work.add_work(&next_stats);
@@ -310,6 +331,7 @@ pub fn simulate_global<M: Model + Clone + 'static>(
             // scheme holds its local tolerance at a floor), and the runs differ by noise
             return Err(not_met(
                 Some(GlobalFloor::NoMoreSteps),
+                None,
                 None,
                 work,
                 last.1,

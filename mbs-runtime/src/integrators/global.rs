@@ -276,9 +276,10 @@ pub fn simulate_global<M: Model + Clone + 'static>(
             }
         };
         if let Some(from) = floor_from {
-            if r_last < 2.0 * from {
+            if r_last < 2.0 * from * (1.0 - 1e-9) {
                 // a run at the floor's edge (or below it, which takes the same steps) would be
-                // less than twice as tight as the last: too close to check it
+                // less than twice as tight as the last: too close to check it (a candidate put
+                // at twice the edge may land a rounding below it, and is checked)
                 let held = Some(GlobalFloor::Held { from });
                 return Err(not_met(held, None, None, work, last.1, runs.len()));
             }

@@ -653,8 +653,8 @@ pub enum Failure {
         floor: Option<GlobalFloor>,
         /// a limit of [`GlobalControl`](crate::GlobalControl) ended the runs
         limit: Option<GlobalLimit>,
-        /// why the next, tighter run stopped, when it did (`None`: the limits of
-        /// [`GlobalControl`](crate::GlobalControl) were reached)
+        /// why the next, tighter run stopped, when it did (`None`: the scheme's floor or a
+        /// limit of [`GlobalControl`](crate::GlobalControl) ended the runs)
         cause: Option<Box<Failure>>,
     },
 }
@@ -707,8 +707,8 @@ impl GlobalLimit {
     }
 }
 
-/// The schemes of the highest order, whose local error test holds no floor where global
-/// control takes them.
+/// The schemes of the highest order (5), whose local error test holds no floor in their
+/// default constraint method (Radau5 at index 3 has one, which the floor's advice covers).
 const HIGHEST_ORDER: [&str; 2] = ["dopri5", "radau5"];
 
 /// What a [`Failure::GlobalToleranceNotMet`] advises, for `scheme`.

@@ -271,7 +271,8 @@ impl fmt::Display for Stats {
             write!(f, "\nerror test on: {}", self.error_test)?;
         }
         if let Some(floor) = self.tolerance_floor {
-            let from = (self.floor_from)
+            let from = self
+                .floor_from
                 .map(|r| format!(", as at every rtol below {r:.1e}"))
                 .unwrap_or_default();
             write!(

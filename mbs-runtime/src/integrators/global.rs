@@ -257,8 +257,13 @@ pub fn simulate_global<M: Model + Clone + 'static>(
                 }
             }
         };
-        let not_met = |floor, limit, cause: Option<Failure>, work, traj: Trajectory, runs| {
+        let not_met = |stop: Stop, work, traj: Trajectory, runs| {
             let t = traj.t.last().copied().unwrap_or(options.t0);
+            let (floor, limit, cause) = match stop {
+                Stop::Floor(f) => (Some(f), None, None),
+                Stop::Limit(l) => (None, Some(l), None),
+                Stop::Failed(f) => (None, None, Some(Box::new(f))),
+            };
             SimError {
                 kind: Failure::GlobalToleranceNotMet {
                     scheme: scheme.name(),
@@ -267,7 +272,7 @@ pub fn simulate_global<M: Model + Clone + 'static>(
                     runs,
                     floor,
                     limit,
-                    cause: cause.map(Box::new),
+                    cause,
                 },
                 t,
                 h: 0.0,
@@ -280,8 +285,8 @@ pub fn simulate_global<M: Model + Clone + 'static>(
                 // a run at the floor's edge (or below it, which takes the same steps) would be
                 // less than twice as tight as the last: too close to check it (a candidate put
                 // at twice the edge may land a rounding below it, and is checked)
-                let held = Some(GlobalFloor::Held { from });
-                return Err(not_met(held, None, None, work, last.1, runs.len()));
+                let held = Stop::Floor(GlobalFloor::Held { from });
+                return Err(not_met(held, work, last.1, runs.len()));
             }
             if r_last * factor < 2.0 * from {
                 factor = if r_last >= 4.0 * from {
@@ -294,34 +299,25 @@ pub fn simulate_global<M: Model + Clone + 'static>(
             }
         }
         let r_next = r_last * factor;
-        let limit = if runs.len() >= control.max_runs {
-            Some(GlobalLimit::Runs {
+        if runs.len() >= control.max_runs {
+            let limit = Stop::Limit(GlobalLimit::Runs {
                 max_runs: control.max_runs,
-            })
-        } else if r_next < control.min_rtol {
-            Some(GlobalLimit::MinRtol {
+            });
+            return Err(not_met(limit, work, last.1, runs.len()));
+        }
+        if r_next < control.min_rtol {
+            let limit = Stop::Limit(GlobalLimit::MinRtol {
                 needed: r_next,
                 min_rtol: control.min_rtol,
-            })
-        } else {
-            None
-        };
-        if limit.is_some() {
-            return Err(not_met(None, limit, None, work, last.1, runs.len()));
+            });
+            return Err(not_met(limit, work, last.1, runs.len()));
         }
         let a_next = a_last * factor;
         let (next, next_stats) = match run(times.clone(), r_next, a_next) {
             Ok(run) => run,
             Err(e) => {
                 work.add_work(&e.stats);
-                return Err(not_met(
-                    None,
-                    None,
-                    Some(e.kind),
-                    work,
-                    last.1,
-                    runs.len() + 1,
-                ));
+                return Err(not_met(Stop::Failed(e.kind), work, last.1, runs.len() + 1));
             }
         };
         work.add_work(&next_stats);
@@ -330,14 +326,8 @@ pub fn simulate_global<M: Model + Clone + 'static>(
         if next_stats.steps as f64 <= 1.05 * last.2.steps as f64 {
             // a tenth of the tolerance and no more steps: rtol does not set the step (the
             // scheme holds its local tolerance at a floor), and the runs differ by noise
-            return Err(not_met(
-                Some(GlobalFloor::NoMoreSteps),
-                None,
-                None,
-                work,
-                last.1,
-                runs.len() + 1,
-            ));
+            let floor = Stop::Floor(GlobalFloor::NoMoreSteps);
+            return Err(not_met(floor, work, last.1, runs.len() + 1));
         }
         // the tighter run's own error is ρ^s of the looser one's
         let ratio = factor.powf(rate.max(0.5));
@@ -367,6 +357,14 @@ pub fn simulate_global<M: Model + Clone + 'static>(
         }
         last = (states, next, next_stats);
     }
+}
+
+/// What ended the runs of a [`Failure::GlobalToleranceNotMet`]: one of its `floor`, `limit`
+/// and `cause`.
+enum Stop {
+    Floor(GlobalFloor),
+    Limit(GlobalLimit),
+    Failed(Failure),
 }
 
 /// max over outputs and components of |a − b| / (atol + rtol·|b|); infinite when the runs'
